@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 /// then renaming. On any error the temporary file is removed and nothing appears.
 pub fn write_atomic<F>(path: &Path, fill: F) -> Result<(), String>
 where
-    F: FnOnce(&mut dyn Write) -> Result<(), String>,
+    F: FnOnce(&mut (dyn Write + Send)) -> Result<(), String>,
 {
     let name = path.display().to_string();
     if path.is_dir() {

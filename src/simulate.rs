@@ -188,82 +188,102 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         None
     };
 
-    let mut loop_body = |w: &mut dyn Write| -> Result<Summary, SimulateError> {
+    // The simulation thread hands raw rows (t, q, v, contacts, penetration) in
+    // blocks to a writer thread, which computes each row's energy and formats the
+    // CSV: the step loop never formats a number. Blocks are recycled (no
+    // allocation once both are in flight), the channel is bounded (the writer
+    // cannot fall behind by more than a few blocks).
+    let width = 1 + sim.model.nq + sim.model.nv + 2;
+    let block_rows = 64usize;
+    let e0 = sim.energy();
+    let mut loop_body = |w: Option<&mut (dyn Write + Send)>| -> Result<Summary, SimulateError> {
         let start = Instant::now();
-        let e0 = sim.energy();
         let mut max_pen = sim.penetration();
-        let io = |e: std::io::Error| SimulateError::Output(format!("cannot write trajectory: {e}"));
-        let mut line = String::with_capacity(64 * (sim.model.nq + sim.model.nv + 4));
-        {
-            let (qn, vn) = column_names(&sim.model);
-            line.push('t');
-            for n in qn.iter().chain(vn.iter()) {
-                line.push(',');
-                line.push_str(n);
-            }
-            line.push_str(",energy,contacts,penetration\n");
-            w.write_all(line.as_bytes()).map_err(io)?;
-        }
-        let mut rb = ryu::Buffer::new();
-        let mut row = |sim: &Simulation,
-                       e: f64,
-                       line: &mut String,
-                       w: &mut dyn Write|
-         -> Result<(), SimulateError> {
-            line.clear();
-            line.push_str(rb.format(sim.time()));
-            for x in sim.q().iter().chain(sim.v().iter()) {
-                line.push(',');
-                line.push_str(rb.format(*x));
-            }
-            line.push(',');
-            line.push_str(rb.format(e));
-            line.push(',');
-            line.push_str(itoa(sim.active_contacts()).as_str());
-            line.push(',');
-            line.push_str(rb.format(sim.penetration()));
-            line.push('\n');
-            w.write_all(line.as_bytes()).map_err(io)
-        };
-        row(&sim, e0, &mut line, w)?;
-        let mut k = 0u64;
-        let mut last_tick = 0u64;
-        let mut e = e0;
-        while sim.time() < duration {
-            sim.step_until(duration)
-                .map_err(|error| SimulateError::Sim {
-                    urdf: urdf_name.clone(),
-                    error,
-                })?;
-            k += 1;
-            max_pen = max_pen.max(sim.penetration());
-            let last = sim.time() >= duration;
-            if last || k % every as u64 == 0 {
-                e = sim.energy();
-                if !e.is_finite() {
-                    return Err(SimulateError::Sim {
+        let writer_model = sim.model.clone();
+        std::thread::scope(|scope| {
+            let (to_writer, from_sim) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
+            let (recycle, recycled) = std::sync::mpsc::channel::<Vec<f64>>();
+            let writer = w.map(|w| {
+                let urdf_name = urdf_name.clone();
+                scope.spawn(move || write_rows(w, &writer_model, width, from_sim, recycle, &urdf_name))
+            });
+            let mut block: Vec<f64> = Vec::with_capacity(width * block_rows);
+            let push_row = |sim: &Simulation, block: &mut Vec<f64>| {
+                block.push(sim.time());
+                block.extend_from_slice(sim.q().as_slice());
+                block.extend_from_slice(sim.v().as_slice());
+                block.push(sim.active_contacts() as f64);
+                block.push(sim.penetration());
+            };
+            // sends a full block (or, at the end, the last one); a writer that hung
+            // up has failed: its error is collected at the join below
+            let send = |block: &mut Vec<f64>| -> bool {
+                if writer.is_none() {
+                    block.clear();
+                    return true;
+                }
+                let next = recycled
+                    .try_recv()
+                    .unwrap_or_else(|_| Vec::with_capacity(width * block_rows));
+                to_writer.send(std::mem::replace(block, next)).is_ok()
+            };
+            push_row(&sim, &mut block);
+            let mut k = 0u64;
+            let mut last_tick = 0u64;
+            let mut sim_result = Ok(());
+            while sim.time() < duration {
+                if let Err(error) = sim.step_until(duration) {
+                    sim_result = Err(SimulateError::Sim {
                         urdf: urdf_name.clone(),
-                        error: SimError::NonFinite {
-                            t: sim.time(),
-                            quantity: "energy".into(),
-                        },
+                        error,
                     });
+                    break;
                 }
-                row(&sim, e, &mut line, w)?;
-            }
-            if let Some(pb) = &progress {
-                let tick = (sim.time() / duration * 1000.0) as u64;
-                if tick != last_tick {
-                    last_tick = tick;
-                    pb.set_position(tick);
-                    pb.set_message(format!("{:.3}", sim.time()));
+                k += 1;
+                max_pen = max_pen.max(sim.penetration());
+                let last = sim.time() >= duration;
+                if last || k % every as u64 == 0 {
+                    push_row(&sim, &mut block);
+                    if block.len() >= width * block_rows && !send(&mut block) {
+                        break;
+                    }
+                }
+                if let Some(pb) = &progress {
+                    let tick = (sim.time() / duration * 1000.0) as u64;
+                    if tick != last_tick {
+                        last_tick = tick;
+                        pb.set_position(tick);
+                        pb.set_message(format!("{:.3}", sim.time()));
+                    }
                 }
             }
-        }
+            if sim_result.is_ok() && !block.is_empty() {
+                send(&mut block);
+            }
+            drop(to_writer);
+            let written = match writer {
+                Some(h) => h
+                    .join()
+                    .unwrap_or_else(|_| Err(SimulateError::Output("trajectory writer failed".into()))),
+                None => Ok(()),
+            };
+            sim_result?;
+            written
+        })?;
         if let Some(pb) = &progress {
             pb.finish_and_clear();
         }
         let wall = start.elapsed().as_secs_f64();
+        let e = sim.energy();
+        if !e.is_finite() {
+            return Err(SimulateError::Sim {
+                urdf: urdf_name.clone(),
+                error: SimError::NonFinite {
+                    t: sim.time(),
+                    quantity: "energy".into(),
+                },
+            });
+        }
         Ok(Summary {
             steps: sim.steps,
             wall_seconds: wall,
@@ -283,7 +303,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
     match &args.out {
         Some(path) => {
             let mut result = None;
-            write_atomic(path, |w| match loop_body(w) {
+            write_atomic(path, |w| match loop_body(Some(w)) {
                 Ok(s) => {
                     result = Some(s);
                     Ok(())
@@ -293,10 +313,93 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             .map_err(SimulateError::Output)?;
             result.ok_or_else(|| SimulateError::Output("no result".into()))
         }
-        None => loop_body(&mut std::io::sink()),
+        None => loop_body(None),
     }
 }
 
-fn itoa(n: usize) -> String {
-    n.to_string()
+/// The writer thread: the header, then for every row its energy (kinetic plus
+/// gravitational potential, cli.md's datum) and the CSV line. Stops with an error
+/// naming the time when the energy is not finite (the step loop checks q and v).
+fn write_rows(
+    w: &mut (dyn Write + Send),
+    model: &Model,
+    width: usize,
+    rows: std::sync::mpsc::Receiver<Vec<f64>>,
+    recycle: std::sync::mpsc::Sender<Vec<f64>>,
+    urdf_name: &str,
+) -> Result<(), SimulateError> {
+    let io = |e: std::io::Error| SimulateError::Output(format!("cannot write trajectory: {e}"));
+    let (nq, nv) = (model.nq, model.nv);
+    let mut data = crate::Data::new(model);
+    let mut q = nalgebra::DVector::zeros(nq);
+    let mut v = nalgebra::DVector::zeros(nv);
+    let mut line = String::with_capacity(32 * width + 64);
+    let (qn, vn) = column_names(model);
+    line.push('t');
+    for n in qn.iter().chain(vn.iter()) {
+        line.push(',');
+        line.push_str(n);
+    }
+    line.push_str(",energy,contacts,penetration\n");
+    w.write_all(line.as_bytes()).map_err(io)?;
+    let mut rb = ryu::Buffer::new();
+    for block in rows {
+        for row in block.chunks_exact(width) {
+            let (t, rest) = row.split_at(1);
+            let (qs, rest) = rest.split_at(nq);
+            let (vs, rest) = rest.split_at(nv);
+            q.as_mut_slice().copy_from_slice(qs);
+            v.as_mut_slice().copy_from_slice(vs);
+            let t = t.first().copied().unwrap_or(0.0);
+            let e = crate::sim::mechanical_energy(model, &mut data, &q, &v);
+            if !e.is_finite() {
+                return Err(SimulateError::Sim {
+                    urdf: urdf_name.to_string(),
+                    error: SimError::NonFinite {
+                        t,
+                        quantity: "energy".into(),
+                    },
+                });
+            }
+            let (contacts, pen) = (
+                rest.first().copied().unwrap_or(0.0),
+                rest.get(1).copied().unwrap_or(0.0),
+            );
+            line.clear();
+            line.push_str(rb.format(t));
+            for x in qs.iter().chain(vs.iter()) {
+                line.push(',');
+                line.push_str(rb.format(*x));
+            }
+            line.push(',');
+            line.push_str(rb.format(e));
+            line.push(',');
+            push_count(&mut line, contacts as u64);
+            line.push(',');
+            line.push_str(rb.format(pen));
+            line.push('\n');
+            w.write_all(line.as_bytes()).map_err(io)?;
+        }
+        let mut block = block;
+        block.clear();
+        let _ = recycle.send(block);
+    }
+    Ok(())
+}
+
+/// Appends a count in decimal without allocating.
+fn push_count(line: &mut String, mut n: u64) {
+    let mut digits = [0u8; 20];
+    let mut k = digits.len();
+    loop {
+        k -= 1;
+        digits[k] = b'0' + (n % 10) as u8;
+        n /= 10;
+        if n == 0 {
+            break;
+        }
+    }
+    for &d in &digits[k..] {
+        line.push(d as char);
+    }
 }

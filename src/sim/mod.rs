@@ -209,7 +209,6 @@ pub struct Simulation {
     tau_c: DVector<f64>,
     has_fext: bool,
     chol: DMatrix<f64>,
-    hinv: DMatrix<f64>,
     tmp: DVector<f64>,
     vfree: DVector<f64>,
     contact_forces: Vec<ContactForce>,
@@ -313,7 +312,6 @@ impl Simulation {
             tau_c: DVector::zeros(nv),
             has_fext: false,
             chol: DMatrix::zeros(nv, nv),
-            hinv: DMatrix::zeros(nv, nv),
             tmp: DVector::zeros(nv),
             vfree: DVector::zeros(nv),
             contact_forces: Vec::with_capacity(max_points),
@@ -434,6 +432,11 @@ impl Simulation {
     /// Kinetic plus gravitational potential energy (J), the potential being
     /// −Σ mᵢ gᵀcᵢ (zero at the world origin).
     pub fn energy(&mut self) -> f64 {
+        if !self.fk_valid {
+            let e = mechanical_energy(&self.model, &mut self.data, &self.q, &self.v);
+            self.fk_valid = true;
+            return e;
+        }
         let ke = kinetic_energy(&self.model, &mut self.data, &self.q, &self.v);
         // the world poses are current when the contact refresh at the end of the
         // last step (or a previous call) computed them at this q
@@ -693,38 +696,20 @@ impl Simulation {
         if self.model.floating_base {
             add_frame_rate(&mut self.vfree, &self.v, h);
         }
-        // Y rows = H⁻¹ jᵣ
+        // Y rows = L⁻¹ jᵣ (H = L Lᵀ): the Delassus matrix is W = J H⁻¹ Jᵀ = Y Yᵀ, so
+        // the solver works on Δv' = Lᵀ Δv with uᵣ = cᵣ + yᵣ·Δv' and one forward
+        // substitution a row, then
+        // Δv = L⁻ᵀ Δv' once at the end
         let nv = self.model.nv;
-        if self.rows.n > nv / 2 {
-            // many rows: H⁻¹ once (nv solves), then each row from the columns its
-            // (sparse: ancestors only) Jacobian touches
-            let hinv = self.hinv.as_mut_slice();
-            hinv.fill(0.0);
-            let l = self.chol.as_slice();
-            for k in 0..nv {
-                let col = &mut hinv[k * nv..(k + 1) * nv];
-                col[k] = 1.0;
-                chol_solve_slice_from(l, nv, col, k);
-            }
-            y_from_hinv(&self.rows.j, &mut self.rows.y, hinv, self.rows.n, nv);
-        } else {
-            for r in 0..self.rows.n {
-                let (j, y) = (
-                    &self.rows.j[r * nv..(r + 1) * nv],
-                    &mut self.rows.y[r * nv..(r + 1) * nv],
-                );
-                y.copy_from_slice(j);
-                chol_solve_slice(self.chol.as_slice(), nv, y);
-            }
-        }
         self.tmp = tau;
-        self.rows.form(self.vfree.as_slice());
+        self.rows.form_factored(self.chol.as_slice(), self.vfree.as_slice());
         let mut dv = std::mem::replace(&mut self.tmp, DVector::zeros(0));
         self.pgs_sweeps += self.rows.solve(
             dv.as_mut_slice(),
             self.opts.solver_iterations,
             self.opts.solver_tol,
         ) as u64;
+        chol_backward(self.chol.as_slice(), nv, dv.as_mut_slice());
         self.tmp = dv;
         self.rows_total += self.rows.n as u64;
         // results: warm starts, joint generalized forces, contact body forces
@@ -1026,6 +1011,13 @@ fn chol_solve_slice_from(l: &[f64], n: usize, x: &mut [f64], first: usize) {
 /// checked `l.len() ≥ n²`, `x.len() ≥ n` (and `N ∈ {0, n}`).
 #[inline(always)]
 fn chol_solve_n<const N: usize>(l: &[f64], n: usize, x: &mut [f64], first: usize) {
+    chol_forward_n::<N>(l, n, x, first);
+    chol_backward_n::<N>(l, n, x);
+}
+
+/// L x' = x in place (forward substitution), x zero before `first`.
+#[inline(always)]
+fn chol_forward_n<const N: usize>(l: &[f64], n: usize, x: &mut [f64], first: usize) {
     let n = if N == 0 { n } else { N };
     let (l, x) = (&l[..n * n], &mut x[..n]);
     // SAFETY: k, i < n; l is n·n long, x n long.
@@ -1039,6 +1031,16 @@ fn chol_solve_n<const N: usize>(l: &[f64], n: usize, x: &mut [f64], first: usize
                 }
             }
         }
+    }
+}
+
+/// Lᵀ x' = x in place (back substitution).
+#[inline(always)]
+fn chol_backward_n<const N: usize>(l: &[f64], n: usize, x: &mut [f64]) {
+    let n = if N == 0 { n } else { N };
+    let (l, x) = (&l[..n * n], &mut x[..n]);
+    // SAFETY: k, i < n; l is n·n long, x n long.
+    unsafe {
         for k in (0..n).rev() {
             let mut s = -0.0;
             for i in k + 1..n {
@@ -1047,6 +1049,28 @@ fn chol_solve_n<const N: usize>(l: &[f64], n: usize, x: &mut [f64], first: usize
             *x.get_unchecked_mut(k) = (*x.get_unchecked(k) - s) / *l.get_unchecked(k * n + k);
         }
     }
+}
+
+macro_rules! by_size {
+    ($n:expr, $f:ident, $($arg:expr),*) => {
+        match $n {
+            6 => $f::<6>($($arg),*),
+            7 => $f::<7>($($arg),*),
+            8 => $f::<8>($($arg),*),
+            9 => $f::<9>($($arg),*),
+            12 => $f::<12>($($arg),*),
+            18 => $f::<18>($($arg),*),
+            _ => $f::<0>($($arg),*),
+        }
+    };
+}
+
+/// Lᵀ x' = x for the Cholesky factor of [`chol_solve_slice`].
+fn chol_backward(l: &[f64], n: usize, x: &mut [f64]) {
+    if l.len() < n * n || x.len() < n {
+        return;
+    }
+    by_size!(n, chol_backward_n, l, n, x)
 }
 
 /// [`cholesky`] (same arithmetic, same order) with the size known at compile
@@ -1099,40 +1123,12 @@ fn cholesky_n<const N: usize>(h: &[f64], l: &mut [f64], n: usize) -> Result<(), 
     Ok(())
 }
 
-/// Rows of Y = J H⁻¹ (H⁻¹ symmetric, column-major `hinv`): yᵣ = Σₖ jᵣₖ H⁻¹ₖ,
-/// over the nonzero entries of each Jacobian row.
-fn y_from_hinv(j: &[f64], y: &mut [f64], hinv: &[f64], rows: usize, nv: usize) {
-    if j.len() < rows * nv || y.len() < rows * nv || hinv.len() < nv * nv {
-        return;
-    }
-    match nv {
-        6 => y_from_hinv_n::<6>(j, y, hinv, rows, nv),
-        7 => y_from_hinv_n::<7>(j, y, hinv, rows, nv),
-        8 => y_from_hinv_n::<8>(j, y, hinv, rows, nv),
-        9 => y_from_hinv_n::<9>(j, y, hinv, rows, nv),
-        12 => y_from_hinv_n::<12>(j, y, hinv, rows, nv),
-        18 => y_from_hinv_n::<18>(j, y, hinv, rows, nv),
-        _ => y_from_hinv_n::<0>(j, y, hinv, rows, nv),
-    }
-}
-
-#[inline(always)]
-fn y_from_hinv_n<const N: usize>(j: &[f64], y: &mut [f64], hinv: &[f64], rows: usize, nv: usize) {
-    let nv = if N == 0 { nv } else { N };
-    for r in 0..rows {
-        let jr = &j[r * nv..(r + 1) * nv];
-        let yr = &mut y[r * nv..(r + 1) * nv];
-        yr.fill(0.0);
-        for k in 0..nv {
-            let jk = jr[k];
-            if jk != 0.0 {
-                let hk = &hinv[k * nv..(k + 1) * nv];
-                for i in 0..nv {
-                    yr[i] += jk * hk[i];
-                }
-            }
-        }
-    }
+/// Kinetic plus gravitational potential energy (cli.md's datum: the potential is
+/// −Σ mᵢ gᵀcᵢ) at (q, v); leaves the world poses of `q` in `data.o_m_i`.
+pub fn mechanical_energy(model: &Model, data: &mut Data, q: &DVector<f64>, v: &DVector<f64>) -> f64 {
+    let ke = kinetic_energy(model, data, q, v);
+    forward_kinematics(model, data, q);
+    ke + potential_energy(model, data)
 }
 
 #[derive(Clone, Copy)]

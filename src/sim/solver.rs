@@ -45,6 +45,7 @@ pub struct Rows {
     cap: usize,
 }
 
+
 impl Rows {
     pub fn new(nv: usize, cap: usize) -> Self {
         Self {
@@ -90,20 +91,70 @@ impl Rows {
         &self.y[r * self.nv..(r + 1) * self.nv]
     }
 
-    /// Computes the Delassus diagonal Wᵣᵣ = jᵣ·H⁻¹jᵣ (rows of `y` = H⁻¹ jᵣ already
-    /// filled) and c = J v* for the free velocity `vfree`.
-    pub fn form(&mut self, vfree: &[f64]) {
-        let nv = self.nv;
-        for r in 0..self.n {
-            let jr = &self.j[r * nv..(r + 1) * nv];
-            self.c[r] = dot(jr, vfree);
-            self.w[r] = dot(jr, &self.y[r * nv..(r + 1) * nv]);
+    /// Fills `y` with the rows of Y = J L⁻ᵀ (yᵣ = L⁻¹ jᵣ, one forward substitution
+    /// a row) for the lower Cholesky factor `l` of H (column-major, nv × nv), the
+    /// Delassus diagonal Wᵣᵣ = jᵣ·H⁻¹jᵣ = ‖yᵣ‖² and c = J v* for the free velocity
+    /// `vfree`.
+    pub fn form_factored(&mut self, l: &[f64], vfree: &[f64]) {
+        let (nv, n) = (self.nv, self.n);
+        if l.len() < nv * nv
+            || vfree.len() < nv
+            || self.j.len() < n * nv
+            || self.y.len() < n * nv
+            || self.w.len() < n
+            || self.c.len() < n
+        {
+            return;
+        }
+        match nv {
+            6 => self.form_n::<6>(l, vfree),
+            7 => self.form_n::<7>(l, vfree),
+            8 => self.form_n::<8>(l, vfree),
+            9 => self.form_n::<9>(l, vfree),
+            12 => self.form_n::<12>(l, vfree),
+            18 => self.form_n::<18>(l, vfree),
+            _ => self.form_n::<0>(l, vfree),
         }
     }
 
-    /// Projected Gauss–Seidel on W = J H⁻¹ Jᵀ, kept implicit: the velocity
-    /// change Δv = H⁻¹Jᵀλ is carried along (in `dv`, length nv) so that a row's
-    /// velocity is uᵣ = cᵣ + jᵣ·Δv, O(nv) a row. Stops when no row's velocity
+    /// [`Rows::form_factored`] with rows `N` long (`N = 0`: `self.nv`); the
+    /// caller checked the lengths.
+    #[inline(always)]
+    fn form_n<const N: usize>(&mut self, l: &[f64], vfree: &[f64]) {
+        let nv = if N == 0 { self.nv } else { N };
+        let n = self.n;
+        let (j, y) = (&self.j[..n * nv], &mut self.y[..n * nv]);
+        let (w, c) = (&mut self.w[..n], &mut self.c[..n]);
+        let (l, vfree) = (&l[..nv * nv], &vfree[..nv]);
+        // SAFETY: r < n, k, i < nv; j and y are n·nv long, l nv·nv, vfree nv,
+        // w and c n (sliced above).
+        unsafe {
+            for r in 0..n {
+                let mut cr = -0.0;
+                let mut wr = -0.0;
+                for k in 0..nv {
+                    let jk = *j.get_unchecked(r * nv + k);
+                    cr += jk * *vfree.get_unchecked(k);
+                    *y.get_unchecked_mut(r * nv + k) = jk;
+                }
+                for k in 0..nv {
+                    let xk = *y.get_unchecked(r * nv + k) / *l.get_unchecked(k * nv + k);
+                    *y.get_unchecked_mut(r * nv + k) = xk;
+                    wr += xk * xk;
+                    for i in k + 1..nv {
+                        *y.get_unchecked_mut(r * nv + i) -= *l.get_unchecked(k * nv + i) * xk;
+                    }
+                }
+                *c.get_unchecked_mut(r) = cr;
+                *w.get_unchecked_mut(r) = wr;
+            }
+        }
+    }
+
+    /// Projected Gauss–Seidel on W = J H⁻¹ Jᵀ = Y Yᵀ (Y = J L⁻ᵀ, H = L Lᵀ), kept
+    /// implicit: Δv' = Lᵀ Δv = Yᵀλ is carried along (in `dv`, length nv) so that
+    /// a row's velocity is uᵣ = cᵣ + yᵣ·Δv', O(nv) a row; the caller recovers
+    /// Δv = L⁻ᵀ Δv'. Stops when no row's velocity
     /// changes by more than `tol` (m/s or rad/s) in a sweep, or after `max_iter`
     /// sweeps; returns the sweeps. Rows with a (numerically) zero diagonal stay at 0.
     pub fn solve(&mut self, dv: &mut [f64], max_iter: usize, tol: f64) -> usize {
@@ -140,7 +191,7 @@ impl Rows {
             return 0;
         }
         let dv = &mut dv[..nv];
-        let (j, y) = (&self.j[..n * nv], &self.y[..n * nv]);
+        let y = &self.y[..n * nv];
         let (kinds, w, c, b) = (&self.kind[..n], &self.w[..n], &self.c[..n], &self.b[..n]);
         let lambda = &mut self.lambda[..n];
         // SAFETY (all unchecked reads below): r < n, k < nv, the slices above are
@@ -180,8 +231,8 @@ impl Rows {
                 match kind {
                     RowKind::Tangent { normal, mu } if r + 1 < n => {
                         let (w11, w22) = unsafe { (*w.get_unchecked(r), *w.get_unchecked(r + 1)) };
-                        let u1 = unsafe { *c.get_unchecked(r) } + rdot::<N>(nv, j, r, dv);
-                        let u2 = unsafe { *c.get_unchecked(r + 1) } + rdot::<N>(nv, j, r + 1, dv);
+                        let u1 = unsafe { *c.get_unchecked(r) } + rdot::<N>(nv, y, r, dv);
+                        let u2 = unsafe { *c.get_unchecked(r + 1) } + rdot::<N>(nv, y, r + 1, dv);
                         let (o1, o2) =
                             unsafe { (*lambda.get_unchecked(r), *lambda.get_unchecked(r + 1)) };
                         let mut t1 = if w11 > 1e-14 { o1 - u1 / w11 } else { 0.0 };
@@ -225,7 +276,7 @@ impl Rows {
                 let wrr = unsafe { *w.get_unchecked(r) };
                 let old = unsafe { *lambda.get_unchecked(r) };
                 let new = if wrr > 1e-14 {
-                    let u = unsafe { *c.get_unchecked(r) } + rdot::<N>(nv, j, r, dv);
+                    let u = unsafe { *c.get_unchecked(r) } + rdot::<N>(nv, y, r, dv);
                     let x = old - (u - unsafe { *b.get_unchecked(r) }) / wrr;
                     match kind {
                         RowKind::Box { limit } => {
