@@ -137,6 +137,10 @@ pub struct GroundShape {
     verts: Vec<Vector3<f64>>,
     /// Number of slots (stable point identities) of this shape.
     pub nslots: usize,
+    /// Radius of a sphere about the geometry origin that holds the shape: a
+    /// shape whose origin is higher than this above the ground (plus the margin)
+    /// cannot touch it, and is skipped without a narrow-phase query.
+    pub bound: f64,
 }
 
 /// A contact point found by [`GroundContact::detect`].
@@ -314,6 +318,12 @@ impl GroundContact {
                 Manifold::Capsule { .. } => 2,
                 Manifold::Cylinder { .. } => 2 + verts.len(),
             };
+            let bound = match manifold {
+                Manifold::Vertices => verts.iter().map(|v| v.norm()).fold(0.0, f64::max),
+                Manifold::Sphere(r) => r,
+                Manifold::Capsule { half, radius } => half + radius,
+                Manifold::Cylinder { half, radius } => half.hypot(radius),
+            };
             shapes.push(GroundShape {
                 body: g.body,
                 link,
@@ -323,6 +333,7 @@ impl GroundContact {
                 manifold,
                 verts,
                 nslots,
+                bound,
             });
         }
         if shapes.is_empty() {
@@ -397,6 +408,10 @@ impl GroundContact {
                 continue;
             };
             let o_m_g = o_m_b.compose(&s.placement);
+            // broad phase: the bounding sphere clear of the plane
+            if o_m_g.trans.z - ground - s.bound > margin {
+                continue;
+            }
             self.queries += 1;
             // parry's half-space query, in the ground frame (z shifted by −ground)
             let mut g_m_shape = o_m_g.compose(&s.parry_offset);

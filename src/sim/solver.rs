@@ -64,11 +64,25 @@ impl Rows {
     pub fn capacity(&self) -> usize {
         self.cap
     }
+    /// Empties the rows; their Jacobian entries are zeroed here, once, so that
+    /// every row pushed after starts from zeros.
     pub fn clear(&mut self) {
+        let used = (self.n * self.nv).min(self.j.len());
+        self.j[..used].fill(0.0);
         self.n = 0;
         self.kind.clear();
     }
-    /// Adds a row (zeroed Jacobian) and returns its index, or `None` when full.
+    /// Drops the last `k` rows (pushed, their Jacobian entries not yet written).
+    pub fn pop(&mut self, k: usize) {
+        let k = k.min(self.n);
+        self.n -= k;
+        self.kind.truncate(self.n);
+        let from = (self.n * self.nv).min(self.j.len());
+        let to = ((self.n + k) * self.nv).min(self.j.len());
+        self.j[from..to].fill(0.0);
+    }
+    /// Adds a row (zeroed Jacobian: rows are zeroed by [`Rows::clear`]) and returns
+    /// its index, or `None` when full.
     pub fn push(&mut self, kind: RowKind, b: f64, warm: f64) -> Option<usize> {
         if self.n >= self.cap {
             return None;
@@ -76,7 +90,6 @@ impl Rows {
         let r = self.n;
         self.n += 1;
         self.kind.push(kind);
-        self.j[r * self.nv..(r + 1) * self.nv].fill(0.0);
         self.b[r] = b;
         self.lambda[r] = warm;
         Some(r)
@@ -157,26 +170,37 @@ impl Rows {
     /// Δv = L⁻ᵀ Δv'. Stops when no row's velocity
     /// changes by more than `tol` (m/s or rad/s) in a sweep, or after `max_iter`
     /// sweeps; returns the sweeps. Rows with a (numerically) zero diagonal stay at 0.
-    pub fn solve(&mut self, dv: &mut [f64], max_iter: usize, tol: f64) -> usize {
+    /// After three plain sweeps, the scalar rows (contact normals, joint friction
+    /// and limits) are over-relaxed by `relax` ∈ (0, 2) (projected SOR, convergent
+    /// for the positive semi-definite W in that range; 1 is plain Gauss–Seidel)
+    /// until converged, then one plain sweep ends the solve; the tangent pairs,
+    /// projected onto the friction disc, are never over-relaxed.
+    pub fn solve(&mut self, dv: &mut [f64], max_iter: usize, tol: f64, relax: f64) -> usize {
         // the row length known at compile time for common sizes: the short dot
         // products and updates are unrolled (same arithmetic, same order)
         match self.nv {
-            6 => self.solve_n::<6>(dv, max_iter, tol),
-            7 => self.solve_n::<7>(dv, max_iter, tol),
-            8 => self.solve_n::<8>(dv, max_iter, tol),
-            9 => self.solve_n::<9>(dv, max_iter, tol),
-            12 => self.solve_n::<12>(dv, max_iter, tol),
-            18 => self.solve_n::<18>(dv, max_iter, tol),
-            _ => self.solve_n::<0>(dv, max_iter, tol),
+            6 => self.solve_n::<6>(dv, max_iter, tol, relax),
+            7 => self.solve_n::<7>(dv, max_iter, tol, relax),
+            8 => self.solve_n::<8>(dv, max_iter, tol, relax),
+            9 => self.solve_n::<9>(dv, max_iter, tol, relax),
+            12 => self.solve_n::<12>(dv, max_iter, tol, relax),
+            18 => self.solve_n::<18>(dv, max_iter, tol, relax),
+            _ => self.solve_n::<0>(dv, max_iter, tol, relax),
         }
     }
 
     /// [`Rows::solve`] with rows `N` long (`N = 0`: `self.nv`).
     #[inline]
-    fn solve_n<const N: usize>(&mut self, dv: &mut [f64], max_iter: usize, tol: f64) -> usize {
+    fn solve_n<const N: usize>(
+        &mut self,
+        dv: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+        relax: f64,
+    ) -> usize {
         let nv = if N == 0 { self.nv } else { N };
         if N != 0 && (dv.len() < N || self.nv != N) {
-            return self.solve_n::<0>(dv, max_iter, tol);
+            return self.solve_n::<0>(dv, max_iter, tol, relax);
         }
         let n = self.n;
         if dv.len() < nv
@@ -221,8 +245,15 @@ impl Rows {
             }
         }
         let mut it = 0;
+        // plain sweeps first; a problem not solved in `PLAIN` sweeps is
+        // over-relaxed, and once that has converged one plain sweep finishes it
+        // (every row then leaves its own residual exactly 0 or projected, as
+        // Gauss–Seidel does)
+        const PLAIN: usize = 3;
+        let mut finishing = false;
         while it < max_iter {
             it += 1;
+            let relax = if it <= PLAIN || finishing { 1.0 } else { relax };
             // (comparisons in place of f64::max: the same result, NaN included)
             let mut change: f64 = 0.0;
             let mut r = 0;
@@ -277,7 +308,7 @@ impl Rows {
                 let old = unsafe { *lambda.get_unchecked(r) };
                 let new = if wrr > 1e-14 {
                     let u = unsafe { *c.get_unchecked(r) } + rdot::<N>(nv, y, r, dv);
-                    let x = old - (u - unsafe { *b.get_unchecked(r) }) / wrr;
+                    let x = old - relax * (u - unsafe { *b.get_unchecked(r) }) / wrr;
                     match kind {
                         RowKind::Box { limit } => {
                             if x < -limit {
@@ -310,8 +341,11 @@ impl Rows {
                 }
                 r += 1;
             }
-            if change <= tol {
+            if finishing || (change <= tol && relax == 1.0) {
                 break;
+            }
+            if change <= tol {
+                finishing = true;
             }
         }
         it
