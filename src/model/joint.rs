@@ -2,6 +2,7 @@
 //! the joint transform `X_J(q)`, the motion subspace `S` (seed eqs. 31–32), the
 //! joint velocity `S q̇`, and the projection `Sᵀ f` (seed eq. 16).
 
+use crate::dynamics::CompositeInertia;
 use crate::spatial::{axis_angle, quat_to_matrix, Force, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Matrix6, Vector3, Vector6};
 
@@ -532,6 +533,10 @@ impl<T: Scalar> AxisOf<T> for AxU<T> {
 pub(crate) trait JointModel<T: Scalar>: Copy {
     /// Number of velocity coordinates.
     const NV: usize;
+    #[inline(always)]
+    fn nv(&self) -> usize {
+        Self::NV
+    }
     /// The axis of `λ(i)Mi`'s rotation when it is a plain rotation about an
     /// axis-aligned joint axis (as [`Joint::axis_rotation`]), a compile-time
     /// constant for each joint model.
@@ -544,6 +549,13 @@ pub(crate) trait JointModel<T: Scalar>: Copy {
     fn add_cross_motion(&self, m: &mut Motion<T>, vi: &Motion<T>, x: &[T]);
     /// `tau += Gᵀ Sᵀ f` (as [`Joint::project_add`]).
     fn project_add(&self, f: &Force<T>, tau: &mut [T]);
+    /// `Sᵀ f` for velocity coordinate `c` of this joint (as [`Joint::project_column`]).
+    fn project_column(&self, c: usize, f: &Force<T>) -> T;
+    /// Column `c` of the motion subspace in frame a given `aMi` (as [`Joint::subspace_in`]).
+    fn subspace_in(&self, c: usize, m: &Se3<T>) -> Motion<T>;
+    /// `Î S` for column `c` of the motion subspace (a column of the 6x6 inertia
+    /// for an axis-aligned joint).
+    fn mul_subspace(&self, ic: &CompositeInertia<T>, c: usize) -> Force<T>;
     /// The underlying joint (for the generic paths).
     fn joint(&self) -> &Joint<T>;
 }
@@ -609,6 +621,26 @@ impl<'j, T: Scalar, A: AxisOf<T>, const AXROT: bool> JointModel<T> for RevoluteJ
         tau[self.j.iv] += self.j.mult * self.ax.get().dot(&f.ang);
     }
     #[inline(always)]
+    fn project_column(&self, _c: usize, f: &Force<T>) -> T {
+        self.j.mult * self.ax.get().dot(&f.ang)
+    }
+    #[inline(always)]
+    fn subspace_in(&self, _c: usize, m: &Se3<T>) -> Motion<T> {
+        let w = self.ax.get().mat_mul(&m.rot) * self.j.mult;
+        Motion::new(w, m.trans.cross(&w))
+    }
+    #[inline(always)]
+    fn mul_subspace(&self, ic: &CompositeInertia<T>, _c: usize) -> Force<T> {
+        let ax = self.ax.get();
+        match ax {
+            Axis::Unit(u) => ic.mul_motion(&Motion::new(u * self.j.mult, Vector3::zeros())),
+            _ => Force {
+                ang: ax.mat_mul(&ic.io) * self.j.mult,
+                lin: ax.cross_from(&ic.h) * (-self.j.mult),
+            },
+        }
+    }
+    #[inline(always)]
     fn joint(&self) -> &Joint<T> {
         self.j
     }
@@ -637,6 +669,25 @@ impl<'j, T: Scalar, A: AxisOf<T>> JointModel<T> for PrismaticJ<'j, T, A> {
     #[inline(always)]
     fn project_add(&self, f: &Force<T>, tau: &mut [T]) {
         tau[self.j.iv] += self.j.mult * self.ax.get().dot(&f.lin);
+    }
+    #[inline(always)]
+    fn project_column(&self, _c: usize, f: &Force<T>) -> T {
+        self.j.mult * self.ax.get().dot(&f.lin)
+    }
+    #[inline(always)]
+    fn subspace_in(&self, _c: usize, m: &Se3<T>) -> Motion<T> {
+        Motion::new(Vector3::zeros(), self.ax.get().mat_mul(&m.rot) * self.j.mult)
+    }
+    #[inline(always)]
+    fn mul_subspace(&self, ic: &CompositeInertia<T>, _c: usize) -> Force<T> {
+        let ax = self.ax.get();
+        match ax {
+            Axis::Unit(u) => ic.mul_motion(&Motion::new(Vector3::zeros(), u * self.j.mult)),
+            _ => Force {
+                ang: ax.cross_from(&ic.h) * self.j.mult,
+                lin: ax.vector() * (ic.m * self.j.mult),
+            },
+        }
     }
     #[inline(always)]
     fn joint(&self) -> &Joint<T> {
@@ -683,6 +734,18 @@ impl<'j, T: Scalar> JointModel<T> for FreeJ<'j, T> {
             t[r] += f.lin[r];
             t[3 + r] += f.ang[r];
         }
+    }
+    #[inline(always)]
+    fn project_column(&self, c: usize, f: &Force<T>) -> T {
+        self.j.project_column(c, f)
+    }
+    #[inline(always)]
+    fn subspace_in(&self, c: usize, m: &Se3<T>) -> Motion<T> {
+        m.act_motion(&self.j.subspace_column(c))
+    }
+    #[inline(always)]
+    fn mul_subspace(&self, ic: &CompositeInertia<T>, c: usize) -> Force<T> {
+        ic.mul_motion(&self.j.subspace_column(c))
     }
     #[inline(always)]
     fn joint(&self) -> &Joint<T> {
