@@ -1,7 +1,7 @@
 //! The composite-rigid-body algorithm (CRBA) for the joint-space inertia matrix H(q).
 
 use crate::dynamics::rnea::act_force_ax;
-use crate::model::{Axis, Data, Joint, JointKind, Model};
+use crate::model::{dispatch_joint, Axis, Data, Joint, JointKind, JointModel, Model};
 use crate::spatial::{Force, Inertia, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Vector3};
 
@@ -178,16 +178,17 @@ pub fn crba<'d, T: Scalar>(
     q: &DVector<T>,
 ) -> &'d nalgebra::DMatrix<T> {
     if model.has_mimic {
-        crba_impl::<T, true>(model, data, q);
+        crba_mimic(model, data, q);
     } else if model.topology.crba_local {
         crba_local(model, data, q);
     } else {
-        crba_impl::<T, false>(model, data, q);
+        crba_world(model, data, q);
     }
     &data.h
 }
 
-fn crba_impl<T: Scalar, const MIMIC: bool>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
+/// The CRBA with mimic joints (H = Gᵀ H_full G, accumulated).
+fn crba_mimic<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     let nb = model.nbodies;
     let joints = &model.joints[..nb];
     let placements = &model.placements[..nb];
@@ -201,14 +202,11 @@ fn crba_impl<T: Scalar, const MIMIC: bool>(model: &Model<T>, data: &mut Data<T>,
         li_m_i[i] = joints[i].placement_compose_ax(&placements[i], ax, q);
         ic[i] = CompositeInertia::from_inertia(&inertias[i]);
     }
-    // Mimic joints accumulate into H. Without them every entry on the tree
-    // pattern is written and the entries off it (unrelated coordinates) are never
-    // touched: they keep the zeros of `Data::new` (as in Pinocchio's Data).
-    if MIMIC {
-        data.h.fill(T::zero());
-    }
+    // Mimic joints accumulate into H (a joint's terms land on its leader's
+    // coordinate), so H starts from zero.
+    data.h.fill(T::zero());
     let h = &mut data.h;
-    if MIMIC {
+    {
         for i in (1..nb).rev() {
             let ji = &joints[i];
             let ici = ic[i];
@@ -244,26 +242,30 @@ fn crba_impl<T: Scalar, const MIMIC: bool>(model: &Model<T>, data: &mut Data<T>,
                 ic[p].add_assign(&moved);
             }
         }
-        return;
     }
-    // Without mimic joints: the world-frame variant (Featherstone RBDA §6.2 with
-    // every quantity in the world frame, as Pinocchio's `crba-world`). Composite
-    // inertias in one frame are plain sums, and H[k, j] = S_jᵀ F_k is a 6-term dot
-    // product of world-frame vectors: no force is transported along the tree.
+}
+
+/// The world-frame CRBA for models without mimic joints (Featherstone RBDA §6.2
+/// with H's entries formed in the world frame, as Pinocchio's `crba-world`):
+/// `H[j, k] = (⁰X̂ⱼ Sⱼ)ᵀ (⁰X̂ᵢ* I^c_i Sₖ)`, a 6-term dot product of world-frame
+/// vectors, so no force is transported along the tree. The composite inertias are
+/// accumulated in body frames (moved to the parent by `λ(i)Mi`, a rotation about
+/// the joint axis for most joints: cheaper than moving every body inertia to the
+/// world), and `F = I^c_i Sₖ` (a column of I^c_i for an axis-aligned joint) is
+/// moved to the world once.
+fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
+    let nb = model.nbodies;
     let nv = model.nv;
+    let q = q.as_slice();
+    let joints = &model.joints[..nb];
+    let placements = &model.placements[..nb];
+    let inertias = &model.inertias[..nb];
+    let parent = &model.parent[..nb];
+    let ident = &model.placement_identity[..nb];
     let lambda = &model.dof_parent[..nv];
+    let li_m_i = &mut data.li_m_i[..nb];
     let o_m_i = &mut data.o_m_i[..nb];
-    for i in 1..nb {
-        let op = &o_m_i[parent[i]];
-        let li = &li_m_i[i];
-        let om = match joints[i].axis_rotation(ident[i]) {
-            // oRᵢ = oRₚ R_axis: two columns mixed.
-            Some(ax) => Se3::new(ax.mul_rot(&op.rot, &li.rot), op.trans + op.rot * li.trans),
-            None => op.compose(li),
-        };
-        o_m_i[i] = om;
-        ic[i] = ic[i].act(&om);
-    }
+    let ic = &mut data.crba_ic[..nb];
     // World-frame subspace columns, structure of arrays: S = (w, v).
     let fs = data.crba_f.as_mut_slice();
     let (sw0, fs) = fs.split_at_mut(nv);
@@ -273,61 +275,75 @@ fn crba_impl<T: Scalar, const MIMIC: bool>(model: &Model<T>, data: &mut Data<T>,
     let (sv1, sv2) = fs.split_at_mut(nv);
     let sv2 = &mut sv2[..nv];
     for i in 1..nb {
-        let ji = &joints[i];
-        for c in 0..ji.nv() {
-            let s = ji.subspace_in(c, &o_m_i[i]);
-            let k = ji.iv + c;
-            (sw0[k], sw1[k], sw2[k]) = (s.ang.x, s.ang.y, s.ang.z);
-            (sv0[k], sv1[k], sv2[k]) = (s.lin.x, s.lin.y, s.lin.z);
-        }
+        let op = o_m_i[parent[i]];
+        let (li, om) = dispatch_joint!(&joints[i], ident[i], jm => {
+            let li = jm.placement(&placements[i], q);
+            let om = match jm.rot_axis() {
+                // oRᵢ = oRₚ R_axis: two columns mixed.
+                Some(ax) => Se3::new(ax.mul_rot(&op.rot, &li.rot), op.trans + op.rot * li.trans),
+                None => op.compose(&li),
+            };
+            let k0 = jm.joint().iv;
+            for c in 0..jm.nv() {
+                let s = jm.subspace_in(c, &om);
+                let k = k0 + c;
+                (sw0[k], sw1[k], sw2[k]) = (s.ang.x, s.ang.y, s.ang.z);
+                (sv0[k], sv1[k], sv2[k]) = (s.lin.x, s.lin.y, s.lin.z);
+            }
+            (li, om)
+        });
+        li_m_i[i] = li;
+        o_m_i[i] = om;
+        ic[i] = CompositeInertia::from_inertia(&inertias[i]);
     }
-    let hs = h.as_mut_slice();
+    let hs = data.h.as_mut_slice();
     // (Short chains take the λ walk: the vector sweep's set-up costs more there.)
     let chain = model.topology.h_dense && nv >= 16;
     for i in (1..nb).rev() {
-        let ji = &joints[i];
-        let ici = ic[i];
-        for c in 0..ji.nv() {
-            let k = ji.iv + c;
-            // F = I^c_i S_k (world frame)
-            let s = Motion::new(
-                Vector3::new(sw0[k], sw1[k], sw2[k]),
-                Vector3::new(sv0[k], sv1[k], sv2[k]),
-            );
-            let f = ici.mul_motion(&s);
-            let col = &mut hs[k * nv..(k + 1) * nv];
-            if chain {
-                // A chain: k's ancestors are 0..k, so column k of the upper
-                // triangle is one contiguous, vectorisable sweep.
-                project(
-                    &f,
-                    [&sw0[..=k], &sw1[..=k], &sw2[..=k]],
-                    [&sv0[..=k], &sv1[..=k], &sv2[..=k]],
-                    &mut col[..=k],
-                );
-            } else {
-                // H[j, k] = S_jᵀ F for j = k and every coordinate on k's path to the root.
-                let (n0, n1, n2) = (f.ang.x, f.ang.y, f.ang.z);
-                let (f0, f1, f2) = (f.lin.x, f.lin.y, f.lin.z);
-                let mut j = k;
-                loop {
-                    col[j] = sw0[j] * n0
-                        + sw1[j] * n1
-                        + sw2[j] * n2
-                        + sv0[j] * f0
-                        + sv1[j] * f1
-                        + sv2[j] * f2;
-                    j = lambda[j];
-                    if j >= nv {
-                        break;
+        let p = parent[i];
+        let (head, tail) = ic.split_at_mut(i);
+        let ici = tail[0];
+        let om = &o_m_i[i];
+        dispatch_joint!(&joints[i], ident[i], jm => {
+            let k0 = jm.joint().iv;
+            for c in 0..jm.nv() {
+                let k = k0 + c;
+                // F = ⁰X̂ᵢ* I^c_i S_k (world frame)
+                let f = om.act_force(&jm.mul_subspace(&ici, c));
+                let col = &mut hs[k * nv..(k + 1) * nv];
+                if chain {
+                    // A chain: k's ancestors are 0..k, so column k of the upper
+                    // triangle is one contiguous, vectorisable sweep.
+                    project(
+                        &f,
+                        [&sw0[..=k], &sw1[..=k], &sw2[..=k]],
+                        [&sv0[..=k], &sv1[..=k], &sv2[..=k]],
+                        &mut col[..=k],
+                    );
+                } else {
+                    // H[j, k] = S_jᵀ F for j = k and every coordinate on k's path to the root.
+                    let (n0, n1, n2) = (f.ang.x, f.ang.y, f.ang.z);
+                    let (f0, f1, f2) = (f.lin.x, f.lin.y, f.lin.z);
+                    let mut j = k;
+                    loop {
+                        col[j] = sw0[j] * n0
+                            + sw1[j] * n1
+                            + sw2[j] * n2
+                            + sv0[j] * f0
+                            + sv1[j] * f1
+                            + sv2[j] * f2;
+                        j = lambda[j];
+                        if j >= nv {
+                            break;
+                        }
                     }
                 }
             }
-        }
-        let p = parent[i];
-        if p != 0 {
-            ic[p].add_assign(&ici);
-        }
+            // I^c_p += ₚX̂ᵢ* I^c_i ⁱX̂ₚ
+            if p != 0 {
+                head[p].add_assign(&ici.act_ax(&li_m_i[i], jm.rot_axis()));
+            }
+        });
     }
     // Mirror the upper triangle into the lower one.
     if chain {
@@ -356,77 +372,111 @@ fn project<T: Scalar>(f: &Force<T>, w: [&[T]; 3], v: [&[T]; 3], out: &mut [T]) {
 }
 
 /// Copies the strict upper triangle of the column-major n x n matrix `a` onto its
-/// lower triangle, by 16 x 16 blocks (cache-friendly for large n).
+/// lower triangle, by 32-row blocks (cache-friendly for large n): each source run
+/// is a contiguous piece of a column, each destination a strided piece of a row.
 fn mirror_blocked<T: Scalar>(a: &mut [T], n: usize) {
-    const B: usize = 16;
-    let mut jb = 0;
-    while jb < n {
-        let je = (jb + B).min(n);
-        let mut ib = 0;
-        while ib <= jb {
-            let ie = (ib + B).min(n);
-            for j in jb..je {
-                for i in ib..ie.min(j) {
-                    a[j + i * n] = a[i + j * n];
+    const B: usize = 32;
+    let a = &mut a[..n * n];
+    let mut ib = 0;
+    while ib < n {
+        let ie = (ib + B).min(n);
+        // Columns j > ib hold the rows ib..min(ie, j) to copy.
+        for j in ib + 1..n {
+            let hi = ie.min(j);
+            for i in ib..hi {
+                // SAFETY: i < j < n, so both i + j n and j + i n are < n², the
+                // length of `a` (sliced above).
+                unsafe {
+                    *a.get_unchecked_mut(j + i * n) = *a.get_unchecked(i + j * n);
                 }
             }
-            ib += B;
         }
-        jb += B;
+        ib += B;
     }
 }
 
 /// The local-frame CRBA (Featherstone RBDA §6.2 as written, Pinocchio's default
 /// `crba`) for models without mimic joints: composite inertias moved to the parent
 /// body by body, `F = I^c_i S_i` in body i's frame (a column of I^c_i for an
-/// axis-aligned joint) carried to each ancestor by ᵖX*ᵢ, one projection there.
-/// With identity placement rotations (most robots' joints) the moves are rotations
-/// about the joint axis ([`CompositeInertia::act_ax`], `act_force_ax`).
+/// axis-aligned joint), then, as in Pinocchio, the forces of body i's whole
+/// subtree (its coordinates are contiguous, `k..dof_subtree_end[k]`, structure of
+/// arrays in `data.crba_f`) are projected on `S_i` — one row of H — and carried
+/// together to the parent frame by ᵖX*ᵢ. Each body's joint kind is matched once
+/// ([`dispatch_joint!`]); with identity placement rotations (most robots' joints)
+/// the moves are rotations about the joint axis ([`CompositeInertia::act_ax`],
+/// `act_force_ax`).
 fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     let nb = model.nbodies;
+    let nv = model.nv;
+    let q = q.as_slice();
     let joints = &model.joints[..nb];
     let placements = &model.placements[..nb];
     let inertias = &model.inertias[..nb];
     let parent = &model.parent[..nb];
     let ident = &model.placement_identity[..nb];
+    let sub_end = &model.topology.dof_subtree_end[..nv];
     let li_m_i = &mut data.li_m_i[..nb];
     let ic = &mut data.crba_ic[..nb];
     for i in 1..nb {
-        let ax = joints[i].axis_rotation(ident[i]);
-        li_m_i[i] = joints[i].placement_compose_ax(&placements[i], ax, q);
         ic[i] = CompositeInertia::from_inertia(&inertias[i]);
     }
+    // Subtree forces, structure of arrays: F = (n, f) per coordinate.
+    let fs = data.crba_f.as_mut_slice();
+    let (n0, fs) = fs.split_at_mut(nv);
+    let (n1, fs) = fs.split_at_mut(nv);
+    let (n2, fs) = fs.split_at_mut(nv);
+    let (f0, fs) = fs.split_at_mut(nv);
+    let (f1, f2) = fs.split_at_mut(nv);
+    let f2 = &mut f2[..nv];
     // Every entry on the tree pattern is written; the others keep Data::new's zeros.
-    let h = &mut data.h;
+    let hs = data.h.as_mut_slice();
+    let hs = &mut hs[..nv * nv];
     for i in (1..nb).rev() {
-        let ji = &joints[i];
-        let ici = ic[i];
-        for ci in 0..ji.nv() {
-            let ki = ji.iv + ci;
-            let mut f = ici.mul_subspace(ji, ci);
-            for cj in 0..=ci {
-                let kj = ji.iv + cj;
-                let val = ji.project_column(cj, &f);
-                h[(ki, kj)] = val;
-                h[(kj, ki)] = val;
+        let p = parent[i];
+        let (head, tail) = ic.split_at_mut(i);
+        let ici = tail[0];
+        let li = dispatch_joint!(&joints[i], ident[i], jm => {
+            let li = jm.placement(&placements[i], q);
+            let k0 = jm.joint().iv;
+            let end = sub_end[k0];
+            // F = I^c_i S_i for the joint's own columns (body i's frame)
+            for c in 0..jm.nv() {
+                let f = jm.mul_subspace(&ici, c);
+                let k = k0 + c;
+                (n0[k], n1[k], n2[k]) = (f.ang.x, f.ang.y, f.ang.z);
+                (f0[k], f1[k], f2[k]) = (f.lin.x, f.lin.y, f.lin.z);
             }
-            let mut j = i;
-            while parent[j] != 0 {
-                f = act_force_ax(&li_m_i[j], joints[j].axis_rotation(ident[j]), &f);
-                j = parent[j];
-                let jj = &joints[j];
-                for cj in 0..jj.nv() {
-                    let kj = jj.iv + cj;
-                    let val = jj.project_column(cj, &f);
-                    h[(ki, kj)] = val;
-                    h[(kj, ki)] = val;
+            // H[k0 + r, c] = S_rᵀ F_c for every coordinate c of the subtree (seed eq. 16)
+            for c in k0..end {
+                let f = Force::new(
+                    Vector3::new(n0[c], n1[c], n2[c]),
+                    Vector3::new(f0[c], f1[c], f2[c]),
+                );
+                for r in 0..jm.nv() {
+                    let val = jm.project_column(r, &f);
+                    hs[(k0 + r) + c * nv] = val;
+                    hs[c + (k0 + r) * nv] = val;
                 }
             }
-        }
-        let p = parent[i];
-        if p != 0 {
-            let moved = ici.act_ax(&li_m_i[i], ji.axis_rotation(ident[i]));
-            ic[p].add_assign(&moved);
-        }
+            if p != 0 {
+                // The subtree's forces to the parent frame: ᵖX̂ᵢ* F
+                let ax = jm.rot_axis();
+                let (n0, n1, n2) = (&mut n0[k0..end], &mut n1[k0..end], &mut n2[k0..end]);
+                let (f0, f1, f2) = (&mut f0[k0..end], &mut f1[k0..end], &mut f2[k0..end]);
+                for c in 0..end - k0 {
+                    let f = Force::new(
+                        Vector3::new(n0[c], n1[c], n2[c]),
+                        Vector3::new(f0[c], f1[c], f2[c]),
+                    );
+                    let g = act_force_ax(&li, ax, &f);
+                    (n0[c], n1[c], n2[c]) = (g.ang.x, g.ang.y, g.ang.z);
+                    (f0[c], f1[c], f2[c]) = (g.lin.x, g.lin.y, g.lin.z);
+                }
+                // I^c_p += ₚX̂ᵢ* I^c_i ⁱX̂ₚ
+                head[p].add_assign(&ici.act_ax(&li, ax));
+            }
+            li
+        });
+        li_m_i[i] = li;
     }
 }

@@ -1,5 +1,4 @@
-use crate::model::Axis;
-use crate::model::{Data, Model};
+use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
 use crate::spatial::{Force, Motion, Scalar, Se3};
 use nalgebra::DVector;
 
@@ -45,56 +44,104 @@ pub(crate) fn rnea_impl<T: Scalar>(
     gravity: bool,
     fext: Option<&[Force<T>]>,
 ) {
+    let q = q.as_slice();
+    // Monomorphised on which of q̇, q̈ are present (no per-body test).
+    match (v, a) {
+        (Some(v), Some(a)) => {
+            rnea_pass::<T, true, true>(model, data, q, v.as_slice(), a.as_slice(), gravity, fext)
+        }
+        (Some(v), None) => rnea_pass::<T, true, false>(model, data, q, v.as_slice(), &[], gravity, fext),
+        (None, Some(a)) => rnea_pass::<T, false, true>(model, data, q, &[], a.as_slice(), gravity, fext),
+        (None, None) => rnea_pass::<T, false, false>(model, data, q, &[], &[], gravity, fext),
+    }
+}
+
+/// [`rnea_impl`] with q̇ present iff `V` and q̈ present iff `A`. The joint kind of
+/// each body is matched once per sweep ([`dispatch_joint!`]); the body step is then
+/// compiled per joint model, with the axis and transform shape known.
+#[inline(always)]
+fn rnea_pass<T: Scalar, const V: bool, const A: bool>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &[T],
+    v: &[T],
+    a: &[T],
+    gravity: bool,
+    fext: Option<&[Force<T>]>,
+) {
+    let nb = model.nbodies;
+    let parent = &model.parent[..nb];
+    let joints = &model.joints[..nb];
+    let placements = &model.placements[..nb];
+    let ident = &model.placement_identity[..nb];
+    let inertias = &model.inertias[..nb];
+    let li_m_i = &mut data.li_m_i[..nb];
+    let o_m_i = &mut data.o_m_i[..nb];
+    let vel = &mut data.v[..nb];
+    let acc = &mut data.a[..nb];
+    let frc = &mut data.f[..nb];
     // seed eq. 21: v̂₋₁ = 0, â₋₁ = [0; −g]
-    data.v[0] = Motion::zero();
-    data.a[0] = if gravity {
+    vel[0] = Motion::zero();
+    acc[0] = if gravity {
         Motion::new(nalgebra::Vector3::zeros(), -model.gravity)
     } else {
         Motion::zero()
     };
-    for i in 1..model.nbodies {
-        let p = model.parent[i];
-        let joint = &model.joints[i];
-        let ax = joint.axis_rotation(model.placement_identity[i]);
-        let li_m_i = joint.placement_compose_ax(&model.placements[i], ax, q);
-        data.li_m_i[i] = li_m_i;
-        // seed eq. 13: v̂ᵢ = ᵢX̂ₚ v̂ₚ + ŝᵢ q̇ᵢ
-        let mut vi = inv_act_motion_ax(&li_m_i, ax, &data.v[p]);
-        // seed eq. 14: âᵢ = ᵢX̂ₚ âₚ + v̂ᵢ × ŝᵢ q̇ᵢ + ŝᵢ q̈ᵢ
-        let mut ai = inv_act_motion_ax(&li_m_i, ax, &data.a[p]);
-        if let Some(v) = v {
-            joint.add_motion(&mut vi, v);
-            ai += joint.cross_motion(&vi, v);
-        }
-        if let Some(a) = a {
-            joint.add_motion(&mut ai, a);
-        }
-        data.v[i] = vi;
-        data.a[i] = ai;
+    for i in 1..nb {
+        let p = parent[i];
+        let (vp, ap) = (vel[p], acc[p]);
+        let (li, vi, ai) = dispatch_joint!(&joints[i], ident[i], jm => {
+            let li = jm.placement(&placements[i], q);
+            let ax = jm.rot_axis();
+            // seed eq. 13: v̂ᵢ = ᵢX̂ₚ v̂ₚ + ŝᵢ q̇ᵢ
+            let mut vi = Motion::zero();
+            if V {
+                vi = inv_act_motion_ax(&li, ax, &vp);
+                jm.add_motion(&mut vi, v);
+            }
+            // seed eq. 14: âᵢ = ᵢX̂ₚ âₚ + v̂ᵢ × ŝᵢ q̇ᵢ + ŝᵢ q̈ᵢ
+            let mut ai = inv_act_motion_ax(&li, ax, &ap);
+            if V {
+                jm.add_cross_motion(&mut ai, &vi, v);
+            }
+            if A {
+                jm.add_motion(&mut ai, a);
+            }
+            (li, vi, ai)
+        });
+        li_m_i[i] = li;
+        vel[i] = vi;
+        acc[i] = ai;
         // seed eq. 15 (own part): f̂ᵢ = Îᵢ âᵢ + v̂ᵢ ×* Îᵢ v̂ᵢ − ᵢX̂₋₁ f̂ᵢˣ
-        let inertia = &model.inertias[i];
-        let mut fi = inertia.mul_motion(&ai) + vi.cross_force(&inertia.mul_motion(&vi));
+        let inertia = &inertias[i];
+        let mut fi = inertia.mul_motion(&ai);
+        if V {
+            fi += vi.cross_force(&inertia.mul_motion(&vi));
+        }
         if let Some(fext) = fext {
-            let o_m_i = data.o_m_i[p].compose(&li_m_i);
-            data.o_m_i[i] = o_m_i;
+            let o_m = o_m_i[p].compose(&li);
+            o_m_i[i] = o_m;
             if let Some(fx) = fext.get(i) {
-                fi -= o_m_i.inv_act_force(fx);
+                fi -= o_m.inv_act_force(fx);
             }
         }
-        data.f[i] = fi;
+        frc[i] = fi;
     }
-    data.tau.fill(T::zero());
-    for i in (1..model.nbodies).rev() {
-        // seed eq. 16: Qᵢ = ŝᵢᵀ f̂ᵢ (a mimic joint adds to its leader's coordinate)
-        let fi = data.f[i];
-        model.joints[i].project_add(&fi, &mut data.tau);
-        // seed eq. 15 (children part): f̂ₚ += ₚX̂ᵢ f̂ᵢ
-        let p = model.parent[i];
-        if p != 0 {
-            let ax = model.joints[i].axis_rotation(model.placement_identity[i]);
-            let fp = act_force_ax(&data.li_m_i[i], ax, &fi);
-            data.f[p] += fp;
-        }
+    let tau = data.tau.as_mut_slice();
+    tau.fill(T::zero());
+    for i in (1..nb).rev() {
+        let p = parent[i];
+        let (head, tail) = frc.split_at_mut(i);
+        let fi = tail[0];
+        let li = &li_m_i[i];
+        dispatch_joint!(&joints[i], ident[i], jm => {
+            // seed eq. 16: Qᵢ = ŝᵢᵀ f̂ᵢ (a mimic joint adds to its leader's coordinate)
+            jm.project_add(&fi, tau);
+            // seed eq. 15 (children part): f̂ₚ += ₚX̂ᵢ f̂ᵢ
+            if p != 0 {
+                head[p] += act_force_ax(li, jm.rot_axis(), &fi);
+            }
+        });
     }
 }
 

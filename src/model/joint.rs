@@ -2,6 +2,7 @@
 //! the joint transform `X_J(q)`, the motion subspace `S` (seed eqs. 31–32), the
 //! joint velocity `S q̇`, and the projection `Sᵀ f` (seed eq. 16).
 
+use crate::dynamics::CompositeInertia;
 use crate::spatial::{axis_angle, quat_to_matrix, Force, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Matrix6, Vector3, Vector6};
 
@@ -86,6 +87,26 @@ impl<T: Scalar> Axis<T> {
             Axis::Y => Vector3::new(-w.z, z, w.x),
             Axis::Z => Vector3::new(w.y, -w.x, z),
             Axis::Unit(u) => w.cross(u),
+        }
+    }
+    /// `x += (w × u) s`, touching the two components an axis-aligned `u` leaves
+    /// non-zero (no products with zero).
+    #[inline(always)]
+    pub fn add_cross_scaled(&self, x: &mut Vector3<T>, w: &Vector3<T>, s: T) {
+        match self {
+            Axis::X => {
+                x.y += w.z * s;
+                x.z -= w.y * s;
+            }
+            Axis::Y => {
+                x.x -= w.z * s;
+                x.z += w.x * s;
+            }
+            Axis::Z => {
+                x.x += w.y * s;
+                x.y -= w.x * s;
+            }
+            Axis::Unit(u) => *x += w.cross(u) * s,
         }
     }
     /// `x += u s`, touching one component for an axis-aligned `u`.
@@ -458,3 +479,339 @@ impl<T: Scalar> Joint<T> {
         }
     }
 }
+
+// ---------------------------------------------------------------------------
+// Joint models: the joint kind matched once per body.
+//
+// The hot loops (RNEA, CRBA) match a body's joint kind once, in
+// [`dispatch_joint!`], and run their body step on one of the zero-sized-axis
+// types below; every helper of that step then works on a compile-time axis and
+// transform shape, with no further `match` (the `Axis` methods fold on the
+// constant axis). This is the one place besides `Joint`'s own methods where joint
+// kinds are matched.
+
+/// An axis known at compile time (`AxX`, `AxY`, `AxZ`) or carried as a unit vector
+/// (`AxU`): `get` returns the [`Axis`], a constant for the zero-sized ones.
+pub(crate) trait AxisOf<T: Scalar>: Copy {
+    fn get(&self) -> Axis<T>;
+}
+#[derive(Clone, Copy)]
+pub(crate) struct AxX;
+#[derive(Clone, Copy)]
+pub(crate) struct AxY;
+#[derive(Clone, Copy)]
+pub(crate) struct AxZ;
+#[derive(Clone, Copy)]
+pub(crate) struct AxU<T: Scalar>(pub Vector3<T>);
+impl<T: Scalar> AxisOf<T> for AxX {
+    #[inline(always)]
+    fn get(&self) -> Axis<T> {
+        Axis::X
+    }
+}
+impl<T: Scalar> AxisOf<T> for AxY {
+    #[inline(always)]
+    fn get(&self) -> Axis<T> {
+        Axis::Y
+    }
+}
+impl<T: Scalar> AxisOf<T> for AxZ {
+    #[inline(always)]
+    fn get(&self) -> Axis<T> {
+        Axis::Z
+    }
+}
+impl<T: Scalar> AxisOf<T> for AxU<T> {
+    #[inline(always)]
+    fn get(&self) -> Axis<T> {
+        Axis::Unit(self.0)
+    }
+}
+
+/// One joint kind with everything the body steps need, specialised at compile time.
+/// Velocity-like arguments (`x`, `tau`) are the model's full coordinate vectors.
+pub(crate) trait JointModel<T: Scalar>: Copy {
+    /// Number of velocity coordinates.
+    const NV: usize;
+    #[inline(always)]
+    fn nv(&self) -> usize {
+        Self::NV
+    }
+    /// The axis of `λ(i)Mi`'s rotation when it is a plain rotation about an
+    /// axis-aligned joint axis (as [`Joint::axis_rotation`]), a compile-time
+    /// constant for each joint model.
+    fn rot_axis(&self) -> Option<Axis<T>>;
+    /// `λ(i)Mi = X_tree · X_J(q)` (as [`Joint::placement_compose`]).
+    fn placement(&self, xt: &Se3<T>, q: &[T]) -> Se3<T>;
+    /// `m += S x` (as [`Joint::add_motion`]).
+    fn add_motion(&self, m: &mut Motion<T>, x: &[T]);
+    /// `m += v × S x` (as [`Joint::cross_motion`]).
+    fn add_cross_motion(&self, m: &mut Motion<T>, vi: &Motion<T>, x: &[T]);
+    /// `tau += Gᵀ Sᵀ f` (as [`Joint::project_add`]).
+    fn project_add(&self, f: &Force<T>, tau: &mut [T]);
+    /// `Sᵀ f` for velocity coordinate `c` of this joint (as [`Joint::project_column`]).
+    fn project_column(&self, c: usize, f: &Force<T>) -> T;
+    /// Column `c` of the motion subspace in frame a given `aMi` (as [`Joint::subspace_in`]).
+    fn subspace_in(&self, c: usize, m: &Se3<T>) -> Motion<T>;
+    /// `Î S` for column `c` of the motion subspace (a column of the 6x6 inertia
+    /// for an axis-aligned joint).
+    fn mul_subspace(&self, ic: &CompositeInertia<T>, c: usize) -> Force<T>;
+    /// The underlying joint (for the generic paths).
+    fn joint(&self) -> &Joint<T>;
+}
+
+/// A revolute joint about axis `A`; `AXROT`: its placement rotation is the
+/// identity (so `λ(i)Mi`'s rotation is a rotation about the axis-aligned `A`).
+#[derive(Clone, Copy)]
+pub(crate) struct RevoluteJ<'j, T: Scalar, A, const AXROT: bool> {
+    pub ax: A,
+    pub j: &'j Joint<T>,
+}
+/// A prismatic joint along axis `A`.
+#[derive(Clone, Copy)]
+pub(crate) struct PrismaticJ<'j, T: Scalar, A> {
+    pub ax: A,
+    pub j: &'j Joint<T>,
+}
+/// The 6-DoF free joint.
+#[derive(Clone, Copy)]
+pub(crate) struct FreeJ<'j, T: Scalar> {
+    pub j: &'j Joint<T>,
+}
+
+impl<'j, T: Scalar, A: AxisOf<T>, const AXROT: bool> JointModel<T> for RevoluteJ<'j, T, A, AXROT> {
+    const NV: usize = 1;
+    #[inline(always)]
+    fn rot_axis(&self) -> Option<Axis<T>> {
+        if AXROT {
+            Some(self.ax.get())
+        } else {
+            None
+        }
+    }
+    #[inline(always)]
+    fn placement(&self, xt: &Se3<T>, q: &[T]) -> Se3<T> {
+        let (s, c) = (self.j.mult * q[self.j.iq] + self.j.offset).sin_cos();
+        let ax = self.ax.get();
+        if AXROT {
+            let (z, o) = (T::zero(), T::one());
+            let rot = match ax {
+                Axis::X => Matrix3::new(o, z, z, z, c, -s, z, s, c),
+                Axis::Y => Matrix3::new(c, z, s, z, o, z, -s, z, c),
+                _ => Matrix3::new(c, -s, z, s, c, z, z, z, o),
+            };
+            Se3::new(rot, xt.trans)
+        } else {
+            Se3::new(ax.rotate_right(&xt.rot, s, c), xt.trans)
+        }
+    }
+    #[inline(always)]
+    fn add_motion(&self, m: &mut Motion<T>, x: &[T]) {
+        self.ax.get().add_scaled(&mut m.ang, self.j.mult * x[self.j.iv]);
+    }
+    #[inline(always)]
+    fn add_cross_motion(&self, m: &mut Motion<T>, vi: &Motion<T>, x: &[T]) {
+        let ax = self.ax.get();
+        let s = self.j.mult * x[self.j.iv];
+        ax.add_cross_scaled(&mut m.ang, &vi.ang, s);
+        ax.add_cross_scaled(&mut m.lin, &vi.lin, s);
+    }
+    #[inline(always)]
+    fn project_add(&self, f: &Force<T>, tau: &mut [T]) {
+        tau[self.j.iv] += self.j.mult * self.ax.get().dot(&f.ang);
+    }
+    #[inline(always)]
+    fn project_column(&self, _c: usize, f: &Force<T>) -> T {
+        self.j.mult * self.ax.get().dot(&f.ang)
+    }
+    #[inline(always)]
+    fn subspace_in(&self, _c: usize, m: &Se3<T>) -> Motion<T> {
+        let w = self.ax.get().mat_mul(&m.rot) * self.j.mult;
+        Motion::new(w, m.trans.cross(&w))
+    }
+    #[inline(always)]
+    fn mul_subspace(&self, ic: &CompositeInertia<T>, _c: usize) -> Force<T> {
+        let ax = self.ax.get();
+        match ax {
+            Axis::Unit(u) => ic.mul_motion(&Motion::new(u * self.j.mult, Vector3::zeros())),
+            _ => Force {
+                ang: ax.mat_mul(&ic.io) * self.j.mult,
+                lin: ax.cross_from(&ic.h) * (-self.j.mult),
+            },
+        }
+    }
+    #[inline(always)]
+    fn joint(&self) -> &Joint<T> {
+        self.j
+    }
+}
+
+impl<'j, T: Scalar, A: AxisOf<T>> JointModel<T> for PrismaticJ<'j, T, A> {
+    const NV: usize = 1;
+    #[inline(always)]
+    fn rot_axis(&self) -> Option<Axis<T>> {
+        None
+    }
+    #[inline(always)]
+    fn placement(&self, xt: &Se3<T>, q: &[T]) -> Se3<T> {
+        let qj = self.j.mult * q[self.j.iq] + self.j.offset;
+        Se3::new(xt.rot, xt.trans + self.ax.get().mat_mul(&xt.rot) * qj)
+    }
+    #[inline(always)]
+    fn add_motion(&self, m: &mut Motion<T>, x: &[T]) {
+        self.ax.get().add_scaled(&mut m.lin, self.j.mult * x[self.j.iv]);
+    }
+    #[inline(always)]
+    fn add_cross_motion(&self, m: &mut Motion<T>, vi: &Motion<T>, x: &[T]) {
+        let s = self.j.mult * x[self.j.iv];
+        self.ax.get().add_cross_scaled(&mut m.lin, &vi.ang, s);
+    }
+    #[inline(always)]
+    fn project_add(&self, f: &Force<T>, tau: &mut [T]) {
+        tau[self.j.iv] += self.j.mult * self.ax.get().dot(&f.lin);
+    }
+    #[inline(always)]
+    fn project_column(&self, _c: usize, f: &Force<T>) -> T {
+        self.j.mult * self.ax.get().dot(&f.lin)
+    }
+    #[inline(always)]
+    fn subspace_in(&self, _c: usize, m: &Se3<T>) -> Motion<T> {
+        Motion::new(Vector3::zeros(), self.ax.get().mat_mul(&m.rot) * self.j.mult)
+    }
+    #[inline(always)]
+    fn mul_subspace(&self, ic: &CompositeInertia<T>, _c: usize) -> Force<T> {
+        let ax = self.ax.get();
+        match ax {
+            Axis::Unit(u) => ic.mul_motion(&Motion::new(Vector3::zeros(), u * self.j.mult)),
+            _ => Force {
+                ang: ax.cross_from(&ic.h) * self.j.mult,
+                lin: ax.vector() * (ic.m * self.j.mult),
+            },
+        }
+    }
+    #[inline(always)]
+    fn joint(&self) -> &Joint<T> {
+        self.j
+    }
+}
+
+impl<'j, T: Scalar> FreeJ<'j, T> {
+    /// `S x` for the free joint's 6 coordinates of `x` (linear first in `x`).
+    #[inline(always)]
+    fn motion(&self, x: &[T]) -> Motion<T> {
+        let x = &x[self.j.iv..self.j.iv + 6];
+        Motion::new(Vector3::new(x[3], x[4], x[5]), Vector3::new(x[0], x[1], x[2]))
+    }
+}
+
+impl<'j, T: Scalar> JointModel<T> for FreeJ<'j, T> {
+    const NV: usize = 6;
+    #[inline(always)]
+    fn rot_axis(&self) -> Option<Axis<T>> {
+        None
+    }
+    #[inline(always)]
+    fn placement(&self, xt: &Se3<T>, q: &[T]) -> Se3<T> {
+        let q = &q[self.j.iq..self.j.iq + 7];
+        let m = Se3::new(
+            quat_to_matrix(q[3], q[4], q[5], q[6]),
+            Vector3::new(q[0], q[1], q[2]),
+        );
+        xt.compose(&m)
+    }
+    #[inline(always)]
+    fn add_motion(&self, m: &mut Motion<T>, x: &[T]) {
+        *m += self.motion(x);
+    }
+    #[inline(always)]
+    fn add_cross_motion(&self, m: &mut Motion<T>, vi: &Motion<T>, x: &[T]) {
+        *m += vi.cross(&self.motion(x));
+    }
+    #[inline(always)]
+    fn project_add(&self, f: &Force<T>, tau: &mut [T]) {
+        let t = &mut tau[self.j.iv..self.j.iv + 6];
+        for r in 0..3 {
+            t[r] += f.lin[r];
+            t[3 + r] += f.ang[r];
+        }
+    }
+    #[inline(always)]
+    fn project_column(&self, c: usize, f: &Force<T>) -> T {
+        self.j.project_column(c, f)
+    }
+    #[inline(always)]
+    fn subspace_in(&self, c: usize, m: &Se3<T>) -> Motion<T> {
+        m.act_motion(&self.j.subspace_column(c))
+    }
+    #[inline(always)]
+    fn mul_subspace(&self, ic: &CompositeInertia<T>, c: usize) -> Force<T> {
+        ic.mul_motion(&self.j.subspace_column(c))
+    }
+    #[inline(always)]
+    fn joint(&self) -> &Joint<T> {
+        self.j
+    }
+}
+
+/// Runs `$body` with `$jm` bound to the [`JointModel`] of joint `$joint`
+/// (`&Joint<T>`) whose placement rotation is the identity iff `$ident`: the joint
+/// kind is matched here, once, and `$body` is compiled once per joint model.
+macro_rules! dispatch_joint {
+    ($joint:expr, $ident:expr, $jm:ident => $body:expr) => {{
+        use $crate::model::joint::{
+            AxU, AxX, AxY, AxZ, Axis, FreeJ, JointKind, PrismaticJ, RevoluteJ,
+        };
+        let j__ = $joint;
+        match (&j__.kind, $ident) {
+            (JointKind::Revolute(Axis::X), true) => {
+                let $jm = RevoluteJ::<_, _, true> { ax: AxX, j: j__ };
+                $body
+            }
+            (JointKind::Revolute(Axis::Y), true) => {
+                let $jm = RevoluteJ::<_, _, true> { ax: AxY, j: j__ };
+                $body
+            }
+            (JointKind::Revolute(Axis::Z), true) => {
+                let $jm = RevoluteJ::<_, _, true> { ax: AxZ, j: j__ };
+                $body
+            }
+            (JointKind::Revolute(Axis::X), false) => {
+                let $jm = RevoluteJ::<_, _, false> { ax: AxX, j: j__ };
+                $body
+            }
+            (JointKind::Revolute(Axis::Y), false) => {
+                let $jm = RevoluteJ::<_, _, false> { ax: AxY, j: j__ };
+                $body
+            }
+            (JointKind::Revolute(Axis::Z), false) => {
+                let $jm = RevoluteJ::<_, _, false> { ax: AxZ, j: j__ };
+                $body
+            }
+            (JointKind::Revolute(Axis::Unit(u)), _) => {
+                let $jm = RevoluteJ::<_, _, false> { ax: AxU(*u), j: j__ };
+                $body
+            }
+            (JointKind::Prismatic(Axis::X), _) => {
+                let $jm = PrismaticJ { ax: AxX, j: j__ };
+                $body
+            }
+            (JointKind::Prismatic(Axis::Y), _) => {
+                let $jm = PrismaticJ { ax: AxY, j: j__ };
+                $body
+            }
+            (JointKind::Prismatic(Axis::Z), _) => {
+                let $jm = PrismaticJ { ax: AxZ, j: j__ };
+                $body
+            }
+            (JointKind::Prismatic(Axis::Unit(u)), _) => {
+                let $jm = PrismaticJ { ax: AxU(*u), j: j__ };
+                $body
+            }
+            (JointKind::Free, _) => {
+                let $jm = FreeJ { j: j__ };
+                $body
+            }
+        }
+    }};
+}
+pub(crate) use dispatch_joint;

@@ -6,11 +6,12 @@
 //! through fixed joints; each URDF link stays addressable as a [`Frame`].
 
 mod data;
-mod joint;
+pub(crate) mod joint;
 mod topology;
 
 pub use data::Data;
 pub use joint::{Axis, Joint, JointKind};
+pub(crate) use joint::{dispatch_joint, JointModel};
 pub use topology::{FdMethod, Topology};
 
 use crate::spatial::{Inertia, Scalar, Se3};

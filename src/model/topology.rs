@@ -29,10 +29,12 @@ pub struct Topology {
     pub fd_method: FdMethod,
     /// Whether the CRBA (without mimic joints) runs in local body frames
     /// (Pinocchio's `crba`) rather than the world frame: local wherever the tree
-    /// branches or the chain is short (≤ 8 coordinates); the world frame's
+    /// branches or the chain is short (< 16 coordinates); the world frame's
     /// contiguous column sweep wins on longer chains. Callgrind instructions per
-    /// call, world → local: ur5 5755 → 5412, kinova 5963 → 5891, solo12 15626 →
-    /// 11788, talos 40440 → 37957, tree_4 13756 → 12067, chain_10 10038 → 10404.
+    /// call, world → local (joint kinds matched once per body, subtree forces
+    /// carried together): ur5 5285 → 4659, solo12 14695 → 10502, talos 37589 →
+    /// 30289, tree_4 12163 → 10021, chain_10 8899 → 7957, chain_20 19610 → 20708,
+    /// chain_50 59909 → 84216.
     pub crba_local: bool,
     /// One past the last coordinate of k's subtree: without mimic joints the
     /// coordinates of a subtree are contiguous, `k..dof_subtree_end[k]`.
@@ -80,7 +82,7 @@ impl Topology {
             sum_depth2,
             h_dense,
             fd_method: FdMethod::Aba,
-            crba_local: !h_dense || nv <= 8,
+            crba_local: !h_dense || nv < 16,
             dof_subtree_end,
         };
         t.fd_method = t.choose(nv, nbodies, has_mimic);
