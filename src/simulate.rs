@@ -342,7 +342,7 @@ fn write_rows(
     }
     line.push_str(",energy,contacts,penetration\n");
     w.write_all(line.as_bytes()).map_err(io)?;
-    let mut rb = ryu::Buffer::new();
+    let mut rb = zmij::Buffer::new();
     for block in rows {
         for row in block.chunks_exact(width) {
             let (t, rest) = row.split_at(1);
