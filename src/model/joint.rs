@@ -3,7 +3,7 @@
 //! joint velocity `S q̇`, and the projection `Sᵀ f` (seed eq. 16).
 
 use crate::dynamics::CompositeInertia;
-use crate::spatial::{axis_angle, quat_to_matrix, Force, Motion, Scalar, Se3};
+use crate::spatial::{axis_angle, quat_to_matrix, sin_cos, Force, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Matrix6, Vector3, Vector6};
 
 /// A joint axis. Axis-aligned axes (most URDF axes are ±x, ±y, ±z) get their own
@@ -53,7 +53,7 @@ impl<T: Scalar> Axis<T> {
     /// The rotation by `q` about this axis.
     #[inline(always)]
     pub fn rotation(&self, q: T) -> Matrix3<T> {
-        let (s, c) = q.sin_cos();
+        let (s, c) = sin_cos(q);
         let (z, o) = (T::zero(), T::one());
         match self {
             Axis::X => Matrix3::new(o, z, z, z, c, -s, z, s, c),
@@ -364,7 +364,7 @@ impl<T: Scalar> Joint<T> {
         match self.kind {
             JointKind::Free => xt.compose(&self.calc(q, None).0),
             JointKind::Revolute(ax) => {
-                let (s, c) = (self.mult * q[self.iq] + self.offset).sin_cos();
+                let (s, c) = sin_cos(self.mult * q[self.iq] + self.offset);
                 Se3::new(ax.rotate_right(&xt.rot, s, c), xt.trans)
             }
             JointKind::Prismatic(ax) => {
@@ -394,7 +394,7 @@ impl<T: Scalar> Joint<T> {
         let Some(ax) = ax else {
             return self.placement_compose(xt, q);
         };
-        let (s, c) = (self.mult * q[self.iq] + self.offset).sin_cos();
+        let (s, c) = sin_cos(self.mult * q[self.iq] + self.offset);
         let (z, o) = (T::zero(), T::one());
         let rot = match ax {
             Axis::X => Matrix3::new(o, z, z, z, c, -s, z, s, c),
@@ -591,7 +591,7 @@ impl<'j, T: Scalar, A: AxisOf<T>, const AXROT: bool> JointModel<T> for RevoluteJ
     }
     #[inline(always)]
     fn placement(&self, xt: &Se3<T>, q: &[T]) -> Se3<T> {
-        let (s, c) = (self.j.mult * q[self.j.iq] + self.j.offset).sin_cos();
+        let (s, c) = sin_cos(self.j.mult * q[self.j.iq] + self.j.offset);
         let ax = self.ax.get();
         if AXROT {
             let (z, o) = (T::zero(), T::one());
