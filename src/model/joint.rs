@@ -556,8 +556,37 @@ pub(crate) trait JointModel<T: Scalar>: Copy {
     /// `Î S` for column `c` of the motion subspace (a column of the 6x6 inertia
     /// for an axis-aligned joint).
     fn mul_subspace(&self, ic: &CompositeInertia<T>, c: usize) -> Force<T>;
+    /// `U = M S` for a 1-DoF joint and a 6x6 angular-first `M` (as [`Joint::mat6_subspace`]).
+    fn mat6_subspace(&self, m: &Matrix6<T>) -> Vector6<T>;
+    /// `Sᵀ x` for a 1-DoF joint and an angular-first 6-vector (as [`Joint::subspace_dot6`]).
+    fn subspace_dot6(&self, x: &Vector6<T>) -> T;
+    /// `m += S x` for a 1-DoF joint and a scalar `x` (`mult` included).
+    fn add_subspace_scaled(&self, m: &mut Motion<T>, x: T);
     /// The underlying joint (for the generic paths).
     fn joint(&self) -> &Joint<T>;
+}
+
+/// [`JointModel::mat6_subspace`] for a 1-DoF joint whose `S` sits in rows `off..off + 3`.
+#[inline(always)]
+fn mat6_col<T: Scalar>(m: &Matrix6<T>, off: usize, ax: Axis<T>, mult: T) -> Vector6<T> {
+    let col: Vector6<T> = match ax {
+        Axis::X => m.column(off).into(),
+        Axis::Y => m.column(off + 1).into(),
+        Axis::Z => m.column(off + 2).into(),
+        Axis::Unit(u) => m.fixed_columns::<3>(off) * u,
+    };
+    col * mult
+}
+/// [`JointModel::subspace_dot6`] for a 1-DoF joint whose `S` sits in rows `off..off + 3`.
+#[inline(always)]
+fn dot6<T: Scalar>(x: &Vector6<T>, off: usize, ax: Axis<T>, mult: T) -> T {
+    let d = match ax {
+        Axis::X => x[off],
+        Axis::Y => x[off + 1],
+        Axis::Z => x[off + 2],
+        Axis::Unit(u) => u.x * x[off] + u.y * x[off + 1] + u.z * x[off + 2],
+    };
+    d * mult
 }
 
 /// A revolute joint about axis `A`; `AXROT`: its placement rotation is the
@@ -641,6 +670,18 @@ impl<'j, T: Scalar, A: AxisOf<T>, const AXROT: bool> JointModel<T> for RevoluteJ
         }
     }
     #[inline(always)]
+    fn mat6_subspace(&self, m: &Matrix6<T>) -> Vector6<T> {
+        mat6_col(m, 0, self.ax.get(), self.j.mult)
+    }
+    #[inline(always)]
+    fn subspace_dot6(&self, x: &Vector6<T>) -> T {
+        dot6(x, 0, self.ax.get(), self.j.mult)
+    }
+    #[inline(always)]
+    fn add_subspace_scaled(&self, m: &mut Motion<T>, x: T) {
+        self.ax.get().add_scaled(&mut m.ang, self.j.mult * x);
+    }
+    #[inline(always)]
     fn joint(&self) -> &Joint<T> {
         self.j
     }
@@ -688,6 +729,18 @@ impl<'j, T: Scalar, A: AxisOf<T>> JointModel<T> for PrismaticJ<'j, T, A> {
                 lin: ax.vector() * (ic.m * self.j.mult),
             },
         }
+    }
+    #[inline(always)]
+    fn mat6_subspace(&self, m: &Matrix6<T>) -> Vector6<T> {
+        mat6_col(m, 3, self.ax.get(), self.j.mult)
+    }
+    #[inline(always)]
+    fn subspace_dot6(&self, x: &Vector6<T>) -> T {
+        dot6(x, 3, self.ax.get(), self.j.mult)
+    }
+    #[inline(always)]
+    fn add_subspace_scaled(&self, m: &mut Motion<T>, x: T) {
+        self.ax.get().add_scaled(&mut m.lin, self.j.mult * x);
     }
     #[inline(always)]
     fn joint(&self) -> &Joint<T> {
@@ -747,6 +800,16 @@ impl<'j, T: Scalar> JointModel<T> for FreeJ<'j, T> {
     fn mul_subspace(&self, ic: &CompositeInertia<T>, c: usize) -> Force<T> {
         ic.mul_motion(&self.j.subspace_column(c))
     }
+    #[inline(always)]
+    fn mat6_subspace(&self, _m: &Matrix6<T>) -> Vector6<T> {
+        Vector6::zeros()
+    }
+    #[inline(always)]
+    fn subspace_dot6(&self, _x: &Vector6<T>) -> T {
+        T::zero()
+    }
+    #[inline(always)]
+    fn add_subspace_scaled(&self, _m: &mut Motion<T>, _x: T) {}
     #[inline(always)]
     fn joint(&self) -> &Joint<T> {
         self.j
