@@ -399,8 +399,8 @@ fn mirror_blocked<T: Scalar>(a: &mut [T], n: usize) {
 /// `crba`) for models without mimic joints: composite inertias moved to the parent
 /// body by body, `F = I^c_i S_i` in body i's frame (a column of I^c_i for an
 /// axis-aligned joint), then, as in Pinocchio, the forces of body i's whole
-/// subtree (its coordinates are contiguous, `k..dof_subtree_end[k]`, structure of
-/// arrays in `data.crba_f`) are projected on `S_i` — one row of H — and carried
+/// subtree (its coordinates are contiguous, `k..dof_subtree_end[k]`; kept in
+/// `data.crba_fc`) are projected on `S_i` — one row of H — and carried
 /// together to the parent frame by ᵖX*ᵢ. Each body's joint kind is matched once
 /// ([`dispatch_joint!`]); with identity placement rotations (most robots' joints)
 /// the moves are rotations about the joint axis ([`CompositeInertia::act_ax`],
@@ -420,14 +420,8 @@ fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     for i in 1..nb {
         ic[i] = CompositeInertia::from_inertia(&inertias[i]);
     }
-    // Subtree forces, structure of arrays: F = (n, f) per coordinate.
-    let fs = data.crba_f.as_mut_slice();
-    let (n0, fs) = fs.split_at_mut(nv);
-    let (n1, fs) = fs.split_at_mut(nv);
-    let (n2, fs) = fs.split_at_mut(nv);
-    let (f0, fs) = fs.split_at_mut(nv);
-    let (f1, f2) = fs.split_at_mut(nv);
-    let f2 = &mut f2[..nv];
+    // Subtree forces F = I^c S per coordinate.
+    let fc = &mut data.crba_fc[..nv];
     // Every entry on the tree pattern is written; the others keep Data::new's zeros.
     let hs = data.h.as_mut_slice();
     let hs = &mut hs[..nv * nv];
@@ -441,19 +435,13 @@ fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
             let end = sub_end[k0];
             // F = I^c_i S_i for the joint's own columns (body i's frame)
             for c in 0..jm.nv() {
-                let f = jm.mul_subspace(&ici, c);
-                let k = k0 + c;
-                (n0[k], n1[k], n2[k]) = (f.ang.x, f.ang.y, f.ang.z);
-                (f0[k], f1[k], f2[k]) = (f.lin.x, f.lin.y, f.lin.z);
+                fc[k0 + c] = jm.mul_subspace(&ici, c);
             }
+            let fsub = &mut fc[k0..end];
             // H[k0 + r, c] = S_rᵀ F_c for every coordinate c of the subtree (seed eq. 16)
-            for c in k0..end {
-                let f = Force::new(
-                    Vector3::new(n0[c], n1[c], n2[c]),
-                    Vector3::new(f0[c], f1[c], f2[c]),
-                );
+            for (c, f) in (k0..end).zip(fsub.iter()) {
                 for r in 0..jm.nv() {
-                    let val = jm.project_column(r, &f);
+                    let val = jm.project_column(r, f);
                     hs[(k0 + r) + c * nv] = val;
                     hs[c + (k0 + r) * nv] = val;
                 }
@@ -461,16 +449,8 @@ fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
             if p != 0 {
                 // The subtree's forces to the parent frame: ᵖX̂ᵢ* F
                 let ax = jm.rot_axis();
-                let (n0, n1, n2) = (&mut n0[k0..end], &mut n1[k0..end], &mut n2[k0..end]);
-                let (f0, f1, f2) = (&mut f0[k0..end], &mut f1[k0..end], &mut f2[k0..end]);
-                for c in 0..end - k0 {
-                    let f = Force::new(
-                        Vector3::new(n0[c], n1[c], n2[c]),
-                        Vector3::new(f0[c], f1[c], f2[c]),
-                    );
-                    let g = act_force_ax(&li, ax, &f);
-                    (n0[c], n1[c], n2[c]) = (g.ang.x, g.ang.y, g.ang.z);
-                    (f0[c], f1[c], f2[c]) = (g.lin.x, g.lin.y, g.lin.z);
+                for f in fsub.iter_mut() {
+                    *f = act_force_ax(&li, ax, f);
                 }
                 // I^c_p += ₚX̂ᵢ* I^c_i ⁱX̂ₚ
                 head[p].add_assign(&ici.act_ax(&li, ax));

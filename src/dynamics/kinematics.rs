@@ -1,24 +1,32 @@
-use crate::model::{Data, Model};
+use crate::model::{dispatch_joint, Data, JointModel, Model};
 use crate::spatial::{Scalar, Se3};
 use nalgebra::DVector;
 
 /// Forward kinematics of every body: `liMi = X_tree,i · X_J(q_i)` and
 /// `oMi = oM_λ(i) · liMi`.
 pub fn forward_kinematics<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
-    for i in 1..model.nbodies {
-        let joint = &model.joints[i];
-        let ax = joint.axis_rotation(model.placement_identity[i]);
-        let li_m_i = joint.placement_compose_ax(&model.placements[i], ax, q);
-        data.li_m_i[i] = li_m_i;
-        let op = &data.o_m_i[model.parent[i]];
-        data.o_m_i[i] = match ax {
-            // oRᵢ = oRₚ R_axis: two columns mixed.
-            Some(ax) => Se3::new(
-                ax.mul_rot(&op.rot, &li_m_i.rot),
-                op.trans + op.rot * li_m_i.trans,
-            ),
-            None => op.compose(&li_m_i),
-        };
+    let nb = model.nbodies;
+    let q = q.as_slice();
+    let joints = &model.joints[..nb];
+    let parent = &model.parent[..nb];
+    let placements = &model.placements[..nb];
+    let ident = &model.placement_identity[..nb];
+    let li_m_i = &mut data.li_m_i[..nb];
+    let o_m_i = &mut data.o_m_i[..nb];
+    for i in 1..nb {
+        let op = o_m_i[parent[i]];
+        // The joint kind matched once per body (dispatch_joint!).
+        let (li, om) = dispatch_joint!(&joints[i], ident[i], jm => {
+            let li = jm.placement(&placements[i], q);
+            let om = match jm.rot_axis() {
+                // oRᵢ = oRₚ R_axis: two columns mixed.
+                Some(ax) => Se3::new(ax.mul_rot(&op.rot, &li.rot), op.trans + op.rot * li.trans),
+                None => op.compose(&li),
+            };
+            (li, om)
+        });
+        li_m_i[i] = li;
+        o_m_i[i] = om;
     }
 }
 

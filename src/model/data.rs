@@ -41,6 +41,9 @@ pub struct Data<T: Scalar = f64> {
     /// CRBA: `F = I^c S` of every velocity coordinate, moved towards the root,
     /// structure of arrays (nv x 6: columns nx, ny, nz, fx, fy, fz).
     pub crba_f: DMatrix<T>,
+    /// CRBA (local frames): `F = I^c S` of every velocity coordinate of the current
+    /// subtree, in the frame it has been carried to.
+    pub crba_fc: Vec<Force<T>>,
     /// ABA: articulated inertia `Iᴬ` of each body (6x6, angular-first, body frame).
     pub aba_ia: Vec<Matrix6<T>>,
     /// ABA: `U = Iᴬ S` of a 1-DoF joint; for a free joint, `τ − pᴬ` as a 6-vector.
@@ -75,6 +78,7 @@ impl<T: Scalar> Data<T> {
             tmp_b: DVector::zeros(nv),
             crba_ic: vec![CompositeInertia::zero(); nb],
             crba_f: DMatrix::zeros(nv, 6),
+            crba_fc: vec![Force::zero(); nv],
             aba_ia: vec![Matrix6::zeros(); nb],
             aba_u: vec![Vector6::zeros(); nb],
             aba_dinv: vec![T::zero(); nb],

@@ -3,7 +3,7 @@
 //! joint velocity `S q̇`, and the projection `Sᵀ f` (seed eq. 16).
 
 use crate::dynamics::CompositeInertia;
-use crate::spatial::{axis_angle, quat_to_matrix, Force, Motion, Scalar, Se3};
+use crate::spatial::{axis_angle, quat_to_matrix, sin_cos, Force, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Matrix6, Vector3, Vector6};
 
 /// A joint axis. Axis-aligned axes (most URDF axes are ±x, ±y, ±z) get their own
@@ -53,7 +53,7 @@ impl<T: Scalar> Axis<T> {
     /// The rotation by `q` about this axis.
     #[inline(always)]
     pub fn rotation(&self, q: T) -> Matrix3<T> {
-        let (s, c) = q.sin_cos();
+        let (s, c) = sin_cos(q);
         let (z, o) = (T::zero(), T::one());
         match self {
             Axis::X => Matrix3::new(o, z, z, z, c, -s, z, s, c),
@@ -364,7 +364,7 @@ impl<T: Scalar> Joint<T> {
         match self.kind {
             JointKind::Free => xt.compose(&self.calc(q, None).0),
             JointKind::Revolute(ax) => {
-                let (s, c) = (self.mult * q[self.iq] + self.offset).sin_cos();
+                let (s, c) = sin_cos(self.mult * q[self.iq] + self.offset);
                 Se3::new(ax.rotate_right(&xt.rot, s, c), xt.trans)
             }
             JointKind::Prismatic(ax) => {
@@ -394,7 +394,7 @@ impl<T: Scalar> Joint<T> {
         let Some(ax) = ax else {
             return self.placement_compose(xt, q);
         };
-        let (s, c) = (self.mult * q[self.iq] + self.offset).sin_cos();
+        let (s, c) = sin_cos(self.mult * q[self.iq] + self.offset);
         let (z, o) = (T::zero(), T::one());
         let rot = match ax {
             Axis::X => Matrix3::new(o, z, z, z, c, -s, z, s, c),
@@ -556,8 +556,37 @@ pub(crate) trait JointModel<T: Scalar>: Copy {
     /// `Î S` for column `c` of the motion subspace (a column of the 6x6 inertia
     /// for an axis-aligned joint).
     fn mul_subspace(&self, ic: &CompositeInertia<T>, c: usize) -> Force<T>;
+    /// `U = M S` for a 1-DoF joint and a 6x6 angular-first `M` (as [`Joint::mat6_subspace`]).
+    fn mat6_subspace(&self, m: &Matrix6<T>) -> Vector6<T>;
+    /// `Sᵀ x` for a 1-DoF joint and an angular-first 6-vector (as [`Joint::subspace_dot6`]).
+    fn subspace_dot6(&self, x: &Vector6<T>) -> T;
+    /// `m += S x` for a 1-DoF joint and a scalar `x` (`mult` included).
+    fn add_subspace_scaled(&self, m: &mut Motion<T>, x: T);
     /// The underlying joint (for the generic paths).
     fn joint(&self) -> &Joint<T>;
+}
+
+/// [`JointModel::mat6_subspace`] for a 1-DoF joint whose `S` sits in rows `off..off + 3`.
+#[inline(always)]
+fn mat6_col<T: Scalar>(m: &Matrix6<T>, off: usize, ax: Axis<T>, mult: T) -> Vector6<T> {
+    let col: Vector6<T> = match ax {
+        Axis::X => m.column(off).into(),
+        Axis::Y => m.column(off + 1).into(),
+        Axis::Z => m.column(off + 2).into(),
+        Axis::Unit(u) => m.fixed_columns::<3>(off) * u,
+    };
+    col * mult
+}
+/// [`JointModel::subspace_dot6`] for a 1-DoF joint whose `S` sits in rows `off..off + 3`.
+#[inline(always)]
+fn dot6<T: Scalar>(x: &Vector6<T>, off: usize, ax: Axis<T>, mult: T) -> T {
+    let d = match ax {
+        Axis::X => x[off],
+        Axis::Y => x[off + 1],
+        Axis::Z => x[off + 2],
+        Axis::Unit(u) => u.x * x[off] + u.y * x[off + 1] + u.z * x[off + 2],
+    };
+    d * mult
 }
 
 /// A revolute joint about axis `A`; `AXROT`: its placement rotation is the
@@ -591,7 +620,7 @@ impl<'j, T: Scalar, A: AxisOf<T>, const AXROT: bool> JointModel<T> for RevoluteJ
     }
     #[inline(always)]
     fn placement(&self, xt: &Se3<T>, q: &[T]) -> Se3<T> {
-        let (s, c) = (self.j.mult * q[self.j.iq] + self.j.offset).sin_cos();
+        let (s, c) = sin_cos(self.j.mult * q[self.j.iq] + self.j.offset);
         let ax = self.ax.get();
         if AXROT {
             let (z, o) = (T::zero(), T::one());
@@ -641,6 +670,18 @@ impl<'j, T: Scalar, A: AxisOf<T>, const AXROT: bool> JointModel<T> for RevoluteJ
         }
     }
     #[inline(always)]
+    fn mat6_subspace(&self, m: &Matrix6<T>) -> Vector6<T> {
+        mat6_col(m, 0, self.ax.get(), self.j.mult)
+    }
+    #[inline(always)]
+    fn subspace_dot6(&self, x: &Vector6<T>) -> T {
+        dot6(x, 0, self.ax.get(), self.j.mult)
+    }
+    #[inline(always)]
+    fn add_subspace_scaled(&self, m: &mut Motion<T>, x: T) {
+        self.ax.get().add_scaled(&mut m.ang, self.j.mult * x);
+    }
+    #[inline(always)]
     fn joint(&self) -> &Joint<T> {
         self.j
     }
@@ -688,6 +729,18 @@ impl<'j, T: Scalar, A: AxisOf<T>> JointModel<T> for PrismaticJ<'j, T, A> {
                 lin: ax.vector() * (ic.m * self.j.mult),
             },
         }
+    }
+    #[inline(always)]
+    fn mat6_subspace(&self, m: &Matrix6<T>) -> Vector6<T> {
+        mat6_col(m, 3, self.ax.get(), self.j.mult)
+    }
+    #[inline(always)]
+    fn subspace_dot6(&self, x: &Vector6<T>) -> T {
+        dot6(x, 3, self.ax.get(), self.j.mult)
+    }
+    #[inline(always)]
+    fn add_subspace_scaled(&self, m: &mut Motion<T>, x: T) {
+        self.ax.get().add_scaled(&mut m.lin, self.j.mult * x);
     }
     #[inline(always)]
     fn joint(&self) -> &Joint<T> {
@@ -747,6 +800,16 @@ impl<'j, T: Scalar> JointModel<T> for FreeJ<'j, T> {
     fn mul_subspace(&self, ic: &CompositeInertia<T>, c: usize) -> Force<T> {
         ic.mul_motion(&self.j.subspace_column(c))
     }
+    #[inline(always)]
+    fn mat6_subspace(&self, _m: &Matrix6<T>) -> Vector6<T> {
+        Vector6::zeros()
+    }
+    #[inline(always)]
+    fn subspace_dot6(&self, _x: &Vector6<T>) -> T {
+        T::zero()
+    }
+    #[inline(always)]
+    fn add_subspace_scaled(&self, _m: &mut Motion<T>, _x: T) {}
     #[inline(always)]
     fn joint(&self) -> &Joint<T> {
         self.j
