@@ -14,12 +14,16 @@ fn setup(tol: Option<f64>) -> Simulation {
     )
     .expect("lamp loads");
     let mut o = SimOptions::default();
+    if let Ok(p) = std::env::var("PKG") {
+        o.package_paths = vec![p.into()];
+    }
     if let Some(t) = tol {
         o.solver_tol = t;
     }
     let mut sim = Simulation::new(model, o).expect("simulation");
     let mut q = sim.q().clone();
-    q[2] = 0.5;
+    let low = sim.lowest_point();
+    q[2] += if std::env::var("LAMP").is_ok() { 0.3 - low } else { 0.5 };
     q[3] = (5f64).to_radians().sin();
     q[6] = (5f64).to_radians().cos();
     let v = sim.v().clone();
