@@ -25,7 +25,7 @@ where
     let tmp = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
     let result = (|| {
         let f = std::fs::File::create(&tmp).map_err(|e| format!("{name}: cannot write: {e}"))?;
-        let mut w = std::io::BufWriter::new(f);
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
         fill(&mut w)?;
         w.flush()
             .map_err(|e| format!("{name}: cannot write: {e}"))?;
