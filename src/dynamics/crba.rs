@@ -372,26 +372,30 @@ fn project<T: Scalar>(f: &Force<T>, w: [&[T]; 3], v: [&[T]; 3], out: &mut [T]) {
 }
 
 /// Copies the strict upper triangle of the column-major n x n matrix `a` onto its
-/// lower triangle, by 32-row blocks (cache-friendly for large n): each source run
-/// is a contiguous piece of a column, each destination a strided piece of a row.
+/// lower triangle, by 16 x 16 tiles (cache- and TLB-friendly for large n: a
+/// 32-row band swept over all columns took 1.6x the time at n = 1000; writing
+/// both triangles as dot products, no copy, took 1.2-1.5x at n = 50-200).
 fn mirror_blocked<T: Scalar>(a: &mut [T], n: usize) {
-    const B: usize = 32;
+    const B: usize = 16;
     let a = &mut a[..n * n];
-    let mut ib = 0;
-    while ib < n {
-        let ie = (ib + B).min(n);
-        // Columns j > ib hold the rows ib..min(ie, j) to copy.
-        for j in ib + 1..n {
-            let hi = ie.min(j);
-            for i in ib..hi {
-                // SAFETY: i < j < n, so both i + j n and j + i n are < n², the
-                // length of `a` (sliced above).
-                unsafe {
-                    *a.get_unchecked_mut(j + i * n) = *a.get_unchecked(i + j * n);
+    let mut jb = 0;
+    while jb < n {
+        let je = (jb + B).min(n);
+        let mut ib = 0;
+        while ib <= jb {
+            let ie = (ib + B).min(n);
+            for j in jb..je {
+                for i in ib..ie.min(j) {
+                    // SAFETY: i < j < n, so both i + j n and j + i n are < n², the
+                    // length of `a` (sliced above).
+                    unsafe {
+                        *a.get_unchecked_mut(j + i * n) = *a.get_unchecked(i + j * n);
+                    }
                 }
             }
+            ib += B;
         }
-        ib += B;
+        jb += B;
     }
 }
 
