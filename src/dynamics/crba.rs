@@ -443,11 +443,19 @@ fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
             }
             let fsub = &mut fc[k0..end];
             // H[k0 + r, c] = S_rᵀ F_c for every coordinate c of the subtree (seed eq. 16)
-            for (c, f) in (k0..end).zip(fsub.iter()) {
-                for r in 0..jm.nv() {
+            // and its mirror H[c, k0 + r].
+            assert!(k0 + jm.nv() <= end && end <= nv, "subtree coordinates out of range");
+            let hp = hs.as_mut_ptr();
+            for r in 0..jm.nv() {
+                let row = k0 + r;
+                for (c, f) in (k0..end).zip(fsub.iter()) {
                     let val = jm.project_column(r, f);
-                    hs[(k0 + r) + c * nv] = val;
-                    hs[c + (k0 + r) * nv] = val;
+                    // SAFETY: row < end <= nv and c < end <= nv (asserted above), so
+                    // both row + c nv and c + row nv are < nv², the length of `hs`.
+                    unsafe {
+                        *hp.add(row + c * nv) = val;
+                        *hp.add(c + row * nv) = val;
+                    }
                 }
             }
             if p != 0 {
