@@ -192,7 +192,7 @@ fn crba_mimic<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     let nb = model.nbodies;
     let joints = &model.joints[..nb];
     let placements = &model.placements[..nb];
-    let inertias = &model.inertias[..nb];
+    let inertias = &model.inertias_origin[..nb];
     let parent = &model.parent[..nb];
     let li_m_i = &mut data.li_m_i[..nb];
     let ic = &mut data.crba_ic[..nb];
@@ -200,7 +200,7 @@ fn crba_mimic<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     for i in 1..nb {
         let ax = joints[i].axis_rotation(ident[i]);
         li_m_i[i] = joints[i].placement_compose_ax(&placements[i], ax, q);
-        ic[i] = CompositeInertia::from_inertia(&inertias[i]);
+        ic[i] = inertias[i];
     }
     // Mimic joints accumulate into H (a joint's terms land on its leader's
     // coordinate), so H starts from zero.
@@ -259,7 +259,7 @@ fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     let q = q.as_slice();
     let joints = &model.joints[..nb];
     let placements = &model.placements[..nb];
-    let inertias = &model.inertias[..nb];
+    let inertias = &model.inertias_origin[..nb];
     let parent = &model.parent[..nb];
     let ident = &model.placement_identity[..nb];
     let lambda = &model.dof_parent[..nv];
@@ -294,7 +294,7 @@ fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
         });
         li_m_i[i] = li;
         o_m_i[i] = om;
-        ic[i] = CompositeInertia::from_inertia(&inertias[i]);
+        ic[i] = inertias[i];
     }
     let hs = data.h.as_mut_slice();
     // (Short chains take the λ walk: the vector sweep's set-up costs more there.)
@@ -415,15 +415,13 @@ fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     let q = q.as_slice();
     let joints = &model.joints[..nb];
     let placements = &model.placements[..nb];
-    let inertias = &model.inertias[..nb];
+    let inertias = &model.inertias_origin[..nb];
     let parent = &model.parent[..nb];
     let ident = &model.placement_identity[..nb];
     let sub_end = &model.topology.dof_subtree_end[..nv];
     let li_m_i = &mut data.li_m_i[..nb];
     let ic = &mut data.crba_ic[..nb];
-    for i in 1..nb {
-        ic[i] = CompositeInertia::from_inertia(&inertias[i]);
-    }
+    ic.copy_from_slice(inertias);
     // Subtree forces F = I^c S per coordinate.
     let fc = &mut data.crba_fc[..nv];
     // Every entry on the tree pattern is written; the others keep Data::new's zeros.
