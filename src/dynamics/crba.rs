@@ -444,9 +444,10 @@ fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
             // and its mirror H[c, k0 + r].
             assert!(k0 + jm.nv() <= end && end <= nv, "subtree coordinates out of range");
             let hp = hs.as_mut_ptr();
-            for r in 0..jm.nv() {
-                let row = k0 + r;
-                for (c, f) in (k0..end).zip(fsub.iter()) {
+            for (dc, f) in fsub.iter().enumerate() {
+                let c = k0 + dc;
+                for r in 0..jm.nv() {
+                    let row = k0 + r;
                     let val = jm.project_column(r, f);
                     // SAFETY: row < end <= nv and c < end <= nv (asserted above), so
                     // both row + c nv and c + row nv are < nv², the length of `hs`.
