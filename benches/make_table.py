@@ -128,42 +128,83 @@ if "generic" in runs:
               "`fd` = ABA unless the cost model says CRBA + RNEA bias + LTDL is cheaper; with mimic joints "
               "always CRBA + Gᵀ H G + dense Cholesky. Measured urdyn fd-crba / aba (generic):", "",
               "| robot | aba ns | fd-crba ns | fd-crba / aba |", "|---|---|---|---|"]
+    below = []
     for key in ORDER:
         r = runs["generic"].get(key, {}).get("urdyn", {}).get("results", {})
         if "aba" in r and "fd-crba" in r:
             a, c = r["aba"]["median_ns"], r["fd-crba"]["median_ns"]
             lines.append(f"| {key} | {fmt(a)} | {fmt(c)} | {c / a:.2f} |")
-    lines += ["", "CRBA + LTDL costs a bias RNEA plus the CRBA sweep before its factorisation, more than "
-              "ABA's whole O(n) pass on every robot and tree timed (ratios 1.1–2.8 here and in earlier "
-              "runs; a ratio below 1 on a 5-DoF chain did not reproduce across runs on this noisy shared "
-              "machine), so the fitted rule picks ABA for every non-mimic model.", ""]
+            if c < a:
+                below.append(f"{key} {c / a:.2f}")
+    lines += ["", "The rule's coefficients (ABA ≈ 200 ns a body, CRBA + RNEA + LTDL ≈ 230 ns a body "
+              "+ Σdepth and Σdepth² terms) were fitted before the hot-path work of this round, which "
+              "cut the CRBA (23–41% in instructions) and RNEA (30–34%) more than ABA (6–16%), so they "
+              "pick ABA for every non-mimic model; fd-crba ran faster than ABA in this run on: "
+              + (", ".join(below) if below else "none") + ". Re-fitting the rule on quiet-machine "
+              "timings is open work.", ""]
 lines += ["## Where a bar is missed, and why (callgrind, `examples/profile.rs`)", "",
-          "Instructions per call (callgrind, difference of 3000- and 1000-call runs), before → after "
-          "the identity-placement flag (`Model::placement_identity`, set at load: a revolute joint whose "
-          "placement rotation is the identity applies its rotation with 4 products a vector in RNEA, fk "
-          "and CRBA) and the per-model local-frame CRBA (`Topology::crba_local`: branching trees and "
-          "chains ≤ 8 DoF; the world-frame CRBA stays on longer chains): "
-          "ur5 rnea 5359 → 5422, crba 5791 → 5412; solo12 rnea 11736 → 11702, crba 15933 → 11788; "
-          "talos rnea 28935 → 28679, crba 41184 → 37957. Movable joints whose URDF origin has zero rpy: 4/6 on ur5, 0/6 on "
-          "kinova, 12/12 on solo12 and anymal, 32/32 on talos.",
+          "Instructions per call (callgrind on `examples/profile.rs`, generic build, difference of "
+          "600- and 200-call runs), before → after this round of work on the hot paths: each body's "
+          "joint kind is matched once per sweep (`dispatch_joint!` in src/model/joint.rs) and the "
+          "body step is compiled per joint model (compile-time axis and transform shape: no `match` "
+          "in the helpers, arrays sliced once so bounds checks vanish); joint angles' sin/cos by "
+          "`libm::sincos` (msun kernels, < 1 ulp, ~35 instructions fewer than the system libm); "
+          "the local-frame CRBA carries each subtree's forces to the parent together (as Pinocchio) "
+          "and starts from origin-form inertias computed at load (`Model::inertias_origin`); the "
+          "world-frame CRBA (chains ≥ 16 DoF) keeps composite inertias in body frames.",
           "",
-          "- **crba**: the local-frame CRBA cut solo12 by 26% and talos by 8% in instructions; what remains "
-          "per body is the libm `sincos` (~110 instructions a joint, 8% of solo12's call), the composite "
-          "inertia move (R I Rᵀ with parallel-axis terms) and per-joint-kind `match`es on every helper call; "
-          "Pinocchio's fixed-size Eigen kernels vectorise the 3x3 work, which gains more in the native "
-          "build (AVX). Kinova's placements all carry rotations, so nothing there got cheaper.",
-          "- **rnea**: the flag saves multiplies but barely any instructions (solo12 −0.3%, talos −0.9%): "
-          "callgrind puts ~14% of solo12's RNEA in `joint.rs` — the joint-kind/axis `match` repeated in "
-          "each helper (placement, two inverse transforms, velocity, acceleration, projection, force "
-          "transform) — and ~6% in slice bounds checks, more than the arithmetic the flag removed. Next "
-          "lever: match the joint kind once per body and run a monomorphised body step per kind. Ratios "
-          "move by ±0.1 between runs on this shared 2-core machine (load above).",
-          "- **Noise**: the same build run twice minutes apart (01:25, load ~6.5, and this run) gave "
-          "crba ratios of 1.41 → 0.92 (chain_10 generic), 1.56 → 0.97 (chain_200 generic), 0.74 → 1.48 "
-          "(tree_4 generic), 1.59 → 0.93 (chain_100 native), 1.12 → 0.97 (kinova native): single ✗ marks "
-          "on crba that do not repeat across runs are load, not code (callgrind counts are the "
-          "deciding measure). The robots' crba ratios were 0.70–0.92 in both runs except kinova native "
-          "(1.12 in the first) and ur5 generic (1.07 here).",
+          "| robot | rnea | crba | aba | fk (+frames) |",
+          "|---|---|---|---|---|",
+          "| ur5 | 5422 → 3797 | 5407 → 3729 | 10927 → 9652 | 2908 → 2624 |",
+          "| kinova | 5632 → 4118 | 5886 → 4349 | 10930 → 10317 | – → 3121 |",
+          "| solo12 | 11702 → 7753 | 11779 → 7143 | 25175 → 21175 | – → 4825 |",
+          "| talos_reduced | 28679 → 19028 | 37948 → 22253 | – → 53640 | – → 13754 |",
+          "| chain_5 | 4447 → 3008 | 3920 → 2615 | – → 7491 | – → 1730 |",
+          "| chain_10 | 8734 → 5892 | 10052 → 6450 | – → 15626 | – → 3298 |",
+          "| chain_50 | 43266 → 29006 | 74953 → 58072 | 97187 → 81185 | 18529 → 15920 |",
+          "| chain_500 | 431408 → 292939 | 3451077 → 2439766 | – → 818447 | – → 158136 |",
+          "| tree_4 | 13070 → 8840 | 12061 → 8019 | 28509 → 23863 | – → 4875 |",
+          "| tree_6 | 54509 → 36779 | 62635 → 39552 | – → 102770 | – → 20037 |",
+          "",
+          "(aba and fk \"before\" were measured after the sincos change, so they show the dispatch "
+          "and ABA's axis-rotation inertia move alone.)",
+          "",
+          "- **crba**: what remains per body is the composite-inertia move (R I Rᵀ with the "
+          "parallel-axis terms; a general rotation on kinova, whose placements all carry rpy), the "
+          "subtree force transports and sincos. On long chains the world-frame column sweep "
+          "(vectorised 6-term dot products) and the transposed copy into the lower triangle are "
+          "O(n²): a copy by 16 x 16 tiles is kept because a 32-row band, with fewer instructions, took "
+          "1.6x the time at n = 1000, and writing both triangles as dot products (no copy) took "
+          "1.2–1.5x at n = 50–200. Pinocchio fills one triangle only. Pinocchio gains more from "
+          "`-march=native` than urdyn does (AVX for Eigen's fixed-size kernels, and fused "
+          "multiply-adds wherever g++ contracts; rustc never fuses a·b + c without an explicit "
+          "`mul_add`), which shows on floating-base CRBA (solo12, anymal, talos). Next levers: "
+          "`mul_add` under `cfg(target_feature = \"fma\")` in the spatial kernels, a symmetric "
+          "2-D rotation for `act_ax` (18 products instead of 24).",
+          "- **rnea**: 30–34% fewer instructions on every model; per body what is left is the "
+          "arithmetic of seed eqs. 13–15 (two inverse transforms, two inertia products, one dual "
+          "cross product, one force transform) plus sincos.",
+          "- **The ✗ of the run recorded here (03:25 UTC)**: *crba on long chains* (chain_100 "
+          "generic 1.31 and native 1.22, chain_500 native 1.88, chain_1000 native 1.08): the O(n²) "
+          "column sweep and triangle copy are memory-bound and their medians swing with load — "
+          "the same world-frame code (bar its triangle copy) gave chain_100 17,111 ns (generic) 16 "
+          "minutes earlier, and this build's chain_500 "
+          "alternated 437k and 637k ns between back-to-back `urdyn bench` runs, while the previous "
+          "build (fa2a4a8), timed interleaved with this one, took 31–34k ns on chain_100 and "
+          "374–567k ns on chain_500; Pinocchio's chain_500 native median was 263,896 ns here "
+          "against 404,837 and 426,619 in the two earlier runs. *rnea on kinova (generic 0.69)*: "
+          "Pinocchio's kinova rnea was 941 ns in both of this round's runs against 1,323 at 01:32; "
+          "kinova's placements all carry rotations, so each of its transforms is a general one "
+          "(as in Pinocchio) and the identity-placement path does not apply. *fd on kinova "
+          "(generic 1.18)*: urdyn's fd is ABA there (the rule above); Pinocchio's fd-crba, 1,588 "
+          "ns, is faster than its own ABA on this robot. *rnea on chain_100 generic, chain_500 "
+          "and chain_1000 native (0.63–0.64)*: the same RNEA code's ratios on these chains were "
+          "0.29–0.49 in the earlier run of this round.",
+          "- **Noise**: this machine has 2 cores shared with other jobs (load above). Pinocchio's own "
+          "medians moved by up to 2x between runs an hour apart (solo12 crba 2,416 → 1,207 ns "
+          "generic; talos crba 5,605 → 3,368 ns native) and urdyn's likewise (ur5 crba 354 and "
+          "703 ns in two runs a minute apart): a single ✗ that does not repeat across runs is load, "
+          "not code. Callgrind counts above are the deciding measure.",
           ""]
 with open(out_md, "w") as fh:
     fh.write("\n".join(lines) + "\n")

@@ -790,15 +790,34 @@ impl<'j, T: Scalar> JointModel<T> for FreeJ<'j, T> {
     }
     #[inline(always)]
     fn project_column(&self, c: usize, f: &Force<T>) -> T {
-        self.j.project_column(c, f)
+        // S = 1 up to the order: linear coordinates first.
+        if c < 3 {
+            f.lin[c]
+        } else {
+            f.ang[c - 3]
+        }
     }
     #[inline(always)]
     fn subspace_in(&self, c: usize, m: &Se3<T>) -> Motion<T> {
-        m.act_motion(&self.j.subspace_column(c))
+        if c < 3 {
+            Motion::new(Vector3::zeros(), m.rot.column(c).into())
+        } else {
+            let w: Vector3<T> = m.rot.column(c - 3).into();
+            Motion::new(w, m.trans.cross(&w))
+        }
     }
     #[inline(always)]
     fn mul_subspace(&self, ic: &CompositeInertia<T>, c: usize) -> Force<T> {
-        ic.mul_motion(&self.j.subspace_column(c))
+        // A column of the 6x6 inertia [I_o, h*; h*ᵀ, m 1] (linear coordinates first).
+        if c < 3 {
+            let ax = [Axis::X, Axis::Y, Axis::Z][c];
+            let mut lin = Vector3::zeros();
+            lin[c] = ic.m;
+            Force::new(ax.cross_from(&ic.h), lin)
+        } else {
+            let ax = [Axis::X, Axis::Y, Axis::Z][c - 3];
+            Force::new(ic.io.column(c - 3).into(), -ax.cross_from(&ic.h))
+        }
     }
     #[inline(always)]
     fn mat6_subspace(&self, _m: &Matrix6<T>) -> Vector6<T> {

@@ -114,6 +114,10 @@ pub struct Model<T: Scalar = f64> {
     pub placement_identity: Vec<bool>,
     /// Spatial inertia of each body in its own frame (links merged).
     pub inertias: Vec<Inertia<T>>,
+    /// The same inertias in origin form (mass, first moment, rotational inertia
+    /// about the frame origin; [`crate::dynamics::CompositeInertia::from_inertia`]),
+    /// computed at load: the CRBA's starting composite inertias.
+    pub inertias_origin: Vec<crate::dynamics::CompositeInertia<T>>,
     /// URDF joint name of each body (entry 0: "universe").
     pub body_joint_names: Vec<String>,
     /// URDF link name of each body (its movable joint's child link).
@@ -228,6 +232,15 @@ impl Model<f64> {
                 .inertias
                 .iter()
                 .map(|i| Inertia::new(c(i.mass), cv(&i.com), i.inertia_c.map(c)))
+                .collect(),
+            inertias_origin: self
+                .inertias_origin
+                .iter()
+                .map(|i| crate::dynamics::CompositeInertia {
+                    m: c(i.m),
+                    h: cv(&i.h),
+                    io: i.io.map(c),
+                })
                 .collect(),
             body_joint_names: self.body_joint_names.clone(),
             body_link_names: self.body_link_names.clone(),

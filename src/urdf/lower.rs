@@ -374,6 +374,10 @@ pub(crate) fn lower(
             .map(|p| p.rot == nalgebra::Matrix3::identity())
             .collect(),
         placements,
+        inertias_origin: inertias
+            .iter()
+            .map(crate::dynamics::CompositeInertia::from_inertia)
+            .collect(),
         inertias,
         body_joint_names,
         body_link_names,
