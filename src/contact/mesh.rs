@@ -3,11 +3,22 @@
 //!
 //! - STL (ASCII or binary) through `stl_io`;
 //! - Wavefront OBJ through `tobj` (every object's `v` positions);
-//! - COLLADA (`.dae`) through a minimal reader: the `<float_array>` of every
-//!   `<source>` that a `<vertices><input semantic="POSITION">` names, scaled by
-//!   `<asset><unit meter>`. Node transforms of the scene graph are not applied
-//!   (URDF exporters write mesh data in the link frame; a DAE that relies on node
-//!   transforms gets a hull in the mesh's own frame).
+//! - COLLADA (`.dae`) through a minimal reader. The vertices are the
+//!   `<float_array>` of the `<source>` that a geometry's
+//!   `<vertices><input semantic="POSITION">` names (the whole array, whether
+//!   or not primitives index all of it), placed by the scene graph: the visual
+//!   scene `<scene><instance_visual_scene url>` names (else the first one) is
+//!   walked, each `<node>`'s transform elements (`<matrix>`, row-major;
+//!   `<translate>`; `<rotate>`, axis and angle in degrees; `<scale>`) are
+//!   multiplied in document order onto its parent's transform, and every
+//!   `<instance_geometry>` (and `<instance_node>` of a node in the file) emits
+//!   its geometry's positions in that transform — a geometry placed twice
+//!   appears twice. The result is scaled by the document's `<asset><unit meter>`.
+//!   `<up_axis>` is ignored, as ROS tools do (so does coal's loader, which
+//!   Pinocchio uses). A `<skew>` or
+//!   `<lookat>` above a placed geometry is an error; `<instance_controller>`
+//!   (skinned meshes) places nothing. A document whose scene places no geometry
+//!   (or that has no scene) gives every POSITION array, untransformed.
 
 use nalgebra::Vector3;
 use std::path::Path;
@@ -83,6 +94,121 @@ pub fn load_vertices(path: &Path, scale: [f64; 3]) -> Result<Vec<Vector3<f64>>, 
     Ok(out)
 }
 
+/// A 4×4 affine transform acting on column vectors (COLLADA's convention).
+type Mat4 = nalgebra::Matrix4<f64>;
+
+/// Most node visits the scene walk makes (`<instance_node>` can form cycles or
+/// blow up exponentially).
+const MAX_DAE_NODE_VISITS: usize = 1_000_000;
+/// Most vertices the scene walk emits (one geometry can be instanced many times).
+const MAX_DAE_VERTICES: usize = 5_000_000;
+
+/// A `<node>` of a visual scene or of `<library_nodes>`.
+struct DaeNode {
+    /// `id`, else `name`, for messages.
+    label: String,
+    /// Product of the node's transform elements, in document order.
+    local: Mat4,
+    /// A transform element that is not applied (`skew`, `lookat`).
+    unsupported: Option<&'static str>,
+    /// `<instance_geometry url>`s.
+    geometries: Vec<String>,
+    /// `<instance_node url>`s.
+    instances: Vec<String>,
+    children: Vec<usize>,
+}
+
+struct DaeVisualScene {
+    id: Option<String>,
+    roots: Vec<usize>,
+}
+
+/// What the text being collected belongs to.
+enum DaeText {
+    /// A `<float_array id>`.
+    Array(String),
+    /// A transform element (`matrix`, `translate`, `rotate`, `scale`) of a node.
+    Transform(&'static str, usize),
+}
+
+/// At most 120 characters of `s`, for messages.
+fn dae_snippet(s: &str) -> String {
+    let mut out: String = s.chars().take(120).collect();
+    if out.len() < s.len() {
+        out.push('…');
+    }
+    out
+}
+
+/// The numbers of a whitespace-separated list; `what` names it in errors.
+fn dae_numbers(text: &str, what: &str) -> Result<Vec<f64>, String> {
+    text.split_whitespace()
+        .map(|s| {
+            s.parse::<f64>()
+                .map_err(|_| format!("{what}: \"{}\" is not a number", dae_snippet(s)))
+        })
+        .collect()
+}
+
+/// The id a local reference `#id` names.
+fn dae_local_ref<'a>(url: &'a str, element: &str) -> Result<&'a str, String> {
+    url.strip_prefix('#').ok_or_else(|| {
+        format!(
+            "<{element} url=\"{}\">: only references inside the file (\"#id\") are read",
+            dae_snippet(url)
+        )
+    })
+}
+
+/// The matrix of a node transform element (`kind` is its name) from its text.
+fn dae_transform(kind: &'static str, text: &str, node: &str) -> Result<Mat4, String> {
+    let what = format!("node \"{}\": <{kind}>", dae_snippet(node));
+    let v = dae_numbers(text, &what)?;
+    let expected = match kind {
+        "matrix" => 16,
+        "rotate" => 4,
+        _ => 3,
+    };
+    if v.len() != expected {
+        return Err(format!(
+            "{what} has {} numbers, expected {expected}",
+            v.len()
+        ));
+    }
+    if !v.iter().all(|x| x.is_finite()) {
+        return Err(format!("{what} has a non-finite number"));
+    }
+    let m = match (kind, v.as_slice()) {
+        ("matrix", _) => {
+            let m = Mat4::from_row_slice(&v);
+            let bottom = [m[(3, 0)], m[(3, 1)], m[(3, 2)], m[(3, 3)] - 1.0];
+            if bottom.iter().any(|x| x.abs() > 1e-9) {
+                return Err(format!(
+                    "{what}: the last row is not 0 0 0 1 (projective transforms are not read)"
+                ));
+            }
+            let mut m = m;
+            m.set_row(3, &nalgebra::RowVector4::new(0.0, 0.0, 0.0, 1.0));
+            m
+        }
+        ("translate", &[x, y, z]) => Mat4::new_translation(&Vector3::new(x, y, z)),
+        ("scale", &[x, y, z]) => Mat4::new_nonuniform_scaling(&Vector3::new(x, y, z)),
+        ("rotate", &[x, y, z, degrees]) => {
+            match nalgebra::Unit::try_new(Vector3::new(x, y, z), 0.0) {
+                Some(axis) => nalgebra::Rotation3::from_axis_angle(&axis, degrees.to_radians())
+                    .to_homogeneous(),
+                None if degrees == 0.0 => Mat4::identity(),
+                None => return Err(format!("{what} has a zero axis")),
+            }
+        }
+        _ => return Err(format!("{what} is not a transform this reader knows")),
+    };
+    if !m.iter().all(|x| x.is_finite()) {
+        return Err(format!("{what} has a non-finite number"));
+    }
+    Ok(m)
+}
+
 /// Positions of a COLLADA document (see the module doc).
 fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
     use quick_xml::events::Event;
@@ -91,82 +217,364 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
     let mut arrays: HashMap<String, Vec<f64>> = HashMap::new();
     // source id -> float_array id
     let mut source_array: HashMap<String, String> = HashMap::new();
+    // Every POSITION source, in document order (the fallback without a scene).
     let mut position_sources: Vec<String> = Vec::new();
+    // geometry id -> its POSITION sources (none for a geometry without them)
+    let mut geometry_positions: HashMap<String, Vec<String>> = HashMap::new();
+    let mut nodes: Vec<DaeNode> = Vec::new();
+    let mut node_ids: HashMap<String, usize> = HashMap::new();
+    let mut scenes: Vec<DaeVisualScene> = Vec::new();
+    let mut scene_url: Option<String> = None;
+    // Local names of the open elements.
+    let mut open: Vec<Vec<u8>> = Vec::new();
+    // The open `<node>`s.
+    let mut node_stack: Vec<usize> = Vec::new();
     let mut current_source: Option<String> = None;
-    let mut current_array: Option<String> = None;
+    let mut current_geometry: Option<String> = None;
+    let mut current_scene: Option<usize> = None;
+    let mut collecting: Option<DaeText> = None;
+    let mut buf = String::new();
     let mut in_vertices = false;
     let mut unit = 1.0;
+    // Ends the text being collected, `collecting`, into its array or node.
+    let finish = |collecting: DaeText,
+                  buf: &str,
+                  arrays: &mut HashMap<String, Vec<f64>>,
+                  nodes: &mut Vec<DaeNode>|
+     -> Result<(), String> {
+        match collecting {
+            DaeText::Array(id) => {
+                let vals: Result<Vec<f64>, _> =
+                    buf.split_whitespace().map(str::parse::<f64>).collect();
+                let vals = vals.map_err(|_| {
+                    format!("float_array \"{}\": not a number list", dae_snippet(&id))
+                })?;
+                arrays.entry(id).or_default().extend(vals);
+            }
+            DaeText::Transform(kind, i) => {
+                if let Some(node) = nodes.get_mut(i) {
+                    let m = dae_transform(kind, buf, &node.label)?;
+                    node.local *= m;
+                }
+            }
+        }
+        Ok(())
+    };
     loop {
         let ev = reader
             .read_event()
             .map_err(|e| format!("not a valid COLLADA (XML) file: {e}"))?;
         match ev {
             Event::Start(ref e) | Event::Empty(ref e) => {
+                let is_start = matches!(ev, Event::Start(_));
                 let name = e.local_name();
+                let parent = open.last().map(Vec::as_slice);
                 let attr = |key: &[u8]| -> Option<String> {
                     e.attributes()
                         .flatten()
                         .find(|a| a.key.local_name().as_ref() == key)
                         .map(|a| String::from_utf8_lossy(&a.value).into_owned())
                 };
+                let in_node = parent == Some(b"node".as_slice());
+                let top_node = node_stack.last().copied();
                 match name.as_ref() {
-                    b"source" => current_source = attr(b"id"),
+                    b"source" if is_start => current_source = attr(b"id"),
                     b"float_array" => {
                         if let Some(id) = attr(b"id") {
                             if let Some(s) = &current_source {
                                 source_array.insert(s.clone(), id.clone());
                             }
-                            if matches!(ev, Event::Start(_)) {
-                                current_array = Some(id);
+                            if is_start {
+                                buf.clear();
+                                collecting = Some(DaeText::Array(id));
+                            } else {
+                                // `<float_array count="0"/>`: an empty array.
+                                arrays.entry(id).or_default();
                             }
                         }
                     }
-                    b"vertices" => in_vertices = matches!(ev, Event::Start(_)),
-                    b"input" if in_vertices => {
-                        if attr(b"semantic").as_deref() == Some("POSITION") {
-                            if let Some(s) = attr(b"source") {
-                                position_sources.push(s.trim_start_matches('#').to_string());
+                    b"geometry" if is_start => {
+                        current_geometry = attr(b"id");
+                        if let Some(g) = &current_geometry {
+                            geometry_positions.entry(g.clone()).or_default();
+                        }
+                    }
+                    b"vertices" => in_vertices = is_start,
+                    b"input" if in_vertices && attr(b"semantic").as_deref() == Some("POSITION") => {
+                        if let Some(s) = attr(b"source") {
+                            let s = s.trim_start_matches('#').to_string();
+                            if let Some(g) = &current_geometry {
+                                geometry_positions
+                                    .entry(g.clone())
+                                    .or_default()
+                                    .push(s.clone());
+                            }
+                            position_sources.push(s);
+                        }
+                    }
+                    // The document's `<COLLADA><asset><unit>` only.
+                    b"unit" if open.len() == 2 && parent == Some(b"asset".as_slice()) => {
+                        if let Some(m) = attr(b"meter") {
+                            match m.trim().parse::<f64>() {
+                                Ok(m) if m.is_finite() && m > 0.0 => unit = m,
+                                _ => {
+                                    return Err(format!(
+                                        "<unit meter=\"{}\">: not a positive number",
+                                        dae_snippet(&m)
+                                    ))
+                                }
                             }
                         }
                     }
-                    b"unit" => {
-                        if let Some(m) = attr(b"meter").and_then(|m| m.trim().parse::<f64>().ok()) {
-                            if m.is_finite() && m > 0.0 {
-                                unit = m;
+                    b"visual_scene" => {
+                        scenes.push(DaeVisualScene {
+                            id: attr(b"id"),
+                            roots: Vec::new(),
+                        });
+                        current_scene = is_start.then(|| scenes.len() - 1);
+                    }
+                    b"instance_visual_scene" if parent == Some(b"scene".as_slice()) => {
+                        scene_url = Some(attr(b"url").ok_or("<instance_visual_scene> has no url")?);
+                    }
+                    b"node" => {
+                        let id = attr(b"id");
+                        let label = id
+                            .clone()
+                            .or_else(|| attr(b"name"))
+                            .unwrap_or_else(|| "(unnamed)".to_string());
+                        let i = nodes.len();
+                        nodes.push(DaeNode {
+                            label,
+                            local: Mat4::identity(),
+                            unsupported: None,
+                            geometries: Vec::new(),
+                            instances: Vec::new(),
+                            children: Vec::new(),
+                        });
+                        if let Some(id) = id {
+                            node_ids.entry(id).or_insert(i);
+                        }
+                        match (parent, top_node, current_scene) {
+                            (Some(b"node"), Some(p), _) => {
+                                if let Some(p) = nodes.get_mut(p) {
+                                    p.children.push(i);
+                                }
+                            }
+                            (Some(b"visual_scene"), _, Some(s)) => {
+                                if let Some(s) = scenes.get_mut(s) {
+                                    s.roots.push(i);
+                                }
+                            }
+                            _ => {}
+                        }
+                        if is_start {
+                            node_stack.push(i);
+                        }
+                    }
+                    kind @ (b"matrix" | b"translate" | b"rotate" | b"scale") if in_node => {
+                        if let Some(i) = top_node {
+                            let kind = match kind {
+                                b"matrix" => "matrix",
+                                b"translate" => "translate",
+                                b"rotate" => "rotate",
+                                _ => "scale",
+                            };
+                            let collect = DaeText::Transform(kind, i);
+                            if is_start {
+                                buf.clear();
+                                collecting = Some(collect);
+                            } else {
+                                finish(collect, "", &mut arrays, &mut nodes)?;
+                            }
+                        }
+                    }
+                    kind @ (b"skew" | b"lookat") if in_node => {
+                        if let Some(node) = top_node.and_then(|i| nodes.get_mut(i)) {
+                            node.unsupported.get_or_insert(if kind == b"skew" {
+                                "skew"
+                            } else {
+                                "lookat"
+                            });
+                        }
+                    }
+                    kind @ (b"instance_geometry" | b"instance_node") if in_node => {
+                        if let Some(node) = top_node.and_then(|i| nodes.get_mut(i)) {
+                            let geometry = kind == b"instance_geometry";
+                            let Some(url) = attr(b"url") else {
+                                return Err(format!(
+                                    "node \"{}\": <{}> has no url",
+                                    dae_snippet(&node.label),
+                                    if geometry {
+                                        "instance_geometry"
+                                    } else {
+                                        "instance_node"
+                                    }
+                                ));
+                            };
+                            if geometry {
+                                node.geometries.push(url);
+                            } else {
+                                node.instances.push(url);
                             }
                         }
                     }
                     _ => {}
                 }
-            }
-            Event::Text(t) => {
-                if let Some(id) = &current_array {
-                    let s = String::from_utf8_lossy(t.as_ref()).into_owned();
-                    let vals: Result<Vec<f64>, _> =
-                        s.split_whitespace().map(str::parse::<f64>).collect();
-                    let vals =
-                        vals.map_err(|_| format!("float_array \"{id}\": not a number list"))?;
-                    arrays.entry(id.clone()).or_default().extend(vals);
+                if is_start {
+                    open.push(name.as_ref().to_vec());
                 }
             }
-            Event::End(ref e) => match e.local_name().as_ref() {
-                b"float_array" => current_array = None,
-                b"source" => current_source = None,
-                b"vertices" => in_vertices = false,
-                _ => {}
-            },
+            Event::Text(ref t) if collecting.is_some() => {
+                buf.push_str(&String::from_utf8_lossy(t.as_ref()));
+            }
+            Event::CData(ref t) if collecting.is_some() => {
+                buf.push_str(&String::from_utf8_lossy(t.as_ref()));
+            }
+            Event::GeneralRef(ref r) if collecting.is_some() => {
+                // `&#32;` and the like; a named entity has no place in numbers.
+                match r.resolve_char_ref() {
+                    Ok(Some(c)) => buf.push(c),
+                    _ => {
+                        let name = String::from_utf8_lossy(r.as_ref()).into_owned();
+                        let element = match &collecting {
+                            Some(DaeText::Array(id)) => {
+                                format!("float_array \"{}\"", dae_snippet(id))
+                            }
+                            Some(DaeText::Transform(kind, _)) => format!("<{kind}>"),
+                            None => String::new(),
+                        };
+                        return Err(format!(
+                            "{element}: the entity reference &{}; in a number list",
+                            dae_snippet(&name)
+                        ));
+                    }
+                }
+            }
+            Event::End(ref e) => {
+                open.pop();
+                match e.local_name().as_ref() {
+                    b"float_array" | b"matrix" | b"translate" | b"rotate" | b"scale" => {
+                        if let Some(c) = collecting.take() {
+                            finish(c, &buf, &mut arrays, &mut nodes)?;
+                            buf.clear();
+                        }
+                    }
+                    b"source" => current_source = None,
+                    b"geometry" => current_geometry = None,
+                    b"vertices" => in_vertices = false,
+                    b"visual_scene" => current_scene = None,
+                    b"node" => {
+                        node_stack.pop();
+                    }
+                    _ => {}
+                }
+            }
             Event::Eof => break,
             _ => {}
         }
     }
+    let positions_of = |s: &str| -> Result<&Vec<f64>, String> {
+        source_array
+            .get(s)
+            .and_then(|a| arrays.get(a))
+            .ok_or_else(|| format!("POSITION source \"{}\" has no float_array", dae_snippet(s)))
+    };
+
+    // The scene `<scene><instance_visual_scene>` names, else the first one.
+    let scene = match &scene_url {
+        Some(url) => {
+            let id = dae_local_ref(url, "instance_visual_scene")?;
+            let found = scenes.iter().find(|s| s.id.as_deref() == Some(id));
+            Some(found.ok_or_else(|| {
+                format!(
+                    "<instance_visual_scene url=\"{}\"> names no visual_scene",
+                    dae_snippet(url)
+                )
+            })?)
+        }
+        None => scenes.first(),
+    };
+    if let Some(scene) = scene {
+        let mut out = Vec::new();
+        let mut instanced = false;
+        // (node, parent's world transform, the node that has an unsupported transform)
+        let mut stack: Vec<(usize, Mat4, Option<usize>)> = scene
+            .roots
+            .iter()
+            .rev()
+            .map(|&r| (r, Mat4::identity(), None))
+            .collect();
+        let mut visits = 0usize;
+        while let Some((i, parent_world, unsupported)) = stack.pop() {
+            visits += 1;
+            if visits > MAX_DAE_NODE_VISITS {
+                return Err(format!(
+                    "the visual scene visits more than {MAX_DAE_NODE_VISITS} nodes \
+                     (an <instance_node> cycle?)"
+                ));
+            }
+            let Some(node) = nodes.get(i) else { continue };
+            let world = parent_world * node.local;
+            let unsupported = if node.unsupported.is_some() {
+                Some(i)
+            } else {
+                unsupported
+            };
+            for url in &node.geometries {
+                instanced = true;
+                if let Some(u) = unsupported.and_then(|u| nodes.get(u)) {
+                    return Err(format!(
+                        "node \"{}\": <{}> is not read, and the node places <instance_geometry url=\"{}\">",
+                        dae_snippet(&u.label),
+                        u.unsupported.unwrap_or("?"),
+                        dae_snippet(url)
+                    ));
+                }
+                let id = dae_local_ref(url, "instance_geometry")?;
+                let sources = geometry_positions.get(id).ok_or_else(|| {
+                    format!(
+                        "<instance_geometry url=\"{}\"> names no geometry",
+                        dae_snippet(url)
+                    )
+                })?;
+                for s in sources {
+                    let arr = positions_of(s)?;
+                    if out.len() + arr.len() / 3 > MAX_DAE_VERTICES {
+                        return Err(format!(
+                            "the visual scene places more than {MAX_DAE_VERTICES} vertices"
+                        ));
+                    }
+                    for c in arr.chunks_exact(3) {
+                        if let &[x, y, z] = c {
+                            let p = world * nalgebra::Vector4::new(x, y, z, 1.0);
+                            out.push([p.x * unit, p.y * unit, p.z * unit]);
+                        }
+                    }
+                }
+            }
+            // Children after instanced nodes, each in document order.
+            for &c in node.children.iter().rev() {
+                stack.push((c, world, unsupported));
+            }
+            for url in node.instances.iter().rev() {
+                let id = dae_local_ref(url, "instance_node")?;
+                let &j = node_ids.get(id).ok_or_else(|| {
+                    format!("<instance_node url=\"{}\"> names no node", dae_snippet(url))
+                })?;
+                stack.push((j, world, unsupported));
+            }
+        }
+        if instanced {
+            return Ok(out);
+        }
+    }
+    // No scene places a geometry: every POSITION array, untransformed.
     let mut out = Vec::new();
     for s in &position_sources {
-        let arr = source_array.get(s).and_then(|a| arrays.get(a));
-        let Some(arr) = arr else {
-            return Err(format!("POSITION source \"{s}\" has no float_array"));
-        };
-        for c in arr.chunks_exact(3) {
-            out.push([c[0] * unit, c[1] * unit, c[2] * unit]);
+        for c in positions_of(s)?.chunks_exact(3) {
+            if let &[x, y, z] = c {
+                out.push([x * unit, y * unit, z * unit]);
+            }
         }
     }
     Ok(out)
@@ -188,6 +596,227 @@ mod tests {
         let p = read_dae_positions(dae).unwrap();
         assert_eq!(p.len(), 2);
         assert!((p[1][2] - 0.006).abs() < 1e-15);
+    }
+
+    /// A document with one triangle geometry `tri` (points (1,0,0), (0,2,0),
+    /// (0,0,3)) and `scene` as its `<library_visual_scenes>` content.
+    fn dae_with_scene(scene: &str) -> String {
+        format!(
+            r##"<?xml version="1.0"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+<asset><unit meter="1"/><up_axis>Y_UP</up_axis></asset>
+<library_geometries><geometry id="tri"><mesh>
+<source id="tri-pos"><float_array id="tri-pos-array" count="9">1 0 0 0 2 0 0 0 3</float_array></source>
+<vertices id="tri-v"><input semantic="POSITION" source="#tri-pos"/></vertices>
+</mesh></geometry>
+<geometry id="unused"><mesh>
+<source id="u-pos"><float_array id="u-pos-array" count="3">100 100 100</float_array></source>
+<vertices id="u-v"><input semantic="POSITION" source="#u-pos"/></vertices>
+</mesh></geometry></library_geometries>
+<library_visual_scenes><visual_scene id="S">{scene}</visual_scene></library_visual_scenes>
+<scene><instance_visual_scene url="#S"/></scene>
+</COLLADA>"##
+        )
+    }
+
+    fn assert_points(got: &[[f64; 3]], want: &[[f64; 3]]) {
+        assert_eq!(got.len(), want.len(), "{got:?}");
+        for (g, w) in got.iter().zip(want) {
+            for k in 0..3 {
+                assert!((g[k] - w[k]).abs() < 1e-12, "{got:?} != {want:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn dae_matrix_scale_and_translation() {
+        // Millimetres scaled to metres and moved, as anymal_foot.dae does
+        // (plus a translation); the never-placed geometry is left out.
+        let dae = dae_with_scene(
+            r##"<node id="cam"><matrix>1 0 0 7 0 1 0 8 0 0 1 9 0 0 0 1</matrix></node>
+<node id="n"><matrix sid="transform">0.001 0 0 0.5
+ 0 0.001 0 -0.25
+ 0 0 0.001 2
+ 0 0 0 1</matrix>
+<instance_geometry url="#tri"><bind_material/></instance_geometry></node>"##,
+        );
+        let p = read_dae_positions(&dae).unwrap();
+        assert_points(
+            &p,
+            &[[0.501, -0.25, 2.0], [0.5, -0.248, 2.0], [0.5, -0.25, 2.003]],
+        );
+        // The unit applies after the node transform, translation included.
+        let dae = dae.replace(r#"meter="1""#, r#"meter="0.5""#);
+        let p = read_dae_positions(&dae).unwrap();
+        assert_points(
+            &p,
+            &[
+                [0.2505, -0.125, 1.0],
+                [0.25, -0.124, 1.0],
+                [0.25, -0.125, 1.0015],
+            ],
+        );
+    }
+
+    #[test]
+    fn dae_nested_nodes_compose_in_order() {
+        // parent: translate then rotate 90° about z; child: translate (1,0,0).
+        // world = T(10,0,0) · Rz(90°) · T(1,0,0), so p -> (10 - (y), x + 1, z).
+        let dae = dae_with_scene(
+            r##"<node id="a"><translate>10 0 0</translate><rotate>0 0 1 90</rotate>
+<node id="b"><translate>1 0 0</translate><instance_geometry url="#tri"/></node>
+</node>"##,
+        );
+        let p = read_dae_positions(&dae).unwrap();
+        assert_points(&p, &[[10.0, 2.0, 0.0], [8.0, 1.0, 0.0], [10.0, 1.0, 3.0]]);
+        // Other order inside one node: rotate, then translate (in the rotated frame).
+        let dae = dae_with_scene(
+            r##"<node id="a"><rotate>0 0 1 90</rotate><translate>1 0 0</translate><scale>2 2 2</scale>
+<instance_geometry url="#tri"/></node>"##,
+        );
+        let p = read_dae_positions(&dae).unwrap();
+        assert_points(&p, &[[0.0, 3.0, 0.0], [-4.0, 1.0, 0.0], [0.0, 1.0, 6.0]]);
+    }
+
+    #[test]
+    fn dae_geometry_placed_twice_gives_both() {
+        let dae = dae_with_scene(
+            r##"<node id="a"><translate>0 0 1</translate><instance_geometry url="#tri"/></node>
+<node id="b"><translate>0 0 -1</translate><instance_geometry url="#tri"/></node>"##,
+        );
+        let p = read_dae_positions(&dae).unwrap();
+        assert_points(
+            &p,
+            &[
+                [1.0, 0.0, 1.0],
+                [0.0, 2.0, 1.0],
+                [0.0, 0.0, 4.0],
+                [1.0, 0.0, -1.0],
+                [0.0, 2.0, -1.0],
+                [0.0, 0.0, 2.0],
+            ],
+        );
+    }
+
+    #[test]
+    fn dae_instance_node_and_chosen_scene() {
+        let dae = r##"<COLLADA>
+<library_geometries><geometry id="g"><mesh>
+<source id="p"><float_array id="pa">1 2 3</float_array></source>
+<vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+</mesh></geometry></library_geometries>
+<library_nodes><node id="lib"><scale>2 2 2</scale><instance_geometry url="#g"/></node></library_nodes>
+<library_visual_scenes>
+<visual_scene id="first"><node><instance_geometry url="#g"/></node></visual_scene>
+<visual_scene id="second"><node><translate>0 0 10</translate><instance_node url="#lib"/></node></visual_scene>
+</library_visual_scenes>
+<scene><instance_visual_scene url="#second"/></scene></COLLADA>"##;
+        assert_points(&read_dae_positions(dae).unwrap(), &[[2.0, 4.0, 16.0]]);
+        // Without <scene>, the first visual scene.
+        let first = dae.replace(
+            r##"<scene><instance_visual_scene url="#second"/></scene>"##,
+            "",
+        );
+        assert_points(&read_dae_positions(&first).unwrap(), &[[1.0, 2.0, 3.0]]);
+        // A scene that places nothing: every POSITION array, untransformed.
+        let none = dae.replace(r##"<instance_node url="#lib"/>"##, "");
+        assert_points(&read_dae_positions(&none).unwrap(), &[[1.0, 2.0, 3.0]]);
+        // An <instance_node> cycle is an error, not a hang.
+        let cycle = dae.replace(
+            r##"<instance_geometry url="#g"/></node></library_nodes>"##,
+            r##"<instance_geometry url="#g"/><instance_node url="#lib"/></node></library_nodes>"##,
+        );
+        let e = read_dae_positions(&cycle).unwrap_err();
+        assert!(e.contains("instance_node"), "{e}");
+    }
+
+    #[test]
+    fn dae_bad_scene_graphs_are_errors() {
+        let cases: &[(&str, &str)] = &[
+            (
+                r##"<node id="n"><matrix>1 0 0 0 0 1 0 0 0 0 1 0 0 0 0</matrix><instance_geometry url="#tri"/></node>"##,
+                "<matrix> has 15 numbers, expected 16",
+            ),
+            (
+                r##"<node id="n"><matrix/><instance_geometry url="#tri"/></node>"##,
+                "<matrix> has 0 numbers",
+            ),
+            (
+                r##"<node id="n"><translate>1 x 2</translate><instance_geometry url="#tri"/></node>"##,
+                "<translate>: \"x\" is not a number",
+            ),
+            (
+                r##"<node id="n"><scale>1 inf 2</scale><instance_geometry url="#tri"/></node>"##,
+                "<scale> has a non-finite number",
+            ),
+            (
+                r##"<node id="n"><rotate>0 0 0 30</rotate><instance_geometry url="#tri"/></node>"##,
+                "<rotate> has a zero axis",
+            ),
+            (
+                r##"<node id="n"><rotate>0 0 1 NaN</rotate><instance_geometry url="#tri"/></node>"##,
+                "<rotate> has a non-finite number",
+            ),
+            (
+                r##"<node id="n"><matrix>1 0 0 0 0 1 0 0 0 0 1 0 0 0 1 1</matrix><instance_geometry url="#tri"/></node>"##,
+                "<matrix>: the last row is not 0 0 0 1",
+            ),
+            (
+                r##"<node id="n"><instance_geometry url="#nowhere"/></node>"##,
+                "<instance_geometry url=\"#nowhere\"> names no geometry",
+            ),
+            (
+                r##"<node id="n"><instance_geometry url="other.dae#tri"/></node>"##,
+                "only references inside the file",
+            ),
+            (
+                r##"<node id="n"><instance_geometry/></node>"##,
+                "<instance_geometry> has no url",
+            ),
+            (
+                r##"<node id="n"><instance_node url="#nowhere"/></node>"##,
+                "<instance_node url=\"#nowhere\"> names no node",
+            ),
+            (
+                r##"<node id="n"><skew>45 1 0 0 0 1 0</skew><node><instance_geometry url="#tri"/></node></node>"##,
+                "node \"n\": <skew> is not read",
+            ),
+        ];
+        for (scene, want) in cases {
+            let e = read_dae_positions(&dae_with_scene(scene)).unwrap_err();
+            assert!(e.contains(want), "{scene}: {e}");
+            if scene.contains("<matrix") {
+                assert!(e.contains("node \"n\""), "{e}");
+            }
+        }
+        // A scene url that names no scene; a bad unit.
+        let e = read_dae_positions(&dae_with_scene("").replace("url=\"#S\"", "url=\"#T\""))
+            .unwrap_err();
+        assert!(
+            e.contains("<instance_visual_scene url=\"#T\"> names no visual_scene"),
+            "{e}"
+        );
+        let e = read_dae_positions(&dae_with_scene("").replace("meter=\"1\"", "meter=\"-2\""))
+            .unwrap_err();
+        assert!(e.contains("<unit meter=\"-2\">"), "{e}");
+        // A camera node with a bad-free <lookat> and no geometry is fine.
+        let ok = dae_with_scene(
+            r##"<node id="cam"><lookat>0 0 1 0 0 0 0 1 0</lookat><instance_camera url="#c"/></node>
+<node id="n"><instance_geometry url="#tri"/></node>"##,
+        );
+        assert_eq!(read_dae_positions(&ok).unwrap().len(), 3);
+    }
+
+    #[test]
+    fn dae_empty_float_array_is_empty_not_missing() {
+        // anymal_hip_l.dae has `<float_array id=".." count="0"/>` geometries.
+        let dae = dae_with_scene(r##"<node><instance_geometry url="#e"/><instance_geometry url="#tri"/></node>"##)
+            .replace(
+                "</library_geometries>",
+                r##"<geometry id="e"><mesh><source id="e-pos"><float_array id="e-pos-array" count="0"/></source>
+<vertices id="e-v"><input semantic="POSITION" source="#e-pos"/></vertices></mesh></geometry></library_geometries>"##,
+            );
+        assert_eq!(read_dae_positions(&dae).unwrap().len(), 3);
     }
 
     #[test]
