@@ -62,8 +62,8 @@ lines = ["# urdyn vs Pinocchio 4.1 — measured side by side", "",
          "in one run, each urdyn measurement right before Pinocchio's on the same URDF).", "",
          load_line, "",
          "Median ns per call. Ratio = urdyn / Pinocchio (lower is better). `crba` is compared with the "
-         "faster of Pinocchio's `crba` and `crba-world` (Pinocchio fills one triangle, urdyn the whole "
-         "matrix); `fd` with Pinocchio's fastest forward dynamics (its method in brackets). "
+         "faster of Pinocchio's `crba` and `crba-world`; both fill H's upper triangle only "
+         "(urdyn's `crba_upper`, which `fd-crba` uses too; `mass_matrix()` adds the mirror copy); `fd` with Pinocchio's fastest forward dynamics (its method in brackets). "
          "Bars from issue 4: rnea ≤ 0.6, aba ≤ 0.8, crba ≤ 1.0, fk ≤ 1.0, fd ≤ 1.0; "
          "✗ marks a ratio above its bar.", ""]
 summary = []

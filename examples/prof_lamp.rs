@@ -37,6 +37,15 @@ fn main() {
     let tol = arg(2);
     let reps = arg(3).unwrap_or(20.0) as usize;
     let mut sim = setup(tol);
+    {
+        let mut cold = setup(tol);
+        let t = std::time::Instant::now();
+        while cold.time() < dur {
+            cold.step_until(dur).expect("step");
+        }
+        let w = t.elapsed().as_secs_f64();
+        println!("first run in this process: {:.2} ms, real-time factor {:.0}", w * 1e3, dur / w);
+    }
     let mut hist = [0u64; 8];
     let mut prev = 0;
     while sim.time() < dur {

@@ -175,7 +175,8 @@ fn call(algo: Algo, model: &Model, data: &mut Data, s: &State) -> Result<f64, St
     Ok(match algo {
         Algo::Rnea => dynamics::rnea(model, data, &s.q, &s.v, &s.a, None)[0],
         Algo::Bias => dynamics::bias(model, data, &s.q, &s.v, None)[0],
-        Algo::Crba => dynamics::crba(model, data, &s.q)[(0, 0)],
+        // H's upper triangle, the work of Pinocchio's crba (mass_matrix mirrors it)
+        Algo::Crba => dynamics::crba_upper(model, data, &s.q)[(0, 0)],
         Algo::Aba => {
             dynamics::aba(model, data, &s.q, &s.v, &s.tau, None).map_err(|e| e.to_string())?[0]
         }

@@ -182,7 +182,28 @@ pub fn crba<'d, T: Scalar>(
     } else if model.topology.crba_local {
         crba_local(model, data, q);
     } else {
-        crba_world(model, data, q);
+        crba_world(model, data, q, true);
+    }
+    &data.h
+}
+
+/// [`crba`] for consumers that read one triangle: H's upper triangle (row ≤
+/// column, with the diagonal) is written to `data.h`; the strict lower triangle
+/// is left as it is (the world-frame variant skips the mirror copy, O(n²) memory
+/// traffic on long chains; the others fill both anyway). This is the work of
+/// Pinocchio's `crba`, which fills the upper triangle only; the tree-sparse LTDL
+/// factorisation reads nothing else.
+pub fn crba_upper<'d, T: Scalar>(
+    model: &Model<T>,
+    data: &'d mut Data<T>,
+    q: &DVector<T>,
+) -> &'d nalgebra::DMatrix<T> {
+    if model.has_mimic {
+        crba_mimic(model, data, q);
+    } else if model.topology.crba_local {
+        crba_local(model, data, q);
+    } else {
+        crba_world(model, data, q, false);
     }
     &data.h
 }
@@ -253,7 +274,7 @@ fn crba_mimic<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
 /// the joint axis for most joints: cheaper than moving every body inertia to the
 /// world), and `F = I^c_i Sₖ` (a column of I^c_i for an axis-aligned joint) is
 /// moved to the world once.
-fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
+fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>, mirror: bool) {
     let nb = model.nbodies;
     let nv = model.nv;
     let q = q.as_slice();
@@ -346,6 +367,9 @@ fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
         });
     }
     // Mirror the upper triangle into the lower one.
+    if !mirror {
+        return;
+    }
     if chain {
         mirror_blocked(hs, nv);
     } else {

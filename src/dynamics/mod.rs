@@ -17,7 +17,7 @@ mod rnea;
 
 pub use aba::aba;
 pub use centroidal::{center_of_mass, centroidal_momentum};
-pub use crba::{crba, CompositeInertia};
+pub use crba::{crba, crba_upper, CompositeInertia};
 
 pub use energy::{kinetic_energy, potential_energy};
 pub use forward_rnea::{forward_dynamics_rnea, mass_matrix_rnea};
@@ -51,8 +51,9 @@ pub fn mass_matrix<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<
 /// Forward dynamics through H: `C` by RNEA (seed eq. 9), H by [`crba`], then
 /// `H q̈ = τ − C` (seed eq. 6) by the tree-sparse LTDL factorisation
 /// ([`ltdl::ltdl`]), or, on a model with mimic joints (whose `Gᵀ H G` is not
-/// tree-shaped), the dense Cholesky. Result in `data.qdd`; `data.h`, `data.bias`
-/// and the factor in `data.chol` are left for reuse.
+/// tree-shaped), the dense Cholesky. Result in `data.qdd`; `data.h` (its upper
+/// triangle, [`crba_upper`]; all of it with mimic joints), `data.bias` and the
+/// factor in `data.chol` are left for reuse.
 pub fn forward_dynamics_crba<'d, T: Scalar>(
     model: &Model<T>,
     data: &'d mut Data<T>,
@@ -65,7 +66,12 @@ pub fn forward_dynamics_crba<'d, T: Scalar>(
         return Err(DynamicsError::MasslessJoint(name.clone()));
     }
     bias(model, data, q, v, fext);
-    crba(model, data, q);
+    if model.has_mimic {
+        crba(model, data, q);
+    } else {
+        // LTDL reads H's upper triangle only
+        crba_upper(model, data, q);
+    }
     data.qdd.copy_from(tau);
     data.qdd -= &data.bias;
     if model.has_mimic {
