@@ -210,16 +210,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             });
             let mut block: Vec<f64> = Vec::with_capacity(width * block_rows);
             let push_row = |sim: &mut Simulation, block: &mut Vec<f64>| -> Result<(), SimulateError> {
-                let e = sim.energy();
-                if !e.is_finite() {
-                    return Err(SimulateError::Sim {
-                        urdf: urdf_name.clone(),
-                        error: SimError::NonFinite {
-                            t: sim.time(),
-                            quantity: "energy".into(),
-                        },
-                    });
-                }
+                let e = finite_energy(sim, &urdf_name)?;
                 block.push(sim.time());
                 block.extend_from_slice(sim.q().as_slice());
                 block.extend_from_slice(sim.v().as_slice());
@@ -289,16 +280,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             pb.finish_and_clear();
         }
         let wall = start.elapsed().as_secs_f64();
-        let e = sim.energy();
-        if !e.is_finite() {
-            return Err(SimulateError::Sim {
-                urdf: urdf_name.clone(),
-                error: SimError::NonFinite {
-                    t: sim.time(),
-                    quantity: "energy".into(),
-                },
-            });
-        }
+        let e = finite_energy(&mut sim, &urdf_name)?;
         Ok(Summary {
             steps: sim.steps,
             wall_seconds: wall,
@@ -383,6 +365,23 @@ fn write_rows(
         let _ = recycle.send(block);
     }
     Ok(())
+}
+
+/// The energy of the current state, or the error naming its time when it is not
+/// finite (q and v are checked by every step; an overflowing energy is not).
+fn finite_energy(sim: &mut Simulation, urdf_name: &str) -> Result<f64, SimulateError> {
+    let e = sim.energy();
+    if e.is_finite() {
+        Ok(e)
+    } else {
+        Err(SimulateError::Sim {
+            urdf: urdf_name.to_string(),
+            error: SimError::NonFinite {
+                t: sim.time(),
+                quantity: "energy".into(),
+            },
+        })
+    }
 }
 
 /// Appends a count in decimal without allocating.

@@ -177,14 +177,7 @@ pub fn crba<'d, T: Scalar>(
     data: &'d mut Data<T>,
     q: &DVector<T>,
 ) -> &'d nalgebra::DMatrix<T> {
-    if model.has_mimic {
-        crba_mimic(model, data, q);
-    } else if model.topology.crba_local {
-        crba_local(model, data, q);
-    } else {
-        crba_world(model, data, q, true);
-    }
-    &data.h
+    crba_dispatch(model, data, q, true)
 }
 
 /// [`crba`] for consumers that read one triangle: H's upper triangle (row ≤
@@ -198,12 +191,23 @@ pub fn crba_upper<'d, T: Scalar>(
     data: &'d mut Data<T>,
     q: &DVector<T>,
 ) -> &'d nalgebra::DMatrix<T> {
+    crba_dispatch(model, data, q, false)
+}
+
+/// The variant of the model (mimic, local frames, world frame); `mirror`: fill
+/// the lower triangle too (only the world-frame variant leaves it out).
+fn crba_dispatch<'d, T: Scalar>(
+    model: &Model<T>,
+    data: &'d mut Data<T>,
+    q: &DVector<T>,
+    mirror: bool,
+) -> &'d nalgebra::DMatrix<T> {
     if model.has_mimic {
         crba_mimic(model, data, q);
     } else if model.topology.crba_local {
         crba_local(model, data, q);
     } else {
-        crba_world(model, data, q, false);
+        crba_world(model, data, q, mirror);
     }
     &data.h
 }
