@@ -83,10 +83,10 @@ fn evaluate_each(
     if let Some(g) = states.gravity {
         model.gravity = nalgebra::Vector3::from(g);
     }
-    if let Some(name) = model.massless_joints.first() {
+    if let Err(e) = dynamics::check_massless(&model) {
         return Err(EvalError::Dynamics {
             file: urdf_file.to_string(),
-            message: DynamicsError::MasslessJoint(name.clone()).to_string(),
+            message: e.to_string(),
         });
     }
     // Every state is checked before any dynamics is computed.

@@ -7,16 +7,9 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use urdyn::dynamics::{self, center_of_mass, forward_kinematics, update_frames};
 use urdyn::{Data, LoadOptions, Model};
 
-struct Lcg(u64);
-impl Lcg {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
+#[path = "common/lcg.rs"]
+mod lcg;
+use lcg::Lcg;
 
 fn load(path: &str, floating: bool) -> Model {
     let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);

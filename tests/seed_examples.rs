@@ -8,20 +8,9 @@ use urdyn::{Data, LoadOptions, Model};
 
 const G: f64 = 9.81;
 
-/// A small deterministic generator (tests need no rand dependency).
-struct Lcg(u64);
-impl Lcg {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
-    }
-    fn vector(&mut self, n: usize, r: f64) -> DVector<f64> {
-        DVector::from_fn(n, |_, _| self.uniform(-r, r))
-    }
-}
+#[path = "common/lcg.rs"]
+mod lcg;
+use lcg::Lcg;
 
 fn load(name: &str, floating: bool) -> Model {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -141,9 +141,7 @@ pub fn aba<'d, T: Scalar>(
     if model.has_mimic {
         return Err(DynamicsError::Mimic);
     }
-    if let Some(name) = model.massless_joints.first() {
-        return Err(DynamicsError::MasslessJoint(name.clone()));
-    }
+    super::check_massless(model)?;
     let nb = model.nbodies;
     let q = q.as_slice();
     let v = v.as_slice();

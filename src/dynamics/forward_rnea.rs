@@ -33,9 +33,7 @@ pub fn forward_dynamics_rnea<'d, T: Scalar>(
     tau: &DVector<T>,
     fext: Option<&[Force<T>]>,
 ) -> Result<&'d DVector<T>, DynamicsError> {
-    if let Some(name) = model.massless_joints.first() {
-        return Err(DynamicsError::MasslessJoint(name.clone()));
-    }
+    super::check_massless(model)?;
     rnea_impl(model, data, q, Some(v), None, true, fext);
     data.bias.copy_from(&data.tau);
     mass_matrix_rnea(model, data, q);

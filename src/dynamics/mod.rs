@@ -43,6 +43,15 @@ use crate::model::{Data, FdMethod, Model};
 use crate::spatial::{Force, Scalar};
 use nalgebra::DVector;
 
+/// Forward dynamics is undefined where a moving joint carries no mass (H is
+/// singular whatever the state): the error names the first such joint.
+pub(crate) fn check_massless<T: Scalar>(model: &Model<T>) -> Result<(), DynamicsError> {
+    match model.massless_joints.first() {
+        Some(name) => Err(DynamicsError::MasslessJoint(name.clone())),
+        None => Ok(()),
+    }
+}
+
 /// The joint-space inertia matrix H(q), written to `data.h` (by [`crba`]).
 pub fn mass_matrix<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     crba(model, data, q);
@@ -62,9 +71,7 @@ pub fn forward_dynamics_crba<'d, T: Scalar>(
     tau: &DVector<T>,
     fext: Option<&[Force<T>]>,
 ) -> Result<&'d DVector<T>, DynamicsError> {
-    if let Some(name) = model.massless_joints.first() {
-        return Err(DynamicsError::MasslessJoint(name.clone()));
-    }
+    check_massless(model)?;
     bias(model, data, q, v, fext);
     if model.has_mimic {
         crba(model, data, q);

@@ -264,9 +264,7 @@ impl Simulation {
                 "--friction must be a non-negative number (got {f})"
             )));
         }
-        if let Some(name) = model.massless_joints.first() {
-            return Err(DynamicsError::MasslessJoint(name.clone()).into());
-        }
+        crate::dynamics::check_massless(&model)?;
         let contact = match opts.ground {
             Some(g) => GroundContact::build(&model, g, opts.contact, &opts.package_paths)?,
             None => None,
