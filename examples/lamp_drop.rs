@@ -73,7 +73,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let panels = area.split_evenly((3, 1));
     let series: [(&str, &str, &Vec<f64>, RGBColor); 3] = [
         ("base height", "z (m)", &z, BLUE),
-        ("energy (kinetic + potential)", "E (joule)", &e, RED),
+        ("energy (kinetic + potential)", "E (J)", &e, RED),
         ("active contact points", "count", &c, BLACK),
     ];
     for (panel, (title, ylabel, ys, color)) in panels.iter().zip(series.iter()) {
