@@ -23,7 +23,11 @@ fn setup(tol: Option<f64>) -> Simulation {
     let mut sim = Simulation::new(model, o).expect("simulation");
     let mut q = sim.q().clone();
     let low = sim.lowest_point();
-    q[2] += if std::env::var("LAMP").is_ok() { 0.3 - low } else { 0.5 };
+    q[2] += if std::env::var("LAMP").is_ok() {
+        0.3 - low
+    } else {
+        0.5
+    };
     q[3] = (5f64).to_radians().sin();
     q[6] = (5f64).to_radians().cos();
     let v = sim.v().clone();
@@ -44,7 +48,11 @@ fn main() {
             cold.step_until(dur).expect("step");
         }
         let w = t.elapsed().as_secs_f64();
-        println!("first run in this process: {:.2} ms, real-time factor {:.0}", w * 1e3, dur / w);
+        println!(
+            "first run in this process: {:.2} ms, real-time factor {:.0}",
+            w * 1e3,
+            dur / w
+        );
     }
     let mut hist = [0u64; 8];
     let mut prev = 0;

@@ -209,16 +209,17 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                 scope.spawn(move || write_rows(w, &writer_model, width, from_sim, recycle))
             });
             let mut block: Vec<f64> = Vec::with_capacity(width * block_rows);
-            let push_row = |sim: &mut Simulation, block: &mut Vec<f64>| -> Result<(), SimulateError> {
-                let e = finite_energy(sim, &urdf_name)?;
-                block.push(sim.time());
-                block.extend_from_slice(sim.q().as_slice());
-                block.extend_from_slice(sim.v().as_slice());
-                block.push(e);
-                block.push(sim.active_contacts() as f64);
-                block.push(sim.penetration());
-                Ok(())
-            };
+            let push_row =
+                |sim: &mut Simulation, block: &mut Vec<f64>| -> Result<(), SimulateError> {
+                    let e = finite_energy(sim, &urdf_name)?;
+                    block.push(sim.time());
+                    block.extend_from_slice(sim.q().as_slice());
+                    block.extend_from_slice(sim.v().as_slice());
+                    block.push(e);
+                    block.push(sim.active_contacts() as f64);
+                    block.push(sim.penetration());
+                    Ok(())
+                };
             // sends a full block (or, at the end, the last one); a writer that hung
             // up has failed: its error is collected at the join below
             let send = |block: &mut Vec<f64>| -> bool {
@@ -268,9 +269,9 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             }
             drop(to_writer);
             let written = match writer {
-                Some(h) => h
-                    .join()
-                    .unwrap_or_else(|_| Err(SimulateError::Output("trajectory writer failed".into()))),
+                Some(h) => h.join().unwrap_or_else(|_| {
+                    Err(SimulateError::Output("trajectory writer failed".into()))
+                }),
                 None => Ok(()),
             };
             sim_result?;

@@ -1,7 +1,7 @@
 //! The articulated-body algorithm (ABA): forward dynamics in O(n).
 
-use super::DynamicsError;
 use super::rnea::{act_force_ax, inv_act_motion_ax};
+use super::DynamicsError;
 use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
 use crate::spatial::{skew, Force, Inertia, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Matrix6, Vector3, Vector6};
@@ -43,7 +43,12 @@ fn act_matrix6<T: Scalar>(x: &Se3<T>, m: &Matrix6<T>) -> Matrix6<T> {
 /// `T = t*` applied as cross products (`T M` column by column, `M T` row by row;
 /// no products with the zeros of `t*`).
 #[inline(always)]
-fn translate6<T: Scalar>(t: &Vector3<T>, a: &Matrix3<T>, b: &Matrix3<T>, c: &Matrix3<T>) -> Matrix6<T> {
+fn translate6<T: Scalar>(
+    t: &Vector3<T>,
+    a: &Matrix3<T>,
+    b: &Matrix3<T>,
+    c: &Matrix3<T>,
+) -> Matrix6<T> {
     // T M: column j is t × M_j.
     let skew_mul = |m: &Matrix3<T>| -> Matrix3<T> {
         Matrix3::from_columns(&[

@@ -50,8 +50,12 @@ pub(crate) fn rnea_impl<T: Scalar>(
         (Some(v), Some(a)) => {
             rnea_pass::<T, true, true>(model, data, q, v.as_slice(), a.as_slice(), gravity, fext)
         }
-        (Some(v), None) => rnea_pass::<T, true, false>(model, data, q, v.as_slice(), &[], gravity, fext),
-        (None, Some(a)) => rnea_pass::<T, false, true>(model, data, q, &[], a.as_slice(), gravity, fext),
+        (Some(v), None) => {
+            rnea_pass::<T, true, false>(model, data, q, v.as_slice(), &[], gravity, fext)
+        }
+        (None, Some(a)) => {
+            rnea_pass::<T, false, true>(model, data, q, &[], a.as_slice(), gravity, fext)
+        }
         (None, None) => rnea_pass::<T, false, false>(model, data, q, &[], &[], gravity, fext),
     }
 }

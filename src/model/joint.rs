@@ -636,7 +636,9 @@ impl<'j, T: Scalar, A: AxisOf<T>, const AXROT: bool> JointModel<T> for RevoluteJ
     }
     #[inline(always)]
     fn add_motion(&self, m: &mut Motion<T>, x: &[T]) {
-        self.ax.get().add_scaled(&mut m.ang, self.j.mult * x[self.j.iv]);
+        self.ax
+            .get()
+            .add_scaled(&mut m.ang, self.j.mult * x[self.j.iv]);
     }
     #[inline(always)]
     fn add_cross_motion(&self, m: &mut Motion<T>, vi: &Motion<T>, x: &[T]) {
@@ -700,7 +702,9 @@ impl<'j, T: Scalar, A: AxisOf<T>> JointModel<T> for PrismaticJ<'j, T, A> {
     }
     #[inline(always)]
     fn add_motion(&self, m: &mut Motion<T>, x: &[T]) {
-        self.ax.get().add_scaled(&mut m.lin, self.j.mult * x[self.j.iv]);
+        self.ax
+            .get()
+            .add_scaled(&mut m.lin, self.j.mult * x[self.j.iv]);
     }
     #[inline(always)]
     fn add_cross_motion(&self, m: &mut Motion<T>, vi: &Motion<T>, x: &[T]) {
@@ -717,7 +721,10 @@ impl<'j, T: Scalar, A: AxisOf<T>> JointModel<T> for PrismaticJ<'j, T, A> {
     }
     #[inline(always)]
     fn subspace_in(&self, _c: usize, m: &Se3<T>) -> Motion<T> {
-        Motion::new(Vector3::zeros(), self.ax.get().mat_mul(&m.rot) * self.j.mult)
+        Motion::new(
+            Vector3::zeros(),
+            self.ax.get().mat_mul(&m.rot) * self.j.mult,
+        )
     }
     #[inline(always)]
     fn mul_subspace(&self, ic: &CompositeInertia<T>, _c: usize) -> Force<T> {
@@ -753,7 +760,10 @@ impl<'j, T: Scalar> FreeJ<'j, T> {
     #[inline(always)]
     fn motion(&self, x: &[T]) -> Motion<T> {
         let x = &x[self.j.iv..self.j.iv + 6];
-        Motion::new(Vector3::new(x[3], x[4], x[5]), Vector3::new(x[0], x[1], x[2]))
+        Motion::new(
+            Vector3::new(x[3], x[4], x[5]),
+            Vector3::new(x[0], x[1], x[2]),
+        )
     }
 }
 
@@ -870,7 +880,10 @@ macro_rules! dispatch_joint {
                 $body
             }
             (JointKind::Revolute(Axis::Unit(u)), _) => {
-                let $jm = RevoluteJ::<_, _, false> { ax: AxU(*u), j: j__ };
+                let $jm = RevoluteJ::<_, _, false> {
+                    ax: AxU(*u),
+                    j: j__,
+                };
                 $body
             }
             (JointKind::Prismatic(Axis::X), _) => {
@@ -886,7 +899,10 @@ macro_rules! dispatch_joint {
                 $body
             }
             (JointKind::Prismatic(Axis::Unit(u)), _) => {
-                let $jm = PrismaticJ { ax: AxU(*u), j: j__ };
+                let $jm = PrismaticJ {
+                    ax: AxU(*u),
+                    j: j__,
+                };
                 $body
             }
             (JointKind::Free, _) => {

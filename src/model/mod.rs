@@ -10,8 +10,8 @@ pub(crate) mod joint;
 mod topology;
 
 pub use data::Data;
-pub use joint::{Axis, Joint, JointKind};
 pub(crate) use joint::{dispatch_joint, JointModel};
+pub use joint::{Axis, Joint, JointKind};
 pub use topology::{FdMethod, Topology};
 
 use crate::spatial::{Inertia, Scalar, Se3};

@@ -33,10 +33,7 @@ pub mod solver;
 
 use crate::contact::{ContactError, ContactParams, ContactPoint, GroundContact};
 use crate::dynamics::linalg::cholesky;
-use crate::dynamics::{
-    bias, forward_dynamics, forward_kinematics, mass_matrix,
-    DynamicsError,
-};
+use crate::dynamics::{bias, forward_dynamics, forward_kinematics, mass_matrix, DynamicsError};
 use crate::model::{Data, JointKind, Model};
 use crate::spatial::{Force, Motion};
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -705,7 +702,8 @@ impl Simulation {
         // Δv = L⁻ᵀ Δv' once at the end
         let nv = self.model.nv;
         self.tmp = tau;
-        self.rows.form_factored(self.chol.as_slice(), self.vfree.as_slice());
+        self.rows
+            .form_factored(self.chol.as_slice(), self.vfree.as_slice());
         let mut dv = std::mem::replace(&mut self.tmp, DVector::zeros(0));
         self.pgs_sweeps += self.rows.solve(
             dv.as_mut_slice(),
@@ -1129,7 +1127,12 @@ fn cholesky_n<const N: usize>(h: &[f64], l: &mut [f64], n: usize) -> Result<(), 
 
 /// Kinetic plus gravitational potential energy (cli.md's datum: the potential is
 /// −Σ mᵢ gᵀcᵢ) at (q, v); leaves the world poses of `q` in `data.o_m_i`.
-pub fn mechanical_energy(model: &Model, data: &mut Data, q: &DVector<f64>, v: &DVector<f64>) -> f64 {
+pub fn mechanical_energy(
+    model: &Model,
+    data: &mut Data,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+) -> f64 {
     forward_kinematics(model, data, q);
     energy_from_kinematics(model, data, v)
 }

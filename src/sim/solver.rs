@@ -45,7 +45,6 @@ pub struct Rows {
     cap: usize,
 }
 
-
 impl Rows {
     pub fn new(nv: usize, cap: usize) -> Self {
         Self {
@@ -257,7 +256,11 @@ impl Rows {
         let mut finishing = false;
         while it < max_iter {
             it += 1;
-            let relax = if it <= PLAIN || finishing || 2 * it > max_iter { 1.0 } else { relax };
+            let relax = if it <= PLAIN || finishing || 2 * it > max_iter {
+                1.0
+            } else {
+                relax
+            };
             // (comparisons in place of f64::max: the same result, NaN included)
             let mut change: f64 = 0.0;
             let mut r = 0;
