@@ -303,11 +303,7 @@ fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>, m
         let op = o_m_i[parent[i]];
         let (li, om) = dispatch_joint!(&joints[i], ident[i], jm => {
             let li = jm.placement(&placements[i], q);
-            let om = match jm.rot_axis() {
-                // oRᵢ = oRₚ R_axis: two columns mixed.
-                Some(ax) => Se3::new(ax.mul_rot(&op.rot, &li.rot), op.trans + op.rot * li.trans),
-                None => op.compose(&li),
-            };
+            let om = jm.world_pose(&op, &li);
             let k0 = jm.joint().iv;
             for c in 0..jm.nv() {
                 let s = jm.subspace_in(c, &om);

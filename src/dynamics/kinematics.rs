@@ -18,11 +18,7 @@ pub fn forward_kinematics<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &D
         // The joint kind matched once per body (dispatch_joint!).
         let (li, om) = dispatch_joint!(&joints[i], ident[i], jm => {
             let li = jm.placement(&placements[i], q);
-            let om = match jm.rot_axis() {
-                // oRᵢ = oRₚ R_axis: two columns mixed.
-                Some(ax) => Se3::new(ax.mul_rot(&op.rot, &li.rot), op.trans + op.rot * li.trans),
-                None => op.compose(&li),
-            };
+            let om = jm.world_pose(&op, &li);
             (li, om)
         });
         li_m_i[i] = li;

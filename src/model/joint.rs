@@ -543,6 +543,15 @@ pub(crate) trait JointModel<T: Scalar>: Copy {
     fn rot_axis(&self) -> Option<Axis<T>>;
     /// `λ(i)Mi = X_tree · X_J(q)` (as [`Joint::placement_compose`]).
     fn placement(&self, xt: &Se3<T>, q: &[T]) -> Se3<T>;
+    /// `oMi = oMλ(i) · λ(i)Mi` for `li` from [`JointModel::placement`]: with a
+    /// plain rotation about the joint axis only two columns of `oRλ(i)` mix.
+    #[inline(always)]
+    fn world_pose(&self, op: &Se3<T>, li: &Se3<T>) -> Se3<T> {
+        match self.rot_axis() {
+            Some(ax) => Se3::new(ax.mul_rot(&op.rot, &li.rot), op.trans + op.rot * li.trans),
+            None => op.compose(li),
+        }
+    }
     /// `m += S x` (as [`Joint::add_motion`]).
     fn add_motion(&self, m: &mut Motion<T>, x: &[T]);
     /// `m += v × S x` (as [`Joint::cross_motion`]).
