@@ -28,6 +28,44 @@
 //!
 //! Nothing is allocated in [`Simulation::step`]: every buffer is sized at construction.
 
+/// `$body` with the constant `$N` set to `$n` for the common sizes of the
+/// simulation's small dense kernels (their loops then have lengths known at
+/// compile time), to 0 otherwise (the kernel reads the length at run time).
+macro_rules! by_size {
+    ($n:expr, $N:ident => $body:expr) => {
+        match $n {
+            6 => {
+                const $N: usize = 6;
+                $body
+            }
+            7 => {
+                const $N: usize = 7;
+                $body
+            }
+            8 => {
+                const $N: usize = 8;
+                $body
+            }
+            9 => {
+                const $N: usize = 9;
+                $body
+            }
+            12 => {
+                const $N: usize = 12;
+                $body
+            }
+            18 => {
+                const $N: usize = 18;
+                $body
+            }
+            _ => {
+                const $N: usize = 0;
+                $body
+            }
+        }
+    };
+}
+
 pub mod dop853_tableau;
 pub mod solver;
 
@@ -986,45 +1024,34 @@ impl Simulation {
 
 /// Solves L Lᵀ x = b in place, L in the lower triangle of the column-major
 /// `l` (n × n), column-oriented so that both passes read contiguous columns.
-#[inline]
 fn chol_solve_slice(l: &[f64], n: usize, x: &mut [f64]) {
-    chol_solve_slice_from(l, n, x, 0)
-}
-
-/// As [`chol_solve_slice`] for a right-hand side whose first `first` entries are 0.
-#[inline]
-fn chol_solve_slice_from(l: &[f64], n: usize, x: &mut [f64], first: usize) {
     if l.len() < n * n || x.len() < n {
         return;
     }
     // common sizes with the length known at compile time (same arithmetic)
-    match n {
-        6 => chol_solve_n::<6>(l, n, x, first),
-        7 => chol_solve_n::<7>(l, n, x, first),
-        8 => chol_solve_n::<8>(l, n, x, first),
-        9 => chol_solve_n::<9>(l, n, x, first),
-        12 => chol_solve_n::<12>(l, n, x, first),
-        18 => chol_solve_n::<18>(l, n, x, first),
-        _ => chol_solve_n::<0>(l, n, x, first),
+    by_size!(n, N => {
+        chol_forward_n::<N>(l, n, x);
+        chol_backward_n::<N>(l, n, x)
+    })
+}
+
+/// Lᵀ x' = x for the Cholesky factor of [`chol_solve_slice`].
+fn chol_backward(l: &[f64], n: usize, x: &mut [f64]) {
+    if l.len() < n * n || x.len() < n {
+        return;
     }
+    by_size!(n, N => chol_backward_n::<N>(l, n, x))
 }
 
-/// The two triangular passes; `N = 0`: the length `n` at run time. The caller
-/// checked `l.len() ≥ n²`, `x.len() ≥ n` (and `N ∈ {0, n}`).
+/// L x' = x in place (forward substitution); `N = 0`: the length `n` at run
+/// time. The caller checked `l.len() ≥ n²`, `x.len() ≥ n` (and `N ∈ {0, n}`).
 #[inline(always)]
-fn chol_solve_n<const N: usize>(l: &[f64], n: usize, x: &mut [f64], first: usize) {
-    chol_forward_n::<N>(l, n, x, first);
-    chol_backward_n::<N>(l, n, x);
-}
-
-/// L x' = x in place (forward substitution), x zero before `first`.
-#[inline(always)]
-fn chol_forward_n<const N: usize>(l: &[f64], n: usize, x: &mut [f64], first: usize) {
+fn chol_forward_n<const N: usize>(l: &[f64], n: usize, x: &mut [f64]) {
     let n = if N == 0 { n } else { N };
     let (l, x) = (&l[..n * n], &mut x[..n]);
     // SAFETY: k, i < n; l is n·n long, x n long.
     unsafe {
-        for k in first..n {
+        for k in 0..n {
             let xk = *x.get_unchecked(k) / *l.get_unchecked(k * n + k);
             *x.get_unchecked_mut(k) = xk;
             if xk != 0.0 {
@@ -1053,28 +1080,6 @@ fn chol_backward_n<const N: usize>(l: &[f64], n: usize, x: &mut [f64]) {
     }
 }
 
-macro_rules! by_size {
-    ($n:expr, $f:ident, $($arg:expr),*) => {
-        match $n {
-            6 => $f::<6>($($arg),*),
-            7 => $f::<7>($($arg),*),
-            8 => $f::<8>($($arg),*),
-            9 => $f::<9>($($arg),*),
-            12 => $f::<12>($($arg),*),
-            18 => $f::<18>($($arg),*),
-            _ => $f::<0>($($arg),*),
-        }
-    };
-}
-
-/// Lᵀ x' = x for the Cholesky factor of [`chol_solve_slice`].
-fn chol_backward(l: &[f64], n: usize, x: &mut [f64]) {
-    if l.len() < n * n || x.len() < n {
-        return;
-    }
-    by_size!(n, chol_backward_n, l, n, x)
-}
-
 /// [`cholesky`] (same arithmetic, same order) with the size known at compile
 /// time for common sizes and the bounds checked once.
 fn cholesky_fast(h: &DMatrix<f64>, l: &mut DMatrix<f64>) -> Result<(), usize> {
@@ -1083,15 +1088,7 @@ fn cholesky_fast(h: &DMatrix<f64>, l: &mut DMatrix<f64>) -> Result<(), usize> {
         return cholesky(h, l);
     }
     let (hs, ls) = (h.as_slice(), l.as_mut_slice());
-    match n {
-        6 => cholesky_n::<6>(hs, ls, n),
-        7 => cholesky_n::<7>(hs, ls, n),
-        8 => cholesky_n::<8>(hs, ls, n),
-        9 => cholesky_n::<9>(hs, ls, n),
-        12 => cholesky_n::<12>(hs, ls, n),
-        18 => cholesky_n::<18>(hs, ls, n),
-        _ => cholesky_n::<0>(hs, ls, n),
-    }
+    by_size!(n, N => cholesky_n::<N>(hs, ls, n))
 }
 
 #[inline(always)]

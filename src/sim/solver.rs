@@ -118,15 +118,7 @@ impl Rows {
         {
             return;
         }
-        match nv {
-            6 => self.form_n::<6>(l, vfree),
-            7 => self.form_n::<7>(l, vfree),
-            8 => self.form_n::<8>(l, vfree),
-            9 => self.form_n::<9>(l, vfree),
-            12 => self.form_n::<12>(l, vfree),
-            18 => self.form_n::<18>(l, vfree),
-            _ => self.form_n::<0>(l, vfree),
-        }
+        by_size!(nv, N => self.form_n::<N>(l, vfree))
     }
 
     /// [`Rows::form_factored`] with rows `N` long (`N = 0`: `self.nv`); the
@@ -181,15 +173,7 @@ impl Rows {
     pub fn solve(&mut self, dv: &mut [f64], max_iter: usize, tol: f64, relax: f64) -> usize {
         // the row length known at compile time for common sizes: the short dot
         // products and updates are unrolled (same arithmetic, same order)
-        match self.nv {
-            6 => self.solve_n::<6>(dv, max_iter, tol, relax),
-            7 => self.solve_n::<7>(dv, max_iter, tol, relax),
-            8 => self.solve_n::<8>(dv, max_iter, tol, relax),
-            9 => self.solve_n::<9>(dv, max_iter, tol, relax),
-            12 => self.solve_n::<12>(dv, max_iter, tol, relax),
-            18 => self.solve_n::<18>(dv, max_iter, tol, relax),
-            _ => self.solve_n::<0>(dv, max_iter, tol, relax),
-        }
+        by_size!(self.nv, N => self.solve_n::<N>(dv, max_iter, tol, relax))
     }
 
     /// [`Rows::solve`] with rows `N` long (`N = 0`: `self.nv`).
@@ -256,11 +240,8 @@ impl Rows {
         let mut finishing = false;
         while it < max_iter {
             it += 1;
-            let relax = if it <= PLAIN || finishing || 2 * it > max_iter {
-                1.0
-            } else {
-                relax
-            };
+            let plain = it <= PLAIN || finishing || 2 * it > max_iter || relax == 1.0;
+            let relax = if plain { 1.0 } else { relax };
             // (comparisons in place of f64::max: the same result, NaN included)
             let mut change: f64 = 0.0;
             let mut r = 0;
@@ -348,7 +329,7 @@ impl Rows {
                 }
                 r += 1;
             }
-            if finishing || (change <= tol && relax == 1.0) {
+            if finishing || (change <= tol && plain) {
                 break;
             }
             if change <= tol {
