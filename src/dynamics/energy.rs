@@ -1,5 +1,5 @@
 use crate::model::{Data, Model};
-use crate::spatial::Scalar;
+use crate::spatial::{Motion, Scalar};
 use nalgebra::DVector;
 
 /// Kinetic energy `½ Σ v̂ᵢᵀ Îᵢ v̂ᵢ` (also fills `data.v`, `data.li_m_i`).
@@ -9,12 +9,26 @@ pub fn kinetic_energy<T: Scalar>(
     q: &DVector<T>,
     v: &DVector<T>,
 ) -> T {
-    let mut ke = T::zero();
     for i in 1..model.nbodies {
-        let (x_j, v_j) = model.joints[i].calc(q, Some(v));
-        let li_m_i = model.placements[i].compose(&x_j);
-        data.li_m_i[i] = li_m_i;
-        let vi = li_m_i.inv_act_motion(&data.v[model.parent[i]]) + v_j;
+        let (x_j, _) = model.joints[i].calc(q, None);
+        data.li_m_i[i] = model.placements[i].compose(&x_j);
+    }
+    kinetic_energy_from_placements(model, data, v)
+}
+
+/// [`kinetic_energy`] with the joint placements of the configuration already in
+/// `data.li_m_i` (forward kinematics ran at this q): one pass of body velocities
+/// (seed eq. 13, into `data.v`), no joint transform.
+pub fn kinetic_energy_from_placements<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    v: &DVector<T>,
+) -> T {
+    let mut ke = T::zero();
+    data.v[0] = Motion::zero();
+    for i in 1..model.nbodies {
+        let mut vi = data.li_m_i[i].inv_act_motion(&data.v[model.parent[i]]);
+        model.joints[i].add_motion(&mut vi, v);
         data.v[i] = vi;
         ke += model.inertias[i].kinetic_energy(&vi);
     }

@@ -19,7 +19,7 @@ pub use aba::aba;
 pub use centroidal::{center_of_mass, centroidal_momentum};
 pub use crba::{crba, crba_upper, CompositeInertia};
 
-pub use energy::{kinetic_energy, potential_energy};
+pub use energy::{kinetic_energy, kinetic_energy_from_placements, potential_energy};
 pub use forward_rnea::{forward_dynamics_rnea, mass_matrix_rnea};
 pub use jacobian::frame_jacobian;
 pub use kinematics::{forward_kinematics, update_frames};

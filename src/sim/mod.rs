@@ -71,7 +71,10 @@ pub mod solver;
 
 use crate::contact::{ContactError, ContactParams, ContactPoint, GroundContact};
 use crate::dynamics::linalg::cholesky;
-use crate::dynamics::{bias, forward_dynamics, forward_kinematics, mass_matrix, DynamicsError};
+use crate::dynamics::{
+    bias, forward_dynamics, forward_kinematics, kinetic_energy_from_placements, mass_matrix,
+    potential_energy, DynamicsError,
+};
 use crate::model::{Data, JointKind, Model};
 use crate::spatial::{Force, Motion};
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -484,7 +487,8 @@ impl Simulation {
             forward_kinematics(&self.model, &mut self.data, &self.q);
             self.fk_valid = true;
         }
-        energy_from_kinematics(&self.model, &mut self.data, &self.v)
+        kinetic_energy_from_placements(&self.model, &mut self.data, &self.v)
+            + potential_energy(&self.model, &self.data)
     }
 
     fn refresh_contacts(&mut self) {
@@ -1120,35 +1124,6 @@ fn cholesky_n<const N: usize>(h: &[f64], l: &mut [f64], n: usize) -> Result<(), 
         }
     }
     Ok(())
-}
-
-/// Kinetic plus gravitational potential energy (cli.md's datum: the potential is
-/// −Σ mᵢ gᵀcᵢ) at (q, v); leaves the world poses of `q` in `data.o_m_i`.
-pub fn mechanical_energy(
-    model: &Model,
-    data: &mut Data,
-    q: &DVector<f64>,
-    v: &DVector<f64>,
-) -> f64 {
-    forward_kinematics(model, data, q);
-    energy_from_kinematics(model, data, v)
-}
-
-/// Σᵢ ½ v̂ᵢᵀ Îᵢ v̂ᵢ − mᵢ gᵀcᵢ in one pass over the bodies, the joint placements
-/// `data.li_m_i` and world poses `data.o_m_i` of the configuration already in
-/// `data` (forward kinematics ran), body velocities (seed eq. 13) into `data.v`.
-fn energy_from_kinematics(model: &Model, data: &mut Data, v: &DVector<f64>) -> f64 {
-    let mut e = 0.0;
-    data.v[0] = Motion::zero();
-    for i in 1..model.nbodies {
-        let mut vi = data.li_m_i[i].inv_act_motion(&data.v[model.parent[i]]);
-        model.joints[i].add_motion(&mut vi, v);
-        data.v[i] = vi;
-        let inertia = &model.inertias[i];
-        let c = data.o_m_i[i].act_point(&inertia.com);
-        e += inertia.kinetic_energy(&vi) - inertia.mass * model.gravity.dot(&c);
-    }
-    e
 }
 
 #[derive(Clone, Copy)]
