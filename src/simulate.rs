@@ -195,19 +195,28 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
     // in the writer.) Blocks are recycled (no
     // allocation once both are in flight), the channel is bounded (the writer
     // cannot fall behind by more than a few blocks).
-    let width = 1 + sim.model.nq + sim.model.nv + 3;
+    let (nq, nv) = (sim.model.nq, sim.model.nv);
+    let width = row_width(nq, nv);
+    let header = {
+        let (qn, vn) = column_names(&sim.model);
+        let mut h = String::from("t");
+        for n in qn.iter().chain(vn.iter()) {
+            h.push(',');
+            h.push_str(n);
+        }
+        h.push_str(",energy,contacts,penetration\n");
+        h
+    };
     let block_rows = 64usize;
     let e0 = sim.energy();
     let mut loop_body = |w: Option<&mut (dyn Write + Send)>| -> Result<Summary, SimulateError> {
         let start = Instant::now();
         let mut max_pen = sim.penetration();
-        let writer_model = sim.model.clone();
         std::thread::scope(|scope| {
             let (to_writer, from_sim) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
             let (recycle, recycled) = std::sync::mpsc::channel::<Vec<f64>>();
-            let writer = w.map(|w| {
-                scope.spawn(move || write_rows(w, &writer_model, width, from_sim, recycle))
-            });
+            let writer =
+                w.map(|w| scope.spawn(|| write_rows(w, &header, (nq, nv), from_sim, recycle)));
             let mut block: Vec<f64> = Vec::with_capacity(width * block_rows);
             let push_row =
                 |sim: &mut Simulation, block: &mut Vec<f64>| -> Result<(), SimulateError> {
@@ -315,25 +324,25 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
     }
 }
 
+/// Numbers in one raw row handed to the writer: t, q (nq), v (nv), energy,
+/// contacts, penetration.
+fn row_width(nq: usize, nv: usize) -> usize {
+    1 + nq + nv + 3
+}
+
 /// The writer thread: the header, then the CSV line of every row.
 fn write_rows(
     w: &mut (dyn Write + Send),
-    model: &Model,
-    width: usize,
+    header: &str,
+    (nq, nv): (usize, usize),
     rows: std::sync::mpsc::Receiver<Vec<f64>>,
     recycle: std::sync::mpsc::Sender<Vec<f64>>,
 ) -> Result<(), SimulateError> {
+    use std::fmt::Write as _;
     let io = |e: std::io::Error| SimulateError::Output(format!("cannot write trajectory: {e}"));
-    let (nq, nv) = (model.nq, model.nv);
+    let width = row_width(nq, nv);
     let mut line = String::with_capacity(32 * width + 64);
-    let (qn, vn) = column_names(model);
-    line.push('t');
-    for n in qn.iter().chain(vn.iter()) {
-        line.push(',');
-        line.push_str(n);
-    }
-    line.push_str(",energy,contacts,penetration\n");
-    w.write_all(line.as_bytes()).map_err(io)?;
+    w.write_all(header.as_bytes()).map_err(io)?;
     let mut rb = zmij::Buffer::new();
     for block in rows {
         for row in block.chunks_exact(width) {
@@ -355,7 +364,8 @@ fn write_rows(
             line.push(',');
             line.push_str(rb.format(e));
             line.push(',');
-            push_count(&mut line, contacts as u64);
+            // (formatting into a String cannot fail)
+            let _ = write!(line, "{}", contacts as u64);
             line.push(',');
             line.push_str(rb.format(pen));
             line.push('\n');
@@ -382,22 +392,5 @@ fn finite_energy(sim: &mut Simulation, urdf_name: &str) -> Result<f64, SimulateE
                 quantity: "energy".into(),
             },
         })
-    }
-}
-
-/// Appends a count in decimal without allocating.
-fn push_count(line: &mut String, mut n: u64) {
-    let mut digits = [0u8; 20];
-    let mut k = digits.len();
-    loop {
-        k -= 1;
-        digits[k] = b'0' + (n % 10) as u8;
-        n /= 10;
-        if n == 0 {
-            break;
-        }
-    }
-    for &d in &digits[k..] {
-        line.push(d as char);
     }
 }
