@@ -192,9 +192,9 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
     // penetration) in blocks to a writer thread, which formats the CSV: the step
     // loop never formats a number. (The energy is computed here, from the
     // kinematics the step's contact detection left, at a fraction of its cost
-    // in the writer.) Blocks are recycled (no
-    // allocation once both are in flight), the channel is bounded (the writer
-    // cannot fall behind by more than a few blocks).
+    // in the writer.) Blocks are recycled (no allocation once both are in
+    // flight), the channel is bounded (the writer cannot fall behind by more
+    // than a few blocks).
     let (nq, nv) = (sim.model.nq, sim.model.nv);
     let width = row_width(nq, nv);
     let header = {

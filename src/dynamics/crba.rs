@@ -231,41 +231,39 @@ fn crba_mimic<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     // coordinate), so H starts from zero.
     data.h.fill(T::zero());
     let h = &mut data.h;
-    {
-        for i in (1..nb).rev() {
-            let ji = &joints[i];
-            let ici = ic[i];
-            for ci in 0..ji.nv() {
-                let ki = ji.iv + ci;
-                // F = I^c_i S_i (column ci)
-                let mut f = ici.mul_motion(&ji.subspace_column(ci));
-                for cj in 0..=ci {
-                    let kj = ji.iv + cj;
-                    let val = ji.project_column(cj, &f);
+    for i in (1..nb).rev() {
+        let ji = &joints[i];
+        let ici = ic[i];
+        for ci in 0..ji.nv() {
+            let ki = ji.iv + ci;
+            // F = I^c_i S_i (column ci)
+            let mut f = ici.mul_motion(&ji.subspace_column(ci));
+            for cj in 0..=ci {
+                let kj = ji.iv + cj;
+                let val = ji.project_column(cj, &f);
+                h[(ki, kj)] += val;
+                if cj != ci {
+                    h[(kj, ki)] += val;
+                }
+            }
+            // Ancestors: F moves to each parent frame (ᵖX*ⱼ, seed eq. 38's dual).
+            let mut j = i;
+            while parent[j] != 0 {
+                f = li_m_i[j].act_force(&f);
+                j = parent[j];
+                let jj = &joints[j];
+                for cj in 0..jj.nv() {
+                    let kj = jj.iv + cj;
+                    let val = jj.project_column(cj, &f);
                     h[(ki, kj)] += val;
-                    if cj != ci {
-                        h[(kj, ki)] += val;
-                    }
-                }
-                // Ancestors: F moves to each parent frame (ᵖX*ⱼ, seed eq. 38's dual).
-                let mut j = i;
-                while parent[j] != 0 {
-                    f = li_m_i[j].act_force(&f);
-                    j = parent[j];
-                    let jj = &joints[j];
-                    for cj in 0..jj.nv() {
-                        let kj = jj.iv + cj;
-                        let val = jj.project_column(cj, &f);
-                        h[(ki, kj)] += val;
-                        h[(kj, ki)] += val;
-                    }
+                    h[(kj, ki)] += val;
                 }
             }
-            let p = parent[i];
-            if p != 0 {
-                let moved = ici.act(&li_m_i[i]);
-                ic[p].add_assign(&moved);
-            }
+        }
+        let p = parent[i];
+        if p != 0 {
+            let moved = ici.act(&li_m_i[i]);
+            ic[p].add_assign(&moved);
         }
     }
 }

@@ -738,10 +738,9 @@ impl Simulation {
         if self.model.floating_base {
             add_frame_rate(&mut self.vfree, &self.v, h);
         }
-        // Y rows = L⁻¹ jᵣ (H = L Lᵀ): the Delassus matrix is W = J H⁻¹ Jᵀ = Y Yᵀ, so
-        // the solver works on Δv' = Lᵀ Δv with uᵣ = cᵣ + yᵣ·Δv' and one forward
-        // substitution a row, then
-        // Δv = L⁻ᵀ Δv' once at the end
+        // Y rows = L⁻¹ jᵣ (H = L Lᵀ, one forward substitution a row): the Delassus
+        // matrix is W = J H⁻¹ Jᵀ = Y Yᵀ, so the solver works on Δv' = Lᵀ Δv with
+        // uᵣ = cᵣ + yᵣ·Δv', and Δv = L⁻ᵀ Δv' once at the end
         let nv = self.model.nv;
         self.tmp = tau;
         self.rows
