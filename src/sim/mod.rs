@@ -33,31 +33,14 @@
 /// compile time), to 0 otherwise (the kernel reads the length at run time).
 macro_rules! by_size {
     ($n:expr, $N:ident => $body:expr) => {
+        by_size!(@sizes $n, $N, $body, 6, 7, 8, 9, 12, 18)
+    };
+    (@sizes $n:expr, $N:ident, $body:expr, $($k:literal),*) => {
         match $n {
-            6 => {
-                const $N: usize = 6;
+            $($k => {
+                const $N: usize = $k;
                 $body
-            }
-            7 => {
-                const $N: usize = 7;
-                $body
-            }
-            8 => {
-                const $N: usize = 8;
-                $body
-            }
-            9 => {
-                const $N: usize = 9;
-                $body
-            }
-            12 => {
-                const $N: usize = 12;
-                $body
-            }
-            18 => {
-                const $N: usize = 18;
-                $body
-            }
+            })*
             _ => {
                 const $N: usize = 0;
                 $body
