@@ -5,17 +5,26 @@
 # Writes benches/results.json (raw medians) and benches/results.md (table of medians
 # and urdyn/Pinocchio ratios), then benches/scaling.png (benches/plot).
 #
-#   benches/compare.sh [--samples N] [--budget SECONDS] [--flavour generic|native|both]
+#   benches/compare.sh [--rounds R] [--samples N] [--budget SECONDS] [--flavour generic|native|both]
+#
+# The machine is shared and noisy (2 cores; a burst of load during one side's
+# measurement moves a single ratio by ±30%), so every model is measured in R rounds
+# (default 5), spread over the run: a round times every model of both flavours, each
+# model by urdyn and Pinocchio back to back, the order alternating from round to
+# round. The table reports, per model and algorithm, the median over rounds of each
+# side's median and the median of the R per-round ratios, with their range.
 #
 # Environment: PINOCCHIO_BENCH (default ../shared/tools/pinocchio-bench/run beside the
 # repository, or /work/shared/tools/pinocchio-bench/run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+ROUNDS=5
 SAMPLES=100
 BUDGET=0.4
 FLAVOURS="generic native"
 while [ $# -gt 0 ]; do
   case "$1" in
+    --rounds) ROUNDS="$2"; shift 2 ;;
     --samples) SAMPLES="$2"; shift 2 ;;
     --budget) BUDGET="$2"; shift 2 ;;
     --flavour) FLAVOURS="$2"; [ "$2" = both ] && FLAVOURS="generic native"; shift 2 ;;
@@ -50,24 +59,36 @@ for d in 4 6 8; do ROBOTS+=("tree_$d|assets/synthetic/tree_$d.urdf||yes"); done
 
 OUT=target/compare
 rm -rf "$OUT"; mkdir -p "$OUT"
-for flavour in $FLAVOURS; do
-  if [ "$flavour" = native ]; then URDYN=target/native/release/urdyn; else URDYN=target/release/urdyn; fi
-  echo "$flavour start $(date -u +%H:%M) $(cut -d' ' -f1-3 /proc/loadavg)" >>"$OUT/load.txt"
-  for entry in "${ROBOTS[@]}"; do
-    IFS='|' read -r name urdf flags pin <<<"$entry"
-    key="${name%% *}"
-    echo "[$flavour] $name" >&2
-    # shellcheck disable=SC2086
-    "$URDYN" bench "$urdf" $flags --json --samples "$SAMPLES" --budget "$BUDGET" 2>/dev/null \
-      >"$OUT/$flavour.$key.urdyn.json"
-    if [ "$pin" = yes ]; then
-      # shellcheck disable=SC2086
-      "$PIN" "$(pwd)/$urdf" $flags --json --"$flavour" --samples "$SAMPLES" --budget "$BUDGET" 2>/dev/null \
-        >"$OUT/$flavour.$key.pinocchio.json"
-    fi
+bench_urdyn() { # flavour key urdf flags round
+  local bin=target/release/urdyn
+  [ "$1" = native ] && bin=target/native/release/urdyn
+  # shellcheck disable=SC2086
+  "$bin" bench "$3" $4 --json --samples "$SAMPLES" --budget "$BUDGET" 2>/dev/null \
+    >"$OUT/$1.$2.urdyn.r$5.json"
+}
+bench_pin() { # flavour key urdf flags round
+  # shellcheck disable=SC2086
+  "$PIN" "$(pwd)/$3" $4 --json --"$1" --samples "$SAMPLES" --budget "$BUDGET" 2>/dev/null \
+    >"$OUT/$1.$2.pinocchio.r$5.json"
+}
+for round in $(seq 1 "$ROUNDS"); do
+  echo "round $round start $(date -u +%H:%M) $(cut -d' ' -f1-3 /proc/loadavg)" >>"$OUT/load.txt"
+  for flavour in $FLAVOURS; do
+    for entry in "${ROBOTS[@]}"; do
+      IFS='|' read -r name urdf flags pin <<<"$entry"
+      key="${name%% *}"
+      echo "[round $round/$ROUNDS, $flavour] $name" >&2
+      if [ "$pin" = yes ] && [ $((round % 2)) -eq 0 ]; then
+        bench_pin "$flavour" "$key" "$urdf" "$flags" "$round"
+        bench_urdyn "$flavour" "$key" "$urdf" "$flags" "$round"
+      else
+        bench_urdyn "$flavour" "$key" "$urdf" "$flags" "$round"
+        [ "$pin" = yes ] && bench_pin "$flavour" "$key" "$urdf" "$flags" "$round"
+      fi
+    done
   done
-  echo "$flavour end $(date -u +%H:%M) $(cut -d' ' -f1-3 /proc/loadavg)" >>"$OUT/load.txt"
 done
+echo "end $(date -u +%H:%M) $(cut -d' ' -f1-3 /proc/loadavg)" >>"$OUT/load.txt"
 python3 benches/make_table.py "$OUT" benches/results.json benches/results.md
 if cargo build --release --quiet --manifest-path benches/plot/Cargo.toml 2>/dev/null; then
   benches/plot/target/release/urdyn-plot benches/results.json benches/scaling.png
