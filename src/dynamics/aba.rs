@@ -1,25 +1,25 @@
 //! The articulated-body algorithm (ABA): forward dynamics in O(n).
 
 use super::rnea::{act_force_ax, inv_act_motion_ax};
-use super::DynamicsError;
+use super::{CompositeInertia, DynamicsError};
 use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
-use crate::spatial::{skew, Force, Inertia, Motion, Scalar, Se3};
+use crate::spatial::ops::{cross, dot3, madd, mat_mat};
+use crate::spatial::{skew, Force, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Matrix6, Vector3, Vector6};
 
-/// The 6x6 angular-first matrix of a rigid-body inertia, seed eq. 39 reordered:
+/// The 6x6 angular-first matrix of a rigid-body inertia in origin form (the
+/// model's `inertias_origin`, computed at load), seed eq. 39 reordered:
 /// `[I_o, h*; h*ᵀ, m 1]` with `h = m c` and `I_o = I_c − m c*c*`.
 #[inline(always)]
-fn inertia_matrix<T: Scalar>(i: &Inertia<T>) -> Matrix6<T> {
-    let h = i.com * i.mass;
-    let hx = skew(&h);
-    let io = i.inertia_origin();
+fn inertia_matrix<T: Scalar>(i: &CompositeInertia<T>) -> Matrix6<T> {
+    let hx = skew(&i.h);
     let mut m = Matrix6::zeros();
-    m.fixed_view_mut::<3, 3>(0, 0).copy_from(&io);
+    m.fixed_view_mut::<3, 3>(0, 0).copy_from(&i.io);
     m.fixed_view_mut::<3, 3>(0, 3).copy_from(&hx);
     m.fixed_view_mut::<3, 3>(3, 0).copy_from(&hx.transpose());
-    m[(3, 3)] = i.mass;
-    m[(4, 4)] = i.mass;
-    m[(5, 5)] = i.mass;
+    m[(3, 3)] = i.m;
+    m[(4, 4)] = i.m;
+    m[(5, 5)] = i.m;
     m
 }
 
@@ -33,9 +33,10 @@ fn act_matrix6<T: Scalar>(x: &Se3<T>, m: &Matrix6<T>) -> Matrix6<T> {
     let a: Matrix3<T> = m.fixed_view::<3, 3>(0, 0).into_owned();
     let b: Matrix3<T> = m.fixed_view::<3, 3>(0, 3).into_owned();
     let c: Matrix3<T> = m.fixed_view::<3, 3>(3, 3).into_owned();
-    let a = r * a * r.transpose();
-    let b = r * b * r.transpose();
-    let c = r * c * r.transpose();
+    let rt = r.transpose();
+    let a = mat_mat(&mat_mat(r, &a), &rt);
+    let b = mat_mat(&mat_mat(r, &b), &rt);
+    let c = mat_mat(&mat_mat(r, &c), &rt);
     translate6(&x.trans, &a, &b, &c)
 }
 
@@ -52,16 +53,16 @@ fn translate6<T: Scalar>(
     // T M: column j is t × M_j.
     let skew_mul = |m: &Matrix3<T>| -> Matrix3<T> {
         Matrix3::from_columns(&[
-            t.cross(&m.column(0)),
-            t.cross(&m.column(1)),
-            t.cross(&m.column(2)),
+            cross(t, &m.column(0).into()),
+            cross(t, &m.column(1).into()),
+            cross(t, &m.column(2).into()),
         ])
     };
     // M T: row i is M_i × t (M_i the i-th row as a vector).
     let mul_skew = |m: &Matrix3<T>| -> Matrix3<T> {
-        let r0 = Vector3::new(m[(0, 0)], m[(0, 1)], m[(0, 2)]).cross(t);
-        let r1 = Vector3::new(m[(1, 0)], m[(1, 1)], m[(1, 2)]).cross(t);
-        let r2 = Vector3::new(m[(2, 0)], m[(2, 1)], m[(2, 2)]).cross(t);
+        let r0 = cross(&Vector3::new(m[(0, 0)], m[(0, 1)], m[(0, 2)]), t);
+        let r1 = cross(&Vector3::new(m[(1, 0)], m[(1, 1)], m[(1, 2)]), t);
+        let r2 = cross(&Vector3::new(m[(2, 0)], m[(2, 1)], m[(2, 2)]), t);
         Matrix3::from_rows(&[r0.transpose(), r1.transpose(), r2.transpose()])
     };
     let tc = skew_mul(c);
@@ -156,6 +157,7 @@ pub fn aba<'d, T: Scalar>(
     let placements = &model.placements[..nb];
     let ident = &model.placement_identity[..nb];
     let inertias = &model.inertias[..nb];
+    let inertias_o = &model.inertias_origin[..nb];
     let li_m_i = &mut data.li_m_i[..nb];
     let o_m_i = &mut data.o_m_i[..nb];
     let vel = &mut data.v[..nb];
@@ -185,7 +187,7 @@ pub fn aba<'d, T: Scalar>(
         vel[i] = vi;
         cc[i] = ci;
         let inertia = &inertias[i];
-        ia[i] = inertia_matrix(inertia);
+        ia[i] = inertia_matrix(&inertias_o[i]);
         let mut pi = vi.cross_force(&inertia.mul_motion(&vi));
         if let Some(fext) = fext {
             let om = o_m_i[p].compose(&m);
@@ -217,8 +219,24 @@ pub fn aba<'d, T: Scalar>(
                 dinv[i] = di;
                 uq[i] = ui;
                 if p != 0 {
-                    let ia_a = ia_tail[0] - (u_col * di) * u_col.transpose();
-                    let pa_a = fvec(&pa_tail[0]) + ia_a * mvec(&cc[i]) + u_col * (di * ui);
+                    // Iᵃ = Iᴬ − U D⁻¹ Uᵀ, pᵃ = pᴬ + Iᵃ c + U D⁻¹ u
+                    let ud = u_col * di;
+                    let mut ia_a = ia_tail[0];
+                    for c in 0..6 {
+                        for r in 0..6 {
+                            ia_a[(r, c)] = madd(-ud[r], u_col[c], ia_a[(r, c)]);
+                        }
+                    }
+                    let mut pa_a = fvec(&pa_tail[0]);
+                    let cv = mvec(&cc[i]);
+                    for r in 0..6 {
+                        pa_a[r] = madd(ud[r], ui, pa_a[r]);
+                    }
+                    for c in 0..6 {
+                        for r in 0..6 {
+                            pa_a[r] = madd(ia_a[(r, c)], cv[c], pa_a[r]);
+                        }
+                    }
                     let ax = jm.rot_axis();
                     ia_head[p] += act_matrix6_ax(li, ax, &ia_a);
                     pa_head[p] += act_force_ax(li, ax, &vforce(&pa_a));
@@ -246,7 +264,9 @@ pub fn aba<'d, T: Scalar>(
             let a1 = inv_act_motion_ax(li, jm.rot_axis(), &ap) + cc[i];
             let iv = jm.joint().iv;
             if jm.nv() == 1 {
-                let x = dinv[i] * (uq[i] - uu[i].dot(&mvec(&a1)));
+                let (u, a) = (&uu[i], mvec(&a1));
+                let ua = madd(u[5], a[5], madd(u[4], a[4], madd(u[3], a[3], dot3(u[0], u[1], u[2], a[0], a[1], a[2]))));
+                let x = dinv[i] * (uq[i] - ua);
                 qdd[iv] = x;
                 let mut ai = a1;
                 jm.add_subspace_scaled(&mut ai, x);

@@ -2,6 +2,7 @@
 
 use crate::dynamics::rnea::act_force_ax;
 use crate::model::{dispatch_joint, Axis, Data, Joint, JointKind, JointModel, Model};
+use crate::spatial::ops::{add_cross, axpy, dot, dot3, madd, mat_mat, mat_vec};
 use crate::spatial::{Force, Inertia, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Vector3};
 
@@ -35,12 +36,12 @@ impl<T: Scalar> CompositeInertia<T> {
         let h = c * m;
         let (hx, hy, hz) = (h.x, h.y, h.z);
         let ic = &i.inertia_c;
-        let xx = ic[(0, 0)] + hy * c.y + hz * c.z;
-        let yy = ic[(1, 1)] + hx * c.x + hz * c.z;
-        let zz = ic[(2, 2)] + hx * c.x + hy * c.y;
-        let xy = ic[(0, 1)] - hx * c.y;
-        let xz = ic[(0, 2)] - hx * c.z;
-        let yz = ic[(1, 2)] - hy * c.z;
+        let xx = madd(hz, c.z, madd(hy, c.y, ic[(0, 0)]));
+        let yy = madd(hz, c.z, madd(hx, c.x, ic[(1, 1)]));
+        let zz = madd(hy, c.y, madd(hx, c.x, ic[(2, 2)]));
+        let xy = madd(-hx, c.y, ic[(0, 1)]);
+        let xz = madd(-hx, c.z, ic[(0, 2)]);
+        let yz = madd(-hy, c.z, ic[(1, 2)]);
         Self {
             m,
             h,
@@ -51,8 +52,8 @@ impl<T: Scalar> CompositeInertia<T> {
     #[inline(always)]
     pub fn mul_motion(&self, v: &Motion<T>) -> Force<T> {
         Force {
-            ang: self.io * v.ang + self.h.cross(&v.lin),
-            lin: v.lin * self.m - self.h.cross(&v.ang),
+            ang: add_cross(&mat_vec(&self.io, &v.ang), &self.h, &v.lin),
+            lin: add_cross(&(v.lin * self.m), &v.ang, &self.h),
         }
     }
     #[inline(always)]
@@ -76,7 +77,7 @@ impl<T: Scalar> CompositeInertia<T> {
         let r = &x.rot;
         let rh = ax.rot_mul(r, &self.h);
         let t = x.trans;
-        let h2 = rh + t * self.m;
+        let h2 = axpy(&rh, &t, self.m);
         // M = R I_o by columns; R I_o Rᵀ = R Mᵀ (I_o symmetric), by columns.
         let io = &self.io;
         let m0 = ax.rot_mul(r, &io.column(0).into());
@@ -86,14 +87,8 @@ impl<T: Scalar> CompositeInertia<T> {
         let e1 = ax.rot_mul(r, &Vector3::new(m0.y, m1.y, m2.y));
         let e2 = ax.rot_mul(r, &Vector3::new(m0.z, m1.z, m2.z));
         // column j of R I_o Rᵀ is e_j; entry (i, j) = e_j[i]
-        let s = rh.dot(&t) + t.dot(&h2);
-        let g = |i: usize, j: usize| t[i] * rh[j] + h2[i] * t[j];
-        let xx = e0.x - g(0, 0) + s;
-        let yy = e1.y - g(1, 1) + s;
-        let zz = e2.z - g(2, 2) + s;
-        let xy = e1.x - g(0, 1);
-        let xz = e2.x - g(0, 2);
-        let yz = e2.y - g(1, 2);
+        let (xx, yy, zz, xy, xz, yz) =
+            shift_entries(e0.x, e1.y, e2.z, e1.x, e2.x, e2.y, &t, &rh, &h2);
         Self {
             m: self.m,
             h: h2,
@@ -119,29 +114,67 @@ impl<T: Scalar> CompositeInertia<T> {
     #[inline(always)]
     pub fn act(&self, x: &Se3<T>) -> Self {
         let r = &x.rot;
-        let rh = r * self.h;
+        let rh = mat_vec(r, &self.h);
         let t = x.trans;
-        let h2 = rh + t * self.m;
+        let h2 = axpy(&rh, &t, self.m);
         // R I_o Rᵀ on the 6 distinct entries: M = R I_o, then rows of M · rows of R.
-        let mm = r * self.io;
+        let mm = mat_mat(r, &self.io);
         let e = |i: usize, j: usize| {
-            mm[(i, 0)] * r[(j, 0)] + mm[(i, 1)] * r[(j, 1)] + mm[(i, 2)] * r[(j, 2)]
+            dot3(
+                mm[(i, 0)],
+                mm[(i, 1)],
+                mm[(i, 2)],
+                r[(j, 0)],
+                r[(j, 1)],
+                r[(j, 2)],
+            )
         };
-        let s = rh.dot(&t) + t.dot(&h2);
-        // − t rhᵀ − h2 tᵀ (symmetric sum) + s 1
-        let g = |i: usize, j: usize| t[i] * rh[j] + h2[i] * t[j];
-        let xx = e(0, 0) - g(0, 0) + s;
-        let yy = e(1, 1) - g(1, 1) + s;
-        let zz = e(2, 2) - g(2, 2) + s;
-        let xy = e(0, 1) - g(0, 1);
-        let xz = e(0, 2) - g(0, 2);
-        let yz = e(1, 2) - g(1, 2);
+        let (xx, yy, zz, xy, xz, yz) = shift_entries(
+            e(0, 0),
+            e(1, 1),
+            e(2, 2),
+            e(0, 1),
+            e(0, 2),
+            e(1, 2),
+            &t,
+            &rh,
+            &h2,
+        );
         Self {
             m: self.m,
             h: h2,
             io: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
         }
     }
+}
+
+/// The translation part of [`CompositeInertia::act`]: from the rotated `R I_o Rᵀ`
+/// entries (xx, yy, zz, xy, xz, yz), `− t rhᵀ − h2 tᵀ + (rh·t + t·h2) 1` added
+/// (`rh = R h`, `h2 = rh + m t`; the two outer products sum to a symmetric matrix).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn shift_entries<T: Scalar>(
+    xx: T,
+    yy: T,
+    zz: T,
+    xy: T,
+    xz: T,
+    yz: T,
+    t: &Vector3<T>,
+    rh: &Vector3<T>,
+    h2: &Vector3<T>,
+) -> (T, T, T, T, T, T) {
+    let s = madd(t.z, h2.z, madd(t.y, h2.y, madd(t.x, h2.x, dot(rh, t))));
+    // entry − (t[i] rh[j] + h2[i] t[j])
+    let g = |e: T, i: usize, j: usize| madd(-h2[i], t[j], madd(-t[i], rh[j], e));
+    (
+        g(xx, 0, 0) + s,
+        g(yy, 1, 1) + s,
+        g(zz, 2, 2) + s,
+        g(xy, 0, 1),
+        g(xz, 0, 2),
+        g(yz, 1, 2),
+    )
 }
 
 /// The joint-space inertia matrix H(q) by the CRBA (Featherstone, RBDA §6.2),
@@ -345,12 +378,11 @@ fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>, m
                     let (f0, f1, f2) = (f.lin.x, f.lin.y, f.lin.z);
                     let mut j = k;
                     loop {
-                        col[j] = sw0[j] * n0
-                            + sw1[j] * n1
-                            + sw2[j] * n2
-                            + sv0[j] * f0
-                            + sv1[j] * f1
-                            + sv2[j] * f2;
+                        col[j] = madd(
+                            sv2[j],
+                            f2,
+                            madd(sv1[j], f1, madd(sv0[j], f0, dot3(sw0[j], sw1[j], sw2[j], n0, n1, n2))),
+                        );
                         j = lambda[j];
                         if j >= nv {
                             break;
@@ -389,7 +421,15 @@ fn project<T: Scalar>(f: &Force<T>, w: [&[T]; 3], v: [&[T]; 3], out: &mut [T]) {
     let (v0, v1, v2) = (&v[0][..len], &v[1][..len], &v[2][..len]);
     let (n, l) = (f.ang, f.lin);
     for j in 0..len {
-        out[j] = w0[j] * n.x + w1[j] * n.y + w2[j] * n.z + v0[j] * l.x + v1[j] * l.y + v2[j] * l.z;
+        out[j] = madd(
+            v2[j],
+            l.z,
+            madd(
+                v1[j],
+                l.y,
+                madd(v0[j], l.x, dot3(w0[j], w1[j], w2[j], n.x, n.y, n.z)),
+            ),
+        );
     }
 }
 

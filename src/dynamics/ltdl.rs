@@ -12,6 +12,7 @@
 //! of `u` holds Lᵀ, so that every inner loop reads one column of `u`; `D[k]` sits
 //! on the diagonal. Only the entries on the tree pattern are read or written.
 
+use crate::spatial::ops::madd;
 use crate::spatial::{lit, Scalar};
 use nalgebra::{DMatrix, DVector};
 
@@ -52,7 +53,7 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
                 let a = colk[i] / d;
                 let coli = &mut left[i * n..i * n + i + 1];
                 for (x, y) in coli.iter_mut().zip(colk[..=i].iter()) {
-                    *x -= a * *y;
+                    *x = madd(-a, *y, *x);
                 }
                 colk[i] = a;
             }
@@ -72,7 +73,7 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
             let mut j = i;
             while j != NONE {
                 let hkj = u[(j, k)];
-                u[(j, i)] -= a * hkj;
+                u[(j, i)] = madd(-a, hkj, u[(j, i)]);
                 j = lambda[j];
             }
             u[(i, k)] = a;
@@ -90,7 +91,7 @@ pub fn ltdl_solve<T: Scalar>(u: &DMatrix<T>, lambda: &[usize], x: &mut DVector<T
         let xi = x[i];
         let mut j = lambda[i];
         while j != NONE {
-            x[j] -= u[(j, i)] * xi;
+            x[j] = madd(-u[(j, i)], xi, x[j]);
             j = lambda[j];
         }
     }
@@ -101,7 +102,7 @@ pub fn ltdl_solve<T: Scalar>(u: &DMatrix<T>, lambda: &[usize], x: &mut DVector<T
         let mut s = x[i];
         let mut j = lambda[i];
         while j != NONE {
-            s -= u[(j, i)] * x[j];
+            s = madd(-u[(j, i)], x[j], s);
             j = lambda[j];
         }
         x[i] = s;

@@ -1,4 +1,5 @@
 use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
+use crate::spatial::ops::add_cross;
 use crate::spatial::{Force, Motion, Scalar, Se3};
 use nalgebra::DVector;
 
@@ -161,7 +162,7 @@ pub(crate) fn inv_act_motion_ax<T: Scalar>(
         None => m.inv_act_motion(x),
         Some(ax) => Motion {
             ang: ax.rot_tr_mul(&m.rot, &x.ang),
-            lin: ax.rot_tr_mul(&m.rot, &(x.lin - m.trans.cross(&x.ang))),
+            lin: ax.rot_tr_mul(&m.rot, &add_cross(&x.lin, &x.ang, &m.trans)),
         },
     }
 }
@@ -174,7 +175,7 @@ pub(crate) fn act_force_ax<T: Scalar>(m: &Se3<T>, ax: Option<Axis<T>>, f: &Force
         Some(ax) => {
             let lin = ax.rot_mul(&m.rot, &f.lin);
             Force {
-                ang: ax.rot_mul(&m.rot, &f.ang) + m.trans.cross(&lin),
+                ang: add_cross(&ax.rot_mul(&m.rot, &f.ang), &m.trans, &lin),
                 lin,
             }
         }

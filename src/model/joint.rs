@@ -3,6 +3,7 @@
 //! joint velocity `S q̇`, and the projection `Sᵀ f` (seed eq. 16).
 
 use crate::dynamics::CompositeInertia;
+use crate::spatial::ops::{axpy, cross, madd, mat_mat, mat_tr_vec, mat_vec};
 use crate::spatial::{axis_angle, quat_to_matrix, sin_cos, Force, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Matrix6, Vector3, Vector6};
 
@@ -69,12 +70,12 @@ impl<T: Scalar> Axis<T> {
     pub fn rotate_right(&self, m: &Matrix3<T>, s: T, c: T) -> Matrix3<T> {
         let (c0, c1, c2) = (m.column(0), m.column(1), m.column(2));
         match self {
-            Axis::X => Matrix3::from_columns(&[c0.into(), c1 * c + c2 * s, c2 * c - c1 * s]),
-            Axis::Y => Matrix3::from_columns(&[c0 * c - c2 * s, c1.into(), c0 * s + c2 * c]),
-            Axis::Z => Matrix3::from_columns(&[c0 * c + c1 * s, c1 * c - c0 * s, c2.into()]),
+            Axis::X => Matrix3::from_columns(&[c0.into(), mix(c1, c, c2, s), mix(c2, c, c1, -s)]),
+            Axis::Y => Matrix3::from_columns(&[mix(c0, c, c2, -s), c1.into(), mix(c0, s, c2, c)]),
+            Axis::Z => Matrix3::from_columns(&[mix(c0, c, c1, s), mix(c1, c, c0, -s), c2.into()]),
             Axis::Unit(u) => {
                 let k = crate::spatial::skew(u);
-                m * (Matrix3::identity() + k * s + k * k * (T::one() - c))
+                mat_mat(m, &(Matrix3::identity() + k * s + k * k * (T::one() - c)))
             }
         }
     }
@@ -95,18 +96,18 @@ impl<T: Scalar> Axis<T> {
     pub fn add_cross_scaled(&self, x: &mut Vector3<T>, w: &Vector3<T>, s: T) {
         match self {
             Axis::X => {
-                x.y += w.z * s;
-                x.z -= w.y * s;
+                x.y = madd(w.z, s, x.y);
+                x.z = madd(-w.y, s, x.z);
             }
             Axis::Y => {
-                x.x -= w.z * s;
-                x.z += w.x * s;
+                x.x = madd(-w.z, s, x.x);
+                x.z = madd(w.x, s, x.z);
             }
             Axis::Z => {
-                x.x += w.y * s;
-                x.y -= w.x * s;
+                x.x = madd(w.y, s, x.x);
+                x.y = madd(-w.x, s, x.y);
             }
-            Axis::Unit(u) => *x += w.cross(u) * s,
+            Axis::Unit(u) => *x = axpy(x, &cross(w, u), s),
         }
     }
     /// `x += u s`, touching one component for an axis-aligned `u`.
@@ -116,7 +117,7 @@ impl<T: Scalar> Axis<T> {
             Axis::X => x.x += s,
             Axis::Y => x.y += s,
             Axis::Z => x.z += s,
-            Axis::Unit(u) => *x += u * s,
+            Axis::Unit(u) => *x = axpy(x, u, s),
         }
     }
     /// `R v` for a rotation `R` about this axis (read from `r`): 4 products for an
@@ -126,20 +127,20 @@ impl<T: Scalar> Axis<T> {
         match self {
             Axis::X => Vector3::new(
                 v.x,
-                r[(1, 1)] * v.y + r[(1, 2)] * v.z,
-                r[(2, 1)] * v.y + r[(2, 2)] * v.z,
+                madd(r[(1, 2)], v.z, r[(1, 1)] * v.y),
+                madd(r[(2, 2)], v.z, r[(2, 1)] * v.y),
             ),
             Axis::Y => Vector3::new(
-                r[(0, 0)] * v.x + r[(0, 2)] * v.z,
+                madd(r[(0, 2)], v.z, r[(0, 0)] * v.x),
                 v.y,
-                r[(2, 0)] * v.x + r[(2, 2)] * v.z,
+                madd(r[(2, 2)], v.z, r[(2, 0)] * v.x),
             ),
             Axis::Z => Vector3::new(
-                r[(0, 0)] * v.x + r[(0, 1)] * v.y,
-                r[(1, 0)] * v.x + r[(1, 1)] * v.y,
+                madd(r[(0, 1)], v.y, r[(0, 0)] * v.x),
+                madd(r[(1, 1)], v.y, r[(1, 0)] * v.x),
                 v.z,
             ),
-            Axis::Unit(_) => r * v,
+            Axis::Unit(_) => mat_vec(r, v),
         }
     }
     /// `Rᵀ v` for a rotation `R` about this axis (read from `r`).
@@ -148,20 +149,20 @@ impl<T: Scalar> Axis<T> {
         match self {
             Axis::X => Vector3::new(
                 v.x,
-                r[(1, 1)] * v.y + r[(2, 1)] * v.z,
-                r[(1, 2)] * v.y + r[(2, 2)] * v.z,
+                madd(r[(2, 1)], v.z, r[(1, 1)] * v.y),
+                madd(r[(2, 2)], v.z, r[(1, 2)] * v.y),
             ),
             Axis::Y => Vector3::new(
-                r[(0, 0)] * v.x + r[(2, 0)] * v.z,
+                madd(r[(2, 0)], v.z, r[(0, 0)] * v.x),
                 v.y,
-                r[(0, 2)] * v.x + r[(2, 2)] * v.z,
+                madd(r[(2, 2)], v.z, r[(0, 2)] * v.x),
             ),
             Axis::Z => Vector3::new(
-                r[(0, 0)] * v.x + r[(1, 0)] * v.y,
-                r[(0, 1)] * v.x + r[(1, 1)] * v.y,
+                madd(r[(1, 0)], v.y, r[(0, 0)] * v.x),
+                madd(r[(1, 1)], v.y, r[(0, 1)] * v.x),
                 v.z,
             ),
-            Axis::Unit(_) => r.tr_mul(v),
+            Axis::Unit(_) => mat_tr_vec(r, v),
         }
     }
     /// `m R` for a rotation `R` about this axis (read from `r`): two columns of `m`
@@ -172,20 +173,20 @@ impl<T: Scalar> Axis<T> {
         match self {
             Axis::X => Matrix3::from_columns(&[
                 c0.into(),
-                c1 * r[(1, 1)] + c2 * r[(2, 1)],
-                c1 * r[(1, 2)] + c2 * r[(2, 2)],
+                mix(c1, r[(1, 1)], c2, r[(2, 1)]),
+                mix(c1, r[(1, 2)], c2, r[(2, 2)]),
             ]),
             Axis::Y => Matrix3::from_columns(&[
-                c0 * r[(0, 0)] + c2 * r[(2, 0)],
+                mix(c0, r[(0, 0)], c2, r[(2, 0)]),
                 c1.into(),
-                c0 * r[(0, 2)] + c2 * r[(2, 2)],
+                mix(c0, r[(0, 2)], c2, r[(2, 2)]),
             ]),
             Axis::Z => Matrix3::from_columns(&[
-                c0 * r[(0, 0)] + c1 * r[(1, 0)],
-                c0 * r[(0, 1)] + c1 * r[(1, 1)],
+                mix(c0, r[(0, 0)], c1, r[(1, 0)]),
+                mix(c0, r[(0, 1)], c1, r[(1, 1)]),
                 c2.into(),
             ]),
-            Axis::Unit(_) => m * r,
+            Axis::Unit(_) => mat_mat(m, r),
         }
     }
     /// `m · u` for a 3x3 matrix (a column for axis-aligned axes).
@@ -195,9 +196,24 @@ impl<T: Scalar> Axis<T> {
             Axis::X => m.column(0).into(),
             Axis::Y => m.column(1).into(),
             Axis::Z => m.column(2).into(),
-            Axis::Unit(u) => m * u,
+            Axis::Unit(u) => mat_vec(m, u),
         }
     }
+}
+
+/// `a x + b y` for two columns of a 3x3 matrix (an axis rotation mixing them).
+#[inline(always)]
+fn mix<T: Scalar>(
+    a: nalgebra::MatrixView3x1<'_, T>,
+    x: T,
+    b: nalgebra::MatrixView3x1<'_, T>,
+    y: T,
+) -> Vector3<T> {
+    Vector3::new(
+        madd(b[0], y, a[0] * x),
+        madd(b[1], y, a[1] * x),
+        madd(b[2], y, a[2] * x),
+    )
 }
 
 /// The kind of a body's joint to its parent.

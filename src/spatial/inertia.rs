@@ -1,3 +1,4 @@
+use super::ops::{add_cross, mat_vec};
 use super::{skew, Force, Motion, Scalar};
 use nalgebra::{Matrix3, Matrix6, Vector3};
 
@@ -39,9 +40,9 @@ impl<T: Scalar> Inertia<T> {
     /// `Î v = [I_c ω + c × f; f]` with `f = m (v − c × ω)` (seed eq. 39 applied to `[ω; v]`).
     #[inline(always)]
     pub fn mul_motion(&self, v: &Motion<T>) -> Force<T> {
-        let lin = (v.lin - self.com.cross(&v.ang)) * self.mass;
+        let lin = add_cross(&v.lin, &v.ang, &self.com) * self.mass;
         Force {
-            ang: self.inertia_c * v.ang + self.com.cross(&lin),
+            ang: add_cross(&mat_vec(&self.inertia_c, &v.ang), &self.com, &lin),
             lin,
         }
     }

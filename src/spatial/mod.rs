@@ -13,6 +13,7 @@
 mod force;
 mod inertia;
 mod motion;
+pub mod ops;
 mod se3;
 
 pub use force::Force;

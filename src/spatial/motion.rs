@@ -1,3 +1,4 @@
+use super::ops::{add_cross, cross, dot, madd};
 use super::{skew, Force, Scalar};
 use nalgebra::{Matrix6, Vector3, Vector6};
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
@@ -28,23 +29,31 @@ impl<T: Scalar> Motion<T> {
     #[inline(always)]
     pub fn cross(&self, m: &Motion<T>) -> Motion<T> {
         Motion {
-            ang: self.ang.cross(&m.ang),
-            lin: self.ang.cross(&m.lin) + self.lin.cross(&m.ang),
+            ang: cross(&self.ang, &m.ang),
+            lin: add_cross(&cross(&self.ang, &m.lin), &self.lin, &m.ang),
         }
     }
     /// The dual cross product `v ×* f = [ω × n + v × f; ω × f]`, with `(v×*) = −(v×)ᵀ`.
     #[inline(always)]
     pub fn cross_force(&self, f: &Force<T>) -> Force<T> {
         Force {
-            ang: self.ang.cross(&f.ang) + self.lin.cross(&f.lin),
-            lin: self.ang.cross(&f.lin),
+            ang: add_cross(&cross(&self.ang, &f.ang), &self.lin, &f.lin),
+            lin: cross(&self.ang, &f.lin),
         }
     }
     /// The power `vᵀ f` of a force on this motion (the seed's spatial transpose, eq. 41,
     /// applied in angular-first coordinates).
     #[inline(always)]
     pub fn dot(&self, f: &Force<T>) -> T {
-        self.ang.dot(&f.ang) + self.lin.dot(&f.lin)
+        madd(
+            self.lin.z,
+            f.lin.z,
+            madd(
+                self.lin.y,
+                f.lin.y,
+                madd(self.lin.x, f.lin.x, dot(&self.ang, &f.ang)),
+            ),
+        )
     }
     pub fn to_vector(&self) -> Vector6<T> {
         Vector6::new(

@@ -1,3 +1,4 @@
+use super::ops::{add_cross, add_mat_vec, mat_mat, mat_tr_mat, mat_tr_vec, mat_vec};
 use super::{skew, Force, Inertia, Motion, Scalar};
 use nalgebra::{Matrix3, Matrix6, Vector3};
 use std::ops::Mul;
@@ -48,62 +49,60 @@ impl<T: Scalar> Se3<T> {
     /// `bMa = aMb⁻¹ = (Rᵀ, −Rᵀ t)`.
     #[inline(always)]
     pub fn inverse(&self) -> Self {
-        let rt = self.rot.transpose();
         Self {
-            rot: rt,
-            trans: -(rt * self.trans),
+            rot: self.rot.transpose(),
+            trans: -mat_tr_vec(&self.rot, &self.trans),
         }
     }
     /// `aMc = aMb · bMc`.
     #[inline(always)]
     pub fn compose(&self, m: &Se3<T>) -> Se3<T> {
         Se3 {
-            rot: self.rot * m.rot,
-            trans: self.trans + self.rot * m.trans,
+            rot: mat_mat(&self.rot, &m.rot),
+            trans: add_mat_vec(&self.trans, &self.rot, &m.trans),
         }
     }
     /// `bMc = aMb⁻¹ · aMc` without forming the inverse.
     #[inline(always)]
     pub fn inv_compose(&self, m: &Se3<T>) -> Se3<T> {
-        let rt = self.rot.transpose();
         Se3 {
-            rot: rt * m.rot,
-            trans: rt * (m.trans - self.trans),
+            rot: mat_tr_mat(&self.rot, &m.rot),
+            trans: mat_tr_vec(&self.rot, &(m.trans - self.trans)),
         }
     }
     /// A point of b in a: `R p + t`.
     #[inline(always)]
     pub fn act_point(&self, p: &Vector3<T>) -> Vector3<T> {
-        self.rot * p + self.trans
+        add_mat_vec(&self.trans, &self.rot, p)
     }
     /// A point of a in b: `Rᵀ (p − t)`.
     #[inline(always)]
     pub fn inv_act_point(&self, p: &Vector3<T>) -> Vector3<T> {
-        self.rot.tr_mul(&(p - self.trans))
+        mat_tr_vec(&self.rot, &(p - self.trans))
     }
     /// Motion from b to a (seed eq. 38): `ω' = R ω`, `v' = R v + t × ω'`.
     #[inline(always)]
     pub fn act_motion(&self, m: &Motion<T>) -> Motion<T> {
-        let ang = self.rot * m.ang;
+        let ang = mat_vec(&self.rot, &m.ang);
         Motion {
             ang,
-            lin: self.rot * m.lin + self.trans.cross(&ang),
+            lin: add_cross(&mat_vec(&self.rot, &m.lin), &self.trans, &ang),
         }
     }
     /// Motion from a to b: `ω' = Rᵀ ω`, `v' = Rᵀ (v − t × ω)`.
     #[inline(always)]
     pub fn inv_act_motion(&self, m: &Motion<T>) -> Motion<T> {
         Motion {
-            ang: self.rot.tr_mul(&m.ang),
-            lin: self.rot.tr_mul(&(m.lin - self.trans.cross(&m.ang))),
+            ang: mat_tr_vec(&self.rot, &m.ang),
+            lin: mat_tr_vec(&self.rot, &add_cross(&m.lin, &m.ang, &self.trans)),
         }
     }
     /// Force from b to a (the dual transform `aX̂b* = aX̂b⁻ᵀ`): `f' = R f`, `n' = R n + t × f'`.
     #[inline(always)]
     pub fn act_force(&self, f: &Force<T>) -> Force<T> {
-        let lin = self.rot * f.lin;
+        let lin = mat_vec(&self.rot, &f.lin);
         Force {
-            ang: self.rot * f.ang + self.trans.cross(&lin),
+            ang: add_cross(&mat_vec(&self.rot, &f.ang), &self.trans, &lin),
             lin,
         }
     }
@@ -111,8 +110,8 @@ impl<T: Scalar> Se3<T> {
     #[inline(always)]
     pub fn inv_act_force(&self, f: &Force<T>) -> Force<T> {
         Force {
-            ang: self.rot.tr_mul(&(f.ang - self.trans.cross(&f.lin))),
-            lin: self.rot.tr_mul(&f.lin),
+            ang: mat_tr_vec(&self.rot, &add_cross(&f.ang, &f.lin, &self.trans)),
+            lin: mat_tr_vec(&self.rot, &f.lin),
         }
     }
     /// Inertia from b to a (mass unchanged, centre of mass moved, `I_c' = R I_c Rᵀ`).
