@@ -125,3 +125,28 @@ fn rpy_matches_axis_composition() {
         axis_angle(&Vector3::z(), y) * axis_angle(&Vector3::y(), p) * axis_angle(&Vector3::x(), r);
     assert!((rpy_to_matrix(r, p, y) - expect).amax() < 1e-15);
 }
+
+proptest! {
+    /// The multiply-add kernels of `ops` against nalgebra's operators (equal up to
+    /// the rounding of the fused products on an FMA build, bit-equal otherwise).
+    #[test]
+    fn ops_kernels_match_nalgebra(a in v3(), b in v3(), x in se3(), y in se3()) {
+        use super::ops::*;
+        let close = |p: &Vector3<f64>, q: &Vector3<f64>| (p - q).norm() <= 1e-14 * (1.0 + q.norm());
+        prop_assert!(close(&cross(&a, &b), &a.cross(&b)));
+        prop_assert!(close(&add_cross(&b, &a, &b), &(b + a.cross(&b))));
+        prop_assert!(close(&mat_vec(&x.rot, &a), &(x.rot * a)));
+        prop_assert!(close(&add_mat_vec(&b, &x.rot, &a), &(b + x.rot * a)));
+        prop_assert!(close(&mat_tr_vec(&x.rot, &a), &(x.rot.transpose() * a)));
+        prop_assert!(close(&axpy(&a, &b, 0.7), &(a + b * 0.7)));
+        prop_assert!((dot(&a, &b) - a.dot(&b)).abs() <= 1e-14 * (1.0 + a.norm() * b.norm()));
+        prop_assert!((mat_mat(&x.rot, &y.rot) - x.rot * y.rot).norm() <= 1e-14);
+        prop_assert!((mat_tr_mat(&x.rot, &y.rot) - x.rot.transpose() * y.rot).norm() <= 1e-14);
+        let m = madd(a.x, b.x, a.y);
+        if cfg!(target_feature = "fma") {
+            prop_assert_eq!(m, a.x.mul_add(b.x, a.y));
+        } else {
+            prop_assert_eq!(m, a.x * b.x + a.y);
+        }
+    }
+}
