@@ -229,3 +229,27 @@ fn tree_crba_and_fd() {
         }
     }
 }
+
+/// The fd rule (`Topology::choose`, fitted on callgrind counts): CRBA + LTDL on a
+/// small branching tree, ABA on a 6-DoF arm and on a chain of 50, and `fd` there
+/// equal to the method it names.
+#[test]
+fn fd_rule_picks_per_model() {
+    for (file, want) in [
+        ("assets/synthetic/tree_4.urdf", FdMethod::CrbaSparse),
+        ("assets/robots/ur5.urdf", FdMethod::Aba),
+        ("assets/synthetic/chain_50.urdf", FdMethod::Aba),
+    ] {
+        let model = load(file);
+        assert_eq!(model.topology.fd_method, want, "{file}");
+        let mut data = Data::new(&model);
+        let s = &random_states(&model, 1, 3)[0];
+        let fd = dynamics::forward_dynamics(&model, &mut data, &s.q, &s.v, &s.tau, None)
+            .unwrap()
+            .clone();
+        let aba = dynamics::aba(&model, &mut data, &s.q, &s.v, &s.tau, None)
+            .unwrap()
+            .clone();
+        assert!((&fd - &aba).norm() <= 1e-10 * (1.0 + aba.norm()), "{file}");
+    }
+}

@@ -89,14 +89,18 @@ impl Topology {
         t
     }
 
-    /// The measured cost rule (benches/results.md, "fd rule"): with B bodies,
-    /// estimated nanoseconds (generic x86-64 build, this machine)
-    /// `ABA ≈ 200·B` and `CRBA + RNEA + LTDL ≈ 230·B + 4·Σdepth + 1·Σdepth²`
-    /// (the per-body work of the bias RNEA and of the CRBA's composite inertias,
-    /// the CRBA's force transports and H entries, the factorisation's
-    /// multiply-adds). Measured, CRBA + LTDL took 1.3× (ur5, solo12) to 3.5×
-    /// (255-body tree) the time of ABA on every robot, chain and tree timed, so
-    /// the rule picks ABA except where ABA cannot go: mimic joints.
+    /// The measured cost rule: estimated instructions per call (callgrind on
+    /// `examples/profile.rs`, deterministic where wall time on a shared machine is
+    /// not), with B bodies, `ABA ≈ 1546·B` and
+    /// `CRBA + RNEA bias + LTDL ≈ 1217·B + 90·Σdepth + 1.94·Σdepth²` (the per-body
+    /// work of the bias RNEA and of the CRBA's composite inertias, the CRBA's force
+    /// transports and H entries, the factorisation's multiply-adds), each fitted by
+    /// relative least squares on ur5, kinova, solo12, talos_reduced, chains of
+    /// 5–50 and binary trees of depth 4–8 (benches/results.md, "fd rule"). Within
+    /// 6% of every measured count; the rule picks CRBA + LTDL for small branching
+    /// trees (tree_4: 20980 against ABA's 23133) and short chains (chain_5, a 2%
+    /// tie), ABA elsewhere, and CRBA + dense Cholesky wherever ABA cannot go:
+    /// mimic joints.
     pub fn choose(&self, _nv: usize, nbodies: usize, has_mimic: bool) -> FdMethod {
         if has_mimic {
             return FdMethod::CrbaDense;
@@ -114,8 +118,8 @@ impl Topology {
     }
 }
 
-/// Cost-model coefficients (ns), fitted on this machine (see `Topology::choose`).
-const ABA_PER_BODY: f64 = 200.0;
-const CRBA_PER_BODY: f64 = 230.0;
-const CRBA_PER_DEPTH: f64 = 4.0;
-const LTDL_PER_DEPTH2: f64 = 1.0;
+/// Cost-model coefficients (instructions), fitted as in `Topology::choose`.
+const ABA_PER_BODY: f64 = 1546.0;
+const CRBA_PER_BODY: f64 = 1217.0;
+const CRBA_PER_DEPTH: f64 = 90.0;
+const LTDL_PER_DEPTH2: f64 = 1.94;
