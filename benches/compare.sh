@@ -9,18 +9,21 @@
 #
 # The machine is shared and noisy (2 cores; a burst of load during one side's
 # measurement moves a single ratio by ±30%), so every model is measured in R rounds
-# (default 5), spread over the run: a round times every model of both flavours, each
-# model by urdyn and Pinocchio back to back, the order alternating from round to
-# round. The table reports, per model and algorithm, the median over rounds of each
-# side's median and the median of the R per-round ratios, with their range.
+# (default 7), spread over the run: a round times every model of both flavours, each
+# model by Pinocchio and then urdyn, back to back. Pinocchio's run spends its first
+# ~1.5 s in Python (URDF to model) before it times anything, so this order puts the two
+# timing windows next to each other (the machine's speed drifts by up to 2x over a
+# few seconds, with or without load). The table reports, per model and algorithm,
+# the median over rounds of each side's median and the median of the R per-round
+# ratios, with their range.
 #
 # Environment: PINOCCHIO_BENCH (default ../shared/tools/pinocchio-bench/run beside the
 # repository, or /work/shared/tools/pinocchio-bench/run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-ROUNDS=5
+ROUNDS=7
 SAMPLES=100
-BUDGET=0.4
+BUDGET=0.3
 FLAVOURS="generic native"
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -78,13 +81,8 @@ for round in $(seq 1 "$ROUNDS"); do
       IFS='|' read -r name urdf flags pin <<<"$entry"
       key="${name%% *}"
       echo "[round $round/$ROUNDS, $flavour] $name" >&2
-      if [ "$pin" = yes ] && [ $((round % 2)) -eq 0 ]; then
-        bench_pin "$flavour" "$key" "$urdf" "$flags" "$round"
-        bench_urdyn "$flavour" "$key" "$urdf" "$flags" "$round"
-      else
-        bench_urdyn "$flavour" "$key" "$urdf" "$flags" "$round"
-        [ "$pin" = yes ] && bench_pin "$flavour" "$key" "$urdf" "$flags" "$round"
-      fi
+      [ "$pin" = yes ] && bench_pin "$flavour" "$key" "$urdf" "$flags" "$round"
+      bench_urdyn "$flavour" "$key" "$urdf" "$flags" "$round"
     done
   done
 done
