@@ -203,67 +203,62 @@ if "generic" in runs:
             lines.append(f"| {key} | {fmt(a)} | {fmt(c)} | {c / a:.2f} |")
             if c < a:
                 below.append(f"{key} {c / a:.2f}")
-    lines += ["", "The rule's coefficients (ABA ≈ 200 ns a body, CRBA + RNEA + LTDL ≈ 230 ns a body "
-              "+ Σdepth and Σdepth² terms) were fitted before the hot-path work of this round, which "
-              "cut the CRBA (23–41% in instructions) and RNEA (30–34%) more than ABA (6–16%), so they "
-              "pick ABA for every non-mimic model; fd-crba ran faster than ABA in this run on: "
-              + (", ".join(below) if below else "none") + ". Re-fitting the rule on quiet-machine "
-              "timings is open work.", ""]
-lines += ["## Where a bar is missed, and why (callgrind, `examples/profile.rs`)", "",
-          "Instructions per call (callgrind on `examples/profile.rs`, generic build, difference of "
-          "600- and 200-call runs), before → after this round of work on the hot paths: each body's "
-          "joint kind is matched once per sweep (`dispatch_joint!` in src/model/joint.rs) and the "
-          "body step is compiled per joint model (compile-time axis and transform shape: no `match` "
-          "in the helpers, arrays sliced once so bounds checks vanish); joint angles' sin/cos by "
-          "`libm::sincos` (msun kernels, < 1 ulp, ~35 instructions fewer than the system libm); "
-          "the local-frame CRBA carries each subtree's forces to the parent together (as Pinocchio) "
-          "and starts from origin-form inertias computed at load (`Model::inertias_origin`); the "
-          "world-frame CRBA (chains ≥ 16 DoF) keeps composite inertias in body frames.",
-          "",
+    lines += ["", "The rule estimates instructions per call (callgrind, deterministic where wall time "
+              "here is not): ABA ≈ 1546·B for B bodies, CRBA + RNEA bias + LTDL ≈ 1217·B + 90·Σdepth + "
+              "1.94·Σdepth², fitted by relative least squares on the counts of ur5, kinova, solo12, "
+              "talos_reduced, chain_5 to chain_50 and tree_4 to tree_8 (within 6% of each). It picks "
+              "CRBA + LTDL for tree_4 (20,980 instructions against ABA's 23,133) and chain_5 (7,350 "
+              "against 7,180, a 2% tie), ABA elsewhere. fd-crba ran faster than ABA in this run on: "
+              + (", ".join(below) if below else "none") + ".", ""]
+lines += ["## Instruction counts (callgrind, `examples/profile.rs`)", "",
+          "Instructions per call (callgrind on `examples/profile.rs`, difference of 600- and 200-call "
+          "runs), deterministic where the wall times above are not.", "",
+          "Session 2 (generic build), before → after: each body's joint kind matched once per sweep "
+          "(`dispatch_joint!`, src/model/joint.rs) with the body step compiled per joint model; joint "
+          "sin/cos by `libm::sincos`; the local-frame CRBA carries a subtree's forces to the parent "
+          "together and starts from origin-form inertias computed at load; the world-frame CRBA "
+          "(chains ≥ 16 DoF) keeps composite inertias in body frames.", "",
           "| robot | rnea | crba | aba | fk (+frames) |",
           "|---|---|---|---|---|",
           "| ur5 | 5422 → 3797 | 5407 → 3729 | 10927 → 9652 | 2908 → 2624 |",
           "| kinova | 5632 → 4118 | 5886 → 4349 | 10930 → 10317 | – → 3121 |",
           "| solo12 | 11702 → 7753 | 11779 → 7143 | 25175 → 21175 | – → 4825 |",
           "| talos_reduced | 28679 → 19028 | 37948 → 22253 | – → 53640 | – → 13754 |",
-          "| chain_5 | 4447 → 3008 | 3920 → 2615 | – → 7491 | – → 1730 |",
-          "| chain_10 | 8734 → 5892 | 10052 → 6450 | – → 15626 | – → 3298 |",
           "| chain_50 | 43266 → 29006 | 74953 → 58072 | 97187 → 81185 | 18529 → 15920 |",
           "| chain_500 | 431408 → 292939 | 3451077 → 2439766 | – → 818447 | – → 158136 |",
           "| tree_4 | 13070 → 8840 | 12061 → 8019 | 28509 → 23863 | – → 4875 |",
-          "| tree_6 | 54509 → 36779 | 62635 → 39552 | – → 102770 | – → 20037 |",
           "",
-          "(aba and fk \"before\" were measured after the sincos change, so they show the dispatch "
-          "and ABA's axis-rotation inertia move alone.)",
+          "Session 3, before → after: the spatial kernels written as multiply-add chains "
+          "(`src/spatial/ops.rs`, `madd`: one fused instruction for `f64` when the build targets FMA, "
+          "`a * b + c` otherwise) in Se3, Motion, Inertia, CompositeInertia, the axis rotations, "
+          "ABA's 6x6 updates and LTDL; ABA starts from the origin-form inertias computed at load. "
+          "The generic build is unchanged but for ABA; an FMA build (counted with "
+          "`-C target-cpu=haswell`, AVX2 + FMA: valgrind cannot run this machine's AVX-512 code) "
+          "drops 3–15%:", "",
+          "| robot | build | rnea | crba | aba | fk (+frames) |",
+          "|---|---|---|---|---|---|",
+          "| ur5 | generic | 3797 → 3818 | 3730 → 3736 | 9646 → 9186 | 2642 → 2657 |",
+          "| ur5 | haswell | 3337 → 3217 | – | 7529 → 6816 | 2390 → 2264 |",
+          "| kinova | generic | 4118 → 4129 | 4351 → 4317 | 10312 → 9841 | 3108 → 3146 |",
+          "| kinova | haswell | 3517 → 3493 | 3795 → 3210 | 8006 → 7228 | 2734 → 2580 |",
+          "| chain_50 | generic | 29007 → 29063 | 58089 → 56774 | 81137 → 77847 | 16005 → 16136 |",
+          "| chain_50 | haswell | 25347 → 24602 | 45577 → 41601 | 64078 → 57741 | 15039 → 14332 |",
+          "| tree_4 | generic | 8841 → 8786 | 8020 → 7963 | 23848 → 23134 | 4899 → 5000 |",
+          "| tree_4 | haswell | 7678 → 7484 | – | 19112 → 17022 | 4632 → 4402 |",
           "",
-          "- **crba**: what remains per body is the composite-inertia move (R I Rᵀ with the "
-          "parallel-axis terms; a general rotation on kinova, whose placements all carry rpy), the "
-          "subtree force transports and sincos. On long chains the world-frame column sweep "
-          "(vectorised 6-term dot products) and the transposed copy into the lower triangle are "
-          "O(n²): a copy by 16 x 16 tiles is kept because a 32-row band, with fewer instructions, took "
-          "1.6x the time at n = 1000, and writing both triangles as dot products (no copy) took "
-          "1.2–1.5x at n = 50–200. Pinocchio fills one triangle only. Pinocchio gains more from "
-          "`-march=native` than urdyn does (AVX for Eigen's fixed-size kernels, and fused "
-          "multiply-adds wherever g++ contracts; rustc never fuses a·b + c without an explicit "
-          "`mul_add`), which shows on floating-base CRBA (solo12, anymal, talos). Next levers: "
-          "`mul_add` under `cfg(target_feature = \"fma\")` in the spatial kernels, a symmetric "
-          "2-D rotation for `act_ax` (18 products instead of 24).",
-          "- **rnea**: 30–34% fewer instructions on every model; per body what is left is the "
-          "arithmetic of seed eqs. 13–15 (two inverse transforms, two inertia products, one dual "
-          "cross product, one force transform) plus sincos.",
-          "- **The ✗ of the run recorded here (03:51 UTC, after `crba_upper`)**: rnea on chain_50 "
-          "(generic 0.63), kinova, chain_200 and chain_1000 (native 0.62–0.65) and crba on chain_50 "
-          "(generic 1.03). The same build's run ten minutes earlier (with the crba mirror, load "
-          "1.5–1.7) gave chain_50 rnea 0.46 and crba 0.71 (generic), kinova rnea 0.49 (native): at "
-          "this margin the ✗ comes and goes with load, the callgrind counts above do not. Long-chain "
-          "crba, ✗ in every earlier run (1.02–1.88), is fixed: the bench's crba computes the upper "
-          "triangle as Pinocchio's does (the mirror copy was half of the time at n = 500–1000); "
-          "chain_500/chain_1000 0.45–0.56 here.",
-          "- **Noise**: this machine has 2 cores shared with other jobs (load above). Pinocchio's own "
-          "medians moved by up to 2x between runs an hour apart (solo12 crba 2,416 → 1,207 ns "
-          "generic; talos crba 5,605 → 3,368 ns native) and urdyn's likewise (ur5 crba 354 and "
-          "703 ns in two runs a minute apart): a single ✗ that does not repeat across runs is load, "
-          "not code. Callgrind counts above are the deciding measure.",
+          "(– : valgrind 3.19 stops on an AVX instruction it does not know in that build.)",
+          "",
+          "- **Why fused multiply-adds**: g++ contracts `a * b + c` by default (Pinocchio's native "
+          "binary holds 5,330 `vfmadd` instructions, its generic one none); rustc never does. With "
+          "`-C llvm-args=-fp-contract=fast` on the whole program, kinova's RNEA went from about 600 "
+          "to 444 ns in one back-to-back test: that flag also changes the rounding of code that "
+          "relies on it (e.g. error-free transformations), so urdyn fuses explicitly, in its own "
+          "kernels only.",
+          "- **Noise**: this machine has 2 virtual cores shared with other jobs. The same binary, "
+          "run twelve times in a row on an idle machine (load 0.15), gave kinova crba medians from "
+          "329 to 688 ns, rising and falling over seconds; Pinocchio's medians move alike. Hence the "
+          "rounds above and the median of per-round ratios; the counts here are the deciding measure "
+          "for a code change.",
           ""]
 with open(out_md, "w") as fh:
     fh.write("\n".join(lines) + "\n")
