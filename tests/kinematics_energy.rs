@@ -201,3 +201,35 @@ fn centroidal_linear_momentum_is_mass_times_com_velocity() {
         }
     }
 }
+
+/// A revolute joint whose placement rotation is a rotation about its own axis
+/// (`rpy="0 0.7 0"` on a y axis) is loaded with that angle folded into the joint
+/// offset (identity placement rotation, the axis-rotation fast path); the link
+/// poses are those of the URDF: oM = T(xyz) Ry(0.7) Ry(q) for the first link, and a
+/// general placement (`rpy="0.3 0.7 0"`) is left as it is.
+#[test]
+fn axis_placement_folded_into_offset() {
+    let urdf = r#"<robot name="fold">
+      <link name="base"/>
+      <link name="a"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+      <link name="b"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="a"/>
+        <origin xyz="0.1 0.2 0.3" rpy="0 0.7 0"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+      <joint name="j2" type="revolute"><parent link="a"/><child link="b"/>
+        <origin xyz="0 0 0.4" rpy="0.3 0.7 0"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+    </robot>"#;
+    let model = urdyn::load_str(urdf, "fold.urdf", LoadOptions::default()).unwrap();
+    assert_eq!(model.placement_identity[1..], [true, false]);
+    let (q1, q2) = (0.25, -0.6);
+    let q = DVector::from_vec(vec![q1, q2]);
+    let mut data = Data::new(&model);
+    dynamics::forward_kinematics(&model, &mut data, &q);
+    let ry = |t: f64| nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::y_axis(), t);
+    let ra = ry(0.7) * ry(q1);
+    let pa = nalgebra::Vector3::new(0.1, 0.2, 0.3);
+    let rb = ra * nalgebra::Rotation3::from_euler_angles(0.3, 0.7, 0.0) * ry(q2);
+    let pb = pa + ra * nalgebra::Vector3::new(0.0, 0.0, 0.4);
+    let (oa, ob) = (&data.o_m_i[1], &data.o_m_i[2]);
+    assert!((oa.rot - ra.matrix()).norm() < 1e-15 && (oa.trans - pa).norm() < 1e-15);
+    assert!((ob.rot - rb.matrix()).norm() < 1e-15 && (ob.trans - pb).norm() < 1e-15);
+}

@@ -361,6 +361,7 @@ pub(crate) fn lower(
     }
 
     let frames: Vec<Frame<f64>> = frames.into_iter().flatten().collect();
+    fold_axis_placements(&mut joints, &mut placements);
     let topology = crate::model::Topology::new(&dof_parent, nbodies, has_mimic);
     Ok(Model {
         name: robot.name.clone(),
@@ -393,4 +394,48 @@ pub(crate) fn lower(
         source: None,
         report,
     })
+}
+
+/// A revolute joint about x, y or z whose placement rotation is itself a rotation
+/// about that axis by θ₀ (URDF arms often write `rpy="0 1.5708 0"` on a y-axis
+/// joint): `R₀ R(q) = R(q + θ₀)`, so θ₀ moves into the joint's offset and the
+/// placement keeps its translation only. The body frames are unchanged; the
+/// algorithms then take the joint's axis-rotation path (a rotation mixing two
+/// coordinates instead of a general 3x3 product). Only exact structure qualifies:
+/// the axis row and column of R₀ are exactly those of the identity.
+fn fold_axis_placements(joints: &mut [Joint<f64>], placements: &mut [Se3<f64>]) {
+    for (j, x) in joints.iter_mut().zip(placements.iter_mut()) {
+        let JointKind::Revolute(ax) = j.kind else {
+            continue;
+        };
+        let (a, b, c) = match ax {
+            Axis::X => (0, 1, 2),
+            Axis::Y => (1, 2, 0),
+            Axis::Z => (2, 0, 1),
+            Axis::Unit(_) => continue,
+        };
+        let r = &x.rot;
+        if *r == nalgebra::Matrix3::identity()
+            || r[(a, a)] != 1.0
+            || r[(a, b)] != 0.0
+            || r[(a, c)] != 0.0
+            || r[(b, a)] != 0.0
+            || r[(c, a)] != 0.0
+        {
+            continue;
+        }
+        // The (b, c) block is [cos θ₀, −sin θ₀; sin θ₀, cos θ₀] (b, c cyclic after a).
+        let theta = r[(c, b)].atan2(r[(b, b)]);
+        let (s, co) = theta.sin_cos();
+        let tol = 4.0 * f64::EPSILON;
+        if (r[(b, b)] - co).abs() > tol
+            || (r[(c, c)] - co).abs() > tol
+            || (r[(c, b)] - s).abs() > tol
+            || (r[(b, c)] + s).abs() > tol
+        {
+            continue;
+        }
+        j.offset += theta;
+        x.rot = nalgebra::Matrix3::identity();
+    }
 }
