@@ -2,7 +2,7 @@
 //! as one JSON document.
 
 use crate::dynamics::{self, DynamicsError};
-use crate::model::{Data, Model};
+use crate::model::{Data, FdMethod, Model};
 use crate::state::{StateError, StatesFile};
 use serde_json::{json, Map, Value};
 
@@ -111,12 +111,20 @@ fn evaluate_each(
                 message: format!("{key}: {}", DynamicsError::Singular(k)),
             });
         }
-        let qdd = dynamics::forward_dynamics(&model, &mut data, &sv.q, &sv.v, &sv.tau, None)
-            .map_err(|e| EvalError::Dynamics {
-                file: states_file.to_string(),
-                message: format!("{key}: {e}"),
-            })?
-            .clone();
+        let qdd = if model.topology.fd_method == FdMethod::CrbaDense {
+            // The engine's fd on a mimic model is exactly this H (CRBA, Gᵀ H G),
+            // this bias and this dense Cholesky: solve with the factor just made.
+            let mut qdd = &sv.tau - &bias;
+            dynamics::linalg::cholesky_solve(&data.chol, &mut qdd);
+            qdd
+        } else {
+            dynamics::forward_dynamics(&model, &mut data, &sv.q, &sv.v, &sv.tau, None)
+                .map_err(|e| EvalError::Dynamics {
+                    file: states_file.to_string(),
+                    message: format!("{key}: {e}"),
+                })?
+                .clone()
+        };
         // Finite inputs can still overflow (a mass of 1e300, a speed of 1e200):
         // an answer with infinities or NaN (JSON null) is an error, not output.
         let finite = |x: &nalgebra::DVector<f64>| x.iter().all(|v| v.is_finite());
