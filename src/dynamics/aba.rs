@@ -3,7 +3,7 @@
 use super::rnea::{act_force_ax, inv_act_motion_ax};
 use super::{CompositeInertia, DynamicsError};
 use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
-use crate::spatial::ops::{cross, dot3, madd, mat_mat};
+use crate::spatial::ops::{cross, madd, mat_mat};
 use crate::spatial::{skew, Force, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Matrix6, Vector3, Vector6};
 
@@ -264,9 +264,7 @@ pub fn aba<'d, T: Scalar>(
             let a1 = inv_act_motion_ax(li, jm.rot_axis(), &ap) + cc[i];
             let iv = jm.joint().iv;
             if jm.nv() == 1 {
-                let (u, a) = (&uu[i], mvec(&a1));
-                let ua = madd(u[5], a[5], madd(u[4], a[4], madd(u[3], a[3], dot3(u[0], u[1], u[2], a[0], a[1], a[2]))));
-                let x = dinv[i] * (uq[i] - ua);
+                let x = dinv[i] * (uq[i] - a1.dot(&vforce(&uu[i])));
                 qdd[iv] = x;
                 let mut ai = a1;
                 jm.add_subspace_scaled(&mut ai, x);

@@ -190,12 +190,12 @@ fn shift_entries<T: Scalar>(
 /// `H[i, j] = Sⱼᵀ ʲXᵢ* F` for every ancestor-or-self j of i (seed eq. 16),
 /// zero for unrelated pairs.
 ///
-/// Without mimic joints every quantity is expressed in the world frame (oMᵢ from
-/// forward kinematics): composite inertias then add without transforms, and
-/// `H[i, j] = (⁰X̂ⱼ Sⱼ)ᵀ (I^c_i ⁰X̂ᵢ Sᵢ)` is a 6-term dot product per entry, walked
-/// along the coordinate parent array λ. The work is O(n) transforms plus
-/// O(Σ depth) = O(n·d) dot products (O(n²) on a chain), with no force
-/// transported from frame to frame.
+/// On chains of 16 or more coordinates without mimic joints, H's entries are formed
+/// in the world frame (`crba_world`, oMᵢ from forward kinematics):
+/// `H[j, k] = (⁰X̂ⱼ Sⱼ)ᵀ (⁰X̂ᵢ* I^c_i Sₖ)` is a 6-term dot product per entry, and
+/// column k of the upper triangle is one contiguous sweep over j = 0..=k. The work
+/// is O(n) transforms plus O(n²) dot products, with no force transported from
+/// frame to frame.
 ///
 /// On branching trees and short chains (`model.topology.crba_local`) the local-frame
 /// variant runs instead (see `crba_local`): fewer instructions there.
@@ -308,8 +308,10 @@ fn crba_mimic<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
 /// accumulated in body frames (moved to the parent by `λ(i)Mi`, a rotation about
 /// the joint axis for most joints: cheaper than moving every body inertia to the
 /// world), and `F = I^c_i Sₖ` (a column of I^c_i for an axis-aligned joint) is
-/// moved to the world once.
+/// moved to the world once. Runs on chains only (`!model.topology.crba_local`):
+/// coordinate k's ancestors are 0..k.
 fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>, mirror: bool) {
+    debug_assert!(model.topology.h_dense, "crba_world runs on chains only");
     let nb = model.nbodies;
     let nv = model.nv;
     let q = q.as_slice();
@@ -318,7 +320,6 @@ fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>, m
     let inertias = &model.inertias_origin[..nb];
     let parent = &model.parent[..nb];
     let ident = &model.placement_identity[..nb];
-    let lambda = &model.dof_parent[..nv];
     let li_m_i = &mut data.li_m_i[..nb];
     let o_m_i = &mut data.o_m_i[..nb];
     let ic = &mut data.crba_ic[..nb];
@@ -349,8 +350,6 @@ fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>, m
         ic[i] = inertias[i];
     }
     let hs = data.h.as_mut_slice();
-    // (Short chains take the λ walk: the vector sweep's set-up costs more there.)
-    let chain = model.topology.h_dense && nv >= 16;
     for i in (1..nb).rev() {
         let p = parent[i];
         let (head, tail) = ic.split_at_mut(i);
@@ -363,32 +362,14 @@ fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>, m
                 // F = ⁰X̂ᵢ* I^c_i S_k (world frame)
                 let f = om.act_force(&jm.mul_subspace(&ici, c));
                 let col = &mut hs[k * nv..(k + 1) * nv];
-                if chain {
-                    // A chain: k's ancestors are 0..k, so column k of the upper
-                    // triangle is one contiguous, vectorisable sweep.
-                    project(
-                        &f,
-                        [&sw0[..=k], &sw1[..=k], &sw2[..=k]],
-                        [&sv0[..=k], &sv1[..=k], &sv2[..=k]],
-                        &mut col[..=k],
-                    );
-                } else {
-                    // H[j, k] = S_jᵀ F for j = k and every coordinate on k's path to the root.
-                    let (n0, n1, n2) = (f.ang.x, f.ang.y, f.ang.z);
-                    let (f0, f1, f2) = (f.lin.x, f.lin.y, f.lin.z);
-                    let mut j = k;
-                    loop {
-                        col[j] = madd(
-                            sv2[j],
-                            f2,
-                            madd(sv1[j], f1, madd(sv0[j], f0, dot3(sw0[j], sw1[j], sw2[j], n0, n1, n2))),
-                        );
-                        j = lambda[j];
-                        if j >= nv {
-                            break;
-                        }
-                    }
-                }
+                // H[j, k] = S_jᵀ F for j = 0..=k (k's ancestors on a chain): column k
+                // of the upper triangle, one contiguous, vectorisable sweep.
+                project(
+                    &f,
+                    [&sw0[..=k], &sw1[..=k], &sw2[..=k]],
+                    [&sv0[..=k], &sv1[..=k], &sv2[..=k]],
+                    &mut col[..=k],
+                );
             }
             // I^c_p += ₚX̂ᵢ* I^c_i ⁱX̂ₚ
             if p != 0 {
@@ -397,19 +378,8 @@ fn crba_world<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>, m
         });
     }
     // Mirror the upper triangle into the lower one.
-    if !mirror {
-        return;
-    }
-    if chain {
+    if mirror {
         mirror_blocked(hs, nv);
-    } else {
-        for k in 0..nv {
-            let mut j = lambda[k];
-            while j < nv {
-                hs[k + j * nv] = hs[j + k * nv];
-                j = lambda[j];
-            }
-        }
     }
 }
 
@@ -419,17 +389,12 @@ fn project<T: Scalar>(f: &Force<T>, w: [&[T]; 3], v: [&[T]; 3], out: &mut [T]) {
     let len = out.len();
     let (w0, w1, w2) = (&w[0][..len], &w[1][..len], &w[2][..len]);
     let (v0, v1, v2) = (&v[0][..len], &v[1][..len], &v[2][..len]);
-    let (n, l) = (f.ang, f.lin);
     for j in 0..len {
-        out[j] = madd(
-            v2[j],
-            l.z,
-            madd(
-                v1[j],
-                l.y,
-                madd(v0[j], l.x, dot3(w0[j], w1[j], w2[j], n.x, n.y, n.z)),
-            ),
+        let s = Motion::new(
+            Vector3::new(w0[j], w1[j], w2[j]),
+            Vector3::new(v0[j], v1[j], v2[j]),
         );
+        out[j] = s.dot(f);
     }
 }
 
