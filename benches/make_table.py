@@ -8,7 +8,7 @@ import subprocess
 import sys
 import time
 
-ALGOS_ALL = ["rnea", "bias", "crba", "aba", "fd", "fd-crba", "fd-rnea", "fk"]
+ALGOS = ["rnea", "bias", "crba", "aba", "fd", "fd-crba", "fd-rnea", "fk"]
 
 
 def pin_ref(pr, algo):
@@ -70,7 +70,7 @@ for flavour, keys in rounds.items():
         if "urdyn" in sides and "pinocchio" in sides:
             ratios = {}
             common = sorted(set(sides["urdyn"]) & set(sides["pinocchio"]))
-            for a in ALGOS_ALL:
+            for a in ALGOS:
                 rs = []
                 for k in common:
                     x = sides["urdyn"][k].get("results", {}).get(a, {}).get("median_ns")
@@ -84,7 +84,6 @@ with open(out_json, "w") as fh:
     json.dump(runs, fh, indent=1, sort_keys=True)
 
 BARS = {"rnea": 0.6, "aba": 0.8, "crba": 1.0, "fk": 1.0, "fd": 1.0}
-ALGOS = ["rnea", "bias", "crba", "aba", "fd", "fd-crba", "fd-rnea", "fk"]
 ORDER = ["ur5", "kinova", "solo12", "anymal", "talos_reduced", "panda"] + \
     [f"chain_{n}" for n in [5, 10, 20, 50, 100, 200, 500, 1000]] + [f"tree_{d}" for d in [4, 6, 8]]
 
