@@ -19,32 +19,38 @@
 //! of its points within `δ` of the plane: a box's corners, a hull's vertices, a
 //! cylinder's lowest rim points plus 6 samples on each rim, a sphere's lowest
 //! point, a capsule's two end-sphere lowest points. More than 8 such points are
-//! reduced to the deepest and the extremes in 8 horizontal directions. Each point
-//! keeps a stable *slot* (shape, feature) so the solver can warm-start.
+//! reduced to at most 9: the deepest, the points kept last step that are still
+//! within the margin, then the extremes in 8 horizontal directions (a persistent
+//! set: a face lying on the ground keeps its points from step to step). Each
+//! point keeps a stable *slot* (shape, feature) so the solver can warm-start.
 //!
-//! # Forces (solved in [`crate::sim`])
+//! # Forces (solved in [`crate::sim`], docs/theory.md §"Constraint rows")
 //! Contact is a velocity-level, time-stepping (Stewart–Trinkle / Anitescu) impulse
 //! model: for a point with normal n = +z, signed gap φ (negative = penetration)
 //! and Jacobian J (ṗ = J q̇), the step's impulse λ = (λₙ, λₜ₁, λₜ₂) satisfies
 //!
 //! - 0 ≤ λₙ ⊥ (uₙ − bₙ) ≥ 0 with uₙ = n·ṗ after the step and
 //!   bₙ = −φ/Δt when φ > 0 (speculative: the gap may close, not overshoot) and
-//!   bₙ = β(−φ)/Δt when φ ≤ 0 (Baumgarte push-out, β = 0.2), or with
-//!   restitution e > 0 and an approaching point, bₙ = max(bₙ, −e uₙ⁻);
+//!   bₙ = 0 when φ ≤ 0, or with restitution e > 0 and an approaching point,
+//!   bₙ = max(bₙ, −e uₙ⁻);
 //! - Coulomb's cone ‖λₜ‖ ≤ μ λₙ with maximal dissipation: λₜ opposes the tangential
 //!   velocity, and the point sticks (uₜ = 0) while inside the cone — static
 //!   friction is exact, not regularised;
 //!
-//! solved by projected Gauss–Seidel on the Delassus matrix W = J H⁻¹ Jᵀ, kept
-//! implicit as W = Y Yᵀ with Y = J L⁻ᵀ (H = L Lᵀ: one forward substitution per
-//! row, the solver carries Lᵀ Δv), warm-started from the last step's impulses
-//! (stable point slots), to 1e-7 m/s (or rad/s) change per sweep, at most 60
-//! sweeps; sweeps 4–30 over-relax the scalar rows by 1.3 (projected SOR) and a
-//! plain sweep ends the solve (`crate::sim::solver`). The
-//! impulse is turned into a world-frame spatial force per body,
-//! f̂ = Σ (p × F, F) with F = (λₙ n + λₜ₁ t₁ + λₜ₂ t₂)/Δt (seed eq. 15's f̂ˣ),
-//! held constant over the step. With zero restitution the model never adds
-//! energy at an impact; it is unconditionally stable at any step (no stiffness).
+//! solved by projected Gauss–Seidel on the Delassus matrix W = J H̃⁻¹ Jᵀ
+//! (H̃ = H + A + Δt·D, damping implicit), kept implicit as W = Y Yᵀ with
+//! Y = J L⁻ᵀ (H̃ = L Lᵀ: one forward substitution per row, the solver carries
+//! Lᵀ Δv), warm-started from the last step's impulses (stable point slots), to
+//! 1e-7 m/s (or rad/s) change per sweep, at most 60 sweeps; sweeps 4–30
+//! over-relax the scalar rows by 1.3 (projected SOR) and a plain sweep ends the
+//! solve (`crate::sim::solver`; a solve stopped by the cap is made
+//! energy-safe). Penetration is removed by the position pass (split impulse):
+//! a pseudo-velocity that moves q, never v, at β = 0.2 of the depth per step
+//! and at most [`ContactParams::max_push_speed`] (0.5 m/s). The impulse is
+//! turned into a world-frame spatial force per body, f̂ = Σ (p × F, F) with
+//! F = (λₙ n + λₜ₁ t₁ + λₜ₂ t₂)/Δt (docs/theory.md §"External forces"). With
+//! zero restitution the model never adds energy at an impact; it is
+//! unconditionally stable at any step (no stiffness).
 
 pub mod mesh;
 mod paths;
@@ -67,8 +73,14 @@ pub struct ContactParams {
     pub friction: f64,
     /// Newton restitution coefficient e (0: perfectly inelastic).
     pub restitution: f64,
-    /// Baumgarte factor β: the fraction of a penetration removed per step.
+    /// Baumgarte factor β: the fraction of a penetration removed per step by
+    /// the position pass (never through the velocity).
     pub baumgarte: f64,
+    /// The fastest the position pass pushes a penetrating point out (m/s): a
+    /// start deep in the ground comes out slowly, never thrown.
+    pub max_push_speed: f64,
+    /// Penetration left alone (m): below it nothing is pushed.
+    pub slop: f64,
     /// Detection margin δ (m): points closer than this to the plane are candidates.
     pub margin: f64,
     /// Points per shape above which they are reduced (to the deepest and the
@@ -84,6 +96,8 @@ impl Default for ContactParams {
             friction: 1.0,
             restitution: 0.0,
             baumgarte: 0.2,
+            max_push_speed: 0.5,
+            slop: 1e-4,
             margin: 0.005,
             max_points_per_shape: 8,
         }
@@ -178,6 +192,10 @@ pub struct GroundContact {
     /// Total number of slots.
     pub nslots: usize,
     scratch: Vec<ContactPoint>,
+    /// Slots the last detection kept, as flags and as a list: a reduced
+    /// manifold keeps them while they stay within the margin.
+    prev_flag: Vec<bool>,
+    prev_list: Vec<usize>,
 }
 
 const CYL_SAMPLES: usize = 6;
@@ -362,6 +380,8 @@ impl GroundContact {
             slot_offset,
             nslots: n,
             scratch: Vec::with_capacity(cap),
+            prev_flag: vec![false; n],
+            prev_list: Vec::with_capacity(n),
         }))
     }
 
@@ -504,37 +524,42 @@ impl GroundContact {
                     }
                 }
             }
-            reduce(scratch, maxp, out);
+            reduce(scratch, maxp, out, &self.prev_flag);
+        }
+        for &k in &self.prev_list {
+            self.prev_flag[k] = false;
+        }
+        self.prev_list.clear();
+        for p in out.iter() {
+            if let Some(f) = self.prev_flag.get_mut(p.slot) {
+                *f = true;
+                self.prev_list.push(p.slot);
+            }
         }
     }
 }
 
-/// Appends `pts` to `out`, reduced to the deepest point and the extremes in
-/// `maxp` evenly spaced horizontal directions when there are more than `maxp`.
-/// Near-ties (within 1 µm, as a flat face's corners are) go to the lowest slot,
-/// so that the choice holds from step to step and the solver's warm start with it.
-fn reduce(pts: &[ContactPoint], maxp: usize, out: &mut Vec<ContactPoint>) {
+/// Appends `pts` to `out`, reduced to at most `maxp + 1` points when there
+/// are more than `maxp`: the deepest point, then the points kept last time
+/// (`prev`, by slot) that are still here, deepest first, then the extremes in
+/// `maxp` evenly spaced horizontal directions. Keeping last step's points makes
+/// the set persistent: a flat face with more candidates than room does not
+/// swap its points from step to step (which, with the solver's warm start,
+/// kept solo8's base rocking in a 6 ms cycle). Near-ties (within 1 µm, as a
+/// flat face's corners are) go to the lowest slot.
+fn reduce(pts: &[ContactPoint], maxp: usize, out: &mut Vec<ContactPoint>, prev: &[bool]) {
     if pts.len() <= maxp {
         out.extend_from_slice(pts);
         return;
     }
     const TIE: f64 = 1e-6;
     let start = out.len();
-    let add = |k: usize, out: &mut Vec<ContactPoint>| {
-        if let Some(p) = pts.get(k) {
-            if !out[start..].iter().any(|q| q.slot == p.slot) {
-                out.push(*p);
-            }
-        }
-    };
+    let cap = maxp + 1;
+    let has = |out: &Vec<ContactPoint>, slot: usize| out[start..].iter().any(|q| q.slot == slot);
     // the best by `key` (larger wins), near-ties to the lowest slot
     let pick = |key: &dyn Fn(&ContactPoint) -> f64| -> usize {
-        let mut best = 0;
-        let mut bv = f64::NEG_INFINITY;
-        for p in pts {
-            bv = bv.max(key(p));
-        }
-        let mut slot = usize::MAX;
+        let bv = pts.iter().map(key).fold(f64::NEG_INFINITY, f64::max);
+        let (mut best, mut slot) = (0, usize::MAX);
         for (k, p) in pts.iter().enumerate() {
             if key(p) >= bv - TIE && p.slot < slot {
                 slot = p.slot;
@@ -543,10 +568,33 @@ fn reduce(pts: &[ContactPoint], maxp: usize, out: &mut Vec<ContactPoint>) {
         }
         best
     };
-    add(pick(&|p| -p.gap), out);
+    out.push(pts[pick(&|p| -p.gap)]);
+    // last step's points, deepest first
+    while out.len() - start < cap {
+        let mut next: Option<usize> = None;
+        for (k, p) in pts.iter().enumerate() {
+            if prev.get(p.slot).copied().unwrap_or(false)
+                && !has(out, p.slot)
+                && next.is_none_or(|b| p.gap < pts[b].gap)
+            {
+                next = Some(k);
+            }
+        }
+        match next {
+            Some(k) => out.push(pts[k]),
+            None => break,
+        }
+    }
+    // directional extremes fill the rest
     for d in 0..maxp {
+        if out.len() - start >= cap {
+            return;
+        }
         let a = std::f64::consts::TAU * d as f64 / maxp as f64;
-        let (s, c) = a.sin_cos();
-        add(pick(&|p| c * p.point.x + s * p.point.y), out);
+        let (sn, c) = a.sin_cos();
+        let k = pick(&|p| c * p.point.x + sn * p.point.y);
+        if !has(out, pts[k].slot) {
+            out.push(pts[k]);
+        }
     }
 }

@@ -5,6 +5,7 @@
 //! world. A body is a movable joint plus every link welded to its child link
 //! through fixed joints; each URDF link stays addressable as a [`Frame`].
 
+pub mod configuration;
 mod data;
 pub(crate) mod joint;
 mod topology;

@@ -10,7 +10,16 @@
 //! - joint friction: |λ| ≤ F Δt, u = 0 inside (a joint loaded below its
 //!   friction F stays at rest);
 //! - joint limit (one-sided): 0 ≤ λ ⊥ u − b ≥ 0, with b = −φ/Δt for a gap φ > 0
-//!   (the joint may reach its limit, not pass it) and βφ⁻/Δt when past it.
+//!   (the joint may reach its limit, not pass it) and b = 0 when past it.
+//!
+//! The velocity solve never pushes a violated constraint back (b ≤ 0 for every
+//! unilateral row): that would turn a position error into kinetic energy.
+//! Violations are removed by a separate *position pass* ([`Rows::solve_position`],
+//! split impulse / post-stabilisation): a pseudo-velocity w = H̃⁻¹Jᵀμ with
+//! 0 ≤ μ ⊥ J w − b_pos ≥ 0 on the unilateral rows, b_pos = min(βφ⁻/Δt, cap),
+//! moves q but never enters v.
+
+use crate::dynamics::linalg::by_size;
 
 /// What a row is.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,6 +51,10 @@ pub struct Rows {
     /// Target (b) of each row.
     pub b: Vec<f64>,
     pub lambda: Vec<f64>,
+    /// Position-pass target of each unilateral row (0: not violated).
+    pub bpos: Vec<f64>,
+    /// Position-pass multipliers.
+    pub mu: Vec<f64>,
     cap: usize,
 }
 
@@ -57,6 +70,8 @@ impl Rows {
             c: vec![0.0; cap],
             b: vec![0.0; cap],
             lambda: vec![0.0; cap],
+            bpos: vec![0.0; cap],
+            mu: vec![0.0; cap],
             cap,
         }
     }
@@ -91,6 +106,7 @@ impl Rows {
         self.kind.push(kind);
         self.b[r] = b;
         self.lambda[r] = warm;
+        self.bpos[r] = 0.0;
         Some(r)
     }
     pub fn jrow_mut(&mut self, r: usize) -> &mut [f64] {
@@ -334,6 +350,56 @@ impl Rows {
             }
             if change <= tol {
                 finishing = true;
+            }
+        }
+        it
+    }
+}
+
+impl Rows {
+    /// The position pass (split impulse): projected Gauss–Seidel on the same
+    /// W = Y Yᵀ over the unilateral rows (contact normals, joint limits) only,
+    /// from μ = 0, for 0 ≤ μᵣ ⊥ yᵣ·w' − b_posᵣ ≥ 0; the pseudo-velocity is
+    /// w = L⁻ᵀ w' (`dw` receives w' = Yᵀμ; the caller back-substitutes). Rows
+    /// that are not violated (b_pos = 0) take part so that pushing one point out
+    /// never pushes another in. Returns the sweeps.
+    pub fn solve_position(&mut self, dw: &mut [f64], max_iter: usize, tol: f64) -> usize {
+        let (nv, n) = (self.nv, self.n);
+        if dw.len() < nv || self.y.len() < n * nv || self.mu.len() < n || self.bpos.len() < n {
+            return 0;
+        }
+        let dw = &mut dw[..nv];
+        dw.iter_mut().for_each(|x| *x = 0.0);
+        let y = &self.y[..n * nv];
+        let mu = &mut self.mu[..n];
+        mu.iter_mut().for_each(|x| *x = 0.0);
+        let mut it = 0;
+        while it < max_iter {
+            it += 1;
+            let mut change: f64 = 0.0;
+            for r in 0..n {
+                if !matches!(self.kind[r], RowKind::Normal | RowKind::Unilateral) {
+                    continue;
+                }
+                let wrr = self.w[r];
+                if !(wrr > 1e-14) {
+                    continue;
+                }
+                let yr = &y[r * nv..(r + 1) * nv];
+                let u = dot(yr, dw);
+                let old = mu[r];
+                let new = (old - (u - self.bpos[r]) / wrr).max(0.0);
+                let d = new - old;
+                if d != 0.0 {
+                    mu[r] = new;
+                    for (x, yk) in dw.iter_mut().zip(yr) {
+                        *x += d * yk;
+                    }
+                    change = change.max((d * wrr).abs());
+                }
+            }
+            if change <= tol {
+                break;
             }
         }
         it

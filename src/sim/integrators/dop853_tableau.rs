@@ -4,6 +4,7 @@
 #![allow(clippy::excessive_precision, clippy::unreadable_literal)]
 
 pub const N_STAGES: usize = 12;
+#[allow(dead_code)]
 pub const C: [f64; 12] = [
     0.0,
     0.05260015195876773,

@@ -1,0 +1,450 @@
+//! One step's constraints: the rows of ground contact (normal + Coulomb cone),
+//! joint Coulomb friction and joint position limits at (q, v), their impulses
+//! by [`solver`](super::solver), and what those impulses do.
+//!
+//! With H̃ = H + A + Δt·D (A the armature, D the joint damping: damping is
+//! implicit, see [`super`]) factored as L Lᵀ and the free velocity v*, the
+//! impulses λ give the end-of-step velocity v⁺ = v* + H̃⁻¹Jᵀλ (the
+//! time-stepping scheme of Stewart–Trinkle / Anitescu), and the position pass
+//! a pseudo-velocity w = H̃⁻¹Jᵀμ that removes penetration and limit violations
+//! at a capped rate without entering v (split impulse).
+//!
+//! Row targets (u = J v⁺, φ the signed gap: contact distance, or distance to a
+//! joint limit):
+//! - φ > 0: b = −φ/Δt (speculative: the gap may close within the step, not
+//!   overshoot); φ ≤ 0: b = 0 (no push-out in the velocity: it would become
+//!   kinetic energy); restitution e > 0 raises b to −e·u⁻ on fast impacts;
+//! - position pass: b_pos = min(β(−φ − slop)/Δt, cap) where φ < −slop.
+
+use super::solver::{self, RowKind, Rows};
+use super::ContactForce;
+use crate::contact::ContactPoint;
+use crate::dynamics::linalg::chol_backward_slice;
+use crate::model::Model;
+use crate::spatial::{Force, Motion, Se3};
+use nalgebra::{DVector, Vector3};
+
+/// What the rows are built from, besides the state.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RowParams {
+    /// Joint friction and limits on.
+    pub joint_dynamics: bool,
+    /// Coulomb friction with the ground, restitution.
+    pub mu: f64,
+    pub restitution: f64,
+    /// |g| (for the restitution threshold).
+    pub gravity: f64,
+    /// Fraction of a violation removed per step by the position pass.
+    pub beta: f64,
+    /// Caps of the position pass's rate: contact (m/s), joint limit (rad/s or m/s).
+    pub contact_push_cap: f64,
+    pub limit_push_cap: f64,
+    /// Violations below these are left alone (m, rad).
+    pub contact_slop: f64,
+    pub limit_slop: f64,
+}
+
+/// How many rows of each kind one assembly made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct RowCounts {
+    pub friction: usize,
+    pub limits: usize,
+    pub contacts: usize,
+    /// Rows whose constraint is violated (position pass needed).
+    pub violated: usize,
+}
+
+impl RowCounts {
+    pub fn total(&self) -> usize {
+        self.friction + self.limits + 3 * self.contacts
+    }
+    /// Whether the step touches anything (a contact point or a joint limit):
+    /// such a step is taken by the time-stepping scheme.
+    pub fn touching(&self) -> bool {
+        self.limits + self.contacts > 0
+    }
+}
+
+/// The solve's result: views into the workspace, valid until the next solve.
+pub(crate) struct Impulses<'a> {
+    /// H̃⁻¹Jᵀλ: v⁺ = v* + dv.
+    pub dv: &'a DVector<f64>,
+    /// The position pass's pseudo-velocity w (None: nothing violated).
+    pub push: Option<&'a DVector<f64>>,
+    /// Generalized force of the joint rows (friction, limits), Jᵀλ/Δt.
+    pub tau_joint: &'a DVector<f64>,
+    /// PGS sweeps used (velocity solve).
+    pub sweeps: usize,
+}
+
+/// Preallocated rows, warm starts and results.
+#[derive(Clone, Debug)]
+pub(crate) struct Constraints {
+    rows: Rows,
+    /// (dof, which): which = 0 friction, 1 lower limit, 2 upper limit, per joint row.
+    joint_rows: Vec<(usize, u8)>,
+    /// The contact point (index into the step's points) of each contact triple.
+    row_point: Vec<usize>,
+    /// Warm-start impulses per contact slot (n, t1, t2) and per joint (friction, lower, upper).
+    warm_contact: Vec<[f64; 3]>,
+    /// The slots of `warm_contact` written by the last solve (only these are cleared).
+    warm_slots: Vec<usize>,
+    warm_joint: Vec<[f64; 3]>,
+    /// World-frame motion subspace columns of each body (≤ 6).
+    sw: Vec<[Motion; 6]>,
+    counts: RowCounts,
+    dv: DVector<f64>,
+    push: DVector<f64>,
+    tau_joint: DVector<f64>,
+    fext: Vec<Force>,
+    contact_forces: Vec<ContactForce>,
+}
+
+impl Constraints {
+    /// Room for `max_points` contact points and every joint's three rows.
+    pub fn new(model: &Model, max_points: usize, nslots: usize) -> Self {
+        let ndof = model.dofs.len();
+        let cap = 3 * max_points + 3 * ndof;
+        let nv = model.nv;
+        Self {
+            rows: Rows::new(nv, cap),
+            joint_rows: Vec::with_capacity(3 * ndof),
+            row_point: Vec::with_capacity(max_points),
+            warm_contact: vec![[0.0; 3]; nslots],
+            warm_slots: Vec::with_capacity(max_points),
+            warm_joint: vec![[0.0; 3]; ndof],
+            sw: vec![[Motion::zero(); 6]; model.nbodies],
+            counts: RowCounts::default(),
+            dv: DVector::zeros(nv),
+            push: DVector::zeros(nv),
+            tau_joint: DVector::zeros(nv),
+            fext: vec![Force::zero(); model.nbodies],
+            contact_forces: Vec::with_capacity(max_points),
+        }
+    }
+
+    /// Forgets the warm starts (a new state was set).
+    pub fn reset_warm_start(&mut self) {
+        self.warm_contact.iter_mut().for_each(|w| *w = [0.0; 3]);
+        self.warm_joint.iter_mut().for_each(|w| *w = [0.0; 3]);
+        self.warm_slots.clear();
+    }
+
+    /// Forgets the last step's forces (a step taken without constraints).
+    pub fn clear_forces(&mut self) {
+        self.fext.iter_mut().for_each(|f| *f = Force::zero());
+        self.contact_forces.clear();
+        self.tau_joint.fill(0.0);
+    }
+
+    /// Rows of the last assembly.
+    pub fn rows_len(&self) -> usize {
+        self.rows.n
+    }
+    pub fn contact_forces(&self) -> &[ContactForce] {
+        &self.contact_forces
+    }
+    pub fn body_forces(&self) -> &[Force] {
+        &self.fext
+    }
+
+    /// Builds the rows at (q, v) for a step `h`: joint friction and limits
+    /// (within 1 mm + 2|v|h of a limit), then three rows per contact point.
+    /// `o_m_i` are the world poses at q (contact Jacobians are built from them).
+    #[allow(clippy::too_many_arguments)]
+    pub fn assemble(
+        &mut self,
+        model: &Model,
+        o_m_i: &[Se3<f64>],
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        points: &[ContactPoint],
+        p: &RowParams,
+        h: f64,
+    ) -> RowCounts {
+        let (vo, qo) = (model.joint_v_offset(), model.joint_q_offset());
+        let rows = &mut self.rows;
+        rows.clear();
+        self.joint_rows.clear();
+        self.row_point.clear();
+        let mut counts = RowCounts::default();
+        let speculative = |gap: f64| if gap > 0.0 { -gap / h } else { 0.0 };
+        let pos_target = |gap: f64, slop: f64, cap: f64| {
+            if gap < -slop {
+                (p.beta * (-gap - slop) / h).min(cap)
+            } else {
+                0.0
+            }
+        };
+        // joint rows: friction (|λ| ≤ F h), limits (λ ≥ 0)
+        if p.joint_dynamics {
+            for (d, info) in model.dofs.iter().enumerate() {
+                let (iq, iv) = (qo + d, vo + d);
+                if info.friction > 0.0 {
+                    let kind = RowKind::Box {
+                        limit: info.friction * h,
+                    };
+                    if let Some(r) = rows.push(kind, 0.0, self.warm_joint[d][0]) {
+                        rows.jrow_mut(r)[iv] = 1.0;
+                        self.joint_rows.push((d, 0));
+                        counts.friction += 1;
+                    }
+                }
+                if info.continuous {
+                    continue;
+                }
+                let (qd, vd) = (q[iq], v[iv]);
+                let margin = 1e-3 + 2.0 * vd.abs() * h;
+                let sides = [
+                    (info.limits.lower, 1.0, 1u8),
+                    (info.limits.upper, -1.0, 2u8),
+                ];
+                for (limit, sign, which) in sides {
+                    let Some(l) = limit else { continue };
+                    // φ = q − lower, or upper − q
+                    let gap = sign * (qd - l);
+                    if gap >= margin {
+                        continue;
+                    }
+                    let w = self.warm_joint[d][which as usize];
+                    if let Some(r) = rows.push(RowKind::Unilateral, speculative(gap), w) {
+                        rows.jrow_mut(r)[iv] = sign;
+                        rows.bpos[r] = pos_target(gap, p.limit_slop, p.limit_push_cap);
+                        if rows.bpos[r] > 0.0 {
+                            counts.violated += 1;
+                        }
+                        self.joint_rows.push((d, which));
+                        counts.limits += 1;
+                    }
+                }
+            }
+        }
+        if points.is_empty() {
+            self.counts = counts;
+            return counts;
+        }
+        // world-frame motion subspace columns
+        for i in 1..model.nbodies {
+            let j = &model.joints[i];
+            let o = o_m_i[i];
+            for c in 0..j.nv().min(6) {
+                self.sw[i][c] = o.act_motion(&j.subspace_column(c));
+            }
+        }
+        let nv = rows.nv;
+        for (pi, pt) in points.iter().enumerate() {
+            let warm = self.warm_contact.get(pt.slot).copied().unwrap_or([0.0; 3]);
+            let Some(rn) = rows.push(RowKind::Normal, 0.0, warm[0]) else {
+                break;
+            };
+            let tangent = RowKind::Tangent {
+                normal: rn,
+                mu: p.mu,
+            };
+            if rows.push(tangent, 0.0, warm[1]).is_none() {
+                rows.pop(1);
+                break;
+            }
+            if rows.push(RowKind::Tangent2, 0.0, warm[2]).is_none() {
+                rows.pop(2);
+                break;
+            }
+            self.row_point.push(pi);
+            counts.contacts += 1;
+            // rows n = z, t₁ = x, t₂ = y: the point velocity v_c + ω_c × p of each
+            // ancestor's world-frame subspace column c
+            let mut b = pt.body;
+            while b != 0 {
+                let j = &model.joints[b];
+                for c in 0..j.nv().min(6) {
+                    let s = &self.sw[b][c];
+                    let vp = s.lin + s.ang.cross(&pt.point);
+                    let col = j.iv + c;
+                    if col < nv {
+                        rows.j[rn * nv + col] += vp.z;
+                        rows.j[(rn + 1) * nv + col] += vp.x;
+                        rows.j[(rn + 2) * nv + col] += vp.y;
+                    }
+                }
+                b = model.parent[b];
+            }
+            // normal target: speculative; restitution only above the speed below
+            // which a bounce of one step under gravity could gain energy:
+            // |u| > 4 g h e / (1 − e²)
+            let mut bn = speculative(pt.gap);
+            let e = p.restitution;
+            if e > 0.0 && e < 1.0 {
+                let un = solver::dot(rows.jrow(rn), v.as_slice());
+                let vmin = (4.0 * p.gravity * h * e / (1.0 - e * e).max(1e-12)).max(1e-3);
+                if un < -vmin && pt.gap < -un * h {
+                    bn = bn.max(-e * un);
+                }
+            }
+            rows.b[rn] = bn;
+            rows.bpos[rn] = pos_target(pt.gap, p.contact_slop, p.contact_push_cap);
+            if rows.bpos[rn] > 0.0 {
+                counts.violated += 1;
+            }
+        }
+        self.counts = counts;
+        counts
+    }
+
+    /// Solves the assembled rows given the factor `l` of H̃ (column-major, lower
+    /// triangle) and the free velocity `vfree`, for a step `h`: the velocity
+    /// impulses λ (warm-started), then, where a row is violated, the position
+    /// pass. Writes the warm starts, the joint rows' generalized force and the
+    /// contact forces.
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve(
+        &mut self,
+        model: &Model,
+        points: &[ContactPoint],
+        l: &[f64],
+        vfree: &DVector<f64>,
+        h: f64,
+        iterations: usize,
+        tol: f64,
+        relaxation: f64,
+    ) -> Impulses<'_> {
+        let nv = model.nv;
+        let vo = model.joint_v_offset();
+        self.clear_forces();
+        self.dv.fill(0.0);
+        let rows = &mut self.rows;
+        // Y rows = L⁻¹ jᵣ (one forward substitution a row): W = J H̃⁻¹ Jᵀ = Y Yᵀ,
+        // the solver works on Δv' = Lᵀ Δv with uᵣ = cᵣ + yᵣ·Δv'
+        rows.form_factored(l, vfree.as_slice());
+        let mut sweeps = rows.solve(self.dv.as_mut_slice(), iterations, tol, relaxation);
+        if sweeps >= iterations {
+            sweeps += energy_safe_exit(
+                rows,
+                l,
+                vfree.as_slice(),
+                self.dv.as_mut_slice(),
+                iterations,
+                tol,
+            );
+        }
+        // Δv = L⁻ᵀ Δv'
+        chol_backward_slice(l, nv, self.dv.as_mut_slice());
+        // the position pass, only where something is violated
+        let pushing = self.counts.violated > 0;
+        if pushing {
+            rows.solve_position(self.push.as_mut_slice(), iterations, tol);
+            chol_backward_slice(l, nv, self.push.as_mut_slice());
+        }
+        // joint rows: warm starts and generalized force
+        for w in self.warm_joint.iter_mut() {
+            *w = [0.0; 3];
+        }
+        for (r, &(d, which)) in self.joint_rows.iter().enumerate() {
+            let lam = rows.lambda[r];
+            self.warm_joint[d][which as usize] = lam;
+            let jv = rows.j[r * nv + vo + d];
+            self.tau_joint[vo + d] += jv * lam / h;
+        }
+        // contact rows: warm starts by slot, forces
+        for &k in &self.warm_slots {
+            if let Some(w) = self.warm_contact.get_mut(k) {
+                *w = [0.0; 3];
+            }
+        }
+        self.warm_slots.clear();
+        let first = self.joint_rows.len();
+        for (c, &pi) in self.row_point.iter().enumerate() {
+            let rn = first + 3 * c;
+            let (ln, l1, l2) = (rows.lambda[rn], rows.lambda[rn + 1], rows.lambda[rn + 2]);
+            let Some(pt) = points.get(pi) else {
+                continue;
+            };
+            if let Some(w) = self.warm_contact.get_mut(pt.slot) {
+                *w = [ln, l1, l2];
+                self.warm_slots.push(pt.slot);
+            }
+            if ln > 0.0 {
+                let f = Vector3::new(l1, l2, ln) / h;
+                if let Some(fb) = self.fext.get_mut(pt.body) {
+                    *fb += Force::at_point(f, &pt.point);
+                }
+                self.contact_forces.push(ContactForce {
+                    point: *pt,
+                    force: f,
+                });
+            }
+        }
+        Impulses {
+            dv: &self.dv,
+            push: if pushing { Some(&self.push) } else { None },
+            tau_joint: &self.tau_joint,
+            sweeps,
+        }
+    }
+}
+
+/// (ΔKE of the impulse, the exact solution's bound Σ λᵣ max(bᵣ, 0), a·d, ‖d‖²)
+/// for the factored Δv' = `d` (a = Lᵀv*: the kinetic energy after the impulse
+/// is ½‖a + d‖² in the H̃-norm).
+fn impulse_work(rows: &Rows, l: &[f64], vfree: &[f64], d: &[f64]) -> (f64, f64, f64, f64) {
+    let nv = rows.nv;
+    let (mut ad, mut dd) = (0.0, 0.0);
+    for k in 0..nv {
+        // a_k = Σ_{i≥k} L[i,k] v*_i (column k of L, contiguous)
+        let mut ak = 0.0;
+        for i in k..nv {
+            ak += l[k * nv + i] * vfree[i];
+        }
+        ad += ak * d[k];
+        dd += d[k] * d[k];
+    }
+    let mut allow = 0.0;
+    for r in 0..rows.n {
+        if matches!(rows.kind[r], RowKind::Normal | RowKind::Unilateral) {
+            allow += rows.lambda[r] * rows.b[r].max(0.0);
+        }
+    }
+    (ad + 0.5 * dd, allow, ad, dd)
+}
+
+/// A solve stopped by the sweep cap may leave an iterate that adds kinetic
+/// energy, which the exact solution never does: its impulses change the kinetic
+/// energy by λᵀu − ½λᵀWλ ≤ Σ λᵣ max(bᵣ, 0) (complementarity on the unilateral
+/// rows, maximal dissipation on the friction rows). While the iterate exceeds
+/// that bound, more plain sweeps run (up to 4× the cap); if it still does, the
+/// impulses are scaled by the largest s ≤ 1 that meets it (a scaled impulse
+/// stays inside every cone and box). Returns the extra sweeps.
+fn energy_safe_exit(
+    rows: &mut Rows,
+    l: &[f64],
+    vfree: &[f64],
+    d: &mut [f64],
+    iterations: usize,
+    tol: f64,
+) -> usize {
+    let nv = rows.nv;
+    if l.len() < nv * nv || vfree.len() < nv || d.len() < nv {
+        return 0;
+    }
+    let budget = 4 * iterations;
+    let mut extra = 0;
+    loop {
+        let (work, allow, _, _) = impulse_work(rows, l, vfree, d);
+        if work <= allow || extra >= budget {
+            break;
+        }
+        let it = rows.solve(d, 10, tol, 1.0);
+        extra += it;
+        if it < 10 {
+            break;
+        }
+    }
+    let (work, allow, ad, dd) = impulse_work(rows, l, vfree, d);
+    if work <= allow || dd <= 0.0 {
+        return extra;
+    }
+    // ΔKE(s) = s a·d + ½ s² ‖d‖² ≤ s·allow ⇐ s ≤ 2(allow − a·d)/‖d‖²
+    let s = (2.0 * (allow - ad) / dd).clamp(0.0, 1.0);
+    d[..nv].iter_mut().for_each(|x| *x *= s);
+    rows.lambda[..rows.n].iter_mut().for_each(|x| *x *= s);
+    extra
+}

@@ -1,0 +1,50 @@
+//! How stiff the joint damping is, for the smooth integrators' switch.
+//!
+//! Joint damping on a light link is stiff: the damping flow v̇ = −M⁻¹D v
+//! (M = H + A) has rates up to λmax(M⁻¹D) (allegro's hand: about 2e6 s⁻¹). An
+//! explicit method is stable on it only while h·λ stays inside its stability
+//! interval (rk4's reaches 2.78, dop853's about 6). Splitting the damping off
+//! (Strang, with an L-stable substep) is stable but wrong for overdamped
+//! links: their creep under a load F is h·F/D a step, and the split moves them
+//! by h²F/(2M), hλ/2 times too far. So the smooth integrators take damping in
+//! their right-hand side while h·tr(M⁻¹D) ≤ [`explicit_limit`] (tr ≥ λmax: a
+//! safe bound), an adaptive step is capped there, and a step where even `dt` is
+//! past it is taken by the time-stepping scheme, whose damping is implicit
+//! (H̃ = H + A + h D): stable at any stiffness and accurate on the creep.
+
+use crate::dynamics::linalg::chol_forward_slice;
+use crate::sim::{Integrator, SimError, Simulation};
+
+/// h·tr((H + A)⁻¹D) up to which an integrator keeps damping explicit.
+pub(crate) fn explicit_limit(integrator: Integrator) -> f64 {
+    match integrator {
+        Integrator::Dop853 => 4.0,
+        _ => 2.0,
+    }
+}
+
+impl Simulation {
+    /// The damping's stiffness bound tr((H + A)⁻¹D) = Σ Dᵢ ‖L⁻¹eᵢ‖² at the
+    /// current q (s⁻¹; 0 without damping).
+    pub(in crate::sim) fn damping_rate(&mut self) -> Result<f64, SimError> {
+        if !self.has_damping {
+            return Ok(0.0);
+        }
+        let nv = self.model.nv;
+        self.factor_mass(0.0)?;
+        let l = self.mass.l.as_slice();
+        let mut rate = 0.0;
+        for i in 0..nv {
+            let d = self.damping[i];
+            if d <= 0.0 {
+                continue;
+            }
+            let x = &mut self.mass.k1;
+            x.fill(0.0);
+            x[i] = 1.0;
+            chol_forward_slice(l, nv, x.as_mut_slice());
+            rate += d * x.norm_squared();
+        }
+        Ok(rate)
+    }
+}

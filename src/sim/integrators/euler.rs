@@ -1,0 +1,99 @@
+//! The time-stepping step (semi-implicit Euler with implicit damping and the
+//! velocity-level constraint impulses), docs/theory.md §"Simulation".
+//!
+//! H̃ = H + A + h·D, v* = v + h H̃⁻¹(τ − C(q, v) − D v),
+//! v⁺ = v* + H̃⁻¹Jᵀλ, q⁺ = q ⊕ h (v⁺ + w)
+//! (λ the impulses, w the position pass's pseudo-velocity: [`super::super::constraints`]).
+
+use crate::dynamics::linalg::chol_solve_slice;
+use crate::dynamics::{bias, forward_dynamics};
+use crate::model::configuration::{integrate_config, rotate_base_velocity};
+use crate::sim::{SimError, Simulation};
+use nalgebra::{DVector, Vector3};
+
+impl Simulation {
+    /// One step of length `h` from (q, v); `rows`: the assembled constraint
+    /// rows are not empty.
+    pub(in crate::sim) fn euler_step(&mut self, h: f64, rows: bool) -> Result<(), SimError> {
+        let nv = self.model.nv;
+        // τ = sat(τ_applied) − D v
+        let mut tau = std::mem::replace(&mut self.mass.tau, DVector::zeros(0));
+        self.clamped_tau(&mut tau);
+        for k in 0..nv {
+            tau[k] -= self.damping[k] * self.v[k];
+        }
+        // v* = v + h H̃⁻¹(τ − C); without rows, damping or armature H̃ = H and
+        // the engine's forward dynamics (ABA or CRBA + LTDL) is fastest
+        let dense = rows || self.has_damping || self.has_armature;
+        let free = if dense {
+            bias(&self.model, &mut self.data, &self.q, &self.v, None);
+            tau -= &self.data.bias;
+            self.factor_mass(h).map(|_| {
+                chol_solve_slice(self.mass.l.as_slice(), nv, tau.as_mut_slice());
+            })
+        } else {
+            forward_dynamics(&self.model, &mut self.data, &self.q, &self.v, &tau, None)
+                .map(|a| tau.copy_from(a))
+                .map_err(SimError::from)
+        };
+        if let Err(e) = free {
+            self.mass.tau = tau;
+            return Err(e);
+        }
+        self.mass.vfree.copy_from(&self.v);
+        self.mass.vfree.axpy(h, &tau, 1.0);
+        self.mass.tau = tau;
+        if self.model.floating_base {
+            add_frame_rate(&mut self.mass.vfree, &self.v, h);
+        }
+        self.rhs_evals += 1;
+        // v⁺ = v* + H̃⁻¹Jᵀλ; the configuration moves by v⁺ + w
+        if rows {
+            let imp = self.cons.solve(
+                &self.model,
+                &self.points,
+                self.mass.l.as_slice(),
+                &self.mass.vfree,
+                h,
+                self.opts.solver_iterations,
+                self.opts.solver_tol,
+                self.opts.solver_relaxation,
+            );
+            self.pgs_sweeps += imp.sweeps as u64;
+            self.v.copy_from(&self.mass.vfree);
+            self.v += imp.dv;
+            self.mass.vtot.copy_from(&self.v);
+            if let Some(w) = imp.push {
+                self.mass.vtot += w;
+            }
+            self.rows_total += self.cons_rows() as u64;
+        } else {
+            self.cons.clear_forces();
+            self.v.copy_from(&self.mass.vfree);
+            self.mass.vtot.copy_from(&self.v);
+        }
+        integrate_config(&self.model, &mut self.q, &self.mass.vtot, h);
+        // the base's linear velocity, found in the start frame R, expressed in
+        // the new frame R⁺ = R exp(h ω_total)
+        rotate_base_velocity(&self.model, &mut self.v, &self.mass.vtot, h);
+        Ok(())
+    }
+
+    fn cons_rows(&self) -> usize {
+        self.cons.rows_len()
+    }
+}
+
+/// Semi-implicit Euler on the free joint works in the frame fixed at the step's
+/// start: the base's linear velocity changes there by the classical acceleration
+/// a_lin + ω × v_lin (the spatial body-frame acceleration misses the frame's own
+/// rotation); it is rotated into the new frame after the position update. Done
+/// this way the rotation of the body-frame velocity is exact and adds no energy.
+pub(in crate::sim) fn add_frame_rate(v_new: &mut DVector<f64>, v_old: &DVector<f64>, h: f64) {
+    let w = Vector3::new(v_old[3], v_old[4], v_old[5]);
+    let vl = Vector3::new(v_old[0], v_old[1], v_old[2]);
+    let d = w.cross(&vl) * h;
+    v_new[0] += d.x;
+    v_new[1] += d.y;
+    v_new[2] += d.z;
+}
