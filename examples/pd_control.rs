@@ -3,7 +3,8 @@
 //! step-by-step library API: read the state, set the joint torques, step, read
 //! the energy and the contact forces.
 //!
-//! τ = Kp (q* − q) − Kd v + g(q) (diagonal gains), with g(q) = C(q, 0) from RNEA (seed eq. 9); the
+//! τ = Kp (q* − q) − Kd v + g(q) (diagonal gains), with g(q) = C(q, 0) from RNEA
+//! (docs/theory.md §"Bias forces"); the
 //! torques are held over each 1 ms step (zero-order hold, RK4) and clamped by the
 //! engine to the URDF effort limits. The arm starts at rest 0.3 rad away from q*
 //! on every joint. Run: `cargo run --release --example pd_control`.

@@ -1,6 +1,6 @@
-//! The seed's worked examples: the particle of section 3.1 (eqs. 24–30) and the
-//! 2D jumping lamp of Figure 1, both moving in the x–y plane with gravity along −y
-//! (seed eq. 21).
+//! The course note's worked examples: the particle of its section 3.1
+//! (docs/theory.md §"Particle example") and the 2D jumping lamp of its Figure 1,
+//! both moving in the x–y plane with gravity along −y (docs/theory.md §"Gravity").
 
 use nalgebra::{DVector, Vector3};
 use urdyn::dynamics::{self, forward_dynamics, forward_kinematics, rnea};
@@ -29,7 +29,7 @@ fn load(name: &str, floating: bool) -> Model {
 
 #[test]
 fn particle_inverse_dynamics_is_newtons_law() {
-    // seed eq. 30: Q0 = m q̈0, Q1 = m (q̈1 + g)
+    // docs/theory.md §"Particle example": Q0 = m q̈0, Q1 = m (q̈1 + g)
     let model = load("particle.urdf", false);
     let m = 2.0;
     assert_eq!(model.dof_names(), vec!["x", "y"]);
@@ -43,18 +43,18 @@ fn particle_inverse_dynamics_is_newtons_law() {
         assert!((tau[0] - m * a[0]).abs() < 1e-12 * (1.0 + tau[0].abs()));
         assert!((tau[1] - m * (a[1] + G)).abs() < 1e-12 * (1.0 + tau[1].abs()));
 
-        // seed eq. 24: v̂0 = [0; q̇0 0 0], v̂1 = [0; q̇0 q̇1 0] (the slider frames keep the
+        // velocities: v̂0 = [0; q̇0 0 0], v̂1 = [0; q̇0 q̇1 0] (the slider frames keep the
         // world's orientation, so the notations line up)
         let (v0, v1) = (data.v[1], data.v[2]);
         assert_eq!(v0.ang, Vector3::zeros());
         assert!((v0.lin - Vector3::new(v[0], 0.0, 0.0)).norm() < 1e-14);
         assert!((v1.lin - Vector3::new(v[0], v[1], 0.0)).norm() < 1e-14);
-        // seed eq. 26: â0 = [0; q̈0 g 0], â1 = [0; q̈0 q̈1+g 0]
+        // accelerations: â0 = [0; q̈0 g 0], â1 = [0; q̈0 q̈1+g 0]
         assert!((data.a[1].lin - Vector3::new(a[0], G, 0.0)).norm() < 1e-13);
         assert!((data.a[2].lin - Vector3::new(a[0], a[1] + G, 0.0)).norm() < 1e-13);
         assert!(data.a[2].ang.norm() < 1e-14);
-        // seed eq. 28: f̂1 = [m q̈0, m(q̈1+g), 0 | 0], f̂0 adds the moment −m q1 q̈0 about z
-        // (the seed writes force-first; ours is [moment; force])
+        // forces: f̂1 = [m q̈0, m(q̈1+g), 0 | 0], f̂0 adds the moment −m q1 q̈0 about z
+        // (the course note writes force-first; ours is [moment; force])
         let f1 = data.f[2];
         assert!((f1.lin - Vector3::new(m * a[0], m * (a[1] + G), 0.0)).norm() < 1e-12);
         assert!(f1.ang.norm() < 1e-12);

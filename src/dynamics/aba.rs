@@ -8,7 +8,7 @@ use crate::spatial::{skew, Force, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Matrix6, Vector3, Vector6};
 
 /// The 6x6 angular-first matrix of a rigid-body inertia in origin form (the
-/// model's `inertias_origin`, computed at load), seed eq. 39 reordered:
+/// model's `inertias_origin`, computed at load), docs/theory.md §"Spatial inertia":
 /// `[I_o, h*; h*ᵀ, m 1]` with `h = m c` and `I_o = I_c − m c*c*`.
 #[inline(always)]
 fn inertia_matrix<T: Scalar>(i: &CompositeInertia<T>) -> Matrix6<T> {
@@ -24,7 +24,8 @@ fn inertia_matrix<T: Scalar>(i: &CompositeInertia<T>) -> Matrix6<T> {
 }
 
 /// `ᵃX*_b I ᵇX_a`: a 6x6 spatial inertia (angular-first, blocks `[A B; Bᵀ C]`)
-/// moved from frame b to frame a, given `aMb = (R, t)` (seed eq. 38 and its dual).
+/// moved from frame b to frame a, given `aMb = (R, t)` (docs/theory.md
+/// §"Plücker transforms").
 /// Rotation: every block becomes `R · Rᵀ`; then translation by `T = t*`:
 /// `C' = C`, `B' = B + T C`, `A' = A − W − Wᵀ − T C T` with `W = B T`.
 #[inline(always)]
@@ -119,17 +120,20 @@ fn vforce<T: Scalar>(x: &Vector6<T>) -> Force<T> {
 }
 
 /// Forward dynamics by the articulated-body algorithm (Featherstone, RBDA §7.3):
-/// `q̈` with `H q̈ + C = τ` (seed eq. 6) in three sweeps, written to `data.qdd`.
+/// `q̈` with `H q̈ + C = τ` (docs/theory.md §"Equation of motion") in three sweeps,
+/// written to `data.qdd` (docs/theory.md §"Articulated-body algorithm").
 ///
-/// 1. Root outwards: velocities (seed eq. 13), the velocity-product accelerations
-///    `cᵢ = v̂ᵢ × ŝᵢ q̇ᵢ` (seed eq. 14's middle term), the rigid-body inertias
-///    `Iᴬᵢ = Îᵢ` (seed eq. 39) and bias forces `pᴬᵢ = v̂ᵢ ×* Îᵢ v̂ᵢ − ᵢX̂₋₁ f̂ᵢˣ`
-///    (seed eq. 15 with â = 0).
+/// 1. Root outwards: velocities (docs/theory.md §"Velocity recursion"), the
+///    velocity-product accelerations `cᵢ = v̂ᵢ × ŝᵢ q̇ᵢ` (docs/theory.md
+///    §"Acceleration recursion"), the rigid-body inertias `Iᴬᵢ = Îᵢ` (docs/theory.md
+///    §"Spatial inertia") and bias forces `pᴬᵢ = v̂ᵢ ×* Îᵢ v̂ᵢ − ᵢX̂₀ f̂ᵢˣ`
+///    (docs/theory.md §"Force recursion" with â = 0).
 /// 2. Leaves inwards: `Uᵢ = Iᴬᵢ Sᵢ`, `Dᵢ = Sᵢᵀ Uᵢ`, `uᵢ = τᵢ − Sᵢᵀ pᴬᵢ`; the parent
 ///    receives `Iᵃ = Iᴬᵢ − Uᵢ Dᵢ⁻¹ Uᵢᵀ` and `pᵃ = pᴬᵢ + Iᵃ cᵢ + Uᵢ Dᵢ⁻¹ uᵢ`, moved by
-///    `ᵖX*ᵢ` (seed eq. 38's dual).
-/// 3. Root outwards, from `â₋₁ = [0; −g]` (seed eq. 21): `a' = ᵢX̂ₚ âₚ + cᵢ`,
-///    `q̈ᵢ = Dᵢ⁻¹ (uᵢ − Uᵢᵀ a')`, `âᵢ = a' + Sᵢ q̈ᵢ` (seed eq. 14).
+///    `ᵖX*ᵢ` (docs/theory.md §"Plücker transforms").
+/// 3. Root outwards, from `â₀ = [0; −g]` (docs/theory.md §"Gravity"):
+///    `a' = ᵢX̂ₚ âₚ + cᵢ`, `q̈ᵢ = Dᵢ⁻¹ (uᵢ − Uᵢᵀ a')`, `âᵢ = a' + Sᵢ q̈ᵢ`
+///    (docs/theory.md §"Acceleration recursion").
 ///
 /// A free joint is one 6-DoF joint (S = 1 up to the coordinate order): its 6x6
 /// `D = Iᴬ` is factorised directly, `âᵢ = Iᴬ⁻¹ (τ − pᴬ)`, and it passes nothing but
@@ -176,7 +180,7 @@ pub fn aba<'d, T: Scalar>(
         let vp = vel[p];
         let (m, vi, ci) = dispatch_joint!(&joints[i], ident[i], jm => {
             let m = jm.placement(&placements[i], q);
-            // seed eq. 13
+            // docs/theory.md §"Velocity recursion"
             let mut vi = inv_act_motion_ax(&m, jm.rot_axis(), &vp);
             jm.add_motion(&mut vi, v);
             let mut ci = Motion::zero();
@@ -260,7 +264,7 @@ pub fn aba<'d, T: Scalar>(
         let ap = acc[p];
         let li = &li_m_i[i];
         let ai = dispatch_joint!(&joints[i], ident[i], jm => {
-            // seed eq. 14
+            // docs/theory.md §"Acceleration recursion"
             let a1 = inv_act_motion_ax(li, jm.rot_axis(), &ap) + cc[i];
             let iv = jm.joint().iv;
             if jm.nv() == 1 {

@@ -37,7 +37,7 @@ pub fn centroidal_momentum<T: Scalar>(
         let li_m_i = model.placements[i].compose(&x_j);
         data.li_m_i[i] = li_m_i;
         data.o_m_i[i] = data.o_m_i[p].compose(&li_m_i);
-        // seed eq. 13
+        // docs/theory.md §"Velocity recursion"
         data.v[i] = li_m_i.inv_act_motion(&data.v[p]) + v_j;
         h += data.o_m_i[i].act_force(&model.inertias[i].mul_motion(&data.v[i]));
     }

@@ -9,8 +9,8 @@ use nalgebra::{DVector, Matrix3, Vector3};
 /// A spatial inertia in "origin form": mass `m`, first moment `h = m c` and the
 /// rotational inertia `I_o = I_c − m c*c*` about the frame origin. Sums of such
 /// inertias (composite bodies) are plain sums of the three parts, which is why the
-/// CRBA keeps its composite inertias this way. As a 6x6 matrix it is seed eq. 39
-/// (angular first): `[I_o, h*; h*ᵀ, m 1]`.
+/// CRBA keeps its composite inertias this way. As a 6x6 matrix
+/// (angular first, docs/theory.md §"Spatial inertia") it is `[I_o, h*; h*ᵀ, m 1]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CompositeInertia<T: Scalar = f64> {
     pub m: T,
@@ -180,15 +180,17 @@ fn shift_entries<T: Scalar>(
 /// The joint-space inertia matrix H(q) by the CRBA (Featherstone, RBDA §6.2),
 /// written to `data.h` (the whole symmetric matrix; `data.li_m_i` is updated).
 ///
-/// H is the matrix of seed eq. 1 (the `H q̈` term of seed eq. 8); the seed builds
-/// it from n inverse-dynamics calls (seed eq. 11), the CRBA from composite bodies:
-/// with `I^c_i` the inertia of body i's whole subtree, rigidly locked
-/// (`I^c_i = Îᵢ + Σ_children ᵢX*ⱼ I^c_j ʲXᵢ`, seed eq. 39 inertias moved with the
-/// transforms of seed eq. 38), the column of joint i is `F = I^c_i Sᵢ` (the force
-/// needed to accelerate the locked subtree along `Sᵢ`, seed eq. 15 with v = 0) and
+/// H is the matrix of docs/theory.md §"Equation of motion"; the course note builds
+/// it from n inverse-dynamics calls (docs/theory.md §"Forward dynamics by inverse
+/// dynamics"), the CRBA from composite bodies (docs/theory.md §"Composite-rigid-body
+/// algorithm"): with `I^c_i` the inertia of body i's whole subtree, rigidly locked
+/// (`I^c_i = Îᵢ + Σ_children ᵢX*ⱼ I^c_j ʲXᵢ`, inertias of docs/theory.md §"Spatial
+/// inertia" moved as in §"Plücker transforms"), the column of joint i is
+/// `F = I^c_i Sᵢ` (the force needed to accelerate the locked subtree along `Sᵢ`,
+/// docs/theory.md §"Force recursion" with v = 0) and
 ///
-/// `H[i, j] = Sⱼᵀ ʲXᵢ* F` for every ancestor-or-self j of i (seed eq. 16),
-/// zero for unrelated pairs.
+/// `H[i, j] = Sⱼᵀ ʲXᵢ* F` for every ancestor-or-self j of i (docs/theory.md
+/// §"Joint-force projection"), zero for unrelated pairs.
 ///
 /// On chains of 16 or more coordinates without mimic joints, H's entries are formed
 /// in the world frame (`crba_world`, oMᵢ from forward kinematics):
@@ -279,7 +281,7 @@ fn crba_mimic<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
                     h[(kj, ki)] += val;
                 }
             }
-            // Ancestors: F moves to each parent frame (ᵖX*ⱼ, seed eq. 38's dual).
+            // Ancestors: F moves to each parent frame (ᵖX*ⱼ, docs/theory.md §"Plücker transforms").
             let mut j = i;
             while parent[j] != 0 {
                 f = li_m_i[j].act_force(&f);
@@ -467,8 +469,8 @@ fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
                 fc[k0 + c] = jm.mul_subspace(&ici, c);
             }
             let fsub = &mut fc[k0..end];
-            // H[k0 + r, c] = S_rᵀ F_c for every coordinate c of the subtree (seed eq. 16)
-            // and its mirror H[c, k0 + r].
+            // H[k0 + r, c] = S_rᵀ F_c for every coordinate c of the subtree
+            // (docs/theory.md §"Joint-force projection") and its mirror H[c, k0 + r].
             assert!(k0 + jm.nv() <= end && end <= nv, "subtree coordinates out of range");
             let hp = hs.as_mut_ptr();
             for (dc, f) in fsub.iter().enumerate() {

@@ -18,7 +18,7 @@ pub fn kinetic_energy<T: Scalar>(
 
 /// [`kinetic_energy`] with the joint placements of the configuration already in
 /// `data.li_m_i` (forward kinematics ran at this q): one pass of body velocities
-/// (seed eq. 13, into `data.v`), no joint transform.
+/// (docs/theory.md §"Velocity recursion", into `data.v`), no joint transform.
 pub fn kinetic_energy_from_placements<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,

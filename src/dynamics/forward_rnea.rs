@@ -5,9 +5,10 @@ use crate::model::{Data, Model};
 use crate::spatial::{Force, Scalar};
 use nalgebra::DVector;
 
-/// H(q) column by column from n inverse-dynamics calls (seed eq. 11), written to
-/// `data.h`. Each column is ID(q, 0, δᵢ) with gravity off: the same n calls as the
-/// seed's `ID(q, q̇, δᵢ) − C`, without its cancellation when C is large.
+/// H(q) column by column from n inverse-dynamics calls (docs/theory.md
+/// §"Forward dynamics by inverse dynamics"), written to `data.h`. Each column is
+/// ID(q, 0, δᵢ) with gravity off: the same n calls as the course note's
+/// `ID(q, q̇, δᵢ) − C`, without its cancellation when C is large.
 pub fn mass_matrix_rnea<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     let nv = model.nv;
     let mut delta = std::mem::replace(&mut data.tmp_a, DVector::zeros(0));
@@ -21,9 +22,9 @@ pub fn mass_matrix_rnea<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVe
     data.tmp_a = delta;
 }
 
-/// The seed's forward dynamics (section 2), kept as the reference method:
-/// C from one inverse-dynamics call (seed eq. 9), H from n more (seed eq. 11),
-/// then a Cholesky solve of `H q̈ = Q − C` (seed eq. 6). The result is written to
+/// The course note's forward dynamics (docs/theory.md §"Forward dynamics by inverse dynamics"),
+/// kept as the reference method: C from one inverse-dynamics call, H from n more,
+/// then a Cholesky solve of `H q̈ = Q − C`. The result is written to
 /// `data.qdd` (also `data.bias`, `data.h`).
 pub fn forward_dynamics_rnea<'d, T: Scalar>(
     model: &Model<T>,

@@ -5,7 +5,8 @@ use nalgebra::DMatrix;
 /// The Jacobian of a link frame, world-aligned at the frame's origin: `J v` is the
 /// frame's `[linear velocity; angular velocity]` in world coordinates (Pinocchio's
 /// `LOCAL_WORLD_ALIGNED`). Column k sums, over the joints on the path to the root
-/// that move with coordinate k, the joint's motion subspace `ŝ` (seed eqs. 31–32)
+/// that move with coordinate k, the joint's motion subspace `ŝ` (docs/theory.md
+/// §"Joints and motion subspace", §"Frame Jacobian")
 /// carried to the world (`⁰X̂ⱼ ŝ`) and read at the frame's origin p:
 /// `[v₀ + ω × p; ω]`. Uses `data.o_m_i` (call forward kinematics first);
 /// `j` must be 6 × nv and is overwritten.

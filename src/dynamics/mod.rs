@@ -1,8 +1,9 @@
 //! Rigid-body dynamics algorithms, one a file, all working on a preallocated
 //! [`Data`](crate::model::Data): forward kinematics, recursive Newton–Euler
-//! inverse dynamics (seed eqs. 13–16), the seed's forward dynamics by n+1 inverse
-//! dynamics calls (seed eqs. 6–11), energies; the fast path: CRBA for H, the
-//! tree-sparse LTDL factorisation, the articulated-body algorithm.
+//! inverse dynamics (docs/theory.md §"Recursive Newton–Euler"), the course note's
+//! forward dynamics by n+1 inverse dynamics calls (docs/theory.md §"Forward dynamics
+//! by inverse dynamics"), energies; the fast path: CRBA for H, the tree-sparse LTDL
+//! factorisation, the articulated-body algorithm (docs/theory.md §"Forward dynamics").
 
 mod aba;
 mod centroidal;
@@ -57,8 +58,9 @@ pub fn mass_matrix<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<
     crba(model, data, q);
 }
 
-/// Forward dynamics through H: `C` by RNEA (seed eq. 9), H by [`crba`], then
-/// `H q̈ = τ − C` (seed eq. 6) by the tree-sparse LTDL factorisation
+/// Forward dynamics through H: `C` by RNEA (docs/theory.md §"Bias forces"), H by
+/// [`crba`], then `H q̈ = τ − C` (docs/theory.md §"Equation of motion") by the
+/// tree-sparse LTDL factorisation (docs/theory.md §"Tree-sparse LTDL")
 /// ([`ltdl::ltdl`]), or, on a model with mimic joints (whose `Gᵀ H G` is not
 /// tree-shaped), the dense Cholesky. Result in `data.qdd`; `data.h` (its upper
 /// triangle, [`crba_upper`]; all of it with mimic joints), `data.bias` and the

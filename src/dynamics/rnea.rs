@@ -3,11 +3,12 @@ use crate::spatial::ops::add_cross;
 use crate::spatial::{Force, Motion, Scalar, Se3};
 use nalgebra::DVector;
 
-/// Recursive Newton–Euler inverse dynamics (seed eqs. 13–16): the generalized forces
-/// `Q = H(q) q̈ + C(q, q̇)` that produce `a`, written to `data.tau` and returned.
-/// Gravity enters as an upward acceleration of the world (seed eq. 21).
+/// Recursive Newton–Euler inverse dynamics (docs/theory.md §"Recursive Newton–Euler"):
+/// the generalized forces `Q = H(q) q̈ + C(q, q̇)` that produce `a`, written to
+/// `data.tau` and returned.
+/// Gravity enters as an upward acceleration of the world (docs/theory.md §"Gravity").
 /// `fext`, if given, holds one external spatial force per body in the **world**
-/// frame (seed eq. 15's `f̂ˣ`; entry 0, the world, is ignored).
+/// frame (`f̂ˣ`, docs/theory.md §"External forces"; entry 0, the world, is ignored).
 pub fn rnea<'d, T: Scalar>(
     model: &Model<T>,
     data: &'d mut Data<T>,
@@ -20,8 +21,8 @@ pub fn rnea<'d, T: Scalar>(
     &data.tau
 }
 
-/// `C(q, q̇)` = ID(q, q̇, 0) (seed eq. 9), gravity and external forces included,
-/// written to `data.bias` and returned.
+/// `C(q, q̇)` = ID(q, q̇, 0) (docs/theory.md §"Bias forces"), gravity and external
+/// forces included, written to `data.bias` and returned.
 pub fn bias<'d, T: Scalar>(
     model: &Model<T>,
     data: &'d mut Data<T>,
@@ -85,7 +86,7 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool>(
     let vel = &mut data.v[..nb];
     let acc = &mut data.a[..nb];
     let frc = &mut data.f[..nb];
-    // seed eq. 21: v̂₋₁ = 0, â₋₁ = [0; −g]
+    // docs/theory.md §"Gravity": v̂₀ = 0, â₀ = [0; −g]
     vel[0] = Motion::zero();
     acc[0] = if gravity {
         Motion::new(nalgebra::Vector3::zeros(), -model.gravity)
@@ -98,13 +99,13 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool>(
         let (li, vi, ai) = dispatch_joint!(&joints[i], ident[i], jm => {
             let li = jm.placement(&placements[i], q);
             let ax = jm.rot_axis();
-            // seed eq. 13: v̂ᵢ = ᵢX̂ₚ v̂ₚ + ŝᵢ q̇ᵢ
+            // docs/theory.md §"Velocity recursion": v̂ᵢ = ᵢX̂ₚ v̂ₚ + ŝᵢ q̇ᵢ
             let mut vi = Motion::zero();
             if V {
                 vi = inv_act_motion_ax(&li, ax, &vp);
                 jm.add_motion(&mut vi, v);
             }
-            // seed eq. 14: âᵢ = ᵢX̂ₚ âₚ + v̂ᵢ × ŝᵢ q̇ᵢ + ŝᵢ q̈ᵢ
+            // docs/theory.md §"Acceleration recursion": âᵢ = ᵢX̂ₚ âₚ + v̂ᵢ × ŝᵢ q̇ᵢ + ŝᵢ q̈ᵢ
             let mut ai = inv_act_motion_ax(&li, ax, &ap);
             if V {
                 jm.add_cross_motion(&mut ai, &vi, v);
@@ -117,7 +118,8 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool>(
         li_m_i[i] = li;
         vel[i] = vi;
         acc[i] = ai;
-        // seed eq. 15 (own part): f̂ᵢ = Îᵢ âᵢ + v̂ᵢ ×* Îᵢ v̂ᵢ − ᵢX̂₋₁ f̂ᵢˣ
+        // docs/theory.md §"Force recursion" (own part):
+        // f̂ᵢ = Îᵢ âᵢ + v̂ᵢ ×* Îᵢ v̂ᵢ − ᵢX̂₀ f̂ᵢˣ
         let inertia = &inertias[i];
         let mut fi = inertia.mul_motion(&ai);
         if V {
@@ -140,9 +142,10 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool>(
         let fi = tail[0];
         let li = &li_m_i[i];
         dispatch_joint!(&joints[i], ident[i], jm => {
-            // seed eq. 16: Qᵢ = ŝᵢᵀ f̂ᵢ (a mimic joint adds to its leader's coordinate)
+            // docs/theory.md §"Joint-force projection": Qᵢ = ŝᵢᵀ f̂ᵢ (a mimic joint adds
+            // to its leader's coordinate)
             jm.project_add(&fi, tau);
-            // seed eq. 15 (children part): f̂ₚ += ₚX̂ᵢ f̂ᵢ
+            // docs/theory.md §"Force recursion" (children part): f̂ₚ += ₚX̂ᵢ f̂ᵢ
             if p != 0 {
                 head[p] += act_force_ax(li, jm.rot_axis(), &fi);
             }

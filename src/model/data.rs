@@ -15,9 +15,10 @@ pub struct Data<T: Scalar = f64> {
     pub o_m_f: Vec<Se3<T>>,
     /// Spatial velocity of each body (body frame).
     pub v: Vec<Motion<T>>,
-    /// Spatial acceleration of each body (body frame, gravity included as in seed eq. 21).
+    /// Spatial acceleration of each body (body frame, gravity included, docs/theory.md §"Gravity").
     pub a: Vec<Motion<T>>,
-    /// Spatial force transmitted by each body's joint (body frame, seed eq. 15).
+    /// Spatial force transmitted by each body's joint (body frame, docs/theory.md
+    /// §"Force recursion").
     pub f: Vec<Force<T>>,
     /// External forces per body, expressed in the body frame (scratch).
     pub fext_body: Vec<Force<T>>,
@@ -25,7 +26,7 @@ pub struct Data<T: Scalar = f64> {
     pub ic: Vec<Inertia<T>>,
     /// Generalized forces from inverse dynamics.
     pub tau: DVector<T>,
-    /// C(q, v) (seed eq. 9).
+    /// C(q, v) (docs/theory.md §"Bias forces").
     pub bias: DVector<T>,
     /// Generalized accelerations from forward dynamics.
     pub qdd: DVector<T>,

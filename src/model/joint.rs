@@ -1,6 +1,7 @@
 //! Joint kinds and everything that depends on them, matched in this one place:
-//! the joint transform `X_J(q)`, the motion subspace `S` (seed eqs. 31–32), the
-//! joint velocity `S q̇`, and the projection `Sᵀ f` (seed eq. 16).
+//! the joint transform `X_J(q)`, the motion subspace `S` (docs/theory.md §"Joints and
+//! motion subspace"), the joint velocity `S q̇`, and the projection `Sᵀ f`
+//! (docs/theory.md §"Joint-force projection").
 
 use crate::dynamics::CompositeInertia;
 use crate::spatial::ops::{axpy, cross, madd, mat_mat, mat_tr_vec, mat_vec};
@@ -222,9 +223,10 @@ pub enum JointKind<T: Scalar = f64> {
     /// 6-DoF free joint (floating base): q = [p; quaternion xyzw] (7), v = [v; ω] in the
     /// body frame (6), as Pinocchio's free flyer.
     Free,
-    /// Rotation about an axis through the joint origin: `ŝ = [u; 0]` (seed eq. 31 with r = 0).
+    /// Rotation about an axis through the joint origin: `ŝ = [u; 0]` (docs/theory.md
+    /// §"Joints and motion subspace").
     Revolute(Axis<T>),
-    /// Translation along an axis: `ŝ = [0; u]` (seed eq. 32).
+    /// Translation along an axis: `ŝ = [0; u]` (docs/theory.md §"Joints and motion subspace").
     Prismatic(Axis<T>),
 }
 
@@ -340,7 +342,8 @@ impl<T: Scalar> Joint<T> {
             JointKind::Prismatic(ax) => Motion::new(Vector3::zeros(), ax.vector() * self.mult),
         }
     }
-    /// `Q += Gᵀ Sᵀ f` (seed eq. 16; a mimic joint adds `mult · Sᵀ f` to its leader).
+    /// `Q += Gᵀ Sᵀ f` (docs/theory.md §"Joint-force projection"; a mimic joint adds
+    /// `mult · Sᵀ f` to its leader).
     #[inline(always)]
     pub fn project_add(&self, f: &Force<T>, tau: &mut DVector<T>) {
         match self.kind {
@@ -453,8 +456,9 @@ impl<T: Scalar> Joint<T> {
         d * self.mult
     }
     /// Column `k` of the motion subspace expressed in frame a, given `aMi` (body i in
-    /// a): `ᵃX̂ᵢ Sₖ` (seed eq. 38); a revolute joint's is `[w; t × w]` with `w = R u`
-    /// (a column of R for an axis-aligned joint), a prismatic joint's `[0; R u]`.
+    /// a): `ᵃX̂ᵢ Sₖ` (docs/theory.md §"Plücker transforms"); a revolute joint's is
+    /// `[w; t × w]` with `w = R u` (a column of R for an axis-aligned joint), a
+    /// prismatic joint's `[0; R u]`.
     #[inline(always)]
     pub fn subspace_in(&self, k: usize, m: &Se3<T>) -> Motion<T> {
         match self.kind {
@@ -478,7 +482,8 @@ impl<T: Scalar> Joint<T> {
             JointKind::Prismatic(ax) => ax.add_scaled(&mut m.lin, self.mult * x[self.iv]),
         }
     }
-    /// `v × S q̇` (seed eq. 14's velocity-product term) for body velocity `v`;
+    /// `v × S q̇` (the velocity-product term of docs/theory.md §"Acceleration
+    /// recursion") for body velocity `v`;
     /// `[ω × u; v × u] q̇` for a revolute joint, `[0; ω × u] q̇` for a prismatic one.
     #[inline(always)]
     pub fn cross_motion(&self, vi: &Motion<T>, qd: &DVector<T>) -> Motion<T> {

@@ -123,7 +123,7 @@ pub struct Model<T: Scalar = f64> {
     pub body_joint_names: Vec<String>,
     /// URDF link name of each body (its movable joint's child link).
     pub body_link_names: Vec<String>,
-    /// Gravity vector in the world frame (seed eq. 21: the world accelerates by −g).
+    /// Gravity vector in the world frame (docs/theory.md §"Gravity": the world accelerates by −g).
     pub gravity: Vector3<T>,
     /// The floating base, if any, is body 1 with a [`JointKind::Free`] joint.
     pub floating_base: bool,

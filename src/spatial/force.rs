@@ -3,7 +3,8 @@ use nalgebra::{Vector3, Vector6};
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 
 /// A spatial force vector `[n; f]`: the moment about the frame's origin and the
-/// resultant force (seed eq. 15's `f̂`). Dual to [`super::Motion`]: `vᵀ f` is power.
+/// resultant force (docs/theory.md §"Spatial vectors"). Dual to [`super::Motion`]:
+/// `vᵀ f` is power.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Force<T: Scalar = f64> {
     pub ang: Vector3<T>,

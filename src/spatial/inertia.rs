@@ -5,7 +5,7 @@ use nalgebra::{Matrix3, Matrix6, Vector3};
 /// A rigid body's spatial inertia: mass `m`, centre of mass `c` and the
 /// rotational inertia `I_c` about the centre of mass, all in the body's frame.
 ///
-/// As a 6x6 matrix (angular-first) it is seed eq. 39 reordered:
+/// As a 6x6 matrix (angular-first, docs/theory.md §"Spatial inertia"):
 /// `Î = [I_c + m c* c*ᵀ, m c*; m c*ᵀ, m 1]`, the lower-left block being the
 /// tensor form of the parallel-axis theorem (`I = I_c + m d²`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,7 +37,7 @@ impl<T: Scalar> Inertia<T> {
             inertia_c: Matrix3::zeros(),
         }
     }
-    /// `Î v = [I_c ω + c × f; f]` with `f = m (v − c × ω)` (seed eq. 39 applied to `[ω; v]`).
+    /// `Î v = [I_c ω + c × f; f]` with `f = m (v − c × ω)` (docs/theory.md §"Spatial inertia").
     #[inline(always)]
     pub fn mul_motion(&self, v: &Motion<T>) -> Force<T> {
         let lin = add_cross(&v.lin, &v.ang, &self.com) * self.mass;

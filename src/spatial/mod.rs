@@ -1,11 +1,12 @@
-//! Spatial vector algebra in Featherstone's notation (seed appendices A and B).
+//! Spatial vector algebra in Featherstone's notation (docs/theory.md §"Notation").
 //!
 //! Every spatial quantity here is stored in structured form — two 3-vectors, a
 //! rotation plus a translation, a mass plus a centre of mass plus a 3x3 inertia —
 //! never as a 6x6 matrix in hot code. The 6x6 forms exist (`to_matrix`) for tests
-//! and for readers who want to check a formula against the seed.
+//! and for readers who want to check a formula against docs/theory.md §"Notation".
 //!
-//! Ordering convention: **angular first** (as the seed's eq. 31 `ŝ = [s; r×s]`):
+//! Ordering convention: **angular first** (as the joint axis `ŝ = [s; r×s]`;
+//! docs/theory.md §"Spatial vectors"):
 //! a motion vector is `[ω; v]`, a force vector is `[n; f]`. The CLI and the eval
 //! JSON use Pinocchio's linear-first order for the floating base; the conversion
 //! happens at that boundary only.
@@ -55,7 +56,7 @@ pub fn lit<T: Scalar>(x: f64) -> T {
     nalgebra::convert(x)
 }
 
-/// The cross-product matrix `t*` of seed eq. 37: `t* u = t × u`.
+/// The cross-product matrix `t*` (docs/theory.md §"Cross products"): `t* u = t × u`.
 #[inline]
 pub fn skew<T: Scalar>(t: &Vector3<T>) -> Matrix3<T> {
     let z = T::zero();

@@ -3,7 +3,7 @@ use super::{skew, Force, Scalar};
 use nalgebra::{Matrix6, Vector3, Vector6};
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 
-/// A spatial motion vector `[ω; v]` (seed eq. 31): angular velocity and the
+/// A spatial motion vector `[ω; v]` (docs/theory.md §"Spatial vectors"): angular velocity and the
 /// linear velocity of the point at the frame's origin. Also a spatial
 /// acceleration or a joint axis `ŝ`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,7 +24,7 @@ impl<T: Scalar> Motion<T> {
             lin: Vector3::zeros(),
         }
     }
-    /// Spatial cross product on motions, seed eq. 40:
+    /// Spatial cross product on motions, docs/theory.md §"Cross products":
     /// `[a; a_o] × [b; b_o] = [a × b; a × b_o + a_o × b]`.
     #[inline(always)]
     pub fn cross(&self, m: &Motion<T>) -> Motion<T> {
@@ -41,8 +41,8 @@ impl<T: Scalar> Motion<T> {
             lin: cross(&self.ang, &f.lin),
         }
     }
-    /// The power `vᵀ f` of a force on this motion (the seed's spatial transpose, eq. 41,
-    /// applied in angular-first coordinates).
+    /// The power `vᵀ f` of a force on this motion (the course note's spatial transpose
+    /// in angular-first coordinates, docs/theory.md §"Spatial vectors").
     #[inline(always)]
     pub fn dot(&self, f: &Force<T>) -> T {
         madd(

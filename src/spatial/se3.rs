@@ -5,8 +5,9 @@ use std::ops::Mul;
 
 /// A rigid transform `aMb`, stored as rotation + translation: `rot` maps
 /// b-coordinates to a-coordinates and `trans` is b's origin seen from a
-/// (`x_a = rot · x_b + trans`). As a spatial transform on motions it is seed
-/// eq. 38, `aX̂b = [R 0; t*R R]`; on forces its dual `[R t*R; 0 R]`.
+/// (`x_a = rot · x_b + trans`). As a spatial transform on motions it is
+/// `aX̂b = [R 0; t*R R]` (docs/theory.md §"Plücker transforms"); on forces its dual
+/// `[R t*R; 0 R]`.
 /// Pinocchio's names: [`Se3::act_motion`] is `act`, [`Se3::inv_act_motion`] `actInv`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Se3<T: Scalar = f64> {
@@ -80,7 +81,7 @@ impl<T: Scalar> Se3<T> {
     pub fn inv_act_point(&self, p: &Vector3<T>) -> Vector3<T> {
         mat_tr_vec(&self.rot, &(p - self.trans))
     }
-    /// Motion from b to a (seed eq. 38): `ω' = R ω`, `v' = R v + t × ω'`.
+    /// Motion from b to a (docs/theory.md §"Plücker transforms"): `ω' = R ω`, `v' = R v + t × ω'`.
     #[inline(always)]
     pub fn act_motion(&self, m: &Motion<T>) -> Motion<T> {
         let ang = mat_vec(&self.rot, &m.ang);
@@ -132,7 +133,8 @@ impl<T: Scalar> Se3<T> {
             inertia_c: self.rot.transpose() * i.inertia_c * self.rot,
         }
     }
-    /// The 6x6 motion transform of seed eq. 38 (tests and documentation only).
+    /// The 6x6 motion transform (docs/theory.md §"Plücker transforms"; tests and
+    /// documentation only).
     pub fn to_motion_matrix(&self) -> Matrix6<T> {
         let mut x = Matrix6::zeros();
         x.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.rot);

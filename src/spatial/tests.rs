@@ -110,7 +110,8 @@ proptest! {
 
 #[test]
 fn parallel_axis_point_mass() {
-    // seed eq. 39: a point mass m at c has I = m (|c|² 1 − c cᵀ) about the origin.
+    // docs/theory.md §"Spatial inertia": a point mass m at c has
+    // I = m (|c|² 1 − c cᵀ) about the origin.
     let c = Vector3::new(0.3, -0.2, 0.5);
     let i: Inertia<f64> = Inertia::new(2.0, c, nalgebra::Matrix3::zeros());
     let expect: nalgebra::Matrix3<f64> =
