@@ -25,6 +25,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         integrator: None,
         tol: 1e-6,
         initial: Some(root.join("assets/lamp_initial.json")),
+        armature: 0.0,
+        above_ground: None,
         ground: None,
         no_ground: false,
         gravity: None,

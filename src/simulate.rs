@@ -18,6 +18,11 @@ pub struct SimulateArgs {
     pub integrator: Option<String>,
     pub tol: f64,
     pub initial: Option<PathBuf>,
+    /// Rotor inertia added to every joint's diagonal of H (finite, >= 0).
+    pub armature: f64,
+    /// With a floating base: lift or lower the base so that the collision
+    /// geometry's lowest point is this far above the ground (after `initial`).
+    pub above_ground: Option<f64>,
     pub ground: Option<f64>,
     pub no_ground: bool,
     pub gravity: Option<[f64; 3]>,
@@ -85,9 +90,48 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             args.duration
         )));
     }
+    if !(args.dt.is_finite() && args.dt > 0.0) {
+        return Err(SimulateError::Option(format!(
+            "--dt must be a positive number (got {})",
+            args.dt
+        )));
+    }
+    if !(args.tol.is_finite() && args.tol > 0.0) {
+        return Err(SimulateError::Option(format!(
+            "--tol must be a positive number (got {})",
+            args.tol
+        )));
+    }
+    if !(args.friction.is_finite() && args.friction >= 0.0) {
+        return Err(SimulateError::Option(format!(
+            "--friction must be a non-negative number (got {})",
+            args.friction
+        )));
+    }
     if args.every == 0 {
         return Err(SimulateError::Option("--every must be at least 1".into()));
     }
+    if !(args.armature.is_finite() && args.armature >= 0.0) {
+        return Err(SimulateError::Option(format!(
+            "--armature must be a non-negative number (got {})",
+            args.armature
+        )));
+    }
+    if let Some(h) = args.above_ground {
+        if !h.is_finite() {
+            return Err(SimulateError::Option(format!(
+                "--above-ground must be a finite number (got {h})"
+            )));
+        }
+        if !args.floating_base {
+            return Err(SimulateError::Option(
+                "--above-ground needs --floating-base (a fixed root cannot be moved)".into(),
+            ));
+        }
+    }
+    // TODO(lead): armature/above_ground wired in sim (armature added to H's
+    // diagonal; above_ground applied to the base after `initial`, before the
+    // first step, with a warning when there is no collision geometry)
     let integrator = match &args.integrator {
         None => None,
         Some(n) => Some(Integrator::from_name(n).ok_or_else(|| {

@@ -67,10 +67,20 @@ struct SimulateCmd {
     #[arg(long)]
     floating_base: bool,
     /// Simulated seconds.
-    #[arg(long, value_name = "S", default_value_t = 2.0)]
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = 2.0,
+        allow_hyphen_values = true
+    )]
     duration: f64,
     /// Step in seconds (the first step of an adaptive integrator).
-    #[arg(long, value_name = "S", default_value_t = 1e-3)]
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = 1e-3,
+        allow_hyphen_values = true
+    )]
     dt: f64,
     /// Integrator (see --list-integrators); default: euler with ground contact, dop853 without.
     #[arg(long, value_name = "NAME")]
@@ -79,16 +89,33 @@ struct SimulateCmd {
     #[arg(long)]
     list_integrators: bool,
     /// Error tolerance of adaptive integrators: RMS_i(e_i / (X + X*|y_i|)) <= 1 per step (fixed-step ones ignore it).
-    #[arg(long, value_name = "X", default_value_t = 1e-6)]
+    #[arg(
+        long,
+        value_name = "X",
+        default_value_t = 1e-6,
+        allow_hyphen_values = true
+    )]
     tol: f64,
     /// One state object as in eval's states list (q, v, base, tau and base.force/torque as constant forces).
     #[arg(long, value_name = "STATE.json")]
     initial: Option<PathBuf>,
+    /// With --floating-base: before the first step, move the base vertically so that the
+    /// lowest point of the collision geometry is H above the ground (after --initial).
+    #[arg(long, value_name = "H", allow_hyphen_values = true)]
+    above_ground: Option<f64>,
+    /// Rotor inertia added to every joint's diagonal of H (kg·m² or kg).
+    #[arg(
+        long,
+        value_name = "X",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    armature: f64,
     /// Ground plane height (contact on when any moving link has collision geometry).
     #[arg(
         long,
         value_name = "Z",
-        allow_negative_numbers = true,
+        allow_hyphen_values = true,
         conflicts_with = "no_ground"
     )]
     ground: Option<f64>,
@@ -100,11 +127,16 @@ struct SimulateCmd {
         long,
         value_name = "GX,GY,GZ",
         value_delimiter = ',',
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     gravity: Option<Vec<f64>>,
     /// Coulomb friction coefficient between links and the ground.
-    #[arg(long, value_name = "MU", default_value_t = 1.0)]
+    #[arg(
+        long,
+        value_name = "MU",
+        default_value_t = 1.0,
+        allow_hyphen_values = true
+    )]
     friction: f64,
     /// A root for package://NAME/... mesh paths (repeatable; ROS_PACKAGE_PATH is also read).
     #[arg(long, value_name = "DIR")]
@@ -113,8 +145,13 @@ struct SimulateCmd {
     #[arg(long, value_name = "TRAJ.csv")]
     out: Option<PathBuf>,
     /// Write every Nth step (the final state is always written).
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    every: usize,
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1,
+        allow_hyphen_values = true
+    )]
+    every: i64,
 }
 
 #[derive(clap::Args)]
@@ -128,10 +165,20 @@ struct BenchArgs {
     #[arg(long = "algo", value_name = "NAME")]
     algos: Vec<String>,
     /// Timed samples per algorithm (each a batch of calls of about 50 µs).
-    #[arg(long, default_value_t = 300)]
-    samples: usize,
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 300,
+        allow_hyphen_values = true
+    )]
+    samples: i64,
     /// Soft time limit per algorithm in seconds (lowers the samples, never below 5).
-    #[arg(long, value_name = "SECONDS", default_value_t = 1.5)]
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 1.5,
+        allow_hyphen_values = true
+    )]
     budget: f64,
     /// Print one JSON object instead of a table.
     #[arg(long)]
@@ -140,6 +187,17 @@ struct BenchArgs {
 
 fn bench(a: BenchArgs) -> Result<()> {
     use urdyn::bench::{self, Algo, BenchError, BenchOptions};
+    // (checked before the robot is loaded; a budget too large for a Duration is
+    // refused here rather than panicking in from_secs_f64)
+    let budget = match std::time::Duration::try_from_secs_f64(a.budget) {
+        Ok(b) if a.budget > 0.0 => b,
+        _ => {
+            return Err(anyhow!(
+                "--budget: must be a positive number of seconds (got {:?})",
+                a.budget
+            ))
+        }
+    };
     let model = urdyn::load_file(
         &a.urdf,
         LoadOptions {
@@ -155,13 +213,13 @@ fn bench(a: BenchArgs) -> Result<()> {
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| anyhow!("--algo: {e}"))?
     };
-    if !(a.budget.is_finite() && a.budget > 0.0) {
-        return Err(anyhow!("--budget: must be a positive number of seconds"));
-    }
+    // (0 is refused by the library, naming --samples)
+    let samples = usize::try_from(a.samples)
+        .map_err(|_| anyhow!("--samples must be at least 1 (got {})", a.samples))?;
     let opts = BenchOptions {
         algos,
-        samples: a.samples,
-        budget: std::time::Duration::from_secs_f64(a.budget),
+        samples,
+        budget,
     };
     let (results, notes) =
         bench::run(&model, &opts).map_err(|e| anyhow!("{}: {e}", a.urdf.display()))?;
@@ -237,6 +295,9 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
         },
         None => None,
     };
+    // (0 is refused by the library, naming --every)
+    let every = usize::try_from(c.every)
+        .map_err(|_| anyhow!("--every must be at least 1 (got {})", c.every))?;
     let args = urdyn::simulate::SimulateArgs {
         urdf,
         floating_base: c.floating_base,
@@ -245,13 +306,15 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
         integrator: c.integrator,
         tol: c.tol,
         initial: c.initial,
+        armature: c.armature,
+        above_ground: c.above_ground,
         ground: c.ground,
         no_ground: c.no_ground,
         gravity,
         friction: c.friction,
         package_path: c.package_path,
         out: c.out,
-        every: c.every,
+        every,
         progress: std::io::stderr().is_terminal(),
     };
     let summary = urdyn::simulate::run(&args)?;
