@@ -129,9 +129,6 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             ));
         }
     }
-    // TODO(lead): armature/above_ground wired in sim (armature added to H's
-    // diagonal; above_ground applied to the base after `initial`, before the
-    // first step, with a warning when there is no collision geometry)
     let integrator = match &args.integrator {
         None => None,
         Some(n) => Some(Integrator::from_name(n).ok_or_else(|| {
@@ -206,6 +203,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         },
         contact,
         package_paths: args.package_path.clone(),
+        armature: args.armature,
         ..SimOptions::default()
     };
     let sim_err = |error| SimulateError::Sim {
@@ -216,6 +214,40 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
     if let Some(sv) = &init {
         sim.set_state(&sv.q, &sv.v).map_err(sim_err)?;
         sim.torques_mut().copy_from(&sv.tau);
+    }
+    if let Some(h) = args.above_ground {
+        if !sim.lift_above_ground(h).map_err(sim_err)? {
+            warn(&format!(
+                "warning: {urdf_name}: --above-ground {h}: no collision geometry touches a ground in this run, nothing moved"
+            ));
+        }
+    }
+    // a start that violates a constraint: one line for the ground (its deepest
+    // link), one a joint outside its limits; the run recovers gently
+    let violations = sim.start_violations();
+    let in_ground: Vec<_> = violations
+        .iter()
+        .filter_map(|v| match v {
+            crate::sim::Violation::Ground { link, depth } => Some((link, *depth)),
+            _ => None,
+        })
+        .collect();
+    if let Some(&(link, depth)) = in_ground.iter().max_by(|a, b| a.1.total_cmp(&b.1)) {
+        let others = match in_ground.len() - 1 {
+            0 => String::new(),
+            1 => " (and 1 other link)".into(),
+            n => format!(" (and {n} other links)"),
+        };
+        warn(&format!(
+            "warning: {urdf_name}: link \"{link}\" starts {depth:.4} m inside the ground{others}; pushed out at most {} m/s",
+            sim.options().contact.max_push_speed
+        ));
+    }
+    for v in violations
+        .iter()
+        .filter(|v| matches!(v, crate::sim::Violation::Limit { .. }))
+    {
+        warn(&format!("warning: {urdf_name}: {v}"));
     }
     let duration = args.duration;
     let every = args.every;
@@ -366,6 +398,11 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         }
         None => loop_body(None),
     }
+}
+
+/// One warning line on standard error (the run goes on).
+fn warn(line: &str) {
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
 }
 
 /// Numbers in one raw row handed to the writer: t, q (nq), v (nv), energy,

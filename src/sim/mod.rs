@@ -693,23 +693,14 @@ impl Simulation {
         }
         let h_fixed = land(self.dt, remaining);
         // 1. the constraint rows at the start of the step (contact points were
-        //    found at this q by the last step's refresh), for the longest step
-        //    the integrator may take: a joint that can reach its limit within it
-        //    has a row
-        let h_probe = match self.integrator {
-            Integrator::Dop853 => {
-                let cap = if self.contact.is_some() {
-                    self.dt
-                } else {
-                    f64::INFINITY
-                };
-                self.smooth.h_next.min(cap).min(remaining).max(h_fixed)
-            }
-            _ => h_fixed,
-        };
-        let mut counts = self.assemble_rows(h_probe);
+        //    found at this q by the last step's refresh): a joint that can
+        //    reach its limit within the step has a row
+        let counts = self.assemble_rows(h_fixed);
         // 2. the step: time stepping when anything touches or the damping is
-        //    too stiff for the explicit integrator even at dt, else the integrator
+        //    too stiff for the explicit integrator even at dt, else the
+        //    integrator; an adaptive step is capped so that no joint can reach a
+        //    limit within it (it approaches in shorter steps, and the impact is
+        //    taken by time stepping) and so that damping stays explicit-stable
         let mut time_stepping =
             self.integrator == Integrator::SemiImplicitEuler || counts.touching();
         let mut h_max = f64::INFINITY;
@@ -719,8 +710,8 @@ impl Simulation {
             time_stepping = rate * h_fixed > limit;
             h_max = limit / rate;
         }
-        if time_stepping && h_probe != h_fixed {
-            counts = self.assemble_rows(h_fixed);
+        if !time_stepping {
+            h_max = h_max.min(self.limit_reach_cap());
         }
         let h = if time_stepping {
             self.euler_step(h_fixed, counts.total() > 0)?;
@@ -746,6 +737,30 @@ impl Simulation {
         self.refresh_contacts();
         self.check_energy()?;
         Ok(h)
+    }
+
+    /// The longest step in which no joint moving toward a limit can reach it
+    /// at twice its current speed (+∞ when none moves toward one). A joint
+    /// within reach at `dt` has a row already (the step is time stepping).
+    fn limit_reach_cap(&self) -> f64 {
+        let mut cap = f64::INFINITY;
+        if !self.opts.joint_dynamics {
+            return cap;
+        }
+        let (qo, vo) = (self.model.joint_q_offset(), self.model.joint_v_offset());
+        for (d, info) in self.model.dofs.iter().enumerate() {
+            if info.continuous {
+                continue;
+            }
+            let (q, v) = (self.q[qo + d], self.v[vo + d]);
+            let gap = match (v < 0.0, info.limits.lower, info.limits.upper) {
+                (true, Some(lo), _) => q - lo,
+                (false, _, Some(hi)) if v > 0.0 => hi - q,
+                _ => continue,
+            };
+            cap = cap.min((gap - 1e-3).max(0.0) / (2.0 * v.abs()));
+        }
+        cap.max(self.dt)
     }
 
     /// The constraint rows at the current state for a step `h`.
