@@ -493,6 +493,11 @@ impl Simulation {
         self.refresh_contacts();
         self.guard.reference = None;
         self.guard.recovering_until = if self.start_violations().is_empty() {
+            let e = self.energy();
+            if e.is_finite() {
+                self.guard.reference = Some(e);
+                self.guard.v_ref.copy_from(&self.v);
+            }
             None
         } else {
             Some(self.t + 2.0)
