@@ -20,6 +20,9 @@ fn setup(tol: Option<f64>) -> Simulation {
     if let Some(t) = tol {
         o.solver_tol = t;
     }
+    if let Some(n) = std::env::var("ITERS").ok().and_then(|s| s.parse().ok()) {
+        o.solver_iterations = n;
+    }
     let mut sim = Simulation::new(model, o).expect("simulation");
     let mut q = sim.q().clone();
     let low = sim.lowest_point();

@@ -18,10 +18,11 @@
 //! [`GroundContact::queries`]). Otherwise the shape's contact *manifold* is made
 //! of its points within `δ` of the plane: a box's corners, a hull's vertices, a
 //! cylinder's lowest rim points plus 6 samples on each rim, a sphere's lowest
-//! point, a capsule's two end-sphere lowest points. More than 8 such points are
-//! reduced to at most 9: the deepest, the points kept last step that are still
-//! within the margin, then the extremes in 8 horizontal directions (a persistent
-//! set: a face lying on the ground keeps its points from step to step). Each
+//! point, a capsule's two end-sphere lowest points. More than 4 such points (8
+//! on a cylinder) are reduced: the deepest, the points kept last step that are
+//! still within the margin, then the extremes in 4 (8) horizontal directions (a
+//! persistent set: a face lying on the ground keeps its points from step to
+//! step). Each
 //! point keeps a stable *slot* (shape, feature) so the solver can warm-start.
 //!
 //! # Forces (solved in [`crate::sim`], docs/theory.md §"Constraint rows")
@@ -39,9 +40,9 @@
 //!
 //! solved by projected Gauss–Seidel on the Delassus matrix W = J H̃⁻¹ Jᵀ
 //! (H̃ = H + A + Δt·D, damping implicit), kept implicit as W = Y Yᵀ with
-//! Y = J L⁻ᵀ (H̃ = L Lᵀ: one forward substitution per row, the solver carries
-//! Lᵀ Δv), warm-started from the last step's impulses (stable point slots), to
-//! 1e-7 m/s (or rad/s) change per sweep, at most 60 sweeps; sweeps 4–30
+//! Y = J R⁻¹ (H̃ = RᵀR, tree-sparse: each row lives on its body's path to the
+//! root, `crate::sim::factor`; the solver carries R Δv), warm-started from the last step's impulses (stable point slots), to
+//! 1e-7 m/s (or rad/s) change per sweep, at most 20 sweeps; sweeps 4–10
 //! over-relax the scalar rows by 1.3 (projected SOR) and a plain sweep ends the
 //! solve (`crate::sim::solver`; a solve stopped by the cap is made
 //! energy-safe). Penetration is removed by the position pass (split impulse):
@@ -83,10 +84,11 @@ pub struct ContactParams {
     pub slop: f64,
     /// Detection margin δ (m): points closer than this to the plane are candidates.
     pub margin: f64,
-    /// Points per shape above which they are reduced (to the deepest and the
-    /// extremes in this many horizontal directions: at most this many plus one).
-    /// 4 made the solver's rows on real robots' meshes fewer but left solo12 lying
-    /// on its mesh links unsettled at 3 s; 8 settles every robot we drop.
+    /// The most contact points a shape gives (MuJoCo gives a hull on a plane at
+    /// most 3, a box 4): the deepest, last step's points still there, then the
+    /// extremes in this many horizontal directions. 4 with that persistent set
+    /// settles every robot of the sweep (without persistence, 4 left solo12
+    /// rocking on its mesh links and needed 8).
     pub max_points_per_shape: usize,
 }
 
@@ -99,7 +101,7 @@ impl Default for ContactParams {
             max_push_speed: 0.5,
             slop: 1e-4,
             margin: 0.005,
-            max_points_per_shape: 8,
+            max_points_per_shape: 4,
         }
     }
 }
@@ -199,6 +201,18 @@ pub struct GroundContact {
 }
 
 const CYL_SAMPLES: usize = 6;
+
+impl GroundShape {
+    /// The most points this shape gives: `maxp`, twice that for a cylinder (its
+    /// two rims: a rolling rim's lowest point moves along it, and the sampled
+    /// neighbours keep a rolling lamp base from sinking at impact).
+    fn point_cap(&self, maxp: usize) -> usize {
+        match self.manifold {
+            Manifold::Cylinder { .. } => 2 * maxp,
+            _ => maxp,
+        }
+    }
+}
 
 fn to_pose(m: &Se3<f64>) -> Pose {
     let r = &m.rot;
@@ -418,7 +432,7 @@ impl GroundContact {
     pub fn max_points(&self) -> usize {
         self.shapes
             .iter()
-            .map(|s| s.nslots.min(self.params.max_points_per_shape.max(1) + 1))
+            .map(|s| s.nslots.min(s.point_cap(self.params.max_points_per_shape.max(1))))
             .sum()
     }
 
@@ -441,6 +455,39 @@ impl GroundContact {
                 continue;
             }
             self.queries += 1;
+            // a hull or point set: its lowest vertex is its support point toward
+            // −z; only the heights are needed to find it and the candidates
+            // (one dot product a vertex, no parry query)
+            if s.manifold == Manifold::Vertices {
+                let r = &o_m_g.rot;
+                let (rx, ry, rz) = (r[(2, 0)], r[(2, 1)], r[(2, 2)]);
+                let tz = o_m_g.trans.z - ground;
+                let low = s
+                    .verts
+                    .iter()
+                    .map(|v| rx * v.x + ry * v.y + rz * v.z + tz)
+                    .fold(f64::INFINITY, f64::min);
+                if low > margin {
+                    continue;
+                }
+                let base = self.slot_offset[si];
+                let scratch = &mut self.scratch;
+                scratch.clear();
+                for (k, v) in s.verts.iter().enumerate() {
+                    if rx * v.x + ry * v.y + rz * v.z + tz <= margin {
+                        let p = o_m_g.act_point(v);
+                        scratch.push(ContactPoint {
+                            shape: si,
+                            slot: base + k,
+                            body: s.body,
+                            point: p,
+                            gap: p.z - ground,
+                        });
+                    }
+                }
+                reduce(scratch, maxp, out, &self.prev_flag);
+                continue;
+            }
             // parry's half-space query, in the ground frame (z shifted by −ground)
             let mut g_m_shape = o_m_g.compose(&s.parry_offset);
             g_m_shape.trans.z -= ground;
@@ -524,7 +571,7 @@ impl GroundContact {
                     }
                 }
             }
-            reduce(scratch, maxp, out, &self.prev_flag);
+            reduce(scratch, s.point_cap(maxp), out, &self.prev_flag);
         }
         for &k in &self.prev_list {
             self.prev_flag[k] = false;
@@ -539,8 +586,8 @@ impl GroundContact {
     }
 }
 
-/// Appends `pts` to `out`, reduced to at most `maxp + 1` points when there
-/// are more than `maxp`: the deepest point, then the points kept last time
+/// Appends `pts` to `out`, reduced to at most `maxp` points when there are
+/// more: the deepest point, then the points kept last time
 /// (`prev`, by slot) that are still here, deepest first, then the extremes in
 /// `maxp` evenly spaced horizontal directions. Keeping last step's points makes
 /// the set persistent: a flat face with more candidates than room does not
@@ -554,7 +601,7 @@ fn reduce(pts: &[ContactPoint], maxp: usize, out: &mut Vec<ContactPoint>, prev: 
     }
     const TIE: f64 = 1e-6;
     let start = out.len();
-    let cap = maxp + 1;
+    let cap = maxp;
     let has = |out: &Vec<ContactPoint>, slot: usize| out[start..].iter().any(|q| q.slot == slot);
     // the best by `key` (larger wins), near-ties to the lowest slot
     let pick = |key: &dyn Fn(&ContactPoint) -> f64| -> usize {

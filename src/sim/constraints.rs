@@ -16,10 +16,10 @@
 //!   kinetic energy); restitution e > 0 raises b to −e·u⁻ on fast impacts;
 //! - position pass: b_pos = min(β(−φ − slop)/Δt, cap) where φ < −slop.
 
+use super::factor::MassFactor;
 use super::solver::{self, RowKind, Rows};
 use super::ContactForce;
 use crate::contact::ContactPoint;
-use crate::dynamics::linalg::chol_backward_slice;
 use crate::model::Model;
 use crate::spatial::{Force, Motion, Se3};
 use nalgebra::{DVector, Vector3};
@@ -98,6 +98,8 @@ pub(crate) struct Constraints {
     tau_joint: DVector<f64>,
     fext: Vec<Force>,
     contact_forces: Vec<ContactForce>,
+    /// R v* (the energy-safe exit's work).
+    a: Vec<f64>,
 }
 
 impl Constraints {
@@ -120,6 +122,7 @@ impl Constraints {
             tau_joint: DVector::zeros(nv),
             fext: vec![Force::zero(); model.nbodies],
             contact_forces: Vec::with_capacity(max_points),
+            a: vec![0.0; nv],
         }
     }
 
@@ -160,6 +163,7 @@ impl Constraints {
         v: &DVector<f64>,
         points: &[ContactPoint],
         p: &RowParams,
+        f: &MassFactor,
         h: f64,
     ) -> RowCounts {
         let (vo, qo) = (model.joint_v_offset(), model.joint_q_offset());
@@ -184,7 +188,8 @@ impl Constraints {
                     let kind = RowKind::Box {
                         limit: info.friction * h,
                     };
-                    if let Some(r) = rows.push(kind, 0.0, self.warm_joint[d][0]) {
+                    let path = f.path_of(iv);
+                    if let Some(r) = rows.push(kind, 0.0, self.warm_joint[d][0], path) {
                         rows.jrow_mut(r)[iv] = 1.0;
                         self.joint_rows.push((d, 0));
                         counts.friction += 1;
@@ -207,7 +212,8 @@ impl Constraints {
                         continue;
                     }
                     let w = self.warm_joint[d][which as usize];
-                    if let Some(r) = rows.push(RowKind::Unilateral, speculative(gap), w) {
+                    let path = f.path_of(iv);
+                    if let Some(r) = rows.push(RowKind::Unilateral, speculative(gap), w, path) {
                         rows.jrow_mut(r)[iv] = sign;
                         rows.bpos[r] = pos_target(gap, p.limit_slop, p.limit_push_cap);
                         if rows.bpos[r] > 0.0 {
@@ -234,18 +240,21 @@ impl Constraints {
         let nv = rows.nv;
         for (pi, pt) in points.iter().enumerate() {
             let warm = self.warm_contact.get(pt.slot).copied().unwrap_or([0.0; 3]);
-            let Some(rn) = rows.push(RowKind::Normal, 0.0, warm[0]) else {
+            // the body's path to the root: its joint's last dof and every ancestor
+            let jb = &model.joints[pt.body];
+            let path = f.path_of((jb.iv + jb.nv()).saturating_sub(1));
+            let Some(rn) = rows.push(RowKind::Normal, 0.0, warm[0], path) else {
                 break;
             };
             let tangent = RowKind::Tangent {
                 normal: rn,
                 mu: p.mu,
             };
-            if rows.push(tangent, 0.0, warm[1]).is_none() {
+            if rows.push(tangent, 0.0, warm[1], path).is_none() {
                 rows.pop(1);
                 break;
             }
-            if rows.push(RowKind::Tangent2, 0.0, warm[2]).is_none() {
+            if rows.push(RowKind::Tangent2, 0.0, warm[2], path).is_none() {
                 rows.pop(2);
                 break;
             }
@@ -300,7 +309,7 @@ impl Constraints {
         &mut self,
         model: &Model,
         points: &[ContactPoint],
-        l: &[f64],
+        f: &MassFactor,
         vfree: &DVector<f64>,
         h: f64,
         iterations: usize,
@@ -312,27 +321,21 @@ impl Constraints {
         self.clear_forces();
         self.dv.fill(0.0);
         let rows = &mut self.rows;
-        // Y rows = L⁻¹ jᵣ (one forward substitution a row): W = J H̃⁻¹ Jᵀ = Y Yᵀ,
-        // the solver works on Δv' = Lᵀ Δv with uᵣ = cᵣ + yᵣ·Δv'
-        rows.form_factored(l, vfree.as_slice());
-        let mut sweeps = rows.solve(self.dv.as_mut_slice(), iterations, tol, relaxation);
+        // Y rows = R⁻ᵀ jᵣ (H̃ = RᵀR, each over its path): W = J H̃⁻¹ Jᵀ = Y Yᵀ,
+        // the solver works on Δv' = R Δv with uᵣ = cᵣ + yᵣ·Δv'
+        rows.form(f, vfree.as_slice());
+        let mut sweeps = rows.solve(f, self.dv.as_mut_slice(), iterations, tol, relaxation);
         if sweeps >= iterations {
-            sweeps += energy_safe_exit(
-                rows,
-                l,
-                vfree.as_slice(),
-                self.dv.as_mut_slice(),
-                iterations,
-                tol,
-            );
+            f.apply_r(vfree.as_slice(), &mut self.a);
+            sweeps += energy_safe_exit(rows, f, &self.a, self.dv.as_mut_slice(), iterations, tol);
         }
-        // Δv = L⁻ᵀ Δv'
-        chol_backward_slice(l, nv, self.dv.as_mut_slice());
+        // Δv = R⁻¹ Δv'
+        f.half_solve(self.dv.as_mut_slice());
         // the position pass, only where something is violated
         let pushing = self.counts.violated > 0;
         if pushing {
-            rows.solve_position(self.push.as_mut_slice(), iterations, tol);
-            chol_backward_slice(l, nv, self.push.as_mut_slice());
+            rows.solve_position(f, self.push.as_mut_slice(), iterations, tol);
+            f.half_solve(self.push.as_mut_slice());
         }
         // joint rows: warm starts and generalized force
         for w in self.warm_joint.iter_mut() {
@@ -383,19 +386,13 @@ impl Constraints {
 }
 
 /// (ΔKE of the impulse, the exact solution's bound Σ λᵣ max(bᵣ, 0), a·d, ‖d‖²)
-/// for the factored Δv' = `d` (a = Lᵀv*: the kinetic energy after the impulse
+/// for the factored Δv' = `d` (a = R v*: the kinetic energy after the impulse
 /// is ½‖a + d‖² in the H̃-norm).
-fn impulse_work(rows: &Rows, l: &[f64], vfree: &[f64], d: &[f64]) -> (f64, f64, f64, f64) {
-    let nv = rows.nv;
+fn impulse_work(rows: &Rows, a: &[f64], d: &[f64]) -> (f64, f64, f64, f64) {
     let (mut ad, mut dd) = (0.0, 0.0);
-    for k in 0..nv {
-        // a_k = Σ_{i≥k} L[i,k] v*_i (column k of L, contiguous)
-        let mut ak = 0.0;
-        for i in k..nv {
-            ak += l[k * nv + i] * vfree[i];
-        }
-        ad += ak * d[k];
-        dd += d[k] * d[k];
+    for (ak, dk) in a.iter().zip(d) {
+        ad += ak * dk;
+        dd += dk * dk;
     }
     let mut allow = 0.0;
     for r in 0..rows.n {
@@ -412,33 +409,33 @@ fn impulse_work(rows: &Rows, l: &[f64], vfree: &[f64], d: &[f64]) -> (f64, f64, 
 /// rows, maximal dissipation on the friction rows). While the iterate exceeds
 /// that bound, more plain sweeps run (up to 4× the cap); if it still does, the
 /// impulses are scaled by the largest s ≤ 1 that meets it (a scaled impulse
-/// stays inside every cone and box). Returns the extra sweeps.
+/// stays inside every cone and box). `a` = R v*. Returns the extra sweeps.
 fn energy_safe_exit(
     rows: &mut Rows,
-    l: &[f64],
-    vfree: &[f64],
+    f: &MassFactor,
+    a: &[f64],
     d: &mut [f64],
     iterations: usize,
     tol: f64,
 ) -> usize {
     let nv = rows.nv;
-    if l.len() < nv * nv || vfree.len() < nv || d.len() < nv {
+    if a.len() < nv || d.len() < nv {
         return 0;
     }
     let budget = 4 * iterations;
     let mut extra = 0;
     loop {
-        let (work, allow, _, _) = impulse_work(rows, l, vfree, d);
+        let (work, allow, _, _) = impulse_work(rows, a, d);
         if work <= allow || extra >= budget {
             break;
         }
-        let it = rows.solve(d, 10, tol, 1.0);
+        let it = rows.solve(f, d, 10, tol, 1.0);
         extra += it;
         if it < 10 {
             break;
         }
     }
-    let (work, allow, ad, dd) = impulse_work(rows, l, vfree, d);
+    let (work, allow, ad, dd) = impulse_work(rows, a, d);
     if work <= allow || dd <= 0.0 {
         return extra;
     }

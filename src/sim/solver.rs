@@ -19,7 +19,7 @@
 //! 0 ≤ μ ⊥ J w − b_pos ≥ 0 on the unilateral rows, b_pos = min(βφ⁻/Δt, cap),
 //! moves q but never enters v.
 
-use crate::dynamics::linalg::by_size;
+use super::factor::MassFactor;
 
 /// What a row is.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,6 +55,9 @@ pub struct Rows {
     pub bpos: Vec<f64>,
     /// Position-pass multipliers.
     pub mu: Vec<f64>,
+    /// Each row's dof path (start, length) in the factor's table: its Jacobian
+    /// and y live there only (compact y: entry t is dof path[t]).
+    pub path: Vec<(usize, usize)>,
     cap: usize,
 }
 
@@ -72,6 +75,7 @@ impl Rows {
             lambda: vec![0.0; cap],
             bpos: vec![0.0; cap],
             mu: vec![0.0; cap],
+            path: vec![(0, 0); cap],
             cap,
         }
     }
@@ -97,7 +101,13 @@ impl Rows {
     }
     /// Adds a row (zeroed Jacobian: rows are zeroed by [`Rows::clear`]) and returns
     /// its index, or `None` when full.
-    pub fn push(&mut self, kind: RowKind, b: f64, warm: f64) -> Option<usize> {
+    pub fn push(
+        &mut self,
+        kind: RowKind,
+        b: f64,
+        warm: f64,
+        path: (usize, usize),
+    ) -> Option<usize> {
         if self.n >= self.cap {
             return None;
         }
@@ -107,6 +117,7 @@ impl Rows {
         self.b[r] = b;
         self.lambda[r] = warm;
         self.bpos[r] = 0.0;
+        self.path[r] = path;
         Some(r)
     }
     pub fn jrow_mut(&mut self, r: usize) -> &mut [f64] {
@@ -115,136 +126,98 @@ impl Rows {
     pub fn jrow(&self, r: usize) -> &[f64] {
         &self.j[r * self.nv..(r + 1) * self.nv]
     }
-    pub fn yrow(&self, r: usize) -> &[f64] {
-        &self.y[r * self.nv..(r + 1) * self.nv]
-    }
-
-    /// Fills `y` with the rows of Y = J L⁻ᵀ (yᵣ = L⁻¹ jᵣ, one forward substitution
-    /// a row) for the lower Cholesky factor `l` of H (column-major, nv × nv), the
-    /// Delassus diagonal Wᵣᵣ = jᵣ·H⁻¹jᵣ = ‖yᵣ‖² and c = J v* for the free velocity
-    /// `vfree`.
-    pub fn form_factored(&mut self, l: &[f64], vfree: &[f64]) {
+    /// Fills y with the rows of Y = J R⁻ᵀ (H̃ = RᵀR, [`MassFactor`]), each over
+    /// its path, the Delassus diagonal Wᵣᵣ = jᵣ·H̃⁻¹jᵣ = ‖yᵣ‖² and c = J v* for
+    /// the free velocity `vfree`.
+    pub fn form(&mut self, f: &MassFactor, vfree: &[f64]) {
         let (nv, n) = (self.nv, self.n);
-        if l.len() < nv * nv
-            || vfree.len() < nv
-            || self.j.len() < n * nv
-            || self.y.len() < n * nv
-            || self.w.len() < n
-            || self.c.len() < n
-        {
+        let table = f.table();
+        if vfree.len() < nv || self.j.len() < n * nv || self.y.len() < n * nv {
             return;
         }
-        by_size!(nv, N => self.form_n::<N>(l, vfree))
-    }
-
-    /// [`Rows::form_factored`] with rows `N` long (`N = 0`: `self.nv`); the
-    /// caller checked the lengths.
-    #[inline(always)]
-    fn form_n<const N: usize>(&mut self, l: &[f64], vfree: &[f64]) {
-        let nv = if N == 0 { self.nv } else { N };
-        let n = self.n;
-        let (j, y) = (&self.j[..n * nv], &mut self.y[..n * nv]);
-        let (w, c) = (&mut self.w[..n], &mut self.c[..n]);
-        let (l, vfree) = (&l[..nv * nv], &vfree[..nv]);
-        // SAFETY: r < n, k, i < nv; j and y are n·nv long, l nv·nv, vfree nv,
-        // w and c n (sliced above).
-        unsafe {
-            for r in 0..n {
-                let mut cr = -0.0;
-                let mut wr = -0.0;
-                for k in 0..nv {
-                    let jk = *j.get_unchecked(r * nv + k);
-                    cr += jk * *vfree.get_unchecked(k);
-                    *y.get_unchecked_mut(r * nv + k) = jk;
-                }
-                for k in 0..nv {
-                    let xk = *y.get_unchecked(r * nv + k) / *l.get_unchecked(k * nv + k);
-                    *y.get_unchecked_mut(r * nv + k) = xk;
-                    wr += xk * xk;
-                    for i in k + 1..nv {
-                        *y.get_unchecked_mut(r * nv + i) -= *l.get_unchecked(k * nv + i) * xk;
-                    }
-                }
-                *c.get_unchecked_mut(r) = cr;
-                *w.get_unchecked_mut(r) = wr;
+        for r in 0..n {
+            let (ps, pl) = self.path[r];
+            let Some(path) = table.get(ps..ps + pl) else {
+                continue;
+            };
+            let jr = &self.j[r * nv..(r + 1) * nv];
+            let yr = &mut self.y[r * nv..r * nv + pl];
+            let mut cr = 0.0;
+            for (yt, &k) in yr.iter_mut().zip(path) {
+                let jk = jr[k];
+                *yt = jk;
+                cr += jk * vfree[k];
             }
+            f.row_transform(path, yr);
+            self.c[r] = cr;
+            self.w[r] = yr.iter().map(|x| x * x).sum();
         }
     }
 
-    /// Projected Gauss–Seidel on W = J H⁻¹ Jᵀ = Y Yᵀ (Y = J L⁻ᵀ, H = L Lᵀ), kept
-    /// implicit: Δv' = Lᵀ Δv = Yᵀλ is carried along (in `dv`, length nv) so that
-    /// a row's velocity is uᵣ = cᵣ + yᵣ·Δv', O(nv) a row; the caller recovers
-    /// Δv = L⁻ᵀ Δv'. Stops when no row's velocity
-    /// changes by more than `tol` (m/s or rad/s) in a sweep, or after `max_iter`
-    /// sweeps; returns the sweeps. Rows with a (numerically) zero diagonal stay at 0.
-    /// After three plain sweeps, the scalar rows (contact normals, joint friction
-    /// and limits) are over-relaxed by `relax` ∈ (0, 2) (projected SOR, convergent
-    /// for the positive semi-definite W in that range; 1 is plain Gauss–Seidel)
-    /// until converged, then one plain sweep ends the solve; the tangent pairs,
-    /// projected onto the friction disc, are never over-relaxed. A solve still
-    /// unconverged after half of `max_iter` sweeps goes on with plain sweeps: an
-    /// over-relaxed iterate left by the sweep limit can add energy (talos_reduced
-    /// standing on its feet did not come to rest that way), a Gauss–Seidel one
-    /// does not in practice.
-    pub fn solve(&mut self, dv: &mut [f64], max_iter: usize, tol: f64, relax: f64) -> usize {
-        // the row length known at compile time for common sizes: the short dot
-        // products and updates are unrolled (same arithmetic, same order)
-        by_size!(self.nv, N => self.solve_n::<N>(dv, max_iter, tol, relax))
-    }
-
-    /// [`Rows::solve`] with rows `N` long (`N = 0`: `self.nv`).
-    #[inline]
-    fn solve_n<const N: usize>(
+    /// Projected Gauss–Seidel on W = Y Yᵀ, kept implicit: Δv' = Yᵀλ is carried
+    /// along (in `dv`, length nv) so that a row's velocity is uᵣ = cᵣ + yᵣ·Δv',
+    /// O(path length) a row; the caller recovers Δv = R⁻¹ Δv'. Stops when no
+    /// row's velocity changes by more than `tol` (m/s or rad/s) in a sweep, or
+    /// after `max_iter` sweeps; returns the sweeps. Rows with a (numerically)
+    /// zero diagonal stay at 0. After three plain sweeps, the scalar rows
+    /// (contact normals, joint friction and limits) are over-relaxed by `relax`
+    /// ∈ (0, 2) (projected SOR, convergent for the positive semi-definite W in
+    /// that range; 1 is plain Gauss–Seidel) until converged, then one plain
+    /// sweep ends the solve; the tangent pairs, projected onto the friction
+    /// disc, are never over-relaxed. A solve still unconverged after half of
+    /// `max_iter` sweeps goes on with plain sweeps.
+    pub fn solve(
         &mut self,
+        f: &MassFactor,
         dv: &mut [f64],
         max_iter: usize,
         tol: f64,
         relax: f64,
     ) -> usize {
-        let nv = if N == 0 { self.nv } else { N };
-        if N != 0 && (dv.len() < N || self.nv != N) {
-            return self.solve_n::<0>(dv, max_iter, tol, relax);
-        }
-        let n = self.n;
+        let (nv, n) = (self.nv, self.n);
+        let table = f.table();
         if dv.len() < nv
-            || self.j.len() < n * nv
             || self.y.len() < n * nv
             || self.kind.len() < n
-            || self.w.len() < n
-            || self.c.len() < n
-            || self.b.len() < n
-            || self.lambda.len() < n
+            || self
+                .path
+                .iter()
+                .take(n)
+                .any(|&(s, l)| s + l > table.len() || l > nv)
         {
             return 0;
         }
         let dv = &mut dv[..nv];
-        let y = &self.y[..n * nv];
+        let (y, paths) = (&self.y[..], &self.path[..n]);
         let (kinds, w, c, b) = (&self.kind[..n], &self.w[..n], &self.c[..n], &self.b[..n]);
         let lambda = &mut self.lambda[..n];
-        // SAFETY (all unchecked reads below): r < n, k < nv, the slices above are
-        // n·nv and n long, dv is nv long.
+        // SAFETY (unchecked reads in rdot/raxpy): every path lies in `table`
+        // (checked above) and holds dof indices < nv; y holds n·nv entries and
+        // a path is at most nv long.
         #[inline(always)]
-        fn rdot<const N: usize>(nv: usize, m: &[f64], r: usize, x: &[f64]) -> f64 {
-            let nv = if N == 0 { nv } else { N };
-            let mut s = -0.0;
-            for k in 0..nv {
-                s += unsafe { m.get_unchecked(r * nv + k) * x.get_unchecked(k) };
+        fn rdot(y: &[f64], r: usize, nv: usize, p: &[usize], x: &[f64]) -> f64 {
+            let mut s = 0.0;
+            for (t, &k) in p.iter().enumerate() {
+                s += unsafe { y.get_unchecked(r * nv + t) * x.get_unchecked(k) };
             }
             s
         }
         #[inline(always)]
-        fn raxpy<const N: usize>(nv: usize, a: f64, m: &[f64], r: usize, x: &mut [f64]) {
-            let nv = if N == 0 { nv } else { N };
-            for k in 0..nv {
-                unsafe { *x.get_unchecked_mut(k) += a * m.get_unchecked(r * nv + k) };
+        fn raxpy(a: f64, y: &[f64], r: usize, nv: usize, p: &[usize], x: &mut [f64]) {
+            for (t, &k) in p.iter().enumerate() {
+                unsafe { *x.get_unchecked_mut(k) += a * y.get_unchecked(r * nv + t) };
             }
         }
-        // Δv from the warm start
+        let path = |r: usize| {
+            let (s, l) = paths[r];
+            &table[s..s + l]
+        };
+        // Δv' from the warm start
         dv.iter_mut().for_each(|x| *x = 0.0);
         for r in 0..n {
             let l = lambda[r];
             if l != 0.0 {
-                raxpy::<N>(nv, l, y, r, dv);
+                raxpy(l, y, r, nv, path(r), dv);
             }
         }
         let mut it = 0;
@@ -258,18 +231,17 @@ impl Rows {
             it += 1;
             let plain = it <= PLAIN || finishing || 2 * it > max_iter || relax == 1.0;
             let relax = if plain { 1.0 } else { relax };
-            // (comparisons in place of f64::max: the same result, NaN included)
             let mut change: f64 = 0.0;
             let mut r = 0;
             while r < n {
-                let kind = unsafe { *kinds.get_unchecked(r) };
+                let kind = kinds[r];
                 match kind {
                     RowKind::Tangent { normal, mu } if r + 1 < n => {
-                        let (w11, w22) = unsafe { (*w.get_unchecked(r), *w.get_unchecked(r + 1)) };
-                        let u1 = unsafe { *c.get_unchecked(r) } + rdot::<N>(nv, y, r, dv);
-                        let u2 = unsafe { *c.get_unchecked(r + 1) } + rdot::<N>(nv, y, r + 1, dv);
-                        let (o1, o2) =
-                            unsafe { (*lambda.get_unchecked(r), *lambda.get_unchecked(r + 1)) };
+                        let (p1, p2) = (path(r), path(r + 1));
+                        let (w11, w22) = (w[r], w[r + 1]);
+                        let u1 = c[r] + rdot(y, r, nv, p1, dv);
+                        let u2 = c[r + 1] + rdot(y, r + 1, nv, p2, dv);
+                        let (o1, o2) = (lambda[r], lambda[r + 1]);
                         let mut t1 = if w11 > 1e-14 { o1 - u1 / w11 } else { 0.0 };
                         let mut t2 = if w22 > 1e-14 { o2 - u2 / w22 } else { 0.0 };
                         let ln = lambda.get(normal).copied().unwrap_or(0.0);
@@ -280,25 +252,16 @@ impl Rows {
                             t1 *= s;
                             t2 *= s;
                         }
-                        unsafe {
-                            *lambda.get_unchecked_mut(r) = t1;
-                            *lambda.get_unchecked_mut(r + 1) = t2;
-                        }
+                        lambda[r] = t1;
+                        lambda[r + 1] = t2;
                         let (d1, d2) = (t1 - o1, t2 - o2);
                         if d1 != 0.0 {
-                            raxpy::<N>(nv, d1, y, r, dv);
+                            raxpy(d1, y, r, nv, p1, dv);
                         }
                         if d2 != 0.0 {
-                            raxpy::<N>(nv, d2, y, r + 1, dv);
+                            raxpy(d2, y, r + 1, nv, p2, dv);
                         }
-                        let a1 = (d1 * w11).abs();
-                        if a1 > change {
-                            change = a1;
-                        }
-                        let a2 = (d2 * w22).abs();
-                        if a2 > change {
-                            change = a2;
-                        }
+                        change = change.max((d1 * w11).abs()).max((d2 * w22).abs());
                         r += 2;
                         continue;
                     }
@@ -308,41 +271,25 @@ impl Rows {
                     }
                     _ => {}
                 }
-                let wrr = unsafe { *w.get_unchecked(r) };
-                let old = unsafe { *lambda.get_unchecked(r) };
+                let wrr = w[r];
+                let old = lambda[r];
+                let p = path(r);
                 let new = if wrr > 1e-14 {
-                    let u = unsafe { *c.get_unchecked(r) } + rdot::<N>(nv, y, r, dv);
-                    let x = old - relax * (u - unsafe { *b.get_unchecked(r) }) / wrr;
+                    let u = c[r] + rdot(y, r, nv, p, dv);
+                    let x = old - relax * (u - b[r]) / wrr;
                     match kind {
-                        RowKind::Box { limit } => {
-                            if x < -limit {
-                                -limit
-                            } else if x > limit {
-                                limit
-                            } else {
-                                x
-                            }
-                        }
-                        _ => {
-                            if x > 0.0 {
-                                x
-                            } else {
-                                0.0
-                            }
-                        }
+                        RowKind::Box { limit } => x.clamp(-limit, limit),
+                        _ => x.max(0.0),
                     }
                 } else {
                     0.0
                 };
-                unsafe { *lambda.get_unchecked_mut(r) = new };
+                lambda[r] = new;
                 let d = new - old;
                 if d != 0.0 {
-                    raxpy::<N>(nv, d, y, r, dv);
+                    raxpy(d, y, r, nv, p, dv);
                 }
-                let a = (d * wrr).abs();
-                if a > change {
-                    change = a;
-                }
+                change = change.max((d * wrr).abs());
                 r += 1;
             }
             if finishing || (change <= tol && plain) {
@@ -363,16 +310,21 @@ impl Rows {
     /// w = L⁻ᵀ w' (`dw` receives w' = Yᵀμ; the caller back-substitutes). Rows
     /// that are not violated (b_pos = 0) take part so that pushing one point out
     /// never pushes another in. Returns the sweeps.
-    pub fn solve_position(&mut self, dw: &mut [f64], max_iter: usize, tol: f64) -> usize {
+    pub fn solve_position(
+        &mut self,
+        f: &MassFactor,
+        dw: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+    ) -> usize {
         let (nv, n) = (self.nv, self.n);
+        let table = f.table();
         if dw.len() < nv || self.y.len() < n * nv || self.mu.len() < n || self.bpos.len() < n {
             return 0;
         }
         let dw = &mut dw[..nv];
         dw.iter_mut().for_each(|x| *x = 0.0);
-        let y = &self.y[..n * nv];
-        let mu = &mut self.mu[..n];
-        mu.iter_mut().for_each(|x| *x = 0.0);
+        self.mu[..n].iter_mut().for_each(|x| *x = 0.0);
         let mut it = 0;
         while it < max_iter {
             it += 1;
@@ -385,15 +337,19 @@ impl Rows {
                 if !(wrr > 1e-14) {
                     continue;
                 }
-                let yr = &y[r * nv..(r + 1) * nv];
-                let u = dot(yr, dw);
-                let old = mu[r];
+                let (ps, pl) = self.path[r];
+                let (Some(p), Some(yr)) = (table.get(ps..ps + pl), self.y.get(r * nv..r * nv + pl))
+                else {
+                    continue;
+                };
+                let u: f64 = yr.iter().zip(p).map(|(a, &k)| a * dw[k]).sum();
+                let old = self.mu[r];
                 let new = (old - (u - self.bpos[r]) / wrr).max(0.0);
                 let d = new - old;
                 if d != 0.0 {
-                    mu[r] = new;
-                    for (x, yk) in dw.iter_mut().zip(yr) {
-                        *x += d * yk;
+                    self.mu[r] = new;
+                    for (a, &k) in yr.iter().zip(p) {
+                        dw[k] += d * a;
                     }
                     change = change.max((d * wrr).abs());
                 }

@@ -5,7 +5,6 @@
 //! v⁺ = v* + H̃⁻¹Jᵀλ, q⁺ = q ⊕ h (v⁺ + w)
 //! (λ the impulses, w the position pass's pseudo-velocity: [`super::super::constraints`]).
 
-use crate::dynamics::linalg::chol_solve_slice;
 use crate::dynamics::{bias, forward_dynamics};
 use crate::model::configuration::{integrate_config, rotate_base_velocity};
 use crate::sim::{SimError, Simulation};
@@ -28,9 +27,7 @@ impl Simulation {
         let free = if dense {
             bias(&self.model, &mut self.data, &self.q, &self.v, None);
             tau -= &self.data.bias;
-            self.factor_mass(h).map(|_| {
-                chol_solve_slice(self.mass.l.as_slice(), nv, tau.as_mut_slice());
-            })
+            self.factor_mass(h).map(|_| self.mass.f.solve(&mut tau))
         } else {
             forward_dynamics(&self.model, &mut self.data, &self.q, &self.v, &tau, None)
                 .map(|a| tau.copy_from(a))
@@ -52,7 +49,7 @@ impl Simulation {
             let imp = self.cons.solve(
                 &self.model,
                 &self.points,
-                self.mass.l.as_slice(),
+                &self.mass.f,
                 &self.mass.vfree,
                 h,
                 self.opts.solver_iterations,

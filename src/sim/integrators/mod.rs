@@ -12,7 +12,6 @@ mod rk4;
 mod smooth;
 
 use super::{SimError, Simulation};
-use crate::dynamics::linalg::cholesky_fast;
 use crate::dynamics::{mass_matrix, DynamicsError};
 
 /// The available integrators.
@@ -70,14 +69,16 @@ impl Integrator {
 }
 
 impl Simulation {
-    /// H̃ = H(q) + A + c·D at the current q, factored as L Lᵀ into `mass.l`
+    /// H̃ = H(q) + A + c·D at the current q, factored into `mass.f`
     /// (`data.h` is left holding H̃).
     fn factor_mass(&mut self, c: f64) -> Result<(), SimError> {
         mass_matrix(&self.model, &mut self.data, &self.q);
         for k in 0..self.model.nv {
             self.data.h[(k, k)] += self.armature[k] + c * self.damping[k];
         }
-        cholesky_fast(&self.data.h, &mut self.mass.l)
+        self.mass
+            .f
+            .factor(&self.data.h)
             .map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)))
     }
 }

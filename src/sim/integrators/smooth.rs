@@ -108,14 +108,14 @@ impl Simulation {
             self.mass.tau = tau;
             return Err(e);
         }
-        chol_solve_slice(self.mass.l.as_slice(), nv, tau.as_mut_slice());
+        self.mass.f.solve(&mut tau);
         self.mass.vfree.copy_from(&self.v);
         self.mass.vfree.axpy(h, &tau, 1.0);
         self.mass.tau = tau;
         let imp = self.cons.solve(
             &self.model,
             &self.points,
-            self.mass.l.as_slice(),
+            &self.mass.f,
             &self.mass.vfree,
             h,
             self.opts.solver_iterations,

@@ -1,0 +1,202 @@
+//! The factor of the step's mass matrix H̃ = H + A + h·D, written H̃ = RᵀR, and
+//! the four things the step does with it (docs/theory.md §"Constraint solve"):
+//! solve H̃ x = b, turn a constraint row j into y = R⁻ᵀ j (so that the Delassus
+//! matrix is W = J H̃⁻¹ Jᵀ = Y Yᵀ), map back Δv = R⁻¹ Δv', and apply R (the
+//! kinetic energy is ½‖R v‖²).
+//!
+//! On a tree (no mimic joint) H̃ is factored as Lᵀ D L by the tree-sparse LTDL
+//! ([`crate::dynamics::ltdl`], no fill), so R = D^½ L. A row whose Jacobian
+//! lives on the path of a body to the root (every contact and joint row) then
+//! gives y on that same path: R⁻ᵀ = D^-½ L⁻ᵀ only moves entries toward the root.
+//! Along a path the tree is a chain, so y is formed in O(depth²) and each solver
+//! sweep reads O(depth) entries a row instead of O(nv²) and O(nv) (MuJoCo's
+//! tree-sparse `mj_factorI` / `mj_solveM` idea). With mimic joints H̃ is not
+//! tree-shaped: a dense Cholesky H̃ = L Lᵀ (R = Lᵀ) and full-length rows.
+
+use crate::dynamics::linalg::cholesky_fast;
+use crate::dynamics::linalg::{chol_backward_slice, chol_forward_slice, chol_solve_slice};
+use crate::dynamics::ltdl::{ltdl, ltdl_solve};
+use crate::model::Model;
+use nalgebra::{DMatrix, DVector};
+
+const NONE: usize = usize::MAX;
+
+/// H̃ factored, with the dof paths rows live on.
+#[derive(Clone, Debug)]
+pub struct MassFactor {
+    tree: bool,
+    n: usize,
+    /// Dense: L (lower, column-major). Tree: the LTDL storage (Lᵀ in the upper
+    /// triangle, D on the diagonal).
+    m: DMatrix<f64>,
+    sqrt_d: Vec<f64>,
+    inv_sqrt_d: Vec<f64>,
+    lambda: Vec<usize>,
+    /// Every dof's path (root … dof, ascending) back to back, then `0..n`.
+    table: Vec<usize>,
+    start: Vec<usize>,
+    len: Vec<usize>,
+    x: DVector<f64>,
+}
+
+impl MassFactor {
+    pub fn new(model: &Model) -> Self {
+        let n = model.nv;
+        let tree = !model.has_mimic && model.dof_parent.len() == n;
+        let mut table = Vec::new();
+        let (mut start, mut len) = (Vec::with_capacity(n + 1), Vec::with_capacity(n + 1));
+        for k in 0..n {
+            let s = table.len();
+            if tree {
+                let mut i = k;
+                while i != NONE {
+                    table.push(i);
+                    i = model.dof_parent[i];
+                }
+                table[s..].reverse();
+            }
+            start.push(s);
+            len.push(table.len() - s);
+        }
+        start.push(table.len());
+        len.push(n);
+        table.extend(0..n);
+        Self {
+            tree,
+            n,
+            m: DMatrix::zeros(n, n),
+            sqrt_d: vec![1.0; n],
+            inv_sqrt_d: vec![1.0; n],
+            lambda: model.dof_parent.clone(),
+            table,
+            start,
+            len,
+            x: DVector::zeros(n),
+        }
+    }
+
+    /// The path of a row acting on dofs up to `dof` (its body's last dof, or a
+    /// joint row's own): (start, length) in [`Self::table`]. A dense factor's
+    /// rows are all full length.
+    pub fn path_of(&self, dof: usize) -> (usize, usize) {
+        let k = if self.tree { dof.min(self.n) } else { self.n };
+        (self.start[k], self.len[k])
+    }
+
+    pub fn table(&self) -> &[usize] {
+        &self.table
+    }
+
+    /// Factors `h` (H̃, full symmetric storage; on a tree only the pattern is
+    /// read). Fails with the index of a pivot that is not positive.
+    pub fn factor(&mut self, h: &DMatrix<f64>) -> Result<(), usize> {
+        if self.tree {
+            ltdl(h, &self.lambda, &mut self.m)?;
+            for k in 0..self.n {
+                let d = self.m[(k, k)];
+                self.sqrt_d[k] = d.sqrt();
+                self.inv_sqrt_d[k] = 1.0 / self.sqrt_d[k];
+            }
+            Ok(())
+        } else {
+            cholesky_fast(h, &mut self.m)
+        }
+    }
+
+    /// x ← H̃⁻¹ x.
+    pub fn solve(&self, x: &mut DVector<f64>) {
+        if self.tree {
+            ltdl_solve(&self.m, &self.lambda, x);
+        } else {
+            chol_solve_slice(self.m.as_slice(), self.n, x.as_mut_slice());
+        }
+    }
+
+    /// y ← R⁻ᵀ y for a row held compactly over `path` (y[t] is the entry of
+    /// dof path[t]; the row is zero off the path).
+    #[inline]
+    pub fn row_transform(&self, path: &[usize], y: &mut [f64]) {
+        let n = self.n;
+        let m = self.m.as_slice();
+        if !self.tree {
+            // R⁻ᵀ = L⁻¹ (the path is 0..n)
+            chol_forward_slice(m, n, y);
+            return;
+        }
+        let len = path.len().min(y.len());
+        // Lᵀ g = j from the leaf in: along a path the tree is a chain, the
+        // ancestors of path[t] are path[..t]; L[i, j] sits at m[i·n + j]
+        for t in (0..len).rev() {
+            let yt = y[t];
+            if yt != 0.0 {
+                let col = path[t] * n;
+                for s in 0..t {
+                    y[s] -= m[col + path[s]] * yt;
+                }
+            }
+        }
+        for t in 0..len {
+            y[t] *= self.inv_sqrt_d[path[t]];
+        }
+    }
+
+    /// z ← R⁻¹ z (full length).
+    pub fn half_solve(&self, z: &mut [f64]) {
+        let n = self.n;
+        if !self.tree {
+            chol_backward_slice(self.m.as_slice(), n, z);
+            return;
+        }
+        // L x = D^-½ z, root outwards
+        for i in 0..n {
+            let mut s = z[i] * self.inv_sqrt_d[i];
+            let mut j = self.lambda[i];
+            while j != NONE {
+                s -= self.m[(j, i)] * z[j];
+                j = self.lambda[j];
+            }
+            z[i] = s;
+        }
+    }
+
+    /// out ← R v.
+    pub fn apply_r(&self, v: &[f64], out: &mut [f64]) {
+        let n = self.n;
+        if !self.tree {
+            // Lᵀ v: a_k = Σ_{i≥k} L[i,k] v_i (column k of L)
+            let l = self.m.as_slice();
+            for k in 0..n {
+                let mut a = 0.0;
+                for i in k..n {
+                    a += l[k * n + i] * v[i];
+                }
+                out[k] = a;
+            }
+            return;
+        }
+        for i in 0..n {
+            let mut s = v[i];
+            let mut j = self.lambda[i];
+            while j != NONE {
+                s += self.m[(j, i)] * v[j];
+                j = self.lambda[j];
+            }
+            out[i] = self.sqrt_d[i] * s;
+        }
+    }
+
+    /// (H̃⁻¹)ₖₖ = ‖R⁻ᵀ eₖ‖².
+    pub fn inverse_diagonal(&mut self, k: usize) -> f64 {
+        let (s, l) = self.path_of(k);
+        let mut x = std::mem::replace(&mut self.x, DVector::zeros(0));
+        x.fill(0.0);
+        let path = &self.table[s..s + l];
+        // e_k is the last entry of its own path (dense: index k)
+        let at = if self.tree { l - 1 } else { k };
+        x[at] = 1.0;
+        self.row_transform(path, &mut x.as_mut_slice()[..l]);
+        let r = x.rows(0, l).norm_squared();
+        self.x = x;
+        r
+    }
+}
