@@ -18,11 +18,11 @@
 //! [`GroundContact::queries`]). Otherwise the shape's contact *manifold* is made
 //! of its points within `δ` of the plane: a box's corners, a hull's vertices, a
 //! cylinder's lowest rim points plus 6 samples on each rim, a sphere's lowest
-//! point, a capsule's two end-sphere lowest points. More than 4 such points (8
-//! on a cylinder) are reduced: the deepest, the points kept last step that are
-//! still within the margin, then the extremes in 4 (8) horizontal directions (a
-//! persistent set: a face lying on the ground keeps its points from step to
-//! step). Each
+//! point, a capsule's two end-sphere lowest points (a hull's candidates from its
+//! vertices' heights, on its vertex graph when it is large). More than 4 such
+//! points are reduced to 4: the deepest and the extremes in 3 horizontal
+//! directions, each preferring a point kept last step (a persistent patch that
+//! spans the support polygon, see `reduce`). Each
 //! point keeps a stable *slot* (shape, feature) so the solver can warm-start.
 //!
 //! # Forces (solved in [`crate::sim`], docs/theory.md §"Constraint rows")
@@ -85,10 +85,10 @@ pub struct ContactParams {
     /// Detection margin δ (m): points closer than this to the plane are candidates.
     pub margin: f64,
     /// The most contact points a shape gives (MuJoCo gives a hull on a plane at
-    /// most 3, a box 4): the deepest, last step's points still there, then the
-    /// extremes in this many horizontal directions. 4 with that persistent set
-    /// settles every robot of the sweep (without persistence, 4 left solo12
-    /// rocking on its mesh links and needed 8).
+    /// most 3, a box 4): the deepest, then the extremes in this many minus one
+    /// horizontal directions, each preferring last step's points. 4 with that
+    /// persistent patch settles every robot of the sweep (without persistence, 4
+    /// left solo12 rocking on its mesh links and needed 8).
     pub max_points_per_shape: usize,
 }
 
@@ -161,6 +161,11 @@ pub struct GroundShape {
     verts: Vec<Vector3<f64>>,
     /// Number of slots (stable point identities) of this shape.
     pub nslots: usize,
+    /// A hull's vertex graph (compressed rows: the neighbours of vertex k are
+    /// `adj[adj_start[k]..adj_start[k + 1]]`), empty for small vertex sets,
+    /// which are scanned whole.
+    adj_start: Vec<u32>,
+    adj: Vec<u32>,
     /// Radius of a sphere about the geometry origin that holds the shape: a
     /// shape whose origin is higher than this above the ground (plus the margin)
     /// cannot touch it, and is skipped without a narrow-phase query.
@@ -198,21 +203,42 @@ pub struct GroundContact {
     /// manifold keeps them while they stay within the margin.
     prev_flag: Vec<bool>,
     prev_list: Vec<usize>,
+    /// Per shape, the vertex where the last lowest-vertex search ended (the
+    /// next one starts there); per slot, the search generation that visited it.
+    last_low: Vec<usize>,
+    visited: Vec<u32>,
+    generation: u32,
+    stack: Vec<u32>,
+}
+
+/// Hulls with more vertices than this are searched on their vertex graph
+/// instead of scanned whole.
+const GRAPH_SEARCH_MIN: usize = 24;
+
+/// The compressed adjacency of a hull's vertex graph from its edges.
+fn hull_adjacency(h: &ConvexPolyhedron) -> (Vec<u32>, Vec<u32>) {
+    let n = h.points().len();
+    let mut nb: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for e in h.edges() {
+        let [a, b] = e.vertices;
+        if (a as usize) < n && (b as usize) < n && a != b {
+            nb[a as usize].push(b);
+            nb[b as usize].push(a);
+        }
+    }
+    let mut start = Vec::with_capacity(n + 1);
+    let mut adj = Vec::new();
+    for list in &mut nb {
+        list.sort_unstable();
+        list.dedup();
+        start.push(adj.len() as u32);
+        adj.extend_from_slice(list);
+    }
+    start.push(adj.len() as u32);
+    (start, adj)
 }
 
 const CYL_SAMPLES: usize = 6;
-
-impl GroundShape {
-    /// The most points this shape gives: `maxp`, twice that for a cylinder (its
-    /// two rims: a rolling rim's lowest point moves along it, and the sampled
-    /// neighbours keep a rolling lamp base from sinking at impact).
-    fn point_cap(&self, maxp: usize) -> usize {
-        match self.manifold {
-            Manifold::Cylinder { .. } => 2 * maxp,
-            _ => maxp,
-        }
-    }
-}
 
 fn to_pose(m: &Se3<f64>) -> Pose {
     let r = &m.rot;
@@ -255,6 +281,7 @@ impl GroundContact {
                 kind,
             };
             let pos = |x: f64| x.is_finite() && x >= 0.0;
+            let mut graph = (Vec::new(), Vec::new());
             let (shape, manifold, verts, parry_offset) = match &g.shape {
                 Shape::Box { size } => {
                     if !size.iter().all(|&s| pos(s)) {
@@ -337,11 +364,14 @@ impl GroundContact {
                     let pv: Vec<PVec> = pts.iter().map(|p| PVec::new(p.x, p.y, p.z)).collect();
                     match ConvexPolyhedron::from_convex_hull(&pv) {
                         Some(h) => {
-                            let v = h
+                            let v: Vec<_> = h
                                 .points()
                                 .iter()
                                 .map(|p| Vector3::new(p.x, p.y, p.z))
                                 .collect();
+                            if v.len() > GRAPH_SEARCH_MIN {
+                                graph = hull_adjacency(&h);
+                            }
                             (ParryShape::Hull(h), Manifold::Vertices, v, Se3::identity())
                         }
                         None => {
@@ -372,6 +402,8 @@ impl GroundContact {
                 shape,
                 manifold,
                 verts,
+                adj_start: graph.0,
+                adj: graph.1,
                 nslots,
                 bound,
             });
@@ -386,6 +418,7 @@ impl GroundContact {
             n += s.nslots;
         }
         let cap = shapes.iter().map(|s| s.nslots).max().unwrap_or(0);
+        let nshapes = shapes.len();
         Ok(Some(Self {
             shapes,
             ground,
@@ -396,6 +429,10 @@ impl GroundContact {
             scratch: Vec::with_capacity(cap),
             prev_flag: vec![false; n],
             prev_list: Vec::with_capacity(n),
+            last_low: vec![0; nshapes],
+            visited: vec![0; n],
+            generation: 0,
+            stack: Vec::with_capacity(n),
         }))
     }
 
@@ -432,7 +469,7 @@ impl GroundContact {
     pub fn max_points(&self) -> usize {
         self.shapes
             .iter()
-            .map(|s| s.nslots.min(s.point_cap(self.params.max_points_per_shape.max(1))))
+            .map(|s| s.nslots.min(self.params.max_points_per_shape.max(1)))
             .sum()
     }
 
@@ -462,27 +499,74 @@ impl GroundContact {
                 let r = &o_m_g.rot;
                 let (rx, ry, rz) = (r[(2, 0)], r[(2, 1)], r[(2, 2)]);
                 let tz = o_m_g.trans.z - ground;
-                let low = s
-                    .verts
-                    .iter()
-                    .map(|v| rx * v.x + ry * v.y + rz * v.z + tz)
-                    .fold(f64::INFINITY, f64::min);
-                if low > margin {
-                    continue;
-                }
+                let height = |v: &Vector3<f64>| rx * v.x + ry * v.y + rz * v.z + tz;
                 let base = self.slot_offset[si];
                 let scratch = &mut self.scratch;
                 scratch.clear();
-                for (k, v) in s.verts.iter().enumerate() {
-                    if rx * v.x + ry * v.y + rz * v.z + tz <= margin {
-                        let p = o_m_g.act_point(v);
-                        scratch.push(ContactPoint {
-                            shape: si,
-                            slot: base + k,
-                            body: s.body,
-                            point: p,
-                            gap: p.z - ground,
-                        });
+                let mut candidate = |k: usize| {
+                    let p = o_m_g.act_point(&s.verts[k]);
+                    scratch.push(ContactPoint {
+                        shape: si,
+                        slot: base + k,
+                        body: s.body,
+                        point: p,
+                        gap: p.z - ground,
+                    });
+                };
+                if s.adj.is_empty() {
+                    // a small vertex set: scanned whole
+                    let low = s.verts.iter().map(height).fold(f64::INFINITY, f64::min);
+                    if low > margin {
+                        continue;
+                    }
+                    for (k, v) in s.verts.iter().enumerate() {
+                        if height(v) <= margin {
+                            candidate(k);
+                        }
+                    }
+                } else {
+                    // a hull: descend the vertex graph from the last lowest vertex
+                    // (a vertex of a convex polytope with no lower neighbour is
+                    // the lowest), then collect the vertices within the margin,
+                    // a connected set on the graph
+                    let nbrs = |k: usize| {
+                        let (a, b) = (s.adj_start[k] as usize, s.adj_start[k + 1] as usize);
+                        &s.adj[a..b]
+                    };
+                    let mut k = self.last_low[si].min(s.verts.len() - 1);
+                    let mut zk = height(&s.verts[k]);
+                    loop {
+                        let mut best = None;
+                        for &j in nbrs(k) {
+                            let zj = height(&s.verts[j as usize]);
+                            if zj < zk {
+                                zk = zj;
+                                best = Some(j as usize);
+                            }
+                        }
+                        match best {
+                            Some(j) => k = j,
+                            None => break,
+                        }
+                    }
+                    self.last_low[si] = k;
+                    if zk > margin {
+                        continue;
+                    }
+                    self.generation = self.generation.wrapping_add(1).max(1);
+                    let gen = self.generation;
+                    self.stack.clear();
+                    self.stack.push(k as u32);
+                    self.visited[base + k] = gen;
+                    while let Some(i) = self.stack.pop() {
+                        candidate(i as usize);
+                        for &j in nbrs(i as usize) {
+                            let slot = base + j as usize;
+                            if self.visited[slot] != gen && height(&s.verts[j as usize]) <= margin {
+                                self.visited[slot] = gen;
+                                self.stack.push(j);
+                            }
+                        }
                     }
                 }
                 reduce(scratch, maxp, out, &self.prev_flag);
@@ -571,7 +655,7 @@ impl GroundContact {
                     }
                 }
             }
-            reduce(scratch, s.point_cap(maxp), out, &self.prev_flag);
+            reduce(scratch, maxp, out, &self.prev_flag);
         }
         for &k in &self.prev_list {
             self.prev_flag[k] = false;
@@ -586,61 +670,55 @@ impl GroundContact {
     }
 }
 
+/// How much shallower (m) a point kept last step may be than the deepest and
+/// still be chosen as the deepest.
+const HOLD_DEEPEST: f64 = 1e-4;
+/// How much less far out (m) a point kept last step may be than a direction's
+/// extreme and still be chosen for it: 2 cm (a foot's size) keeps a patch while
+/// the contact lasts; 1 mm left solo12 with 2× the sweeps (its patches changed
+/// every few steps).
+const HOLD_EXTREME: f64 = 2e-2;
+
 /// Appends `pts` to `out`, reduced to at most `maxp` points when there are
-/// more: the deepest point, then the points kept last time
-/// (`prev`, by slot) that are still here, deepest first, then the extremes in
-/// `maxp` evenly spaced horizontal directions. Keeping last step's points makes
-/// the set persistent: a flat face with more candidates than room does not
-/// swap its points from step to step (which, with the solver's warm start,
-/// kept solo8's base rocking in a 6 ms cycle). Near-ties (within 1 µm, as a
-/// flat face's corners are) go to the lowest slot.
+/// more: the deepest point, then the extremes in `maxp − 1` evenly spaced
+/// horizontal directions (a patch spanning the support polygon: a cylinder
+/// lying flat keeps three rim points 120° apart, not a cluster). Each choice
+/// prefers a point kept last time (`prev`, by slot) when it is within
+/// [`HOLD_DEEPEST`] or [`HOLD_EXTREME`] of the best, then the lowest slot: the set stays the same from step to step while the contact does, so
+/// warm starts keep working (a deepest point that flipped between near-equal
+/// corners kept solo8's base rocking in a 6 ms cycle).
 fn reduce(pts: &[ContactPoint], maxp: usize, out: &mut Vec<ContactPoint>, prev: &[bool]) {
     if pts.len() <= maxp {
         out.extend_from_slice(pts);
         return;
     }
-    const TIE: f64 = 1e-6;
     let start = out.len();
-    let cap = maxp;
-    let has = |out: &Vec<ContactPoint>, slot: usize| out[start..].iter().any(|q| q.slot == slot);
-    // the best by `key` (larger wins), near-ties to the lowest slot
-    let pick = |key: &dyn Fn(&ContactPoint) -> f64| -> usize {
+    let was = |p: &ContactPoint| prev.get(p.slot).copied().unwrap_or(false);
+    // the best by `key` (larger wins): within `hold` of it, a point kept last
+    // time first, then the lowest slot
+    let pick = |key: &dyn Fn(&ContactPoint) -> f64, hold: f64| -> usize {
         let bv = pts.iter().map(key).fold(f64::NEG_INFINITY, f64::max);
-        let (mut best, mut slot) = (0, usize::MAX);
+        let (mut best, mut rank) = (0, (true, usize::MAX));
         for (k, p) in pts.iter().enumerate() {
-            if key(p) >= bv - TIE && p.slot < slot {
-                slot = p.slot;
+            let near = key(p) >= bv - if was(p) { hold } else { 1e-6 };
+            let r = (!was(p), p.slot);
+            if near && r < rank {
+                rank = r;
                 best = k;
             }
         }
         best
     };
-    out.push(pts[pick(&|p| -p.gap)]);
-    // last step's points, deepest first
-    while out.len() - start < cap {
-        let mut next: Option<usize> = None;
-        for (k, p) in pts.iter().enumerate() {
-            if prev.get(p.slot).copied().unwrap_or(false)
-                && !has(out, p.slot)
-                && next.is_none_or(|b| p.gap < pts[b].gap)
-            {
-                next = Some(k);
-            }
-        }
-        match next {
-            Some(k) => out.push(pts[k]),
-            None => break,
-        }
-    }
-    // directional extremes fill the rest
-    for d in 0..maxp {
-        if out.len() - start >= cap {
+    out.push(pts[pick(&|p| -p.gap, HOLD_DEEPEST)]);
+    let dirs = maxp.saturating_sub(1).max(1);
+    for d in 0..dirs {
+        if out.len() - start >= maxp {
             return;
         }
-        let a = std::f64::consts::TAU * d as f64 / maxp as f64;
+        let a = std::f64::consts::TAU * d as f64 / dirs as f64;
         let (sn, c) = a.sin_cos();
-        let k = pick(&|p| c * p.point.x + sn * p.point.y);
-        if !has(out, pts[k].slot) {
+        let k = pick(&|p| c * p.point.x + sn * p.point.y, HOLD_EXTREME);
+        if !out[start..].iter().any(|q| q.slot == pts[k].slot) {
             out.push(pts[k]);
         }
     }

@@ -58,6 +58,12 @@ pub struct Rows {
     /// Each row's dof path (start, length) in the factor's table: its Jacobian
     /// and y live there only (compact y: entry t is dof path[t]).
     pub path: Vec<(usize, usize)>,
+    /// At a contact's normal row: the off-diagonal entries of its 3×3 block of
+    /// W (n·t₁, n·t₂, t₁·t₂), so that a sweep reads the contact's path once.
+    pub w_block: Vec<[f64; 3]>,
+    is_block: Vec<bool>,
+    /// Each row's velocity at its update in the last sweep.
+    u_prev: Vec<f64>,
     cap: usize,
 }
 
@@ -76,6 +82,9 @@ impl Rows {
             bpos: vec![0.0; cap],
             mu: vec![0.0; cap],
             path: vec![(0, 0); cap],
+            w_block: vec![[0.0; 3]; cap],
+            is_block: vec![false; cap],
+            u_prev: vec![0.0; cap],
             cap,
         }
     }
@@ -152,6 +161,30 @@ impl Rows {
             self.c[r] = cr;
             self.w[r] = yr.iter().map(|x| x * x).sum();
         }
+        // each contact's block: its three rows share one path
+        for r in 0..n {
+            if self.kind[r] == RowKind::Normal && self.is_contact(r) {
+                let pl = self.path[r].1;
+                let (yn, y1, y2) = (
+                    &self.y[r * nv..r * nv + pl],
+                    &self.y[(r + 1) * nv..(r + 1) * nv + pl],
+                    &self.y[(r + 2) * nv..(r + 2) * nv + pl],
+                );
+                let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+                self.w_block[r] = [dot(yn, y1), dot(yn, y2), dot(y1, y2)];
+            }
+        }
+    }
+
+    /// Whether row r is a contact normal followed by its two tangent rows on
+    /// the same path (as `sim::constraints` pushes them).
+    #[inline]
+    fn is_contact(&self, r: usize) -> bool {
+        r + 2 < self.n
+            && matches!(self.kind[r + 1], RowKind::Tangent { normal, .. } if normal == r)
+            && self.kind[r + 2] == RowKind::Tangent2
+            && self.path[r + 1] == self.path[r]
+            && self.path[r + 2] == self.path[r]
     }
 
     /// Projected Gauss–Seidel on W = Y Yᵀ, kept implicit: Δv' = Yᵀλ is carried
@@ -190,6 +223,33 @@ impl Rows {
         let dv = &mut dv[..nv];
         let (y, paths) = (&self.y[..], &self.path[..n]);
         let (kinds, w, c, b) = (&self.kind[..n], &self.w[..n], &self.c[..n], &self.b[..n]);
+        // which rows start a contact's block (computed once a solve)
+        let contact = &mut self.is_block[..n];
+        for (r, cflag) in contact.iter_mut().enumerate() {
+            *cflag = kinds[r] == RowKind::Normal
+                && r + 2 < n
+                && matches!(kinds[r + 1], RowKind::Tangent { normal, .. } if normal == r)
+                && kinds[r + 2] == RowKind::Tangent2
+                && paths[r + 1] == paths[r]
+                && paths[r + 2] == paths[r];
+        }
+        let contact = &self.is_block[..n];
+        let w_block = &self.w_block[..n];
+        let u_prev = &mut self.u_prev[..n];
+        // a row's convergence measure: its own residual |Δλ|·Wᵣᵣ, or, when
+        // smaller, how much its velocity moved since the last sweep (redundant
+        // contacts can trade impulse among themselves for many sweeps while no
+        // velocity changes: that is converged)
+        #[inline(always)]
+        fn measure(first: bool, residual: f64, u: f64, prev: &mut f64) -> f64 {
+            let moved = (u - *prev).abs();
+            *prev = u;
+            if first {
+                residual
+            } else {
+                residual.min(moved)
+            }
+        }
         let lambda = &mut self.lambda[..n];
         // SAFETY (unchecked reads in rdot/raxpy): every path lies in `table`
         // (checked above) and holds dof indices < nv; y holds n·nv entries and
@@ -231,10 +291,71 @@ impl Rows {
             it += 1;
             let plain = it <= PLAIN || finishing || 2 * it > max_iter || relax == 1.0;
             let relax = if plain { 1.0 } else { relax };
+            let first = it == 1;
             let mut change: f64 = 0.0;
             let mut r = 0;
             while r < n {
                 let kind = kinds[r];
+                if contact[r] {
+                    // a contact's three rows in one pass over its path: the
+                    // normal, then the tangent pair from the velocity the
+                    // normal's change left (through the block's entries)
+                    let p = path(r);
+                    let (mut dn, mut d1, mut d2) = (0.0, 0.0, 0.0);
+                    for (t, &k) in p.iter().enumerate() {
+                        let x = unsafe { *dv.get_unchecked(k) };
+                        unsafe {
+                            dn += y.get_unchecked(r * nv + t) * x;
+                            d1 += y.get_unchecked((r + 1) * nv + t) * x;
+                            d2 += y.get_unchecked((r + 2) * nv + t) * x;
+                        }
+                    }
+                    let [wn1, wn2, _] = w_block[r];
+                    let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
+                    let on = lambda[r];
+                    let un = c[r] + dn;
+                    let nn = if wnn > 1e-14 {
+                        (on - relax * (un - b[r]) / wnn).max(0.0)
+                    } else {
+                        0.0
+                    };
+                    let dln = nn - on;
+                    lambda[r] = nn;
+                    let mu = match kinds[r + 1] {
+                        RowKind::Tangent { mu, .. } => mu,
+                        _ => 0.0,
+                    };
+                    let (o1, o2) = (lambda[r + 1], lambda[r + 2]);
+                    let u1 = c[r + 1] + d1 + dln * wn1;
+                    let u2 = c[r + 2] + d2 + dln * wn2;
+                    let mut t1 = if w11 > 1e-14 { o1 - u1 / w11 } else { 0.0 };
+                    let mut t2 = if w22 > 1e-14 { o2 - u2 / w22 } else { 0.0 };
+                    let lim = mu * nn;
+                    let m = (t1 * t1 + t2 * t2).sqrt();
+                    if m > lim {
+                        let s = if m > 0.0 { lim / m } else { 0.0 };
+                        t1 *= s;
+                        t2 *= s;
+                    }
+                    lambda[r + 1] = t1;
+                    lambda[r + 2] = t2;
+                    let (dl1, dl2) = (t1 - o1, t2 - o2);
+                    if dln != 0.0 || dl1 != 0.0 || dl2 != 0.0 {
+                        for (t, &k) in p.iter().enumerate() {
+                            unsafe {
+                                *dv.get_unchecked_mut(k) += dln * y.get_unchecked(r * nv + t)
+                                    + dl1 * y.get_unchecked((r + 1) * nv + t)
+                                    + dl2 * y.get_unchecked((r + 2) * nv + t);
+                            }
+                        }
+                    }
+                    change = change
+                        .max(measure(first, (dln * wnn).abs(), un, &mut u_prev[r]))
+                        .max(measure(first, (dl1 * w11).abs(), u1, &mut u_prev[r + 1]))
+                        .max(measure(first, (dl2 * w22).abs(), u2, &mut u_prev[r + 2]));
+                    r += 3;
+                    continue;
+                }
                 match kind {
                     RowKind::Tangent { normal, mu } if r + 1 < n => {
                         let (p1, p2) = (path(r), path(r + 1));
@@ -261,7 +382,9 @@ impl Rows {
                         if d2 != 0.0 {
                             raxpy(d2, y, r + 1, nv, p2, dv);
                         }
-                        change = change.max((d1 * w11).abs()).max((d2 * w22).abs());
+                        change = change
+                            .max(measure(first, (d1 * w11).abs(), u1, &mut u_prev[r]))
+                            .max(measure(first, (d2 * w22).abs(), u2, &mut u_prev[r + 1]));
                         r += 2;
                         continue;
                     }
@@ -274,8 +397,9 @@ impl Rows {
                 let wrr = w[r];
                 let old = lambda[r];
                 let p = path(r);
+                let mut u = 0.0;
                 let new = if wrr > 1e-14 {
-                    let u = c[r] + rdot(y, r, nv, p, dv);
+                    u = c[r] + rdot(y, r, nv, p, dv);
                     let x = old - relax * (u - b[r]) / wrr;
                     match kind {
                         RowKind::Box { limit } => x.clamp(-limit, limit),
@@ -289,7 +413,7 @@ impl Rows {
                 if d != 0.0 {
                     raxpy(d, y, r, nv, p, dv);
                 }
-                change = change.max((d * wrr).abs());
+                change = change.max(measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
                 r += 1;
             }
             if finishing || (change <= tol && plain) {
