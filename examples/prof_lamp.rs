@@ -31,8 +31,12 @@ fn setup(tol: Option<f64>) -> Simulation {
     } else {
         0.5
     };
-    q[3] = (5f64).to_radians().sin();
-    q[6] = (5f64).to_radians().cos();
+    let tilt: f64 = std::env::var("TILT")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5.0);
+    q[3] = (tilt).to_radians().sin();
+    q[6] = (tilt).to_radians().cos();
     let v = sim.v().clone();
     sim.set_state(&q, &v).expect("state");
     sim

@@ -692,34 +692,55 @@ fn reduce(pts: &[ContactPoint], maxp: usize, out: &mut Vec<ContactPoint>, prev: 
         out.extend_from_slice(pts);
         return;
     }
-    let start = out.len();
-    let was = |p: &ContactPoint| prev.get(p.slot).copied().unwrap_or(false);
-    // the best by `key` (larger wins): within `hold` of it, a point kept last
-    // time first, then the lowest slot
-    let pick = |key: &dyn Fn(&ContactPoint) -> f64, hold: f64| -> usize {
-        let bv = pts.iter().map(key).fold(f64::NEG_INFINITY, f64::max);
-        let (mut best, mut rank) = (0, (true, usize::MAX));
-        for (k, p) in pts.iter().enumerate() {
-            let near = key(p) >= bv - if was(p) { hold } else { 1e-6 };
-            let r = (!was(p), p.slot);
-            if near && r < rank {
-                rank = r;
-                best = k;
+    const MAXD: usize = 8;
+    let dirs = maxp.saturating_sub(1).clamp(1, MAXD);
+    let mut dir = [(0.0, 0.0); MAXD];
+    for (d, x) in dir.iter_mut().enumerate().take(dirs) {
+        let (sn, c) = (std::f64::consts::TAU * d as f64 / dirs as f64).sin_cos();
+        *x = (c, sn);
+    }
+    // criterion 0: depth; 1..=dirs: how far out along a direction
+    let key = |p: &ContactPoint, q: usize| -> f64 {
+        if q == 0 {
+            -p.gap
+        } else {
+            let (c, sn) = dir[q - 1];
+            c * p.point.x + sn * p.point.y
+        }
+    };
+    // one pass for every criterion's best value
+    let mut best = [f64::NEG_INFINITY; MAXD + 1];
+    for p in pts {
+        for (q, b) in best.iter_mut().enumerate().take(dirs + 1) {
+            let k = key(p, q);
+            if k > *b {
+                *b = k;
             }
         }
-        best
-    };
-    out.push(pts[pick(&|p| -p.gap, HOLD_DEEPEST)]);
-    let dirs = maxp.saturating_sub(1).max(1);
-    for d in 0..dirs {
-        if out.len() - start >= maxp {
-            return;
+    }
+    // one pass for each criterion's choice: within its hold of the best a point
+    // kept last time first, then the lowest slot
+    let mut choice = [(true, usize::MAX, 0usize); MAXD + 1];
+    for (i, p) in pts.iter().enumerate() {
+        let was = prev.get(p.slot).copied().unwrap_or(false);
+        for (q, ch) in choice.iter_mut().enumerate().take(dirs + 1) {
+            let hold = match (was, q) {
+                (false, _) => 1e-6,
+                (true, 0) => HOLD_DEEPEST,
+                (true, _) => HOLD_EXTREME,
+            };
+            if key(p, q) >= best[q] - hold && (!was, p.slot) < (ch.0, ch.1) {
+                *ch = (!was, p.slot, i);
+            }
         }
-        let a = std::f64::consts::TAU * d as f64 / dirs as f64;
-        let (sn, c) = a.sin_cos();
-        let k = pick(&|p| c * p.point.x + sn * p.point.y, HOLD_EXTREME);
-        if !out[start..].iter().any(|q| q.slot == pts[k].slot) {
-            out.push(pts[k]);
+    }
+    let start = out.len();
+    for &(_, _, i) in choice.iter().take(dirs + 1) {
+        if out.len() - start >= maxp {
+            break;
+        }
+        if !out[start..].iter().any(|q| q.slot == pts[i].slot) {
+            out.push(pts[i]);
         }
     }
 }
