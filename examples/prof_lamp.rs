@@ -23,6 +23,9 @@ fn setup(tol: Option<f64>) -> Simulation {
     if let Some(n) = std::env::var("ITERS").ok().and_then(|s| s.parse().ok()) {
         o.solver_iterations = n;
     }
+    if let Some(w) = std::env::var("RELAX").ok().and_then(|s| s.parse().ok()) {
+        o.solver_relaxation = w;
+    }
     let mut sim = Simulation::new(model, o).expect("simulation");
     let mut q = sim.q().clone();
     let low = sim.lowest_point();

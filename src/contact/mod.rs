@@ -42,7 +42,7 @@
 //! (H̃ = H + A + Δt·D, damping implicit), kept implicit as W = Y Yᵀ with
 //! Y = J R⁻¹ (H̃ = RᵀR, tree-sparse: each row lives on its body's path to the
 //! root, `crate::sim::factor`; the solver carries R Δv), warm-started from the last step's impulses (stable point slots), to
-//! 1e-7 m/s (or rad/s) change per sweep, at most 20 sweeps; sweeps 4–10
+//! 1e-6 m/s (or rad/s) change per sweep, at most 20 sweeps; sweeps 4–10
 //! over-relax the scalar rows by 1.3 (projected SOR) and a plain sweep ends the
 //! solve (`crate::sim::solver`; a solve stopped by the cap is made
 //! energy-safe). Penetration is removed by the position pass (split impulse):
@@ -486,11 +486,15 @@ impl GroundContact {
             let Some(o_m_b) = o_m_i.get(s.body) else {
                 continue;
             };
-            let o_m_g = o_m_b.compose(&s.placement);
-            // broad phase: the bounding sphere clear of the plane
-            if o_m_g.trans.z - ground - s.bound > margin {
+            // broad phase: the bounding sphere clear of the plane (the height of
+            // the geometry origin alone, before the whole pose is composed)
+            let r = &o_m_b.rot;
+            let pt = &s.placement.trans;
+            let z = r[(2, 0)] * pt.x + r[(2, 1)] * pt.y + r[(2, 2)] * pt.z + o_m_b.trans.z;
+            if z - ground - s.bound > margin {
                 continue;
             }
+            let o_m_g = o_m_b.compose(&s.placement);
             self.queries += 1;
             // a hull or point set: its lowest vertex is its support point toward
             // −z; only the heights are needed to find it and the candidates

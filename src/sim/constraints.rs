@@ -83,6 +83,8 @@ pub(crate) struct Constraints {
     rows: Rows,
     /// (dof, which): which = 0 friction, 1 lower limit, 2 upper limit, per joint row.
     joint_rows: Vec<(usize, u8)>,
+    /// The first joint row (contact triples come first).
+    first_joint_row: usize,
     /// The contact point (index into the step's points) of each contact triple.
     row_point: Vec<usize>,
     /// Warm-start impulses per contact slot (n, t1, t2) and per joint (friction, lower, upper).
@@ -111,6 +113,7 @@ impl Constraints {
         Self {
             rows: Rows::new(nv, cap),
             joint_rows: Vec::with_capacity(3 * ndof),
+            first_joint_row: 0,
             row_point: Vec::with_capacity(max_points),
             warm_contact: vec![[0.0; 3]; nslots],
             warm_slots: Vec::with_capacity(max_points),
@@ -180,6 +183,78 @@ impl Constraints {
                 0.0
             }
         };
+        // contact rows first: a sweep then meets the joint rows (friction,
+        // limits) after the contacts have moved (talos_reduced, whose every
+        // joint has friction, converged in fewer sweeps this way)
+        if !points.is_empty() {
+            // world-frame motion subspace columns
+            for i in 1..model.nbodies {
+                let j = &model.joints[i];
+                let o = o_m_i[i];
+                for c in 0..j.nv().min(6) {
+                    self.sw[i][c] = o.act_motion(&j.subspace_column(c));
+                }
+            }
+            let nv = rows.nv;
+            for (pi, pt) in points.iter().enumerate() {
+                let warm = self.warm_contact.get(pt.slot).copied().unwrap_or([0.0; 3]);
+                // the body's path to the root: its joint's last dof and every ancestor
+                let jb = &model.joints[pt.body];
+                let path = f.path_of((jb.iv + jb.nv()).saturating_sub(1));
+                let Some(rn) = rows.push(RowKind::Normal, 0.0, warm[0], path) else {
+                    break;
+                };
+                let tangent = RowKind::Tangent {
+                    normal: rn,
+                    mu: p.mu,
+                };
+                if rows.push(tangent, 0.0, warm[1], path).is_none() {
+                    rows.pop(1);
+                    break;
+                }
+                if rows.push(RowKind::Tangent2, 0.0, warm[2], path).is_none() {
+                    rows.pop(2);
+                    break;
+                }
+                self.row_point.push(pi);
+                counts.contacts += 1;
+                // rows n = z, t₁ = x, t₂ = y: the point velocity v_c + ω_c × p of each
+                // ancestor's world-frame subspace column c
+                let mut b = pt.body;
+                while b != 0 {
+                    let j = &model.joints[b];
+                    for c in 0..j.nv().min(6) {
+                        let s = &self.sw[b][c];
+                        let vp = s.lin + s.ang.cross(&pt.point);
+                        let col = j.iv + c;
+                        if col < nv {
+                            rows.j[rn * nv + col] += vp.z;
+                            rows.j[(rn + 1) * nv + col] += vp.x;
+                            rows.j[(rn + 2) * nv + col] += vp.y;
+                        }
+                    }
+                    b = model.parent[b];
+                }
+                // normal target: speculative; restitution only above the speed below
+                // which a bounce of one step under gravity could gain energy:
+                // |u| > 4 g h e / (1 − e²)
+                let mut bn = speculative(pt.gap);
+                let e = p.restitution;
+                if e > 0.0 && e < 1.0 {
+                    let un = solver::dot(rows.jrow(rn), v.as_slice());
+                    let vmin = (4.0 * p.gravity * h * e / (1.0 - e * e).max(1e-12)).max(1e-3);
+                    if un < -vmin && pt.gap < -un * h {
+                        bn = bn.max(-e * un);
+                    }
+                }
+                rows.b[rn] = bn;
+                rows.bpos[rn] = pos_target(pt.gap, p.contact_slop, p.contact_push_cap);
+                if rows.bpos[rn] > 0.0 {
+                    counts.violated += 1;
+                }
+            }
+        }
+        self.first_joint_row = rows.n;
         // joint rows: friction (|λ| ≤ F h), limits (λ ≥ 0)
         if p.joint_dynamics {
             for (d, info) in model.dofs.iter().enumerate() {
@@ -223,76 +298,6 @@ impl Constraints {
                         counts.limits += 1;
                     }
                 }
-            }
-        }
-        if points.is_empty() {
-            self.counts = counts;
-            return counts;
-        }
-        // world-frame motion subspace columns
-        for i in 1..model.nbodies {
-            let j = &model.joints[i];
-            let o = o_m_i[i];
-            for c in 0..j.nv().min(6) {
-                self.sw[i][c] = o.act_motion(&j.subspace_column(c));
-            }
-        }
-        let nv = rows.nv;
-        for (pi, pt) in points.iter().enumerate() {
-            let warm = self.warm_contact.get(pt.slot).copied().unwrap_or([0.0; 3]);
-            // the body's path to the root: its joint's last dof and every ancestor
-            let jb = &model.joints[pt.body];
-            let path = f.path_of((jb.iv + jb.nv()).saturating_sub(1));
-            let Some(rn) = rows.push(RowKind::Normal, 0.0, warm[0], path) else {
-                break;
-            };
-            let tangent = RowKind::Tangent {
-                normal: rn,
-                mu: p.mu,
-            };
-            if rows.push(tangent, 0.0, warm[1], path).is_none() {
-                rows.pop(1);
-                break;
-            }
-            if rows.push(RowKind::Tangent2, 0.0, warm[2], path).is_none() {
-                rows.pop(2);
-                break;
-            }
-            self.row_point.push(pi);
-            counts.contacts += 1;
-            // rows n = z, t₁ = x, t₂ = y: the point velocity v_c + ω_c × p of each
-            // ancestor's world-frame subspace column c
-            let mut b = pt.body;
-            while b != 0 {
-                let j = &model.joints[b];
-                for c in 0..j.nv().min(6) {
-                    let s = &self.sw[b][c];
-                    let vp = s.lin + s.ang.cross(&pt.point);
-                    let col = j.iv + c;
-                    if col < nv {
-                        rows.j[rn * nv + col] += vp.z;
-                        rows.j[(rn + 1) * nv + col] += vp.x;
-                        rows.j[(rn + 2) * nv + col] += vp.y;
-                    }
-                }
-                b = model.parent[b];
-            }
-            // normal target: speculative; restitution only above the speed below
-            // which a bounce of one step under gravity could gain energy:
-            // |u| > 4 g h e / (1 − e²)
-            let mut bn = speculative(pt.gap);
-            let e = p.restitution;
-            if e > 0.0 && e < 1.0 {
-                let un = solver::dot(rows.jrow(rn), v.as_slice());
-                let vmin = (4.0 * p.gravity * h * e / (1.0 - e * e).max(1e-12)).max(1e-3);
-                if un < -vmin && pt.gap < -un * h {
-                    bn = bn.max(-e * un);
-                }
-            }
-            rows.b[rn] = bn;
-            rows.bpos[rn] = pos_target(pt.gap, p.contact_slop, p.contact_push_cap);
-            if rows.bpos[rn] > 0.0 {
-                counts.violated += 1;
             }
         }
         self.counts = counts;
@@ -341,7 +346,8 @@ impl Constraints {
         for w in self.warm_joint.iter_mut() {
             *w = [0.0; 3];
         }
-        for (r, &(d, which)) in self.joint_rows.iter().enumerate() {
+        for (k, &(d, which)) in self.joint_rows.iter().enumerate() {
+            let r = self.first_joint_row + k;
             let lam = rows.lambda[r];
             self.warm_joint[d][which as usize] = lam;
             let jv = rows.j[r * nv + vo + d];
@@ -354,9 +360,8 @@ impl Constraints {
             }
         }
         self.warm_slots.clear();
-        let first = self.joint_rows.len();
         for (c, &pi) in self.row_point.iter().enumerate() {
-            let rn = first + 3 * c;
+            let rn = 3 * c;
             let (ln, l1, l2) = (rows.lambda[rn], rows.lambda[rn + 1], rows.lambda[rn + 2]);
             let Some(pt) = points.get(pi) else {
                 continue;

@@ -136,7 +136,7 @@ impl Default for SimOptions {
             joint_dynamics: true,
             armature: 0.0,
             solver_iterations: 20,
-            solver_tol: 1e-7,
+            solver_tol: 1e-6,
             solver_relaxation: 1.3,
             limit_push_speed: 1.0,
             max_energy_rise: Some(EnergyBound {
