@@ -211,6 +211,10 @@ pub struct GroundContact {
     stack: Vec<u32>,
 }
 
+/// A large hull's patch is chosen among its vertices at most this far (m)
+/// above its lowest one (and within the margin).
+const BAND: f64 = 2e-3;
+
 /// Hulls with more vertices than this are searched on their vertex graph
 /// instead of scanned whole.
 const GRAPH_SEARCH_MIN: usize = 24;
@@ -557,6 +561,11 @@ impl GroundContact {
                     if zk > margin {
                         continue;
                     }
+                    // the band the patch is chosen from: within BAND of the
+                    // lowest vertex (a face lying flat on the ground is all
+                    // inside it; the vertices further up a rounded edge are not
+                    // needed to span the patch)
+                    let band = margin.min(zk + BAND);
                     self.generation = self.generation.wrapping_add(1).max(1);
                     let gen = self.generation;
                     self.stack.clear();
@@ -566,7 +575,7 @@ impl GroundContact {
                         candidate(i as usize);
                         for &j in nbrs(i as usize) {
                             let slot = base + j as usize;
-                            if self.visited[slot] != gen && height(&s.verts[j as usize]) <= margin {
+                            if self.visited[slot] != gen && height(&s.verts[j as usize]) <= band {
                                 self.visited[slot] = gen;
                                 self.stack.push(j);
                             }
