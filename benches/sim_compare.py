@@ -101,6 +101,16 @@ ROBOTS = {
     "go2": "go2_description/urdf/go2.urdf",
     "a1": "a1_description/urdf/a1.urdf",
     "anymal": "anymal_c_simple_description/urdf/anymal.urdf",
+    # beyond the four: every other legged robot and humanoid of
+    # example-robot-data that MuJoCo's URDF importer compiles
+    "solo8": "solo_description/robots/solo.urdf",
+    "bolt": "bolt_description/robots/bolt.urdf",
+    "laikago": "laikago_description/urdf/laikago.urdf",
+    "quadruped": "quadruped_description/urdf/quadruped.urdf",
+    "b1": "b1_description/urdf/b1.urdf",
+    "go1": "go1_description/urdf/go1.urdf",
+    "anymal_b": "anymal_b_simple_description/robots/anymal.urdf",
+    "g1_hands": "g1_description/urdf/g1_29dof_with_hand_rev_1_0.urdf",
 }
 REST_SPEED = 0.05  # m/s
 G = 9.81

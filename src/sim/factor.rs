@@ -140,6 +140,37 @@ impl MassFactor {
         }
     }
 
+    /// [`Self::row_transform`] of three rows on one path (a contact's normal
+    /// and tangents) in one pass over the factor.
+    #[inline]
+    pub fn row_transform3(&self, path: &[usize], y0: &mut [f64], y1: &mut [f64], y2: &mut [f64]) {
+        if !self.tree {
+            self.row_transform(path, y0);
+            self.row_transform(path, y1);
+            self.row_transform(path, y2);
+            return;
+        }
+        let n = self.n;
+        let m = self.m.as_slice();
+        let len = path.len().min(y0.len()).min(y1.len()).min(y2.len());
+        for t in (0..len).rev() {
+            let (a0, a1, a2) = (y0[t], y1[t], y2[t]);
+            let col = path[t] * n;
+            for s in 0..t {
+                let l = m[col + path[s]];
+                y0[s] -= l * a0;
+                y1[s] -= l * a1;
+                y2[s] -= l * a2;
+            }
+        }
+        for t in 0..len {
+            let d = self.inv_sqrt_d[path[t]];
+            y0[t] *= d;
+            y1[t] *= d;
+            y2[t] *= d;
+        }
+    }
+
     /// z ← R⁻¹ z (full length).
     pub fn half_solve(&self, z: &mut [f64]) {
         let n = self.n;

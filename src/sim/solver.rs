@@ -144,35 +144,43 @@ impl Rows {
         if vfree.len() < nv || self.j.len() < n * nv || self.y.len() < n * nv {
             return;
         }
-        for r in 0..n {
+        let mut r = 0;
+        while r < n {
             let (ps, pl) = self.path[r];
             let Some(path) = table.get(ps..ps + pl) else {
+                r += 1;
                 continue;
             };
-            let jr = &self.j[r * nv..(r + 1) * nv];
-            let yr = &mut self.y[r * nv..r * nv + pl];
-            let mut cr = 0.0;
-            for (yt, &k) in yr.iter_mut().zip(path) {
-                let jk = jr[k];
-                *yt = jk;
-                cr += jk * vfree[k];
+            // a contact's three rows share the path: gathered, then transformed
+            // in one pass over the factor
+            let k = if self.is_contact(r) { 3 } else { 1 };
+            for q in r..r + k {
+                let jr = &self.j[q * nv..(q + 1) * nv];
+                let yr = &mut self.y[q * nv..q * nv + pl];
+                let mut cq = 0.0;
+                for (yt, &d) in yr.iter_mut().zip(path) {
+                    let jk = jr[d];
+                    *yt = jk;
+                    cq += jk * vfree[d];
+                }
+                self.c[q] = cq;
             }
-            f.row_transform(path, yr);
-            self.c[r] = cr;
-            self.w[r] = yr.iter().map(|x| x * x).sum();
-        }
-        // each contact's block: its three rows share one path
-        for r in 0..n {
-            if self.kind[r] == RowKind::Normal && self.is_contact(r) {
-                let pl = self.path[r].1;
-                let (yn, y1, y2) = (
-                    &self.y[r * nv..r * nv + pl],
-                    &self.y[(r + 1) * nv..(r + 1) * nv + pl],
-                    &self.y[(r + 2) * nv..(r + 2) * nv + pl],
-                );
-                let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-                self.w_block[r] = [dot(yn, y1), dot(yn, y2), dot(y1, y2)];
+            if k == 3 {
+                let (a, rest) = self.y[r * nv..].split_at_mut(nv);
+                let (b, c) = rest.split_at_mut(nv);
+                let (y0, y1, y2) = (&mut a[..pl], &mut b[..pl], &mut c[..pl]);
+                f.row_transform3(path, y0, y1, y2);
+                let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
+                self.w[r] = dot(y0, y0);
+                self.w[r + 1] = dot(y1, y1);
+                self.w[r + 2] = dot(y2, y2);
+                self.w_block[r] = [dot(y0, y1), dot(y0, y2), dot(y1, y2)];
+            } else {
+                let yr = &mut self.y[r * nv..r * nv + pl];
+                f.row_transform(path, yr);
+                self.w[r] = yr.iter().map(|x| x * x).sum();
             }
+            r += k;
         }
     }
 
