@@ -214,7 +214,7 @@ impl std::fmt::Display for Violation {
 
 /// Dense work of the implicit mass matrix H̃ = H + A + h·D.
 #[derive(Clone, Debug)]
-struct MassWork {
+pub(crate) struct MassWork {
     /// The factor of the last H̃.
     f: factor::MassFactor,
     vfree: DVector<f64>,
@@ -562,9 +562,7 @@ impl Simulation {
                     continue;
                 }
                 let q = self.q[qo + d];
-                let lower = info.limits.lower.unwrap_or(f64::NEG_INFINITY);
-                let upper = info.limits.upper.unwrap_or(f64::INFINITY);
-                let amount = (lower - q).max(q - upper);
+                let (lower, upper, amount) = limit_excess(info, q);
                 if amount > 1e-9 {
                     out.push(Violation::Limit {
                         joint: info.name.clone(),
@@ -589,13 +587,7 @@ impl Simulation {
                 if info.continuous {
                     continue;
                 }
-                let q = self.q[qo + d];
-                if let Some(l) = info.limits.lower {
-                    excess = excess.max(l - q);
-                }
-                if let Some(u) = info.limits.upper {
-                    excess = excess.max(q - u);
-                }
+                excess = excess.max(limit_excess(info, self.q[qo + d]).2);
             }
         }
         (self.penetration(), excess)
@@ -865,6 +857,14 @@ impl Simulation {
             *o = self.tau_applied[k].clamp(-e, e);
         }
     }
+}
+
+/// A joint's limits (±∞ where the URDF gives none) and how far `q` lies
+/// outside them (negative inside).
+fn limit_excess(info: &crate::model::DofInfo, q: f64) -> (f64, f64, f64) {
+    let lower = info.limits.lower.unwrap_or(f64::NEG_INFINITY);
+    let upper = info.limits.upper.unwrap_or(f64::INFINITY);
+    (lower, upper, (lower - q).max(q - upper))
 }
 
 /// `dt`, or the remaining time when that is shorter or exceeds `dt` by less

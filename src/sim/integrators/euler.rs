@@ -5,6 +5,7 @@
 //! v⁺ = v* + H̃⁻¹Jᵀλ, q⁺ = q ⊕ h (v⁺ + w)
 //! (λ the impulses, w the position pass's pseudo-velocity: [`super::super::constraints`]).
 
+use super::solve_rows;
 use crate::dynamics::{bias, forward_dynamics};
 use crate::model::configuration::{integrate_config, rotate_base_velocity};
 use crate::sim::{SimError, Simulation};
@@ -14,47 +15,22 @@ impl Simulation {
     /// One step of length `h` from (q, v); `rows`: the assembled constraint
     /// rows are not empty.
     pub(in crate::sim) fn euler_step(&mut self, h: f64, rows: bool) -> Result<(), SimError> {
-        let nv = self.model.nv;
-        // τ = sat(τ_applied) − D v
-        let mut tau = std::mem::replace(&mut self.mass.tau, DVector::zeros(0));
-        self.clamped_tau(&mut tau);
-        for k in 0..nv {
-            tau[k] -= self.damping[k] * self.v[k];
-        }
-        // v* = v + h H̃⁻¹(τ − C); without rows, damping or armature H̃ = H and
-        // the engine's forward dynamics (ABA or CRBA + LTDL) is fastest
-        let dense = rows || self.has_damping || self.has_armature;
-        let free = if dense {
-            bias(&self.model, &mut self.data, &self.q, &self.v, None);
-            tau -= &self.data.bias;
-            self.factor_mass(h).map(|_| self.mass.f.solve(&mut tau))
-        } else {
-            forward_dynamics(&self.model, &mut self.data, &self.q, &self.v, &tau, None)
-                .map(|a| tau.copy_from(a))
-                .map_err(SimError::from)
-        };
-        if let Err(e) = free {
-            self.mass.tau = tau;
-            return Err(e);
-        }
-        self.mass.vfree.copy_from(&self.v);
-        self.mass.vfree.axpy(h, &tau, 1.0);
-        self.mass.tau = tau;
+        // v* = v + h H̃⁻¹(τ − C − D v); without rows, damping or armature H̃ = H
+        // and the engine's forward dynamics (ABA or CRBA + LTDL) is fastest
+        self.free_velocity(h, rows || self.has_damping || self.has_armature)?;
         if self.model.floating_base {
             add_frame_rate(&mut self.mass.vfree, &self.v, h);
         }
         self.rhs_evals += 1;
         // v⁺ = v* + H̃⁻¹Jᵀλ; the configuration moves by v⁺ + w
         if rows {
-            let imp = self.cons.solve(
+            let imp = solve_rows(
+                &mut self.cons,
                 &self.model,
                 &self.points,
-                &self.mass.f,
-                &self.mass.vfree,
+                &self.mass,
+                &self.opts,
                 h,
-                self.opts.solver_iterations,
-                self.opts.solver_tol,
-                self.opts.solver_relaxation,
             );
             self.pgs_sweeps += imp.sweeps as u64;
             self.v.copy_from(&self.mass.vfree);
@@ -78,6 +54,34 @@ impl Simulation {
 
     fn cons_rows(&self) -> usize {
         self.cons.rows_len()
+    }
+
+    /// The free velocity v* = v + h H̃⁻¹(sat(τ) − C(q, v) − D v) into
+    /// `mass.vfree`, with H̃ = H + A + h D factored into `mass.f` when `dense`
+    /// (needed for constraint rows, damping or armature), else by the engine's
+    /// forward dynamics (H̃ = H). No frame-rate term.
+    pub(in crate::sim) fn free_velocity(&mut self, h: f64, dense: bool) -> Result<(), SimError> {
+        let nv = self.model.nv;
+        let mut tau = std::mem::replace(&mut self.mass.tau, DVector::zeros(0));
+        self.clamped_tau(&mut tau);
+        for k in 0..nv {
+            tau[k] -= self.damping[k] * self.v[k];
+        }
+        let free = if dense {
+            bias(&self.model, &mut self.data, &self.q, &self.v, None);
+            tau -= &self.data.bias;
+            self.factor_mass(h).map(|_| self.mass.f.solve(&mut tau))
+        } else {
+            forward_dynamics(&self.model, &mut self.data, &self.q, &self.v, &tau, None)
+                .map(|a| tau.copy_from(a))
+                .map_err(SimError::from)
+        };
+        if free.is_ok() {
+            self.mass.vfree.copy_from(&self.v);
+            self.mass.vfree.axpy(h, &tau, 1.0);
+        }
+        self.mass.tau = tau;
+        free
     }
 }
 

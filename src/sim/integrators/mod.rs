@@ -11,8 +11,11 @@ mod euler;
 mod rk4;
 mod smooth;
 
-use super::{SimError, Simulation};
+use super::constraints::{Constraints, Impulses};
+use super::{MassWork, SimError, SimOptions, Simulation};
+use crate::contact::ContactPoint;
 use crate::dynamics::{mass_matrix, DynamicsError};
+use crate::model::Model;
 
 /// The available integrators.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -81,4 +84,27 @@ impl Simulation {
             .factor(&self.data.h)
             .map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)))
     }
+}
+
+/// The assembled rows' impulses at the free velocity `mass.vfree` with the
+/// factor `mass.f` (fields of a [`Simulation`] passed apart, so that the
+/// result borrows the constraints only).
+pub(in crate::sim) fn solve_rows<'a>(
+    cons: &'a mut Constraints,
+    model: &Model,
+    points: &[ContactPoint],
+    mass: &MassWork,
+    opts: &SimOptions,
+    h: f64,
+) -> Impulses<'a> {
+    cons.solve(
+        model,
+        points,
+        &mass.f,
+        &mass.vfree,
+        h,
+        opts.solver_iterations,
+        opts.solver_tol,
+        opts.solver_relaxation,
+    )
 }

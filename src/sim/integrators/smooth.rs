@@ -2,6 +2,7 @@
 //! of the undamped system with the step's constant forcing, the state vector,
 //! joint friction held over a step, and the limit projection after it.
 
+use super::solve_rows;
 use crate::dynamics::linalg::{chol_solve_slice, cholesky_fast};
 use crate::dynamics::{bias, forward_dynamics, mass_matrix, DynamicsError};
 use crate::model::configuration::{config_rate, normalize_quat};
@@ -96,31 +97,14 @@ impl Simulation {
             return Ok(());
         }
         self.assemble_rows(h);
-        let nv = self.model.nv;
-        let mut tau = std::mem::replace(&mut self.mass.tau, nalgebra::DVector::zeros(0));
-        self.clamped_tau(&mut tau);
-        for k in 0..nv {
-            tau[k] -= self.damping[k] * self.v[k];
-        }
-        bias(&self.model, &mut self.data, &self.q, &self.v, None);
-        tau -= &self.data.bias;
-        if let Err(e) = self.factor_mass(h) {
-            self.mass.tau = tau;
-            return Err(e);
-        }
-        self.mass.f.solve(&mut tau);
-        self.mass.vfree.copy_from(&self.v);
-        self.mass.vfree.axpy(h, &tau, 1.0);
-        self.mass.tau = tau;
-        let imp = self.cons.solve(
+        self.free_velocity(h, true)?;
+        let imp = solve_rows(
+            &mut self.cons,
             &self.model,
             &self.points,
-            &self.mass.f,
-            &self.mass.vfree,
+            &self.mass,
+            &self.opts,
             h,
-            self.opts.solver_iterations,
-            self.opts.solver_tol,
-            self.opts.solver_relaxation,
         );
         self.pgs_sweeps += imp.sweeps as u64;
         self.smooth.tau_c.copy_from(imp.tau_joint);
