@@ -11,12 +11,11 @@
 //! There is no self-collision: contact is between links and the ground only.
 //!
 //! # Detection
-//! Per step, each shape is posed in the ground's frame and parry's half-space
-//! query (`contact_halfspace_support_map`, the shape's support point toward −z)
-//! gives its deepest point and signed distance. A shape further than the margin
-//! `δ` (5 mm) from the plane is done with (one query, counted in
-//! [`GroundContact::queries`]). Otherwise the shape's contact *manifold* is made
-//! of its points within `δ` of the plane: a box's corners, a hull's vertices, a
+//! Per step, a shape whose bounding sphere is clear of the plane by more than
+//! the margin `δ` (5 mm) is skipped from its origin's height alone. Otherwise
+//! (one query, counted in [`GroundContact::queries`]) its contact *manifold* is
+//! its points within `δ` of the plane, found without a general support query
+//! (a plane's cheap special cases, as MuJoCo's colliders): a box's corners, a hull's vertices, a
 //! cylinder's lowest rim points plus 6 samples on each rim, a sphere's lowest
 //! point, a capsule's two end-sphere lowest points (a hull's candidates from its
 //! vertices' heights, on its vertex graph when it is large). More than 4 such
@@ -60,10 +59,7 @@ use crate::model::{Model, Shape};
 use crate::spatial::Se3;
 use nalgebra::{Matrix3, Vector3};
 use parry3d_f64::math::{Pose, Vector as PVec};
-use parry3d_f64::query::contact::contact_halfspace_support_map;
-use parry3d_f64::shape::{
-    Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, HalfSpace, SupportMap,
-};
+use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, SupportMap};
 pub use paths::resolve_mesh_path;
 use std::path::PathBuf;
 
@@ -485,7 +481,6 @@ impl GroundContact {
         let ground = self.ground;
         let margin = self.params.margin;
         let maxp = self.params.max_points_per_shape.max(1);
-        let hs = HalfSpace::new(PVec::Z);
         for (si, s) in self.shapes.iter().enumerate() {
             let Some(o_m_b) = o_m_i.get(s.body) else {
                 continue;
@@ -585,46 +580,10 @@ impl GroundContact {
                 reduce(scratch, maxp, out, &self.prev_flag);
                 continue;
             }
-            // parry's half-space query, in the ground frame (z shifted by −ground)
-            let mut g_m_shape = o_m_g.compose(&s.parry_offset);
-            g_m_shape.trans.z -= ground;
-            let pose = to_pose(&g_m_shape);
-            let hit = match &s.shape {
-                ParryShape::Ball(b) => {
-                    contact_halfspace_support_map(&pose, &hs, b as &dyn SupportMap, margin)
-                }
-                ParryShape::Capsule(b) => {
-                    contact_halfspace_support_map(&pose, &hs, b as &dyn SupportMap, margin)
-                }
-                ParryShape::Cuboid(b) => {
-                    contact_halfspace_support_map(&pose, &hs, b as &dyn SupportMap, margin)
-                }
-                ParryShape::Cylinder(b) => {
-                    contact_halfspace_support_map(&pose, &hs, b as &dyn SupportMap, margin)
-                }
-                ParryShape::Hull(b) => {
-                    contact_halfspace_support_map(&pose, &hs, b as &dyn SupportMap, margin)
-                }
-                ParryShape::Points => {
-                    let low = s
-                        .verts
-                        .iter()
-                        .map(|v| o_m_g.act_point(v).z - ground)
-                        .fold(f64::INFINITY, f64::min);
-                    (low <= margin).then(|| {
-                        parry3d_f64::query::Contact::new(
-                            PVec::ZERO,
-                            PVec::ZERO,
-                            PVec::Z,
-                            PVec::Z,
-                            low,
-                        )
-                    })
-                }
-            };
-            if hit.is_none() {
-                continue;
-            }
+            // a sphere, capsule or cylinder: its manifold points are computed
+            // directly (a sphere's and a capsule's lowest points, a cylinder's
+            // lowest rim points, where its lowest point always lies, and its
+            // rim samples); none within the margin, no contact
             let base = self.slot_offset[si];
             let scratch = &mut self.scratch;
             scratch.clear();
