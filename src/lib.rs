@@ -15,4 +15,12 @@ pub mod state;
 pub mod urdf;
 
 pub use model::{Data, Model};
+/// The nalgebra this crate is built with (its vectors and matrices are in the API):
+/// `urdyn::nalgebra::DVector` always matches.
+pub use nalgebra;
 pub use urdf::{load_file, load_str, LoadOptions, UrdfError};
+
+/// The README's Rust examples, compiled and run by `cargo test` (doctests).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
