@@ -322,27 +322,21 @@ def sweep_one(job, args, have_above_ground):
     for d in args.package_paths:
         pk += ["--package-path", d]
     with tempfile.TemporaryDirectory(prefix="sweep_", dir=args.tmpdir) as tmp:
-        rc, out, err, _ = run([args.urdyn, "inspect", urdf] + (["--floating-base"] if floating else []) + pk,
-                              args.timeout)
-        if rc == "timeout":
-            r.update(exit="timeout", finite=None, error="inspect: timeout after %g s" % args.timeout,
-                     **{"pass": False, "fail_reasons": ["timeout"]})
-            return r
-        if rc != 0:
-            r.update(loads=False, load_error=first_line(err) or "inspect: %s" % rc)
-            return r
         empty = os.path.join(tmp, "empty.json")
         with open(empty, "w") as fh:
             json.dump({"states": []}, fh)
-        rc, out, err, _ = run([args.urdyn, "eval", urdf, "--states", empty]
-                              + (["--floating-base"] if floating else []), args.timeout)
-        if rc == "timeout":
-            r.update(exit="timeout", finite=None, error="eval: timeout after %g s" % args.timeout,
-                     **{"pass": False, "fail_reasons": ["timeout"]})
-            return r
-        if rc != 0:
-            r.update(loads=False, load_error=first_line(err) or "eval: %s" % rc)
-            return r
+        fb = ["--floating-base"] if floating else []
+        # the URDF loads when both inspect and eval (an empty batch) accept it
+        for what, cmd in (("inspect", [args.urdyn, "inspect", urdf] + fb + pk),
+                          ("eval", [args.urdyn, "eval", urdf, "--states", empty] + fb)):
+            rc, out, err, _ = run(cmd, args.timeout)
+            if rc == "timeout":
+                r.update(exit="timeout", finite=None, error="%s: timeout after %g s" % (what, args.timeout),
+                         **{"pass": False, "fail_reasons": ["timeout"]})
+                return r
+            if rc != 0:
+                r.update(loads=False, load_error=first_line(err) or "%s: %s" % (what, rc))
+                return r
         dofs = json.loads(out)["dof_names"]
         r["dofs"] = len(dofs)
         try:

@@ -11,15 +11,9 @@ fn urdyn() -> Command {
     Command::new(env!("CARGO_BIN_EXE_urdyn"))
 }
 
-fn read_csv(p: &std::path::Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(p).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect())
-        .collect();
-    (header, rows)
-}
+#[path = "common/csv.rs"]
+mod csv;
+use csv::read_csv;
 
 #[test]
 fn lamp_drop_acceptance() {

@@ -20,15 +20,9 @@ fn simulate(args: &[&str], out: &Path) -> Output {
         .unwrap()
 }
 
-fn read_csv(p: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(p).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect())
-        .collect();
-    (header, rows)
-}
+#[path = "common/csv.rs"]
+mod csv;
+use csv::read_csv;
 
 fn col(h: &[String], n: &str) -> usize {
     h.iter()

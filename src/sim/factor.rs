@@ -83,6 +83,12 @@ impl MassFactor {
         (self.start[k], self.len[k])
     }
 
+    /// Whether H̃ is factored tree-sparse (reading its upper triangle only) or
+    /// dense (reading its lower triangle).
+    pub fn is_tree(&self) -> bool {
+        self.tree
+    }
+
     pub fn table(&self) -> &[usize] {
         &self.table
     }

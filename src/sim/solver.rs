@@ -189,6 +189,7 @@ impl Rows {
     #[inline]
     fn is_contact(&self, r: usize) -> bool {
         r + 2 < self.n
+            && self.kind[r] == RowKind::Normal
             && matches!(self.kind[r + 1], RowKind::Tangent { normal, .. } if normal == r)
             && self.kind[r + 2] == RowKind::Tangent2
             && self.path[r + 1] == self.path[r]
@@ -216,6 +217,10 @@ impl Rows {
         relax: f64,
     ) -> usize {
         let (nv, n) = (self.nv, self.n);
+        // which rows start a contact's block (computed once a solve)
+        for r in 0..n.min(self.is_block.len()) {
+            self.is_block[r] = self.is_contact(r);
+        }
         let table = f.table();
         if dv.len() < nv
             || self.y.len() < n * nv
@@ -231,16 +236,6 @@ impl Rows {
         let dv = &mut dv[..nv];
         let (y, paths) = (&self.y[..], &self.path[..n]);
         let (kinds, w, c, b) = (&self.kind[..n], &self.w[..n], &self.c[..n], &self.b[..n]);
-        // which rows start a contact's block (computed once a solve)
-        let contact = &mut self.is_block[..n];
-        for (r, cflag) in contact.iter_mut().enumerate() {
-            *cflag = kinds[r] == RowKind::Normal
-                && r + 2 < n
-                && matches!(kinds[r + 1], RowKind::Tangent { normal, .. } if normal == r)
-                && kinds[r + 2] == RowKind::Tangent2
-                && paths[r + 1] == paths[r]
-                && paths[r + 2] == paths[r];
-        }
         let contact = &self.is_block[..n];
         let w_block = &self.w_block[..n];
         let u_prev = &mut self.u_prev[..n];

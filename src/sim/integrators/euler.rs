@@ -39,7 +39,7 @@ impl Simulation {
             if let Some(w) = imp.push {
                 self.mass.vtot += w;
             }
-            self.rows_total += self.cons_rows() as u64;
+            self.rows_total += self.cons.rows_len() as u64;
         } else {
             self.cons.clear_forces();
             self.v.copy_from(&self.mass.vfree);
@@ -50,10 +50,6 @@ impl Simulation {
         // the new frame R⁺ = R exp(h ω_total)
         rotate_base_velocity(&self.model, &mut self.v, &self.mass.vtot, h);
         Ok(())
-    }
-
-    fn cons_rows(&self) -> usize {
-        self.cons.rows_len()
     }
 
     /// The free velocity v* = v + h H̃⁻¹(sat(τ) − C(q, v) − D v) into
