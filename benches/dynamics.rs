@@ -4,7 +4,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use std::hint::black_box;
 use std::path::PathBuf;
-use urdyn::bench::random_states;
+use urdyn::cli::bench::random_states;
 use urdyn::{dynamics, Data, LoadOptions};
 
 fn robots() -> Vec<(&'static str, &'static str, bool)> {

@@ -17,7 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .unwrap_or_else(|| root.join("target"));
     std::fs::create_dir_all(&out_dir)?;
     let csv = out_dir.join("lamp_drop.csv");
-    let args = urdyn::simulate::SimulateArgs {
+    let args = urdyn::cli::simulate::SimulateArgs {
         urdf: root.join("assets/lamp.urdf"),
         floating_base: true,
         duration: 3.0,
@@ -36,7 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         every: 1,
         progress: false,
     };
-    let summary = urdyn::simulate::run(&args)?;
+    let summary = urdyn::cli::simulate::run(&args)?;
     eprintln!("{summary}");
 
     // read the trajectory back

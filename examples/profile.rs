@@ -2,7 +2,7 @@
 //! calls one algorithm N times on a fixed pool of random states (for callgrind,
 //! whose instruction counts are stable on a shared, noisy machine).
 use std::hint::black_box;
-use urdyn::bench::random_states;
+use urdyn::cli::bench::random_states;
 use urdyn::{dynamics, Data, LoadOptions};
 
 fn main() {

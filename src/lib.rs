@@ -1,17 +1,14 @@
 //! urdyn: URDF-driven rigid multibody dynamics in Featherstone's spatial-vector
-//! notation. Data flows one way: [`urdf`] → [`model`] → [`dynamics`] → tools
-//! ([`eval`], [`inspect`]).
-pub mod bench;
+//! notation. Data flows one way: [`spatial`] ← [`model`] ← [`urdf`];
+//! [`dynamics`] (on [`model`]) ← [`contact`] ← [`sim`] ← tools (the `cli` module,
+//! behind the default `cli` feature).
+#[cfg(feature = "cli")]
+pub mod cli;
 pub mod contact;
 pub mod dynamics;
-pub mod eval;
-pub mod inspect;
 pub mod model;
-pub mod output;
 pub mod sim;
-pub mod simulate;
 pub mod spatial;
-pub mod state;
 pub mod urdf;
 
 pub use model::{Data, Model};

@@ -3,7 +3,7 @@
 //! allocates while a count is taken.
 
 use std::path::PathBuf;
-use urdyn::bench::random_states;
+use urdyn::cli::bench::random_states;
 use urdyn::dynamics;
 use urdyn::{Data, LoadOptions};
 

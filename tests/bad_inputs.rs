@@ -653,9 +653,9 @@ fn evaluate_json_matches_evaluate() {
         )
         .unwrap();
         let text = std::fs::read_to_string(bad.join("states_ok.json")).unwrap();
-        let states = urdyn::state::parse_states(&text, "s").unwrap();
-        let v = urdyn::eval::evaluate(&model, &states, "u", "s").unwrap();
-        let j = urdyn::eval::evaluate_json(&model, &states, "u", "s").unwrap();
+        let states = urdyn::cli::state::parse_states(&text, "s").unwrap();
+        let v = urdyn::cli::eval::evaluate(&model, &states, "u", "s").unwrap();
+        let j = urdyn::cli::eval::evaluate_json(&model, &states, "u", "s").unwrap();
         assert_eq!(serde_json::to_string(&v).unwrap(), j);
     }
 }

@@ -1,7 +1,8 @@
 //! A state at which H is singular to working precision fails with an error naming
 //! the state's index (eval-contract.md); the same model at a regular state evaluates.
 
-use urdyn::{eval, state, LoadOptions};
+use urdyn::cli::{eval, state};
+use urdyn::LoadOptions;
 
 /// A point mass on a prismatic slider carried by a revolute joint: at slider
 /// position 0 the mass sits on the revolute axis and H's first row vanishes.

@@ -4,7 +4,7 @@
 
 use nalgebra::{DMatrix, DVector};
 use std::path::PathBuf;
-use urdyn::bench::{random_states, State};
+use urdyn::cli::bench::{random_states, State};
 use urdyn::dynamics::{self, ltdl};
 use urdyn::model::FdMethod;
 use urdyn::{Data, LoadOptions, Model};

@@ -4,7 +4,8 @@
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use urdyn::{eval, state, LoadOptions};
+use urdyn::cli::{eval, state};
+use urdyn::LoadOptions;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

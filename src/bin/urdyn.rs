@@ -5,7 +5,8 @@ use anyhow::{anyhow, Result};
 use clap::{Parser, Subcommand};
 use std::io::Write;
 use std::path::PathBuf;
-use urdyn::{eval, inspect, output, state, LoadOptions};
+use urdyn::cli::{eval, inspect, output, state};
+use urdyn::LoadOptions;
 
 #[derive(Parser)]
 #[command(
@@ -186,7 +187,7 @@ struct BenchArgs {
 }
 
 fn bench(a: BenchArgs) -> Result<()> {
-    use urdyn::bench::{self, Algo, BenchError, BenchOptions};
+    use urdyn::cli::bench::{self, Algo, BenchError, BenchOptions};
     // (checked before the robot is loaded; a budget too large for a Duration is
     // refused here rather than panicking in from_secs_f64)
     let budget = match std::time::Duration::try_from_secs_f64(a.budget) {
@@ -298,7 +299,7 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
     // (0 is refused by the library, naming --every)
     let every = usize::try_from(c.every)
         .map_err(|_| anyhow!("--every must be at least 1 (got {})", c.every))?;
-    let args = urdyn::simulate::SimulateArgs {
+    let args = urdyn::cli::simulate::SimulateArgs {
         urdf,
         floating_base: c.floating_base,
         duration: c.duration,
@@ -317,7 +318,7 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
         every,
         progress: std::io::stderr().is_terminal(),
     };
-    let summary = urdyn::simulate::run(&args)?;
+    let summary = urdyn::cli::simulate::run(&args)?;
     eprintln!("urdyn {summary}");
     Ok(())
 }

@@ -3,7 +3,7 @@
 
 use crate::dynamics::{self, DynamicsError};
 use crate::model::{Data, FdMethod, Model};
-use crate::state::{StateError, StatesFile};
+use crate::cli::state::{StateError, StatesFile};
 use serde_json::{json, Map, Value};
 
 /// Why an evaluation failed: names the file and the key or joint.

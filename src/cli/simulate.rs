@@ -1,8 +1,8 @@
 //! `urdyn simulate` (cli.md): run a [`Simulation`] and write its trajectory CSV.
 
-use crate::output::write_atomic;
+use crate::cli::output::write_atomic;
 use crate::sim::{column_names, Integrator, SimError, SimOptions, Simulation};
-use crate::state;
+use crate::cli::state;
 use crate::{LoadOptions, Model};
 use std::io::Write;
 use std::path::PathBuf;
