@@ -27,10 +27,10 @@ fn main() {
         let s = &states[k % states.len()];
         match algo.as_str() {
             "rnea" => {
-                black_box(dynamics::rnea(&model, &mut data, &s.q, &s.v, &s.a, None));
+                black_box(dynamics::rnea(&model, &mut data, &s.q, &s.v, &s.a, None).ok());
             }
             "crba" => {
-                black_box(dynamics::crba(&model, &mut data, &s.q));
+                black_box(dynamics::crba(&model, &mut data, &s.q).ok());
             }
             "aba" => {
                 black_box(dynamics::aba(&model, &mut data, &s.q, &s.v, &s.tau, None).ok());
@@ -47,7 +47,7 @@ fn main() {
                 );
             }
             "fk" => {
-                dynamics::forward_kinematics(&model, &mut data, &s.q);
+                black_box(dynamics::forward_kinematics(&model, &mut data, &s.q).is_ok());
                 dynamics::update_frames(&model, &mut data);
                 black_box(&data.o_m_f);
             }

@@ -41,13 +41,13 @@ fn crba_matches_rnea_columns_on_fixtures() {
     for (name, model) in fixtures() {
         let mut data = Data::new(&model);
         for s in random_states(&model, 8, 11) {
-            dynamics::mass_matrix_rnea(&model, &mut data, &s.q);
+            dynamics::mass_matrix_rnea(&model, &mut data, &s.q).unwrap();
             let want = data.h.clone();
             // Stale H from another state first: every entry on the tree pattern
             // must be rewritten (off-pattern entries stay the zeros of Data::new).
             let other = &random_states(&model, 1, 99)[0];
-            dynamics::crba(&model, &mut data, &other.q);
-            dynamics::crba(&model, &mut data, &s.q);
+            dynamics::crba(&model, &mut data, &other.q).unwrap();
+            dynamics::crba(&model, &mut data, &s.q).unwrap();
             let e = (&data.h - &want).amax() / want.amax();
             assert!(e < 1e-12, "{name}: crba vs rnea columns {e:e}");
             assert_eq!(data.h, data.h.transpose(), "{name}: H not symmetric");
@@ -136,7 +136,7 @@ fn ltdl_solves_like_dense_cholesky() {
         }
         let mut data = Data::new(&model);
         let s = &random_states(&model, 1, 14)[0];
-        dynamics::crba(&model, &mut data, &s.q);
+        dynamics::crba(&model, &mut data, &s.q).unwrap();
         let h = data.h.clone();
         let mut u = DMatrix::zeros(model.nv, model.nv);
         ltdl::ltdl(&h, &model.dof_parent, &mut u).unwrap();
@@ -170,8 +170,8 @@ fn load(rel: &str) -> Model {
 /// ‖H q̈ + C − τ‖ / (‖H‖ ‖q̈‖ + ‖τ‖) with C and H from the seed's methods.
 fn backward_error(model: &Model, s: &State, qdd: &DVector<f64>) -> f64 {
     let mut data = Data::new(model);
-    let c = dynamics::bias(model, &mut data, &s.q, &s.v, None).clone();
-    dynamics::mass_matrix_rnea(model, &mut data, &s.q);
+    let c = dynamics::bias(model, &mut data, &s.q, &s.v, None).unwrap().clone();
+    dynamics::mass_matrix_rnea(model, &mut data, &s.q).unwrap();
     let h = data.h.clone();
     let r = &h * qdd + c - &s.tau;
     r.norm() / (h.norm() * qdd.norm() + s.tau.norm())

@@ -1,6 +1,8 @@
 //! Every fixture robot and state against Pinocchio (tests/oracle/make_fixtures.py):
-//! tau, qdd, bias, H, link poses and the base block, max relative error
-//! max|x − y| / max(1, max|y|) ≤ 1e-9 per quantity.
+//! tau, qdd, bias, H, link poses and the base block (external wrenches included),
+//! max relative error max|x − y| / max(1, max|y|) ≤ 1e-9 per quantity; the
+//! kinematic quantities of contract v2 (frame Jacobians, velocities, classical
+//! accelerations, centre of mass, momentum, energies) ≤ 1e-12.
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -16,6 +18,11 @@ fn root() -> PathBuf {
 struct Cmp {
     worst: f64,
     where_: String,
+    /// The worst kinematic (contract v2) error and where.
+    worst_kin: f64,
+    where_kin: String,
+    /// Worst error per quantity name (for the report).
+    per: std::collections::BTreeMap<String, f64>,
 }
 
 fn flat(v: &Value, out: &mut Vec<f64>) {
@@ -39,10 +46,83 @@ fn rel(got: &[f64], want: &[f64]) -> f64 {
 impl Cmp {
     fn add(&mut self, what: String, e: f64) {
         assert!(e.is_finite(), "{what}: non-finite comparison");
+        let q = what.split(' ').nth(2).unwrap_or("").to_string();
+        let w = self.per.entry(q).or_insert(0.0);
+        *w = w.max(e);
         if e > self.worst {
             self.worst = e;
             self.where_ = what;
         }
+    }
+    fn add_kin(&mut self, what: String, e: f64) {
+        self.add(what.clone(), 0.0);
+        let q = what.split(' ').nth(2).unwrap_or("").to_string();
+        let w = self.per.entry(q).or_insert(0.0);
+        *w = w.max(e);
+        assert!(e.is_finite(), "{what}: non-finite comparison");
+        if e > self.worst_kin {
+            self.worst_kin = e;
+            self.where_kin = what;
+        }
+    }
+}
+
+/// The rows of a matrix with its columns reordered by `perm` (got's column of
+/// each of want's), flattened.
+fn permuted_columns(m: &Value, perm: &[usize]) -> Vec<f64> {
+    let mut out = Vec::new();
+    for row in m.as_array().unwrap() {
+        for &k in perm {
+            out.push(row[k].as_f64().unwrap());
+        }
+    }
+    out
+}
+
+/// Contract v2: the frames a state asked for, the centre of mass, the momentum and
+/// the energies.
+fn compare_kinematics(c: &mut Cmp, s: usize, g: &Value, w: &Value, perm: &[usize]) {
+    let pair = |gv: &Value, wv: &Value| {
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        flat(gv, &mut a);
+        flat(wv, &mut b);
+        rel(&a, &b)
+    };
+    if let Some(wf) = w.get("frames").and_then(|f| f.as_object()) {
+        let gf = g["frames"].as_object().expect("frames missing");
+        assert_eq!(gf.len(), wf.len(), "state {s}: frame count");
+        for (link, wl) in wf {
+            let gl = &gf[link];
+            for key in ["jacobian", "jacobian_local"] {
+                let mut want = Vec::new();
+                flat(&wl[key], &mut want);
+                let e = rel(&permuted_columns(&gl[key], perm), &want);
+                c.add_kin(format!("state {s} {key} {link}"), e);
+            }
+            for key in ["velocity", "acceleration"] {
+                for part in ["linear", "angular"] {
+                    let e = pair(&gl[key][part], &wl[key][part]);
+                    c.add_kin(format!("state {s} {key} {link} {part}"), e);
+                }
+            }
+        }
+    } else {
+        assert!(g.get("frames").is_none(), "state {s}: frames not asked for");
+    }
+    for part in ["position", "velocity"] {
+        c.add_kin(format!("state {s} com_{part}"), pair(&g["com"][part], &w["com"][part]));
+    }
+    let mut want = Vec::new();
+    flat(&w["com"]["jacobian"], &mut want);
+    let e = rel(&permuted_columns(&g["com"]["jacobian"], perm), &want);
+    c.add_kin(format!("state {s} com_jacobian"), e);
+    for part in ["linear", "angular"] {
+        let e = pair(&g["momentum"][part], &w["momentum"][part]);
+        c.add_kin(format!("state {s} momentum_{part}"), e);
+    }
+    for part in ["kinetic", "potential"] {
+        let e = pair(&g["energy"][part], &w["energy"][part]);
+        c.add_kin(format!("state {s} energy_{part}"), e);
     }
 }
 
@@ -50,6 +130,9 @@ fn compare(name: &str, got: &Value, want: &Value) -> Cmp {
     let mut c = Cmp {
         worst: 0.0,
         where_: String::new(),
+        worst_kin: 0.0,
+        where_kin: String::new(),
+        per: Default::default(),
     };
     let gn: Vec<String> = serde_json::from_value(got["dof_names"].clone()).unwrap();
     let wn: Vec<String> = serde_json::from_value(want["dof_names"].clone()).unwrap();
@@ -118,6 +201,7 @@ fn compare(name: &str, got: &Value, want: &Value) -> Cmp {
             }
             c.add(format!("state {s} base"), rel(&gb, &wb));
         }
+        compare_kinematics(&mut c, s, g, w, &perm);
     }
     c
 }
@@ -162,20 +246,33 @@ fn eval_matches_pinocchio_on_every_fixture() {
         "fixtures missing: run tests/oracle/run.sh"
     );
     let mut failures = Vec::new();
+    let mut per = std::collections::BTreeMap::<String, f64>::new();
     for d in &dirs {
         let (name, c) = run_fixture(d);
         println!(
-            "{name:24} worst relative error {:.2e} ({})",
-            c.worst, c.where_
+            "{name:24} worst relative error {:.2e} ({}); kinematics {:.2e} ({})",
+            c.worst, c.where_, c.worst_kin, c.where_kin
         );
+        for (q, e) in &c.per {
+            let w = per.entry(q.clone()).or_insert(0.0);
+            *w = w.max(*e);
+        }
         if c.worst > 1e-9 {
             failures.push(format!("{name}: {:.3e} at {}", c.worst, c.where_));
         }
+        if c.worst_kin > 1e-12 {
+            failures.push(format!("{name}: {:.3e} at {}", c.worst_kin, c.where_kin));
+        }
     }
-    assert!(failures.is_empty(), "fixtures over 1e-9: {failures:#?}");
+    println!("worst relative error per quantity over every fixture:");
+    for (q, e) in &per {
+        println!("  {q:24} {e:.2e}");
+    }
+    assert!(failures.is_empty(), "fixtures over tolerance: {failures:#?}");
 }
 
-/// FD(ID(q̈)) = q̈ on every fixture robot and state, fixed and floating.
+/// FD(ID(q̈)) = q̈ on every fixture robot and state, fixed and floating, with the
+/// state's external wrenches (`fext`) applied to both.
 #[test]
 fn forward_dynamics_inverts_inverse_dynamics_on_every_fixture() {
     for dir in fixtures() {
@@ -198,18 +295,29 @@ fn forward_dynamics_inverts_inverse_dynamics_on_every_fixture() {
         }
         let mut data = urdyn::Data::new(&model);
         let mut worst = 0.0f64;
+        let mut pushed = 0;
         for (i, s) in states.states.iter().enumerate() {
             let sv = s
                 .to_vectors(&model, "states.json", &format!("states[{i}]"))
                 .unwrap();
-            let tau = urdyn::dynamics::rnea(&model, &mut data, &sv.q, &sv.v, &sv.a, None).clone();
-            let qdd =
-                urdyn::dynamics::forward_dynamics(&model, &mut data, &sv.q, &sv.v, &tau, None)
-                    .unwrap()
-                    .clone();
+            // the state's external wrenches, by link, onto their bodies
+            let mut fext = vec![urdyn::spatial::Force::zero(); model.nbodies];
+            urdyn::dynamics::forward_kinematics(&model, &mut data, &sv.q).unwrap();
+            for (link, f, t) in &sv.fext {
+                urdyn::dynamics::add_link_wrench(&model, &data, *link, f, t, &mut fext).unwrap();
+            }
+            pushed += usize::from(!sv.fext.is_empty());
+            let fx = Some(fext.as_slice());
+            let tau = urdyn::dynamics::rnea(&model, &mut data, &sv.q, &sv.v, &sv.a, fx)
+                .unwrap()
+                .clone();
+            let qdd = urdyn::dynamics::forward_dynamics(&model, &mut data, &sv.q, &sv.v, &tau, fx)
+                .unwrap()
+                .clone();
             worst = worst.max((&qdd - &sv.a).amax() / (1.0f64).max(sv.a.amax()));
         }
-        println!("{name:24} FD(ID(a)) relative error {worst:.2e}");
+        println!("{name:24} FD(ID(a)) relative error {worst:.2e} ({pushed} states with fext)");
+        assert!(pushed >= 3, "{name}: the fixture has no external wrenches");
         assert!(worst <= 1e-10, "{name}: FD(ID(a)) off by {worst:e}");
     }
 }

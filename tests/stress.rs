@@ -31,10 +31,10 @@ type AlgoFn<T> = fn(&Model<T>, &mut Data<T>, &Input<T>) -> Result<DVector<T>, St
 fn algorithms<T: Scalar>() -> Vec<(&'static str, AlgoFn<T>)> {
     vec![
         ("rnea", |m, d, s| {
-            Ok(dynamics::rnea(m, d, &s.q, &s.v, &s.a, None).clone())
+            Ok(dynamics::rnea(m, d, &s.q, &s.v, &s.a, None).unwrap().clone())
         }),
         ("H (n rnea)", |m, d, s| {
-            dynamics::mass_matrix_rnea(m, d, &s.q);
+            dynamics::mass_matrix_rnea(m, d, &s.q).unwrap();
             Ok(flat(&d.h))
         }),
         ("fd-rnea", |m, d, s| {
@@ -42,7 +42,7 @@ fn algorithms<T: Scalar>() -> Vec<(&'static str, AlgoFn<T>)> {
                 .cloned()
                 .map_err(|e| e.to_string())
         }),
-        ("H (crba)", |m, d, s| Ok(flat(dynamics::crba(m, d, &s.q)))),
+        ("H (crba)", |m, d, s| Ok(flat(dynamics::crba(m, d, &s.q).unwrap()))),
         ("fd-crba+ltdl", |m, d, s| {
             dynamics::forward_dynamics_crba(m, d, &s.q, &s.v, &s.tau, None)
                 .cloned()
@@ -184,7 +184,7 @@ fn evaluate(case: &Case) -> Row {
         // τ = ID(q, v, a) in double-double, rounded: every algorithm gets the
         // same f64 inputs in both precisions.
         let (qd, vd, ad) = (to_dd(q), to_dd(v), to_dd(a));
-        let tau = to_f64(dynamics::rnea(&mdd, &mut ddd, &qd, &vd, &ad, None));
+        let tau = to_f64(dynamics::rnea(&mdd, &mut ddd, &qd, &vd, &ad, None).unwrap());
         let s64 = Input {
             q: q.clone(),
             v: v.clone(),
@@ -198,9 +198,9 @@ fn evaluate(case: &Case) -> Row {
             tau: to_dd(&tau),
         };
         // Exact-ish H and C (double-double) for backward errors.
-        dynamics::mass_matrix_rnea(&mdd, &mut ddd, &sdd.q);
+        dynamics::mass_matrix_rnea(&mdd, &mut ddd, &sdd.q).unwrap();
         let hdd = ddd.h.clone();
-        let cdd = dynamics::bias(&mdd, &mut ddd, &sdd.q, &sdd.v, None).clone();
+        let cdd = dynamics::bias(&mdd, &mut ddd, &sdd.q, &sdd.v, None).unwrap().clone();
         let h = hdd.map(|x| x.to_f64());
         let hnorm = h.iter().fold(0.0f64, |m, x| m.max(x.abs())) * h.nrows() as f64;
         let c2 = cond2(&h);
@@ -444,7 +444,7 @@ fn dd_scalar_is_double_double() {
     let q = to_dd(&rng.vec(m.nq, 1.0));
     let v = to_dd(&rng.vec(m.nv, 1.0));
     let a = to_dd(&rng.vec(m.nv, 1.0));
-    let t1 = dynamics::rnea(&m, &mut d, &q, &v, &a, None).clone();
+    let t1 = dynamics::rnea(&m, &mut d, &q, &v, &a, None).unwrap().clone();
     // Forward dynamics in DD inverts it to double-double precision.
     let qdd = dynamics::forward_dynamics_rnea(&m, &mut d, &q, &v, &t1, None)
         .unwrap()

@@ -173,10 +173,10 @@ const SEED: u64 = 0x5EED_0DD5;
 #[inline(never)]
 fn call(algo: Algo, model: &Model, data: &mut Data, s: &State) -> Result<f64, String> {
     Ok(match algo {
-        Algo::Rnea => dynamics::rnea(model, data, &s.q, &s.v, &s.a, None)[0],
-        Algo::Bias => dynamics::bias(model, data, &s.q, &s.v, None)[0],
+        Algo::Rnea => dynamics::rnea(model, data, &s.q, &s.v, &s.a, None).map_err(|e| e.to_string())?[0],
+        Algo::Bias => dynamics::bias(model, data, &s.q, &s.v, None).map_err(|e| e.to_string())?[0],
         // H's upper triangle, the work of Pinocchio's crba (mass_matrix mirrors it)
-        Algo::Crba => dynamics::crba_upper(model, data, &s.q)[(0, 0)],
+        Algo::Crba => dynamics::crba_upper(model, data, &s.q).map_err(|e| e.to_string())?[(0, 0)],
         Algo::Aba => {
             dynamics::aba(model, data, &s.q, &s.v, &s.tau, None).map_err(|e| e.to_string())?[0]
         }
@@ -187,7 +187,7 @@ fn call(algo: Algo, model: &Model, data: &mut Data, s: &State) -> Result<f64, St
         Algo::Fd => dynamics::forward_dynamics(model, data, &s.q, &s.v, &s.tau, None)
             .map_err(|e| e.to_string())?[0],
         Algo::Fk => {
-            dynamics::forward_kinematics(model, data, &s.q);
+            dynamics::forward_kinematics(model, data, &s.q).map_err(|e| e.to_string())?;
             dynamics::update_frames(model, data);
             data.o_m_f.last().map_or(0.0, |m| m.trans.x)
         }

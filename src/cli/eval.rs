@@ -1,9 +1,11 @@
 //! `urdyn eval` (eval-contract.md): every dynamics quantity of a batch of states,
 //! as one JSON document.
 
-use crate::dynamics::{self, DynamicsError};
-use crate::model::{Data, FdMethod, Model};
-use crate::cli::state::{StateError, StatesFile};
+use crate::cli::state::{StateError, StateVectors, StatesFile};
+use crate::dynamics::{self, DynamicsError, Reference};
+use crate::model::{Data, Model};
+use crate::spatial::{Force, Motion};
+use nalgebra::{DMatrix, Vector3};
 use serde_json::{json, Map, Value};
 
 /// Why an evaluation failed: names the file and the key or joint.
@@ -17,6 +19,80 @@ pub enum EvalError {
 
 fn vec3(x: &nalgebra::DVector<f64>, at: usize) -> Value {
     json!([x[at], x[at + 1], x[at + 2]])
+}
+
+fn v3(x: &Vector3<f64>) -> Value {
+    json!([x.x, x.y, x.z])
+}
+
+/// A matrix as a list of rows.
+fn matrix(m: &DMatrix<f64>) -> Vec<Value> {
+    (0..m.nrows())
+        .map(|r| Value::from(m.row(r).iter().copied().collect::<Vec<f64>>()))
+        .collect()
+}
+
+fn motion(m: &Motion<f64>) -> Value {
+    json!({"linear": v3(&m.lin), "angular": v3(&m.ang)})
+}
+
+/// A state's kinematic outputs (eval-contract.md "Frames, external forces, centre
+/// of mass, momentum and energy"), as JSON, and whether every number is finite.
+struct Kinematics {
+    frames: Option<Value>,
+    com: Value,
+    momentum: Value,
+    energy: Value,
+    finite: bool,
+}
+
+/// The frames a state asked for, its centre of mass, momentum and energies, all by
+/// the library's kinematics (model gravity already the file's).
+fn kinematics(model: &Model, data: &mut Data, sv: &StateVectors) -> Result<Kinematics, DynamicsError> {
+    let mut finite = true;
+    let mut fin = |xs: &[f64]| finite &= xs.iter().all(|x| x.is_finite());
+    dynamics::forward_kinematics_second_order(model, data, &sv.q, &sv.v, &sv.a)?;
+    let mut frames = None;
+    if !sv.frames.is_empty() {
+        let mut out = Map::new();
+        let mut j = DMatrix::zeros(6, model.nv);
+        let mut jl = DMatrix::zeros(6, model.nv);
+        for &f in &sv.frames {
+            dynamics::frame_jacobian(model, data, f, Reference::WorldAligned, &mut j)?;
+            dynamics::frame_jacobian(model, data, f, Reference::Local, &mut jl)?;
+            let vel = dynamics::frame_velocity(model, data, f, Reference::WorldAligned)?;
+            let acc = dynamics::frame_classical_acceleration(model, data, f, Reference::WorldAligned)?;
+            fin(j.as_slice());
+            fin(jl.as_slice());
+            fin(vel.to_vector().as_slice());
+            fin(acc.to_vector().as_slice());
+            out.insert(
+                model.frames[f.0].name.clone(),
+                json!({"jacobian": matrix(&j), "jacobian_local": matrix(&jl),
+                       "velocity": motion(&vel), "acceleration": motion(&acc)}),
+            );
+        }
+        frames = Some(Value::Object(out));
+    }
+    let c = dynamics::center_of_mass(model, data);
+    let cd = dynamics::center_of_mass_velocity(model, data);
+    let mut jc = DMatrix::zeros(3, model.nv);
+    dynamics::center_of_mass_jacobian(model, data, &mut jc)?;
+    let pe = dynamics::potential_energy(model, data);
+    let ke = dynamics::kinetic_energy(model, data, &sv.q, &sv.v)?;
+    let (k_g, l) = dynamics::centroidal_momentum(model, data, &sv.q, &sv.v)?;
+    for x in [&c, &cd, &k_g, &l] {
+        fin(x.as_slice());
+    }
+    fin(jc.as_slice());
+    fin(&[ke, pe]);
+    Ok(Kinematics {
+        frames,
+        com: json!({"position": v3(&c), "velocity": v3(&cd), "jacobian": matrix(&jc)}),
+        momentum: json!({"linear": v3(&l), "angular": v3(&k_g)}),
+        energy: json!({"kinetic": ke, "potential": pe}),
+        finite,
+    })
 }
 
 /// The most degrees of freedom `eval` answers: its output holds the dense nv×nv
@@ -97,34 +173,38 @@ fn evaluate_each(
     let mut data = Data::new(&model);
     let names = model.dof_names();
     let vo = model.joint_v_offset();
+    let mut fext = vec![Force::zero(); model.nbodies];
     for (i, sv) in vectors.iter().enumerate() {
         let key = format!("states[{i}]");
-        let tau = dynamics::rnea(&model, &mut data, &sv.q, &sv.v, &sv.a, None).clone();
-        let bias = dynamics::bias(&model, &mut data, &sv.q, &sv.v, None).clone();
-        dynamics::mass_matrix(&model, &mut data, &sv.q);
-        let h = data.h.clone();
+        let dyn_err = |e: DynamicsError| EvalError::Dynamics {
+            file: states_file.to_string(),
+            message: format!("{key}: {e}"),
+        };
+        // the external wrenches, by link, onto their bodies at this q
+        dynamics::forward_kinematics(&model, &mut data, &sv.q).map_err(dyn_err)?;
+        fext.fill(Force::zero());
+        for (link, f, t) in &sv.fext {
+            dynamics::add_link_wrench(&model, &data, *link, f, t, &mut fext).map_err(dyn_err)?;
+        }
+        let fx = (!sv.fext.is_empty()).then_some(fext.as_slice());
+        let tau = dynamics::rnea(&model, &mut data, &sv.q, &sv.v, &sv.a, fx)
+            .map_err(dyn_err)?
+            .clone();
+        let bias = dynamics::bias(&model, &mut data, &sv.q, &sv.v, fx)
+            .map_err(dyn_err)?
+            .clone();
+        let h = dynamics::mass_matrix(&model, &mut data, &sv.q)
+            .map_err(dyn_err)?
+            .clone();
         // The contract's singularity test is on H itself (a pivot at most 64 ε of its
         // diagonal), whichever algorithm the engine's fd then uses.
         if let Err(k) = dynamics::linalg::cholesky(&h, &mut data.chol) {
-            return Err(EvalError::Dynamics {
-                file: states_file.to_string(),
-                message: format!("{key}: {}", DynamicsError::Singular(k)),
-            });
+            return Err(dyn_err(DynamicsError::Singular(k)));
         }
-        let qdd = if model.topology.fd_method == FdMethod::CrbaDense {
-            // The engine's fd on a mimic model is exactly this H (CRBA, Gᵀ H G),
-            // this bias and this dense Cholesky: solve with the factor just made.
-            let mut qdd = &sv.tau - &bias;
-            dynamics::linalg::cholesky_solve(&data.chol, &mut qdd);
-            qdd
-        } else {
-            dynamics::forward_dynamics(&model, &mut data, &sv.q, &sv.v, &sv.tau, None)
-                .map_err(|e| EvalError::Dynamics {
-                    file: states_file.to_string(),
-                    message: format!("{key}: {e}"),
-                })?
-                .clone()
-        };
+        let qdd = dynamics::forward_dynamics(&model, &mut data, &sv.q, &sv.v, &sv.tau, fx)
+            .map_err(dyn_err)?
+            .clone();
+        let kin = kinematics(&model, &mut data, sv).map_err(dyn_err)?;
         // Finite inputs can still overflow (a mass of 1e300, a speed of 1e200):
         // an answer with infinities or NaN (JSON null) is an error, not output.
         let finite = |x: &nalgebra::DVector<f64>| x.iter().all(|v| v.is_finite());
@@ -133,6 +213,7 @@ fn evaluate_each(
             ("bias", finite(&bias)),
             ("qdd", finite(&qdd)),
             ("mass_matrix", h.iter().all(|v| v.is_finite())),
+            ("a frame, centre of mass, momentum or energy", kin.finite),
         ] {
             if !ok {
                 return Err(EvalError::Dynamics {
@@ -141,7 +222,7 @@ fn evaluate_each(
                 });
             }
         }
-        dynamics::forward_kinematics(&model, &mut data, &sv.q);
+        dynamics::forward_kinematics(&model, &mut data, &sv.q).map_err(dyn_err)?;
         dynamics::update_frames(&model, &mut data);
         if let Some(f) = data.o_m_f.iter().position(|m| {
             !(m.rot.iter().all(|x| x.is_finite()) && m.trans.iter().all(|x| x.is_finite()))
@@ -162,9 +243,7 @@ fn evaluate_each(
             }
             Value::Object(m)
         };
-        let rows: Vec<Value> = (0..model.nv)
-            .map(|r| Value::from(h.row(r).iter().copied().collect::<Vec<f64>>()))
-            .collect();
+        let rows = matrix(&h);
         let mut poses = Map::new();
         for (k, f) in model.frames.iter().enumerate() {
             let m = &data.o_m_f[k];
@@ -182,6 +261,12 @@ fn evaluate_each(
         r.insert("bias".into(), by_name(&bias));
         r.insert("mass_matrix".into(), Value::Array(rows));
         r.insert("link_poses".into(), Value::Object(poses));
+        if let Some(frames) = kin.frames {
+            r.insert("frames".into(), frames);
+        }
+        r.insert("com".into(), kin.com);
+        r.insert("momentum".into(), kin.momentum);
+        r.insert("energy".into(), kin.energy);
         if model.floating_base {
             r.insert(
                 "base".into(),

@@ -1,8 +1,8 @@
 //! States JSON (eval-contract.md): parsing with every key checked, and conversion
 //! of one state into the engine's q, v, a, τ vectors.
 
-use crate::model::Model;
-use nalgebra::DVector;
+use crate::model::{FrameId, Model};
+use nalgebra::{DVector, Vector3};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 
@@ -39,7 +39,19 @@ pub struct BaseState {
     pub torque: Option<[f64; 3]>,
 }
 
-/// One state: joint maps keyed by URDF joint name, and the base.
+/// An external wrench on a URDF link (eval-contract.md, "fext"): world
+/// coordinates, the force acting at the link frame's origin, the torque a pure couple.
+#[derive(Debug, Clone, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LinkWrench {
+    /// Force (N), world coordinates, at the link frame's origin (zero if left out).
+    pub force: Option<[f64; 3]>,
+    /// Couple (N·m), world coordinates (zero if left out).
+    pub torque: Option<[f64; 3]>,
+}
+
+/// One state: joint maps keyed by URDF joint name, the base, external wrenches by
+/// link and the links whose kinematics the result reports.
 #[derive(Debug, Clone, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct State {
@@ -48,6 +60,10 @@ pub struct State {
     pub a: Option<BTreeMap<String, f64>>,
     pub tau: Option<BTreeMap<String, f64>>,
     pub base: Option<BaseState>,
+    /// External wrenches keyed by URDF link name.
+    pub fext: Option<BTreeMap<String, LinkWrench>>,
+    /// URDF links whose frame kinematics the result reports.
+    pub frames: Option<Vec<String>>,
 }
 
 /// A whole `STATES.json`.
@@ -66,6 +82,10 @@ pub struct StateVectors {
     pub a: DVector<f64>,
     /// Generalized forces: joint `tau` and, with a floating base, `base.force/torque`.
     pub tau: DVector<f64>,
+    /// External wrenches: link, force, torque (world coordinates), in key order.
+    pub fext: Vec<(FrameId, Vector3<f64>, Vector3<f64>)>,
+    /// The links asked for in `frames`, in the file's order.
+    pub frames: Vec<FrameId>,
 }
 
 fn parse_json<'a, D: Deserialize<'a>>(text: &'a str, file: &str) -> Result<D, StateError> {
@@ -125,13 +145,24 @@ fn require_object(v: &serde_json::Value, file: &str, path: &str) -> Result<(), S
 
 fn check_state_shape(v: &serde_json::Value, file: &str, key: &str) -> Result<(), StateError> {
     require_object(v, file, key)?;
-    if let Some(b) = v.get("base") {
-        let bkey = if key.starts_with('(') {
-            "base".to_string()
+    let sub = |name: &str| {
+        if key.starts_with('(') {
+            name.to_string()
         } else {
-            format!("{key}.base")
-        };
-        require_object(b, file, &bkey)?;
+            format!("{key}.{name}")
+        }
+    };
+    if let Some(b) = v.get("base") {
+        require_object(b, file, &sub("base"))?;
+    }
+    if let Some(f) = v.get("fext") {
+        let fkey = sub("fext");
+        require_object(f, file, &fkey)?;
+        if let Some(map) = f.as_object() {
+            for (link, w) in map {
+                require_object(w, file, &format!("{fkey}.{link}"))?;
+            }
+        }
     }
     Ok(())
 }
@@ -155,10 +186,17 @@ pub fn parse_states(text: &str, file: &str) -> Result<StatesFile, StateError> {
     Ok(s)
 }
 
-/// Parses one state object (simulate's `--initial`).
+/// Parses one state object (simulate's `--initial`, cli.md: `fext` and `frames`
+/// are not allowed there).
 pub fn parse_state(text: &str, file: &str) -> Result<State, StateError> {
     check_state_shape(&parse_value::<State>(text, file)?, file, "(top level)")?;
-    parse_json(text, file)
+    let st: State = parse_json(text, file)?;
+    for (present, key) in [(st.fext.is_some(), "fext"), (st.frames.is_some(), "frames")] {
+        if present {
+            return Err(StateError::new(file, key, "not allowed in --initial (eval only)"));
+        }
+    }
+    Ok(st)
 }
 
 /// Reads a file into a string, naming it on error.
@@ -195,16 +233,18 @@ impl State {
             let Some(map) = map else { continue };
             for (joint, &x) in map {
                 let k = format!("{key}.{name}.{joint}");
-                let Some(d) = model.dof_index(joint) else {
+                let Ok(iv) = model.v_index(joint) else {
                     let why = if model.body_joint_names.iter().any(|n| n == joint) {
-                        "is a mimic joint (it follows its leader and is not a key)"
-                    } else if model.frames.is_empty() {
-                        "unknown joint"
+                        "is a mimic joint (it follows its leader and is not a key)".to_string()
                     } else {
-                        "unknown joint (not a movable, non-mimic joint of this robot)"
+                        let near = crate::model::nearest(joint, model.dof_names())
+                            .map(|n| format!("; nearest: \"{n}\""))
+                            .unwrap_or_default();
+                        format!("unknown joint (not a movable, non-mimic joint of this robot{near})")
                     };
                     return Err(StateError::new(file, k, why));
                 };
+                let d = iv - vo;
                 if !x.is_finite() {
                     return Err(StateError::new(file, k, "non-finite number"));
                 }
@@ -271,6 +311,30 @@ impl State {
             put(&mut tau, 0, &b.force);
             put(&mut tau, 3, &b.torque);
         }
-        Ok(StateVectors { q, v, a, tau })
+        let mut fext = Vec::new();
+        for (link, w) in self.fext.iter().flatten() {
+            let k = format!("{key}.fext.{link}");
+            let f = model
+                .frame_id(link)
+                .map_err(|e| StateError::new(file, k.as_str(), e.to_string()))?;
+            let mut fv = [Vector3::zeros(), Vector3::zeros()];
+            for (slot, x, field) in [(0, &w.force, "force"), (1, &w.torque, "torque")] {
+                if let Some(x) = x {
+                    if !x.iter().all(|c| c.is_finite()) {
+                        return Err(StateError::new(file, format!("{k}.{field}"), "non-finite number"));
+                    }
+                    fv[slot] = Vector3::from(*x);
+                }
+            }
+            fext.push((f, fv[0], fv[1]));
+        }
+        let mut frames = Vec::new();
+        for (i, link) in self.frames.iter().flatten().enumerate() {
+            let f = model.frame_id(link).map_err(|e| {
+                StateError::new(file, format!("{key}.frames[{i}]"), e.to_string())
+            })?;
+            frames.push(f);
+        }
+        Ok(StateVectors { q, v, a, tau, fext, frames })
     }
 }

@@ -148,6 +148,7 @@ pub fn aba<'d, T: Scalar>(
     tau: &DVector<T>,
     fext: Option<&[Force<T>]>,
 ) -> Result<&'d DVector<T>, DynamicsError> {
+    super::check_sizes(model, q, &[("v", v), ("tau", tau)], fext)?;
     if model.has_mimic {
         return Err(DynamicsError::Mimic);
     }

@@ -1,3 +1,4 @@
+use super::{check_sizes, DynamicsError};
 use crate::model::{Data, Model};
 use crate::spatial::{Force, Scalar};
 use nalgebra::{DVector, Vector3};
@@ -29,7 +30,8 @@ pub fn centroidal_momentum<T: Scalar>(
     data: &mut Data<T>,
     q: &DVector<T>,
     v: &DVector<T>,
-) -> (Vector3<T>, Vector3<T>) {
+) -> Result<(Vector3<T>, Vector3<T>), DynamicsError> {
+    check_sizes(model, q, &[("v", v)], None)?;
     let mut h = Force::zero();
     for i in 1..model.nbodies {
         let p = model.parent[i];
@@ -43,5 +45,5 @@ pub fn centroidal_momentum<T: Scalar>(
     }
     let c = center_of_mass(model, data);
     // moment about G: n_G = n_O − c × f
-    (h.ang - c.cross(&h.lin), h.lin)
+    Ok((h.ang - c.cross(&h.lin), h.lin))
 }

@@ -211,8 +211,9 @@ pub fn crba<'d, T: Scalar>(
     model: &Model<T>,
     data: &'d mut Data<T>,
     q: &DVector<T>,
-) -> &'d nalgebra::DMatrix<T> {
-    crba_dispatch(model, data, q, true)
+) -> Result<&'d nalgebra::DMatrix<T>, super::DynamicsError> {
+    super::check_sizes(model, q, &[], None)?;
+    Ok(crba_dispatch(model, data, q, true))
 }
 
 /// [`crba`] for consumers that read one triangle: H's upper triangle (row ≤
@@ -225,8 +226,9 @@ pub fn crba_upper<'d, T: Scalar>(
     model: &Model<T>,
     data: &'d mut Data<T>,
     q: &DVector<T>,
-) -> &'d nalgebra::DMatrix<T> {
-    crba_dispatch(model, data, q, false)
+) -> Result<&'d nalgebra::DMatrix<T>, super::DynamicsError> {
+    super::check_sizes(model, q, &[], None)?;
+    Ok(crba_dispatch(model, data, q, false))
 }
 
 /// The variant of the model (mimic, local frames, world frame); `mirror`: fill

@@ -1,3 +1,4 @@
+use super::{check_sizes, DynamicsError};
 use crate::model::{Data, Model};
 use crate::spatial::{Motion, Scalar};
 use nalgebra::DVector;
@@ -8,7 +9,8 @@ pub fn kinetic_energy<T: Scalar>(
     data: &mut Data<T>,
     q: &DVector<T>,
     v: &DVector<T>,
-) -> T {
+) -> Result<T, DynamicsError> {
+    check_sizes(model, q, &[("v", v)], None)?;
     for i in 1..model.nbodies {
         let (x_j, _) = model.joints[i].calc(q, None);
         data.li_m_i[i] = model.placements[i].compose(&x_j);
@@ -23,7 +25,8 @@ pub fn kinetic_energy_from_placements<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,
     v: &DVector<T>,
-) -> T {
+) -> Result<T, DynamicsError> {
+    crate::model::DimensionError::check("v", model.nv, v.len())?;
     let mut ke = T::zero();
     data.v[0] = Motion::zero();
     for i in 1..model.nbodies {
@@ -32,7 +35,7 @@ pub fn kinetic_energy_from_placements<T: Scalar>(
         data.v[i] = vi;
         ke += model.inertias[i].kinetic_energy(&vi);
     }
-    ke
+    Ok(ke)
 }
 
 /// Gravitational potential energy `−Σ mᵢ gᵀ cᵢ` over the bodies' world centres of
@@ -45,4 +48,29 @@ pub fn potential_energy<T: Scalar>(model: &Model<T>, data: &Data<T>) -> T {
         pe -= inertia.mass * model.gravity.dot(&c);
     }
     pe
+}
+
+/// Kinetic and potential energy `(T, V)` of the state (q, v) for a caller without
+/// a [`Data`] (docs/theory.md §"Energies"): one pass of joint transforms and body
+/// velocities into a per-body scratch allocated here (2 × nbodies small entries).
+pub fn energies<T: Scalar>(
+    model: &Model<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+) -> Result<(T, T), DynamicsError> {
+    check_sizes(model, q, &[("v", v)], None)?;
+    let mut pose = vec![crate::spatial::Se3::identity(); model.nbodies];
+    let mut vel = vec![Motion::zero(); model.nbodies];
+    let (mut ke, mut pe) = (T::zero(), T::zero());
+    for i in 1..model.nbodies {
+        let p = model.parent[i];
+        let (x_j, v_j) = model.joints[i].calc(q, Some(v));
+        let li = model.placements[i].compose(&x_j);
+        pose[i] = pose[p].compose(&li);
+        vel[i] = li.inv_act_motion(&vel[p]) + v_j;
+        let inertia = &model.inertias[i];
+        ke += inertia.kinetic_energy(&vel[i]);
+        pe -= inertia.mass * model.gravity.dot(&pose[i].act_point(&inertia.com));
+    }
+    Ok((ke, pe))
 }

@@ -9,7 +9,12 @@ use nalgebra::DVector;
 /// §"Forward dynamics by inverse dynamics"), written to `data.h`. Each column is
 /// ID(q, 0, δᵢ) with gravity off: the same n calls as the course note's
 /// `ID(q, q̇, δᵢ) − C`, without its cancellation when C is large.
-pub fn mass_matrix_rnea<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
+pub fn mass_matrix_rnea<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+) -> Result<(), DynamicsError> {
+    super::check_sizes(model, q, &[], None)?;
     let nv = model.nv;
     let mut delta = std::mem::replace(&mut data.tmp_a, DVector::zeros(0));
     delta.fill(T::zero());
@@ -20,6 +25,7 @@ pub fn mass_matrix_rnea<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVe
         data.h.set_column(i, &data.tau);
     }
     data.tmp_a = delta;
+    Ok(())
 }
 
 /// The course note's forward dynamics (docs/theory.md §"Forward dynamics by inverse dynamics"),
@@ -34,10 +40,11 @@ pub fn forward_dynamics_rnea<'d, T: Scalar>(
     tau: &DVector<T>,
     fext: Option<&[Force<T>]>,
 ) -> Result<&'d DVector<T>, DynamicsError> {
+    super::check_sizes(model, q, &[("v", v), ("tau", tau)], fext)?;
     super::check_massless(model)?;
     rnea_impl(model, data, q, Some(v), None, true, fext);
     data.bias.copy_from(&data.tau);
-    mass_matrix_rnea(model, data, q);
+    mass_matrix_rnea(model, data, q)?;
     cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)?;
     data.qdd.copy_from(tau);
     data.qdd -= &data.bias;

@@ -4,7 +4,20 @@ use nalgebra::DVector;
 
 /// Forward kinematics of every body: `liMi = X_tree,i · X_J(q_i)` and
 /// `oMi = oM_λ(i) · liMi`.
-pub fn forward_kinematics<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
+/// `q` must have nq entries (else the error, nothing computed).
+pub fn forward_kinematics<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+) -> Result<(), super::DynamicsError> {
+    super::check_sizes(model, q, &[], None)?;
+    forward_kinematics_pass(model, data, q);
+    Ok(())
+}
+
+/// [`forward_kinematics`] for callers whose `q` has nq entries by construction
+/// (the simulation's own state).
+pub(crate) fn forward_kinematics_pass<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     let nb = model.nbodies;
     let q = q.as_slice();
     let joints = &model.joints[..nb];

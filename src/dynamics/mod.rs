@@ -7,9 +7,12 @@
 
 mod aba;
 mod centroidal;
+mod com;
 mod crba;
 mod energy;
+mod external;
 mod forward_rnea;
+mod frames;
 mod jacobian;
 mod kinematics;
 pub mod linalg;
@@ -18,12 +21,16 @@ mod rnea;
 
 pub use aba::aba;
 pub use centroidal::{center_of_mass, centroidal_momentum};
+pub use com::{center_of_mass_jacobian, center_of_mass_velocity};
+pub use external::add_link_wrench;
+pub use frames::{frame_classical_acceleration, frame_velocity, forward_kinematics_second_order};
 pub use crba::{crba, crba_upper, CompositeInertia};
 
-pub use energy::{kinetic_energy, kinetic_energy_from_placements, potential_energy};
+pub use energy::{energies, kinetic_energy, kinetic_energy_from_placements, potential_energy};
 pub use forward_rnea::{forward_dynamics_rnea, mass_matrix_rnea};
-pub use jacobian::frame_jacobian;
+pub use jacobian::{frame_jacobian, Reference};
 pub use kinematics::{forward_kinematics, update_frames};
+pub(crate) use kinematics::forward_kinematics_pass;
 pub use rnea::{bias, rnea};
 
 /// Why forward dynamics has no answer.
@@ -38,11 +45,36 @@ pub enum DynamicsError {
     /// The articulated-body algorithm cannot express mimic coupling.
     #[error("the articulated-body algorithm cannot handle mimic joints (use forward_dynamics)")]
     Mimic,
+    /// A vector or matrix argument of the wrong size (q: nq, v/a/tau: nv, fext: nbodies).
+    #[error(transparent)]
+    Dimension(#[from] DimensionError),
+    /// A frame or joint id the model does not have.
+    #[error(transparent)]
+    Name(#[from] NameError),
 }
 
-use crate::model::{Data, FdMethod, Model};
+use crate::model::{Data, DimensionError, FdMethod, Model, NameError};
 use crate::spatial::{Force, Scalar};
 use nalgebra::DVector;
+
+/// The sizes every entry point checks, in O(1): `q` has nq entries, each of `vs`
+/// nv, `fext` (if given) nbodies.
+#[inline]
+pub(crate) fn check_sizes<T: Scalar>(
+    model: &Model<T>,
+    q: &DVector<T>,
+    vs: &[(&'static str, &DVector<T>)],
+    fext: Option<&[Force<T>]>,
+) -> Result<(), DimensionError> {
+    DimensionError::check("q", model.nq, q.len())?;
+    for (name, x) in vs {
+        DimensionError::check(name, model.nv, x.len())?;
+    }
+    if let Some(f) = fext {
+        DimensionError::check("fext", model.nbodies, f.len())?;
+    }
+    Ok(())
+}
 
 /// Forward dynamics is undefined where a moving joint carries no mass (H is
 /// singular whatever the state): the error names the first such joint.
@@ -54,8 +86,12 @@ pub(crate) fn check_massless<T: Scalar>(model: &Model<T>) -> Result<(), Dynamics
 }
 
 /// The joint-space inertia matrix H(q), written to `data.h` (by [`crba`]).
-pub fn mass_matrix<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
-    crba(model, data, q);
+pub fn mass_matrix<'d, T: Scalar>(
+    model: &Model<T>,
+    data: &'d mut Data<T>,
+    q: &DVector<T>,
+) -> Result<&'d nalgebra::DMatrix<T>, DynamicsError> {
+    crba(model, data, q)
 }
 
 /// Forward dynamics through H: `C` by RNEA (docs/theory.md §"Bias forces"), H by
@@ -73,13 +109,14 @@ pub fn forward_dynamics_crba<'d, T: Scalar>(
     tau: &DVector<T>,
     fext: Option<&[Force<T>]>,
 ) -> Result<&'d DVector<T>, DynamicsError> {
+    check_sizes(model, q, &[("v", v), ("tau", tau)], fext)?;
     check_massless(model)?;
-    bias(model, data, q, v, fext);
+    bias(model, data, q, v, fext)?;
     if model.has_mimic {
-        crba(model, data, q);
+        crba(model, data, q)?;
     } else {
         // LTDL reads H's upper triangle only
-        crba_upper(model, data, q);
+        crba_upper(model, data, q)?;
     }
     data.qdd.copy_from(tau);
     data.qdd -= &data.bias;

@@ -1,3 +1,4 @@
+use super::{check_sizes, DynamicsError};
 use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
 use crate::spatial::ops::add_cross;
 use crate::spatial::{Force, Motion, Scalar, Se3};
@@ -16,9 +17,10 @@ pub fn rnea<'d, T: Scalar>(
     v: &DVector<T>,
     a: &DVector<T>,
     fext: Option<&[Force<T>]>,
-) -> &'d DVector<T> {
+) -> Result<&'d DVector<T>, DynamicsError> {
+    check_sizes(model, q, &[("v", v), ("a", a)], fext)?;
     rnea_impl(model, data, q, Some(v), Some(a), true, fext);
-    &data.tau
+    Ok(&data.tau)
 }
 
 /// `C(q, q̇)` = ID(q, q̇, 0) (docs/theory.md §"Bias forces"), gravity and external
@@ -29,10 +31,11 @@ pub fn bias<'d, T: Scalar>(
     q: &DVector<T>,
     v: &DVector<T>,
     fext: Option<&[Force<T>]>,
-) -> &'d DVector<T> {
+) -> Result<&'d DVector<T>, DynamicsError> {
+    check_sizes(model, q, &[("v", v)], fext)?;
     rnea_impl(model, data, q, Some(v), None, true, fext);
     data.bias.copy_from(&data.tau);
-    &data.bias
+    Ok(&data.bias)
 }
 
 /// The one RNEA pass behind every entry point. `v = None` means q̇ = 0, `a = None`

@@ -102,3 +102,136 @@ pub fn normalize_quat(q: &mut DVector<f64>) {
         }
     }
 }
+
+// ---------------------------------------------------------------------------
+// The manifold for tools: q ⊕ v, q₁ ⊖ q₀, neutral and random configurations,
+// configurations by joint name (sizes checked, no panic).
+
+use super::{DimensionError, NameError};
+
+/// `q ⊕ v`: the configuration reached from `q` by the velocity `v` held for one
+/// unit of time, as the simulator steps ([`integrate_config`] with h = 1): a free
+/// base moves by `R(q) v_lin` (world) and turns by `exp(ω)` (body frame); every
+/// other joint adds. (Pinocchio's `integrate` moves a free base along the SE(3)
+/// exponential instead; the two agree to first order.)
+pub fn integrate(
+    model: &Model,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+) -> Result<DVector<f64>, DimensionError> {
+    DimensionError::check("q", model.nq, q.len())?;
+    DimensionError::check("v", model.nv, v.len())?;
+    let mut out = q.clone();
+    integrate_config(model, &mut out, v, 1.0);
+    Ok(out)
+}
+
+/// `q₁ ⊖ q₀`: the velocity `v` with [`integrate`]`(q₀, v) = q₁` — a free base's
+/// `v_lin = R(q₀)ᵀ (p₁ − p₀)` and `ω = log(q₀⁻¹ ⊗ q₁)` (the shorter rotation),
+/// every other joint `q₁ − q₀`.
+pub fn difference(
+    model: &Model,
+    q0: &DVector<f64>,
+    q1: &DVector<f64>,
+) -> Result<DVector<f64>, DimensionError> {
+    DimensionError::check("q0", model.nq, q0.len())?;
+    DimensionError::check("q1", model.nq, q1.len())?;
+    let (qo, vo) = (model.joint_q_offset(), model.joint_v_offset());
+    let mut v = DVector::zeros(model.nv);
+    if model.floating_base {
+        let n0 = (q0[3] * q0[3] + q0[4] * q0[4] + q0[5] * q0[5] + q0[6] * q0[6]).sqrt();
+        let n1 = (q1[3] * q1[3] + q1[4] * q1[4] + q1[5] * q1[5] + q1[6] * q1[6]).sqrt();
+        let (x0, y0, z0, w0) = (q0[3] / n0, q0[4] / n0, q0[5] / n0, q0[6] / n0);
+        let (x1, y1, z1, w1) = (q1[3] / n1, q1[4] / n1, q1[5] / n1, q1[6] / n1);
+        let r0 = quat_to_matrix(x0, y0, z0, w0);
+        let dp = r0.transpose() * Vector3::new(q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]);
+        // d = conj(q0) ⊗ q1
+        let mut dw = w0 * w1 + x0 * x1 + y0 * y1 + z0 * z1;
+        let mut dv = Vector3::new(
+            w0 * x1 - x0 * w1 - y0 * z1 + z0 * y1,
+            w0 * y1 + x0 * z1 - y0 * w1 - z0 * x1,
+            w0 * z1 - x0 * y1 + y0 * x1 - z0 * w1,
+        );
+        if dw < 0.0 {
+            dw = -dw;
+            dv = -dv;
+        }
+        let s = dv.norm();
+        // ω = 2 atan2(|d_v|, d_w) d_v / |d_v|
+        let w = if s > 1e-12 {
+            dv * (2.0 * s.atan2(dw) / s)
+        } else {
+            dv * (2.0 / dw)
+        };
+        for k in 0..3 {
+            v[k] = dp[k];
+            v[3 + k] = w[k];
+        }
+    }
+    for d in 0..model.dofs.len() {
+        v[vo + d] = q1[qo + d] - q0[qo + d];
+    }
+    Ok(v)
+}
+
+/// A random configuration inside the joint limits (uniform; a continuous joint,
+/// or one without limits, in [−π, π]; a free base at the origin with a uniformly
+/// random orientation), reproducible from `seed`.
+pub fn random_configuration(model: &Model, seed: u64) -> DVector<f64> {
+    let mut state = seed ^ 0x9E37_79B9_7F4A_7C15;
+    // splitmix64: a uniform number in [0, 1)
+    let mut unit = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut q = model.neutral();
+    if model.floating_base {
+        // Shoemake's uniform unit quaternion
+        let (u1, u2, u3) = (unit(), unit(), unit());
+        let tau = 2.0 * std::f64::consts::PI;
+        let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+        q[3] = a * (tau * u2).sin();
+        q[4] = a * (tau * u2).cos();
+        q[5] = b * (tau * u3).sin();
+        q[6] = b * (tau * u3).cos();
+    }
+    let qo = model.joint_q_offset();
+    for (d, dof) in model.dofs.iter().enumerate() {
+        let (lo, hi) = match (dof.limits.lower, dof.limits.upper) {
+            (Some(lo), Some(hi)) if lo < hi && !dof.continuous => (lo, hi),
+            _ => (-std::f64::consts::PI, std::f64::consts::PI),
+        };
+        q[qo + d] = lo + (hi - lo) * unit();
+    }
+    q
+}
+
+impl Model {
+    /// The configuration with the named joints at the given positions and every
+    /// other at [`Model::neutral`]. Keys are degrees of freedom (movable, non-mimic
+    /// joints); an unknown name is an error naming it and the nearest known one.
+    pub fn configuration_from_names<'a>(
+        &self,
+        values: impl IntoIterator<Item = (&'a str, f64)>,
+    ) -> Result<DVector<f64>, NameError> {
+        let mut q = self.neutral();
+        for (name, x) in values {
+            q[self.q_index(name)?] = x;
+        }
+        Ok(q)
+    }
+    /// Every degree of freedom's position in `q` by joint name, in engine order.
+    pub fn positions_by_name(&self, q: &DVector<f64>) -> Result<Vec<(&str, f64)>, DimensionError> {
+        DimensionError::check("q", self.nq, q.len())?;
+        let qo = self.joint_q_offset();
+        Ok(self
+            .dofs
+            .iter()
+            .enumerate()
+            .map(|(d, dof)| (dof.name.as_str(), q[qo + d]))
+            .collect())
+    }
+}

@@ -8,7 +8,10 @@
 pub mod configuration;
 mod data;
 pub(crate) mod joint;
+mod names;
 mod topology;
+
+pub use names::{edit_distance, nearest, BodyId, FrameId, JointId, NameError};
 
 pub use data::Data;
 pub(crate) use joint::{dispatch_joint, JointModel};
@@ -166,10 +169,14 @@ impl<T: Scalar> Model<T> {
     pub fn dof_names(&self) -> Vec<&str> {
         self.dofs.iter().map(|d| d.name.as_str()).collect()
     }
-    /// Position of a DoF by joint name.
+    /// Position of a DoF by joint name in [`Model::dofs`]: neither a q nor a v
+    /// index (those are offset by a floating base).
+    #[deprecated(note = "an index into `dofs`, neither q nor v: use `q_index`, `v_index` or `joint_id` + `joint_v_range`")]
     pub fn dof_index(&self, name: &str) -> Option<usize> {
         self.dofs.iter().position(|d| d.name == name)
     }
+    /// Index of a URDF link in [`Model::frames`] (see [`Model::frame_id`] for an
+    /// error naming the nearest link).
     pub fn frame_index(&self, name: &str) -> Option<usize> {
         self.frames.iter().position(|f| f.name == name)
     }
@@ -198,6 +205,30 @@ impl<T: Scalar> Model<T> {
                 return false;
             }
             i = self.parent[i];
+        }
+    }
+}
+
+/// A vector or matrix of the wrong size for the model: names the argument.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("{arg} has {got} entries, the model needs {expected}")]
+pub struct DimensionError {
+    /// The argument's name (`"q"`, `"v"`, `"fext"`, …).
+    pub arg: &'static str,
+    /// The size the model needs (nq, nv, nbodies, …).
+    pub expected: usize,
+    /// The size given.
+    pub got: usize,
+}
+
+impl DimensionError {
+    /// `Ok` iff `got == expected`, else the error naming `arg` (O(1)).
+    #[inline]
+    pub fn check(arg: &'static str, expected: usize, got: usize) -> Result<(), Self> {
+        if got == expected {
+            Ok(())
+        } else {
+            Err(Self { arg, expected, got })
         }
     }
 }

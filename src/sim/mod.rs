@@ -68,7 +68,7 @@ pub use integrators::Integrator;
 
 use crate::contact::{ContactError, ContactParams, ContactPoint, GroundContact};
 use crate::dynamics::DynamicsError;
-use crate::dynamics::{forward_kinematics, kinetic_energy_from_placements, potential_energy};
+use crate::dynamics::{forward_kinematics_pass as forward_kinematics, kinetic_energy_from_placements, potential_energy};
 use crate::model::configuration::normalize_quat;
 use crate::model::{Data, JointKind, Model};
 use crate::spatial::Force;
@@ -496,7 +496,7 @@ impl Simulation {
         self.refresh_contacts();
         self.guard.reference = None;
         self.guard.recovering_until = if self.start_violations().is_empty() {
-            let e = self.energy();
+            let e = self.update_energy();
             if e.is_finite() {
                 self.guard.reference = Some(e);
                 self.guard.v_ref.copy_from(&self.v);
@@ -634,6 +634,20 @@ impl Simulation {
     pub fn contact_forces(&self) -> &[ContactForce] {
         self.cons.contact_forces()
     }
+    /// The URDF link whose collision shape made a contact point (a point of
+    /// [`Simulation::contact_points`] or [`ContactForce::point`]); `None` for a
+    /// point this simulation did not find.
+    pub fn contact_link(&self, point: &ContactPoint) -> Option<&str> {
+        let c = self.contact.as_ref()?;
+        c.shapes.get(point.shape).map(|s| s.link.as_str())
+    }
+    /// [`Simulation::contact_forces`] named by URDF link (the link whose
+    /// collision shape touched, not the merged body).
+    pub fn link_contact_forces(&self) -> impl Iterator<Item = (&str, &ContactForce)> + '_ {
+        self.contact_forces()
+            .iter()
+            .map(|f| (self.contact_link(&f.point).unwrap_or(""), f))
+    }
     /// Number of contact points that carried force in the last step.
     pub fn active_contacts(&self) -> usize {
         self.cons.contact_forces().len()
@@ -645,8 +659,33 @@ impl Simulation {
     }
     /// Kinetic plus gravitational potential energy (J), the potential being
     /// −Σ mᵢ gᵀcᵢ (zero at the world origin); with an armature, its rotors'
-    /// ½ A v² is kinetic energy too.
-    pub fn energy(&mut self) -> f64 {
+    /// ½ A v² is kinetic energy too. The value the step's energy guard computed
+    /// when there is one (no work, no allocation), else computed afresh from
+    /// (q, v) with a small per-body scratch ([`crate::dynamics::energies`]).
+    pub fn energy(&self) -> f64 {
+        if let Some(e) = self.energy_now {
+            return e;
+        }
+        let (ke, pe) = crate::dynamics::energies(&self.model, &self.q, &self.v)
+            .unwrap_or((f64::NAN, f64::NAN));
+        ke + pe + self.armature_energy()
+    }
+
+    /// The rotors' kinetic energy `½ Σ A v²` (0 without an armature).
+    fn armature_energy(&self) -> f64 {
+        if !self.has_armature {
+            return 0.0;
+        }
+        let mut e = 0.0;
+        for (a, v) in self.armature.iter().zip(self.v.iter()) {
+            e += 0.5 * a * v * v;
+        }
+        e
+    }
+
+    /// [`Simulation::energy`], cached until the state changes (the energy guard's
+    /// path: the poses of the last contact refresh reused).
+    fn update_energy(&mut self) -> f64 {
         if let Some(e) = self.energy_now {
             return e;
         }
@@ -656,13 +695,11 @@ impl Simulation {
             forward_kinematics(&self.model, &mut self.data, &self.q);
             self.fk_valid = true;
         }
-        let mut e = kinetic_energy_from_placements(&self.model, &mut self.data, &self.v)
-            + potential_energy(&self.model, &self.data);
-        if self.has_armature {
-            for (a, v) in self.armature.iter().zip(self.v.iter()) {
-                e += 0.5 * a * v * v;
-            }
-        }
+        // v has nv entries (the simulation's own state): no size error
+        let e = kinetic_energy_from_placements(&self.model, &mut self.data, &self.v)
+            .unwrap_or(f64::NAN)
+            + potential_energy(&self.model, &self.data)
+            + self.armature_energy();
         self.energy_now = Some(e);
         e
     }
@@ -812,7 +849,7 @@ impl Simulation {
             }
             self.guard.recovering_until = None;
         }
-        let e = self.energy();
+        let e = self.update_energy();
         if !e.is_finite() {
             return Err(SimError::NonFinite {
                 t: self.t,

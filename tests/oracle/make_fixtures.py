@@ -194,7 +194,7 @@ def rand_unit_quat(rng):
             return q / n
 
 
-def make_states(name, dofs, joints, floating):
+def make_states(name, dofs, joints, floating, links, root_link):
     rng = np.random.default_rng(zlib.crc32(name.encode()) ^ 0x5EED)
 
     def q_sample(n):
@@ -258,7 +258,26 @@ def make_states(name, dofs, joints, floating):
     if floating:
         s["base"] = base_full(pos_scale=20.0)
     states.append(s)
+    add_frames_and_fext(name, states, links, root_link)
     return states
+
+
+def add_frames_and_fext(name, states, links, root_link):
+    """Contract v2 inputs, drawn from their own generator (the states' other values stay
+    as they were): `frames` on states 1-5 (the root link, the last link and a random one),
+    external wrenches on states 1, 2, 4 and 5 (the root's included: no effect when the
+    root is welded to the world); state 3 asks for frames with no wrench."""
+    rng = np.random.default_rng(zlib.crc32(name.encode()) ^ 0xF00D)
+    vec = lambda s: [float(x) for x in rng.uniform(-s, s, 3)]
+    pick = lambda: links[int(rng.integers(len(links)))]
+    for k in range(1, len(states)):
+        frames = [root_link, links[-1], pick()]
+        states[k]["frames"] = list(dict.fromkeys(frames))
+    states[1]["fext"] = {pick(): {"force": vec(5.0), "torque": vec(2.0)},
+                         links[-1]: {"force": vec(5.0), "torque": vec(2.0)}}
+    states[2]["fext"] = {pick(): {"force": vec(5.0)}}
+    states[4]["fext"] = {root_link: {"force": vec(20.0), "torque": vec(5.0)}}
+    states[5]["fext"] = {pick(): {"torque": vec(3.0)}, links[-1]: {"force": vec(10.0)}}
 
 
 # --------------------------------------------------------------------------- dynamics
@@ -372,8 +391,24 @@ class Robot:
         assert np.allclose(G @ v_red, v, rtol=0, atol=1e-14)
         assert np.allclose(G @ a_red, a, rtol=0, atol=1e-14)
 
-        rnea = pin.rnea(m, d, q, v, a).copy()
-        nle = pin.nonLinearEffects(m, d, q, v).copy()
+        # external wrenches: world force at the link origin p and a couple, as the
+        # spatial force [f; τ + p × f] at the world origin, then in each joint's frame
+        pin.framesForwardKinematics(m, d, q)
+        fext = pin.StdVec_Force()
+        for _ in range(m.njoints):
+            fext.append(pin.Force.Zero())
+        for link, w in state.get("fext", {}).items():
+            fr = m.frames[m.getFrameId(link, pin.BODY)]
+            p = d.oMf[m.getFrameId(link, pin.BODY)].translation
+            f = np.array(w.get("force", [0.0] * 3))
+            t = np.array(w.get("torque", [0.0] * 3))
+            jid = fr.parentJoint
+            if jid == 0:
+                continue  # welded to the world: no effect
+            fw = pin.Force(f, t + np.cross(p, f))
+            fext[jid] = fext[jid] + d.oMi[jid].actInv(fw)
+        rnea = pin.rnea(m, d, q, v, a, fext).copy()
+        nle = pin.rnea(m, d, q, v, np.zeros(m.nv), fext).copy()
         M = pin.crba(m, d, q).copy()
         M = np.triu(M) + np.triu(M, 1).T
         H = G.T @ M @ G
@@ -384,7 +419,7 @@ class Robot:
         assert np.max(np.abs(H @ a_red + bias - tau)) < 1e-9 * scale, "tau != H a + C"
         aba_err = None
         if not self.reduced:
-            qdd_aba = pin.aba(m, d, q, v, tau_in).copy()
+            qdd_aba = pin.aba(m, d, q, v, tau_in, fext).copy()
             aba_err = float(np.max(np.abs(qdd_aba - qdd)) / max(1.0, float(np.max(np.abs(qdd)))))
             assert aba_err < ABA_TOL, f"ABA disagrees with solve(H): {aba_err}"
         cond = float(np.linalg.cond(H))
@@ -411,6 +446,7 @@ class Robot:
         assert pose_err < POSE_TOL, f"yourdfpy link poses disagree: {pose_err}"
 
         fl = lambda x: [float(y) for y in x]
+        kin = self.kinematics(state, q, v, a, v_red, a_red)
         res = {
             "tau": {n: float(tau[nb + k]) for k, n in enumerate(self.dofs)},
             "qdd": {n: float(qdd[nb + k]) for k, n in enumerate(self.dofs)},
@@ -425,12 +461,55 @@ class Robot:
                 "bias_force": fl(bias[0:3]), "bias_torque": fl(bias[3:6]),
                 "linear_acceleration": fl(qdd[0:3]), "angular_acceleration": fl(qdd[3:6]),
             }
+        res.update(kin)
         return res, cond, pose_err, aba_err
+
+    def kinematics(self, state, q, v, a, v_red, a_red):
+        """Contract v2 outputs: the requested frames' Jacobians (world-aligned and local),
+        velocities and classical accelerations, the centre of mass with its velocity and
+        Jacobian, the centroidal momentum and the energies (reduced: J_full G)."""
+        m, d, G = self.model, self.data, self.G
+        fl = lambda x: [float(y) for y in x]
+        rows = lambda M: [fl(r) for r in M]
+        pin.computeJointJacobians(m, d, q)
+        pin.forwardKinematics(m, d, q, v, a)
+        pin.updateFramePlacements(m, d)
+        out = {}
+        if "frames" in state:
+            frames = {}
+            for link in state["frames"]:
+                fid = m.getFrameId(link, pin.BODY)
+                J = pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED) @ G
+                Jl = pin.getFrameJacobian(m, d, fid, pin.LOCAL) @ G
+                vel = pin.getFrameVelocity(m, d, fid, pin.LOCAL_WORLD_ALIGNED)
+                acc = pin.getFrameClassicalAcceleration(m, d, fid, pin.LOCAL_WORLD_ALIGNED)
+                jv = J @ v_red
+                assert np.allclose(jv, np.concatenate([vel.linear, vel.angular]), rtol=0,
+                                   atol=1e-12 * max(1.0, float(np.max(np.abs(jv))))), "J v != velocity"
+                frames[link] = {
+                    "jacobian": rows(J), "jacobian_local": rows(Jl),
+                    "velocity": {"linear": fl(vel.linear), "angular": fl(vel.angular)},
+                    "acceleration": {"linear": fl(acc.linear), "angular": fl(acc.angular)},
+                }
+            out["frames"] = frames
+        com = pin.centerOfMass(m, d, q, v).copy()
+        vcom = d.vcom[0].copy()
+        Jc = pin.jacobianCenterOfMass(m, d, q) @ G
+        assert np.allclose(Jc @ v_red, vcom, rtol=0, atol=1e-12 * max(1.0, float(np.max(np.abs(vcom)))))
+        pin.computeCentroidalMomentum(m, d, q, v)
+        hg = d.hg
+        out["com"] = {"position": fl(com), "velocity": fl(vcom), "jacobian": rows(Jc)}
+        out["momentum"] = {"linear": fl(hg.linear), "angular": fl(hg.angular)}
+        out["energy"] = {"kinetic": float(pin.computeKineticEnergy(m, d, q, v)),
+                         "potential": float(pin.computePotentialEnergy(m, d, q))}
+        return out
 
 
 def particle_check(results, states):
     """The seed's section 3.1 closed form: Q_x = m qdd_x, Q_y = m (qdd_y + g), m = 2."""
     for st, r in zip(states, results):
+        if "fext" in st:
+            continue  # the closed form is that of the unpushed particle
         ax = st.get("a", {}).get("x", 0.0)
         ay = st.get("a", {}).get("y", 0.0)
         assert abs(r["tau"]["x"] - 2.0 * ax) < 1e-12
@@ -477,6 +556,8 @@ def pin_mimic_check(robot, states, results, gravity):
         iv = [m.joints[i].idx_v for i in ids]
         worst = 0.0
         for st, r in zip(states, results):
+            if "fext" in st:
+                continue  # compared without external wrenches
             q, v, a = pin.neutral(m), np.zeros(m.nv), np.zeros(m.nv)
             for n, i in zip(robot.dofs, ids):
                 j = m.joints[i]
@@ -519,7 +600,8 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         for name, urdf_rel, floating, gravity in FIXTURES:
             robot = Robot(urdf_rel, floating, tmp)
-            states = make_states(name, robot.dofs, robot.joints, floating)
+            states = make_states(name, robot.dofs, robot.joints, floating, robot.links,
+                                 robot.root_link)
             g = gravity if gravity is not None else G_DOWN
             results, conds, perrs, aerrs = [], [], [], []
             for st in states:

@@ -64,9 +64,11 @@ impl Simulation {
             tau[k] -= self.damping[k] * self.v[k];
         }
         let free = if dense {
-            bias(&self.model, &mut self.data, &self.q, &self.v, None);
-            tau -= &self.data.bias;
-            self.factor_mass(h).map(|_| self.mass.f.solve(&mut tau))
+            bias(&self.model, &mut self.data, &self.q, &self.v, None)
+                .map_err(SimError::from)
+                .map(|c| tau -= c)
+                .and_then(|_| self.factor_mass(h))
+                .map(|_| self.mass.f.solve(&mut tau))
         } else {
             forward_dynamics(&self.model, &mut self.data, &self.q, &self.v, &tau, None)
                 .map(|a| tau.copy_from(a))

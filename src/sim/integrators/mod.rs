@@ -77,9 +77,9 @@ impl Simulation {
     /// tree-sparse factorisation reads).
     fn factor_mass(&mut self, c: f64) -> Result<(), SimError> {
         if self.mass.f.is_tree() {
-            crba_upper(&self.model, &mut self.data, &self.q);
+            crba_upper(&self.model, &mut self.data, &self.q)?;
         } else {
-            mass_matrix(&self.model, &mut self.data, &self.q);
+            mass_matrix(&self.model, &mut self.data, &self.q)?;
         }
         for k in 0..self.model.nv {
             self.data.h[(k, k)] += self.armature[k] + c * self.damping[k];

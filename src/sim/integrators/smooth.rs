@@ -48,8 +48,8 @@ impl Simulation {
         if self.has_armature {
             // (H + A) v̇ = τ − C by a dense factorisation
             let d = &mut w.data;
-            bias(model, d, &w.qn, &w.vv, None);
-            mass_matrix(model, d, &w.qn);
+            bias(model, d, &w.qn, &w.vv, None)?;
+            mass_matrix(model, d, &w.qn)?;
             for k in 0..nv {
                 d.h[(k, k)] += self.armature[k];
                 d.qdd[k] = w.tau[k] - d.bias[k];
