@@ -124,6 +124,8 @@ fn wrong_lengths_are_errors_at_every_entry_point() {
             let mut sim = Simulation::new(m.clone(), SimOptions { ground: None, ..Default::default() }).unwrap();
             assert!(sim.set_state(&qb, &z).is_err());
             assert!(sim.set_state(&q, &vb).is_err());
+            assert!(sim.set_torques(&vb).is_err());
+            assert!(sim.torques().len() == nv);
         }
         // the right sizes pass, and a frame id past the end is an error, not zeros
         dynamics::rnea(&m, &mut d, &q, &z, &z, Some(&fx)).unwrap();

@@ -1,25 +1,7 @@
-use super::{check_sizes, DynamicsError};
+use super::{center_of_mass, check_sizes, DynamicsError};
 use crate::model::{Data, Model};
 use crate::spatial::{Force, Scalar};
 use nalgebra::{DVector, Vector3};
-
-/// The centre of mass of the moving bodies in the world frame,
-/// `c = Σ mᵢ ⁰Xᵢ cᵢ / Σ mᵢ`, from `data.o_m_i` (call forward kinematics first).
-/// Returns the origin for a massless model.
-pub fn center_of_mass<T: Scalar>(model: &Model<T>, data: &Data<T>) -> Vector3<T> {
-    let mut mc = Vector3::zeros();
-    let mut m = T::zero();
-    for i in 1..model.nbodies {
-        let inertia = &model.inertias[i];
-        mc += data.o_m_i[i].act_point(&inertia.com) * inertia.mass;
-        m += inertia.mass;
-    }
-    if m > T::zero() {
-        mc / m
-    } else {
-        Vector3::zeros()
-    }
-}
 
 /// The centroidal momentum `h_G = [k_G; M ċ]`: the total spatial momentum
 /// `Σ ⁰X*ᵢ Îᵢ v̂ᵢ` expressed at the centre of mass with world-aligned axes

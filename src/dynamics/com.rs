@@ -1,23 +1,40 @@
 use super::DynamicsError;
 use crate::model::{DimensionError, Data, Model};
-use crate::spatial::Scalar;
+use crate::spatial::{Inertia, Scalar};
 use nalgebra::{DMatrix, Vector3};
+
+/// The centre of mass of the moving bodies in the world frame,
+/// `c = Σ mᵢ ⁰Xᵢ cᵢ / Σ mᵢ` (docs/theory.md §"Centre of mass"), from `data.o_m_i`
+/// (call forward kinematics first). Returns the origin for a massless model.
+pub fn center_of_mass<T: Scalar>(model: &Model<T>, data: &Data<T>) -> Vector3<T> {
+    mass_weighted_mean(model, |i, inertia| data.o_m_i[i].act_point(&inertia.com))
+}
 
 /// The velocity of the centre of mass of the bodies that move (world axes),
 /// `ċ = Σ mᵢ ⁰Rᵢ (vᵢ + ωᵢ × cᵢ) / Σ mᵢ` (docs/theory.md §"Centre of mass
 /// Jacobian"; it is `J_c v`). Reads `data.o_m_i` and `data.v`
 /// ([`super::forward_kinematics_second_order`] first). Zero for a massless model.
 pub fn center_of_mass_velocity<T: Scalar>(model: &Model<T>, data: &Data<T>) -> Vector3<T> {
-    let mut mv = Vector3::zeros();
+    mass_weighted_mean(model, |i, inertia| {
+        let v = &data.v[i];
+        data.o_m_i[i].rot * (v.lin + v.ang.cross(&inertia.com))
+    })
+}
+
+/// `Σ mᵢ xᵢ / Σ mᵢ` over the bodies that move, `xᵢ = x(i, Iᵢ)` (zero if massless).
+fn mass_weighted_mean<T: Scalar>(
+    model: &Model<T>,
+    x: impl Fn(usize, &Inertia<T>) -> Vector3<T>,
+) -> Vector3<T> {
+    let mut mx = Vector3::zeros();
     let mut m = T::zero();
     for i in 1..model.nbodies {
         let inertia = &model.inertias[i];
-        let v = &data.v[i];
-        mv += data.o_m_i[i].rot * (v.lin + v.ang.cross(&inertia.com)) * inertia.mass;
+        mx += x(i, inertia) * inertia.mass;
         m += inertia.mass;
     }
     if m > T::zero() {
-        mv / m
+        mx / m
     } else {
         Vector3::zeros()
     }

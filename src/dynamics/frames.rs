@@ -1,7 +1,7 @@
 use super::jacobian::frame_pose;
 use super::{check_sizes, DynamicsError, Reference};
 use crate::model::{Data, FrameId, Model};
-use crate::spatial::{Motion, Scalar};
+use crate::spatial::{Motion, Scalar, Se3};
 use nalgebra::DVector;
 
 /// Forward kinematics to second order (Pinocchio's `forwardKinematics(q, v, a)`):
@@ -44,9 +44,9 @@ pub fn frame_velocity<T: Scalar>(
     frame: FrameId,
     reference: Reference,
 ) -> Result<Motion<T>, DynamicsError> {
-    let (body, o_m_f) = frame_pose(model, data, frame)?;
-    let local = model.frames[frame.0].placement.inv_act_motion(&data.v[body]);
-    Ok(express(local, &o_m_f.rot, reference))
+    in_frame(model, data, frame, reference, |f_x_i, body| {
+        f_x_i.inv_act_motion(&data.v[body])
+    })
 }
 
 /// The classical acceleration of a link frame (docs/theory.md §"Classical
@@ -61,12 +61,26 @@ pub fn frame_classical_acceleration<T: Scalar>(
     frame: FrameId,
     reference: Reference,
 ) -> Result<Motion<T>, DynamicsError> {
+    in_frame(model, data, frame, reference, |f_x_i, body| {
+        let v = f_x_i.inv_act_motion(&data.v[body]);
+        let mut acc = f_x_i.inv_act_motion(&data.a[body]);
+        acc.lin += v.ang.cross(&v.lin);
+        acc
+    })
+}
+
+/// A motion of a link frame: `local(ⁱM_f, body)` gives it in the frame's axes,
+/// re-expressed in world axes when asked.
+fn in_frame<T: Scalar>(
+    model: &Model<T>,
+    data: &Data<T>,
+    frame: FrameId,
+    reference: Reference,
+    local: impl FnOnce(&Se3<T>, usize) -> Motion<T>,
+) -> Result<Motion<T>, DynamicsError> {
     let (body, o_m_f) = frame_pose(model, data, frame)?;
-    let placement = &model.frames[frame.0].placement;
-    let v = placement.inv_act_motion(&data.v[body]);
-    let mut acc = placement.inv_act_motion(&data.a[body]);
-    acc.lin += v.ang.cross(&v.lin);
-    Ok(express(acc, &o_m_f.rot, reference))
+    let m = local(&model.frames[frame.0].placement, body);
+    Ok(express(m, &o_m_f.rot, reference))
 }
 
 /// A motion given in a frame's axes, re-expressed in world axes when asked.

@@ -20,8 +20,8 @@ pub mod ltdl;
 mod rnea;
 
 pub use aba::aba;
-pub use centroidal::{center_of_mass, centroidal_momentum};
-pub use com::{center_of_mass_jacobian, center_of_mass_velocity};
+pub use centroidal::centroidal_momentum;
+pub use com::{center_of_mass, center_of_mass_jacobian, center_of_mass_velocity};
 pub use external::add_link_wrench;
 pub use frames::{frame_classical_acceleration, frame_velocity, forward_kinematics_second_order};
 pub use crba::{crba, crba_upper, CompositeInertia};
@@ -58,22 +58,41 @@ use crate::spatial::{Force, Scalar};
 use nalgebra::DVector;
 
 /// The sizes every entry point checks, in O(1): `q` has nq entries, each of `vs`
-/// nv, `fext` (if given) nbodies.
-#[inline]
+/// nv, `fext` (if given) nbodies. The test is a few compares inline; the error is
+/// built out of line ([`size_error`]), so the algorithms' hot code is unchanged.
+#[inline(always)]
 pub(crate) fn check_sizes<T: Scalar>(
     model: &Model<T>,
     q: &DVector<T>,
     vs: &[(&'static str, &DVector<T>)],
     fext: Option<&[Force<T>]>,
 ) -> Result<(), DimensionError> {
-    DimensionError::check("q", model.nq, q.len())?;
-    for (name, x) in vs {
-        DimensionError::check(name, model.nv, x.len())?;
+    let ok = q.len() == model.nq
+        && vs.iter().all(|(_, x)| x.len() == model.nv)
+        && fext.is_none_or(|f| f.len() == model.nbodies);
+    if ok {
+        Ok(())
+    } else {
+        Err(size_error(model, q.len(), &vs.iter().map(|(n, x)| (*n, x.len())).collect::<Vec<_>>(), fext.map(<[_]>::len)))
     }
-    if let Some(f) = fext {
-        DimensionError::check("fext", model.nbodies, f.len())?;
-    }
-    Ok(())
+}
+
+/// The error of [`check_sizes`]: the first argument of the wrong size.
+#[cold]
+#[inline(never)]
+fn size_error<T: Scalar>(
+    model: &Model<T>,
+    q: usize,
+    vs: &[(&'static str, usize)],
+    fext: Option<usize>,
+) -> DimensionError {
+    let mut checks = vec![("q", model.nq, q)];
+    checks.extend(vs.iter().map(|&(n, len)| (n, model.nv, len)));
+    checks.extend(fext.map(|len| ("fext", model.nbodies, len)));
+    checks
+        .into_iter()
+        .find_map(|(arg, expected, got)| DimensionError::check(arg, expected, got).err())
+        .unwrap_or(DimensionError { arg: "q", expected: model.nq, got: q })
 }
 
 /// Forward dynamics is undefined where a moving joint carries no mass (H is

@@ -603,6 +603,19 @@ impl Simulation {
     pub fn torques(&self) -> &DVector<f64> {
         &self.tau_applied
     }
+    /// Sets the applied generalized forces (as [`Simulation::torques_mut`]), their
+    /// length (nv) and finiteness checked: a wrong length is an error, nothing set.
+    pub fn set_torques(&mut self, tau: &DVector<f64>) -> Result<(), SimError> {
+        if tau.len() != self.model.nv || !tau.iter().all(|x| x.is_finite()) {
+            return Err(SimError::Invalid(format!(
+                "torques of size {} (the model needs nv = {}), finite",
+                tau.len(),
+                self.model.nv
+            )));
+        }
+        self.torques_mut().copy_from(tau);
+        Ok(())
+    }
     /// Whether this simulation has ground contact.
     pub fn has_contact(&self) -> bool {
         self.contact.is_some()
