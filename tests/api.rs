@@ -135,6 +135,15 @@ fn wrong_lengths_are_errors_at_every_entry_point() {
             dynamics::frame_jacobian(&m, &d, bad, Reference::WorldAligned, &mut j),
             Err(DynamicsError::Name(NameError::OutOfRange { .. }))
         ));
+        assert!(dynamics::frame_placement(&m, &d, bad).is_err());
+        // frame_placement reads one frame as update_frames writes them all
+        dynamics::forward_kinematics(&m, &mut d, &m.neutral()).unwrap();
+        dynamics::update_frames(&m, &mut d);
+        for k in 0..m.frames.len() {
+            let p = dynamics::frame_placement(&m, &d, FrameId(k)).unwrap();
+            assert!((p.rot - d.o_m_f[k].rot).amax() < 1e-15);
+            assert!((p.trans - d.o_m_f[k].trans).amax() < 1e-15);
+        }
         assert!(dynamics::frame_velocity(&m, &d, bad, Reference::Local).is_err());
         assert!(dynamics::frame_classical_acceleration(&m, &d, bad, Reference::Local).is_err());
     }

@@ -1,4 +1,4 @@
-use super::jacobian::frame_pose;
+use super::kinematics::frame_pose;
 use super::DynamicsError;
 use crate::model::{Data, DimensionError, FrameId, Model};
 use crate::spatial::{Force, Scalar};

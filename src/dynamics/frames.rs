@@ -1,4 +1,4 @@
-use super::jacobian::frame_pose;
+use super::kinematics::frame_pose;
 use super::{check_sizes, DynamicsError, Reference};
 use crate::model::{Data, FrameId, Model};
 use crate::spatial::{Motion, Scalar, Se3};

@@ -1,6 +1,7 @@
+use super::kinematics::frame_pose;
 use super::DynamicsError;
-use crate::model::{Data, DimensionError, FrameId, Model, NameError};
-use crate::spatial::{Scalar, Se3};
+use crate::model::{Data, DimensionError, FrameId, Model};
+use crate::spatial::Scalar;
 use nalgebra::{DMatrix, Vector3};
 
 /// The coordinates a frame quantity (Jacobian, velocity, acceleration) is given in:
@@ -15,21 +16,6 @@ pub enum Reference {
     /// The frame's own axes at its origin (Pinocchio's `LOCAL`; the eval
     /// contract's `jacobian_local`).
     Local,
-}
-
-/// The world pose `⁰M_f` of a link frame from `data.o_m_i`, or the error for an id
-/// the model does not have.
-pub(crate) fn frame_pose<T: Scalar>(
-    model: &Model<T>,
-    data: &Data<T>,
-    frame: FrameId,
-) -> Result<(usize, Se3<T>), DynamicsError> {
-    let f = model.frames.get(frame.0).ok_or(NameError::OutOfRange {
-        kind: "frame",
-        id: frame.0,
-        len: model.frames.len(),
-    })?;
-    Ok((f.body, data.o_m_i[f.body].compose(&f.placement)))
 }
 
 /// The Jacobian of a link frame: `J v` is the frame's `[linear velocity of its
@@ -50,12 +36,12 @@ pub(crate) fn frame_pose<T: Scalar>(
 /// let mut data = urdyn::Data::new(&model);
 /// let q = model.neutral();
 /// forward_kinematics(&model, &mut data, &q).unwrap();
-/// let tip = model.frame_id("link2").unwrap();
+/// let tip = model.frame_id("lower").unwrap();
 /// let mut j = DMatrix::zeros(6, model.nv);
 /// frame_jacobian(&model, &data, tip, Reference::WorldAligned, &mut j).unwrap();
 /// // a misspelt link is an error naming the nearest one
-/// let err = model.frame_id("lnk2").unwrap_err();
-/// assert!(err.to_string().contains("\"link2\""));
+/// let err = model.frame_id("lowr").unwrap_err();
+/// assert!(err.to_string().contains("(nearest: \"lower\")"));
 /// ```
 pub fn frame_jacobian<T: Scalar>(
     model: &Model<T>,

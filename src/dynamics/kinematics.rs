@@ -1,4 +1,4 @@
-use crate::model::{dispatch_joint, Data, JointModel, Model};
+use crate::model::{dispatch_joint, Data, FrameId, JointModel, Model, NameError};
 use crate::spatial::{Scalar, Se3};
 use nalgebra::DVector;
 
@@ -51,3 +51,29 @@ pub fn update_frames<T: Scalar>(model: &Model<T>, data: &mut Data<T>) {
         };
     }
 }
+
+/// The world pose `⁰M_f = ⁰Mᵢ ⁱM_f` of one URDF link frame, from `data.o_m_i` (call
+/// [`forward_kinematics`] first); an id the model does not have is an error.
+pub fn frame_placement<T: Scalar>(
+    model: &Model<T>,
+    data: &Data<T>,
+    frame: FrameId,
+) -> Result<Se3<T>, super::DynamicsError> {
+    frame_pose(model, data, frame).map(|(_, m)| m)
+}
+
+/// The body of a link frame and its world pose `⁰M_f` from `data.o_m_i`, or the
+/// error for an id the model does not have.
+pub(crate) fn frame_pose<T: Scalar>(
+    model: &Model<T>,
+    data: &Data<T>,
+    frame: FrameId,
+) -> Result<(usize, Se3<T>), super::DynamicsError> {
+    let f = model.frames.get(frame.0).ok_or(NameError::OutOfRange {
+        kind: "frame",
+        id: frame.0,
+        len: model.frames.len(),
+    })?;
+    Ok((f.body, data.o_m_i[f.body].compose(&f.placement)))
+}
+

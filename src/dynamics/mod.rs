@@ -29,7 +29,7 @@ pub use crba::{crba, crba_upper, CompositeInertia};
 pub use energy::{energies, kinetic_energy, kinetic_energy_from_placements, potential_energy};
 pub use forward_rnea::{forward_dynamics_rnea, mass_matrix_rnea};
 pub use jacobian::{frame_jacobian, Reference};
-pub use kinematics::{forward_kinematics, update_frames};
+pub use kinematics::{forward_kinematics, frame_placement, update_frames};
 pub(crate) use kinematics::forward_kinematics_pass;
 pub use rnea::{bias, rnea};
 
