@@ -233,7 +233,7 @@ pub fn crba_upper<'d, T: Scalar>(
 
 /// The variant of the model (mimic, local frames, world frame); `mirror`: fill
 /// the lower triangle too (only the world-frame variant leaves it out).
-fn crba_dispatch<'d, T: Scalar>(
+pub(crate) fn crba_dispatch<'d, T: Scalar>(
     model: &Model<T>,
     data: &'d mut Data<T>,
     q: &DVector<T>,

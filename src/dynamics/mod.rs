@@ -130,13 +130,10 @@ pub fn forward_dynamics_crba<'d, T: Scalar>(
 ) -> Result<&'d DVector<T>, DynamicsError> {
     check_sizes(model, q, &[("v", v), ("tau", tau)], fext)?;
     check_massless(model)?;
-    bias(model, data, q, v, fext)?;
-    if model.has_mimic {
-        crba(model, data, q)?;
-    } else {
-        // LTDL reads H's upper triangle only
-        crba_upper(model, data, q)?;
-    }
+    // sizes checked above: the unchecked passes
+    rnea::bias_pass(model, data, q, v, fext);
+    // LTDL reads H's upper triangle only (mirrored for the dense Cholesky)
+    crba::crba_dispatch(model, data, q, model.has_mimic);
     data.qdd.copy_from(tau);
     data.qdd -= &data.bias;
     if model.has_mimic {

@@ -33,9 +33,20 @@ pub fn bias<'d, T: Scalar>(
     fext: Option<&[Force<T>]>,
 ) -> Result<&'d DVector<T>, DynamicsError> {
     check_sizes(model, q, &[("v", v)], fext)?;
+    bias_pass(model, data, q, v, fext);
+    Ok(&data.bias)
+}
+
+/// [`bias`] for callers that checked the sizes already.
+pub(crate) fn bias_pass<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+    fext: Option<&[Force<T>]>,
+) {
     rnea_impl(model, data, q, Some(v), None, true, fext);
     data.bias.copy_from(&data.tau);
-    Ok(&data.bias)
 }
 
 /// The one RNEA pass behind every entry point. `v = None` means q̇ = 0, `a = None`
@@ -49,27 +60,53 @@ pub(crate) fn rnea_impl<T: Scalar>(
     gravity: bool,
     fext: Option<&[Force<T>]>,
 ) {
-    let q = q.as_slice();
-    // Monomorphised on which of q̇, q̈ are present (no per-body test).
-    match (v, a) {
-        (Some(v), Some(a)) => {
-            rnea_pass::<T, true, true>(model, data, q, v.as_slice(), a.as_slice(), gravity, fext)
-        }
-        (Some(v), None) => {
-            rnea_pass::<T, true, false>(model, data, q, v.as_slice(), &[], gravity, fext)
-        }
-        (None, Some(a)) => {
-            rnea_pass::<T, false, true>(model, data, q, &[], a.as_slice(), gravity, fext)
-        }
-        (None, None) => rnea_pass::<T, false, false>(model, data, q, &[], &[], gravity, fext),
+    // Monomorphised on whether external forces are given: the pass without them
+    // carries no per-body test and no world poses.
+    match fext {
+        Some(_) => rnea_variant::<T, true>(model, data, q, v, a, gravity, fext),
+        None => rnea_variant::<T, false>(model, data, q, v, a, gravity, None),
     }
 }
 
-/// [`rnea_impl`] with q̇ present iff `V` and q̈ present iff `A`. The joint kind of
+/// [`rnea_impl`] with external forces present iff `F`.
+#[inline(always)]
+fn rnea_variant<T: Scalar, const F: bool>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: Option<&DVector<T>>,
+    a: Option<&DVector<T>>,
+    gravity: bool,
+    fext: Option<&[Force<T>]>,
+) {
+    let q = q.as_slice();
+    // Monomorphised on which of q̇, q̈ are present (no per-body test).
+    match (v, a) {
+        (Some(v), Some(a)) => rnea_pass::<T, true, true, F>(
+            model,
+            data,
+            q,
+            v.as_slice(),
+            a.as_slice(),
+            gravity,
+            fext,
+        ),
+        (Some(v), None) => {
+            rnea_pass::<T, true, false, F>(model, data, q, v.as_slice(), &[], gravity, fext)
+        }
+        (None, Some(a)) => {
+            rnea_pass::<T, false, true, F>(model, data, q, &[], a.as_slice(), gravity, fext)
+        }
+        (None, None) => rnea_pass::<T, false, false, F>(model, data, q, &[], &[], gravity, fext),
+    }
+}
+
+/// [`rnea_impl`] with q̇ present iff `V`, q̈ present iff `A` and external forces
+/// read iff `F`. The joint kind of
 /// each body is matched once per sweep ([`dispatch_joint!`]); the body step is then
 /// compiled per joint model, with the axis and transform shape known.
 #[inline(always)]
-fn rnea_pass<T: Scalar, const V: bool, const A: bool>(
+fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool>(
     model: &Model<T>,
     data: &mut Data<T>,
     q: &[T],
@@ -128,7 +165,7 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool>(
         if V {
             fi += vi.cross_force(&inertia.mul_motion(&vi));
         }
-        if let Some(fext) = fext {
+        if let (true, Some(fext)) = (F, fext) {
             let o_m = o_m_i[p].compose(&li);
             o_m_i[i] = o_m;
             if let Some(fx) = fext.get(i) {
