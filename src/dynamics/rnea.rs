@@ -62,41 +62,29 @@ pub(crate) fn rnea_impl<T: Scalar>(
 ) {
     // Monomorphised on whether external forces are given: the pass without them
     // carries no per-body test and no world poses.
+    let (q, v, a) = (q.as_slice(), v.map(|x| x.as_slice()), a.map(|x| x.as_slice()));
     match fext {
         Some(_) => rnea_variant::<T, true>(model, data, q, v, a, gravity, fext),
         None => rnea_variant::<T, false>(model, data, q, v, a, gravity, None),
     }
 }
 
-/// [`rnea_impl`] with external forces present iff `F`.
+/// [`rnea_impl`] on slices, with external forces present iff `F`.
 #[inline(always)]
 fn rnea_variant<T: Scalar, const F: bool>(
     model: &Model<T>,
     data: &mut Data<T>,
-    q: &DVector<T>,
-    v: Option<&DVector<T>>,
-    a: Option<&DVector<T>>,
+    q: &[T],
+    v: Option<&[T]>,
+    a: Option<&[T]>,
     gravity: bool,
     fext: Option<&[Force<T>]>,
 ) {
-    let q = q.as_slice();
     // Monomorphised on which of q̇, q̈ are present (no per-body test).
     match (v, a) {
-        (Some(v), Some(a)) => rnea_pass::<T, true, true, F>(
-            model,
-            data,
-            q,
-            v.as_slice(),
-            a.as_slice(),
-            gravity,
-            fext,
-        ),
-        (Some(v), None) => {
-            rnea_pass::<T, true, false, F>(model, data, q, v.as_slice(), &[], gravity, fext)
-        }
-        (None, Some(a)) => {
-            rnea_pass::<T, false, true, F>(model, data, q, &[], a.as_slice(), gravity, fext)
-        }
+        (Some(v), Some(a)) => rnea_pass::<T, true, true, F>(model, data, q, v, a, gravity, fext),
+        (Some(v), None) => rnea_pass::<T, true, false, F>(model, data, q, v, &[], gravity, fext),
+        (None, Some(a)) => rnea_pass::<T, false, true, F>(model, data, q, &[], a, gravity, fext),
         (None, None) => rnea_pass::<T, false, false, F>(model, data, q, &[], &[], gravity, fext),
     }
 }
