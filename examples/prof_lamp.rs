@@ -65,9 +65,12 @@ fn main() {
         );
     }
     let mut hist = [0u64; 8];
+    let mut tsum = [0f64; 8];
     let mut prev = 0;
     while sim.time() < dur {
+        let t0 = std::time::Instant::now();
         sim.step_until(dur).expect("step");
+        let el = t0.elapsed().as_secs_f64();
         let sw = sim.pgs_sweeps - prev;
         prev = sim.pgs_sweeps;
         let b = match sw {
@@ -81,7 +84,9 @@ fn main() {
             _ => 7,
         };
         hist[b] += 1;
+        tsum[b] += el;
     }
+    println!("time per bucket (ms): {:?}", tsum.iter().map(|x| (x * 1e5).round() / 100.0).collect::<Vec<_>>());
     println!("sweeps per step [0, 1, 2-3, 4-7, 8-15, 16-31, 32-59, 60+]: {hist:?}");
     println!(
         "mean sweeps/step {:.2}, rows/step {:.1}, queries {}",
