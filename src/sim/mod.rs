@@ -263,6 +263,10 @@ struct EnergyGuard {
 ///     sim.step().unwrap();
 /// }
 /// ```
+///
+/// A `Simulation` clones (model, contact shapes and workspace included): a batch
+/// of runs builds its meshes' hulls once and clones the prototype.
+#[derive(Clone, Debug)]
 pub struct Simulation {
     pub model: Model,
     integrator: Integrator,
