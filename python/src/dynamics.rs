@@ -35,7 +35,11 @@ fn dyn_error(model: &PyModel, e: DynamicsError) -> PyErr {
                 .model
                 .joints
                 .iter()
-                .position(|j| j.mult != 1.0 || j.offset != 0.0)
+                .enumerate()
+                .skip(1)
+                // a mimic joint shares its leader's velocity coordinate
+                .find(|&(b, j)| model.model.joints[1..b].iter().any(|o| o.iv == j.iv))
+                .map(|(b, _)| b)
                 .and_then(|b| model.model.body_joint_names.get(b).cloned())
                 .unwrap_or_default();
             value_error(format!(
