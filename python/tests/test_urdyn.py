@@ -334,3 +334,30 @@ def test_gil_is_released_during_a_rollout():
     during = [x for x in ticks if start < x < end]
     assert end - start > 0.05, "rollout too short to tell"
     assert len(during) >= 5, f"the other thread ran {len(during)} times in {end - start:.3f} s"
+
+
+def test_ray_example_equals_local_rollout():
+    ray = pytest.importorskip("ray", reason="ray not installed (pip install ray)")
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("ray_rollouts", ROOT / "python" / "examples" / "ray_rollouts.py")
+    ex = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ex)
+    ray.init(num_cpus=2, include_dashboard=False, ignore_reinit_error=True)
+    try:
+        model = urdyn.Model.from_urdf(UR5)
+        q0, v0 = ex.initial_states(model, 6)
+        q, v = ex.rollouts_on_ray(model, q0, v0, nstep=200, batches=2, ground=None)
+        lq, lv = urdyn.rollout(model, q0, v0, nstep=200, ground=None)
+        assert np.array_equal(q, lq) and np.array_equal(v, lv)
+    finally:
+        ray.shutdown()
+
+
+def test_readme_python_blocks_run(monkeypatch):
+    text = (ROOT / "README.md").read_text()
+    blocks = [b.split("```", 1)[0] for b in text.split("```python\n")[1:]]
+    assert len(blocks) >= 2
+    monkeypatch.chdir(ROOT)
+    for code in blocks:
+        exec(compile(code, "README.md", "exec"), {})
