@@ -23,6 +23,9 @@ fn setup(tol: Option<f64>) -> Simulation {
     if let Some(n) = std::env::var("ITERS").ok().and_then(|s| s.parse().ok()) {
         o.solver_iterations = n;
     }
+    if let Some(sv) = std::env::var("SOLVER").ok().and_then(|s| urdyn::sim::Solver::from_name(&s)) {
+        o.solver = sv;
+    }
     if let Some(w) = std::env::var("RELAX").ok().and_then(|s| s.parse().ok()) {
         o.solver_relaxation = w;
     }
