@@ -39,9 +39,11 @@ def run(robot, rel, share, solver):
     out = subprocess.run([os.path.join(ROOT, "target/release/examples/prof_lamp"), "3", "1e-6", "3"],
                          env=env, cwd=ROOT, capture_output=True, text=True, timeout=900)
     if out.returncode != 0:
-        raise RuntimeError(f"{robot} {solver}: {out.stderr.strip().splitlines()[-1:]}")
+        m = re.search(r"step: (\w+ \{[^}]*\})", out.stderr)
+        return {"us": float("inf"), "failed": m.group(1) if m else out.stderr.strip()[-200:]}
     t = out.stdout
-    g = lambda pat: float(re.search(pat, t).group(1))  # noqa: E731
+    def g(pat):
+        return float(re.search(pat, t).group(1))
     return {"us": g(r"([0-9.]+) us/step"), "iters": g(r"mean sweeps/step ([0-9.]+)"),
             "pen": g(r"penetration ([0-9.e+-]+) m"), "vmax": g(r"max \|v\| ([0-9.e+-]+)"),
             "energy": g(r"energy ([0-9.e+-]+) J")}
@@ -60,7 +62,7 @@ def main():
             for solver in ("pgs", "newton"):
                 r = run(robot, rel, a.share, solver)
                 k = (robot, solver)
-                if k not in best or r["us"] < best[k]["us"]:
+                if k not in best or r["us"] < best[k]["us"] or "failed" in r:
                     best[k] = r
                 print(robot, solver, r, flush=True)
     lines = ["# Constraint solver: projected Gauss–Seidel against primal Newton (benches/solver_compare.py)", "",
@@ -71,6 +73,11 @@ def main():
              "|---|---|---|---|---|---|---|---|"]
     for robot in ROBOTS:
         p, n = best[(robot, "pgs")], best[(robot, "newton")]
+        if "failed" in p or "failed" in n:
+            bad = p if "failed" in p else n
+            lines.append(f"| {robot} | {p.get('us', 0):.2f} | failed | – | {p.get('iters', 0):.2f} | – | "
+                         f"{p.get('pen', 0):.1e} / {p.get('vmax', 0):.1e} | {bad['failed']} |")
+            continue
         lines.append(f"| {robot} | {p['us']:.2f} | {n['us']:.2f} | {n['us'] / p['us']:.2f} | {p['iters']:.2f} | "
                      f"{n['iters']:.2f} | {p['pen']:.1e} / {p['vmax']:.1e} | {n['pen']:.1e} / {n['vmax']:.1e} |")
     with open(a.md, "w") as f:

@@ -337,9 +337,11 @@ impl Constraints {
             Solver::Pgs => rows.solve(f, self.dv.as_mut_slice(), iterations, tol, relaxation),
             Solver::Newton => self.newton.solve(rows, f, self.dv.as_mut_slice(), iterations, tol),
         };
-        if solver == Solver::Pgs && sweeps >= iterations {
+        if sweeps >= iterations {
+            // (a Newton solve stopped by the cap is scaled, never swept)
+            let more = if solver == Solver::Pgs { iterations } else { 0 };
             f.apply_r(vfree.as_slice(), &mut self.a);
-            sweeps += energy_safe_exit(rows, f, &self.a, self.dv.as_mut_slice(), iterations, tol);
+            sweeps += energy_safe_exit(rows, f, &self.a, self.dv.as_mut_slice(), more, tol);
         }
         // Δv = R⁻¹ Δv'
         f.half_solve(self.dv.as_mut_slice());
