@@ -65,6 +65,17 @@ impl<'j, T: Scalar> JointModel<T> for FreeJ<'j, T> {
         }
     }
     #[inline(always)]
+    fn subspace(&self, c: usize) -> Motion<T> {
+        // Linear coordinates first.
+        let mut m = Motion::zero();
+        if c < 3 {
+            m.lin[c] = T::one();
+        } else {
+            m.ang[c - 3] = T::one();
+        }
+        m
+    }
+    #[inline(always)]
     fn subspace_in(&self, c: usize, m: &Se3<T>) -> Motion<T> {
         if c < 3 {
             Motion::new(Vector3::zeros(), m.rot.column(c).into())

@@ -59,6 +59,7 @@ impl<T: Scalar> Joint<T> {
     // hot loops use), so each exists once, in revolute.rs, prismatic.rs, free.rs.
 
     /// Number of velocity coordinates this joint moves (1, or 6 for a free joint).
+    #[inline(always)]
     pub fn nv(&self) -> usize {
         dispatch_joint!(self, false, jm => jm.nv())
     }
@@ -80,7 +81,7 @@ impl<T: Scalar> Joint<T> {
     /// (`mult` included).
     #[inline(always)]
     pub fn subspace_column(&self, k: usize) -> Motion<T> {
-        dispatch_joint!(self, false, jm => jm.subspace_in(k, &Se3::identity()))
+        dispatch_joint!(self, false, jm => jm.subspace(k))
     }
     /// `Sᵀ f` for velocity coordinate `k` of this joint (`mult` included),
     /// docs/theory.md §"Joint-force projection".
@@ -143,7 +144,10 @@ pub(crate) trait JointModel<T: Scalar>: Copy {
     fn project_add(&self, f: &Force<T>, tau: &mut [T]);
     /// `Sᵀ f` for velocity coordinate `c` of this joint.
     fn project_column(&self, c: usize, f: &Force<T>) -> T;
-    /// Column `c` of the motion subspace in frame a given `aMi`.
+    /// Column `c` of the motion subspace `S` in the body frame (`mult` included).
+    fn subspace(&self, c: usize) -> Motion<T>;
+    /// Column `c` of the motion subspace in frame a given `aMi`: `ᵃX̂ᵢ Sₖ`
+    /// (docs/theory.md §"Plücker transforms").
     fn subspace_in(&self, c: usize, m: &Se3<T>) -> Motion<T>;
     /// `Î S` for column `c` of the motion subspace (a column of the 6x6 inertia
     /// for an axis-aligned joint).

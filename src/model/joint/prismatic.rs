@@ -42,6 +42,10 @@ impl<'j, T: Scalar, A: AxisOf<T>> JointModel<T> for PrismaticJ<'j, T, A> {
         self.j.mult * self.ax.get().dot(&f.lin)
     }
     #[inline(always)]
+    fn subspace(&self, _c: usize) -> Motion<T> {
+        Motion::new(Vector3::zeros(), self.ax.get().vector() * self.j.mult)
+    }
+    #[inline(always)]
     fn subspace_in(&self, _c: usize, m: &Se3<T>) -> Motion<T> {
         Motion::new(
             Vector3::zeros(),

@@ -62,6 +62,10 @@ impl<'j, T: Scalar, A: AxisOf<T>, const AXROT: bool> JointModel<T> for RevoluteJ
         self.j.mult * self.ax.get().dot(&f.ang)
     }
     #[inline(always)]
+    fn subspace(&self, _c: usize) -> Motion<T> {
+        Motion::new(self.ax.get().vector() * self.j.mult, Vector3::zeros())
+    }
+    #[inline(always)]
     fn subspace_in(&self, _c: usize, m: &Se3<T>) -> Motion<T> {
         let w = self.ax.get().mat_mul(&m.rot) * self.j.mult;
         Motion::new(w, m.trans.cross(&w))
