@@ -89,7 +89,14 @@ pub struct ImportReport {
     pub merged: Vec<(String, String)>,
     /// The kinematic tree, one line a link, indented by depth.
     pub tree: Vec<String>,
+    /// What the import skipped on purpose because no dynamics reads it
+    /// (`<gazebo>`, `<transmission>`, `<sensor>`, xacro leftovers, `<calibration>`, ...).
     pub ignored: Vec<String>,
+    /// Suspicious but usable input, one line each, naming the element: inertias
+    /// that are not positive semi-definite (loaded as written) or not physical,
+    /// massless subtrees, unknown limits, attributes and elements outside the URDF
+    /// specification, malformed visuals and materials. `urdyn inspect --strict`
+    /// makes the first one an error.
     pub warnings: Vec<String>,
 }
 
