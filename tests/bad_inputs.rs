@@ -166,6 +166,13 @@ const BAD_URDF: &[(&str, &[&str])] = &[
     ),
     ("nan_inertia.urdf", &["link \"l1\" <inertial>", "<inertia>"]),
     (
+        "malformed_collision.urdf",
+        &[
+            "link \"l1\" <collision> <geometry> <box>",
+            "size=\"1 2\" is not 3 numbers",
+        ],
+    ),
+    (
         "inf_inertial_origin.urdf",
         &["link \"l1\" <inertial>", "<origin>"],
     ),

@@ -79,6 +79,8 @@ files["malformed_visual.urdf"] = robot('  <material name="red"><color rgba="1 0 
     + link("l1") + joint("j1","base","l1")
     + '  <gazebo reference="l1"><mu1>0.2</mu1><anything at="all"><deep/></anything></gazebo>\n'
     + '  <transmission name="t1"><type>SimpleTransmission</type><joint name="j1"><hardwareInterface>x</hardwareInterface></joint></transmission>\n')
+# The same defect in a <collision> (read by contact) stays an error.
+files["malformed_collision.urdf"] = robot(link("base") + '  <link name="l1">' + inertial() + '<collision><geometry><box size="1 2"/></geometry></collision></link>\n' + joint("j1","base","l1"))
 files["no_limit.urdf"] = robot(link("base") + link("l1") + link("l2") + joint("j1","base","l1", limit=None) + joint("j2","l1","l2", t="prismatic", limit=None))
 files["massless_joint.urdf"] = robot(link("base") + link("l1") + link("tip", inertial(m="0", ixx="0", iyy="0", izz="0")) + joint("j1","base","l1") + joint("wrist","l1","tip", axis="1 0 0"))
 files["massless_joint_nointertial.urdf"] = robot(link("base") + link("l1") + '  <link name="tip"/>\n' + joint("j1","base","l1") + joint("wrist","l1","tip", axis="1 0 0"))
