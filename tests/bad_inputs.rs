@@ -514,7 +514,20 @@ fn unknown_attribute_is_named_and_ignored() {
 /// `<transmission>` contents are not looked into.
 #[test]
 fn visual_only_problems_never_stop_a_load() {
+    // ... nor do `version`, `xmlns:xacro`, a xacro leftover or PyBullet's <contact>:
+    // they are listed as ignored.
     assert_eq!(inspect_warnings("texture_no_filename.urdf").trim(), "none");
+    let r = run(&["inspect", "texture_no_filename.urdf"]);
+    for ignored in [
+        "<xacro:property> elements (xacro leftovers, not expanded)",
+        "<link> <contact> elements (PyBullet extension, not used by dynamics)",
+    ] {
+        assert!(
+            r.stdout.contains(ignored),
+            "{ignored:?} not in\n{}",
+            r.stdout
+        );
+    }
     let r = run(&["inspect", "malformed_visual.urdf"]);
     assert!(r.stdout.contains("<gazebo> elements") && r.stdout.contains("<transmission> elements"));
     assert!(!r.stdout.contains("anything") && !r.stdout.contains("hardwareInterface"));

@@ -13,7 +13,8 @@ mod build;
 /// reads, are checked by the scan but not built) plus what the scan found.
 pub(crate) struct Parsed {
     pub robot: urdf_rs::Robot,
-    /// Elements skipped whole (`<gazebo>`, `<transmission>`, `<sensor>`, xacro leftovers).
+    /// Elements skipped whole (`<gazebo>`, `<transmission>`, `<sensor>`, xacro
+    /// leftovers), one line a kind, as the import report prints them.
     pub ignored_tags: Vec<String>,
     /// Unknown attributes and elements, malformed visuals and materials.
     pub warnings: Vec<String>,
@@ -348,7 +349,7 @@ impl Scan<'_> {
             return Mode::Skip;
         }
         if tag.starts_with("xacro:") {
-            self.ignore(format!("<{tag}> elements (xacro leftovers)"));
+            self.ignore(format!("<{tag}> elements (xacro leftovers, not expanded)"));
             return Mode::Skip;
         }
         if stack.len() == 1 {
@@ -356,7 +357,7 @@ impl Scan<'_> {
                 "link" | "joint" => Mode::Strict,
                 "material" => Mode::Lenient,
                 _ if SKIPPED_TOP_LEVEL.contains(&tag) => {
-                    self.ignore(format!("<{tag}>"));
+                    self.ignore(format!("<{tag}> elements (not used by dynamics)"));
                     Mode::Skip
                 }
                 _ => {
@@ -368,7 +369,9 @@ impl Scan<'_> {
             };
         }
         if parent.tag == "link" && SKIPPED_IN_LINK.contains(&tag) {
-            self.ignore(format!("<link> <{tag}> elements (PyBullet extension)"));
+            self.ignore(format!(
+                "<link> <{tag}> elements (PyBullet extension, not used by dynamics)"
+            ));
             return Mode::Skip;
         }
         if !known_children(&parent.tag).contains(&tag) {

@@ -40,11 +40,7 @@ pub(crate) fn validate(parsed: &Parsed, file: &str) -> Result<Checked, UrdfError
         ));
     }
     let mut warnings = parsed.warnings.clone();
-    let mut ignored: Vec<String> = parsed
-        .ignored_tags
-        .iter()
-        .map(|t| format!("{t} elements (not used by dynamics)"))
-        .collect();
+    let mut ignored: Vec<String> = parsed.ignored_tags.clone();
 
     // Names.
     let mut link_index: HashMap<&str, usize> = HashMap::new();

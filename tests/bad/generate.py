@@ -8,8 +8,8 @@ def link(name, inert=None):
 def joint(name, parent, child, t="revolute", axis="0 0 1", limit='<limit lower="-1" upper="1" effort="10" velocity="5"/>', origin='<origin xyz="0 0 0.5" rpy="0 0 0"/>', extra=""):
     ax = f'<axis xyz="{axis}"/>' if axis is not None else ""
     return f'  <joint name="{name}" type="{t}"><parent link="{parent}"/><child link="{child}"/>{origin}{ax}{limit or ""}{extra}</joint>\n'
-def robot(body, name="bad"):
-    return f'<?xml version="1.0"?>\n<robot name="{name}">\n{body}</robot>\n'
+def robot(body, name="bad", attrs=""):
+    return f'<?xml version="1.0"?>\n<robot name="{name}"{attrs}>\n{body}</robot>\n'
 files = {}
 chain = link("base") + link("l1") + link("l2") + joint("j1","base","l1") + joint("j2","l1","l2")
 files["ok.urdf"] = robot(link("base") + link("l1") + link("l2") + link("l3") + joint("j1","base","l1") + joint("j2","l1","l2")
@@ -73,7 +73,8 @@ files["unknown_attribute.urdf"] = robot(link("base") + link("l1") + link("l2")
     + joint("j2","l1","l2", limit='<limit lowr="-1" upper="1" effort="10" velocity="5"/>', extra='<spring stiffness="3"/>'))
 files["texture_no_filename.urdf"] = robot('  <material name="grey"><color rgba="0.5 0.5 0.5 1"/><texture/></material>\n'
     + '  <link name="base">' + inertial() + '<visual><geometry><box size="1 1 1"/></geometry><material name="skin"><texture/></material></visual></link>\n'
-    + link("l1") + joint("j1","base","l1"))
+    + '  <link name="l1">' + inertial() + '<contact><lateral_friction value="1"/></contact></link>\n' + joint("j1","base","l1")
+    + '  <xacro:property name="leftover" value="1"/>\n', attrs=' version="1.0" xmlns:xacro="http://www.ros.org/wiki/xacro"')
 files["malformed_visual.urdf"] = robot('  <material name="red"><color rgba="1 0 0"/></material>\n'
     + '  <link name="base">' + inertial() + '<visual><geometry><box size="1 2"/></geometry></visual><visual><geometry/></visual></link>\n'
     + link("l1") + joint("j1","base","l1")
