@@ -28,7 +28,9 @@ pub fn forward_kinematics_second_order<T: Scalar>(
         data.o_m_i[i] = data.o_m_i[p].compose(&li);
         let vi = li.inv_act_motion(&data.v[p]) + v_j;
         // âᵢ = ᵢX̂ₚ âₚ + v̂ᵢ × ŝᵢ q̇ᵢ + ŝᵢ q̈ᵢ
-        data.a[i] = li.inv_act_motion(&data.a[p]) + vi.cross(&v_j) + joint.motion(a);
+        let mut ai = li.inv_act_motion(&data.a[p]) + vi.cross(&v_j);
+        joint.add_motion(&mut ai, a);
+        data.a[i] = ai;
         data.v[i] = vi;
     }
     Ok(())

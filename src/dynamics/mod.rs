@@ -19,12 +19,13 @@ pub mod linalg;
 pub mod ltdl;
 mod rnea;
 
+pub use crate::spatial::CompositeInertia;
 pub use aba::aba;
 pub use centroidal::centroidal_momentum;
 pub use com::{center_of_mass, center_of_mass_jacobian, center_of_mass_velocity};
+pub use crba::{crba, crba_upper};
 pub use external::add_link_wrench;
 pub use frames::{frame_classical_acceleration, frame_velocity, forward_kinematics_second_order};
-pub use crba::{crba, crba_upper, CompositeInertia};
 
 pub use energy::{energies, kinetic_energy, kinetic_energy_from_placements, potential_energy};
 pub use forward_rnea::{forward_dynamics_rnea, mass_matrix_rnea};

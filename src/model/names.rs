@@ -134,7 +134,8 @@ impl<T: Scalar> Model<T> {
     /// position then quaternion x, y, z, w; 1 for a revolute or prismatic joint).
     /// A mimic joint owns none: its range is empty. The universe's is empty.
     pub fn joint_q_range(&self, id: JointId) -> Result<Range<usize>, NameError> {
-        self.joint_range(id, |j| (j.iq, j.nq()))
+        // a free joint's q is position and quaternion: 7
+        self.joint_range(id, |j| (j.iq, if matches!(j.kind, JointKind::Free) { 7 } else { 1 }))
     }
     /// The joint's velocity coordinates: `v[range]` (and `a`, `tau`; 6 for the free
     /// base: body-frame linear then angular; 1 for a revolute or prismatic joint).
