@@ -6,8 +6,9 @@ use crate::model::{PyData, PyModel};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use urdyn::dynamics::{self, DynamicsError};
-use urdyn::nalgebra::{DMatrix, Vector3};
+use urdyn::dynamics::{self, DynamicsError, Reference};
+use urdyn::model::FrameId;
+use urdyn::nalgebra::DMatrix;
 
 /// Registers this file's functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -61,7 +62,8 @@ fn read_q(d: &mut PyData, q: &Bound<'_, PyAny>) -> PyResult<()> {
 fn read_fext(m: &PyModel, d: &mut PyData, fext: Option<&Bound<'_, PyDict>>) -> PyResult<bool> {
     match fext {
         Some(f) if !f.is_empty() => {
-            dynamics::forward_kinematics(&m.model, &mut d.data, &d.q);
+            dynamics::forward_kinematics(&m.model, &mut d.data, &d.q)
+                .map_err(|e| dyn_error(m, e))?;
             let PyData { data, fext, .. } = d;
             m.fext(f, &data.o_m_i, fext)?;
             Ok(true)
@@ -108,7 +110,8 @@ pub fn rnea<'py>(
     read_vec(a, "a", "nv", &mut d.a)?;
     let has = read_fext(&model, d, fext)?;
     let f = has.then_some(&d.fext[..]);
-    let tau = dynamics::rnea(&model.model, &mut d.data, &d.q, &d.v, &d.a, f);
+    let tau = dynamics::rnea(&model.model, &mut d.data, &d.q, &d.v, &d.a, f)
+        .map_err(|e| dyn_error(&model, e))?;
     Ok(vec_out(py, tau.as_slice()))
 }
 
@@ -130,7 +133,8 @@ pub fn nonlinear_effects<'py>(
     read_vec(v, "v", "nv", &mut d.v)?;
     let has = read_fext(&model, d, fext)?;
     let f = has.then_some(&d.fext[..]);
-    let c = dynamics::bias(&model.model, &mut d.data, &d.q, &d.v, f);
+    let c = dynamics::bias(&model.model, &mut d.data, &d.q, &d.v, f)
+        .map_err(|e| dyn_error(&model, e))?;
     Ok(vec_out(py, c.as_slice()))
 }
 
@@ -145,7 +149,7 @@ pub fn crba<'py>(
     let d = &mut *data;
     d.check(&model.model)?;
     read_q(d, q)?;
-    let h = dynamics::crba(&model.model, &mut d.data, &d.q);
+    let h = dynamics::crba(&model.model, &mut d.data, &d.q).map_err(|e| dyn_error(&model, e))?;
     Ok(mat_out(py, h))
 }
 
@@ -230,10 +234,10 @@ pub fn forward_dynamics_rnea<'py>(
 }
 
 /// World pose of a link frame (kinematics at `d.q` computed here).
-fn link_pose(model: &PyModel, d: &mut PyData, link: usize) -> urdyn::spatial::Se3<f64> {
-    dynamics::forward_kinematics(&model.model, &mut d.data, &d.q);
-    let f = &model.model.frames[link];
-    d.data.o_m_i[f.body].compose(&f.placement)
+fn link_pose(model: &PyModel, d: &mut PyData, link: usize) -> PyResult<urdyn::spatial::Se3<f64>> {
+    let m = &model.model;
+    dynamics::forward_kinematics(m, &mut d.data, &d.q).map_err(|e| dyn_error(model, e))?;
+    dynamics::frame_placement(m, &d.data, FrameId(link)).map_err(|e| dyn_error(model, e))
 }
 
 /// The 4×4 homogeneous world pose of URDF link `link` at q.
@@ -249,7 +253,7 @@ pub fn frame_placement<'py>(
     d.check(&model.model)?;
     read_q(d, q)?;
     let i = model.link(link, "link")?;
-    let x = link_pose(&model, d, i);
+    let x = link_pose(&model, d, i)?;
     let mut m = DMatrix::identity(4, 4);
     for r in 0..3 {
         for c in 0..3 {
@@ -261,10 +265,10 @@ pub fn frame_placement<'py>(
 }
 
 /// The reference of a Jacobian's rows.
-fn reference(s: &str) -> PyResult<bool> {
+fn reference(s: &str) -> PyResult<Reference> {
     match s {
-        "world_aligned" => Ok(false),
-        "local" => Ok(true),
+        "world_aligned" => Ok(Reference::WorldAligned),
+        "local" => Ok(Reference::Local),
         _ => Err(value_error(format!(
             "reference: \"{s}\" is neither \"world_aligned\" nor \"local\""
         ))),
@@ -273,22 +277,18 @@ fn reference(s: &str) -> PyResult<bool> {
 
 /// The 6 × nv Jacobian of link `link` at q into `j`: rows linear velocity of
 /// its origin then angular velocity, world-aligned or in the link's frame.
-fn jacobian(model: &PyModel, d: &mut PyData, link: usize, local: bool) -> DMatrix<f64> {
-    let x = link_pose(model, d, link);
-    let mut j = DMatrix::zeros(6, model.model.nv);
-    dynamics::frame_jacobian(&model.model, &d.data, link, &mut j);
-    if local {
-        let rt = x.rot.transpose();
-        for c in 0..j.ncols() {
-            let lin = rt * Vector3::new(j[(0, c)], j[(1, c)], j[(2, c)]);
-            let ang = rt * Vector3::new(j[(3, c)], j[(4, c)], j[(5, c)]);
-            for r in 0..3 {
-                j[(r, c)] = lin[r];
-                j[(r + 3, c)] = ang[r];
-            }
-        }
-    }
-    j
+fn jacobian(
+    model: &PyModel,
+    d: &mut PyData,
+    link: usize,
+    reference: Reference,
+) -> PyResult<DMatrix<f64>> {
+    let m = &model.model;
+    dynamics::forward_kinematics(m, &mut d.data, &d.q).map_err(|e| dyn_error(model, e))?;
+    let mut j = DMatrix::zeros(6, m.nv);
+    dynamics::frame_jacobian(m, &d.data, FrameId(link), reference, &mut j)
+        .map_err(|e| dyn_error(model, e))?;
+    Ok(j)
 }
 
 /// The 6 × nv Jacobian of URDF link `link` at q; `reference` "world_aligned"
@@ -308,7 +308,7 @@ pub fn frame_jacobian<'py>(
     d.check(&model.model)?;
     read_q(d, q)?;
     let i = model.link(link, "link")?;
-    let j = jacobian(&model, d, i, local);
+    let j = jacobian(&model, d, i, local)?;
     Ok(mat_out(py, &j))
 }
 
@@ -331,7 +331,7 @@ pub fn frame_velocity<'py>(
     read_q(d, q)?;
     read_vec(v, "v", "nv", &mut d.v)?;
     let i = model.link(link, "link")?;
-    let j = jacobian(&model, d, i, local);
+    let j = jacobian(&model, d, i, local)?;
     let vel = j * &d.v;
     Ok(vec_out(py, vel.as_slice()))
 }
@@ -347,15 +347,14 @@ pub fn center_of_mass<'py>(
     let d = &mut *data;
     d.check(&model.model)?;
     read_q(d, q)?;
-    dynamics::forward_kinematics(&model.model, &mut d.data, &d.q);
+    dynamics::forward_kinematics(&model.model, &mut d.data, &d.q)
+        .map_err(|e| dyn_error(&model, e))?;
     let c = dynamics::center_of_mass(&model.model, &d.data);
     Ok(vec_out(py, c.as_slice()))
 }
 
-/// The 3 × nv Jacobian of the centre of mass: column k is Σᵢ (mᵢ/M) of the
-/// velocity of body i's centre of mass per unit of coordinate k, i.e. for each
-/// joint column s, (M_sub/M)(v_s + ω_s × c_sub) over the subtree it moves
-/// (mass M_sub, centre c_sub).
+/// The 3 × nv Jacobian of the centre of mass of the links that move
+/// (`urdyn::dynamics::center_of_mass_jacobian`).
 #[pyfunction]
 pub fn center_of_mass_jacobian<'py>(
     py: Python<'py>,
@@ -367,39 +366,9 @@ pub fn center_of_mass_jacobian<'py>(
     d.check(&model.model)?;
     read_q(d, q)?;
     let m = &model.model;
-    dynamics::forward_kinematics(m, &mut d.data, &d.q);
-    let nb = m.nbodies;
-    // subtree masses and first moments, leaves inwards (parent[i] < i)
-    let mut mass = vec![0.0; nb];
-    let mut mc = vec![Vector3::zeros(); nb];
-    for i in 1..nb {
-        let inertia = &m.inertias[i];
-        mass[i] = inertia.mass;
-        mc[i] = d.data.o_m_i[i].act_point(&inertia.com) * inertia.mass;
-    }
-    for i in (2..nb).rev() {
-        let p = m.parent[i];
-        if p != 0 {
-            mass[p] += mass[i];
-            let add = mc[i];
-            mc[p] += add;
-        }
-    }
-    let total: f64 = m.inertias.iter().skip(1).map(|i| i.mass).sum();
+    dynamics::forward_kinematics(m, &mut d.data, &d.q).map_err(|e| dyn_error(&model, e))?;
     let mut j = DMatrix::zeros(3, m.nv);
-    if total > 0.0 {
-        for i in 1..nb {
-            let joint = &m.joints[i];
-            for k in 0..joint.nv() {
-                let s = d.data.o_m_i[i].act_motion(&joint.subspace_column(k));
-                // (M_sub v_s + ω_s × (M_sub c_sub)) / M
-                let col = (s.lin * mass[i] + s.ang.cross(&mc[i])) / total;
-                for r in 0..3 {
-                    j[(r, joint.iv + k)] += col[r];
-                }
-            }
-        }
-    }
+    dynamics::center_of_mass_jacobian(m, &d.data, &mut j).map_err(|e| dyn_error(&model, e))?;
     Ok(mat_out(py, &j))
 }
 
@@ -417,7 +386,8 @@ pub fn centroidal_momentum<'py>(
     d.check(&model.model)?;
     read_q(d, q)?;
     read_vec(v, "v", "nv", &mut d.v)?;
-    let (k, l) = dynamics::centroidal_momentum(&model.model, &mut d.data, &d.q, &d.v);
+    let (k, l) = dynamics::centroidal_momentum(&model.model, &mut d.data, &d.q, &d.v)
+        .map_err(|e| dyn_error(&model, e))?;
     Ok(vec_out(py, &[l.x, l.y, l.z, k.x, k.y, k.z]))
 }
 
@@ -433,7 +403,7 @@ pub fn kinetic_energy(
     d.check(&model.model)?;
     read_q(d, q)?;
     read_vec(v, "v", "nv", &mut d.v)?;
-    Ok(dynamics::kinetic_energy(&model.model, &mut d.data, &d.q, &d.v))
+    dynamics::kinetic_energy(&model.model, &mut d.data, &d.q, &d.v).map_err(|e| dyn_error(&model, e))
 }
 
 /// Gravitational potential energy −Σ mᵢ gᵀcᵢ of the links that move (J).
@@ -446,6 +416,7 @@ pub fn potential_energy(
     let d = &mut *data;
     d.check(&model.model)?;
     read_q(d, q)?;
-    dynamics::forward_kinematics(&model.model, &mut d.data, &d.q);
+    dynamics::forward_kinematics(&model.model, &mut d.data, &d.q)
+        .map_err(|e| dyn_error(&model, e))?;
     Ok(dynamics::potential_energy(&model.model, &d.data))
 }
