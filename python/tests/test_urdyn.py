@@ -76,32 +76,51 @@ def test_fixtures_agree_with_pinocchio(case):
         g = state.get("gravity", states.get("gravity", [0, 0, -9.81]))
         model.gravity = g
         q, v, a, tau = vectors(model, state)
+        # contract v2: the state's external wrenches enter every dynamics quantity
+        fx = {
+            link: (w.get("force", [0.0] * 3), w.get("torque", [0.0] * 3))
+            for link, w in state.get("fext", {}).items()
+        } or None
         wb = want.get("base", {})
         base = lambda *keys: [x for key in keys for x in wb[key]] if fb else None  # noqa: E731
         errs = {
-            "tau": rel(urdyn.rnea(model, data, q, v, a), by_name(model, want["tau"], base("force", "torque"))),
+            "tau": rel(urdyn.rnea(model, data, q, v, a, fx), by_name(model, want["tau"], base("force", "torque"))),
             "bias": rel(
-                urdyn.nonlinear_effects(model, data, q, v),
+                urdyn.nonlinear_effects(model, data, q, v, fx),
                 by_name(model, want["bias"], base("bias_force", "bias_torque")),
             ),
             "qdd": rel(
-                urdyn.forward_dynamics(model, data, q, v, tau),
-                by_name(model, want["qdd"], base("linear_acceleration", "angular_acceleration")),
-            ),
-            "qdd_rnea": rel(
-                urdyn.forward_dynamics_rnea(model, data, q, v, tau),
+                urdyn.forward_dynamics(model, data, q, v, tau, fx),
                 by_name(model, want["qdd"], base("linear_acceleration", "angular_acceleration")),
             ),
             "H": rel(urdyn.crba(model, data, q)[np.ix_(perm, perm)], want["mass_matrix"]),
         }
+        if fx is None:  # forward_dynamics_rnea takes no external wrenches
+            errs["qdd_rnea"] = rel(
+                urdyn.forward_dynamics_rnea(model, data, q, v, tau),
+                by_name(model, want["qdd"], base("linear_acceleration", "angular_acceleration")),
+            )
         if not meta.get("has_mimic", case in ("mimic", "panda")):
             errs["qdd_aba"] = rel(
-                urdyn.aba(model, data, q, v, tau),
+                urdyn.aba(model, data, q, v, tau, fx),
                 by_name(model, want["qdd"], base("linear_acceleration", "angular_acceleration")),
             )
         for link, pose in want["link_poses"].items():
             m = urdyn.frame_placement(model, data, q, link)
             errs[f"pose {link}"] = max(rel(m[:3, 3], pose["position"]), rel(m[:3, :3], pose["rotation"]))
+        # contract v2 kinematics (columns in the expected order: perm)
+        for link, fw in want.get("frames", {}).items():
+            for ref, key in (("world_aligned", "jacobian"), ("local", "jacobian_local")):
+                J = urdyn.frame_jacobian(model, data, q, link, reference=ref)
+                errs[f"{key} {link}"] = rel(J[:, perm], fw[key])
+            vel = urdyn.frame_velocity(model, data, q, v, link)
+            errs[f"velocity {link}"] = rel(vel, fw["velocity"]["linear"] + fw["velocity"]["angular"])
+        errs["com"] = rel(urdyn.center_of_mass(model, data, q), want["com"]["position"])
+        errs["com_jacobian"] = rel(urdyn.center_of_mass_jacobian(model, data, q)[:, perm], want["com"]["jacobian"])
+        hg = urdyn.centroidal_momentum(model, data, q, v)
+        errs["momentum"] = rel(hg, want["momentum"]["linear"] + want["momentum"]["angular"])
+        errs["kinetic"] = rel([urdyn.kinetic_energy(model, data, q, v)], [want["energy"]["kinetic"]])
+        errs["potential"] = rel([urdyn.potential_energy(model, data, q)], [want["energy"]["potential"]])
         what, e = max(errs.items(), key=lambda kv: kv[1])
         assert e <= 1e-9, f"{case} state {k}: {what} off by {e:.2e}"
         worst = max(worst, e)
