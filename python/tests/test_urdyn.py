@@ -103,7 +103,7 @@ def test_fixtures_agree_with_pinocchio(case):
             m = urdyn.frame_placement(model, data, q, link)
             errs[f"pose {link}"] = max(rel(m[:3, 3], pose["position"]), rel(m[:3, :3], pose["rotation"]))
         what, e = max(errs.items(), key=lambda kv: kv[1])
-        assert e <= 1e-9, f"{case} state {k}: {what} off by {e:.2e}"
+        assert e <= 1e-12, f"{case} state {k}: {what} off by {e:.2e}"
         worst = max(worst, e)
     print(f"{case}: worst relative error {worst:.1e}")
 
