@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! urdyn: URDF-driven rigid multibody dynamics in Featherstone's spatial-vector
 //! notation. Data flows one way: [`spatial`] ← [`model`] ← [`urdf`];
 //! [`dynamics`] (on [`model`]) ← [`contact`] ← [`sim`] ← tools (the `cli` module,
