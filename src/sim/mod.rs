@@ -23,7 +23,7 @@
 //! on an overdamped link's creep. `rk4` and `dop853` keep damping in their
 //! right-hand side while Δt·tr((H + A)⁻¹D) lies inside their stability
 //! interval (an adaptive step is capped there); a step where even `dt` does
-//! not is taken by the time-stepping scheme ([`integrators`]'s damping file
+//! not is taken by the time-stepping scheme (`src/sim/integrators/damping.rs`
 //! says why not a splitting).
 //!
 //! # Contact and limits: time stepping
@@ -356,7 +356,7 @@ pub struct Simulation {
     guard: EnergyGuard,
     /// The energy at the current state, once computed.
     energy_now: Option<f64>,
-    /// Steps taken, rejected (adaptive), right-hand-side evaluations.
+    /// Steps taken.
     pub steps: u64,
     /// Adaptive (`dop853`) steps rejected by the error test and retried
     /// shorter; not counted in `steps`.
