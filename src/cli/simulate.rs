@@ -29,6 +29,9 @@ pub struct SimulateArgs {
     pub friction: f64,
     pub package_path: Vec<PathBuf>,
     pub out: Option<PathBuf>,
+    /// Also write the replay page of `urdyn view` for this run, with its contacts
+    /// (written atomically after the trajectory).
+    pub html: Option<PathBuf>,
     pub every: usize,
     /// Show a progress bar (the binary sets this when standard error is a terminal).
     pub progress: bool,
@@ -79,6 +82,9 @@ pub enum SimulateError {
     Option(String),
     #[error("{0}")]
     Output(String),
+    /// The replay page (`--html`) could not be made.
+    #[error(transparent)]
+    View(#[from] crate::cli::view::ViewError),
 }
 
 /// Runs the command. The trajectory file is written atomically: a failed run
@@ -206,6 +212,17 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         armature: args.armature,
         ..SimOptions::default()
     };
+    // The page's geometry is read before anything is simulated (a missing mesh
+    // is reported at once).
+    let geometry = match &args.html {
+        Some(_) => Some(crate::cli::view::Geometry::load(
+            &model,
+            &args.urdf,
+            &args.package_path,
+        )?),
+        None => None,
+    };
+    let ground = opts.ground;
     let sim_err = |error| SimulateError::Sim {
         urdf: urdf_name.clone(),
         error,
@@ -285,6 +302,10 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
     };
     let block_rows = 64usize;
     let e0 = sim.energy();
+    let mut recorder = args
+        .html
+        .as_ref()
+        .map(|_| crate::cli::view::Recorder::new(&sim.model, duration, true));
     let mut loop_body = |w: Option<&mut (dyn Write + Send)>| -> Result<Summary, SimulateError> {
         let start = Instant::now();
         let mut max_pen = sim.penetration();
@@ -294,17 +315,31 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             let writer =
                 w.map(|w| scope.spawn(|| write_rows(w, &header, (nq, nv), from_sim, recycle)));
             let mut block: Vec<f64> = Vec::with_capacity(width * block_rows);
-            let push_row =
-                |sim: &mut Simulation, block: &mut Vec<f64>| -> Result<(), SimulateError> {
-                    let e = finite_energy(sim, &urdf_name)?;
-                    block.push(sim.time());
-                    block.extend_from_slice(sim.q().as_slice());
-                    block.extend_from_slice(sim.v().as_slice());
-                    block.push(e);
-                    block.push(sim.active_contacts() as f64);
-                    block.push(sim.penetration());
-                    Ok(())
-                };
+            let push_row = |sim: &mut Simulation,
+                            block: &mut Vec<f64>,
+                            recorder: &mut Option<crate::cli::view::Recorder>,
+                            last: bool|
+             -> Result<(), SimulateError> {
+                let e = finite_energy(sim, &urdf_name)?;
+                block.push(sim.time());
+                block.extend_from_slice(sim.q().as_slice());
+                block.extend_from_slice(sim.v().as_slice());
+                block.push(e);
+                block.push(sim.active_contacts() as f64);
+                block.push(sim.penetration());
+                if let Some(r) = recorder {
+                    let plot = [e, sim.active_contacts() as f64, sim.penetration()];
+                    r.offer_with(sim.time(), sim.q(), plot, last, |out| {
+                        out.extend(sim.contact_forces().iter().map(|c| {
+                            crate::cli::view::ContactArrow {
+                                point: c.point.point.into(),
+                                force: c.force.into(),
+                            }
+                        }))
+                    });
+                }
+                Ok(())
+            };
             // sends a full block (or, at the end, the last one); a writer that hung
             // up has failed: its error is collected at the join below
             let send = |block: &mut Vec<f64>| -> bool {
@@ -317,7 +352,8 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                     .unwrap_or_else(|_| Vec::with_capacity(width * block_rows));
                 to_writer.send(std::mem::replace(block, next)).is_ok()
             };
-            let mut sim_result = push_row(&mut sim, &mut block);
+            let mut sim_result =
+                push_row(&mut sim, &mut block, &mut recorder, duration <= 0.0);
             let mut k = 0u64;
             let mut last_tick = 0u64;
             while sim_result.is_ok() && sim.time() < duration {
@@ -332,7 +368,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                 max_pen = max_pen.max(sim.penetration());
                 let last = sim.time() >= duration;
                 if last || k % every as u64 == 0 {
-                    if let Err(e) = push_row(&mut sim, &mut block) {
+                    if let Err(e) = push_row(&mut sim, &mut block, &mut recorder, last) {
                         sim_result = Err(e);
                         break;
                     }
@@ -383,7 +419,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             contact_queries: sim.contact_queries(),
         })
     };
-    match &args.out {
+    let summary = match &args.out {
         Some(path) => {
             let mut result = None;
             write_atomic(path, |w| match loop_body(Some(w)) {
@@ -397,7 +433,11 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             result.ok_or_else(|| SimulateError::Output("no result".into()))
         }
         None => loop_body(None),
+    }?;
+    if let (Some(path), Some(geometry), Some(recorder)) = (&args.html, &geometry, &recorder) {
+        crate::cli::view::write_page(path, &sim.model, geometry, recorder, ground)?;
     }
+    Ok(summary)
 }
 
 /// One warning line on standard error (the run goes on).
