@@ -1,8 +1,8 @@
 //! `urdyn simulate` (cli.md): run a [`Simulation`] and write its trajectory CSV.
 
 use crate::cli::output::write_atomic;
-use crate::sim::{column_names, Integrator, SimError, SimOptions, Simulation};
 use crate::cli::state;
+use crate::sim::{column_names, Integrator, SimError, SimOptions, Simulation};
 use crate::{LoadOptions, Model};
 use std::io::Write;
 use std::path::PathBuf;
@@ -352,8 +352,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                     .unwrap_or_else(|_| Vec::with_capacity(width * block_rows));
                 to_writer.send(std::mem::replace(block, next)).is_ok()
             };
-            let mut sim_result =
-                push_row(&mut sim, &mut block, &mut recorder, duration <= 0.0);
+            let mut sim_result = push_row(&mut sim, &mut block, &mut recorder, duration <= 0.0);
             let mut k = 0u64;
             let mut last_tick = 0u64;
             while sim_result.is_ok() && sim.time() < duration {

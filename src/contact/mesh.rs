@@ -63,7 +63,10 @@ pub fn load_vertices(path: &Path, scale: [f64; 3]) -> Result<Vec<Vector3<f64>>, 
 pub fn load_mesh(path: &Path, scale: [f64; 3]) -> Result<TriMesh, MeshError> {
     let (raw, triangles) = read_raw(path, true)?;
     let n = raw.len();
-    if let Some(t) = triangles.iter().find(|t| t.iter().any(|&i| i as usize >= n)) {
+    if let Some(t) = triangles
+        .iter()
+        .find(|t| t.iter().any(|&i| i as usize >= n))
+    {
         return Err(err(
             path,
             format!("a triangle {t:?} indexes past the {n} vertices"),
@@ -76,7 +79,11 @@ pub fn load_mesh(path: &Path, scale: [f64; 3]) -> Result<TriMesh, MeshError> {
 }
 
 /// Scales raw positions, refusing an empty mesh and non-finite vertices.
-fn scaled(path: &Path, raw: Vec<[f64; 3]>, scale: [f64; 3]) -> Result<Vec<Vector3<f64>>, MeshError> {
+fn scaled(
+    path: &Path,
+    raw: Vec<[f64; 3]>,
+    scale: [f64; 3],
+) -> Result<Vec<Vector3<f64>>, MeshError> {
     if raw.is_empty() {
         return Err(err(path, "the mesh has no vertices"));
     }
@@ -92,7 +99,10 @@ fn scaled(path: &Path, raw: Vec<[f64; 3]>, scale: [f64; 3]) -> Result<Vec<Vector
 }
 
 /// Raw positions of a mesh file and, when `with_triangles`, its triangles.
-fn read_raw(path: &Path, with_triangles: bool) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), MeshError> {
+fn read_raw(
+    path: &Path,
+    with_triangles: bool,
+) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), MeshError> {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
@@ -107,7 +117,8 @@ fn read_raw(path: &Path, with_triangles: bool) -> Result<(Vec<[f64; 3]>, Vec<[u3
             if with_triangles {
                 for face in &mesh.faces {
                     let [a, b, c] = face.vertices;
-                    let idx = |i: usize| u32::try_from(i).map_err(|_| err(path, "too many vertices"));
+                    let idx =
+                        |i: usize| u32::try_from(i).map_err(|_| err(path, "too many vertices"));
                     triangles.push([idx(a)?, idx(b)?, idx(c)?]);
                 }
             }
@@ -217,9 +228,10 @@ impl DaePrim {
         };
         let stride = self.stride.max(1);
         let corner = |p: &[u32], k: usize| -> Result<u32, String> {
-            let i = p.get(k * stride + offset).copied().ok_or_else(|| {
-                format!("<{}>: <p> ends inside a vertex", self.kind)
-            })?;
+            let i = p
+                .get(k * stride + offset)
+                .copied()
+                .ok_or_else(|| format!("<{}>: <p> ends inside a vertex", self.kind))?;
             if i as usize >= n {
                 return Err(format!(
                     "<{}>: vertex index {i} is past the {n} positions",
@@ -697,24 +709,27 @@ fn read_dae(text: &str, with_triangles: bool) -> Result<(Vec<[f64; 3]>, Vec<[u32
             .ok_or_else(|| format!("POSITION source \"{}\" has no float_array", dae_snippet(s)))
     };
     // The triangles of geometry `g` whose POSITION sources start at `bases`.
-    let emit_triangles = |g: &str,
-                          bases: &HashMap<&str, u32>,
-                          tris: &mut Vec<[u32; 3]>|
-     -> Result<(), String> {
-        for prim in geometry_prims.get(g).map(Vec::as_slice).unwrap_or_default() {
-            let Some((_, vref)) = &prim.vertex else { continue };
-            let src = vertices_source.get(vref).map(String::as_str).unwrap_or(vref);
-            let (Some(&base), Ok(arr)) = (bases.get(src), positions_of(src)) else {
-                return Err(format!(
-                    "<{}>: the VERTEX input \"{}\" names no POSITION source of its geometry",
-                    prim.kind,
-                    dae_snippet(vref)
-                ));
-            };
-            prim.triangles(arr.len() / 3, tris, base)?;
-        }
-        Ok(())
-    };
+    let emit_triangles =
+        |g: &str, bases: &HashMap<&str, u32>, tris: &mut Vec<[u32; 3]>| -> Result<(), String> {
+            for prim in geometry_prims.get(g).map(Vec::as_slice).unwrap_or_default() {
+                let Some((_, vref)) = &prim.vertex else {
+                    continue;
+                };
+                let src = vertices_source
+                    .get(vref)
+                    .map(String::as_str)
+                    .unwrap_or(vref);
+                let (Some(&base), Ok(arr)) = (bases.get(src), positions_of(src)) else {
+                    return Err(format!(
+                        "<{}>: the VERTEX input \"{}\" names no POSITION source of its geometry",
+                        prim.kind,
+                        dae_snippet(vref)
+                    ));
+                };
+                prim.triangles(arr.len() / 3, tris, base)?;
+            }
+            Ok(())
+        };
     let mut tris: Vec<[u32; 3]> = Vec::new();
 
     // The scene `<scene><instance_visual_scene>` names, else the first one.
@@ -1090,7 +1105,14 @@ mod tests {
         assert_eq!(p[6], [0.5, 0.5, 1.0]);
         assert_eq!(
             t,
-            vec![[0, 1, 2], [0, 2, 3], [3, 2, 1], [4, 5, 6], [4, 6, 7], [7, 6, 5]]
+            vec![
+                [0, 1, 2],
+                [0, 2, 3],
+                [3, 2, 1],
+                [4, 5, 6],
+                [4, 6, 7],
+                [7, 6, 5]
+            ]
         );
         // The positions are those load_vertices reads.
         assert_eq!(read_dae_positions(dae).unwrap(), p);
@@ -1116,7 +1138,10 @@ mod tests {
         assert_eq!(m.vertices.len(), 4);
         assert_eq!(m.triangles.len(), 2);
         // The second triangle is (1,0,0), (1,1,0), (0,1,0), x scaled by 2.
-        let corners: Vec<_> = m.triangles[1].iter().map(|&i| m.vertices[i as usize]).collect();
+        let corners: Vec<_> = m.triangles[1]
+            .iter()
+            .map(|&i| m.vertices[i as usize])
+            .collect();
         assert_eq!(corners[0], Vector3::new(2.0, 0.0, 0.0));
         assert_eq!(corners[1], Vector3::new(2.0, 1.0, 0.0));
         assert_eq!(corners[2], Vector3::new(0.0, 1.0, 0.0));
@@ -1133,7 +1158,9 @@ mod tests {
             (b - a).cross(&(c - a)).norm() / 2.0
         };
         assert!((area(&m.triangles[0]) + area(&m.triangles[1]) - 1.0).abs() < 1e-12);
-        assert!(m.triangles[2].iter().all(|&i| m.vertices[i as usize].z == 5.0));
+        assert!(m.triangles[2]
+            .iter()
+            .all(|&i| m.vertices[i as usize].z == 5.0));
     }
 
     #[test]

@@ -499,39 +499,66 @@ impl Geometry {
         let mut geometry = Geometry::default();
         let mut mesh_index: HashMap<(PathBuf, [u64; 3]), usize> = HashMap::new();
         for link in &robot.links {
-            let Some(frame) = model.frame_index(&link.name).and_then(|k| model.frames.get(k))
+            let Some(frame) = model
+                .frame_index(&link.name)
+                .and_then(|k| model.frames.get(k))
             else {
                 continue;
             };
-            let element = if link.visual.is_empty() { "collision" } else { "visual" };
-            let pieces: Vec<(&urdf_rs::Pose, &urdf_rs::Geometry, Option<&urdf_rs::Material>)> =
-                if link.visual.is_empty() {
-                    link.collision
-                        .iter()
-                        .map(|c| (&c.origin, &c.geometry, None))
-                        .collect()
-                } else {
-                    link.visual
-                        .iter()
-                        .map(|v| (&v.origin, &v.geometry, v.material.as_ref()))
-                        .collect()
-                };
+            let element = if link.visual.is_empty() {
+                "collision"
+            } else {
+                "visual"
+            };
+            let pieces: Vec<(
+                &urdf_rs::Pose,
+                &urdf_rs::Geometry,
+                Option<&urdf_rs::Material>,
+            )> = if link.visual.is_empty() {
+                link.collision
+                    .iter()
+                    .map(|c| (&c.origin, &c.geometry, None))
+                    .collect()
+            } else {
+                link.visual
+                    .iter()
+                    .map(|v| (&v.origin, &v.geometry, v.material.as_ref()))
+                    .collect()
+            };
             for (origin, geom, material) in pieces {
                 let at = || format!("{name}: link \"{}\": <{element}>", link.name);
                 let [r, p, y] = origin.rpy.0;
                 let local = Se3::new(rpy_to_matrix(r, p, y), Vector3::from(origin.xyz.0));
                 let placement = frame.placement.compose(&local);
-                if !(placement.rot.iter().chain(placement.trans.iter()).all(|x| x.is_finite())) {
-                    return Err(ViewError::Geometry(format!("{}: <origin> is not finite", at())));
+                if !(placement
+                    .rot
+                    .iter()
+                    .chain(placement.trans.iter())
+                    .all(|x| x.is_finite()))
+                {
+                    return Err(ViewError::Geometry(format!(
+                        "{}: <origin> is not finite",
+                        at()
+                    )));
                 }
                 let dims_ok = |d: &[f64]| d.iter().all(|x| x.is_finite() && *x >= 0.0);
                 let shape = match geom {
                     urdf_rs::Geometry::Box { size } if dims_ok(&size.0) => VisualShape::Box(size.0),
-                    urdf_rs::Geometry::Cylinder { radius, length } if dims_ok(&[*radius, *length]) => {
-                        VisualShape::Cylinder { radius: *radius, length: *length }
+                    urdf_rs::Geometry::Cylinder { radius, length }
+                        if dims_ok(&[*radius, *length]) =>
+                    {
+                        VisualShape::Cylinder {
+                            radius: *radius,
+                            length: *length,
+                        }
                     }
-                    urdf_rs::Geometry::Capsule { radius, length } if dims_ok(&[*radius, *length]) => {
-                        VisualShape::Capsule { radius: *radius, length: *length }
+                    urdf_rs::Geometry::Capsule { radius, length }
+                        if dims_ok(&[*radius, *length]) =>
+                    {
+                        VisualShape::Capsule {
+                            radius: *radius,
+                            length: *length,
+                        }
                     }
                     urdf_rs::Geometry::Sphere { radius } if dims_ok(&[*radius]) => {
                         VisualShape::Sphere { radius: *radius }
@@ -559,9 +586,8 @@ impl Geometry {
                         let k = match mesh_index.get(&key) {
                             Some(&k) => k,
                             None => {
-                                let m = load_mesh(&path, scale).map_err(|e| {
-                                    ViewError::Geometry(format!("{}: {e}", at()))
-                                })?;
+                                let m = load_mesh(&path, scale)
+                                    .map_err(|e| ViewError::Geometry(format!("{}: {e}", at())))?;
                                 geometry.meshes.push(m);
                                 mesh_index.insert(key, geometry.meshes.len() - 1);
                                 geometry.meshes.len() - 1
@@ -695,7 +721,11 @@ fn base64(bytes: &[u8]) -> String {
     const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
     for c in bytes.chunks(3) {
-        let b = [c[0], c.get(1).copied().unwrap_or(0), c.get(2).copied().unwrap_or(0)];
+        let b = [
+            c[0],
+            c.get(1).copied().unwrap_or(0),
+            c.get(2).copied().unwrap_or(0),
+        ];
         let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
         for k in 0..4 {
             if k <= c.len() {
@@ -711,9 +741,15 @@ fn base64(bytes: &[u8]) -> String {
 /// A rotation matrix row-major.
 fn rows9(r: &Matrix3<f64>) -> [f64; 9] {
     [
-        r[(0, 0)], r[(0, 1)], r[(0, 2)],
-        r[(1, 0)], r[(1, 1)], r[(1, 2)],
-        r[(2, 0)], r[(2, 1)], r[(2, 2)],
+        r[(0, 0)],
+        r[(0, 1)],
+        r[(0, 2)],
+        r[(1, 0)],
+        r[(1, 1)],
+        r[(1, 2)],
+        r[(2, 0)],
+        r[(2, 1)],
+        r[(2, 2)],
     ]
 }
 
@@ -725,7 +761,9 @@ fn mesh_json(m: &TriMesh) -> Value {
     let mut v = Vec::with_capacity(m.vertices.len() * 6);
     for p in &m.vertices {
         for k in 0..3 {
-            let q = ((p[k] - lo[k]) / ext[k] * 65535.0).round().clamp(0.0, 65535.0) as u16;
+            let q = ((p[k] - lo[k]) / ext[k] * 65535.0)
+                .round()
+                .clamp(0.0, 65535.0) as u16;
             v.extend_from_slice(&q.to_le_bytes());
         }
     }
@@ -766,8 +804,12 @@ fn page_data(model: &Model, geometry: &Geometry, rec: &Recorder, ground: Option<
             let (kind, dims, mesh) = match &v.shape {
                 VisualShape::Mesh(k) => ("mesh", vec![], Some(*k)),
                 VisualShape::Box(s) => ("box", s.to_vec(), None),
-                VisualShape::Cylinder { radius, length } => ("cylinder", vec![*radius, *length], None),
-                VisualShape::Capsule { radius, length } => ("capsule", vec![*radius, *length], None),
+                VisualShape::Cylinder { radius, length } => {
+                    ("cylinder", vec![*radius, *length], None)
+                }
+                VisualShape::Capsule { radius, length } => {
+                    ("capsule", vec![*radius, *length], None)
+                }
                 VisualShape::Sphere { radius } => ("sphere", vec![*radius], None),
             };
             json!({"link": v.link, "body": v.body, "p": v.placement.trans.as_slice(),
@@ -778,7 +820,10 @@ fn page_data(model: &Model, geometry: &Geometry, rec: &Recorder, ground: Option<
     let f64s: Vec<u8> = rec.positions.iter().flat_map(|x| x.to_le_bytes()).collect();
     let f32s: Vec<u8> = rec.rotations.iter().flat_map(|x| x.to_le_bytes()).collect();
     let series = |k: usize| -> Vec<Option<f64>> {
-        rec.plot.iter().map(|p| Some(p[k]).filter(|x| x.is_finite())).collect()
+        rec.plot
+            .iter()
+            .map(|p| Some(p[k]).filter(|x| x.is_finite()))
+            .collect()
     };
     let contacts = if rec.with_contacts {
         let arrows: Vec<u8> = rec
@@ -817,7 +862,12 @@ fn html_escape(s: &str) -> String {
 }
 
 /// The whole page: the template with its style, script and data inlined.
-pub fn page_html(model: &Model, geometry: &Geometry, rec: &Recorder, ground: Option<f64>) -> String {
+pub fn page_html(
+    model: &Model,
+    geometry: &Geometry,
+    rec: &Recorder,
+    ground: Option<f64>,
+) -> String {
     // JSON inside <script>: "</" only occurs in strings, where "<\/" means the same.
     let data = page_data(model, geometry, rec, ground)
         .to_string()
@@ -838,4 +888,138 @@ pub fn page_html(model: &Model, geometry: &Geometry, rec: &Recorder, ground: Opt
     }
     out.push_str(rest);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_matches_the_rfc_vectors() {
+        // RFC 4648 §10.
+        for (raw, enc) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            assert_eq!(base64(raw.as_bytes()), enc);
+        }
+        assert_eq!(base64(&[0xfb, 0xff]), "+/8=");
+    }
+
+    #[test]
+    fn sampler_keeps_one_row_a_frame_interval() {
+        // Rows every millisecond for 1 s: the first row at or after each 1/60 s.
+        let mut s = FrameSampler::new(1.0, 100);
+        let kept: Vec<usize> = (0..=1000).filter(|&k| s.take(k as f64 * 1e-3)).collect();
+        let want: Vec<usize> = (0..=60)
+            .map(|j| (j as f64 * 1000.0 / 60.0 - 1e-9).ceil() as usize)
+            .collect();
+        assert_eq!(kept, want);
+        // A long run at 1 kB a frame: the poses stay within MAX_POSE_BYTES.
+        let mut s = FrameSampler::new(1e4, 1000);
+        let n = (0..=1_000_000).filter(|&k| s.take(k as f64 * 1e-2)).count();
+        assert!(
+            n * 1000 <= MAX_POSE_BYTES && n * 1000 > MAX_POSE_BYTES * 9 / 10,
+            "{n}"
+        );
+    }
+
+    /// A UV sphere of radius 1 with about 2·n² triangles.
+    fn sphere(n: usize) -> TriMesh {
+        let mut m = TriMesh::default();
+        for i in 0..=n {
+            let th = std::f64::consts::PI * i as f64 / n as f64;
+            for j in 0..n {
+                let ph = 2.0 * std::f64::consts::PI * j as f64 / n as f64;
+                m.vertices.push(Vector3::new(
+                    th.sin() * ph.cos(),
+                    th.sin() * ph.sin(),
+                    th.cos(),
+                ));
+            }
+        }
+        for i in 0..n {
+            for j in 0..n {
+                let (a, b) = ((i * n + j) as u32, (i * n + (j + 1) % n) as u32);
+                let (c, d) = (a + n as u32, b + n as u32);
+                m.triangles.push([a, b, d]);
+                m.triangles.push([a, d, c]);
+            }
+        }
+        m
+    }
+
+    #[test]
+    fn simplify_stays_under_the_limit_and_on_the_shape() {
+        let m = sphere(200);
+        assert!(m.triangles.len() > 70_000);
+        let s = simplify(&m, 5_000);
+        assert!(
+            s.triangles.len() <= 5_000 && s.triangles.len() > 1_000,
+            "{}",
+            s.triangles.len()
+        );
+        // Cluster means lie inside the sphere, near its surface; the bounding box
+        // is nearly kept; every index is valid.
+        for v in &s.vertices {
+            assert!(v.norm() <= 1.0 + 1e-12 && v.norm() > 0.9, "{}", v.norm());
+        }
+        let (lo, hi) = bounds(&s);
+        assert!((hi - lo).iter().all(|e| *e > 1.9), "{lo} {hi}");
+        assert!(s
+            .triangles
+            .iter()
+            .flatten()
+            .all(|&i| (i as usize) < s.vertices.len()));
+        // A mesh under the limit is kept as it is.
+        assert_eq!(simplify(&m, 100_000), m);
+    }
+
+    #[test]
+    fn collision_geometry_where_a_link_has_no_visual_and_material_colours() {
+        let dir = tempfile::tempdir().unwrap();
+        let urdf = dir.path().join("r.urdf");
+        std::fs::write(
+            &urdf,
+            r#"<robot name="r">
+<material name="red"><color rgba="1 0 0 1"/></material>
+<link name="a"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
+<collision><origin xyz="0 0 1"/><geometry><box size="1 2 3"/></geometry></collision></link>
+<joint name="j" type="revolute"><parent link="a"/><child link="b"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/>
+<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+<link name="b"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
+<visual><origin xyz="0 0.5 0"/><geometry><sphere radius="0.25"/></geometry><material name="red"/></visual>
+<visual><geometry><cylinder radius="0.1" length="2"/></geometry><material name="x"><color rgba="0 0 1 0.5"/></material></visual>
+<collision><geometry><sphere radius="9"/></geometry></collision></link>
+<joint name="f" type="fixed"><parent link="b"/><child link="c"/><origin xyz="0 0 2"/></joint>
+<link name="c"><visual><geometry><box size="1 1 1"/></geometry></visual></link>
+</robot>"#,
+        )
+        .unwrap();
+        let model = crate::load_file(&urdf, LoadOptions::default()).unwrap();
+        let g = Geometry::load(&model, &urdf, &[]).unwrap();
+        let v: Vec<_> = g
+            .visuals
+            .iter()
+            .map(|v| (v.link.as_str(), v.shape.clone(), v.rgba, v.placement.trans))
+            .collect();
+        assert_eq!(v.len(), 4, "{v:?}");
+        assert_eq!(v[0].0, "a");
+        assert_eq!(v[0].1, VisualShape::Box([1.0, 2.0, 3.0]));
+        assert_eq!(v[0].2, DEFAULT_RGBA);
+        assert_eq!(v[1].1, VisualShape::Sphere { radius: 0.25 });
+        assert_eq!(v[1].2, [1.0, 0.0, 0.0, 1.0]);
+        assert_eq!(v[2].2, [0.0, 0.0, 1.0, 0.5]);
+        // c is welded to b: its box sits on b's body, 2 m up.
+        assert_eq!(v[3].0, "c");
+        let body_b = model.frames[model.frame_index("b").unwrap()].body;
+        assert_eq!(g.visuals[3].body, body_b);
+        assert!((v[3].3 - Vector3::new(0.0, 0.0, 2.0)).norm() < 1e-12);
+        assert!((v[1].3 - Vector3::new(0.0, 0.5, 0.0)).norm() < 1e-12);
+    }
 }

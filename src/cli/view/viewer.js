@@ -306,7 +306,10 @@
       const m = D.meshes[v.mesh];
       radius = 0.5 * Math.hypot(m.ext[0], m.ext[1], m.ext[2]) + Math.hypot(m.min[0] + m.ext[0] / 2, m.min[1] + m.ext[1] / 2, m.min[2] + m.ext[2] / 2);
     } else {
-      radius = Math.hypot(scale[0], scale[1], scale[2] + (v.kind === "capsule" ? v.dims[1] : 0));
+      const d = v.dims;
+      radius = v.kind === "box" ? Math.hypot(d[0], d[1], d[2]) / 2
+        : v.kind === "cylinder" ? Math.hypot(d[0], d[1] / 2)
+          : d[0] + (v.kind === "capsule" ? d[1] / 2 : 0);
     }
     return { d, body: v.body, local: { R: v.R, p: v.p }, scale, color: v.rgba, radius };
   });
@@ -364,8 +367,8 @@
   const end = nframes ? sceneBounds(nframes - 1) : start;
   const mid = [0, 1, 2].map((k) => (start.c[k] + end.c[k]) / 2);
   const span = Math.max(start.r, end.r) + Math.hypot(...sub(start.c, end.c)) / 2;
-  const cam = { target: mid, dist: span * 2.0, yaw: -1.1, pitch: 0.32 };
-  cam.target[2] = Math.max(cam.target[2] - span * 0.15, groundZ + span * 0.3);
+  const cam = { target: mid, dist: span * 2.4, yaw: -1.1, pitch: 0.32 };
+  cam.target[2] = Math.max(cam.target[2], groundZ + span * 0.3);
 
   function eye() {
     const cp = Math.cos(cam.pitch);
