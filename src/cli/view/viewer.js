@@ -363,12 +363,13 @@
   const groundZ = D.ground === null || D.ground === undefined ? 0 : D.ground;
   const R0 = start.r;
   const minor = Math.pow(10, Math.floor(Math.log10(R0 / 2)));
-  // The camera looks at the middle of the first and last frames' robots.
-  const end = nframes ? sceneBounds(nframes - 1) : start;
-  const mid = [0, 1, 2].map((k) => (start.c[k] + end.c[k]) / 2);
-  const span = Math.max(start.r, end.r) + Math.hypot(...sub(start.c, end.c)) / 2;
-  const cam = { target: mid, dist: span * 2.4, yaw: -1.1, pitch: 0.32 };
-  cam.target[2] = Math.max(cam.target[2], groundZ + span * 0.3);
+  // The camera looks at the robot (following it, unless "follow" is off) from
+  // a distance that shows it whole; panning moves the point looked at.
+  const cam = { offset: [0, 0, 0], fixed: start.c.slice(), dist: R0 * 2.5, yaw: -1.1, pitch: 0.3, target: start.c.slice() };
+  function aim(sb) {
+    const c = ui.follow.checked ? sb.c : cam.fixed;
+    cam.target = [c[0] + cam.offset[0], c[1] + cam.offset[1], Math.max(c[2], groundZ + R0 * 0.25) + cam.offset[2]];
+  }
 
   function eye() {
     const cp = Math.cos(cam.pitch);
@@ -382,6 +383,7 @@
   // ---- drawing --------------------------------------------------------------
   let frame = 0;
   const ui = {
+    follow: document.getElementById("follow"),
     frames: document.getElementById("frames"),
     forces: document.getElementById("forces"),
   };
@@ -394,6 +396,7 @@
     const f = Math.min(frame, Math.max(0, nframes - 1));
     const world = visuals.map((v) => ({ v, m: poseMat4(visualWorld(f, v), v.scale) }));
     const sb = nframes ? sceneBounds(f) : start;
+    aim(sb);
     const e = eye();
     const view = lookAt(e, cam.target, [0, 0, 1]);
     const far = cam.dist * 4 + R0 * 60, near = Math.max(cam.dist * 0.01, 1e-4);
@@ -587,6 +590,12 @@
   });
   slider.addEventListener("input", () => { setPlaying(false); const k = +slider.value; simT = times[k]; show(k); });
   ui.frames.addEventListener("change", () => { dirty = true; });
+  ui.follow.addEventListener("change", () => {
+    // keep the view where it is: the offset moves to the other reference point
+    const c = ui.follow.checked ? sceneBounds(frame).c : cam.fixed;
+    for (let i = 0; i < 3; i++) cam.offset[i] = cam.target[i] - c[i];
+    dirty = true;
+  });
   ui.forces.addEventListener("change", () => { dirty = true; });
   window.addEventListener("keydown", (e) => {
     if (e.code === "Space" && e.target.tagName !== "BUTTON") { e.preventDefault(); playBtn.click(); }
@@ -614,7 +623,7 @@
     if (drag.pan || e.shiftKey) {
       const k = cam.dist * 0.0016;
       const f = norm(sub(cam.target, eye())), s = norm(cross(f, [0, 0, 1])), u = cross(s, f);
-      for (let i = 0; i < 3; i++) cam.target[i] += (-dx * s[i] + dy * u[i]) * k;
+      for (let i = 0; i < 3; i++) cam.offset[i] += (-dx * s[i] + dy * u[i]) * k;
     } else {
       cam.yaw -= dx * 0.008;
       cam.pitch = Math.max(-1.5, Math.min(1.5, cam.pitch + dy * 0.008));
