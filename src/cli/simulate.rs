@@ -11,27 +11,41 @@ use std::time::Instant;
 /// The command's options, as cli.md lists them.
 #[derive(Clone, Debug)]
 pub struct SimulateArgs {
+    /// The URDF file.
     pub urdf: PathBuf,
+    /// Give the root link a free 6-DoF joint (unit quaternion).
     pub floating_base: bool,
+    /// Simulated seconds.
     pub duration: f64,
+    /// Step (the first step of an adaptive integrator), s.
     pub dt: f64,
+    /// Integrator name (`None`: the project's best general choice).
     pub integrator: Option<String>,
+    /// Error tolerance of adaptive integrators.
     pub tol: f64,
+    /// One state object (as in eval's `states`) to start from.
     pub initial: Option<PathBuf>,
     /// Rotor inertia added to every joint's diagonal of H (finite, >= 0).
     pub armature: f64,
     /// With a floating base: lift or lower the base so that the collision
     /// geometry's lowest point is this far above the ground (after `initial`).
     pub above_ground: Option<f64>,
+    /// Ground plane height (`None`: 0).
     pub ground: Option<f64>,
+    /// No ground plane: no contact at all.
     pub no_ground: bool,
+    /// Gravity vector (`None`: the model's).
     pub gravity: Option<[f64; 3]>,
+    /// Coulomb friction coefficient between links and the ground.
     pub friction: f64,
+    /// Roots for `package://NAME/...` mesh paths.
     pub package_path: Vec<PathBuf>,
+    /// The trajectory CSV (written atomically).
     pub out: Option<PathBuf>,
     /// Also write the replay page of `urdyn view` for this run, with its contacts
     /// (written atomically after the trajectory).
     pub html: Option<PathBuf>,
+    /// Write every Nth step (the final state always).
     pub every: usize,
     /// Show a progress bar (the binary sets this when standard error is a terminal).
     pub progress: bool,
@@ -40,14 +54,23 @@ pub struct SimulateArgs {
 /// What a run did (the summary line).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Summary {
+    /// Steps taken.
     pub steps: u64,
+    /// Wall-clock seconds of the step loop.
     pub wall_seconds: f64,
+    /// Simulated seconds.
     pub simulated_seconds: f64,
+    /// Simulated over wall-clock seconds.
     pub real_time_factor: f64,
+    /// Mechanical energy at the start (J).
     pub energy_start: f64,
+    /// Mechanical energy at the end (J).
     pub energy_end: f64,
+    /// Deepest penetration into the ground during the run (m).
     pub max_penetration: f64,
+    /// The integrator's name.
     pub integrator: &'static str,
+    /// Narrow-phase contact queries made.
     pub contact_queries: u64,
 }
 
@@ -70,16 +93,26 @@ impl std::fmt::Display for Summary {
 /// A failed run: one line naming the file, option or quantity.
 #[derive(Debug, thiserror::Error)]
 pub enum SimulateError {
+    /// The URDF could not be imported.
     #[error(transparent)]
     Urdf(#[from] crate::UrdfError),
+    /// The `--initial` state is malformed.
     #[error(transparent)]
     State(#[from] state::StateError),
     /// (Not a `#[source]`: the message already carries the cause, and the CLI
     /// prints the chain — it would appear twice.)
+    /// The simulation failed (diverged, turned non-finite, ...).
     #[error("{urdf}: {error}")]
-    Sim { urdf: String, error: SimError },
+    Sim {
+        /// The URDF file.
+        urdf: String,
+        /// What went wrong.
+        error: SimError,
+    },
+    /// A bad option value.
     #[error("{0}")]
     Option(String),
+    /// The trajectory could not be written.
     #[error("{0}")]
     Output(String),
     /// The replay page (`--html`) could not be made.

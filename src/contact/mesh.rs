@@ -27,7 +27,9 @@ use std::path::Path;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{file}: {message}")]
 pub struct MeshError {
+    /// The mesh file.
     pub file: String,
+    /// What is wrong with it.
     pub message: String,
 }
 

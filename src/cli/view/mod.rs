@@ -738,19 +738,9 @@ fn base64(bytes: &[u8]) -> String {
     out
 }
 
-/// A rotation matrix row-major.
-fn rows9(r: &Matrix3<f64>) -> [f64; 9] {
-    [
-        r[(0, 0)],
-        r[(0, 1)],
-        r[(0, 2)],
-        r[(1, 0)],
-        r[(1, 1)],
-        r[(1, 2)],
-        r[(2, 0)],
-        r[(2, 1)],
-        r[(2, 2)],
-    ]
+/// A rotation matrix row-major (nalgebra stores column-major: the transpose's storage).
+fn rows9(r: &Matrix3<f64>) -> Vec<f64> {
+    r.transpose().as_slice().to_vec()
 }
 
 /// The mesh quantised: 16 bits a coordinate over its bounding box, indices as
