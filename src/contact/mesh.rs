@@ -5,8 +5,11 @@
 //! - Wavefront OBJ through `tobj` (every object's `v` positions);
 //! - COLLADA (`.dae`) through a minimal reader. The vertices are the
 //!   `<float_array>` of the `<source>` that a geometry's
-//!   `<vertices><input semantic="POSITION">` names (the whole array, whether
-//!   or not primitives index all of it), placed by the scene graph: the visual
+//!   `<vertices><input semantic="POSITION">` names, those of them that the
+//!   geometry's `<triangles>`, `<polylist>` and `<polygons>` index (the whole
+//!   array for a geometry without such primitives or whose primitives index
+//!   nothing; assimp, which coal and Pinocchio use, also drops positions that
+//!   nothing indexes: see docs/meshes.md), placed by the scene graph: the visual
 //!   scene `<scene><instance_visual_scene url>` names (else the first one) is
 //!   walked, each `<node>`'s transform elements (`<matrix>`, row-major;
 //!   `<translate>`; `<rotate>`, axis and angle in degrees; `<scale>`) are
@@ -155,8 +158,10 @@ fn read_raw(
         "dae" => {
             let bytes = std::fs::read(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
             let text = String::from_utf8_lossy(&bytes);
-            let (p, t) = read_dae(&text, with_triangles).map_err(|m| err(path, m))?;
-            triangles = t;
+            let (p, t) = read_dae(&text).map_err(|m| err(path, m))?;
+            if with_triangles {
+                triangles = t;
+            }
             p
         }
         other => {
@@ -358,12 +363,12 @@ fn dae_transform(kind: &'static str, text: &str, node: &str) -> Result<Mat4, Str
 /// Positions of a COLLADA document (see the module doc).
 #[cfg(test)]
 fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
-    read_dae(text, false).map(|(p, _)| p)
+    read_dae(text).map(|(p, _)| p)
 }
 
 /// Positions of a COLLADA document (see the module doc) and, when
-/// `with_triangles`, the triangles of the placed geometries' primitives.
-fn read_dae(text: &str, with_triangles: bool) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
+/// the triangles of the placed geometries' primitives.
+fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
     use quick_xml::events::Event;
     use std::collections::HashMap;
     let mut reader = quick_xml::Reader::from_str(text);
@@ -391,7 +396,7 @@ fn read_dae(text: &str, with_triangles: bool) -> Result<(Vec<[f64; 3]>, Vec<[u32
     // `<vertices id>` -> its POSITION source
     let mut vertices_source: HashMap<String, String> = HashMap::new();
     let mut current_vertices: Option<String> = None;
-    // geometry id -> its primitives (read only `with_triangles`)
+    // geometry id -> its primitives
     let mut geometry_prims: HashMap<String, Vec<DaePrim>> = HashMap::new();
     let mut geometry_order: Vec<String> = Vec::new();
     let mut current_prim: Option<DaePrim> = None;
@@ -467,7 +472,7 @@ fn read_dae(text: &str, with_triangles: bool) -> Result<(Vec<[f64; 3]>, Vec<[u32
                         current_vertices = attr(b"id");
                     }
                     kind @ (b"triangles" | b"polylist" | b"polygons")
-                        if with_triangles && is_start && current_geometry.is_some() =>
+                        if is_start && current_geometry.is_some() =>
                     {
                         current_prim = Some(DaePrim {
                             kind: match kind {
@@ -750,6 +755,8 @@ fn read_dae(text: &str, with_triangles: bool) -> Result<(Vec<[f64; 3]>, Vec<[u32
     };
     if let Some(scene) = scene {
         let mut out = Vec::new();
+        // Whether each placed position is kept.
+        let mut used: Vec<bool> = Vec::new();
         let mut instanced = false;
         // (node, parent's world transform, the node that has an unsupported transform)
         let mut stack: Vec<(usize, Mat4, Option<usize>)> = scene
@@ -792,6 +799,7 @@ fn read_dae(text: &str, with_triangles: bool) -> Result<(Vec<[f64; 3]>, Vec<[u32
                     )
                 })?;
                 let mut bases: HashMap<&str, u32> = HashMap::new();
+                let first_triangle = tris.len();
                 for s in sources {
                     let arr = positions_of(s)?;
                     bases.entry(s.as_str()).or_insert(out.len() as u32);
@@ -807,8 +815,15 @@ fn read_dae(text: &str, with_triangles: bool) -> Result<(Vec<[f64; 3]>, Vec<[u32
                         }
                     }
                 }
-                if with_triangles {
-                    emit_triangles(id, &bases, &mut tris)?;
+                emit_triangles(id, &bases, &mut tris)?;
+                // Only the positions its primitives index (all of them when it has
+                // none, or when they index nothing).
+                let placed = tris.get(first_triangle..).unwrap_or_default();
+                used.resize(out.len(), placed.is_empty());
+                for &i in placed.iter().flatten() {
+                    if let Some(u) = used.get_mut(i as usize) {
+                        *u = true;
+                    }
                 }
             }
             // Children after instanced nodes, each in document order.
@@ -824,7 +839,7 @@ fn read_dae(text: &str, with_triangles: bool) -> Result<(Vec<[f64; 3]>, Vec<[u32
             }
         }
         if instanced {
-            return Ok((out, tris));
+            return Ok(keep_used(out, tris, &used));
         }
     }
     // No scene places a geometry: every POSITION array, untransformed.
@@ -838,12 +853,35 @@ fn read_dae(text: &str, with_triangles: bool) -> Result<(Vec<[f64; 3]>, Vec<[u32
             }
         }
     }
-    if with_triangles {
-        for g in &geometry_order {
-            emit_triangles(g, &bases, &mut tris)?;
-        }
+    for g in &geometry_order {
+        emit_triangles(g, &bases, &mut tris)?;
     }
     Ok((out, tris))
+}
+
+/// The positions marked `used`, and the triangles (which index only used ones)
+/// renumbered for them.
+fn keep_used(
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    used: &[bool],
+) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    if used.iter().all(|&u| u) {
+        return (positions, triangles);
+    }
+    let mut new_index = vec![0u32; positions.len()];
+    let mut kept = Vec::with_capacity(positions.len());
+    for (i, p) in positions.into_iter().enumerate() {
+        if used.get(i).copied().unwrap_or(true) {
+            new_index[i] = kept.len() as u32;
+            kept.push(p);
+        }
+    }
+    let triangles = triangles
+        .into_iter()
+        .map(|t| t.map(|i| new_index.get(i as usize).copied().unwrap_or(0)))
+        .collect();
+    (kept, triangles)
 }
 
 #[cfg(test)]
@@ -1102,7 +1140,7 @@ mod tests {
 <node><instance_geometry url="#sq"/></node>
 <node><translate>0 0 2</translate><instance_geometry url="#sq"/></node>
 </visual_scene></library_visual_scenes></COLLADA>"##;
-        let (p, t) = read_dae(dae, true).unwrap();
+        let (p, t) = read_dae(dae).unwrap();
         assert_eq!(p.len(), 8);
         assert_eq!(p[6], [0.5, 0.5, 1.0]);
         assert_eq!(
@@ -1120,10 +1158,23 @@ mod tests {
         assert_eq!(read_dae_positions(dae).unwrap(), p);
         // An index past the positions is an error naming the primitive.
         let bad = dae.replace("<p>3 2 1</p>", "<p>3 2 9</p>");
-        let e = read_dae(&bad, true).unwrap_err();
+        let e = read_dae(&bad).unwrap_err();
         assert!(e.contains("<triangles>: vertex index 9"), "{e}");
-        // ... which load_vertices never reads.
-        assert_eq!(read_dae_positions(&bad).unwrap().len(), 8);
+        // A position no primitive indexes is dropped (from the vertices and from
+        // the triangles' numbering), in every placed copy.
+        let extra = dae
+            .replace("0 1 0</float_array>", "0 1 0 5 5 5</float_array>")
+            .replace("<p>3 2 1</p>", "<p>3 2 1</p><p></p>");
+        let (p2, t2) = read_dae(&extra).unwrap();
+        assert_eq!((p2, t2), (p.clone(), t.clone()));
+        // Without primitives a geometry's every position is kept.
+        let bare = extra
+            .split("<polylist")
+            .next()
+            .map(|head| format!("{head}</mesh>{}", extra.split("</triangles>\n</mesh>").nth(1).unwrap_or("")))
+            .unwrap();
+        let (p3, t3) = read_dae(&bare).unwrap();
+        assert_eq!((p3.len(), t3.len()), (10, 0), "{bare}");
     }
 
     #[test]
