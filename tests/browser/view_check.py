@@ -14,7 +14,8 @@ the Python standard library only.
           first and the last row);
         - linkPose(name) of every URDF link, at several of the page's times, equals
           `urdyn eval`'s link_poses of that CSV row's q (to 1e-6);
-        - screenshots at the start and at the end are drawn (not blank) and differ.
+        - screenshots at the start and at the end are drawn (not blank) and differ;
+        - the play button moves the slider on.
         --update-docs writes the end screenshot to docs/lamp_drop.png.
 
     view_check.py shot PAGE.html OUT.png [--time T] [--size WxH]
@@ -342,6 +343,14 @@ def check_lamp(args):
             failures.append("a screenshot shows no robot (blank page?)")
         if diff < 0.002:
             failures.append("the start and end screenshots do not differ")
+        # Playback: from the start, the play button moves the slider on.
+        b.evaluate(f"urdynViewer.seek({json.dumps(times[0])}); document.getElementById('play').click()")
+        time.sleep(0.6)
+        moved = b.evaluate("+document.getElementById('slider').value")
+        print(f"playback: slider at frame {moved} after 0.6 s")
+        if not moved > 0:
+            failures.append("the play button did not move the slider")
+        b.evaluate(f"urdynViewer.seek({json.dumps(times[-1])})")
         if args.update_docs:
             with open(os.path.join(ROOT, "docs", "lamp_drop.png"), "wb") as f:
                 f.write(last)

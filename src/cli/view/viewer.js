@@ -33,11 +33,20 @@
   }
 
   // ---- small math (double precision; matrices column-major 4×4) ---------
-  // Body b's pose at frame f: {R: row-major 3×3, p: [3]} (R maps body to world).
-  function bodyPose(f, b) {
+  // Body b's pose at frame f: {R: row-major 3×3, p: [3]} (R maps body to world);
+  // with 0 < a < 1, the pose a of the way to frame f + 1 (drawing during playback).
+  function bodyPose(f, b, a) {
     if (b === 0) return { R: [1, 0, 0, 0, 1, 0, 0, 0, 1], p: [0, 0, 0] };
     const i = (f * M + b - 1);
     let x = rotations[4 * i], y = rotations[4 * i + 1], z = rotations[4 * i + 2], w = rotations[4 * i + 3];
+    let p = [positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]];
+    if (a > 0 && f + 1 < nframes) {
+      const j = i + M;
+      const q1 = [rotations[4 * j], rotations[4 * j + 1], rotations[4 * j + 2], rotations[4 * j + 3]];
+      const s = x * q1[0] + y * q1[1] + z * q1[2] + w * q1[3] < 0 ? -1 : 1;
+      x += a * (s * q1[0] - x); y += a * (s * q1[1] - y); z += a * (s * q1[2] - z); w += a * (s * q1[3] - w);
+      p = p.map((v, k) => v + a * (positions[3 * j + k] - v));
+    }
     const n = Math.hypot(x, y, z, w);
     x /= n; y /= n; z /= n; w /= n;
     const R = [
@@ -45,7 +54,7 @@
       2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
       2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y),
     ];
-    return { R, p: [positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]] };
+    return { R, p };
   }
   function mul3(A, B) { // row-major 3×3 product
     const C = new Array(9);
@@ -100,10 +109,10 @@
   }
 
   // The world pose of a URDF link at frame f, as eval's link_poses.
-  function linkPoseAt(f, name) {
+  function linkPoseAt(f, name, a) {
     const l = linkByName.get(name);
     if (!l) return null;
-    return compose(bodyPose(f, l.body), { R: l.R, p: l.p });
+    return compose(bodyPose(f, l.body, a || 0), { R: l.R, p: l.p });
   }
 
   // ---- WebGL ------------------------------------------------------------
@@ -345,18 +354,18 @@
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
 
   // ---- scene extent, camera ------------------------------------------------
-  function visualWorld(f, v) { return compose(bodyPose(f, v.body), v.local); }
-  function sceneBounds(f) {
+  function visualWorld(f, v, a) { return compose(bodyPose(f, v.body, a || 0), v.local); }
+  function sceneBounds(f, a) {
     let c = [0, 0, 0], n = 0;
-    const ps = visuals.map((v) => visualWorld(f, v).p);
+    const ps = visuals.map((v) => visualWorld(f, v, a).p);
     for (const p of ps) { c = [c[0] + p[0], c[1] + p[1], c[2] + p[2]]; n++; }
     if (!n) {
-      for (const l of links) { const p = linkPoseAt(f, l.name).p; c = [c[0] + p[0], c[1] + p[1], c[2] + p[2]]; n++; }
+      for (const l of links) { const p = linkPoseAt(f, l.name, a).p; c = [c[0] + p[0], c[1] + p[1], c[2] + p[2]]; n++; }
     }
     c = n ? [c[0] / n, c[1] / n, c[2] / n] : [0, 0, 0];
     let r = 0.05;
     visuals.forEach((v, i) => { r = Math.max(r, Math.hypot(...sub(ps[i], c)) + v.radius); });
-    if (!visuals.length) for (const l of links) r = Math.max(r, Math.hypot(...sub(linkPoseAt(f, l.name).p, c)) + 0.05);
+    if (!visuals.length) for (const l of links) r = Math.max(r, Math.hypot(...sub(linkPoseAt(f, l.name, a).p, c)) + 0.05);
     return { c, r };
   }
   const start = nframes ? sceneBounds(0) : { c: [0, 0, 0], r: 1 };
@@ -382,6 +391,7 @@
 
   // ---- drawing --------------------------------------------------------------
   let frame = 0;
+  let blend = 0; // during playback: how far the drawing is between frame and frame + 1
   const ui = {
     follow: document.getElementById("follow"),
     frames: document.getElementById("frames"),
@@ -394,8 +404,8 @@
     const w = Math.max(1, Math.round(canvas.clientWidth * dpr)), h = Math.max(1, Math.round(canvas.clientHeight * dpr));
     if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
     const f = Math.min(frame, Math.max(0, nframes - 1));
-    const world = visuals.map((v) => ({ v, m: poseMat4(visualWorld(f, v), v.scale) }));
-    const sb = nframes ? sceneBounds(f) : start;
+    const world = visuals.map((v) => ({ v, m: poseMat4(visualWorld(f, v, blend), v.scale) }));
+    const sb = nframes ? sceneBounds(f, blend) : start;
     aim(sb);
     const e = eye();
     const view = lookAt(e, cam.target, [0, 0, 1]);
@@ -473,7 +483,7 @@
     if (ui.frames.checked) {
       const s = R0 * 0.12;
       for (const l of links) {
-        const P = linkPoseAt(f, l.name);
+        const P = linkPoseAt(f, l.name, blend);
         for (let k = 0; k < 3; k++) {
           const col = [k === 0 ? 0.9 : 0.1, k === 1 ? 0.75 : 0.1, k === 2 ? 0.95 : 0.1];
           seg(P.p, [P.p[0] + P.R[k] * s, P.p[1] + P.R[3 + k] * s, P.p[2] + P.R[6 + k] * s], col);
@@ -583,7 +593,13 @@
     clock.textContent = nframes ? `${times[k].toFixed(3)} s` : "";
     dirty = true;
   }
-  function setPlaying(p) { playing = p && nframes > 1; playBtn.textContent = playing ? "❚❚" : "▶"; lastWall = null; }
+  function setPlaying(p) {
+    playing = p && nframes > 1;
+    playBtn.textContent = playing ? "❚❚" : "▶";
+    lastWall = null;
+    blend = 0;
+    dirty = true;
+  }
   playBtn.addEventListener("click", () => {
     if (!playing && frame >= nframes - 1) { simT = times[0]; show(0); }
     setPlaying(!playing);
@@ -646,6 +662,9 @@
       lastWall = now;
       const k = floorFrame(simT);
       if (k !== frame) show(k);
+      const a = playing && k + 1 < nframes ? (simT - times[k]) / (times[k + 1] - times[k]) : 0;
+      blend = a > 0 && a < 1 ? a : 0;
+      dirty = true;
     }
     if (dirty) { dirty = false; draw(); drawPlot(); }
     requestAnimationFrame(tick);
