@@ -23,6 +23,9 @@ fn setup(tol: Option<f64>) -> Simulation {
     if let Some(n) = std::env::var("ITERS").ok().and_then(|s| s.parse().ok()) {
         o.solver_iterations = n;
     }
+    if let Some(sv) = std::env::var("SOLVER").ok().and_then(|s| urdyn::sim::Solver::from_name(&s)) {
+        o.solver = sv;
+    }
     if let Some(w) = std::env::var("RELAX").ok().and_then(|s| s.parse().ok()) {
         o.solver_relaxation = w;
     }
@@ -65,9 +68,12 @@ fn main() {
         );
     }
     let mut hist = [0u64; 8];
+    let mut tsum = [0f64; 8];
     let mut prev = 0;
     while sim.time() < dur {
+        let t0 = std::time::Instant::now();
         sim.step_until(dur).expect("step");
+        let el = t0.elapsed().as_secs_f64();
         let sw = sim.pgs_sweeps - prev;
         prev = sim.pgs_sweeps;
         let b = match sw {
@@ -81,7 +87,9 @@ fn main() {
             _ => 7,
         };
         hist[b] += 1;
+        tsum[b] += el;
     }
+    println!("time per bucket (ms): {:?}", tsum.iter().map(|x| (x * 1e5).round() / 100.0).collect::<Vec<_>>());
     println!("sweeps per step [0, 1, 2-3, 4-7, 8-15, 16-31, 32-59, 60+]: {hist:?}");
     println!(
         "mean sweeps/step {:.2}, rows/step {:.1}, queries {}",

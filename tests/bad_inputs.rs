@@ -164,15 +164,14 @@ const BAD_URDF: &[(&str, &[&str])] = &[
         "nonnumeric_mass.urdf",
         &["link \"l1\" <inertial> <mass>", "heavy"],
     ),
-    (
-        "indefinite_inertia.urdf",
-        &["link \"l1\" <inertial>", "indefinite"],
-    ),
-    (
-        "indefinite_offdiag.urdf",
-        &["link \"l1\" <inertial>", "indefinite"],
-    ),
     ("nan_inertia.urdf", &["link \"l1\" <inertial>", "<inertia>"]),
+    (
+        "malformed_collision.urdf",
+        &[
+            "link \"l1\" <collision> <geometry> <box>",
+            "size=\"1 2\" is not 3 numbers",
+        ],
+    ),
     (
         "inf_inertial_origin.urdf",
         &["link \"l1\" <inertial>", "<origin>"],
@@ -231,6 +230,21 @@ const WARN: &[(&str, &[&str])] = &[
         &["joint \"j1\": no <limit>", "joint \"j2\": no <limit>"],
     ),
     ("mesh_dotdot.urdf", &["not found"]),
+    (
+        "malformed_visual.urdf",
+        &[
+            "material \"red\" <color>: rgba=\"1 0 0\" is not 4 numbers (not used by dynamics)",
+            "link \"base\" <visual> <geometry> <box>: size=\"1 2\" is not 3 numbers",
+            "link \"base\" <visual> <geometry>: needs exactly one shape",
+        ],
+    ),
+    (
+        "unknown_attribute.urdf",
+        &[
+            "unknown attribute \"lowr\" on <limit> of joint \"j1\" (ignored; 1 more like it)",
+            "unknown element <spring> in joint \"j2\"",
+        ],
+    ),
     ("ok.urdf", &[]),
 ];
 
@@ -396,6 +410,131 @@ fn warnings_are_not_errors() {
     // A missing <limit> is unknown, never a locked joint: inspect says so.
     let r = run(&["inspect", "no_limit.urdf"]);
     assert!(r.stdout.contains("no position limit known"));
+}
+
+/// The warnings section of `urdyn inspect FILE` (which must succeed).
+fn inspect_warnings(file: &str) -> String {
+    let r = run(&["inspect", file]);
+    assert_eq!(r.code, Some(0), "{file}: {}", r.stderr);
+    r.stdout
+        .split("\nwarnings:\n")
+        .nth(1)
+        .unwrap_or("")
+        .to_string()
+}
+
+/// An inertia that is not positive semi-definite loads as written with a warning
+/// naming the link and its principal moments (Pinocchio's behaviour); the
+/// dynamics are then the URDF's, and an H that is not positive definite is the
+/// contract's singular-H error.
+#[test]
+fn indefinite_inertia_loads_as_written() {
+    // izz = -0.05 about the joint axis: H = [-0.05].
+    let w = inspect_warnings("indefinite_inertia.urdf");
+    assert!(
+        w.contains("link \"l1\": inertia is not positive semi-definite (principal moments 1.000e-1, 1.000e-1, -5.000e-2)"),
+        "{w}"
+    );
+    assert_rejected(
+        &[
+            "eval",
+            "indefinite_inertia.urdf",
+            "--states",
+            "states_one.json",
+        ],
+        &["states_one.json", "states[0]", "singular"],
+    );
+    assert_rejected(
+        &["inspect", "--strict", "indefinite_inertia.urdf"],
+        &[
+            "indefinite_inertia.urdf",
+            "link \"l1\"",
+            "not positive semi-definite",
+            "--strict",
+        ],
+    );
+    // ixy = 0.5 with ixx = iyy = 0.1: principal moments 0.1 ± 0.5 and 0.1.
+    let w = inspect_warnings("indefinite_offdiag.urdf");
+    assert!(
+        w.contains("link \"l1\": inertia is not positive semi-definite"),
+        "{w}"
+    );
+    assert!(w.contains("-4.000e-1") && w.contains("6.000e-1"), "{w}");
+    // Fixed base: the joint turns about z, where the tensor is fine: H = [izz] = [0.1].
+    let r = run(&[
+        "eval",
+        "indefinite_offdiag.urdf",
+        "--states",
+        "states_one.json",
+    ]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).expect("JSON");
+    let h = v["results"][0]["mass_matrix"][0][0]
+        .as_f64()
+        .expect("H[0][0]");
+    assert!((h - 0.1).abs() < 1e-15, "H = {h}");
+    // Floating base: the base block holds the tensor about x and y, made
+    // indefinite (0.45 ± 0.5 with l1 0.5 m above the base): singular.
+    assert_rejected(
+        &[
+            "eval",
+            "indefinite_offdiag.urdf",
+            "--states",
+            "states_one.json",
+            "--floating-base",
+        ],
+        &["states_one.json", "states[0]", "singular"],
+    );
+}
+
+/// A misspelt attribute is a warning naming it, and the value it was meant to
+/// set keeps its default (here lower = 0 of URDF 1.0).
+#[test]
+fn unknown_attribute_is_named_and_ignored() {
+    let r = run(&["inspect", "unknown_attribute.urdf"]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(r.stdout.contains("j1  [0, 1]"), "{}", r.stdout);
+    assert_rejected(
+        &["inspect", "--strict", "unknown_attribute.urdf"],
+        &[
+            "unknown_attribute.urdf",
+            "unknown attribute \"lowr\" on <limit> of joint \"j1\"",
+        ],
+    );
+    // Without warnings --strict changes nothing.
+    let plain = run(&["inspect", "ok.urdf"]);
+    let strict = run(&["inspect", "--strict", "ok.urdf"]);
+    assert_eq!(strict.code, Some(0), "{}", strict.stderr);
+    assert_eq!(plain.stdout, strict.stdout);
+    assert!(inspect_warnings("ok.urdf").trim() == "none");
+}
+
+/// What no dynamics reads never stops a load: a `<texture>` without `filename`
+/// (urdfdom reads it as no texture) gives no warning at all; `<gazebo>` and
+/// `<transmission>` contents are not looked into.
+#[test]
+fn visual_only_problems_never_stop_a_load() {
+    // ... nor do `version`, `xmlns:xacro`, a xacro leftover or PyBullet's <contact>:
+    // they are listed as ignored.
+    assert_eq!(inspect_warnings("texture_no_filename.urdf").trim(), "none");
+    let r = run(&["inspect", "texture_no_filename.urdf"]);
+    for ignored in [
+        "<xacro:property> elements (xacro leftovers, not expanded)",
+        "<link> <contact> elements (PyBullet extension, not used by dynamics)",
+    ] {
+        assert!(
+            r.stdout.contains(ignored),
+            "{ignored:?} not in\n{}",
+            r.stdout
+        );
+    }
+    let r = run(&["inspect", "malformed_visual.urdf"]);
+    assert!(r.stdout.contains("<gazebo> elements") && r.stdout.contains("<transmission> elements"));
+    assert!(!r.stdout.contains("anything") && !r.stdout.contains("hardwareInterface"));
+    assert_rejected(
+        &["inspect", "--strict", "malformed_visual.urdf"],
+        &["malformed_visual.urdf", "material \"red\" <color>"],
+    );
 }
 
 #[test]

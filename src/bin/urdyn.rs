@@ -32,6 +32,9 @@ enum Command {
         /// A root for package://NAME/... mesh paths (repeatable; ROS_PACKAGE_PATH is also read).
         #[arg(long, value_name = "DIR")]
         package_path: Vec<PathBuf>,
+        /// Treat every warning as an error: fail (non-zero exit) with the first one.
+        #[arg(long)]
+        strict: bool,
     },
     /// Evaluate inverse dynamics, forward dynamics, C(q, v), H(q) and link poses for a
     /// batch of states (JSON in, JSON out; see eval-contract.md).
@@ -266,8 +269,14 @@ fn run(cli: Cli) -> Result<()> {
             urdf,
             floating_base,
             package_path,
+            strict,
         } => {
             let model = urdyn::load_file(&urdf, LoadOptions { floating_base })?;
+            if strict {
+                if let Some(w) = inspect::warnings(&model, &package_path).first() {
+                    anyhow::bail!("{}: {w} (--strict: warnings are errors)", urdf.display());
+                }
+            }
             let text = inspect::report(&model, &package_path);
             std::io::stdout().write_all(text.as_bytes())?;
         }

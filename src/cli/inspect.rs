@@ -5,6 +5,23 @@ use crate::model::{Model, Shape};
 use std::fmt::Write;
 use std::path::PathBuf;
 
+/// Every warning of the import report plus the inspection's own (mesh files
+/// that are not found), in the order `inspect` prints them.
+pub fn warnings(model: &Model, package_paths: &[PathBuf]) -> Vec<String> {
+    let mut warnings = model.report.warnings.clone();
+    for c in &model.collisions {
+        if let Shape::Mesh { filename, .. } = &c.shape {
+            if resolve_mesh_path(filename, model.source.as_deref(), package_paths).is_none() {
+                warnings.push(format!(
+                    "link \"{}\": mesh file \"{filename}\" not found (needed only for contact)",
+                    c.link
+                ));
+            }
+        }
+    }
+    warnings
+}
+
 /// A human-readable report: the tree, the DoFs, masses, merged links, collision
 /// geometry and warnings.
 pub fn report(model: &Model, package_paths: &[PathBuf]) -> String {
@@ -73,18 +90,9 @@ pub fn report(model: &Model, package_paths: &[PathBuf]) -> String {
     if model.collisions.is_empty() {
         let _ = writeln!(s, "  none");
     }
-    let mut warnings = model.report.warnings.clone();
     for c in &model.collisions {
         let extra = match &c.shape {
-            Shape::Mesh { filename, .. } => {
-                if resolve_mesh_path(filename, model.source.as_deref(), package_paths).is_none() {
-                    warnings.push(format!(
-                        "link \"{}\": mesh file \"{filename}\" not found (needed only for contact)",
-                        c.link
-                    ));
-                }
-                format!(" {filename}")
-            }
+            Shape::Mesh { filename, .. } => format!(" {filename}"),
             _ => String::new(),
         };
         let _ = writeln!(s, "  {}: {}{}", c.link, c.shape.kind(), extra);
@@ -95,6 +103,7 @@ pub fn report(model: &Model, package_paths: &[PathBuf]) -> String {
             let _ = writeln!(s, "  {i}");
         }
     }
+    let warnings = warnings(model, package_paths);
     let _ = writeln!(s, "\nwarnings:");
     if warnings.is_empty() {
         let _ = writeln!(s, "  none");

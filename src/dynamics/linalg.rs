@@ -72,7 +72,8 @@ macro_rules! by_size {
 }
 pub(crate) use by_size;
 
-/// [`cholesky`] on `f64` (same arithmetic, same order) with the size known at
+/// [`cholesky`] on `f64` (same order; a column scaled by the pivot's reciprocal,
+/// so last-bit differences) with the size known at
 /// compile time for common sizes and the bounds checked once: the lower
 /// triangle of `l` receives L with `h = L Lᵀ`; `h`'s lower triangle is read.
 pub fn cholesky_fast(h: &DMatrix<f64>, l: &mut DMatrix<f64>) -> Result<(), usize> {
@@ -103,12 +104,14 @@ fn cholesky_n<const N: usize>(h: &[f64], l: &mut [f64], n: usize) -> Result<(), 
             }
             let djj = d.sqrt();
             *l.get_unchecked_mut(j * n + j) = djj;
+            // one division a column (a multiply by the reciprocal below)
+            let inv = 1.0 / djj;
             for i in (j + 1)..n {
                 let mut s = *h.get_unchecked(j * n + i);
                 for k in 0..j {
                     s -= *l.get_unchecked(k * n + i) * *l.get_unchecked(k * n + j);
                 }
-                *l.get_unchecked_mut(j * n + i) = s / djj;
+                *l.get_unchecked_mut(j * n + i) = s * inv;
             }
         }
     }

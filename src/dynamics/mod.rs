@@ -16,9 +16,10 @@ pub mod linalg;
 pub mod ltdl;
 mod rnea;
 
+pub use crate::spatial::CompositeInertia;
 pub use aba::aba;
 pub use centroidal::{center_of_mass, centroidal_momentum};
-pub use crba::{crba, crba_upper, CompositeInertia};
+pub use crba::{crba, crba_upper};
 
 pub use energy::{kinetic_energy, kinetic_energy_from_placements, potential_energy};
 pub use forward_rnea::{forward_dynamics_rnea, mass_matrix_rnea};

@@ -1,12 +1,14 @@
 use super::Model;
-use crate::dynamics::CompositeInertia;
-use crate::spatial::{Force, Inertia, Motion, Scalar, Se3};
+use crate::spatial::{CompositeInertia, Force, Motion, Scalar, Se3};
 use nalgebra::{DMatrix, DVector, Matrix6, Vector6};
 
 /// The preallocated workspace of every algorithm: sized once from a [`Model`],
-/// then reused with no allocation in the hot path.
+/// then reused with no allocation in the hot path. The results and the
+/// kinematics come first; then each algorithm's own scratch, named after it
+/// (`crba_*`, `aba_*`), which nothing outside that algorithm reads.
 #[derive(Clone, Debug)]
 pub struct Data<T: Scalar = f64> {
+    // Kinematics (forward kinematics, RNEA, ABA).
     /// `liMi`: body i's frame in its parent's frame.
     pub li_m_i: Vec<Se3<T>>,
     /// `oMi`: body i's frame in the world.
@@ -20,10 +22,8 @@ pub struct Data<T: Scalar = f64> {
     /// Spatial force transmitted by each body's joint (body frame, docs/theory.md
     /// §"Force recursion").
     pub f: Vec<Force<T>>,
-    /// External forces per body, expressed in the body frame (scratch).
-    pub fext_body: Vec<Force<T>>,
-    /// Composite / articulated inertias (scratch for CRBA and ABA).
-    pub ic: Vec<Inertia<T>>,
+
+    // Results.
     /// Generalized forces from inverse dynamics.
     pub tau: DVector<T>,
     /// C(q, v) (docs/theory.md §"Bias forces").
@@ -32,11 +32,15 @@ pub struct Data<T: Scalar = f64> {
     pub qdd: DVector<T>,
     /// The joint-space inertia matrix H(q) (full, symmetric).
     pub h: DMatrix<T>,
-    /// Cholesky factor workspace.
+    /// The factor of H (Cholesky or tree-sparse LTDL, docs/theory.md §"Tree-sparse LTDL").
     pub chol: DMatrix<T>,
-    /// Scratch vectors of size nv.
+
+    // Forward dynamics by inverse dynamics (docs/theory.md §"Forward dynamics by
+    // inverse dynamics").
+    /// Scratch vector of size nv.
     pub tmp_a: DVector<T>,
-    pub tmp_b: DVector<T>,
+
+    // CRBA (docs/theory.md §"Composite-rigid-body algorithm").
     /// CRBA: composite inertia of each body's subtree (origin form, body frame).
     pub crba_ic: Vec<CompositeInertia<T>>,
     /// CRBA: `F = I^c S` of every velocity coordinate, moved towards the root,
@@ -45,6 +49,8 @@ pub struct Data<T: Scalar = f64> {
     /// CRBA (local frames): `F = I^c S` of every velocity coordinate of the current
     /// subtree, in the frame it has been carried to.
     pub crba_fc: Vec<Force<T>>,
+
+    // ABA (docs/theory.md §"Articulated-body algorithm").
     /// ABA: articulated inertia `Iᴬ` of each body (6x6, angular-first, body frame).
     pub aba_ia: Vec<Matrix6<T>>,
     /// ABA: `U = Iᴬ S` of a 1-DoF joint; for a free joint, `τ − pᴬ` as a 6-vector.
@@ -58,6 +64,7 @@ pub struct Data<T: Scalar = f64> {
 }
 
 impl<T: Scalar> Data<T> {
+    /// The workspace for `model`, every entry zero (or the identity).
     pub fn new(model: &Model<T>) -> Self {
         let nb = model.nbodies;
         let nv = model.nv;
@@ -68,15 +75,12 @@ impl<T: Scalar> Data<T> {
             v: vec![Motion::zero(); nb],
             a: vec![Motion::zero(); nb],
             f: vec![Force::zero(); nb],
-            fext_body: vec![Force::zero(); nb],
-            ic: vec![Inertia::zero(); nb],
             tau: DVector::zeros(nv),
             bias: DVector::zeros(nv),
             qdd: DVector::zeros(nv),
             h: DMatrix::zeros(nv, nv),
             chol: DMatrix::zeros(nv, nv),
             tmp_a: DVector::zeros(nv),
-            tmp_b: DVector::zeros(nv),
             crba_ic: vec![CompositeInertia::zero(); nb],
             crba_f: DMatrix::zeros(nv, 6),
             crba_fc: vec![Force::zero(); nv],

@@ -89,7 +89,14 @@ pub struct ImportReport {
     pub merged: Vec<(String, String)>,
     /// The kinematic tree, one line a link, indented by depth.
     pub tree: Vec<String>,
+    /// What the import skipped on purpose because no dynamics reads it
+    /// (`<gazebo>`, `<transmission>`, `<sensor>`, xacro leftovers, `<calibration>`, ...).
     pub ignored: Vec<String>,
+    /// Suspicious but usable input, one line each, naming the element: inertias
+    /// that are not positive semi-definite (loaded as written) or not physical,
+    /// massless subtrees, unknown limits, attributes and elements outside the URDF
+    /// specification, malformed visuals and materials. `urdyn inspect --strict`
+    /// makes the first one an error.
     pub warnings: Vec<String>,
 }
 
@@ -116,9 +123,9 @@ pub struct Model<T: Scalar = f64> {
     /// Spatial inertia of each body in its own frame (links merged).
     pub inertias: Vec<Inertia<T>>,
     /// The same inertias in origin form (mass, first moment, rotational inertia
-    /// about the frame origin; [`crate::dynamics::CompositeInertia::from_inertia`]),
+    /// about the frame origin; [`crate::spatial::CompositeInertia::from_inertia`]),
     /// computed at load: the CRBA's starting composite inertias.
-    pub inertias_origin: Vec<crate::dynamics::CompositeInertia<T>>,
+    pub inertias_origin: Vec<crate::spatial::CompositeInertia<T>>,
     /// URDF joint name of each body (entry 0: "universe").
     pub body_joint_names: Vec<String>,
     /// URDF link name of each body (its movable joint's child link).
@@ -237,7 +244,7 @@ impl Model<f64> {
             inertias_origin: self
                 .inertias_origin
                 .iter()
-                .map(|i| crate::dynamics::CompositeInertia {
+                .map(|i| crate::spatial::CompositeInertia {
                     m: c(i.m),
                     h: cv(&i.h),
                     io: i.io.map(c),

@@ -18,7 +18,8 @@
 
 use super::factor::MassFactor;
 use super::solver::{self, RowKind, Rows};
-use super::ContactForce;
+use super::newton::Newton;
+use super::{ContactForce, Solver};
 use crate::contact::ContactPoint;
 use crate::model::Model;
 use crate::spatial::{Force, Motion, Se3};
@@ -102,6 +103,7 @@ pub(crate) struct Constraints {
     contact_forces: Vec<ContactForce>,
     /// R v* (the energy-safe exit's work).
     a: Vec<f64>,
+    newton: Newton,
 }
 
 impl Constraints {
@@ -126,6 +128,7 @@ impl Constraints {
             fext: vec![Force::zero(); model.nbodies],
             contact_forces: Vec::with_capacity(max_points),
             a: vec![0.0; nv],
+            newton: Newton::new(nv, cap),
         }
     }
 
@@ -320,6 +323,7 @@ impl Constraints {
         iterations: usize,
         tol: f64,
         relaxation: f64,
+        solver: Solver,
     ) -> Impulses<'_> {
         let nv = model.nv;
         let vo = model.joint_v_offset();
@@ -329,10 +333,15 @@ impl Constraints {
         // Y rows = R⁻ᵀ jᵣ (H̃ = RᵀR, each over its path): W = J H̃⁻¹ Jᵀ = Y Yᵀ,
         // the solver works on Δv' = R Δv with uᵣ = cᵣ + yᵣ·Δv'
         rows.form(f, vfree.as_slice());
-        let mut sweeps = rows.solve(f, self.dv.as_mut_slice(), iterations, tol, relaxation);
+        let mut sweeps = match solver {
+            Solver::Pgs => rows.solve(f, self.dv.as_mut_slice(), iterations, tol, relaxation),
+            Solver::Newton => self.newton.solve(rows, f, self.dv.as_mut_slice(), iterations, tol),
+        };
         if sweeps >= iterations {
+            // (a Newton solve stopped by the cap is scaled, never swept)
+            let more = if solver == Solver::Pgs { iterations } else { 0 };
             f.apply_r(vfree.as_slice(), &mut self.a);
-            sweeps += energy_safe_exit(rows, f, &self.a, self.dv.as_mut_slice(), iterations, tol);
+            sweeps += energy_safe_exit(rows, f, &self.a, self.dv.as_mut_slice(), more, tol);
         }
         // Δv = R⁻¹ Δv'
         f.half_solve(self.dv.as_mut_slice());

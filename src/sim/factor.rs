@@ -13,8 +13,7 @@
 //! tree-sparse `mj_factorI` / `mj_solveM` idea). With mimic joints H̃ is not
 //! tree-shaped: a dense Cholesky H̃ = L Lᵀ (R = Lᵀ) and full-length rows.
 
-use crate::dynamics::linalg::cholesky_fast;
-use crate::dynamics::linalg::{chol_backward_slice, chol_forward_slice, chol_solve_slice};
+use crate::dynamics::linalg::{by_size, cholesky_fast};
 use crate::dynamics::ltdl::{ltdl, ltdl_solve};
 use crate::model::Model;
 use nalgebra::{DMatrix, DVector};
@@ -29,7 +28,10 @@ pub struct MassFactor {
     /// Dense: L (lower, column-major). Tree: the LTDL storage (Lᵀ in the upper
     /// triangle, D on the diagonal).
     m: DMatrix<f64>,
+    /// Tree: D^½. Dense: unused.
     sqrt_d: Vec<f64>,
+    /// Tree: D^-½. Dense: 1 / Lₖₖ (the substitutions multiply, never divide:
+    /// a division costs a dozen multiplies, and a step does hundreds).
     inv_sqrt_d: Vec<f64>,
     lambda: Vec<usize>,
     /// Every dof's path (root … dof, ascending) back to back, then `0..n`.
@@ -42,7 +44,12 @@ pub struct MassFactor {
 impl MassFactor {
     pub fn new(model: &Model) -> Self {
         let n = model.nv;
-        let tree = !model.has_mimic && model.dof_parent.len() == n;
+        let chain = model
+            .dof_parent
+            .iter()
+            .enumerate()
+            .all(|(k, &p)| p == k.wrapping_sub(1));
+        let tree = !model.has_mimic && model.dof_parent.len() == n && !(chain && n <= 18);
         let mut table = Vec::new();
         let (mut start, mut len) = (Vec::with_capacity(n + 1), Vec::with_capacity(n + 1));
         for k in 0..n {
@@ -105,7 +112,11 @@ impl MassFactor {
             }
             Ok(())
         } else {
-            cholesky_fast(h, &mut self.m)
+            cholesky_fast(h, &mut self.m)?;
+            for k in 0..self.n {
+                self.inv_sqrt_d[k] = 1.0 / self.m[(k, k)];
+            }
+            Ok(())
         }
     }
 
@@ -114,7 +125,11 @@ impl MassFactor {
         if self.tree {
             ltdl_solve(&self.m, &self.lambda, x);
         } else {
-            chol_solve_slice(self.m.as_slice(), self.n, x.as_mut_slice());
+            let (l, inv, x) = (self.m.as_slice(), &self.inv_sqrt_d[..], x.as_mut_slice());
+            by_size!(self.n, N => {
+                dense_forward::<N, 1>(l, inv, self.n, [x]);
+                dense_backward::<N>(l, inv, self.n, x)
+            })
         }
     }
 
@@ -126,7 +141,7 @@ impl MassFactor {
         let m = self.m.as_slice();
         if !self.tree {
             // R⁻ᵀ = L⁻¹ (the path is 0..n)
-            chol_forward_slice(m, n, y);
+            by_size!(n, N => dense_forward::<N, 1>(m, &self.inv_sqrt_d, n, [y]));
             return;
         }
         let len = path.len().min(y.len());
@@ -150,14 +165,12 @@ impl MassFactor {
     /// and tangents) in one pass over the factor.
     #[inline]
     pub fn row_transform3(&self, path: &[usize], y0: &mut [f64], y1: &mut [f64], y2: &mut [f64]) {
-        if !self.tree {
-            self.row_transform(path, y0);
-            self.row_transform(path, y1);
-            self.row_transform(path, y2);
-            return;
-        }
         let n = self.n;
         let m = self.m.as_slice();
+        if !self.tree {
+            by_size!(n, N => dense_forward::<N, 3>(m, &self.inv_sqrt_d, n, [y0, y1, y2]));
+            return;
+        }
         let len = path.len().min(y0.len()).min(y1.len()).min(y2.len());
         for t in (0..len).rev() {
             let (a0, a1, a2) = (y0[t], y1[t], y2[t]);
@@ -181,7 +194,7 @@ impl MassFactor {
     pub fn half_solve(&self, z: &mut [f64]) {
         let n = self.n;
         if !self.tree {
-            chol_backward_slice(self.m.as_slice(), n, z);
+            by_size!(n, N => dense_backward::<N>(self.m.as_slice(), &self.inv_sqrt_d, n, z));
             return;
         }
         // L x = D^-½ z, root outwards
@@ -235,5 +248,55 @@ impl MassFactor {
         let r = x.rows(0, l).norm_squared();
         self.x = x;
         r
+    }
+}
+
+/// L x' = x in place for K vectors at once (forward substitution; L lower,
+/// column-major n × n, `inv` its reciprocal diagonal). `N = 0`: the length `n`
+/// at run time, else `N = n`. Does nothing when a length does not fit.
+#[inline(always)]
+fn dense_forward<const N: usize, const K: usize>(
+    l: &[f64],
+    inv: &[f64],
+    n: usize,
+    x: [&mut [f64]; K],
+) {
+    let n = if N == 0 { n } else { N };
+    if l.len() < n * n || inv.len() < n || x.iter().any(|x| x.len() < n) {
+        return;
+    }
+    let mut x = x.map(|x| &mut x[..n]);
+    let (l, inv) = (&l[..n * n], &inv[..n]);
+    for k in 0..n {
+        let mut xk = [0.0; K];
+        for (a, xs) in xk.iter_mut().zip(x.iter_mut()) {
+            *a = xs[k] * inv[k];
+            xs[k] = *a;
+        }
+        let col = &l[k * n..(k + 1) * n];
+        for i in k + 1..n {
+            let lik = col[i];
+            for (a, xs) in xk.iter().zip(x.iter_mut()) {
+                xs[i] -= lik * a;
+            }
+        }
+    }
+}
+
+/// Lᵀ x' = x in place (back substitution), as [`dense_forward`].
+#[inline(always)]
+fn dense_backward<const N: usize>(l: &[f64], inv: &[f64], n: usize, x: &mut [f64]) {
+    let n = if N == 0 { n } else { N };
+    if l.len() < n * n || inv.len() < n || x.len() < n {
+        return;
+    }
+    let (l, inv, x) = (&l[..n * n], &inv[..n], &mut x[..n]);
+    for k in (0..n).rev() {
+        let col = &l[k * n..(k + 1) * n];
+        let mut s = 0.0;
+        for i in k + 1..n {
+            s += x[i] * col[i];
+        }
+        x[k] = (x[k] - s) * inv[k];
     }
 }

@@ -61,6 +61,7 @@
 
 pub mod constraints;
 pub mod factor;
+pub mod newton;
 pub(crate) mod integrators;
 pub mod solver;
 
@@ -112,6 +113,9 @@ pub struct SimOptions {
     /// the force distribution only, never energy.
     pub solver_iterations: usize,
     pub solver_tol: f64,
+    /// The constraint solver: projected Gauss–Seidel (the default) or the
+    /// primal Newton method ([`newton`]; benches/solver_compare.md measures both).
+    pub solver: Solver,
     /// Over-relaxation of the solver's scalar rows (projected SOR), in (0, 2).
     /// 1.3 (over-relaxing only sweeps 4 to `solver_iterations`/2, then one plain
     /// sweep) cut the lamp drop's mean sweeps per step from 7.1 to 5.0 (same
@@ -137,6 +141,7 @@ impl Default for SimOptions {
             armature: 0.0,
             solver_iterations: 20,
             solver_tol: 1e-6,
+            solver: Solver::Pgs,
             solver_relaxation: 1.3,
             limit_push_speed: 1.0,
             max_energy_rise: Some(EnergyBound {
@@ -144,6 +149,30 @@ impl Default for SimOptions {
                 absolute: 1e-2,
             }),
         }
+    }
+}
+
+/// The velocity-level constraint solver.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Solver {
+    /// Projected Gauss–Seidel on the Delassus matrix, exact disc cones ([`solver`]).
+    #[default]
+    Pgs,
+    /// Primal Newton on nearly hard constraints, pyramidal cones ([`newton`]).
+    Newton,
+}
+
+impl Solver {
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Solver::Pgs => "pgs",
+            Solver::Newton => "newton",
+        }
+    }
+    /// The solver of a command-line name.
+    pub fn from_name(s: &str) -> Option<Self> {
+        [Solver::Pgs, Solver::Newton].into_iter().find(|x| x.name() == s)
     }
 }
 
@@ -263,6 +292,10 @@ struct EnergyGuard {
 ///     sim.step().unwrap();
 /// }
 /// ```
+///
+/// A `Simulation` clones (model, contact shapes and workspace included): a batch
+/// of runs builds its meshes' hulls once and clones the prototype.
+#[derive(Clone, Debug)]
 pub struct Simulation {
     pub model: Model,
     integrator: Integrator,

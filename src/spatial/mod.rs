@@ -11,12 +11,17 @@
 //! JSON use Pinocchio's linear-first order for the floating base; the conversion
 //! happens at that boundary only.
 
+mod axis;
+mod composite;
 mod force;
 mod inertia;
 mod motion;
 pub mod ops;
 mod se3;
 
+pub use axis::Axis;
+pub(crate) use axis::{AxU, AxX, AxY, AxZ, AxisOf};
+pub use composite::CompositeInertia;
 pub use force::Force;
 pub use inertia::Inertia;
 pub use motion::Motion;

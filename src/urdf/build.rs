@@ -6,12 +6,11 @@
 use super::super::UrdfError;
 use quick_xml::events::{BytesStart, Event};
 use urdf_rs::{
-    Axis, Calibration, Collision, Color, Dynamics, Geometry, Inertia, Inertial, Joint, JointLimit,
-    JointType, Link, LinkName, Mass, Material, Mimic, Pose, Robot, SafetyController, Texture, Vec3,
-    Vec4, Visual,
+    Axis, Calibration, Collision, Dynamics, Geometry, Inertia, Inertial, Joint, JointLimit,
+    JointType, Link, LinkName, Mass, Mimic, Pose, Robot, SafetyController, Vec3,
 };
 
-/// A small element tree: one top-level `<link>`, `<joint>` or `<material>`.
+/// A small element tree: one top-level `<link>` or `<joint>`.
 struct El {
     tag: String,
     attrs: Vec<(String, String)>,
@@ -151,35 +150,6 @@ impl Ctx<'_> {
         Ok(g)
     }
 
-    fn material(&self, el: &El, label: &str) -> Result<Material, UrdfError> {
-        let color = match el.child("color") {
-            Some(c) => {
-                let l = format!("{label} <color>");
-                let v = self
-                    .numbers(c, "rgba", &l)?
-                    .ok_or_else(|| self.err(&l, "missing attribute rgba"))?;
-                Some(Color {
-                    rgba: Vec4(
-                        <[f64; 4]>::try_from(v)
-                            .map_err(|_| self.err(&l, "rgba must be 4 numbers"))?,
-                    ),
-                })
-            }
-            None => None,
-        };
-        let texture = match el.child("texture") {
-            Some(t) => Some(Texture {
-                filename: self.string(t, "filename", &format!("{label} <texture>"))?,
-            }),
-            None => None,
-        };
-        Ok(Material {
-            name: el.attr("name").unwrap_or_default().to_string(),
-            color,
-            texture,
-        })
-    }
-
     fn link(&self, el: &El) -> Result<Link, UrdfError> {
         let name = self.string(el, "name", "<link>")?;
         let label = format!("link \"{name}\"");
@@ -210,19 +180,6 @@ impl Ctx<'_> {
                 }
             }
         };
-        let mut visual = Vec::new();
-        for (k, v) in el.all("visual").enumerate() {
-            let l = format!("{label} <visual> #{}", k + 1);
-            visual.push(Visual {
-                name: v.attr("name").map(str::to_string),
-                origin: self.pose(v.child("origin"), &l)?,
-                geometry: self.geometry(v.child("geometry"), &l)?,
-                material: match v.child("material") {
-                    Some(m) => Some(self.material(m, &format!("{l} <material>"))?),
-                    None => None,
-                },
-            });
-        }
         let mut collision = Vec::new();
         for (k, c) in el.all("collision").enumerate() {
             let l = format!("{label} <collision> #{}", k + 1);
@@ -235,7 +192,8 @@ impl Ctx<'_> {
         Ok(Link {
             name,
             inertial,
-            visual,
+            // Visuals are not used by dynamics: the scan checks them (warnings only).
+            visual: Vec::new(),
             collision,
         })
     }
@@ -430,8 +388,9 @@ fn element(e: &BytesStart, file: &str) -> Result<El, UrdfError> {
     })
 }
 
-/// Reads the robot: the `<robot>` attributes and each top-level `<link>`,
-/// `<joint>` and `<material>`, in file order.
+/// Reads the robot: the `<robot>` attributes and each top-level `<link>` and
+/// `<joint>`, in file order (`<material>`s and `<visual>`s, which no dynamics
+/// reads, are left out: the scan has checked them).
 pub(super) fn build(text: &str, file: &str) -> Result<Robot, UrdfError> {
     let mut reader = quick_xml::Reader::from_str(text);
     let mut depth = 0usize;
@@ -452,11 +411,7 @@ pub(super) fn build(text: &str, file: &str) -> Result<Robot, UrdfError> {
     let finish = |ctx: &Ctx, robot: &mut Robot, t: El| -> Result<(), UrdfError> {
         match t.tag.as_str() {
             "link" => robot.links.push(ctx.link(&t)?),
-            "joint" => robot.joints.push(ctx.joint(&t)?),
-            _ => {
-                let label = format!("material \"{}\"", t.attr("name").unwrap_or(""));
-                robot.materials.push(ctx.material(&t, &label)?)
-            }
+            _ => robot.joints.push(ctx.joint(&t)?),
         }
         Ok(())
     };
@@ -488,7 +443,7 @@ pub(super) fn build(text: &str, file: &str) -> Result<Robot, UrdfError> {
                 ctx.version = super::robot_version(robot.version.as_deref());
                 false
             }
-            1 => matches!(e.name().as_ref(), b"link" | b"joint" | b"material"),
+            1 => matches!(e.name().as_ref(), b"link" | b"joint"),
             _ => !stack.is_empty(),
         };
         if keep {

@@ -377,7 +377,7 @@ pub(crate) fn lower(
         placements,
         inertias_origin: inertias
             .iter()
-            .map(crate::dynamics::CompositeInertia::from_inertia)
+            .map(crate::spatial::CompositeInertia::from_inertia)
             .collect(),
         inertias,
         body_joint_names,

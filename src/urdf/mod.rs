@@ -22,8 +22,11 @@ pub struct LoadOptions {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{file}: {}{message}", element.as_ref().map(|e| format!("{e}: ")).unwrap_or_default())]
 pub struct UrdfError {
+    /// The file (as given to the loader).
     pub file: String,
+    /// The offending element (`joint "j1" <limit>`), where there is one.
     pub element: Option<String>,
+    /// What is wrong.
     pub message: String,
 }
 

@@ -9,10 +9,15 @@ use super::UrdfError;
 #[path = "build.rs"]
 mod build;
 
-/// The urdf-rs robot plus the top-level tags that urdf-rs drops (reported as ignored).
+/// The urdf-rs robot (links and joints; visuals and materials, which no dynamics
+/// reads, are checked by the scan but not built) plus what the scan found.
 pub(crate) struct Parsed {
     pub robot: urdf_rs::Robot,
+    /// Elements skipped whole (`<gazebo>`, `<transmission>`, `<sensor>`, xacro
+    /// leftovers), one line a kind, as the import report prints them.
     pub ignored_tags: Vec<String>,
+    /// Unknown attributes and elements, malformed visuals and materials.
+    pub warnings: Vec<String>,
 }
 
 pub(crate) fn parse(text: &str, file: &str) -> Result<Parsed, UrdfError> {
@@ -34,11 +39,12 @@ pub(crate) fn parse(text: &str, file: &str) -> Result<Parsed, UrdfError> {
             "document type declarations are not allowed",
         ));
     }
-    let ignored_tags = scan_top_level(text, file)?;
+    let mut scan = scan(text, file)?;
     let robot = build::build(text, file)?;
     Ok(Parsed {
         robot,
-        ignored_tags,
+        ignored_tags: std::mem::take(&mut scan.ignored),
+        warnings: scan.into_warnings(),
     })
 }
 
@@ -81,6 +87,80 @@ fn numeric_arity(tag: &str, attr: &str) -> Option<usize> {
     })
 }
 
+/// The attributes the URDF specification (urdfdom, urdf-rs, URDF 1.0–1.2) gives an
+/// element; `None` for an element outside it. `xmlns` declarations are known everywhere.
+fn known_attrs(tag: &str) -> Option<&'static [&'static str]> {
+    Some(match tag {
+        "robot" => &["name", "version"],
+        "link" | "visual" | "collision" | "material" => &["name"],
+        "joint" => &["name", "type"],
+        "inertial" | "geometry" => &[],
+        "origin" => &["xyz", "rpy", "quat_xyzw"],
+        "mass" => &["value"],
+        "inertia" => &["ixx", "ixy", "ixz", "iyy", "iyz", "izz"],
+        "box" => &["size"],
+        "cylinder" | "capsule" => &["radius", "length"],
+        "sphere" => &["radius"],
+        "mesh" => &["filename", "scale"],
+        "color" => &["rgba"],
+        "texture" => &["filename"],
+        "parent" | "child" => &["link"],
+        "axis" => &["xyz"],
+        // urdfdom's JointCalibration also holds a reference position.
+        "calibration" => &["rising", "falling", "reference_position"],
+        "dynamics" => &["damping", "friction"],
+        "limit" => &[
+            "lower",
+            "upper",
+            "effort",
+            "velocity",
+            "acceleration",
+            "deceleration",
+            "jerk",
+        ],
+        "mimic" => &["joint", "multiplier", "offset"],
+        "safety_controller" => &[
+            "soft_lower_limit",
+            "soft_upper_limit",
+            "k_position",
+            "k_velocity",
+        ],
+        _ => return None,
+    })
+}
+
+/// The child elements the URDF specification allows below a (read) element.
+fn known_children(tag: &str) -> &'static [&'static str] {
+    match tag {
+        "link" => &["inertial", "visual", "collision"],
+        "inertial" => &["origin", "mass", "inertia"],
+        "visual" => &["origin", "geometry", "material"],
+        "collision" => &["origin", "geometry"],
+        "geometry" => &SHAPES,
+        "material" => &["color", "texture"],
+        "joint" => &[
+            "origin",
+            "parent",
+            "child",
+            "axis",
+            "calibration",
+            "dynamics",
+            "limit",
+            "mimic",
+            "safety_controller",
+        ],
+        _ => &[],
+    }
+}
+
+/// Top-level elements that no dynamics reads, skipped with their whole subtree:
+/// simulator and controller extensions and the URDF sensor element.
+const SKIPPED_TOP_LEVEL: [&str; 4] = ["gazebo", "transmission", "sensor", "ros2_control"];
+
+/// Link children outside the URDF specification that a widely used reader
+/// defines (PyBullet's `<contact>` friction parameters), skipped whole.
+const SKIPPED_IN_LINK: [&str; 1] = ["contact"];
+
 /// Attributes without which urdf-rs cannot read an element.
 fn required_attrs(tag: &str, parent: &str, version: (u32, u32)) -> &'static [&'static str] {
     match (tag, parent) {
@@ -97,8 +177,8 @@ fn required_attrs(tag: &str, parent: &str, version: (u32, u32)) -> &'static [&'s
         ("cylinder" | "capsule", "geometry") => &["radius", "length"],
         ("sphere", "geometry") => &["radius"],
         ("mesh", "geometry") => &["filename"],
+        // A `<texture>` without `filename` is no texture (urdfdom's reading).
         ("color", "material") => &["rgba"],
-        ("texture", "material") => &["filename"],
         _ => &[],
     }
 }
@@ -142,6 +222,18 @@ const SHAPES: [&str; 5] = ["box", "cylinder", "capsule", "sphere", "mesh"];
 /// The deepest element nesting accepted.
 const MAX_DEPTH: usize = 64;
 
+/// How the scan treats an element and its subtree.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    /// Read by the dynamics (links, joints, collisions): a problem is an error.
+    Strict,
+    /// Known to the URDF specification but read by no dynamics (`<visual>`,
+    /// `<material>`): a problem is a warning.
+    Lenient,
+    /// Not looked into (`<gazebo>`, `<transmission>`, unknown elements).
+    Skip,
+}
+
 /// An open element during the scan.
 struct Open {
     tag: String,
@@ -149,6 +241,7 @@ struct Open {
     /// are named by their path below it (`joint "j1" <origin>`), built on error only.
     label: Option<String>,
     children: Vec<String>,
+    mode: Mode,
 }
 
 /// The error name of the element below `stack` called `tag` (or of the innermost
@@ -176,44 +269,149 @@ fn path_label(stack: &[Open], tag: Option<&str>) -> String {
     s
 }
 
-/// Checks that the document is well-formed XML with a `<robot>` root, that every
-/// element urdf-rs reads has its required attributes and children, that numeric
-/// attributes hold the right count of numbers, and that no undeclared entity is
-/// referenced — each error naming the element. Lists the top-level elements that
-/// urdf-rs ignores (`<transmission>`, `<gazebo>`, …).
-fn scan_top_level(text: &str, file: &str) -> Result<Vec<String>, UrdfError> {
-    use quick_xml::events::{BytesStart, Event};
-    use std::borrow::Cow;
-    let mut reader = quick_xml::Reader::from_str(text);
-    let mut stack: Vec<Open> = Vec::new();
-    let mut seen_root = false;
-    let mut version = (1, 0);
-    let mut ignored: Vec<String> = Vec::new();
-    let fail = |label: &str, msg: String| UrdfError::new(file, Some(label.to_string()), msg);
+/// What the checking scan found that is not an error.
+struct Scan<'a> {
+    file: &'a str,
+    version: (u32, u32),
+    seen_root: bool,
+    ignored: Vec<String>,
+    warnings: Vec<String>,
+    /// Grouped warnings (unknown names, malformed visuals), one entry per kind
+    /// (key): the first place's message, its suffix and how many places.
+    grouped: Vec<(String, String, &'static str, usize)>,
+}
 
-    // Opens an element: checks its attributes, returns its entry.
-    let mut open = |e: &BytesStart,
-                    stack: &mut Vec<Open>,
-                    seen_root: &mut bool,
-                    version: &mut (u32, u32)|
-     -> Result<Open, UrdfError> {
+impl Scan<'_> {
+    /// Records an unknown attribute or element: one warning for each distinct
+    /// name on each kind of element, naming its first place and counting the rest
+    /// (a robot's vendor extensions do not drown its other warnings).
+    fn unknown(&mut self, key: String, message: impl FnOnce() -> String) {
+        self.group(key, message, "ignored");
+    }
+
+    /// A warning of kind `key`: the first one is kept, the others counted.
+    fn group(&mut self, key: String, message: impl FnOnce() -> String, suffix: &'static str) {
+        match self.grouped.iter_mut().find(|e| e.0 == key) {
+            Some(entry) => entry.3 += 1,
+            None => self.grouped.push((key, message(), suffix, 1)),
+        }
+    }
+
+    /// The warnings, grouped ones last.
+    fn into_warnings(self) -> Vec<String> {
+        let mut w = self.warnings;
+        for (_, msg, suffix, n) in self.grouped {
+            w.push(if n == 1 {
+                format!("{msg} ({suffix})")
+            } else {
+                format!("{msg} ({suffix}; {} more like it)", n - 1)
+            });
+        }
+        w
+    }
+
+    /// An error in a strict element; a warning (the load goes on) in a lenient one.
+    fn problem(&mut self, mode: Mode, label: &str, msg: String) -> Result<(), UrdfError> {
+        match mode {
+            Mode::Strict => Err(UrdfError::new(self.file, Some(label.to_string()), msg)),
+            _ => {
+                // Grouped by the label without its names: one warning for the
+                // same defect in every link's visual.
+                let key: String = label
+                    .split('"')
+                    .step_by(2)
+                    .chain([msg.as_str()])
+                    .collect::<Vec<_>>()
+                    .join("|");
+                self.group(key, || format!("{label}: {msg}"), "not used by dynamics");
+                Ok(())
+            }
+        }
+    }
+
+    fn fail(&self, label: &str, msg: String) -> UrdfError {
+        UrdfError::new(self.file, Some(label.to_string()), msg)
+    }
+
+    fn ignore(&mut self, what: String) {
+        if !self.ignored.contains(&what) {
+            self.ignored.push(what);
+        }
+    }
+
+    /// The mode of a new element `tag` below `stack`; warns about an element the
+    /// URDF specification does not have there.
+    fn mode_of(&mut self, tag: &str, stack: &[Open]) -> Mode {
+        let Some(parent) = stack.last() else {
+            return Mode::Strict;
+        };
+        if parent.mode == Mode::Skip {
+            return Mode::Skip;
+        }
+        if tag.starts_with("xacro:") {
+            self.ignore(format!("<{tag}> elements (xacro leftovers, not expanded)"));
+            return Mode::Skip;
+        }
+        if stack.len() == 1 {
+            return match tag {
+                "link" | "joint" => Mode::Strict,
+                "material" => Mode::Lenient,
+                _ if SKIPPED_TOP_LEVEL.contains(&tag) => {
+                    self.ignore(format!("<{tag}> elements (not used by dynamics)"));
+                    Mode::Skip
+                }
+                _ => {
+                    self.unknown(format!("<{tag}> in <robot>"), || {
+                        format!("unknown element <{tag}> in <robot>")
+                    });
+                    Mode::Skip
+                }
+            };
+        }
+        if parent.tag == "link" && SKIPPED_IN_LINK.contains(&tag) {
+            self.ignore(format!(
+                "<link> <{tag}> elements (PyBullet extension, not used by dynamics)"
+            ));
+            return Mode::Skip;
+        }
+        if !known_children(&parent.tag).contains(&tag) {
+            self.unknown(format!("<{tag}> in <{}>", parent.tag), || {
+                format!("unknown element <{tag}> in {}", path_label(stack, None))
+            });
+            return Mode::Skip;
+        }
+        if tag == "visual" {
+            Mode::Lenient
+        } else {
+            parent.mode
+        }
+    }
+
+    /// Opens an element: checks its attributes, returns its entry.
+    fn open(
+        &mut self,
+        e: &quick_xml::events::BytesStart,
+        stack: &[Open],
+    ) -> Result<Open, UrdfError> {
+        use std::borrow::Cow;
         let tag = String::from_utf8_lossy(e.name().as_ref()).into_owned();
         let here = |stack: &[Open]| path_label(stack, Some(&tag));
         if stack.len() >= MAX_DEPTH {
             // URDF needs about six levels; a deeper document is not a robot (and
             // would make the element trees below recurse deeply).
             let top = path_label(&stack[..2.min(stack.len())], None);
-            return Err(fail(
+            return Err(self.fail(
                 &top,
                 format!("elements nested deeper than {MAX_DEPTH} levels"),
             ));
         }
         let mut attrs: Vec<(Cow<str>, Cow<str>)> = Vec::new();
         for a in e.attributes() {
-            let a = a.map_err(|err| fail(&here(stack), format!("malformed attribute: {err}")))?;
+            let a =
+                a.map_err(|err| self.fail(&here(stack), format!("malformed attribute: {err}")))?;
             let key = String::from_utf8_lossy(a.key.into_inner());
             let value = a.unescape_value().map_err(|err| {
-                fail(
+                self.fail(
                     &here(stack),
                     format!("attribute {key}: {}", one_line(&err.to_string())),
                 )
@@ -224,17 +422,14 @@ fn scan_top_level(text: &str, file: &str) -> Result<Vec<String>, UrdfError> {
         let parent = stack.last().map(|p| p.tag.as_str()).unwrap_or("");
         let label = match (stack.len(), tag.as_str()) {
             (0, _) => {
-                if *seen_root {
-                    return Err(fail(&here(stack), "more than one root element".into()));
+                if self.seen_root {
+                    return Err(self.fail(&here(stack), "more than one root element".into()));
                 }
                 if tag != "robot" {
-                    return Err(fail(
-                        &here(stack),
-                        "the root element must be <robot>".into(),
-                    ));
+                    return Err(self.fail(&here(stack), "the root element must be <robot>".into()));
                 }
-                *seen_root = true;
-                *version = robot_version(get("version"));
+                self.seen_root = true;
+                self.version = robot_version(get("version"));
                 Some("<robot>".to_string())
             }
             (1, "link" | "joint" | "material") => Some(match get("name") {
@@ -248,30 +443,35 @@ fn scan_top_level(text: &str, file: &str) -> Result<Vec<String>, UrdfError> {
             }),
             _ => None,
         };
+        let mode = self.mode_of(&tag, stack);
         let label_str = |stack: &[Open]| match &label {
             Some(l) => l.clone(),
             None => here(stack),
         };
-        if stack.len() == 1 && !matches!(tag.as_str(), "link" | "joint" | "material") {
-            let t = format!("<{tag}>");
-            if !ignored.contains(&t) {
-                ignored.push(t);
+        if mode != Mode::Skip {
+            let known = known_attrs(&tag).unwrap_or(&[]);
+            for (k, _) in &attrs {
+                if !known.contains(&k.as_ref()) && !k.starts_with("xmlns") {
+                    self.unknown(format!("\"{k}\" on <{tag}>"), || {
+                        let on = match &label {
+                            Some(l) => l.clone(),
+                            None => format!("<{tag}> of {}", path_label(stack, None)),
+                        };
+                        format!("unknown attribute \"{k}\" on {on}")
+                    });
+                }
             }
-        }
-        // Elements inside ignored top-level tags are not read by urdf-rs.
-        let read_tag = |t: &str| matches!(t, "link" | "joint" | "material");
-        let read = stack.get(1).is_none_or(|top| read_tag(&top.tag))
-            && (stack.len() != 1 || read_tag(&tag));
-        if read && !stack.is_empty() {
-            for req in required_attrs(&tag, parent, *version) {
-                if get(req).is_none() {
-                    return Err(fail(&label_str(stack), format!("missing attribute {req}")));
+            if !stack.is_empty() {
+                for req in required_attrs(&tag, parent, self.version) {
+                    if get(req).is_none() {
+                        self.problem(mode, &label_str(stack), format!("missing attribute {req}"))?;
+                    }
                 }
             }
             if tag == "joint" && parent == "robot" {
                 if let Some(t) = get("type") {
                     if !JOINT_TYPES.contains(&t) {
-                        return Err(fail(
+                        return Err(self.fail(
                             &label_str(stack),
                             format!(
                                 "unknown joint type \"{t}\" (expected one of {})",
@@ -291,10 +491,11 @@ fn scan_top_level(text: &str, file: &str) -> Result<Vec<String>, UrdfError> {
                         } else {
                             format!("{n} numbers")
                         };
-                        return Err(fail(
+                        self.problem(
+                            mode,
                             &label_str(stack),
                             format!("{k}=\"{v}\" is not {what}"),
-                        ));
+                        )?;
                     }
                 }
             }
@@ -303,28 +504,27 @@ fn scan_top_level(text: &str, file: &str) -> Result<Vec<String>, UrdfError> {
             tag,
             label,
             children: Vec::new(),
+            mode,
         })
-    };
-    // Closes an element: checks its children.
-    let close = |o: Open, stack: &mut Vec<Open>| -> Result<(), UrdfError> {
+    }
+
+    /// Closes an element: checks its children.
+    fn close(&mut self, o: Open, stack: &mut [Open]) -> Result<(), UrdfError> {
         let parent = stack.last().map(|p| p.tag.as_str()).unwrap_or("");
         let o_label = |stack: &[Open]| match &o.label {
             Some(l) => l.clone(),
             None => path_label(stack, Some(&o.tag)),
         };
-        let read = stack
-            .get(1)
-            .is_none_or(|top| matches!(top.tag.as_str(), "link" | "joint" | "material"));
-        if read {
+        if o.mode != Mode::Skip {
             let (required, once) = child_rules(&o.tag, parent);
             for r in required {
                 if !o.children.iter().any(|c| c == r) {
-                    return Err(fail(&o_label(stack), format!("missing <{r}>")));
+                    self.problem(o.mode, &o_label(stack), format!("missing <{r}>"))?;
                 }
             }
             for r in once {
                 if o.children.iter().filter(|c| *c == r).count() > 1 {
-                    return Err(fail(&o_label(stack), format!("more than one <{r}>")));
+                    self.problem(o.mode, &o_label(stack), format!("more than one <{r}>"))?;
                 }
             }
             if o.tag == "geometry" {
@@ -334,13 +534,14 @@ fn scan_top_level(text: &str, file: &str) -> Result<Vec<String>, UrdfError> {
                     .filter(|c| SHAPES.contains(&c.as_str()))
                     .count();
                 if shapes != 1 {
-                    return Err(fail(
+                    self.problem(
+                        o.mode,
                         &o_label(stack),
                         format!(
                             "needs exactly one shape ({}), found {shapes}",
                             SHAPES.join(", ")
                         ),
-                    ));
+                    )?;
                 }
             }
         }
@@ -348,8 +549,29 @@ fn scan_top_level(text: &str, file: &str) -> Result<Vec<String>, UrdfError> {
             p.children.push(o.tag);
         }
         Ok(())
-    };
+    }
+}
 
+/// Checks that the document is well-formed XML with a `<robot>` root, that every
+/// element the dynamics reads has its required attributes and children, that
+/// numeric attributes hold the right count of numbers, and that no undeclared
+/// entity is referenced — each error naming the element. What no dynamics reads
+/// never stops a load: a malformed `<visual>` or `<material>` is a warning,
+/// `<gazebo>`, `<transmission>`, `<sensor>` and xacro leftovers are skipped whole
+/// (listed as ignored), and an attribute or element outside the URDF specification
+/// is a warning naming it and where it stands.
+fn scan<'a>(text: &str, file: &'a str) -> Result<Scan<'a>, UrdfError> {
+    use quick_xml::events::Event;
+    let mut reader = quick_xml::Reader::from_str(text);
+    let mut stack: Vec<Open> = Vec::new();
+    let mut scan = Scan {
+        file,
+        version: (1, 0),
+        seen_root: false,
+        ignored: Vec::new(),
+        warnings: Vec::new(),
+        grouped: Vec::new(),
+    };
     loop {
         let ev = reader.read_event().map_err(|e| {
             let at = if stack.is_empty() {
@@ -369,16 +591,16 @@ fn scan_top_level(text: &str, file: &str) -> Result<Vec<String>, UrdfError> {
         })?;
         match ev {
             Event::Start(e) => {
-                let o = open(&e, &mut stack, &mut seen_root, &mut version)?;
+                let o = scan.open(&e, &stack)?;
                 stack.push(o);
             }
             Event::Empty(e) => {
-                let o = open(&e, &mut stack, &mut seen_root, &mut version)?;
-                close(o, &mut stack)?;
+                let o = scan.open(&e, &stack)?;
+                scan.close(o, &mut stack)?;
             }
             Event::End(_) => {
                 if let Some(o) = stack.pop() {
-                    close(o, &mut stack)?;
+                    scan.close(o, &mut stack)?;
                 }
             }
             Event::GeneralRef(r) => {
@@ -391,7 +613,7 @@ fn scan_top_level(text: &str, file: &str) -> Result<Vec<String>, UrdfError> {
                     } else {
                         path_label(&stack, None)
                     };
-                    return Err(fail(
+                    return Err(scan.fail(
                         &label,
                         format!("undeclared or invalid entity reference &{name};"),
                     ));
@@ -402,13 +624,13 @@ fn scan_top_level(text: &str, file: &str) -> Result<Vec<String>, UrdfError> {
         }
     }
     if !stack.is_empty() {
-        return Err(fail(
+        return Err(scan.fail(
             &path_label(&stack, None),
             "truncated XML: unclosed elements at end of file".into(),
         ));
     }
-    if !seen_root {
+    if !scan.seen_root {
         return Err(UrdfError::new(file, None, "no <robot> element"));
     }
-    Ok(ignored)
+    Ok(scan)
 }

@@ -39,12 +39,8 @@ pub(crate) fn validate(parsed: &Parsed, file: &str) -> Result<Checked, UrdfError
             "no <link> elements",
         ));
     }
-    let mut warnings = Vec::new();
-    let mut ignored: Vec<String> = parsed
-        .ignored_tags
-        .iter()
-        .map(|t| format!("{t} elements (not used by dynamics)"))
-        .collect();
+    let mut warnings = parsed.warnings.clone();
+    let mut ignored: Vec<String> = parsed.ignored_tags.clone();
 
     // Names.
     let mut link_index: HashMap<&str, usize> = HashMap::new();
@@ -109,12 +105,14 @@ pub(crate) fn validate(parsed: &Parsed, file: &str) -> Result<Checked, UrdfError
         let tol = 1e-9 * scale.max(1e-300);
         let (e0, e1, e2) = (eig[0], eig[1], eig[2]);
         if e0.min(e1).min(e2) < -tol {
-            return Err(err(
-                el,
-                format!("inertia is indefinite (principal moments {e0:.3e}, {e1:.3e}, {e2:.3e})"),
+            // Loaded as written, as Pinocchio does: the dynamics are exactly the
+            // URDF's; a mass matrix that is then not positive definite is the
+            // singular-H error of the algorithms (docs/theory.md, "Spatial inertia").
+            warnings.push(format!(
+                "link \"{}\": inertia is not positive semi-definite (principal moments {e0:.3e}, {e1:.3e}, {e2:.3e}): loaded as written",
+                l.name
             ));
-        }
-        if scale > 0.0 {
+        } else if scale > 0.0 {
             let s = [e0, e1, e2];
             let bad = (0..3).any(|k| s[(k + 1) % 3] + s[(k + 2) % 3] < s[k] - tol);
             if bad {

@@ -8,8 +8,8 @@ def link(name, inert=None):
 def joint(name, parent, child, t="revolute", axis="0 0 1", limit='<limit lower="-1" upper="1" effort="10" velocity="5"/>', origin='<origin xyz="0 0 0.5" rpy="0 0 0"/>', extra=""):
     ax = f'<axis xyz="{axis}"/>' if axis is not None else ""
     return f'  <joint name="{name}" type="{t}"><parent link="{parent}"/><child link="{child}"/>{origin}{ax}{limit or ""}{extra}</joint>\n'
-def robot(body, name="bad"):
-    return f'<?xml version="1.0"?>\n<robot name="{name}">\n{body}</robot>\n'
+def robot(body, name="bad", attrs=""):
+    return f'<?xml version="1.0"?>\n<robot name="{name}"{attrs}>\n{body}</robot>\n'
 files = {}
 chain = link("base") + link("l1") + link("l2") + joint("j1","base","l1") + joint("j2","l1","l2")
 files["ok.urdf"] = robot(link("base") + link("l1") + link("l2") + link("l3") + joint("j1","base","l1") + joint("j2","l1","l2")
@@ -67,6 +67,21 @@ files["mesh_dotdot.urdf"] = robot(link("base") + f'  <link name="l1">{inertial()
 files["semidefinite_inertia.urdf"] = robot(link("base") + link("l1", inertial(ixx="0", iyy="0", izz="0", origin='<origin xyz="0.3 0 0"/>')) + link("l2", inertial(ixx="0.1", iyy="0.1", izz="0")) + joint("j1","base","l1") + joint("j2","l1","l2", axis="1 0 0"))
 files["quadruped_base_1e-6.urdf"] = robot(link("base", inertial(m="5", ixx="1e-6", iyy="1e-6", izz="1e-6", ixy="1e-6", ixz="1e-6", iyz="1e-6")) + link("l1") + joint("j1","base","l1"))
 files["triangle_inequality.urdf"] = robot(link("base") + link("l1", inertial(ixx="0.01", iyy="0.01", izz="0.5")) + joint("j1","base","l1"))
+# What urdyn does not know, or what no dynamics reads, is a warning, never an error.
+files["unknown_attribute.urdf"] = robot(link("base") + link("l1") + link("l2")
+    + joint("j1","base","l1", limit='<limit lowr="-1.5" upper="1" effort="10" velocity="5"/>')
+    + joint("j2","l1","l2", limit='<limit lowr="-1" upper="1" effort="10" velocity="5"/>', extra='<spring stiffness="3"/>'))
+files["texture_no_filename.urdf"] = robot('  <material name="grey"><color rgba="0.5 0.5 0.5 1"/><texture/></material>\n'
+    + '  <link name="base">' + inertial() + '<visual><geometry><box size="1 1 1"/></geometry><material name="skin"><texture/></material></visual></link>\n'
+    + '  <link name="l1">' + inertial() + '<contact><lateral_friction value="1"/></contact></link>\n' + joint("j1","base","l1")
+    + '  <xacro:property name="leftover" value="1"/>\n', attrs=' version="1.0" xmlns:xacro="http://www.ros.org/wiki/xacro"')
+files["malformed_visual.urdf"] = robot('  <material name="red"><color rgba="1 0 0"/></material>\n'
+    + '  <link name="base">' + inertial() + '<visual><geometry><box size="1 2"/></geometry></visual><visual><geometry/></visual></link>\n'
+    + link("l1") + joint("j1","base","l1")
+    + '  <gazebo reference="l1"><mu1>0.2</mu1><anything at="all"><deep/></anything></gazebo>\n'
+    + '  <transmission name="t1"><type>SimpleTransmission</type><joint name="j1"><hardwareInterface>x</hardwareInterface></joint></transmission>\n')
+# The same defect in a <collision> (read by contact) stays an error.
+files["malformed_collision.urdf"] = robot(link("base") + '  <link name="l1">' + inertial() + '<collision><geometry><box size="1 2"/></geometry></collision></link>\n' + joint("j1","base","l1"))
 files["no_limit.urdf"] = robot(link("base") + link("l1") + link("l2") + joint("j1","base","l1", limit=None) + joint("j2","l1","l2", t="prismatic", limit=None))
 files["massless_joint.urdf"] = robot(link("base") + link("l1") + link("tip", inertial(m="0", ixx="0", iyy="0", izz="0")) + joint("j1","base","l1") + joint("wrist","l1","tip", axis="1 0 0"))
 files["massless_joint_nointertial.urdf"] = robot(link("base") + link("l1") + '  <link name="tip"/>\n' + joint("j1","base","l1") + joint("wrist","l1","tip", axis="1 0 0"))

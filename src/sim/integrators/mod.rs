@@ -111,5 +111,6 @@ pub(in crate::sim) fn solve_rows<'a>(
         opts.solver_iterations,
         opts.solver_tol,
         opts.solver_relaxation,
+        opts.solver,
     )
 }

@@ -1,0 +1,76 @@
+//! Argument conversion: array-likes in, checked lengths and finite numbers, one
+//! clear `ValueError` line naming the argument otherwise.
+
+use numpy::{AllowTypeChange, PyArrayLike1, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use urdyn::nalgebra::DVector;
+
+/// A `ValueError` with this message.
+pub fn value_error(msg: impl Into<String>) -> PyErr {
+    PyValueError::new_err(msg.into())
+}
+
+/// Copies the 1-D array-like `x` into `out` (length `n`, the model's `what`):
+/// a wrong length, another shape or a non-finite entry is a `ValueError`
+/// naming `name`.
+pub fn read_vec(
+    x: &Bound<'_, PyAny>,
+    name: &str,
+    what: &str,
+    out: &mut DVector<f64>,
+) -> PyResult<()> {
+    let n = out.len();
+    let arr: PyArrayLike1<'_, f64, AllowTypeChange> = x.extract().map_err(|_| {
+        value_error(format!(
+            "{name}: expected a 1-D array of {n} numbers ({what} = {n})"
+        ))
+    })?;
+    if arr.len() != n {
+        return Err(value_error(format!(
+            "{name} has {} entries, the model has {what} = {n}",
+            arr.len()
+        )));
+    }
+    let view = arr.as_array();
+    for (i, (o, &x)) in out.iter_mut().zip(view.iter()).enumerate() {
+        if !x.is_finite() {
+            return Err(value_error(format!("{name}[{i}] is not a finite number ({x})")));
+        }
+        *o = x;
+    }
+    Ok(())
+}
+
+/// A 3-vector (`name` in messages).
+pub fn read3(x: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 3]> {
+    let mut v = DVector::zeros(3);
+    read_vec(x, name, "length", &mut v)?;
+    Ok([v[0], v[1], v[2]])
+}
+
+/// A contiguous float64 copy of an array-like of any dimension, with its shape
+/// (`name` in messages).
+pub fn read_array(x: &Bound<'_, PyAny>, name: &str) -> PyResult<(Vec<usize>, Vec<f64>)> {
+    let py = x.py();
+    let np = py.import("numpy")?;
+    let arr = np
+        .call_method1("ascontiguousarray", (x, "float64"))
+        .map_err(|e| value_error(format!("{name}: not an array of numbers ({e})")))?;
+    let arr = arr
+        .cast::<numpy::PyArrayDyn<f64>>()
+        .map_err(|_| value_error(format!("{name}: not an array of numbers")))?;
+    let ro = arr.readonly();
+    let shape = ro.shape().to_vec();
+    let data = ro
+        .as_slice()
+        .map_err(|_| value_error(format!("{name}: not a contiguous array")))?
+        .to_vec();
+    if let Some(i) = data.iter().position(|x| !x.is_finite()) {
+        return Err(value_error(format!(
+            "{name}: entry {i} (flat index) is not a finite number ({})",
+            data[i]
+        )));
+    }
+    Ok((shape, data))
+}

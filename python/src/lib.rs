@@ -1,0 +1,35 @@
+//! `urdyn._urdyn`: the Python face of the urdyn engine (PyO3 + rust-numpy).
+//!
+//! A thin layer: every number is computed by the Rust library; this file only
+//! checks and converts arguments (one-line `ValueError`s naming the argument),
+//! releases the GIL around batches and lays results out in numpy arrays. The
+//! names are fixed by `shared/spec/python.md` (Pinocchio's where it has one).
+
+mod args;
+mod dynamics;
+mod model;
+mod sim;
+
+use pyo3::prelude::*;
+
+pyo3::create_exception!(
+    urdyn,
+    SimulationError,
+    pyo3::exceptions::PyRuntimeError,
+    "A simulation that diverged or turned non-finite. From `rollout`, `.q` and `.v` \
+     hold the partial results (NaN after the failure) and `.index` the batch index."
+);
+
+/// The extension module.
+#[pymodule]
+fn _urdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<model::PyModel>()?;
+    m.add_class::<model::PyData>()?;
+    m.add_class::<sim::PySimulation>()?;
+    m.add("SimulationError", m.py().get_type::<SimulationError>())?;
+    m.add_function(wrap_pyfunction!(model::_model_from_state, m)?)?;
+    dynamics::register(m)?;
+    m.add_function(wrap_pyfunction!(sim::rollout, m)?)?;
+    m.add_function(wrap_pyfunction!(sim::integrators, m)?)?;
+    Ok(())
+}

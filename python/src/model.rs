@@ -1,0 +1,304 @@
+//! `urdyn.Model` (the immutable model, its names, pickling) and `urdyn.Data`
+//! (the preallocated workspace).
+
+use crate::args::{read3, value_error};
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use std::collections::HashMap;
+use std::path::PathBuf;
+use urdyn::nalgebra::{DVector, Vector3};
+use urdyn::spatial::Force;
+use urdyn::{LoadOptions, Model};
+
+/// A multibody model imported from a URDF (`Model.from_urdf`).
+#[pyclass(name = "Model", module = "urdyn")]
+#[derive(Clone)]
+pub struct PyModel {
+    pub model: Model,
+    /// The URDF text (a pickled model is rebuilt from it).
+    pub text: String,
+    /// The name used in messages (the file's path, or "<string>").
+    pub file: String,
+    pub package_dirs: Vec<PathBuf>,
+    /// Index into `model.frames` of every URDF link.
+    pub links: HashMap<String, usize>,
+}
+
+impl PyModel {
+    fn build(
+        text: String,
+        file: String,
+        floating_base: bool,
+        source: Option<PathBuf>,
+        package_dirs: Vec<PathBuf>,
+    ) -> PyResult<Self> {
+        let mut model = urdyn::load_str(&text, &file, LoadOptions { floating_base })
+            .map_err(|e| value_error(e.to_string()))?;
+        model.source = source;
+        let links = model
+            .frames
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.name.clone(), i))
+            .collect();
+        Ok(Self {
+            model,
+            text,
+            file,
+            package_dirs,
+            links,
+        })
+    }
+
+    /// The frame index of URDF link `name` (`arg` in the message).
+    pub fn link(&self, name: &str, arg: &str) -> PyResult<usize> {
+        self.links.get(name).copied().ok_or_else(|| {
+            let near = self
+                .links
+                .keys()
+                .min_by_key(|k| edit_distance(k, name))
+                .map(|k| format!(" (nearest: \"{k}\")"))
+                .unwrap_or_default();
+            value_error(format!(
+                "{arg}: unknown link \"{name}\" in {}{near}",
+                self.file
+            ))
+        })
+    }
+
+    /// The world wrenches `{link: (force3, torque3)}` at the link origins as
+    /// per-body spatial forces in the world frame at the world origin
+    /// (docs/theory.md §"External forces"), needing the world poses in `o_m_i`.
+    pub fn fext(
+        &self,
+        dict: &Bound<'_, pyo3::types::PyDict>,
+        o_m_i: &[urdyn::spatial::Se3<f64>],
+        out: &mut [Force],
+    ) -> PyResult<()> {
+        out.iter_mut().for_each(|f| *f = Force::zero());
+        for (key, value) in dict.iter() {
+            let name: String = key
+                .extract()
+                .map_err(|_| value_error("fext: keys must be link names (str)"))?;
+            let fi = self.link(&name, "fext")?;
+            let pair = value.cast::<pyo3::types::PySequence>().map_err(|_| {
+                value_error(format!("fext[\"{name}\"]: expected (force3, torque3)"))
+            })?;
+            if pair.len().unwrap_or(0) != 2 {
+                return Err(value_error(format!(
+                    "fext[\"{name}\"]: expected (force3, torque3)"
+                )));
+            }
+            let f = read3(&pair.get_item(0)?, &format!("fext[\"{name}\"] force"))?;
+            let t = read3(&pair.get_item(1)?, &format!("fext[\"{name}\"] torque"))?;
+            let frame = &self.model.frames[fi];
+            if frame.body == 0 {
+                continue; // welded to the world: no effect
+            }
+            let p = o_m_i[frame.body].act_point(&frame.placement.trans);
+            let f = Vector3::new(f[0], f[1], f[2]);
+            let t = Vector3::new(t[0], t[1], t[2]);
+            // moved from the link origin p to the world origin: n_O = τ + p × f
+            out[frame.body] += Force::new(t + p.cross(&f), f);
+        }
+        Ok(())
+    }
+}
+
+/// Levenshtein distance (for "nearest known name").
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+#[pymethods]
+impl PyModel {
+    /// Imports a URDF file. `package_dirs`: roots for `package://` mesh paths
+    /// (used by `Simulation` for collision meshes).
+    #[staticmethod]
+    #[pyo3(signature = (path, floating_base=false, package_dirs=None))]
+    fn from_urdf(
+        path: PathBuf,
+        floating_base: bool,
+        package_dirs: Option<Vec<PathBuf>>,
+    ) -> PyResult<Self> {
+        // the library's loader gives the CLI's messages for a bad file
+        urdyn::load_file(&path, LoadOptions { floating_base })
+            .map_err(|e| value_error(e.to_string()))?;
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| value_error(format!("{}: cannot read file: {e}", path.display())))?;
+        Self::build(
+            text,
+            path.display().to_string(),
+            floating_base,
+            Some(path),
+            package_dirs.unwrap_or_default(),
+        )
+    }
+
+    /// Imports URDF text.
+    #[staticmethod]
+    #[pyo3(signature = (xml, floating_base=false))]
+    fn from_urdf_string(xml: String, floating_base: bool) -> PyResult<Self> {
+        Self::build(xml, "<string>".into(), floating_base, None, Vec::new())
+    }
+
+    /// Length of q.
+    #[getter]
+    fn nq(&self) -> usize {
+        self.model.nq
+    }
+    /// Length of v, a, tau.
+    #[getter]
+    fn nv(&self) -> usize {
+        self.model.nv
+    }
+    /// The joint degrees of freedom in engine order (the base's 6 not included).
+    #[getter]
+    fn dof_names(&self) -> Vec<String> {
+        self.model.dofs.iter().map(|d| d.name.clone()).collect()
+    }
+    /// Every URDF link, in the URDF's order.
+    #[getter]
+    fn link_names(&self) -> Vec<String> {
+        self.model.frames.iter().map(|f| f.name.clone()).collect()
+    }
+    /// Whether the root has a free 6-DoF joint.
+    #[getter]
+    fn floating_base(&self) -> bool {
+        self.model.floating_base
+    }
+    /// The robot's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.model.name.clone()
+    }
+    /// Mass of the links that move (kg).
+    #[getter]
+    fn total_mass(&self) -> f64 {
+        self.model.inertias.iter().skip(1).map(|i| i.mass).sum()
+    }
+    /// The import report's warnings.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.model.report.warnings.clone()
+    }
+    /// Gravity in the world frame (m/s²).
+    #[getter]
+    fn gravity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.model.gravity.as_slice())
+    }
+    #[setter]
+    fn set_gravity(&mut self, g: &Bound<'_, PyAny>) -> PyResult<()> {
+        let g = read3(g, "gravity")?;
+        self.model.gravity = Vector3::new(g[0], g[1], g[2]);
+        Ok(())
+    }
+    /// The neutral configuration: joints at 0, the base at the origin with the
+    /// identity orientation.
+    fn neutral<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let mut q = DVector::zeros(self.model.nq);
+        if self.model.floating_base {
+            q[6] = 1.0;
+        }
+        PyArray1::from_slice(py, q.as_slice())
+    }
+    /// A new preallocated workspace for this model.
+    fn create_data(&self) -> PyData {
+        PyData::new(&self.model)
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "urdyn.Model(\"{}\", nq={}, nv={}, floating_base={})",
+            self.model.name,
+            self.model.nq,
+            self.model.nv,
+            if self.model.floating_base { "True" } else { "False" }
+        )
+    }
+    /// Pickling: the URDF text and the options (the model is rebuilt from them).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Py<PyAny>, Bound<'py, PyTuple>)> {
+        let f = py.import("urdyn._urdyn")?.getattr("_model_from_state")?.unbind();
+        let dirs: Vec<String> = self
+            .package_dirs
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        let g = [self.model.gravity.x, self.model.gravity.y, self.model.gravity.z];
+        let source = self.model.source.as_ref().map(|p| p.display().to_string());
+        let args = (
+            self.text.clone(),
+            self.file.clone(),
+            self.model.floating_base,
+            dirs,
+            g,
+            source,
+        )
+            .into_pyobject(py)?;
+        Ok((f, args))
+    }
+}
+
+/// Rebuilds a pickled `Model`.
+#[pyfunction]
+pub fn _model_from_state(
+    text: String,
+    file: String,
+    floating_base: bool,
+    package_dirs: Vec<PathBuf>,
+    gravity: [f64; 3],
+    source: Option<PathBuf>,
+) -> PyResult<PyModel> {
+    let mut m = PyModel::build(text, file, floating_base, source, package_dirs)?;
+    m.model.gravity = Vector3::new(gravity[0], gravity[1], gravity[2]);
+    Ok(m)
+}
+
+/// The preallocated workspace of one model (`model.create_data()`).
+#[pyclass(name = "Data", module = "urdyn")]
+pub struct PyData {
+    pub data: urdyn::Data,
+    pub nq: usize,
+    pub nv: usize,
+    pub nbodies: usize,
+    pub q: DVector<f64>,
+    pub v: DVector<f64>,
+    pub a: DVector<f64>,
+    pub fext: Vec<Force>,
+}
+
+impl PyData {
+    pub fn new(model: &Model) -> Self {
+        Self {
+            data: urdyn::Data::new(model),
+            nq: model.nq,
+            nv: model.nv,
+            nbodies: model.nbodies,
+            q: DVector::zeros(model.nq),
+            v: DVector::zeros(model.nv),
+            a: DVector::zeros(model.nv),
+            fext: vec![Force::zero(); model.nbodies],
+        }
+    }
+    /// A `ValueError` unless this workspace was made for a model of `model`'s shape.
+    pub fn check(&self, model: &Model) -> PyResult<()> {
+        if self.nq != model.nq || self.nv != model.nv || self.nbodies != model.nbodies {
+            return Err(value_error(format!(
+                "data: made for another model (nq = {}, nv = {}), this one has nq = {}, nv = {}",
+                self.nq, self.nv, model.nq, model.nv
+            )));
+        }
+        Ok(())
+    }
+}
