@@ -317,6 +317,9 @@ fn run(cli: Cli) -> Result<()> {
                 package_path,
                 out,
             })?;
+            for w in &summary.warnings {
+                eprintln!("warning: {w}");
+            }
             eprintln!("urdyn {summary}");
         }
     }

@@ -255,6 +255,9 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         )?),
         None => None,
     };
+    for w in geometry.iter().flat_map(|g| &g.warnings) {
+        warn(&format!("warning: {w}"));
+    }
     let ground = opts.ground;
     let sim_err = |error| SimulateError::Sim {
         urdf: urdf_name.clone(),

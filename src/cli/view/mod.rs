@@ -22,12 +22,14 @@ use crate::cli::output::write_atomic;
 use crate::contact::mesh::{load_mesh, TriMesh};
 use crate::dynamics::forward_kinematics;
 use crate::model::Data;
-use crate::spatial::{rpy_to_matrix, Se3};
+use crate::spatial::Se3;
 use crate::{LoadOptions, Model};
 use nalgebra::{DVector, Matrix3, Rotation3, UnitQuaternion, Vector3};
 use serde_json::{json, Value};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+
+mod visuals;
 
 const PAGE_HTML: &str = include_str!("page.html");
 const VIEWER_JS: &str = include_str!("viewer.js");
@@ -70,6 +72,8 @@ pub struct PageSummary {
     pub simplified: usize,
     /// Size of the page in bytes.
     pub bytes: usize,
+    /// Visual elements left out (malformed), one line each.
+    pub warnings: Vec<String>,
 }
 
 impl std::fmt::Display for PageSummary {
@@ -148,6 +152,7 @@ pub fn write_page(
         triangles: geometry.meshes.iter().map(|m| m.triangles.len()).sum(),
         simplified: geometry.simplified,
         bytes: html.len(),
+        warnings: geometry.warnings.clone(),
     })
 }
 
@@ -476,6 +481,8 @@ pub struct Geometry {
     pub simplified: usize,
     /// Every drawn piece.
     pub visuals: Vec<Visual>,
+    /// Visual elements left out (malformed), one line each, naming the URDF and link.
+    pub warnings: Vec<String>,
 }
 
 /// The colour of a visual without a material, and of collision geometry.
@@ -489,88 +496,42 @@ impl Geometry {
         let name = urdf.display().to_string();
         let text = std::fs::read_to_string(urdf)
             .map_err(|e| ViewError::Geometry(format!("{name}: cannot read: {e}")))?;
-        let robot = urdf_rs::read_from_string(&text)
-            .map_err(|e| ViewError::Geometry(format!("{name}: {e}")))?;
-        let materials: HashMap<&str, [f64; 4]> = robot
-            .materials
-            .iter()
-            .filter_map(|m| Some((m.name.as_str(), m.color.as_ref()?.rgba.0)))
-            .collect();
-        let mut geometry = Geometry::default();
+        let drawables =
+            visuals::read(&text).map_err(|e| ViewError::Geometry(format!("{name}: {e}")))?;
+        let mut geometry = Geometry {
+            warnings: drawables
+                .warnings
+                .iter()
+                .map(|w| format!("{name}: {w}"))
+                .collect(),
+            ..Geometry::default()
+        };
         let mut mesh_index: HashMap<(PathBuf, [u64; 3]), usize> = HashMap::new();
-        for link in &robot.links {
+        for link in &drawables.links {
             let Some(frame) = model
                 .frame_index(&link.name)
                 .and_then(|k| model.frames.get(k))
             else {
                 continue;
             };
-            let element = if link.visual.is_empty() {
-                "collision"
+            let (element, pieces) = if link.visuals.is_empty() {
+                ("collision", &link.collisions)
             } else {
-                "visual"
+                ("visual", &link.visuals)
             };
-            let pieces: Vec<(
-                &urdf_rs::Pose,
-                &urdf_rs::Geometry,
-                Option<&urdf_rs::Material>,
-            )> = if link.visual.is_empty() {
-                link.collision
-                    .iter()
-                    .map(|c| (&c.origin, &c.geometry, None))
-                    .collect()
-            } else {
-                link.visual
-                    .iter()
-                    .map(|v| (&v.origin, &v.geometry, v.material.as_ref()))
-                    .collect()
-            };
-            for (origin, geom, material) in pieces {
+            for piece in pieces {
                 let at = || format!("{name}: link \"{}\": <{element}>", link.name);
-                let [r, p, y] = origin.rpy.0;
-                let local = Se3::new(rpy_to_matrix(r, p, y), Vector3::from(origin.xyz.0));
-                let placement = frame.placement.compose(&local);
-                if !(placement
-                    .rot
-                    .iter()
-                    .chain(placement.trans.iter())
-                    .all(|x| x.is_finite()))
-                {
-                    return Err(ViewError::Geometry(format!(
-                        "{}: <origin> is not finite",
-                        at()
-                    )));
-                }
-                let dims_ok = |d: &[f64]| d.iter().all(|x| x.is_finite() && *x >= 0.0);
-                let shape = match geom {
-                    urdf_rs::Geometry::Box { size } if dims_ok(&size.0) => VisualShape::Box(size.0),
-                    urdf_rs::Geometry::Cylinder { radius, length }
-                        if dims_ok(&[*radius, *length]) =>
-                    {
-                        VisualShape::Cylinder {
-                            radius: *radius,
-                            length: *length,
-                        }
+                let placement = frame.placement.compose(&Se3::new(piece.rot, piece.xyz));
+                let shape = match &piece.shape {
+                    visuals::Shape::Box(size) => VisualShape::Box(*size),
+                    &visuals::Shape::Cylinder(radius, length) => {
+                        VisualShape::Cylinder { radius, length }
                     }
-                    urdf_rs::Geometry::Capsule { radius, length }
-                        if dims_ok(&[*radius, *length]) =>
-                    {
-                        VisualShape::Capsule {
-                            radius: *radius,
-                            length: *length,
-                        }
+                    &visuals::Shape::Capsule(radius, length) => {
+                        VisualShape::Capsule { radius, length }
                     }
-                    urdf_rs::Geometry::Sphere { radius } if dims_ok(&[*radius]) => {
-                        VisualShape::Sphere { radius: *radius }
-                    }
-                    urdf_rs::Geometry::Mesh { filename, scale } => {
-                        let scale = scale.as_ref().map(|s| s.0).unwrap_or([1.0; 3]);
-                        if !scale.iter().all(|x| x.is_finite()) {
-                            return Err(ViewError::Geometry(format!(
-                                "{}: <mesh filename=\"{filename}\"> has a non-finite scale",
-                                at()
-                            )));
-                        }
+                    &visuals::Shape::Sphere(radius) => VisualShape::Sphere { radius },
+                    visuals::Shape::Mesh(filename, scale) => {
                         let path = crate::contact::resolve_mesh_path(
                             filename,
                             Some(urdf),
@@ -586,7 +547,7 @@ impl Geometry {
                         let k = match mesh_index.get(&key) {
                             Some(&k) => k,
                             None => {
-                                let m = load_mesh(&path, scale)
+                                let m = load_mesh(&path, *scale)
                                     .map_err(|e| ViewError::Geometry(format!("{}: {e}", at())))?;
                                 geometry.meshes.push(m);
                                 mesh_index.insert(key, geometry.meshes.len() - 1);
@@ -595,21 +556,15 @@ impl Geometry {
                         };
                         VisualShape::Mesh(k)
                     }
-                    _ => {
-                        return Err(ViewError::Geometry(format!(
-                            "{}: <geometry> has a negative or non-finite dimension",
-                            at()
-                        )))
-                    }
                 };
-                let rgba = material
-                    .and_then(|m| {
-                        m.color
+                let rgba = piece
+                    .color
+                    .or_else(|| {
+                        piece
+                            .material
                             .as_ref()
-                            .map(|c| c.rgba.0)
-                            .or_else(|| materials.get(m.name.as_str()).copied())
+                            .and_then(|m| drawables.materials.get(m).copied())
                     })
-                    .filter(|c| c.iter().all(|x| x.is_finite()))
                     .map(|c| c.map(|x| x.clamp(0.0, 1.0)))
                     .unwrap_or(DEFAULT_RGBA);
                 geometry.visuals.push(Visual {
