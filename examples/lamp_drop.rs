@@ -3,8 +3,9 @@
 //! `urdyn simulate assets/lamp.urdf --floating-base --duration 3 --initial assets/lamp_initial.json --out lamp_drop.csv`,
 //! then plots base height, energy and contact count against time.
 //!
-//! `cargo run --release --example lamp_drop [OUT_DIR]` writes `OUT_DIR/lamp_drop.csv`
-//! and `OUT_DIR/lamp_drop.png` (OUT_DIR defaults to `target`).
+//! `cargo run --release --example lamp_drop [OUT_DIR]` writes `OUT_DIR/lamp_drop.csv`,
+//! `OUT_DIR/lamp_drop.png` and the 3D replay page `OUT_DIR/lamp_drop.html` (as
+//! `simulate --html` writes it; OUT_DIR defaults to `target`).
 
 use plotters::prelude::*;
 use std::path::PathBuf;
@@ -33,6 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         friction: 1.0,
         package_path: vec![],
         out: Some(csv.clone()),
+        html: Some(out_dir.join("lamp_drop.html")),
         every: 1,
         progress: false,
     };
@@ -102,6 +104,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ))?;
     }
     area.present()?;
-    println!("wrote {} and {}", csv.display(), png.display());
+    println!(
+        "wrote {}, {} and {}",
+        csv.display(),
+        png.display(),
+        out_dir.join("lamp_drop.html").display()
+    );
     Ok(())
 }

@@ -122,7 +122,7 @@ def test_fixtures_agree_with_pinocchio(case):
         errs["kinetic"] = rel([urdyn.kinetic_energy(model, data, q, v)], [want["energy"]["kinetic"]])
         errs["potential"] = rel([urdyn.potential_energy(model, data, q)], [want["energy"]["potential"]])
         what, e = max(errs.items(), key=lambda kv: kv[1])
-        assert e <= 1e-9, f"{case} state {k}: {what} off by {e:.2e}"
+        assert e <= 1e-12, f"{case} state {k}: {what} off by {e:.2e}"
         worst = max(worst, e)
     print(f"{case}: worst relative error {worst:.1e}")
 

@@ -57,6 +57,23 @@ enum Command {
     Simulate(Box<SimulateCmd>),
     /// Time each dynamics algorithm on random states of this robot (median ns per call).
     Bench(BenchArgs),
+    /// Write one self-contained HTML page that replays a trajectory CSV of `simulate`
+    /// in 3D (no network, no other file; opens from disk in any current browser).
+    View {
+        /// The URDF file.
+        urdf: PathBuf,
+        /// The trajectory CSV that `simulate --out` wrote.
+        traj: PathBuf,
+        /// The root link has a free 6-DoF joint (as when the trajectory was simulated).
+        #[arg(long)]
+        floating_base: bool,
+        /// A root for package://NAME/... mesh paths (repeatable; ROS_PACKAGE_PATH is also read).
+        #[arg(long, value_name = "DIR")]
+        package_path: Vec<PathBuf>,
+        /// The page to write (atomically).
+        #[arg(long, value_name = "PAGE.html")]
+        out: PathBuf,
+    },
 }
 
 /// `urdyn simulate` options (cli.md).
@@ -148,6 +165,10 @@ struct SimulateCmd {
     /// Trajectory CSV file (written atomically).
     #[arg(long, value_name = "TRAJ.csv")]
     out: Option<PathBuf>,
+    /// Also write the 3D replay page of `urdyn view` for this run, with its contact
+    /// points and forces.
+    #[arg(long, value_name = "PAGE.html")]
+    html: Option<PathBuf>,
     /// Write every Nth step (the final state is always written).
     #[arg(
         long,
@@ -282,6 +303,25 @@ fn run(cli: Cli) -> Result<()> {
             }
         }
         Command::Simulate(cmd) => run_simulate(*cmd)?,
+        Command::View {
+            urdf,
+            traj,
+            floating_base,
+            package_path,
+            out,
+        } => {
+            let summary = urdyn::cli::view::run(&urdyn::cli::view::ViewArgs {
+                urdf,
+                traj,
+                floating_base,
+                package_path,
+                out,
+            })?;
+            for w in &summary.warnings {
+                eprintln!("warning: {w}");
+            }
+            eprintln!("urdyn {summary}");
+        }
     }
     Ok(())
 }
@@ -324,6 +364,7 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
         friction: c.friction,
         package_path: c.package_path,
         out: c.out,
+        html: c.html,
         every,
         progress: std::io::stderr().is_terminal(),
     };

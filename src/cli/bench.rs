@@ -14,18 +14,28 @@ use std::time::{Duration, Instant};
 /// One timed algorithm.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Algo {
+    /// `rnea`: inverse dynamics τ = ID(q, v, a) ([`dynamics::rnea`]).
     Rnea,
+    /// `bias`: C(q, v) = ID(q, v, 0) ([`dynamics::bias`]).
     Bias,
+    /// `crba`: the upper triangle of H(q) ([`dynamics::crba_upper`], Pinocchio's work).
     Crba,
+    /// `aba`: forward dynamics by the articulated-body algorithm ([`dynamics::aba`]).
     Aba,
+    /// `fd-rnea`: forward dynamics by nv + 1 inverse dynamics calls
+    /// ([`dynamics::forward_dynamics_rnea`]).
     FdRnea,
     /// CRBA + RNEA bias + LTDL (dense Cholesky with mimic joints).
     FdCrba,
+    /// `fd`: the engine's forward dynamics, by the model's chosen method
+    /// ([`dynamics::forward_dynamics`]).
     Fd,
+    /// `fk`: forward kinematics of every body and frame.
     Fk,
 }
 
 impl Algo {
+    /// Every algorithm, in the order `bench` times and prints them.
     pub const ALL: [Algo; 8] = [
         Algo::Rnea,
         Algo::Bias,
@@ -36,6 +46,7 @@ impl Algo {
         Algo::Fd,
         Algo::Fk,
     ];
+    /// The command-line name (`--algo`, and the key in `--json`).
     pub fn name(self) -> &'static str {
         match self {
             Algo::Rnea => "rnea",
@@ -48,6 +59,7 @@ impl Algo {
             Algo::Fk => "fk",
         }
     }
+    /// The algorithm of a command-line name; `None` for an unknown name.
     pub fn from_name(s: &str) -> Option<Algo> {
         Algo::ALL.into_iter().find(|a| a.name() == s)
     }
@@ -56,20 +68,32 @@ impl Algo {
 /// Why a benchmark could not run.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BenchError {
+    /// An `--algo` name that is not one of [`Algo::ALL`] (the name given).
     #[error("unknown algorithm \"{0}\" (known: rnea, bias, crba, aba, fd-rnea, fd-crba, fd, fk)")]
     UnknownAlgo(String),
+    /// `--samples 0`.
     #[error("--samples must be at least 1")]
     NoSamples,
+    /// A dynamics call failed on a benchmark state.
     #[error("{algo}: {message}")]
-    Dynamics { algo: &'static str, message: String },
+    Dynamics {
+        /// The algorithm's command-line name.
+        algo: &'static str,
+        /// The dynamics error, as text.
+        message: String,
+    },
 }
 
 /// Median and minimum nanoseconds per call over the samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Timing {
+    /// Median time per call over the samples (ns).
     pub median_ns: f64,
+    /// Fastest sample's time per call (ns).
     pub min_ns: f64,
+    /// Samples taken (fewer than asked when the budget ran out, never below 5).
     pub samples: usize,
+    /// Calls per sample (a batch of about 50 µs).
     pub batch: usize,
 }
 
@@ -78,9 +102,11 @@ pub struct Timing {
 pub struct Rng(u64);
 
 impl Rng {
+    /// A generator starting from `seed` (the same seed gives the same sequence).
     pub fn new(seed: u64) -> Self {
         Rng(seed)
     }
+    /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
@@ -101,9 +127,13 @@ impl Rng {
 /// A state: configuration, velocity, acceleration and generalized force.
 #[derive(Clone, Debug)]
 pub struct State {
+    /// Configuration (nq).
     pub q: DVector<f64>,
+    /// Velocity (nv).
     pub v: DVector<f64>,
+    /// Acceleration (nv).
     pub a: DVector<f64>,
+    /// Generalized force (nv; N·m or N per joint).
     pub tau: DVector<f64>,
 }
 
@@ -148,6 +178,7 @@ pub fn random_states(model: &Model, n: usize, seed: u64) -> Vec<State> {
 /// What to time and how long.
 #[derive(Clone, Debug)]
 pub struct BenchOptions {
+    /// The algorithms to time, in this order (default: [`Algo::ALL`]).
     pub algos: Vec<Algo>,
     /// Samples per algorithm (lowered for slow calls by `budget`, never below 5).
     pub samples: usize,

@@ -1,5 +1,6 @@
 //! The command line's tool layer: what the `urdyn` binary does with the engine
-//! (states files, the `eval` contract, `inspect`, `simulate`, `bench`, output files).
+//! (states files, the `eval` contract, `inspect`, `simulate`, `bench`, the replay
+//! page of `view`, output files).
 //!
 //! Not part of the engine: nothing in [`crate::spatial`], [`crate::model`],
 //! [`crate::urdf`], [`crate::dynamics`], [`crate::contact`] or [`crate::sim`] imports
@@ -11,3 +12,4 @@ pub mod inspect;
 pub mod output;
 pub mod simulate;
 pub mod state;
+pub mod view;

@@ -1,8 +1,8 @@
 //! `urdyn simulate` (cli.md): run a [`Simulation`] and write its trajectory CSV.
 
 use crate::cli::output::write_atomic;
-use crate::sim::{column_names, Integrator, SimError, SimOptions, Simulation};
 use crate::cli::state;
+use crate::sim::{column_names, Integrator, SimError, SimOptions, Simulation};
 use crate::{LoadOptions, Model};
 use std::io::Write;
 use std::path::PathBuf;
@@ -11,24 +11,41 @@ use std::time::Instant;
 /// The command's options, as cli.md lists them.
 #[derive(Clone, Debug)]
 pub struct SimulateArgs {
+    /// The URDF file.
     pub urdf: PathBuf,
+    /// Give the root link a free 6-DoF joint (unit quaternion).
     pub floating_base: bool,
+    /// Simulated seconds.
     pub duration: f64,
+    /// Step (the first step of an adaptive integrator), s.
     pub dt: f64,
+    /// Integrator name (`None`: the project's best general choice).
     pub integrator: Option<String>,
+    /// Error tolerance of adaptive integrators.
     pub tol: f64,
+    /// One state object (as in eval's `states`) to start from.
     pub initial: Option<PathBuf>,
     /// Rotor inertia added to every joint's diagonal of H (finite, >= 0).
     pub armature: f64,
     /// With a floating base: lift or lower the base so that the collision
     /// geometry's lowest point is this far above the ground (after `initial`).
     pub above_ground: Option<f64>,
+    /// Ground plane height (`None`: 0).
     pub ground: Option<f64>,
+    /// No ground plane: no contact at all.
     pub no_ground: bool,
+    /// Gravity vector (`None`: the model's).
     pub gravity: Option<[f64; 3]>,
+    /// Coulomb friction coefficient between links and the ground.
     pub friction: f64,
+    /// Roots for `package://NAME/...` mesh paths.
     pub package_path: Vec<PathBuf>,
+    /// The trajectory CSV (written atomically).
     pub out: Option<PathBuf>,
+    /// Also write the replay page of `urdyn view` for this run, with its contacts
+    /// (written atomically after the trajectory).
+    pub html: Option<PathBuf>,
+    /// Write every Nth step (the final state always).
     pub every: usize,
     /// Show a progress bar (the binary sets this when standard error is a terminal).
     pub progress: bool,
@@ -37,14 +54,23 @@ pub struct SimulateArgs {
 /// What a run did (the summary line).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Summary {
+    /// Steps taken.
     pub steps: u64,
+    /// Wall-clock seconds of the step loop.
     pub wall_seconds: f64,
+    /// Simulated seconds.
     pub simulated_seconds: f64,
+    /// Simulated over wall-clock seconds.
     pub real_time_factor: f64,
+    /// Mechanical energy at the start (J).
     pub energy_start: f64,
+    /// Mechanical energy at the end (J).
     pub energy_end: f64,
+    /// Deepest penetration into the ground during the run (m).
     pub max_penetration: f64,
+    /// The integrator's name.
     pub integrator: &'static str,
+    /// Narrow-phase contact queries made.
     pub contact_queries: u64,
 }
 
@@ -67,18 +93,31 @@ impl std::fmt::Display for Summary {
 /// A failed run: one line naming the file, option or quantity.
 #[derive(Debug, thiserror::Error)]
 pub enum SimulateError {
+    /// The URDF could not be imported.
     #[error(transparent)]
     Urdf(#[from] crate::UrdfError),
+    /// The `--initial` state is malformed.
     #[error(transparent)]
     State(#[from] state::StateError),
     /// (Not a `#[source]`: the message already carries the cause, and the CLI
     /// prints the chain — it would appear twice.)
+    /// The simulation failed (diverged, turned non-finite, ...).
     #[error("{urdf}: {error}")]
-    Sim { urdf: String, error: SimError },
+    Sim {
+        /// The URDF file.
+        urdf: String,
+        /// What went wrong.
+        error: SimError,
+    },
+    /// A bad option value.
     #[error("{0}")]
     Option(String),
+    /// The trajectory could not be written.
     #[error("{0}")]
     Output(String),
+    /// The replay page (`--html`) could not be made.
+    #[error(transparent)]
+    View(#[from] crate::cli::view::ViewError),
 }
 
 /// Runs the command. The trajectory file is written atomically: a failed run
@@ -206,6 +245,20 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         armature: args.armature,
         ..SimOptions::default()
     };
+    // The page's geometry is read before anything is simulated (a missing mesh
+    // is reported at once).
+    let geometry = match &args.html {
+        Some(_) => Some(crate::cli::view::Geometry::load(
+            &model,
+            &args.urdf,
+            &args.package_path,
+        )?),
+        None => None,
+    };
+    for w in geometry.iter().flat_map(|g| &g.warnings) {
+        warn(&format!("warning: {w}"));
+    }
+    let ground = opts.ground;
     let sim_err = |error| SimulateError::Sim {
         urdf: urdf_name.clone(),
         error,
@@ -285,6 +338,10 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
     };
     let block_rows = 64usize;
     let e0 = sim.energy();
+    let mut recorder = args
+        .html
+        .as_ref()
+        .map(|_| crate::cli::view::Recorder::new(&sim.model, duration, true));
     let mut loop_body = |w: Option<&mut (dyn Write + Send)>| -> Result<Summary, SimulateError> {
         let start = Instant::now();
         let mut max_pen = sim.penetration();
@@ -294,17 +351,31 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             let writer =
                 w.map(|w| scope.spawn(|| write_rows(w, &header, (nq, nv), from_sim, recycle)));
             let mut block: Vec<f64> = Vec::with_capacity(width * block_rows);
-            let push_row =
-                |sim: &mut Simulation, block: &mut Vec<f64>| -> Result<(), SimulateError> {
-                    let e = finite_energy(sim, &urdf_name)?;
-                    block.push(sim.time());
-                    block.extend_from_slice(sim.q().as_slice());
-                    block.extend_from_slice(sim.v().as_slice());
-                    block.push(e);
-                    block.push(sim.active_contacts() as f64);
-                    block.push(sim.penetration());
-                    Ok(())
-                };
+            let push_row = |sim: &mut Simulation,
+                            block: &mut Vec<f64>,
+                            recorder: &mut Option<crate::cli::view::Recorder>,
+                            last: bool|
+             -> Result<(), SimulateError> {
+                let e = finite_energy(sim, &urdf_name)?;
+                block.push(sim.time());
+                block.extend_from_slice(sim.q().as_slice());
+                block.extend_from_slice(sim.v().as_slice());
+                block.push(e);
+                block.push(sim.active_contacts() as f64);
+                block.push(sim.penetration());
+                if let Some(r) = recorder {
+                    let plot = [e, sim.active_contacts() as f64, sim.penetration()];
+                    r.offer_with(sim.time(), sim.q(), plot, last, |out| {
+                        out.extend(sim.contact_forces().iter().map(|c| {
+                            crate::cli::view::ContactArrow {
+                                point: c.point.point.into(),
+                                force: c.force.into(),
+                            }
+                        }))
+                    });
+                }
+                Ok(())
+            };
             // sends a full block (or, at the end, the last one); a writer that hung
             // up has failed: its error is collected at the join below
             let send = |block: &mut Vec<f64>| -> bool {
@@ -317,7 +388,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                     .unwrap_or_else(|_| Vec::with_capacity(width * block_rows));
                 to_writer.send(std::mem::replace(block, next)).is_ok()
             };
-            let mut sim_result = push_row(&mut sim, &mut block);
+            let mut sim_result = push_row(&mut sim, &mut block, &mut recorder, duration <= 0.0);
             let mut k = 0u64;
             let mut last_tick = 0u64;
             while sim_result.is_ok() && sim.time() < duration {
@@ -332,7 +403,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                 max_pen = max_pen.max(sim.penetration());
                 let last = sim.time() >= duration;
                 if last || k % every as u64 == 0 {
-                    if let Err(e) = push_row(&mut sim, &mut block) {
+                    if let Err(e) = push_row(&mut sim, &mut block, &mut recorder, last) {
                         sim_result = Err(e);
                         break;
                     }
@@ -383,7 +454,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             contact_queries: sim.contact_queries(),
         })
     };
-    match &args.out {
+    let summary = match &args.out {
         Some(path) => {
             let mut result = None;
             write_atomic(path, |w| match loop_body(Some(w)) {
@@ -397,7 +468,11 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             result.ok_or_else(|| SimulateError::Output("no result".into()))
         }
         None => loop_body(None),
+    }?;
+    if let (Some(path), Some(geometry), Some(recorder)) = (&args.html, &geometry, &recorder) {
+        crate::cli::view::write_page(path, &sim.model, geometry, recorder, ground)?;
     }
+    Ok(summary)
 }
 
 /// One warning line on standard error (the run goes on).

@@ -5,8 +5,11 @@
 //! - Wavefront OBJ through `tobj` (every object's `v` positions);
 //! - COLLADA (`.dae`) through a minimal reader. The vertices are the
 //!   `<float_array>` of the `<source>` that a geometry's
-//!   `<vertices><input semantic="POSITION">` names (the whole array, whether
-//!   or not primitives index all of it), placed by the scene graph: the visual
+//!   `<vertices><input semantic="POSITION">` names, those of them that the
+//!   geometry's `<triangles>`, `<polylist>` and `<polygons>` index (the whole
+//!   array for a geometry without such primitives or whose primitives index
+//!   nothing; assimp, which coal and Pinocchio use, also drops positions that
+//!   nothing indexes: see docs/meshes.md), placed by the scene graph: the visual
 //!   scene `<scene><instance_visual_scene url>` names (else the first one) is
 //!   walked, each `<node>`'s transform elements (`<matrix>`, row-major;
 //!   `<translate>`; `<rotate>`, axis and angle in degrees; `<scale>`) are
@@ -27,7 +30,9 @@ use std::path::Path;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{file}: {message}")]
 pub struct MeshError {
+    /// The mesh file.
     pub file: String,
+    /// What is wrong with it.
     pub message: String,
 }
 
@@ -38,48 +43,52 @@ fn err(path: &Path, message: impl Into<String>) -> MeshError {
     }
 }
 
+/// A triangle mesh as a mesh file gives it: vertex positions (in the file's
+/// units times the scale asked for) and triangles as indices into them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriMesh {
+    /// Vertex positions.
+    pub vertices: Vec<Vector3<f64>>,
+    /// Triangles, three indices into `vertices` each (polygons fan-triangulated).
+    pub triangles: Vec<[u32; 3]>,
+}
+
 /// The vertex positions of a mesh file, in the file's units times `scale`.
 /// Non-finite coordinates are an error; an empty mesh is an error.
 pub fn load_vertices(path: &Path, scale: [f64; 3]) -> Result<Vec<Vector3<f64>>, MeshError> {
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    let raw: Vec<[f64; 3]> = match ext.as_str() {
-        "stl" => {
-            let mut f =
-                std::fs::File::open(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
-            let mesh = stl_io::read_stl(&mut f)
-                .map_err(|e| err(path, format!("not a valid STL file: {e}")))?;
-            mesh.vertices
-                .iter()
-                .map(|v| [v.0[0] as f64, v.0[1] as f64, v.0[2] as f64])
-                .collect()
-        }
-        "obj" => {
-            let opts = tobj::LoadOptions::default();
-            let (models, _) = tobj::load_obj(path, &opts)
-                .map_err(|e| err(path, format!("not a valid OBJ file: {e}")))?;
-            let mut out = Vec::new();
-            for m in &models {
-                for c in m.mesh.positions.chunks_exact(3) {
-                    out.push([c[0] as f64, c[1] as f64, c[2] as f64]);
-                }
-            }
-            out
-        }
-        "dae" => {
-            let bytes = std::fs::read(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
-            let text = String::from_utf8_lossy(&bytes);
-            read_dae_positions(&text).map_err(|m| err(path, m))?
-        }
-        other => {
-            return Err(err(
-                path,
-                format!("unsupported mesh format \"{other}\" (STL, OBJ and DAE are read)"),
-            ))
-        }
-    };
+    let (raw, _) = read_raw(path, false)?;
+    scaled(path, raw, scale)
+}
+
+/// The vertices and triangles of a mesh file (STL, OBJ, DAE as [`load_vertices`]
+/// reads them: the same vertices, DAE nodes placed alike), in the file's units
+/// times `scale`. DAE triangles come from `<triangles>`, `<polylist>` and
+/// `<polygons>` (fan-triangulated), OBJ faces are triangulated; an index outside
+/// the vertices is an error, and so is a mesh without vertices.
+pub fn load_mesh(path: &Path, scale: [f64; 3]) -> Result<TriMesh, MeshError> {
+    let (raw, triangles) = read_raw(path, true)?;
+    let n = raw.len();
+    if let Some(t) = triangles
+        .iter()
+        .find(|t| t.iter().any(|&i| i as usize >= n))
+    {
+        return Err(err(
+            path,
+            format!("a triangle {t:?} indexes past the {n} vertices"),
+        ));
+    }
+    Ok(TriMesh {
+        vertices: scaled(path, raw, scale)?,
+        triangles,
+    })
+}
+
+/// Scales raw positions, refusing an empty mesh and non-finite vertices.
+fn scaled(
+    path: &Path,
+    raw: Vec<[f64; 3]>,
+    scale: [f64; 3],
+) -> Result<Vec<Vector3<f64>>, MeshError> {
     if raw.is_empty() {
         return Err(err(path, "the mesh has no vertices"));
     }
@@ -92,6 +101,77 @@ pub fn load_vertices(path: &Path, scale: [f64; 3]) -> Result<Vec<Vector3<f64>>, 
         out.push(v);
     }
     Ok(out)
+}
+
+/// Raw positions of a mesh file and, when `with_triangles`, its triangles.
+fn read_raw(
+    path: &Path,
+    with_triangles: bool,
+) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), MeshError> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let mut triangles = Vec::new();
+    let raw: Vec<[f64; 3]> = match ext.as_str() {
+        "stl" => {
+            let mut f =
+                std::fs::File::open(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
+            let mesh = stl_io::read_stl(&mut f)
+                .map_err(|e| err(path, format!("not a valid STL file: {e}")))?;
+            if with_triangles {
+                for face in &mesh.faces {
+                    let [a, b, c] = face.vertices;
+                    let idx =
+                        |i: usize| u32::try_from(i).map_err(|_| err(path, "too many vertices"));
+                    triangles.push([idx(a)?, idx(b)?, idx(c)?]);
+                }
+            }
+            mesh.vertices
+                .iter()
+                .map(|v| [v.0[0] as f64, v.0[1] as f64, v.0[2] as f64])
+                .collect()
+        }
+        "obj" => {
+            let opts = tobj::LoadOptions {
+                triangulate: with_triangles,
+                ..tobj::LoadOptions::default()
+            };
+            let (models, _) = tobj::load_obj(path, &opts)
+                .map_err(|e| err(path, format!("not a valid OBJ file: {e}")))?;
+            let mut out = Vec::new();
+            for m in &models {
+                let base = u32::try_from(out.len()).map_err(|_| err(path, "too many vertices"))?;
+                if with_triangles {
+                    for t in m.mesh.indices.chunks_exact(3) {
+                        if let &[a, b, c] = t {
+                            triangles.push([base + a, base + b, base + c]);
+                        }
+                    }
+                }
+                for c in m.mesh.positions.chunks_exact(3) {
+                    out.push([c[0] as f64, c[1] as f64, c[2] as f64]);
+                }
+            }
+            out
+        }
+        "dae" => {
+            let bytes = std::fs::read(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
+            let text = String::from_utf8_lossy(&bytes);
+            let (p, t) = read_dae(&text).map_err(|m| err(path, m))?;
+            if with_triangles {
+                triangles = t;
+            }
+            p
+        }
+        other => {
+            return Err(err(
+                path,
+                format!("unsupported mesh format \"{other}\" (STL, OBJ and DAE are read)"),
+            ))
+        }
+    };
+    Ok((raw, triangles))
 }
 
 /// A 4×4 affine transform acting on column vectors (COLLADA's convention).
@@ -129,6 +209,77 @@ enum DaeText {
     Array(String),
     /// A transform element (`matrix`, `translate`, `rotate`, `scale`) of a node.
     Transform(&'static str, usize),
+    /// A `<vcount>` or `<p>` of the primitive being read.
+    Indices(&'static str),
+}
+
+/// A `<triangles>`, `<polylist>` or `<polygons>` element of a geometry.
+#[derive(Default)]
+struct DaePrim {
+    kind: &'static str,
+    /// Indices per vertex (the largest input offset plus one).
+    stride: usize,
+    /// The offset and `source` (a `<vertices>` id) of the VERTEX input.
+    vertex: Option<(usize, String)>,
+    vcount: Vec<usize>,
+    /// Every `<p>`, in order (`<polygons>` has one per polygon).
+    ps: Vec<Vec<u32>>,
+}
+
+impl DaePrim {
+    /// The primitive's triangles as indices into its position source of `n`
+    /// vertices (polygons fan-triangulated).
+    fn triangles(&self, n: usize, out: &mut Vec<[u32; 3]>, base: u32) -> Result<(), String> {
+        let Some((offset, _)) = &self.vertex else {
+            return Ok(());
+        };
+        let stride = self.stride.max(1);
+        let corner = |p: &[u32], k: usize| -> Result<u32, String> {
+            let i = p
+                .get(k * stride + offset)
+                .copied()
+                .ok_or_else(|| format!("<{}>: <p> ends inside a vertex", self.kind))?;
+            if i as usize >= n {
+                return Err(format!(
+                    "<{}>: vertex index {i} is past the {n} positions",
+                    self.kind
+                ));
+            }
+            Ok(base + i)
+        };
+        let mut fan = |p: &[u32], first: usize, count: usize| -> Result<(), String> {
+            if count < 3 {
+                return Ok(());
+            }
+            let a = corner(p, first)?;
+            for k in first + 1..first + count - 1 {
+                out.push([a, corner(p, k)?, corner(p, k + 1)?]);
+            }
+            Ok(())
+        };
+        match self.kind {
+            "polylist" => {
+                let p: Vec<u32> = self.ps.concat();
+                let mut first = 0;
+                for &c in &self.vcount {
+                    fan(&p, first, c)?;
+                    first += c;
+                }
+            }
+            "polygons" => {
+                for p in &self.ps {
+                    fan(p, 0, p.len() / stride)?;
+                }
+            }
+            _ => {
+                let p: Vec<u32> = self.ps.concat();
+                for t in 0..p.len() / (3 * stride) {
+                    fan(&p, 3 * t, 3)?;
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// At most 120 characters of `s`, for messages.
@@ -210,7 +361,14 @@ fn dae_transform(kind: &'static str, text: &str, node: &str) -> Result<Mat4, Str
 }
 
 /// Positions of a COLLADA document (see the module doc).
+#[cfg(test)]
 fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
+    read_dae(text).map(|(p, _)| p)
+}
+
+/// Positions of a COLLADA document (see the module doc) and, when
+/// the triangles of the placed geometries' primitives.
+fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
     use quick_xml::events::Event;
     use std::collections::HashMap;
     let mut reader = quick_xml::Reader::from_str(text);
@@ -235,6 +393,13 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
     let mut collecting: Option<DaeText> = None;
     let mut buf = String::new();
     let mut in_vertices = false;
+    // `<vertices id>` -> its POSITION source
+    let mut vertices_source: HashMap<String, String> = HashMap::new();
+    let mut current_vertices: Option<String> = None;
+    // geometry id -> its primitives
+    let mut geometry_prims: HashMap<String, Vec<DaePrim>> = HashMap::new();
+    let mut geometry_order: Vec<String> = Vec::new();
+    let mut current_prim: Option<DaePrim> = None;
     let mut unit = 1.0;
     // Ends the text being collected, `collecting`, into its array or node.
     let finish = |collecting: DaeText,
@@ -257,6 +422,8 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
                     node.local *= m;
                 }
             }
+            // (read by the caller)
+            DaeText::Indices(_) => {}
         }
         Ok(())
     };
@@ -297,12 +464,58 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
                         current_geometry = attr(b"id");
                         if let Some(g) = &current_geometry {
                             geometry_positions.entry(g.clone()).or_default();
+                            geometry_order.push(g.clone());
                         }
                     }
-                    b"vertices" => in_vertices = is_start,
+                    b"vertices" => {
+                        in_vertices = is_start;
+                        current_vertices = attr(b"id");
+                    }
+                    kind @ (b"triangles" | b"polylist" | b"polygons")
+                        if is_start && current_geometry.is_some() =>
+                    {
+                        current_prim = Some(DaePrim {
+                            kind: match kind {
+                                b"triangles" => "triangles",
+                                b"polylist" => "polylist",
+                                _ => "polygons",
+                            },
+                            ..DaePrim::default()
+                        });
+                    }
+                    b"input" if current_prim.is_some() && !in_vertices => {
+                        let offset = match attr(b"offset") {
+                            Some(o) => o.trim().parse::<usize>().map_err(|_| {
+                                format!("<input offset=\"{}\">: not an index", dae_snippet(&o))
+                            })?,
+                            None => 0,
+                        };
+                        if let Some(prim) = current_prim.as_mut() {
+                            prim.stride = prim.stride.max(offset + 1);
+                            if attr(b"semantic").as_deref() == Some("VERTEX") {
+                                let src = attr(b"source").unwrap_or_default();
+                                prim.vertex =
+                                    Some((offset, src.trim_start_matches('#').to_string()));
+                            }
+                        }
+                    }
+                    kind @ (b"vcount" | b"p") if current_prim.is_some() => {
+                        let kind = if kind == b"p" { "p" } else { "vcount" };
+                        if is_start {
+                            buf.clear();
+                            collecting = Some(DaeText::Indices(kind));
+                        } else if let Some(prim) = current_prim.as_mut() {
+                            if kind == "p" {
+                                prim.ps.push(Vec::new());
+                            }
+                        }
+                    }
                     b"input" if in_vertices && attr(b"semantic").as_deref() == Some("POSITION") => {
                         if let Some(s) = attr(b"source") {
                             let s = s.trim_start_matches('#').to_string();
+                            if let Some(v) = &current_vertices {
+                                vertices_source.insert(v.clone(), s.clone());
+                            }
                             if let Some(g) = &current_geometry {
                                 geometry_positions
                                     .entry(g.clone())
@@ -441,6 +654,7 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
                                 format!("float_array \"{}\"", dae_snippet(id))
                             }
                             Some(DaeText::Transform(kind, _)) => format!("<{kind}>"),
+                            Some(DaeText::Indices(kind)) => format!("<{kind}>"),
                             None => String::new(),
                         };
                         return Err(format!(
@@ -457,6 +671,28 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
                         if let Some(c) = collecting.take() {
                             finish(c, &buf, &mut arrays, &mut nodes)?;
                             buf.clear();
+                        }
+                    }
+                    b"vcount" | b"p" => {
+                        if let (Some(DaeText::Indices(kind)), Some(prim)) =
+                            (collecting.take(), current_prim.as_mut())
+                        {
+                            let ints: Result<Vec<u32>, _> =
+                                buf.split_whitespace().map(str::parse::<u32>).collect();
+                            let ints = ints.map_err(|_| {
+                                format!("<{}><{kind}>: not a list of indices", prim.kind)
+                            })?;
+                            if kind == "p" {
+                                prim.ps.push(ints);
+                            } else {
+                                prim.vcount.extend(ints.iter().map(|&c| c as usize));
+                            }
+                            buf.clear();
+                        }
+                    }
+                    b"triangles" | b"polylist" | b"polygons" => {
+                        if let (Some(prim), Some(g)) = (current_prim.take(), &current_geometry) {
+                            geometry_prims.entry(g.clone()).or_default().push(prim);
                         }
                     }
                     b"source" => current_source = None,
@@ -479,6 +715,29 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
             .and_then(|a| arrays.get(a))
             .ok_or_else(|| format!("POSITION source \"{}\" has no float_array", dae_snippet(s)))
     };
+    // The triangles of geometry `g` whose POSITION sources start at `bases`.
+    let emit_triangles =
+        |g: &str, bases: &HashMap<&str, u32>, tris: &mut Vec<[u32; 3]>| -> Result<(), String> {
+            for prim in geometry_prims.get(g).map(Vec::as_slice).unwrap_or_default() {
+                let Some((_, vref)) = &prim.vertex else {
+                    continue;
+                };
+                let src = vertices_source
+                    .get(vref)
+                    .map(String::as_str)
+                    .unwrap_or(vref);
+                let (Some(&base), Ok(arr)) = (bases.get(src), positions_of(src)) else {
+                    return Err(format!(
+                        "<{}>: the VERTEX input \"{}\" names no POSITION source of its geometry",
+                        prim.kind,
+                        dae_snippet(vref)
+                    ));
+                };
+                prim.triangles(arr.len() / 3, tris, base)?;
+            }
+            Ok(())
+        };
+    let mut tris: Vec<[u32; 3]> = Vec::new();
 
     // The scene `<scene><instance_visual_scene>` names, else the first one.
     let scene = match &scene_url {
@@ -496,6 +755,8 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
     };
     if let Some(scene) = scene {
         let mut out = Vec::new();
+        // Whether each placed position is kept.
+        let mut used: Vec<bool> = Vec::new();
         let mut instanced = false;
         // (node, parent's world transform, the node that has an unsupported transform)
         let mut stack: Vec<(usize, Mat4, Option<usize>)> = scene
@@ -537,8 +798,11 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
                         dae_snippet(url)
                     )
                 })?;
+                let mut bases: HashMap<&str, u32> = HashMap::new();
+                let first_triangle = tris.len();
                 for s in sources {
                     let arr = positions_of(s)?;
+                    bases.entry(s.as_str()).or_insert(out.len() as u32);
                     if out.len() + arr.len() / 3 > MAX_DAE_VERTICES {
                         return Err(format!(
                             "the visual scene places more than {MAX_DAE_VERTICES} vertices"
@@ -549,6 +813,16 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
                             let p = world * nalgebra::Vector4::new(x, y, z, 1.0);
                             out.push([p.x * unit, p.y * unit, p.z * unit]);
                         }
+                    }
+                }
+                emit_triangles(id, &bases, &mut tris)?;
+                // Only the positions its primitives index (all of them when it has
+                // none, or when they index nothing).
+                let placed = tris.get(first_triangle..).unwrap_or_default();
+                used.resize(out.len(), placed.is_empty());
+                for &i in placed.iter().flatten() {
+                    if let Some(u) = used.get_mut(i as usize) {
+                        *u = true;
                     }
                 }
             }
@@ -565,19 +839,49 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
             }
         }
         if instanced {
-            return Ok(out);
+            return Ok(keep_used(out, tris, &used));
         }
     }
     // No scene places a geometry: every POSITION array, untransformed.
     let mut out = Vec::new();
+    let mut bases: HashMap<&str, u32> = HashMap::new();
     for s in &position_sources {
+        bases.entry(s.as_str()).or_insert(out.len() as u32);
         for c in positions_of(s)?.chunks_exact(3) {
             if let &[x, y, z] = c {
                 out.push([x * unit, y * unit, z * unit]);
             }
         }
     }
-    Ok(out)
+    for g in &geometry_order {
+        emit_triangles(g, &bases, &mut tris)?;
+    }
+    Ok((out, tris))
+}
+
+/// The positions marked `used`, and the triangles (which index only used ones)
+/// renumbered for them.
+fn keep_used(
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    used: &[bool],
+) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    if used.iter().all(|&u| u) {
+        return (positions, triangles);
+    }
+    let mut new_index = vec![0u32; positions.len()];
+    let mut kept = Vec::with_capacity(positions.len());
+    for (i, p) in positions.into_iter().enumerate() {
+        if used.get(i).copied().unwrap_or(true) {
+            new_index[i] = kept.len() as u32;
+            kept.push(p);
+        }
+    }
+    let triangles = triangles
+        .into_iter()
+        .map(|t| t.map(|i| new_index.get(i as usize).copied().unwrap_or(0)))
+        .collect();
+    (kept, triangles)
 }
 
 #[cfg(test)]
@@ -817,6 +1121,99 @@ mod tests {
 <vertices id="e-v"><input semantic="POSITION" source="#e-pos"/></vertices></mesh></geometry></library_geometries>"##,
             );
         assert_eq!(read_dae_positions(&dae).unwrap().len(), 3);
+    }
+
+    #[test]
+    fn dae_triangles_of_placed_polylists() {
+        // A unit square as one quad (polylist, normals interleaved: stride 2) and
+        // one triangle, placed twice: the second copy's indices start at 4.
+        let dae = r##"<COLLADA><asset><unit meter="0.5"/></asset>
+<library_geometries><geometry id="sq"><mesh>
+<source id="p"><float_array id="pa">0 0 0 1 0 0 1 1 0 0 1 0</float_array></source>
+<source id="n"><float_array id="na">0 0 1</float_array></source>
+<vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+<polylist count="1"><input semantic="VERTEX" source="#v" offset="0"/>
+<input semantic="NORMAL" source="#n" offset="1"/><vcount>4</vcount><p>0 0 1 0 2 0 3 0</p></polylist>
+<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>3 2 1</p></triangles>
+</mesh></geometry></library_geometries>
+<library_visual_scenes><visual_scene id="S">
+<node><instance_geometry url="#sq"/></node>
+<node><translate>0 0 2</translate><instance_geometry url="#sq"/></node>
+</visual_scene></library_visual_scenes></COLLADA>"##;
+        let (p, t) = read_dae(dae).unwrap();
+        assert_eq!(p.len(), 8);
+        assert_eq!(p[6], [0.5, 0.5, 1.0]);
+        assert_eq!(
+            t,
+            vec![
+                [0, 1, 2],
+                [0, 2, 3],
+                [3, 2, 1],
+                [4, 5, 6],
+                [4, 6, 7],
+                [7, 6, 5]
+            ]
+        );
+        // The positions are those load_vertices reads.
+        assert_eq!(read_dae_positions(dae).unwrap(), p);
+        // An index past the positions is an error naming the primitive.
+        let bad = dae.replace("<p>3 2 1</p>", "<p>3 2 9</p>");
+        let e = read_dae(&bad).unwrap_err();
+        assert!(e.contains("<triangles>: vertex index 9"), "{e}");
+        // A position no primitive indexes is dropped (from the vertices and from
+        // the triangles' numbering), in every placed copy.
+        let extra = dae
+            .replace("0 1 0</float_array>", "0 1 0 5 5 5</float_array>")
+            .replace("<p>3 2 1</p>", "<p>3 2 1</p><p></p>");
+        let (p2, t2) = read_dae(&extra).unwrap();
+        assert_eq!((p2, t2), (p.clone(), t.clone()));
+        // Without primitives a geometry's every position is kept.
+        let bare = extra
+            .split("<polylist")
+            .next()
+            .map(|head| format!("{head}</mesh>{}", extra.split("</triangles>\n</mesh>").nth(1).unwrap_or("")))
+            .unwrap();
+        let (p3, t3) = read_dae(&bare).unwrap();
+        assert_eq!((p3.len(), t3.len()), (10, 0), "{bare}");
+    }
+
+    #[test]
+    fn stl_and_obj_triangles() {
+        let dir = tempfile::tempdir().unwrap();
+        let stl = dir.path().join("t.stl");
+        std::fs::write(
+            &stl,
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n\
+             facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n",
+        )
+        .unwrap();
+        let m = load_mesh(&stl, [2.0, 1.0, 1.0]).unwrap();
+        assert_eq!(m.vertices.len(), 4);
+        assert_eq!(m.triangles.len(), 2);
+        // The second triangle is (1,0,0), (1,1,0), (0,1,0), x scaled by 2.
+        let corners: Vec<_> = m.triangles[1]
+            .iter()
+            .map(|&i| m.vertices[i as usize])
+            .collect();
+        assert_eq!(corners[0], Vector3::new(2.0, 0.0, 0.0));
+        assert_eq!(corners[1], Vector3::new(2.0, 1.0, 0.0));
+        assert_eq!(corners[2], Vector3::new(0.0, 1.0, 0.0));
+        assert_eq!(load_vertices(&stl, [2.0, 1.0, 1.0]).unwrap(), m.vertices);
+
+        let obj = dir.path().join("q.obj");
+        std::fs::write(&obj, "o a\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\no b\nv 0 0 5\nv 1 0 5\nv 0 1 5\nf 5 6 7\n").unwrap();
+        let m = load_mesh(&obj, [1.0; 3]).unwrap();
+        assert_eq!(m.vertices.len(), 7);
+        assert_eq!(m.triangles.len(), 3);
+        // The quad's two triangles cover its area (1), the last triangle is z = 5.
+        let area = |t: &[u32; 3]| {
+            let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+            (b - a).cross(&(c - a)).norm() / 2.0
+        };
+        assert!((area(&m.triangles[0]) + area(&m.triangles[1]) - 1.0).abs() < 1e-12);
+        assert!(m.triangles[2]
+            .iter()
+            .all(|&i| m.vertices[i as usize].z == 5.0));
     }
 
     #[test]

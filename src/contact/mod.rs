@@ -105,16 +105,32 @@ impl Default for ContactParams {
 /// Why ground contact could not be set up.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ContactError {
+    /// A collision mesh file that no package root or path resolves to.
     #[error("link \"{link}\": collision mesh \"{file}\" not found (give its package root with --package-path or ROS_PACKAGE_PATH, or run with --no-ground)")]
-    MissingMesh { link: String, file: String },
+    MissingMesh {
+        /// The URDF link whose `<collision>` names the mesh.
+        link: String,
+        /// The mesh filename as the URDF gives it.
+        file: String,
+    },
+    /// A collision mesh file that was found but could not be read (unreadable,
+    /// malformed, empty, or with non-finite coordinates).
     #[error("link \"{link}\": {source}")]
     Mesh {
+        /// The URDF link whose `<collision>` names the mesh.
         link: String,
+        /// What went wrong with the file.
         #[source]
         source: mesh::MeshError,
     },
+    /// A collision primitive with a non-finite or negative dimension.
     #[error("link \"{link}\": collision {kind} has a non-finite or negative size")]
-    BadSize { link: String, kind: &'static str },
+    BadSize {
+        /// The URDF link the primitive belongs to.
+        link: String,
+        /// The primitive: `box`, `sphere`, `cylinder` or `capsule`.
+        kind: &'static str,
+    },
 }
 
 #[derive(Clone, Debug)]
@@ -175,6 +191,7 @@ pub struct ContactPoint {
     pub shape: usize,
     /// A stable identity of the point across steps (global slot index).
     pub slot: usize,
+    /// The body the shape moves with (index into the model's bodies).
     pub body: usize,
     /// The point on the shape, world frame.
     pub point: Vector3<f64>,
@@ -185,9 +202,11 @@ pub struct ContactPoint {
 /// The ground plane and every shape that can touch it.
 #[derive(Clone, Debug)]
 pub struct GroundContact {
+    /// Every collision shape of a moving link; [`ContactPoint::shape`] indexes it.
     pub shapes: Vec<GroundShape>,
     /// Ground height (the plane z = ground, normal +z).
     pub ground: f64,
+    /// The contact parameters it was built with.
     pub params: ContactParams,
     /// Narrow-phase queries performed so far (one per shape per detection).
     pub queries: u64,

@@ -1,6 +1,6 @@
 //! One step's constraints: the rows of ground contact (normal + Coulomb cone),
 //! joint Coulomb friction and joint position limits at (q, v), their impulses
-//! by [`solver`](super::solver), and what those impulses do.
+//! by [`solver`], and what those impulses do.
 //!
 //! With H̃ = H + A + Δt·D (A the armature, D the joint damping: damping is
 //! implicit, see [`super`]) factored as L Lᵀ and the free velocity v*, the
@@ -32,6 +32,7 @@ pub(crate) struct RowParams {
     pub joint_dynamics: bool,
     /// Coulomb friction with the ground, restitution.
     pub mu: f64,
+    /// Newton restitution coefficient e of ground impacts (0: inelastic).
     pub restitution: f64,
     /// |g| (for the restitution threshold).
     pub gravity: f64,
@@ -39,23 +40,29 @@ pub(crate) struct RowParams {
     pub beta: f64,
     /// Caps of the position pass's rate: contact (m/s), joint limit (rad/s or m/s).
     pub contact_push_cap: f64,
+    /// The joint-limit cap (rad/s or m/s).
     pub limit_push_cap: f64,
     /// Violations below these are left alone (m, rad).
     pub contact_slop: f64,
+    /// The joint-limit slop (rad or m).
     pub limit_slop: f64,
 }
 
 /// How many rows of each kind one assembly made.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct RowCounts {
+    /// Joint-friction rows (one per joint with URDF friction).
     pub friction: usize,
+    /// Joint-limit rows (one per joint within reach of a limit).
     pub limits: usize,
+    /// Contact points (three rows each: normal and two tangents).
     pub contacts: usize,
     /// Rows whose constraint is violated (position pass needed).
     pub violated: usize,
 }
 
 impl RowCounts {
+    /// All rows: friction + limits + 3 · contacts.
     pub fn total(&self) -> usize {
         self.friction + self.limits + 3 * self.contacts
     }
@@ -150,9 +157,12 @@ impl Constraints {
     pub fn rows_len(&self) -> usize {
         self.rows.n
     }
+    /// The contact points that carried force in the last solve, with their forces.
     pub fn contact_forces(&self) -> &[ContactForce] {
         &self.contact_forces
     }
+    /// The contact wrench on each body from the last solve (world frame, at the
+    /// world origin; entry 0 is the world).
     pub fn body_forces(&self) -> &[Force] {
         &self.fext
     }

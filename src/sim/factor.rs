@@ -42,6 +42,9 @@ pub struct MassFactor {
 }
 
 impl MassFactor {
+    /// The factor's storage and dof paths for `model` (nv × nv), chosen once:
+    /// tree-sparse LTDL on a tree, dense Cholesky with mimic joints or on a
+    /// chain of at most 18 dofs (its H has no zeros for LTDL to skip).
     pub fn new(model: &Model) -> Self {
         let n = model.nv;
         let chain = model
@@ -96,6 +99,8 @@ impl MassFactor {
         self.tree
     }
 
+    /// Every dof's path to the root (root first) back to back, then `0..nv`
+    /// (the full-length path); [`MassFactor::path_of`] gives a row's slice.
     pub fn table(&self) -> &[usize] {
         &self.table
     }
@@ -133,8 +138,8 @@ impl MassFactor {
         }
     }
 
-    /// y ← R⁻ᵀ y for a row held compactly over `path` (y[t] is the entry of
-    /// dof path[t]; the row is zero off the path).
+    /// y ← R⁻ᵀ y for a row held compactly over `path` (`y[t]` is the entry of
+    /// dof `path[t]`; the row is zero off the path).
     #[inline]
     pub fn row_transform(&self, path: &[usize], y: &mut [f64]) {
         let n = self.n;

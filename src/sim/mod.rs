@@ -23,7 +23,7 @@
 //! on an overdamped link's creep. `rk4` and `dop853` keep damping in their
 //! right-hand side while Δt·tr((H + A)⁻¹D) lies inside their stability
 //! interval (an adaptive step is capped there); a step where even `dt` does
-//! not is taken by the time-stepping scheme ([`integrators`]'s damping file
+//! not is taken by the time-stepping scheme (`src/sim/integrators/damping.rs`
 //! says why not a splitting).
 //!
 //! # Contact and limits: time stepping
@@ -81,6 +81,7 @@ use std::path::PathBuf;
 /// than `relative · (|E_ref| + M·|g|·1 m) + absolute` (M the total mass).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EnergyBound {
+    /// Allowed rise as a fraction of `|E_ref| + M·|g|·1 m` (dimensionless).
     pub relative: f64,
     /// J.
     pub absolute: f64,
@@ -97,6 +98,7 @@ pub struct SimOptions {
     pub tol: f64,
     /// Ground height; `None`: no ground (no contact work at all).
     pub ground: Option<f64>,
+    /// Ground contact: friction, restitution, position pass, detection margin.
     pub contact: ContactParams,
     /// Roots for `package://` mesh paths.
     pub package_paths: Vec<PathBuf>,
@@ -112,6 +114,8 @@ pub struct SimOptions {
     /// cap is made energy-safe (`constraints`), so the cap costs accuracy in
     /// the force distribution only, never energy.
     pub solver_iterations: usize,
+    /// The solve stops when no row's velocity changes by more than this in a
+    /// sweep (m/s or rad/s).
     pub solver_tol: f64,
     /// The constraint solver: projected Gauss–Seidel (the default) or the
     /// primal Newton method ([`newton`]; benches/solver_compare.md measures both).
@@ -179,20 +183,34 @@ impl Solver {
 /// Why a simulation could not be set up or continue.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
+    /// Ground contact could not be set up (a collision mesh missing or unreadable).
     #[error(transparent)]
     Contact(#[from] ContactError),
+    /// The dynamics failed (a joint moving only massless links, a singular mass matrix).
     #[error(transparent)]
     Dynamics(#[from] DynamicsError),
+    /// q or v turned non-finite (or an adaptive step size underflowed).
     #[error("the state turned non-finite at t = {t} s ({quantity})")]
-    NonFinite { t: f64, quantity: String },
+    NonFinite {
+        /// Simulated time of the failure (s).
+        t: f64,
+        /// The first non-finite quantity, by its trajectory column name (`q:NAME`, `v:NAME`).
+        quantity: String,
+    },
     /// A passive run whose energy rose past the bound.
     #[error("diverging at t = {t} s: the energy rose from {reference:.6e} J to {energy:.6e} J with no torque applied ({quantity} grew fastest)")]
     Diverging {
+        /// Simulated time of the failure (s).
         t: f64,
+        /// Mechanical energy now (J).
         energy: f64,
+        /// The reference energy it rose from (J).
         reference: f64,
+        /// The velocity coordinate whose magnitude grew most since the
+        /// reference, by its column name (`v:NAME`).
         quantity: String,
     },
+    /// A bad option or state (non-positive `dt`, wrong state length, …): the message.
     #[error("{0}")]
     Invalid(String),
 }
@@ -200,6 +218,7 @@ pub enum SimError {
 /// A point of ground contact after a step: where, how deep, and its force.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactForce {
+    /// The contact point (link shape, world position, gap).
     pub point: ContactPoint,
     /// World-frame force on the link at `point.point` (N).
     pub force: Vector3<f64>,
@@ -209,13 +228,23 @@ pub struct ContactForce {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Violation {
     /// A link's collision geometry is `depth` m inside the ground.
-    Ground { link: String, depth: f64 },
+    Ground {
+        /// The URDF link.
+        link: String,
+        /// Its deepest point's penetration (m, positive).
+        depth: f64,
+    },
     /// A joint is `amount` outside its limits [lower, upper] (at `q`).
     Limit {
+        /// The URDF joint.
         joint: String,
+        /// Its position (rad or m).
         q: f64,
+        /// Lower limit (rad or m; −∞ when the URDF gives none).
         lower: f64,
+        /// Upper limit (rad or m; +∞ when the URDF gives none).
         upper: f64,
+        /// How far outside the limits `q` lies (rad or m, positive).
         amount: f64,
     },
 }
@@ -297,6 +326,7 @@ struct EnergyGuard {
 /// of runs builds its meshes' hulls once and clones the prototype.
 #[derive(Clone, Debug)]
 pub struct Simulation {
+    /// The model simulated (its joints, limits, damping, collision geometry).
     pub model: Model,
     integrator: Integrator,
     dt: f64,
@@ -326,12 +356,18 @@ pub struct Simulation {
     guard: EnergyGuard,
     /// The energy at the current state, once computed.
     energy_now: Option<f64>,
-    /// Steps taken, rejected (adaptive), right-hand-side evaluations.
+    /// Steps taken.
     pub steps: u64,
+    /// Adaptive (`dop853`) steps rejected by the error test and retried
+    /// shorter; not counted in `steps`.
     pub rejected: u64,
+    /// Right-hand-side (dynamics) evaluations: one a time-stepping step, one a
+    /// Runge–Kutta stage.
     pub rhs_evals: u64,
     /// Projected Gauss–Seidel sweeps and constraint rows, summed over the steps.
     pub pgs_sweeps: u64,
+    /// Constraint rows solved, summed over the steps (rows / steps: the mean
+    /// rows a step that touched anything).
     pub rows_total: u64,
 }
 
@@ -474,24 +510,33 @@ impl Simulation {
         Ok(sim)
     }
 
+    /// The integrator in use (`SimOptions::integrator`, or the scene's default).
     pub fn integrator(&self) -> Integrator {
         self.integrator
     }
+    /// Simulated time (s), 0 at construction.
     pub fn time(&self) -> f64 {
         self.t
     }
+    /// Sets the simulated time (s); the state is untouched.
     pub fn set_time(&mut self, t: f64) {
         self.t = t;
     }
+    /// The step (s): every step's for a fixed-step integrator, the first for `dop853`.
     pub fn dt(&self) -> f64 {
         self.dt
     }
+    /// The options it was built with.
     pub fn options(&self) -> &SimOptions {
         &self.opts
     }
+    /// Configuration (nq): with a floating base, position (m, world) and
+    /// quaternion (x, y, z, w) first, then the joints (rad or m).
     pub fn q(&self) -> &DVector<f64> {
         &self.q
     }
+    /// Velocity (nv): with a floating base, linear (m/s) and angular (rad/s)
+    /// velocity in the body frame first, then the joint rates (rad/s or m/s).
     pub fn v(&self) -> &DVector<f64> {
         &self.v
     }
@@ -633,6 +678,7 @@ impl Simulation {
         self.forcing_changed = true;
         &mut self.tau_applied
     }
+    /// The applied generalized forces (nv) as set, before clamping to effort limits.
     pub fn torques(&self) -> &DVector<f64> {
         &self.tau_applied
     }

@@ -28,35 +28,53 @@ pub enum RowKind {
     Normal,
     /// First of a contact's two tangent rows; the next row is its partner.
     /// `normal` is the row index of the contact's normal, `mu` the friction.
-    Tangent { normal: usize, mu: f64 },
+    Tangent {
+        /// Row index of the contact's normal row.
+        normal: usize,
+        /// Coulomb friction coefficient μ of the contact's cone.
+        mu: f64,
+    },
     /// The second tangent row (handled with the first).
     Tangent2,
     /// Joint friction: |λ| ≤ limit.
-    Box { limit: f64 },
+    Box {
+        /// Largest impulse magnitude, F·Δt (N·m·s or N·s).
+        limit: f64,
+    },
     /// Joint limit: λ ≥ 0.
     Unilateral,
 }
 
-/// Preallocated rows: Jacobians (row-major, `nv` wide), H⁻¹Jᵀ, diag W, targets.
+/// Preallocated rows: Jacobians (row-major, `nv` wide), Y = J R⁻ᵀ, diag W,
+/// targets. Every per-row vector holds `capacity()` entries, the first `n` in use.
 #[derive(Clone, Debug)]
 pub struct Rows {
+    /// Width of a row: the model's nv.
     pub nv: usize,
+    /// Rows in use.
     pub n: usize,
+    /// Each row's kind (`n` entries).
     pub kind: Vec<RowKind>,
+    /// Jacobians J, row-major, `nv` per row (row r: `j[r·nv .. (r+1)·nv]`).
     pub j: Vec<f64>,
+    /// Rows of Y = J R⁻ᵀ (H̃ = RᵀR), `nv` apart, each held compactly over its
+    /// path (entry t belongs to dof `path[t]`); filled by [`Rows::form`].
     pub y: Vec<f64>,
+    /// Delassus diagonal Wᵣᵣ = ‖yᵣ‖² (the row's velocity per unit impulse).
     pub w: Vec<f64>,
     /// J v* (free velocity).
     pub c: Vec<f64>,
     /// Target (b) of each row.
     pub b: Vec<f64>,
+    /// Impulse of each row (N·s for contact rows, N·m·s or N·s for joint rows);
+    /// the warm start on entry to [`Rows::solve`], the solution after.
     pub lambda: Vec<f64>,
     /// Position-pass target of each unilateral row (0: not violated).
     pub bpos: Vec<f64>,
     /// Position-pass multipliers.
     pub mu: Vec<f64>,
     /// Each row's dof path (start, length) in the factor's table: its Jacobian
-    /// and y live there only (compact y: entry t is dof path[t]).
+    /// and y live there only (compact y: entry t is dof `path[t]`).
     pub path: Vec<(usize, usize)>,
     /// At a contact's normal row: the off-diagonal entries of its 3×3 block of
     /// W (n·t₁, n·t₂, t₁·t₂), so that a sweep reads the contact's path once.
@@ -68,6 +86,7 @@ pub struct Rows {
 }
 
 impl Rows {
+    /// Room for `cap` rows of width `nv`, all allocated here (none in a step).
     pub fn new(nv: usize, cap: usize) -> Self {
         Self {
             nv,
@@ -88,6 +107,7 @@ impl Rows {
             cap,
         }
     }
+    /// The most rows that fit.
     pub fn capacity(&self) -> usize {
         self.cap
     }
@@ -129,9 +149,11 @@ impl Rows {
         self.path[r] = path;
         Some(r)
     }
+    /// Row `r` of J (`nv` entries), to be written.
     pub fn jrow_mut(&mut self, r: usize) -> &mut [f64] {
         &mut self.j[r * self.nv..(r + 1) * self.nv]
     }
+    /// Row `r` of J (`nv` entries).
     pub fn jrow(&self, r: usize) -> &[f64] {
         &self.j[r * self.nv..(r + 1) * self.nv]
     }
@@ -489,6 +511,7 @@ impl Rows {
     }
 }
 
+/// `Σ aₖ bₖ` over the shorter of the two slices.
 #[inline(always)]
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()

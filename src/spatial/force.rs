@@ -7,15 +7,19 @@ use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 /// `vᵀ f` is power.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Force<T: Scalar = f64> {
+    /// Moment `n` about the frame's origin (N·m).
     pub ang: Vector3<T>,
+    /// Resultant force `f` (N).
     pub lin: Vector3<T>,
 }
 
 impl<T: Scalar> Force<T> {
+    /// `[ang; lin]`: moment about the origin (N·m), then force (N).
     #[inline(always)]
     pub fn new(ang: Vector3<T>, lin: Vector3<T>) -> Self {
         Self { ang, lin }
     }
+    /// The zero force.
     #[inline(always)]
     pub fn zero() -> Self {
         Self {
@@ -31,17 +35,20 @@ impl<T: Scalar> Force<T> {
             lin: f,
         }
     }
+    /// The 6-vector `[n; f]` (angular first).
     pub fn to_vector(&self) -> Vector6<T> {
         Vector6::new(
             self.ang.x, self.ang.y, self.ang.z, self.lin.x, self.lin.y, self.lin.z,
         )
     }
+    /// From a 6-vector `[n; f]` (angular first), the inverse of [`Force::to_vector`].
     pub fn from_vector(x: &Vector6<T>) -> Self {
         Self {
             ang: Vector3::new(x[0], x[1], x[2]),
             lin: Vector3::new(x[3], x[4], x[5]),
         }
     }
+    /// Whether all six entries are finite.
     pub fn is_finite(&self) -> bool {
         self.ang
             .iter()

@@ -10,8 +10,11 @@ use nalgebra::{Matrix3, Matrix6, Vector3};
 /// tensor form of the parallel-axis theorem (`I = I_c + m d²`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Inertia<T: Scalar = f64> {
+    /// Mass `m` (kg).
     pub mass: T,
+    /// Centre of mass `c` in the body's frame (m).
     pub com: Vector3<T>,
+    /// Rotational inertia `I_c` about the centre of mass, body-frame axes (kg·m²).
     pub inertia_c: Matrix3<T>,
 }
 
@@ -22,6 +25,8 @@ impl<T: Scalar> Default for Inertia<T> {
 }
 
 impl<T: Scalar> Inertia<T> {
+    /// From mass (kg), centre of mass (m, body frame) and the rotational
+    /// inertia about the centre of mass (kg·m²), unchecked.
     pub fn new(mass: T, com: Vector3<T>, inertia_c: Matrix3<T>) -> Self {
         Self {
             mass,
@@ -29,6 +34,7 @@ impl<T: Scalar> Inertia<T> {
             inertia_c,
         }
     }
+    /// The zero inertia (a massless body; the world's).
     #[inline(always)]
     pub fn zero() -> Self {
         Self {

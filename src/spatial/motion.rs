@@ -8,15 +8,20 @@ use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 /// acceleration or a joint axis `ŝ`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Motion<T: Scalar = f64> {
+    /// Angular part ω (rad/s; rad/s² for an acceleration).
     pub ang: Vector3<T>,
+    /// Linear velocity of the point at the frame's origin (m/s; m/s² for an
+    /// acceleration).
     pub lin: Vector3<T>,
 }
 
 impl<T: Scalar> Motion<T> {
+    /// `[ang; lin]`: angular part, then the linear part at the frame's origin.
     #[inline(always)]
     pub fn new(ang: Vector3<T>, lin: Vector3<T>) -> Self {
         Self { ang, lin }
     }
+    /// The zero motion.
     #[inline(always)]
     pub fn zero() -> Self {
         Self {
@@ -55,11 +60,13 @@ impl<T: Scalar> Motion<T> {
             ),
         )
     }
+    /// The 6-vector `[ω; v]` (angular first).
     pub fn to_vector(&self) -> Vector6<T> {
         Vector6::new(
             self.ang.x, self.ang.y, self.ang.z, self.lin.x, self.lin.y, self.lin.z,
         )
     }
+    /// From a 6-vector `[ω; v]` (angular first), the inverse of [`Motion::to_vector`].
     pub fn from_vector(x: &Vector6<T>) -> Self {
         Self {
             ang: Vector3::new(x[0], x[1], x[2]),
@@ -79,6 +86,7 @@ impl<T: Scalar> Motion<T> {
     pub fn cross_force_matrix(&self) -> Matrix6<T> {
         -self.cross_matrix().transpose()
     }
+    /// Whether all six entries are finite.
     pub fn is_finite(&self) -> bool {
         self.ang
             .iter()

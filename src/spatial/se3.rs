@@ -11,7 +11,9 @@ use std::ops::Mul;
 /// Pinocchio's names: [`Se3::act_motion`] is `act`, [`Se3::inv_act_motion`] `actInv`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Se3<T: Scalar = f64> {
+    /// Rotation `R`: b-coordinates to a-coordinates.
     pub rot: Matrix3<T>,
+    /// Translation `t`: b's origin in a-coordinates (m).
     pub trans: Vector3<T>,
 }
 
@@ -22,10 +24,12 @@ impl<T: Scalar> Default for Se3<T> {
 }
 
 impl<T: Scalar> Se3<T> {
+    /// From rotation `R` and translation `t` (m); `R` is not checked to be a rotation.
     #[inline(always)]
     pub fn new(rot: Matrix3<T>, trans: Vector3<T>) -> Self {
         Self { rot, trans }
     }
+    /// The identity transform (`R = 1`, `t = 0`).
     #[inline(always)]
     pub fn identity() -> Self {
         Self {
@@ -33,6 +37,7 @@ impl<T: Scalar> Se3<T> {
             trans: Vector3::zeros(),
         }
     }
+    /// A pure translation by `trans` (m).
     #[inline(always)]
     pub fn from_translation(trans: Vector3<T>) -> Self {
         Self {
@@ -40,6 +45,7 @@ impl<T: Scalar> Se3<T> {
             trans,
         }
     }
+    /// A pure rotation `rot` (no translation).
     #[inline(always)]
     pub fn from_rotation(rot: Matrix3<T>) -> Self {
         Self {

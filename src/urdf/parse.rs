@@ -12,6 +12,7 @@ mod build;
 /// The urdf-rs robot (links and joints; visuals and materials, which no dynamics
 /// reads, are checked by the scan but not built) plus what the scan found.
 pub(crate) struct Parsed {
+    /// The robot as urdf-rs reads it.
     pub robot: urdf_rs::Robot,
     /// Elements skipped whole (`<gazebo>`, `<transmission>`, `<sensor>`, xacro
     /// leftovers), one line a kind, as the import report prints them.

@@ -9,12 +9,15 @@ use urdf_rs::JointType;
 
 /// What validation established about the parsed robot.
 pub(crate) struct Checked {
+    /// The root link (index into `robot.links`): the one link no joint has as child.
     pub root: usize,
     /// Child joints of each link, in file order.
     pub children: Vec<Vec<usize>>,
     /// For each joint: Some((ultimate leader joint, multiplier, offset)) if it mimics.
     pub mimic: Vec<Option<(usize, f64, f64)>>,
+    /// The scan's warnings plus validation's own (the import report's).
     pub warnings: Vec<String>,
+    /// Elements skipped whole, one line a kind (the import report's).
     pub ignored: Vec<String>,
 }
 

@@ -3,7 +3,10 @@
 //! Hairer's `dop853.f` (values identical to SciPy's `dop853_coefficients.py`).
 #![allow(clippy::excessive_precision, clippy::unreadable_literal)]
 
+/// Stages of a step (the 13th evaluation, at the new point, is the next step's first).
 pub const N_STAGES: usize = 12;
+/// Nodes cₛ: stage s is evaluated at t + cₛ h (unused: the right-hand side
+/// does not depend on t).
 #[allow(dead_code)]
 pub const C: [f64; 12] = [
     0.0,
@@ -19,6 +22,7 @@ pub const C: [f64; 12] = [
     0.8571428571428571,
     1.0,
 ];
+/// Runge–Kutta matrix: stage s is evaluated at y + h Σ_{j<s} `A[s][j]` kⱼ.
 pub const A: [[f64; 12]; 12] = [
     [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
     [
@@ -176,6 +180,7 @@ pub const A: [[f64; 12]; 12] = [
         0.0,
     ],
 ];
+/// Weights of the 8th-order solution y⁺ = y + h Σ `B[j]` kⱼ.
 pub const B: [f64; 12] = [
     0.054293734116568765,
     0.0,
@@ -190,6 +195,7 @@ pub const B: [f64; 12] = [
     0.20136540080403034,
     0.04471061572777259,
 ];
+/// The 3rd-order error estimator's weights (13 entries: kⱼ, then f(y⁺)).
 pub const E3: [f64; 13] = [
     -0.18980075407240762,
     0.0,
@@ -205,6 +211,7 @@ pub const E3: [f64; 13] = [
     0.02265179219836082,
     0.0,
 ];
+/// The 5th-order error estimator's weights (13 entries: kⱼ, then f(y⁺)).
 pub const E5: [f64; 13] = [
     0.01312004499419488,
     0.0,

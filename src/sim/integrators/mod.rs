@@ -20,12 +20,19 @@ use crate::model::Model;
 /// The available integrators.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Integrator {
+    /// `euler`: semi-implicit (symplectic) Euler, fixed step, damping implicit;
+    /// the time-stepping scheme (docs/theory.md §"Time stepping").
     SemiImplicitEuler,
+    /// `rk4`: classical 4th-order Runge–Kutta, fixed step (docs/theory.md
+    /// §"Smooth integrators").
     Rk4,
+    /// `dop853`: Dormand–Prince 8(5,3), adaptive step under
+    /// [`SimOptions::tol`] (docs/theory.md §"Smooth integrators").
     Dop853,
 }
 
 impl Integrator {
+    /// Every integrator, in the order the command line lists them.
     pub const ALL: [Integrator; 3] = [
         Integrator::SemiImplicitEuler,
         Integrator::Rk4,
@@ -39,9 +46,11 @@ impl Integrator {
             Integrator::Dop853 => "dop853",
         }
     }
+    /// The integrator of a command-line name; `None` for an unknown name.
     pub fn from_name(s: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|i| i.name() == s)
     }
+    /// A one-line description for `--help` and listings.
     pub fn description(self) -> &'static str {
         match self {
             Integrator::SemiImplicitEuler => {
@@ -55,6 +64,8 @@ impl Integrator {
             }
         }
     }
+    /// Whether the step size is chosen by error control (`dop853`); the
+    /// others take `dt` every step.
     pub fn is_adaptive(self) -> bool {
         matches!(self, Integrator::Dop853)
     }
