@@ -12,9 +12,16 @@ use serde_json::{json, Map, Value};
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum EvalError {
     #[error(transparent)]
+    /// The states file is bad (names the file and the key).
     State(#[from] StateError),
     #[error("{file}: {message}")]
-    Dynamics { file: String, message: String },
+    /// The dynamics has no answer (a massless joint, a singular H, an overflow).
+    Dynamics {
+        /// The file to blame (the URDF or the states file).
+        file: String,
+        /// What went wrong, with the state's index.
+        message: String,
+    },
 }
 
 fn vec3(x: &nalgebra::DVector<f64>, at: usize) -> Value {

@@ -10,8 +10,11 @@ use std::collections::BTreeMap;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{file}: {key}: {message}")]
 pub struct StateError {
+    /// The file.
     pub file: String,
+    /// The key path in it (`states[3].q.elbow`).
     pub key: String,
+    /// What is wrong with it.
     pub message: String,
 }
 
@@ -29,13 +32,21 @@ impl StateError {
 #[derive(Debug, Clone, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct BaseState {
+    /// World position of the root link's origin (m).
     pub position: Option<[f64; 3]>,
+    /// Orientation, quaternion x, y, z, w (normalised if within 1e-3 of unit norm).
     pub orientation_xyzw: Option<[f64; 4]>,
+    /// Body-frame linear velocity of the root origin (m/s).
     pub linear_velocity: Option<[f64; 3]>,
+    /// Body-frame angular velocity (rad/s).
     pub angular_velocity: Option<[f64; 3]>,
+    /// Body-frame spatial linear acceleration (m/s², the derivative of `linear_velocity`).
     pub linear_acceleration: Option<[f64; 3]>,
+    /// Body-frame angular acceleration (rad/s²).
     pub angular_acceleration: Option<[f64; 3]>,
+    /// The base's generalized force: a force at the root origin, body frame (N).
     pub force: Option<[f64; 3]>,
+    /// The base's generalized torque, body frame (N·m).
     pub torque: Option<[f64; 3]>,
 }
 
@@ -55,10 +66,15 @@ pub struct LinkWrench {
 #[derive(Debug, Clone, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct State {
+    /// Joint positions by joint name (rad or m).
     pub q: Option<BTreeMap<String, f64>>,
+    /// Joint velocities by joint name.
     pub v: Option<BTreeMap<String, f64>>,
+    /// Joint accelerations by joint name.
     pub a: Option<BTreeMap<String, f64>>,
+    /// Joint efforts by joint name (N·m or N).
     pub tau: Option<BTreeMap<String, f64>>,
+    /// The floating base (read with `--floating-base` only).
     pub base: Option<BaseState>,
     /// External wrenches keyed by URDF link name.
     pub fext: Option<BTreeMap<String, LinkWrench>>,
@@ -70,15 +86,20 @@ pub struct State {
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct StatesFile {
+    /// Gravity in the world frame (default `[0, 0, -9.81]`).
     pub gravity: Option<[f64; 3]>,
+    /// The states to evaluate.
     pub states: Vec<State>,
 }
 
 /// The vectors of one state, in engine order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StateVectors {
+    /// Configuration (nq).
     pub q: DVector<f64>,
+    /// Velocity (nv).
     pub v: DVector<f64>,
+    /// Acceleration (nv).
     pub a: DVector<f64>,
     /// Generalized forces: joint `tau` and, with a floating base, `base.force/torque`.
     pub tau: DVector<f64>,
