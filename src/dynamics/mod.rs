@@ -1,5 +1,5 @@
 //! Rigid-body dynamics algorithms, one a file, all working on a preallocated
-//! [`Data`](crate::model::Data): forward kinematics, recursive Newton–Euler
+//! [`Data`]: forward kinematics, recursive Newton–Euler
 //! inverse dynamics (docs/theory.md §"Recursive Newton–Euler"), the course note's
 //! forward dynamics by n+1 inverse dynamics calls (docs/theory.md §"Forward dynamics
 //! by inverse dynamics"), energies; the fast path: CRBA for H, the tree-sparse LTDL

@@ -26,16 +26,22 @@ use std::path::PathBuf;
 /// gives none (urdf-rs reads a missing `<limit>` as 0..0: that is "unknown").
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct JointLimits {
+    /// Lowest position (rad or m).
     pub lower: Option<f64>,
+    /// Highest position (rad or m).
     pub upper: Option<f64>,
+    /// Largest applied torque or force (N·m or N); simulation clamps to it.
     pub effort: Option<f64>,
+    /// Largest speed (rad/s or m/s), as the URDF gives it (not enforced).
     pub velocity: Option<f64>,
 }
 
 /// Per-DoF data kept for simulation (not used by the rigid-body algorithms).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DofInfo {
+    /// The URDF joint's name.
     pub name: String,
+    /// From `<limit>` (a continuous joint has no position limits).
     pub limits: JointLimits,
     /// Viscous damping (N·m·s/rad or N·s/m) from `<dynamics damping>`.
     pub damping: f64,
@@ -48,22 +54,52 @@ pub struct DofInfo {
 /// A URDF link as a frame on its body: `placement` is `body_M_link`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame<T: Scalar = f64> {
+    /// The URDF link's name.
     pub name: String,
+    /// The body the link is merged into (0: welded to the world).
     pub body: usize,
+    /// `body_M_link`: the link frame in the body frame.
     pub placement: Se3<T>,
 }
 
 /// A collision shape as the URDF gives it (meshes are not read at import).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
-    Box { size: [f64; 3] },
-    Cylinder { radius: f64, length: f64 },
-    Capsule { radius: f64, length: f64 },
-    Sphere { radius: f64 },
-    Mesh { filename: String, scale: [f64; 3] },
+    /// A box centred at its frame.
+    Box {
+        /// Edge lengths along x, y, z (m).
+        size: [f64; 3],
+    },
+    /// A cylinder along its frame's z, centred.
+    Cylinder {
+        /// Radius (m).
+        radius: f64,
+        /// Length along z (m).
+        length: f64,
+    },
+    /// A capsule along its frame's z, centred (urdf-rs's extension).
+    Capsule {
+        /// Radius (m).
+        radius: f64,
+        /// Length of the cylindrical part along z (m).
+        length: f64,
+    },
+    /// A sphere centred at its frame.
+    Sphere {
+        /// Radius (m).
+        radius: f64,
+    },
+    /// A mesh file (STL, OBJ, DAE), read when contact shapes are built.
+    Mesh {
+        /// The URDF's `filename` (`package://`, `file://` or a path relative to the URDF).
+        filename: String,
+        /// Per-axis scale.
+        scale: [f64; 3],
+    },
 }
 
 impl Shape {
+    /// The shape's URDF element name (`box`, `cylinder`, `capsule`, `sphere`, `mesh`).
     pub fn kind(&self) -> &'static str {
         match self {
             Shape::Box { .. } => "box",
@@ -79,9 +115,13 @@ impl Shape {
 /// the body frame (`body_M_geom`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CollisionGeom {
+    /// The URDF link the element belongs to.
     pub link: String,
+    /// The body that link is merged into (0: welded to the world).
     pub body: usize,
+    /// `body_M_geom`: the shape's frame in the body frame.
     pub placement: Se3<f64>,
+    /// The geometry.
     pub shape: Shape,
 }
 
@@ -107,11 +147,13 @@ pub struct ImportReport {
 /// entry 0 being the world.
 #[derive(Clone, Debug)]
 pub struct Model<T: Scalar = f64> {
+    /// The `<robot name>`.
     pub name: String,
     /// Dimension of the configuration vector q (7 for a free base, then 1 per DoF).
     pub nq: usize,
     /// Dimension of the velocity vector v (6 for a free base, then 1 per DoF).
     pub nv: usize,
+    /// Bodies, the world (0) included: links merged through fixed joints count once.
     pub nbodies: usize,
     /// `parent[i] < i`; `parent[0] = 0` (the world).
     pub parent: Vec<usize>,
@@ -141,6 +183,7 @@ pub struct Model<T: Scalar = f64> {
     pub dofs: Vec<DofInfo>,
     /// Every URDF link, in the URDF's order.
     pub frames: Vec<Frame<T>>,
+    /// Every `<collision>` element, in the URDF's order.
     pub collisions: Vec<CollisionGeom>,
     /// For the velocity coordinate k, the previous coordinate on its path to the root
     /// (`λ(k)` of the tree-sparse factorisation), or `usize::MAX` at a root.
@@ -153,6 +196,7 @@ pub struct Model<T: Scalar = f64> {
     pub topology: Topology,
     /// The URDF file this model came from (mesh paths are resolved against it).
     pub source: Option<PathBuf>,
+    /// What the import merged, ignored or warned about.
     pub report: ImportReport,
 }
 
@@ -165,6 +209,7 @@ impl<T: Scalar> Model<T> {
             0
         }
     }
+    /// Index of the first joint coordinate in q (7 with a free base, else 0).
     pub fn joint_q_offset(&self) -> usize {
         if self.floating_base {
             7

@@ -415,7 +415,11 @@ impl Recorder {
     }
 
     fn keep(&mut self, t: f64, q: &DVector<f64>, plot: [f64; 3]) {
-        forward_kinematics(&self.model, &mut self.data, q);
+        // q is nq long (the CSV reader and the simulation size it): the size
+        // check cannot fail, and a frame without poses is never kept
+        if forward_kinematics(&self.model, &mut self.data, q).is_err() {
+            return;
+        }
         for m in self.data.o_m_i.iter().skip(1).take(self.nmoving) {
             self.positions.extend_from_slice(m.trans.as_slice());
             let r = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m.rot));
