@@ -6,7 +6,7 @@
 //! §"Floating base"); joints after it have q̇ = v.
 
 use super::Model;
-use crate::spatial::{axis_angle, quat_to_matrix};
+use crate::spatial::{axis_angle, quat_to_matrix, sin_cos};
 use nalgebra::{DVector, Vector3};
 
 /// q ← q ⊕ h v: p += h R v_lin, quaternion ← quaternion ⊗ exp(h ω / 2)
@@ -22,7 +22,7 @@ pub fn integrate_config(model: &Model, q: &mut DVector<f64>, v: &DVector<f64>, h
         let w = Vector3::new(v[3], v[4], v[5]) * h;
         let th = w.norm();
         let (s, c) = if th > 1e-12 {
-            let (s, c) = (th / 2.0).sin_cos();
+            let (s, c) = sin_cos(th / 2.0);
             (s / th, c)
         } else {
             (0.5 - th * th / 48.0, 1.0 - th * th / 8.0)
