@@ -218,6 +218,9 @@ pub struct GroundContact {
     /// manifold keeps them while they stay within the margin.
     prev_flag: Vec<bool>,
     prev_list: Vec<usize>,
+    /// The horizontal directions a reduced manifold's extremes are taken along
+    /// (cos, sin), computed once ([`reduce_directions`]).
+    reduce_dirs: [(f64, f64); MAX_DIRS],
     /// Per shape, the vertex where the last lowest-vertex search ended (the
     /// next one starts there); per slot, the search generation that visited it.
     last_low: Vec<usize>,
@@ -448,6 +451,7 @@ impl GroundContact {
             scratch: Vec::with_capacity(cap),
             prev_flag: vec![false; n],
             prev_list: Vec::with_capacity(n),
+            reduce_dirs: reduce_directions(params.max_points_per_shape),
             last_low: vec![0; nshapes],
             visited: vec![0; n],
             generation: 0,
@@ -596,7 +600,7 @@ impl GroundContact {
                         }
                     }
                 }
-                reduce(scratch, maxp, out, &self.prev_flag);
+                reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
                 continue;
             }
             // a sphere, capsule or cylinder: its manifold points are computed
@@ -646,7 +650,7 @@ impl GroundContact {
                     }
                 }
             }
-            reduce(scratch, maxp, out, &self.prev_flag);
+            reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
         }
         for &k in &self.prev_list {
             self.prev_flag[k] = false;
@@ -670,6 +674,21 @@ const HOLD_DEEPEST: f64 = 1e-4;
 /// every few steps).
 const HOLD_EXTREME: f64 = 2e-2;
 
+/// Most horizontal directions a reduced manifold uses.
+const MAX_DIRS: usize = 8;
+
+/// The `maxp − 1` (1 to [`MAX_DIRS`]) evenly spread horizontal directions
+/// (cos, sin) of [`reduce`].
+fn reduce_directions(maxp: usize) -> [(f64, f64); MAX_DIRS] {
+    let dirs = maxp.saturating_sub(1).clamp(1, MAX_DIRS);
+    let mut dir = [(0.0, 0.0); MAX_DIRS];
+    for (d, x) in dir.iter_mut().enumerate().take(dirs) {
+        let (sn, c) = (std::f64::consts::TAU * d as f64 / dirs as f64).sin_cos();
+        *x = (c, sn);
+    }
+    dir
+}
+
 /// Appends `pts` to `out`, reduced to at most `maxp` points when there are
 /// more: the deepest point, then the extremes in `maxp − 1` evenly spaced
 /// horizontal directions (a patch spanning the support polygon: a cylinder
@@ -678,18 +697,20 @@ const HOLD_EXTREME: f64 = 2e-2;
 /// [`HOLD_DEEPEST`] or [`HOLD_EXTREME`] of the best, then the lowest slot: the set stays the same from step to step while the contact does, so
 /// warm starts keep working (a deepest point that flipped between near-equal
 /// corners kept solo8's base rocking in a 6 ms cycle).
-fn reduce(pts: &[ContactPoint], maxp: usize, out: &mut Vec<ContactPoint>, prev: &[bool]) {
+/// `dir`: [`reduce_directions`] of `maxp`.
+fn reduce(
+    pts: &[ContactPoint],
+    maxp: usize,
+    out: &mut Vec<ContactPoint>,
+    prev: &[bool],
+    dir: &[(f64, f64); MAX_DIRS],
+) {
     if pts.len() <= maxp {
         out.extend_from_slice(pts);
         return;
     }
-    const MAXD: usize = 8;
+    const MAXD: usize = MAX_DIRS;
     let dirs = maxp.saturating_sub(1).clamp(1, MAXD);
-    let mut dir = [(0.0, 0.0); MAXD];
-    for (d, x) in dir.iter_mut().enumerate().take(dirs) {
-        let (sn, c) = (std::f64::consts::TAU * d as f64 / dirs as f64).sin_cos();
-        *x = (c, sn);
-    }
     // criterion 0: depth; 1..=dirs: how far out along a direction
     let key = |p: &ContactPoint, q: usize| -> f64 {
         if q == 0 {
