@@ -33,6 +33,7 @@ pub use jacobian::{frame_jacobian, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, update_frames};
 pub(crate) use kinematics::forward_kinematics_pass;
 pub use rnea::{bias, rnea};
+pub(crate) use rnea::bias_at_placements;
 
 /// Why forward dynamics has no answer.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

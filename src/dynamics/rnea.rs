@@ -49,6 +49,14 @@ pub(crate) fn bias_pass<T: Scalar>(
     data.bias.copy_from(&data.tau);
 }
 
+/// [`bias`] (no external forces, sizes checked by the caller) at the q whose
+/// joint placements `data.li_m_i` already hold (forward kinematics ran at it):
+/// the pass reads them instead of recomputing each joint's transform.
+pub(crate) fn bias_at_placements<T: Scalar>(model: &Model<T>, data: &mut Data<T>, v: &DVector<T>) {
+    rnea_pass::<T, true, false, false, true>(model, data, &[], v.as_slice(), &[], true, None);
+    data.bias.copy_from(&data.tau);
+}
+
 /// The one RNEA pass behind every entry point. `v = None` means q̇ = 0, `a = None`
 /// means q̈ = 0, `gravity = false` leaves the world unaccelerated.
 pub(crate) fn rnea_impl<T: Scalar>(
@@ -82,10 +90,10 @@ fn rnea_variant<T: Scalar, const F: bool>(
 ) {
     // Monomorphised on which of q̇, q̈ are present (no per-body test).
     match (v, a) {
-        (Some(v), Some(a)) => rnea_pass::<T, true, true, F>(model, data, q, v, a, gravity, fext),
-        (Some(v), None) => rnea_pass::<T, true, false, F>(model, data, q, v, &[], gravity, fext),
-        (None, Some(a)) => rnea_pass::<T, false, true, F>(model, data, q, &[], a, gravity, fext),
-        (None, None) => rnea_pass::<T, false, false, F>(model, data, q, &[], &[], gravity, fext),
+        (Some(v), Some(a)) => rnea_pass::<T, true, true, F, false>(model, data, q, v, a, gravity, fext),
+        (Some(v), None) => rnea_pass::<T, true, false, F, false>(model, data, q, v, &[], gravity, fext),
+        (None, Some(a)) => rnea_pass::<T, false, true, F, false>(model, data, q, &[], a, gravity, fext),
+        (None, None) => rnea_pass::<T, false, false, F, false>(model, data, q, &[], &[], gravity, fext),
     }
 }
 
@@ -94,7 +102,7 @@ fn rnea_variant<T: Scalar, const F: bool>(
 /// each body is matched once per sweep ([`dispatch_joint!`]); the body step is then
 /// compiled per joint model, with the axis and transform shape known.
 #[inline(always)]
-fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool>(
+fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bool>(
     model: &Model<T>,
     data: &mut Data<T>,
     q: &[T],
@@ -125,7 +133,8 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool>(
         let p = parent[i];
         let (vp, ap) = (vel[p], acc[p]);
         let (li, vi, ai) = dispatch_joint!(&joints[i], ident[i], jm => {
-            let li = jm.placement(&placements[i], q);
+            // ᵢXₚ at q, or (K) as forward kinematics left it at this q
+            let li = if K { li_m_i[i] } else { jm.placement(&placements[i], q) };
             let ax = jm.rot_axis();
             // docs/theory.md §"Velocity recursion": v̂ᵢ = ᵢX̂ₚ v̂ₚ + ŝᵢ q̇ᵢ
             let mut vi = Motion::zero();

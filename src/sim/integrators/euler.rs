@@ -6,7 +6,7 @@
 //! (λ the impulses, w the position pass's pseudo-velocity: [`super::super::constraints`]).
 
 use super::solve_rows;
-use crate::dynamics::{bias, forward_dynamics};
+use crate::dynamics::{bias, bias_at_placements, forward_dynamics};
 use crate::model::configuration::{integrate_config, rotate_base_velocity};
 use crate::sim::{SimError, Simulation};
 use nalgebra::{DVector, Vector3};
@@ -64,8 +64,15 @@ impl Simulation {
             tau[k] -= self.damping[k] * self.v[k];
         }
         let free = if dense {
-            bias(&self.model, &mut self.data, &self.q, &self.v, None)
-                .map_err(SimError::from)
+            // C(q, v); when forward kinematics ran at this q (the last step's
+            // contact refresh), its joint placements are reused
+            let c = if self.fk_valid && self.v.len() == nv {
+                bias_at_placements(&self.model, &mut self.data, &self.v);
+                Ok(&self.data.bias)
+            } else {
+                bias(&self.model, &mut self.data, &self.q, &self.v, None)
+            };
+            c.map_err(SimError::from)
                 .map(|c| tau -= c)
                 .and_then(|_| self.factor_mass(h))
                 .map(|_| self.mass.f.solve(&mut tau))
