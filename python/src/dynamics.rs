@@ -65,7 +65,7 @@ fn read_fext(m: &PyModel, d: &mut PyData, fext: Option<&Bound<'_, PyDict>>) -> P
             dynamics::forward_kinematics(&m.model, &mut d.data, &d.q)
                 .map_err(|e| dyn_error(m, e))?;
             let PyData { data, fext, .. } = d;
-            m.fext(f, &data.o_m_i, fext)?;
+            m.fext(f, data, fext)?;
             Ok(true)
         }
         _ => Ok(false),

@@ -8,6 +8,7 @@ use pyo3::types::PyTuple;
 use std::collections::HashMap;
 use std::path::PathBuf;
 use urdyn::nalgebra::{DVector, Vector3};
+use urdyn::model::FrameId;
 use urdyn::spatial::Force;
 use urdyn::{LoadOptions, Model};
 
@@ -54,10 +55,8 @@ impl PyModel {
     /// The frame index of URDF link `name` (`arg` in the message).
     pub fn link(&self, name: &str, arg: &str) -> PyResult<usize> {
         self.links.get(name).copied().ok_or_else(|| {
-            let near = self
-                .links
-                .keys()
-                .min_by_key(|k| edit_distance(k, name))
+            let links = self.model.frames.iter().map(|f| f.name.as_str());
+            let near = urdyn::model::nearest(name, links)
                 .map(|k| format!(" (nearest: \"{k}\")"))
                 .unwrap_or_default();
             value_error(format!(
@@ -68,12 +67,12 @@ impl PyModel {
     }
 
     /// The world wrenches `{link: (force3, torque3)}` at the link origins as
-    /// per-body spatial forces in the world frame at the world origin
-    /// (docs/theory.md §"External forces"), needing the world poses in `o_m_i`.
+    /// per-body spatial forces ([`urdyn::dynamics::add_link_wrench`]), needing
+    /// the world poses in `data` (forward kinematics at the state's q).
     pub fn fext(
         &self,
         dict: &Bound<'_, pyo3::types::PyDict>,
-        o_m_i: &[urdyn::spatial::Se3<f64>],
+        data: &urdyn::Data,
         out: &mut [Force],
     ) -> PyResult<()> {
         out.iter_mut().for_each(|f| *f = Force::zero());
@@ -92,34 +91,12 @@ impl PyModel {
             }
             let f = read3(&pair.get_item(0)?, &format!("fext[\"{name}\"] force"))?;
             let t = read3(&pair.get_item(1)?, &format!("fext[\"{name}\"] torque"))?;
-            let frame = &self.model.frames[fi];
-            if frame.body == 0 {
-                continue; // welded to the world: no effect
-            }
-            let p = o_m_i[frame.body].act_point(&frame.placement.trans);
-            let f = Vector3::new(f[0], f[1], f[2]);
-            let t = Vector3::new(t[0], t[1], t[2]);
-            // moved from the link origin p to the world origin: n_O = τ + p × f
-            out[frame.body] += Force::new(t + p.cross(&f), f);
+            let (f, t) = (Vector3::from(f), Vector3::from(t));
+            urdyn::dynamics::add_link_wrench(&self.model, data, FrameId(fi), &f, &t, out)
+                .map_err(|e| value_error(format!("fext[\"{name}\"]: {e}")))?;
         }
         Ok(())
     }
-}
-
-/// Levenshtein distance (for "nearest known name").
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
-            prev = cur;
-        }
-    }
-    row[b.len()]
 }
 
 #[pymethods]
