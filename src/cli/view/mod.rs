@@ -21,7 +21,7 @@
 use crate::cli::output::write_atomic;
 use crate::contact::mesh::{load_mesh, TriMesh};
 use crate::dynamics::forward_kinematics;
-use crate::model::Data;
+use crate::model::{Data, Shape};
 use crate::spatial::Se3;
 use crate::{LoadOptions, Model};
 use nalgebra::{DVector, Matrix3, Rotation3, UnitQuaternion, Vector3};
@@ -527,15 +527,11 @@ impl Geometry {
                 let at = || format!("{name}: link \"{}\": <{element}>", link.name);
                 let placement = frame.placement.compose(&Se3::new(piece.rot, piece.xyz));
                 let shape = match &piece.shape {
-                    visuals::Shape::Box(size) => VisualShape::Box(*size),
-                    &visuals::Shape::Cylinder(radius, length) => {
-                        VisualShape::Cylinder { radius, length }
-                    }
-                    &visuals::Shape::Capsule(radius, length) => {
-                        VisualShape::Capsule { radius, length }
-                    }
-                    &visuals::Shape::Sphere(radius) => VisualShape::Sphere { radius },
-                    visuals::Shape::Mesh(filename, scale) => {
+                    Shape::Box { size } => VisualShape::Box(*size),
+                    &Shape::Cylinder { radius, length } => VisualShape::Cylinder { radius, length },
+                    &Shape::Capsule { radius, length } => VisualShape::Capsule { radius, length },
+                    &Shape::Sphere { radius } => VisualShape::Sphere { radius },
+                    Shape::Mesh { filename, scale } => {
                         let path = crate::contact::resolve_mesh_path(
                             filename,
                             Some(urdf),

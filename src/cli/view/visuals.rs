@@ -4,19 +4,10 @@
 //! reads them), and so does this reader: a malformed piece is left out with a
 //! warning naming the link and the element.
 
+use crate::model::Shape;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use quick_xml::events::{BytesStart, Event};
 use std::collections::HashMap;
-
-/// The shape of a piece, as the URDF gives it.
-#[derive(Clone, Debug, PartialEq)]
-pub(super) enum Shape {
-    Box([f64; 3]),
-    Cylinder(f64, f64),
-    Capsule(f64, f64),
-    Sphere(f64),
-    Mesh(String, [f64; 3]),
-}
 
 /// A `<visual>` or `<collision>` element.
 #[derive(Clone, Debug, PartialEq)]
@@ -111,14 +102,25 @@ fn shape(e: &BytesStart, name: &str) -> Result<Option<Shape>, String> {
             if s.iter().any(|x| *x < 0.0) {
                 return Err("<box size>: negative".into());
             }
-            Shape::Box(s)
+            Shape::Box { size: s }
         }
-        "cylinder" => Shape::Cylinder(size("radius")?, size("length")?),
-        "capsule" => Shape::Capsule(size("radius")?, size("length")?),
-        "sphere" => Shape::Sphere(size("radius")?),
+        "cylinder" => Shape::Cylinder {
+            radius: size("radius")?,
+            length: size("length")?,
+        },
+        "capsule" => Shape::Capsule {
+            radius: size("radius")?,
+            length: size("length")?,
+        },
+        "sphere" => Shape::Sphere {
+            radius: size("radius")?,
+        },
         "mesh" => {
             let file = attr(e, b"filename").ok_or("<mesh> has no filename")?;
-            Shape::Mesh(file, numbers_attr::<3>(e, name, "scale", Some([1.0; 3]))?)
+            Shape::Mesh {
+                filename: file,
+                scale: numbers_attr::<3>(e, name, "scale", Some([1.0; 3]))?,
+            }
         }
         _ => return Ok(None),
     }))
@@ -330,16 +332,30 @@ mod tests {
         assert_eq!(a.visuals.len(), 2);
         assert_eq!(
             a.visuals[0].shape,
-            Shape::Mesh("package://p/m.dae".into(), [2.0; 3])
+            Shape::Mesh {
+                filename: "package://p/m.dae".into(),
+                scale: [2.0; 3]
+            }
         );
         assert_eq!(a.visuals[0].material.as_deref(), Some("red"));
         assert_eq!(a.visuals[0].xyz, Vector3::new(1.0, 2.0, 3.0));
         // rpy (0, 0, π/2) maps x to y.
         assert!((a.visuals[0].rot * Vector3::x() - Vector3::y()).norm() < 1e-15);
-        assert_eq!(a.visuals[1].shape, Shape::Cylinder(1.0, 2.0));
+        assert_eq!(
+            a.visuals[1].shape,
+            Shape::Cylinder {
+                radius: 1.0,
+                length: 2.0
+            }
+        );
         assert_eq!(a.visuals[1].color, Some([0.0, 1.0, 0.0, 0.5]));
         assert_eq!(a.visuals[1].material, None);
-        assert_eq!(a.collisions[0].shape, Shape::Box([1.0, 2.0, 3.0]));
+        assert_eq!(
+            a.collisions[0].shape,
+            Shape::Box {
+                size: [1.0, 2.0, 3.0]
+            }
+        );
         assert_eq!(d.warnings.len(), 2, "{:?}", d.warnings);
         assert!(d.warnings[0].contains("link \"a\": <visual> <sphere radius=\"oops\">"));
         assert!(d.warnings[1].contains("has no <geometry>"));
