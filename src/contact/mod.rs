@@ -709,8 +709,7 @@ fn reduce(
         out.extend_from_slice(pts);
         return;
     }
-    const MAXD: usize = MAX_DIRS;
-    let dirs = maxp.saturating_sub(1).clamp(1, MAXD);
+    let dirs = maxp.saturating_sub(1).clamp(1, MAX_DIRS);
     // criterion 0: depth; 1..=dirs: how far out along a direction
     let key = |p: &ContactPoint, q: usize| -> f64 {
         if q == 0 {
@@ -721,7 +720,7 @@ fn reduce(
         }
     };
     // one pass for every criterion's best value
-    let mut best = [f64::NEG_INFINITY; MAXD + 1];
+    let mut best = [f64::NEG_INFINITY; MAX_DIRS + 1];
     for p in pts {
         for (q, b) in best.iter_mut().enumerate().take(dirs + 1) {
             let k = key(p, q);
@@ -732,7 +731,7 @@ fn reduce(
     }
     // one pass for each criterion's choice: within its hold of the best a point
     // kept last time first, then the lowest slot
-    let mut choice = [(true, usize::MAX, 0usize); MAXD + 1];
+    let mut choice = [(true, usize::MAX, 0usize); MAX_DIRS + 1];
     for (i, p) in pts.iter().enumerate() {
         let was = prev.get(p.slot).copied().unwrap_or(false);
         for (q, ch) in choice.iter_mut().enumerate().take(dirs + 1) {

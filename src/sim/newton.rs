@@ -60,6 +60,8 @@ pub struct Newton {
     eb: Vec<f64>,
     deb: Vec<f64>,
     yf: Vec<f64>,
+    active: Vec<bool>,
+    active_prev: Vec<bool>,
 }
 
 impl Newton {
@@ -78,6 +80,8 @@ impl Newton {
             eb: Vec::with_capacity(cap),
             deb: Vec::with_capacity(cap),
             yf: vec![0.0; nv],
+            active: Vec::with_capacity(3 * cap),
+            active_prev: Vec::with_capacity(3 * cap),
         }
     }
 
@@ -180,9 +184,10 @@ impl Newton {
         let dot = |y: &[f64], p: &[usize], v: &[f64]| -> f64 {
             y.iter().zip(p).map(|(a, &k)| a * v[k]).sum()
         };
-        let nf = self.facets.len();
         let mut it = 0;
-        let mut active_prev: Option<Vec<bool>> = None;
+        // the active set (quadratic pieces) of each facet and box, this iteration
+        // and the last (preallocated: no allocation a step)
+        self.active.clear();
         while it < max_iter {
             it += 1;
             // e, gradient, Hessian at x
@@ -192,7 +197,8 @@ impl Newton {
                 self.grad[k] = x[k];
             }
             self.e.clear();
-            let mut active = Vec::with_capacity(nf + self.boxes.len());
+            std::mem::swap(&mut self.active, &mut self.active_prev);
+            self.active.clear();
             for fa in &self.facets {
                 let c = facet_y(fa, &mut self.yf);
                 let p = path(fa.row);
@@ -200,7 +206,7 @@ impl Newton {
                 let e = c + dot(&self.yf[..l], p, x);
                 self.e.push(e);
                 let on = e < 0.0 && fa.d > 0.0;
-                active.push(on);
+                self.active.push(on);
                 if on {
                     for (a, &ka) in p.iter().enumerate() {
                         let ga = fa.d * self.yf[a];
@@ -219,7 +225,7 @@ impl Newton {
                 let e = rows.c[r] - rows.b[r] + dot(y, p, x);
                 self.eb.push(e);
                 let quad = (d * e).abs() <= lim;
-                active.push(quad);
+                self.active.push(quad);
                 let slope = if quad { d * e } else { lim * e.signum() };
                 for (a, &ka) in p.iter().enumerate() {
                     self.grad[ka] += slope * y[a];
@@ -231,10 +237,9 @@ impl Newton {
                 }
             }
             let gnorm = self.grad.iter().map(|g| g * g).sum::<f64>().sqrt();
-            if gnorm <= tol || active_prev.as_ref() == Some(&active) && it > 1 {
+            if gnorm <= tol || it > 1 && self.active == self.active_prev {
                 break;
             }
-            active_prev = Some(active);
             // δ = −(I + Σ D y yᵀ)⁻¹ ∇φ (the factorisation reads the lower triangle)
             if cholesky_fast(&self.hess, &mut self.chol).is_err() {
                 break;
