@@ -16,7 +16,7 @@ import argparse
 import os
 import re
 import subprocess
-import sys
+import sysconfig
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -51,8 +51,8 @@ def run(robot, rel, share, solver):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--share", default=os.path.join(sys.prefix, "lib", "python3.11", "site-packages",
-                                                    "cmeel.prefix", "share"))
+    ap.add_argument("--share", default=os.path.join(sysconfig.get_paths()["purelib"], "cmeel.prefix", "share"),
+                    help="the folder holding example-robot-data/ (default: this Python's pip install)")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--md", default=os.path.join(HERE, "solver_compare.md"))
     a = ap.parse_args()
