@@ -23,7 +23,10 @@ fn setup(tol: Option<f64>) -> Simulation {
     if let Some(n) = std::env::var("ITERS").ok().and_then(|s| s.parse().ok()) {
         o.solver_iterations = n;
     }
-    if let Some(sv) = std::env::var("SOLVER").ok().and_then(|s| urdyn::sim::Solver::from_name(&s)) {
+    if let Some(sv) = std::env::var("SOLVER")
+        .ok()
+        .and_then(|s| urdyn::sim::Solver::from_name(&s))
+    {
         o.solver = sv;
     }
     if let Some(w) = std::env::var("RELAX").ok().and_then(|s| s.parse().ok()) {
@@ -89,7 +92,12 @@ fn main() {
         hist[b] += 1;
         tsum[b] += el;
     }
-    println!("time per bucket (ms): {:?}", tsum.iter().map(|x| (x * 1e5).round() / 100.0).collect::<Vec<_>>());
+    println!(
+        "time per bucket (ms): {:?}",
+        tsum.iter()
+            .map(|x| (x * 1e5).round() / 100.0)
+            .collect::<Vec<_>>()
+    );
     println!("sweeps per step [0, 1, 2-3, 4-7, 8-15, 16-31, 32-59, 60+]: {hist:?}");
     println!(
         "mean sweeps/step {:.2}, rows/step {:.1}, queries {}",

@@ -24,7 +24,10 @@ fn dim(arg: &'static str, expected: usize, got: usize) -> DynamicsError {
 /// short or one entry long with the error naming the argument and both sizes.
 #[test]
 fn wrong_lengths_are_errors_at_every_entry_point() {
-    for (path, fb) in [("assets/robots/ur5.urdf", false), ("assets/robots/solo12.urdf", true)] {
+    for (path, fb) in [
+        ("assets/robots/ur5.urdf", false),
+        ("assets/robots/solo12.urdf", true),
+    ] {
         let m = load(path, fb);
         let mut d = Data::new(&m);
         let (nq, nv, nb) = (m.nq, m.nv, m.nbodies);
@@ -39,55 +42,106 @@ fn wrong_lengths_are_errors_at_every_entry_point() {
             let e = |r: Result<(), DynamicsError>| r.unwrap_err();
             let d = &mut d;
             // q
-            assert_eq!(e(dynamics::rnea(&m, d, &qb, &z, &z, None).map(|_| ())), dim("q", nq, lq));
-            assert_eq!(e(dynamics::bias(&m, d, &qb, &z, None).map(|_| ())), dim("q", nq, lq));
-            assert_eq!(e(dynamics::crba(&m, d, &qb).map(|_| ())), dim("q", nq, lq));
-            assert_eq!(e(dynamics::crba_upper(&m, d, &qb).map(|_| ())), dim("q", nq, lq));
-            assert_eq!(e(dynamics::mass_matrix(&m, d, &qb).map(|_| ())), dim("q", nq, lq));
-            assert_eq!(e(dynamics::mass_matrix_rnea(&m, d, &qb)), dim("q", nq, lq));
-            assert_eq!(e(dynamics::forward_kinematics(&m, d, &qb)), dim("q", nq, lq));
             assert_eq!(
-                e(dynamics::forward_kinematics_second_order(&m, d, &qb, &z, &z)),
+                e(dynamics::rnea(&m, d, &qb, &z, &z, None).map(|_| ())),
                 dim("q", nq, lq)
             );
-            assert_eq!(e(dynamics::kinetic_energy(&m, d, &qb, &z).map(|_| ())), dim("q", nq, lq));
-            assert_eq!(e(dynamics::energies(&m, &qb, &z).map(|_| ())), dim("q", nq, lq));
+            assert_eq!(
+                e(dynamics::bias(&m, d, &qb, &z, None).map(|_| ())),
+                dim("q", nq, lq)
+            );
+            assert_eq!(e(dynamics::crba(&m, d, &qb).map(|_| ())), dim("q", nq, lq));
+            assert_eq!(
+                e(dynamics::crba_upper(&m, d, &qb).map(|_| ())),
+                dim("q", nq, lq)
+            );
+            assert_eq!(
+                e(dynamics::mass_matrix(&m, d, &qb).map(|_| ())),
+                dim("q", nq, lq)
+            );
+            assert_eq!(e(dynamics::mass_matrix_rnea(&m, d, &qb)), dim("q", nq, lq));
+            assert_eq!(
+                e(dynamics::forward_kinematics(&m, d, &qb)),
+                dim("q", nq, lq)
+            );
+            assert_eq!(
+                e(dynamics::forward_kinematics_second_order(
+                    &m, d, &qb, &z, &z
+                )),
+                dim("q", nq, lq)
+            );
+            assert_eq!(
+                e(dynamics::kinetic_energy(&m, d, &qb, &z).map(|_| ())),
+                dim("q", nq, lq)
+            );
+            assert_eq!(
+                e(dynamics::energies(&m, &qb, &z).map(|_| ())),
+                dim("q", nq, lq)
+            );
             assert_eq!(
                 e(dynamics::centroidal_momentum(&m, d, &qb, &z).map(|_| ())),
                 dim("q", nq, lq)
             );
             // v, a, tau
-            assert_eq!(e(dynamics::rnea(&m, d, &q, &vb, &z, None).map(|_| ())), dim("v", nv, lv));
-            assert_eq!(e(dynamics::rnea(&m, d, &q, &z, &vb, None).map(|_| ())), dim("a", nv, lv));
-            assert_eq!(e(dynamics::bias(&m, d, &q, &vb, None).map(|_| ())), dim("v", nv, lv));
+            assert_eq!(
+                e(dynamics::rnea(&m, d, &q, &vb, &z, None).map(|_| ())),
+                dim("v", nv, lv)
+            );
+            assert_eq!(
+                e(dynamics::rnea(&m, d, &q, &z, &vb, None).map(|_| ())),
+                dim("a", nv, lv)
+            );
+            assert_eq!(
+                e(dynamics::bias(&m, d, &q, &vb, None).map(|_| ())),
+                dim("v", nv, lv)
+            );
             for fd in [
                 dynamics::aba::<f64>,
                 dynamics::forward_dynamics::<f64>,
                 dynamics::forward_dynamics_crba::<f64>,
                 dynamics::forward_dynamics_rnea::<f64>,
             ] {
-                assert_eq!(e(fd(&m, d, &qb, &z, &z, None).map(|_| ())), dim("q", nq, lq));
-                assert_eq!(e(fd(&m, d, &q, &vb, &z, None).map(|_| ())), dim("v", nv, lv));
-                assert_eq!(e(fd(&m, d, &q, &z, &vb, None).map(|_| ())), dim("tau", nv, lv));
+                assert_eq!(
+                    e(fd(&m, d, &qb, &z, &z, None).map(|_| ())),
+                    dim("q", nq, lq)
+                );
+                assert_eq!(
+                    e(fd(&m, d, &q, &vb, &z, None).map(|_| ())),
+                    dim("v", nv, lv)
+                );
+                assert_eq!(
+                    e(fd(&m, d, &q, &z, &vb, None).map(|_| ())),
+                    dim("tau", nv, lv)
+                );
                 assert_eq!(
                     e(fd(&m, d, &q, &z, &z, Some(&fb_)).map(|_| ())),
                     dim("fext", nb, lf)
                 );
             }
             assert_eq!(
-                e(dynamics::forward_kinematics_second_order(&m, d, &q, &vb, &z)),
+                e(dynamics::forward_kinematics_second_order(
+                    &m, d, &q, &vb, &z
+                )),
                 dim("v", nv, lv)
             );
             assert_eq!(
-                e(dynamics::forward_kinematics_second_order(&m, d, &q, &z, &vb)),
+                e(dynamics::forward_kinematics_second_order(
+                    &m, d, &q, &z, &vb
+                )),
                 dim("a", nv, lv)
             );
-            assert_eq!(e(dynamics::kinetic_energy(&m, d, &q, &vb).map(|_| ())), dim("v", nv, lv));
+            assert_eq!(
+                e(dynamics::kinetic_energy(&m, d, &q, &vb).map(|_| ())),
+                dim("v", nv, lv)
+            );
             assert_eq!(
                 e(dynamics::kinetic_energy_from_placements(&m, d, &vb).map(|_| ())),
                 dim("v", nv, lv)
             );
-            assert_eq!(e(dynamics::energies(&m, &q, &vb).map(|_| ())), dim("v", nv, lv));
+            assert_eq!(
+                e(dynamics::energies(&m, &q, &vb).map(|_| ())),
+                dim("v", nv, lv)
+            );
             assert_eq!(
                 e(dynamics::centroidal_momentum(&m, d, &q, &vb).map(|_| ())),
                 dim("v", nv, lv)
@@ -97,17 +151,33 @@ fn wrong_lengths_are_errors_at_every_entry_point() {
                 e(dynamics::rnea(&m, d, &q, &z, &z, Some(&fb_)).map(|_| ())),
                 dim("fext", nb, lf)
             );
-            assert_eq!(e(dynamics::bias(&m, d, &q, &z, Some(&fb_)).map(|_| ())), dim("fext", nb, lf));
+            assert_eq!(
+                e(dynamics::bias(&m, d, &q, &z, Some(&fb_)).map(|_| ())),
+                dim("fext", nb, lf)
+            );
             let mut fb2 = fb_.clone();
             let (f0, t0) = (Vector3::zeros(), Vector3::zeros());
             assert_eq!(
-                e(dynamics::add_link_wrench(&m, d, FrameId(0), &f0, &t0, &mut fb2)),
+                e(dynamics::add_link_wrench(
+                    &m,
+                    d,
+                    FrameId(0),
+                    &f0,
+                    &t0,
+                    &mut fb2
+                )),
                 dim("fext", nb, lf)
             );
             // matrices
             let mut j = DMatrix::zeros(6, lv);
             assert_eq!(
-                e(dynamics::frame_jacobian(&m, d, FrameId(0), Reference::Local, &mut j)),
+                e(dynamics::frame_jacobian(
+                    &m,
+                    d,
+                    FrameId(0),
+                    Reference::Local,
+                    &mut j
+                )),
                 dim("jacobian columns", nv, lv)
             );
             let mut jc = DMatrix::zeros(3, lv);
@@ -116,12 +186,40 @@ fn wrong_lengths_are_errors_at_every_entry_point() {
                 dim("com jacobian columns", nv, lv)
             );
             // the configuration manifold
-            assert_eq!(integrate(&m, &qb, &z).unwrap_err(), DimensionError { arg: "q", expected: nq, got: lq });
-            assert_eq!(integrate(&m, &q, &vb).unwrap_err(), DimensionError { arg: "v", expected: nv, got: lv });
-            assert_eq!(difference(&m, &q, &qb).unwrap_err(), DimensionError { arg: "q1", expected: nq, got: lq });
+            assert_eq!(
+                integrate(&m, &qb, &z).unwrap_err(),
+                DimensionError {
+                    arg: "q",
+                    expected: nq,
+                    got: lq
+                }
+            );
+            assert_eq!(
+                integrate(&m, &q, &vb).unwrap_err(),
+                DimensionError {
+                    arg: "v",
+                    expected: nv,
+                    got: lv
+                }
+            );
+            assert_eq!(
+                difference(&m, &q, &qb).unwrap_err(),
+                DimensionError {
+                    arg: "q1",
+                    expected: nq,
+                    got: lq
+                }
+            );
             assert_eq!(m.positions_by_name(&qb).unwrap_err().got, lq);
             // the simulation
-            let mut sim = Simulation::new(m.clone(), SimOptions { ground: None, ..Default::default() }).unwrap();
+            let mut sim = Simulation::new(
+                m.clone(),
+                SimOptions {
+                    ground: None,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
             assert!(sim.set_state(&qb, &z).is_err());
             assert!(sim.set_state(&q, &vb).is_err());
             assert!(sim.set_torques(&vb).is_err());
@@ -155,9 +253,17 @@ fn names_resolve_and_unknown_names_name_the_nearest() {
     let e = m.frame_id("FL_FOOTT").unwrap_err();
     assert_eq!(
         e,
-        NameError::Unknown { kind: "link", name: "FL_FOOTT".into(), nearest: Some("FL_FOOT".into()) }
+        NameError::Unknown {
+            kind: "link",
+            name: "FL_FOOTT".into(),
+            nearest: Some("FL_FOOT".into())
+        }
     );
-    assert!(e.to_string().contains("unknown link \"FL_FOOTT\" (nearest: \"FL_FOOT\")"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("unknown link \"FL_FOOTT\" (nearest: \"FL_FOOT\")"),
+        "{e}"
+    );
     let e = m.joint_id("FL_KFE_joint").unwrap_err();
     assert!(e.to_string().contains("nearest: \"FL_KFE\""), "{e}");
     // the free base: 7 q and 6 v coordinates first; each joint after it one of each
@@ -204,7 +310,10 @@ fn a_mimic_joint_owns_no_coordinate() {
 
 #[test]
 fn integrate_and_difference_are_inverse_on_the_manifold() {
-    for (path, fb) in [("assets/robots/solo12.urdf", true), ("assets/robots/ur5.urdf", false)] {
+    for (path, fb) in [
+        ("assets/robots/solo12.urdf", true),
+        ("assets/robots/ur5.urdf", false),
+    ] {
         let m = load(path, fb);
         for seed in 0..20 {
             let q0 = random_configuration(&m, seed);
@@ -218,7 +327,11 @@ fn integrate_and_difference_are_inverse_on_the_manifold() {
                 let hi = dof.limits.upper.unwrap_or(std::f64::consts::PI);
                 assert!(x >= lo.min(-std::f64::consts::PI) && x <= hi.max(std::f64::consts::PI));
                 if !dof.continuous && lo < hi {
-                    assert!(x >= lo && x <= hi, "{} = {x} outside [{lo}, {hi}]", dof.name);
+                    assert!(
+                        x >= lo && x <= hi,
+                        "{} = {x} outside [{lo}, {hi}]",
+                        dof.name
+                    );
                 }
             }
             if fb {
@@ -245,7 +358,9 @@ fn integrate_and_difference_are_inverse_on_the_manifold() {
         assert_eq!((&q - m.neutral()).amax(), 0.25);
         let back = m.positions_by_name(&q).unwrap();
         assert_eq!(back[1], (name.as_str(), 0.25));
-        let e = m.configuration_from_names([("nonexistent_joint", 1.0)]).unwrap_err();
+        let e = m
+            .configuration_from_names([("nonexistent_joint", 1.0)])
+            .unwrap_err();
         assert!(e.to_string().contains("nonexistent_joint"));
     }
 }
@@ -285,7 +400,14 @@ fn contact_forces_name_the_link_that_touched() {
   </link>
   <joint name="ankle" type="fixed"><parent link="base"/><child link="foot"/><origin xyz="0 0 -0.2"/></joint>
 </robot>"#;
-    let m = urdyn::load_str(urdf, "footed.urdf", LoadOptions { floating_base: true }).unwrap();
+    let m = urdyn::load_str(
+        urdf,
+        "footed.urdf",
+        LoadOptions {
+            floating_base: true,
+        },
+    )
+    .unwrap();
     assert_eq!(m.body_link_names[1], "base");
     let mut sim = Simulation::new(m.clone(), SimOptions::default()).unwrap();
     let mut q = m.neutral();

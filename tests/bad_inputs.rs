@@ -326,23 +326,51 @@ const BAD_STATES: &[(&str, bool, &[&str])] = &[
     (
         "states_fext_unknown_link.json",
         false,
-        &["states[1].fext.link_2", "unknown link \"link_2\"", "nearest: \"l2\""],
+        &[
+            "states[1].fext.link_2",
+            "unknown link \"link_2\"",
+            "nearest: \"l2\"",
+        ],
     ),
     (
         "states_frames_unknown_link.json",
         true,
-        &["states[0].frames[1]", "unknown link \"l22\"", "nearest: \"l2\""],
+        &[
+            "states[0].frames[1]",
+            "unknown link \"l22\"",
+            "nearest: \"l2\"",
+        ],
     ),
     (
         "states_fext_four_vector.json",
         false,
         &["states[0].fext.l1.force", "too many"],
     ),
-    ("states_fext_misspelt.json", false, &["states[0].fext.l1.forse"]),
-    ("states_fext_huge.json", false, &["states[0].fext.l2.torque", "out of range"]),
-    ("states_fext_as_array.json", false, &["states[0].fext.l2", "object"]),
-    ("states_fext_list.json", false, &["states[0].fext", "object"]),
-    ("states_frames_not_list.json", false, &["states[0].frames", "sequence"]),
+    (
+        "states_fext_misspelt.json",
+        false,
+        &["states[0].fext.l1.forse"],
+    ),
+    (
+        "states_fext_huge.json",
+        false,
+        &["states[0].fext.l2.torque", "out of range"],
+    ),
+    (
+        "states_fext_as_array.json",
+        false,
+        &["states[0].fext.l2", "object"],
+    ),
+    (
+        "states_fext_list.json",
+        false,
+        &["states[0].fext", "object"],
+    ),
+    (
+        "states_frames_not_list.json",
+        false,
+        &["states[0].frames", "sequence"],
+    ),
     ("states_misspelt_state.json", false, &["states[0].qq"]),
     (
         "states_misspelt_base.json",
@@ -570,9 +598,10 @@ fn bad_states_are_rejected_naming_the_key() {
         assert_rejected(&args, &e);
     }
     // The good states files are answered, fixed and floating.
-    for (fb, file) in [false, true].into_iter().flat_map(|fb| {
-        [(fb, "states_ok.json"), (fb, "states_ok_v2.json")]
-    }) {
+    for (fb, file) in [false, true]
+        .into_iter()
+        .flat_map(|fb| [(fb, "states_ok.json"), (fb, "states_ok_v2.json")])
+    {
         let mut args = vec!["eval", "ok.urdf", "--states", file];
         if fb {
             args.push("--floating-base");

@@ -170,7 +170,9 @@ fn load(rel: &str) -> Model {
 /// ‖H q̈ + C − τ‖ / (‖H‖ ‖q̈‖ + ‖τ‖) with C and H from the seed's methods.
 fn backward_error(model: &Model, s: &State, qdd: &DVector<f64>) -> f64 {
     let mut data = Data::new(model);
-    let c = dynamics::bias(model, &mut data, &s.q, &s.v, None).unwrap().clone();
+    let c = dynamics::bias(model, &mut data, &s.q, &s.v, None)
+        .unwrap()
+        .clone();
     dynamics::mass_matrix_rnea(model, &mut data, &s.q).unwrap();
     let h = data.h.clone();
     let r = &h * qdd + c - &s.tau;

@@ -97,7 +97,14 @@ fn frame_jacobians_match_finite_differences() {
                 forward_kinematics(&model, &mut data, &q).unwrap();
                 update_frames(&model, &mut data);
                 for k in 0..model.frames.len() {
-                    dynamics::frame_jacobian(&model, &data, FrameId(k), Reference::WorldAligned, &mut j).unwrap();
+                    dynamics::frame_jacobian(
+                        &model,
+                        &data,
+                        FrameId(k),
+                        Reference::WorldAligned,
+                        &mut j,
+                    )
+                    .unwrap();
                     let jv = &j * &v;
                     let lin = (plus[k].trans - minus[k].trans) / (2.0 * h);
                     let ang = log3(&(plus[k].rot * minus[k].rot.transpose())) / (2.0 * h);
@@ -123,7 +130,14 @@ fn floating_root_jacobian_rotates_body_velocities_into_the_world() {
     forward_kinematics(&model, &mut data, &q).unwrap();
     let root = model.frame_index(&model.body_link_names[1]).unwrap();
     let mut j = DMatrix::zeros(6, model.nv);
-    dynamics::frame_jacobian(&model, &data, FrameId(root), Reference::WorldAligned, &mut j).unwrap();
+    dynamics::frame_jacobian(
+        &model,
+        &data,
+        FrameId(root),
+        Reference::WorldAligned,
+        &mut j,
+    )
+    .unwrap();
     let r = data.o_m_i[1].rot;
     assert!((j.view((0, 0), (3, 3)) - r).amax() < 1e-14);
     assert!((j.view((3, 3), (3, 3)) - r).amax() < 1e-14);
@@ -160,7 +174,9 @@ fn gravity_torques_are_the_gradient_of_potential_energy() {
         let mut data = Data::new(&model);
         let (q, _) = random_state(&model, &mut rng, false);
         let zero = DVector::zeros(model.nv);
-        let g = dynamics::bias(&model, &mut data, &q, &zero, None).unwrap().clone();
+        let g = dynamics::bias(&model, &mut data, &q, &zero, None)
+            .unwrap()
+            .clone();
         for k in 0..model.nv {
             let h = 1e-6;
             let mut pe = |s: f64| {

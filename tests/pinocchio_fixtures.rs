@@ -110,7 +110,10 @@ fn compare_kinematics(c: &mut Cmp, s: usize, g: &Value, w: &Value, perm: &[usize
         assert!(g.get("frames").is_none(), "state {s}: frames not asked for");
     }
     for part in ["position", "velocity"] {
-        c.add_kin(format!("state {s} com_{part}"), pair(&g["com"][part], &w["com"][part]));
+        c.add_kin(
+            format!("state {s} com_{part}"),
+            pair(&g["com"][part], &w["com"][part]),
+        );
     }
     let mut want = Vec::new();
     flat(&w["com"]["jacobian"], &mut want);
@@ -268,7 +271,10 @@ fn eval_matches_pinocchio_on_every_fixture() {
     for (q, e) in &per {
         println!("  {q:24} {e:.2e}");
     }
-    assert!(failures.is_empty(), "fixtures over tolerance: {failures:#?}");
+    assert!(
+        failures.is_empty(),
+        "fixtures over tolerance: {failures:#?}"
+    );
 }
 
 /// The robots that once failed to load (a `<texture>` without `filename`, 1e-6 kg
@@ -283,7 +289,12 @@ fn icub_and_tiago_match_pinocchio_to_1e_12() {
             c.worst, c.where_
         );
         assert!(c.worst <= 1e-12, "{name}: {:.3e} at {}", c.worst, c.where_);
-        assert!(c.worst_kin <= 1e-12, "{name}: {:.3e} at {}", c.worst_kin, c.where_kin);
+        assert!(
+            c.worst_kin <= 1e-12,
+            "{name}: {:.3e} at {}",
+            c.worst_kin,
+            c.where_kin
+        );
     }
 }
 
@@ -333,7 +344,10 @@ fn forward_dynamics_inverts_inverse_dynamics_on_every_fixture() {
             worst = worst.max((&qdd - &sv.a).amax() / (1.0f64).max(sv.a.amax()));
         }
         println!("{name:24} FD(ID(a)) relative error {worst:.2e} ({pushed} states with fext)");
-        assert!(pushed >= 2, "{name}: the fixture has too few external wrenches");
+        assert!(
+            pushed >= 2,
+            "{name}: the fixture has too few external wrenches"
+        );
         assert!(worst <= 1e-10, "{name}: FD(ID(a)) off by {worst:e}");
     }
 }

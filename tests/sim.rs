@@ -59,7 +59,10 @@ fn incline(mu: f64, solver: Solver) -> (f64, f64, f64) {
 fn incline_static_friction_holds() {
     for solver in [Solver::Pgs, Solver::Newton] {
         let (x, _, pen) = incline(0.5, solver);
-        assert!(x.abs() < 1e-3, "{solver:?}: box crept {x} m in 2 s with mu = 0.5");
+        assert!(
+            x.abs() < 1e-3,
+            "{solver:?}: box crept {x} m in 2 s with mu = 0.5"
+        );
         assert!(pen < 1e-3);
         eprintln!("{solver:?} mu=0.5: displacement after 2 s = {x:e} m, penetration {pen:e}");
     }

@@ -31,7 +31,9 @@ type AlgoFn<T> = fn(&Model<T>, &mut Data<T>, &Input<T>) -> Result<DVector<T>, St
 fn algorithms<T: Scalar>() -> Vec<(&'static str, AlgoFn<T>)> {
     vec![
         ("rnea", |m, d, s| {
-            Ok(dynamics::rnea(m, d, &s.q, &s.v, &s.a, None).unwrap().clone())
+            Ok(dynamics::rnea(m, d, &s.q, &s.v, &s.a, None)
+                .unwrap()
+                .clone())
         }),
         ("H (n rnea)", |m, d, s| {
             dynamics::mass_matrix_rnea(m, d, &s.q).unwrap();
@@ -42,7 +44,9 @@ fn algorithms<T: Scalar>() -> Vec<(&'static str, AlgoFn<T>)> {
                 .cloned()
                 .map_err(|e| e.to_string())
         }),
-        ("H (crba)", |m, d, s| Ok(flat(dynamics::crba(m, d, &s.q).unwrap()))),
+        ("H (crba)", |m, d, s| {
+            Ok(flat(dynamics::crba(m, d, &s.q).unwrap()))
+        }),
         ("fd-crba+ltdl", |m, d, s| {
             dynamics::forward_dynamics_crba(m, d, &s.q, &s.v, &s.tau, None)
                 .cloned()
@@ -200,7 +204,9 @@ fn evaluate(case: &Case) -> Row {
         // Exact-ish H and C (double-double) for backward errors.
         dynamics::mass_matrix_rnea(&mdd, &mut ddd, &sdd.q).unwrap();
         let hdd = ddd.h.clone();
-        let cdd = dynamics::bias(&mdd, &mut ddd, &sdd.q, &sdd.v, None).unwrap().clone();
+        let cdd = dynamics::bias(&mdd, &mut ddd, &sdd.q, &sdd.v, None)
+            .unwrap()
+            .clone();
         let h = hdd.map(|x| x.to_f64());
         let hnorm = h.iter().fold(0.0f64, |m, x| m.max(x.abs())) * h.nrows() as f64;
         let c2 = cond2(&h);
@@ -444,7 +450,9 @@ fn dd_scalar_is_double_double() {
     let q = to_dd(&rng.vec(m.nq, 1.0));
     let v = to_dd(&rng.vec(m.nv, 1.0));
     let a = to_dd(&rng.vec(m.nv, 1.0));
-    let t1 = dynamics::rnea(&m, &mut d, &q, &v, &a, None).unwrap().clone();
+    let t1 = dynamics::rnea(&m, &mut d, &q, &v, &a, None)
+        .unwrap()
+        .clone();
     // Forward dynamics in DD inverts it to double-double precision.
     let qdd = dynamics::forward_dynamics_rnea(&m, &mut d, &q, &v, &t1, None)
         .unwrap()

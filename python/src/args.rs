@@ -35,7 +35,9 @@ pub fn read_vec(
     let view = arr.as_array();
     for (i, (o, &x)) in out.iter_mut().zip(view.iter()).enumerate() {
         if !x.is_finite() {
-            return Err(value_error(format!("{name}[{i}] is not a finite number ({x})")));
+            return Err(value_error(format!(
+                "{name}[{i}] is not a finite number ({x})"
+            )));
         }
         *o = x;
     }

@@ -403,7 +403,8 @@ pub fn kinetic_energy(
     d.check(&model.model)?;
     read_q(d, q)?;
     read_vec(v, "v", "nv", &mut d.v)?;
-    dynamics::kinetic_energy(&model.model, &mut d.data, &d.q, &d.v).map_err(|e| dyn_error(&model, e))
+    dynamics::kinetic_energy(&model.model, &mut d.data, &d.q, &d.v)
+        .map_err(|e| dyn_error(&model, e))
 }
 
 /// Gravitational potential energy −Σ mᵢ gᵀcᵢ of the links that move (J).

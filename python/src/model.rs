@@ -7,8 +7,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use std::collections::HashMap;
 use std::path::PathBuf;
-use urdyn::nalgebra::{DVector, Vector3};
 use urdyn::model::FrameId;
+use urdyn::nalgebra::{DVector, Vector3};
 use urdyn::spatial::Force;
 use urdyn::{LoadOptions, Model};
 
@@ -201,18 +201,29 @@ impl PyModel {
             self.model.name,
             self.model.nq,
             self.model.nv,
-            if self.model.floating_base { "True" } else { "False" }
+            if self.model.floating_base {
+                "True"
+            } else {
+                "False"
+            }
         )
     }
     /// Pickling: the URDF text and the options (the model is rebuilt from them).
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Py<PyAny>, Bound<'py, PyTuple>)> {
-        let f = py.import("urdyn._urdyn")?.getattr("_model_from_state")?.unbind();
+        let f = py
+            .import("urdyn._urdyn")?
+            .getattr("_model_from_state")?
+            .unbind();
         let dirs: Vec<String> = self
             .package_dirs
             .iter()
             .map(|p| p.display().to_string())
             .collect();
-        let g = [self.model.gravity.x, self.model.gravity.y, self.model.gravity.z];
+        let g = [
+            self.model.gravity.x,
+            self.model.gravity.y,
+            self.model.gravity.z,
+        ];
         let source = self.model.source.as_ref().map(|p| p.display().to_string());
         let args = (
             self.text.clone(),

@@ -31,7 +31,9 @@ fn prototype(
     package_dirs: Option<Vec<PathBuf>>,
 ) -> PyResult<Simulation> {
     if !(dt > 0.0 && dt.is_finite()) {
-        return Err(value_error(format!("dt must be a positive number (got {dt})")));
+        return Err(value_error(format!(
+            "dt must be a positive number (got {dt})"
+        )));
     }
     if !(friction >= 0.0 && friction.is_finite()) {
         return Err(value_error(format!(
@@ -40,7 +42,9 @@ fn prototype(
     }
     if let Some(g) = ground {
         if !g.is_finite() {
-            return Err(value_error(format!("ground must be a finite number (got {g})")));
+            return Err(value_error(format!(
+                "ground must be a finite number (got {g})"
+            )));
         }
     }
     let integrator = match integrator {
@@ -60,7 +64,8 @@ fn prototype(
         ..SimOptions::default()
     };
     opts.contact.friction = friction;
-    Simulation::new(model.model.clone(), opts).map_err(|e| value_error(format!("{}: {e}", model.file)))
+    Simulation::new(model.model.clone(), opts)
+        .map_err(|e| value_error(format!("{}: {e}", model.file)))
 }
 
 /// One step of `dt` of simulated time (an adaptive integrator may take several
@@ -78,12 +83,22 @@ fn set_torques(sim: &mut Simulation, tau: &[f64]) {
     let vo = if sim.model.floating_base { 6 } else { 0 };
     let t = sim.torques_mut();
     for k in 0..t.len() {
-        t[k] = if k < vo { 0.0 } else { tau.get(k).copied().unwrap_or(0.0) };
+        t[k] = if k < vo {
+            0.0
+        } else {
+            tau.get(k).copied().unwrap_or(0.0)
+        };
     }
 }
 
 /// A `SimulationError` with `.q`, `.v` (and `.index`) attached.
-fn sim_error(py: Python<'_>, msg: String, q: Py<PyAny>, v: Py<PyAny>, index: Option<usize>) -> PyErr {
+fn sim_error(
+    py: Python<'_>,
+    msg: String,
+    q: Py<PyAny>,
+    v: Py<PyAny>,
+    index: Option<usize>,
+) -> PyErr {
     let err = SimulationError::new_err(msg);
     let value = err.value(py);
     let _ = value.setattr("q", q);
@@ -152,8 +167,12 @@ impl PySimulation {
             Ok::<(), SimError>(())
         });
         r.map_err(|e| {
-            let q = PyArray1::from_slice(py, self.sim.q().as_slice()).into_any().unbind();
-            let v = PyArray1::from_slice(py, self.sim.v().as_slice()).into_any().unbind();
+            let q = PyArray1::from_slice(py, self.sim.q().as_slice())
+                .into_any()
+                .unbind();
+            let v = PyArray1::from_slice(py, self.sim.v().as_slice())
+                .into_any()
+                .unbind();
             sim_error(py, e.to_string(), q, v, None)
         })
     }
@@ -264,36 +283,38 @@ pub fn rollout<'py>(
         let qo = unsafe { qa.as_slice_mut() }.map_err(|e| value_error(e.to_string()))?;
         let vo = unsafe { va.as_slice_mut() }.map_err(|e| value_error(e.to_string()))?;
         // a failure: (batch index, whether the input was bad, message)
-        let run = |(i, (qo, vo)): (usize, (&mut [f64], &mut [f64]))| -> Option<(usize, bool, String)> {
-            let mut sim = proto.clone();
-            let q = DVector::from_column_slice(&q0[i * nq..(i + 1) * nq]);
-            let v = DVector::from_column_slice(&v0[i * nv..(i + 1) * nv]);
-            let fail = |qo: &mut [f64], vo: &mut [f64], from: usize, input: bool, msg: String| {
-                qo[from * nq..].fill(f64::NAN);
-                vo[from * nv..].fill(f64::NAN);
-                Some((i, input, msg))
+        let run =
+            |(i, (qo, vo)): (usize, (&mut [f64], &mut [f64]))| -> Option<(usize, bool, String)> {
+                let mut sim = proto.clone();
+                let q = DVector::from_column_slice(&q0[i * nq..(i + 1) * nq]);
+                let v = DVector::from_column_slice(&v0[i * nv..(i + 1) * nv]);
+                let fail =
+                    |qo: &mut [f64], vo: &mut [f64], from: usize, input: bool, msg: String| {
+                        qo[from * nq..].fill(f64::NAN);
+                        vo[from * nv..].fill(f64::NAN);
+                        Some((i, input, msg))
+                    };
+                if let Err(e) = sim.set_state(&q, &v) {
+                    return fail(qo, vo, 0, true, format!("q0[{i}], v0[{i}]: {e}"));
+                }
+                if let Torques::Constant(t) = &torques {
+                    set_torques(&mut sim, &t[i * nv..(i + 1) * nv]);
+                }
+                qo[..nq].copy_from_slice(sim.q().as_slice());
+                vo[..nv].copy_from_slice(sim.v().as_slice());
+                for k in 0..nstep {
+                    if let Torques::PerStep(t) = &torques {
+                        let at = (i * nstep + k) * nv;
+                        set_torques(&mut sim, &t[at..at + nv]);
+                    }
+                    if let Err(e) = advance(&mut sim, dt) {
+                        return fail(qo, vo, k + 1, false, format!("batch index {i}: {e}"));
+                    }
+                    qo[(k + 1) * nq..(k + 2) * nq].copy_from_slice(sim.q().as_slice());
+                    vo[(k + 1) * nv..(k + 2) * nv].copy_from_slice(sim.v().as_slice());
+                }
+                None
             };
-            if let Err(e) = sim.set_state(&q, &v) {
-                return fail(qo, vo, 0, true, format!("q0[{i}], v0[{i}]: {e}"));
-            }
-            if let Torques::Constant(t) = &torques {
-                set_torques(&mut sim, &t[i * nv..(i + 1) * nv]);
-            }
-            qo[..nq].copy_from_slice(sim.q().as_slice());
-            vo[..nv].copy_from_slice(sim.v().as_slice());
-            for k in 0..nstep {
-                if let Torques::PerStep(t) = &torques {
-                    let at = (i * nstep + k) * nv;
-                    set_torques(&mut sim, &t[at..at + nv]);
-                }
-                if let Err(e) = advance(&mut sim, dt) {
-                    return fail(qo, vo, k + 1, false, format!("batch index {i}: {e}"));
-                }
-                qo[(k + 1) * nq..(k + 2) * nq].copy_from_slice(sim.q().as_slice());
-                vo[(k + 1) * nv..(k + 2) * nv].copy_from_slice(sim.v().as_slice());
-            }
-            None
-        };
         let (sq, sv) = ((nstep + 1) * nq, (nstep + 1) * nv);
         py.detach(|| {
             let mut work = move || -> Vec<(usize, bool, String)> {

@@ -204,7 +204,9 @@ const SEED: u64 = 0x5EED_0DD5;
 #[inline(never)]
 fn call(algo: Algo, model: &Model, data: &mut Data, s: &State) -> Result<f64, String> {
     Ok(match algo {
-        Algo::Rnea => dynamics::rnea(model, data, &s.q, &s.v, &s.a, None).map_err(|e| e.to_string())?[0],
+        Algo::Rnea => {
+            dynamics::rnea(model, data, &s.q, &s.v, &s.a, None).map_err(|e| e.to_string())?[0]
+        }
         Algo::Bias => dynamics::bias(model, data, &s.q, &s.v, None).map_err(|e| e.to_string())?[0],
         // H's upper triangle, the work of Pinocchio's crba (mass_matrix mirrors it)
         Algo::Crba => dynamics::crba_upper(model, data, &s.q).map_err(|e| e.to_string())?[(0, 0)],

@@ -55,7 +55,11 @@ struct Kinematics {
 
 /// The frames a state asked for, its centre of mass, momentum and energies, all by
 /// the library's kinematics (model gravity already the file's).
-fn kinematics(model: &Model, data: &mut Data, sv: &StateVectors) -> Result<Kinematics, DynamicsError> {
+fn kinematics(
+    model: &Model,
+    data: &mut Data,
+    sv: &StateVectors,
+) -> Result<Kinematics, DynamicsError> {
     let mut finite = true;
     let mut fin = |xs: &[f64]| finite &= xs.iter().all(|x| x.is_finite());
     dynamics::forward_kinematics_second_order(model, data, &sv.q, &sv.v, &sv.a)?;
@@ -68,7 +72,8 @@ fn kinematics(model: &Model, data: &mut Data, sv: &StateVectors) -> Result<Kinem
             dynamics::frame_jacobian(model, data, f, Reference::WorldAligned, &mut j)?;
             dynamics::frame_jacobian(model, data, f, Reference::Local, &mut jl)?;
             let vel = dynamics::frame_velocity(model, data, f, Reference::WorldAligned)?;
-            let acc = dynamics::frame_classical_acceleration(model, data, f, Reference::WorldAligned)?;
+            let acc =
+                dynamics::frame_classical_acceleration(model, data, f, Reference::WorldAligned)?;
             fin(j.as_slice());
             fin(jl.as_slice());
             fin(vel.to_vector().as_slice());

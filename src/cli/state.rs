@@ -214,7 +214,11 @@ pub fn parse_state(text: &str, file: &str) -> Result<State, StateError> {
     let st: State = parse_json(text, file)?;
     for (present, key) in [(st.fext.is_some(), "fext"), (st.frames.is_some(), "frames")] {
         if present {
-            return Err(StateError::new(file, key, "not allowed in --initial (eval only)"));
+            return Err(StateError::new(
+                file,
+                key,
+                "not allowed in --initial (eval only)",
+            ));
         }
     }
     Ok(st)
@@ -261,7 +265,9 @@ impl State {
                         let near = crate::model::nearest(joint, model.dof_names())
                             .map(|n| format!("; nearest: \"{n}\""))
                             .unwrap_or_default();
-                        format!("unknown joint (not a movable, non-mimic joint of this robot{near})")
+                        format!(
+                            "unknown joint (not a movable, non-mimic joint of this robot{near})"
+                        )
                     };
                     return Err(StateError::new(file, k, why));
                 };
@@ -342,7 +348,11 @@ impl State {
             for (slot, x, field) in [(0, &w.force, "force"), (1, &w.torque, "torque")] {
                 if let Some(x) = x {
                     if !x.iter().all(|c| c.is_finite()) {
-                        return Err(StateError::new(file, format!("{k}.{field}"), "non-finite number"));
+                        return Err(StateError::new(
+                            file,
+                            format!("{k}.{field}"),
+                            "non-finite number",
+                        ));
                     }
                     fv[slot] = Vector3::from(*x);
                 }
@@ -351,11 +361,18 @@ impl State {
         }
         let mut frames = Vec::new();
         for (i, link) in self.frames.iter().flatten().enumerate() {
-            let f = model.frame_id(link).map_err(|e| {
-                StateError::new(file, format!("{key}.frames[{i}]"), e.to_string())
-            })?;
+            let f = model
+                .frame_id(link)
+                .map_err(|e| StateError::new(file, format!("{key}.frames[{i}]"), e.to_string()))?;
             frames.push(f);
         }
-        Ok(StateVectors { q, v, a, tau, fext, frames })
+        Ok(StateVectors {
+            q,
+            v,
+            a,
+            tau,
+            fext,
+            frames,
+        })
     }
 }

@@ -1171,7 +1171,12 @@ mod tests {
         let bare = extra
             .split("<polylist")
             .next()
-            .map(|head| format!("{head}</mesh>{}", extra.split("</triangles>\n</mesh>").nth(1).unwrap_or("")))
+            .map(|head| {
+                format!(
+                    "{head}</mesh>{}",
+                    extra.split("</triangles>\n</mesh>").nth(1).unwrap_or("")
+                )
+            })
             .unwrap();
         let (p3, t3) = read_dae(&bare).unwrap();
         assert_eq!((p3.len(), t3.len()), (10, 0), "{bare}");

@@ -1,5 +1,5 @@
 use super::DynamicsError;
-use crate::model::{DimensionError, Data, Model};
+use crate::model::{Data, DimensionError, Model};
 use crate::spatial::{Inertia, Scalar};
 use nalgebra::{DMatrix, Vector3};
 

@@ -17,7 +17,11 @@ pub fn forward_kinematics<T: Scalar>(
 
 /// [`forward_kinematics`] for callers whose `q` has nq entries by construction
 /// (the simulation's own state).
-pub(crate) fn forward_kinematics_pass<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
+pub(crate) fn forward_kinematics_pass<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+) {
     let nb = model.nbodies;
     let q = q.as_slice();
     let joints = &model.joints[..nb];
@@ -76,4 +80,3 @@ pub(crate) fn frame_pose<T: Scalar>(
     })?;
     Ok((f.body, data.o_m_i[f.body].compose(&f.placement)))
 }
-

@@ -25,15 +25,15 @@ pub use centroidal::centroidal_momentum;
 pub use com::{center_of_mass, center_of_mass_jacobian, center_of_mass_velocity};
 pub use crba::{crba, crba_upper};
 pub use external::add_link_wrench;
-pub use frames::{frame_classical_acceleration, frame_velocity, forward_kinematics_second_order};
+pub use frames::{forward_kinematics_second_order, frame_classical_acceleration, frame_velocity};
 
 pub use energy::{energies, kinetic_energy, kinetic_energy_from_placements, potential_energy};
 pub use forward_rnea::{forward_dynamics_rnea, mass_matrix_rnea};
 pub use jacobian::{frame_jacobian, Reference};
-pub use kinematics::{forward_kinematics, frame_placement, update_frames};
 pub(crate) use kinematics::forward_kinematics_pass;
-pub use rnea::{bias, rnea};
+pub use kinematics::{forward_kinematics, frame_placement, update_frames};
 pub(crate) use rnea::bias_at_placements;
+pub use rnea::{bias, rnea};
 
 /// Why forward dynamics has no answer.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -75,7 +75,12 @@ pub(crate) fn check_sizes<T: Scalar>(
     if ok {
         Ok(())
     } else {
-        Err(size_error(model, q.len(), &vs.iter().map(|(n, x)| (*n, x.len())).collect::<Vec<_>>(), fext.map(<[_]>::len)))
+        Err(size_error(
+            model,
+            q.len(),
+            &vs.iter().map(|(n, x)| (*n, x.len())).collect::<Vec<_>>(),
+            fext.map(<[_]>::len),
+        ))
     }
 }
 
@@ -94,7 +99,11 @@ fn size_error<T: Scalar>(
     checks
         .into_iter()
         .find_map(|(arg, expected, got)| DimensionError::check(arg, expected, got).err())
-        .unwrap_or(DimensionError { arg: "q", expected: model.nq, got: q })
+        .unwrap_or(DimensionError {
+            arg: "q",
+            expected: model.nq,
+            got: q,
+        })
 }
 
 /// Forward dynamics is undefined where a moving joint carries no mass (H is

@@ -70,7 +70,11 @@ pub(crate) fn rnea_impl<T: Scalar>(
 ) {
     // Monomorphised on whether external forces are given: the pass without them
     // carries no per-body test and no world poses.
-    let (q, v, a) = (q.as_slice(), v.map(|x| x.as_slice()), a.map(|x| x.as_slice()));
+    let (q, v, a) = (
+        q.as_slice(),
+        v.map(|x| x.as_slice()),
+        a.map(|x| x.as_slice()),
+    );
     match fext {
         Some(_) => rnea_variant::<T, true>(model, data, q, v, a, gravity, fext),
         None => rnea_variant::<T, false>(model, data, q, v, a, gravity, None),
@@ -90,10 +94,18 @@ fn rnea_variant<T: Scalar, const F: bool>(
 ) {
     // Monomorphised on which of q̇, q̈ are present (no per-body test).
     match (v, a) {
-        (Some(v), Some(a)) => rnea_pass::<T, true, true, F, false>(model, data, q, v, a, gravity, fext),
-        (Some(v), None) => rnea_pass::<T, true, false, F, false>(model, data, q, v, &[], gravity, fext),
-        (None, Some(a)) => rnea_pass::<T, false, true, F, false>(model, data, q, &[], a, gravity, fext),
-        (None, None) => rnea_pass::<T, false, false, F, false>(model, data, q, &[], &[], gravity, fext),
+        (Some(v), Some(a)) => {
+            rnea_pass::<T, true, true, F, false>(model, data, q, v, a, gravity, fext)
+        }
+        (Some(v), None) => {
+            rnea_pass::<T, true, false, F, false>(model, data, q, v, &[], gravity, fext)
+        }
+        (None, Some(a)) => {
+            rnea_pass::<T, false, true, F, false>(model, data, q, &[], a, gravity, fext)
+        }
+        (None, None) => {
+            rnea_pass::<T, false, false, F, false>(model, data, q, &[], &[], gravity, fext)
+        }
     }
 }
 

@@ -223,7 +223,9 @@ impl<T: Scalar> Model<T> {
     }
     /// Position of a DoF by joint name in [`Model::dofs`]: neither a q nor a v
     /// index (those are offset by a floating base).
-    #[deprecated(note = "an index into `dofs`, neither q nor v: use `q_index`, `v_index` or `joint_id` + `joint_v_range`")]
+    #[deprecated(
+        note = "an index into `dofs`, neither q nor v: use `q_index`, `v_index` or `joint_id` + `joint_v_range`"
+    )]
     pub fn dof_index(&self, name: &str) -> Option<usize> {
         self.dofs.iter().position(|d| d.name == name)
     }

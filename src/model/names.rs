@@ -65,7 +65,12 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 /// The candidate closest to `name` by [`edit_distance`]; among equals the one
 /// sharing the longest prefix with `name`, then the first.
 pub fn nearest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<String> {
-    let prefix = |c: &str| name.chars().zip(c.chars()).take_while(|(a, b)| a == b).count();
+    let prefix = |c: &str| {
+        name.chars()
+            .zip(c.chars())
+            .take_while(|(a, b)| a == b)
+            .count()
+    };
     candidates
         .into_iter()
         .map(|c| (edit_distance(name, c), usize::MAX - prefix(c), c))
@@ -78,19 +83,26 @@ fn find<'a>(
     name: &str,
     names: impl Iterator<Item = &'a str> + Clone,
 ) -> Result<usize, NameError> {
-    names.clone().position(|n| n == name).ok_or_else(|| NameError::Unknown {
-        kind,
-        name: name.to_string(),
-        nearest: nearest(name, names),
-    })
+    names
+        .clone()
+        .position(|n| n == name)
+        .ok_or_else(|| NameError::Unknown {
+            kind,
+            name: name.to_string(),
+            nearest: nearest(name, names),
+        })
 }
 
 impl<T: Scalar> Model<T> {
     /// The joint of a URDF joint name (movable joints, mimic joints included;
     /// the free base's joint is "root_joint").
     pub fn joint_id(&self, name: &str) -> Result<JointId, NameError> {
-        find("joint", name, self.body_joint_names.iter().skip(1).map(String::as_str))
-            .map(|i| JointId(i + 1))
+        find(
+            "joint",
+            name,
+            self.body_joint_names.iter().skip(1).map(String::as_str),
+        )
+        .map(|i| JointId(i + 1))
     }
     /// The frame of a URDF link (every link, fixed-joint children included).
     pub fn frame_id(&self, link: &str) -> Result<FrameId, NameError> {
@@ -106,14 +118,22 @@ impl<T: Scalar> Model<T> {
         self.body_joint_names
             .get(id.0)
             .map(String::as_str)
-            .ok_or(NameError::OutOfRange { kind: "joint", id: id.0, len: self.nbodies })
+            .ok_or(NameError::OutOfRange {
+                kind: "joint",
+                id: id.0,
+                len: self.nbodies,
+            })
     }
     /// The URDF link name of a frame.
     pub fn frame_name(&self, id: FrameId) -> Result<&str, NameError> {
         self.frames
             .get(id.0)
             .map(|f| f.name.as_str())
-            .ok_or(NameError::OutOfRange { kind: "frame", id: id.0, len: self.frames.len() })
+            .ok_or(NameError::OutOfRange {
+                kind: "frame",
+                id: id.0,
+                len: self.frames.len(),
+            })
     }
     /// Every URDF link name, in `model.frames` order.
     pub fn link_names(&self) -> Vec<&str> {
@@ -122,7 +142,9 @@ impl<T: Scalar> Model<T> {
     /// Whether a joint is a mimic joint (it follows a leader and owns no coordinate).
     pub fn is_mimic(&self, id: JointId) -> bool {
         self.joints.get(id.0).is_some_and(|j| {
-            id.0 != 0 && !matches!(j.kind, JointKind::Free) && self.body_joint_names[id.0] != self.dof_name_at(j.iv)
+            id.0 != 0
+                && !matches!(j.kind, JointKind::Free)
+                && self.body_joint_names[id.0] != self.dof_name_at(j.iv)
         })
     }
     fn dof_name_at(&self, iv: usize) -> &str {
@@ -135,7 +157,16 @@ impl<T: Scalar> Model<T> {
     /// A mimic joint owns none: its range is empty. The universe's is empty.
     pub fn joint_q_range(&self, id: JointId) -> Result<Range<usize>, NameError> {
         // a free joint's q is position and quaternion: 7
-        self.joint_range(id, |j| (j.iq, if matches!(j.kind, JointKind::Free) { 7 } else { 1 }))
+        self.joint_range(id, |j| {
+            (
+                j.iq,
+                if matches!(j.kind, JointKind::Free) {
+                    7
+                } else {
+                    1
+                },
+            )
+        })
     }
     /// The joint's velocity coordinates: `v[range]` (and `a`, `tau`; 6 for the free
     /// base: body-frame linear then angular; 1 for a revolute or prismatic joint).
@@ -148,10 +179,11 @@ impl<T: Scalar> Model<T> {
         id: JointId,
         f: impl Fn(&super::Joint<T>) -> (usize, usize),
     ) -> Result<Range<usize>, NameError> {
-        let j = self
-            .joints
-            .get(id.0)
-            .ok_or(NameError::OutOfRange { kind: "joint", id: id.0, len: self.nbodies })?;
+        let j = self.joints.get(id.0).ok_or(NameError::OutOfRange {
+            kind: "joint",
+            id: id.0,
+            len: self.nbodies,
+        })?;
         if id.0 == 0 || self.is_mimic(id) {
             return Ok(0..0);
         }
@@ -168,6 +200,10 @@ impl<T: Scalar> Model<T> {
     }
     /// The position of a degree of freedom in `model.dofs` (neither a q nor a v index).
     fn dof_position(&self, joint: &str) -> Result<usize, NameError> {
-        find("degree of freedom", joint, self.dofs.iter().map(|d| d.name.as_str()))
+        find(
+            "degree of freedom",
+            joint,
+            self.dofs.iter().map(|d| d.name.as_str()),
+        )
     }
 }

@@ -17,8 +17,8 @@
 //! - position pass: b_pos = min(β(−φ − slop)/Δt, cap) where φ < −slop.
 
 use super::factor::MassFactor;
-use super::solver::{self, RowKind, Rows};
 use super::newton::Newton;
+use super::solver::{self, RowKind, Rows};
 use super::{ContactForce, Solver};
 use crate::contact::ContactPoint;
 use crate::model::Model;
@@ -345,7 +345,9 @@ impl Constraints {
         rows.form(f, vfree.as_slice());
         let mut sweeps = match solver {
             Solver::Pgs => rows.solve(f, self.dv.as_mut_slice(), iterations, tol, relaxation),
-            Solver::Newton => self.newton.solve(rows, f, self.dv.as_mut_slice(), iterations, tol),
+            Solver::Newton => self
+                .newton
+                .solve(rows, f, self.dv.as_mut_slice(), iterations, tol),
         };
         if sweeps >= iterations {
             // (a Newton solve stopped by the cap is scaled, never swept)

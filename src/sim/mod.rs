@@ -61,15 +61,17 @@
 
 pub mod constraints;
 pub mod factor;
-pub mod newton;
 pub(crate) mod integrators;
+pub mod newton;
 pub mod solver;
 
 pub use integrators::Integrator;
 
 use crate::contact::{ContactError, ContactParams, ContactPoint, GroundContact};
 use crate::dynamics::DynamicsError;
-use crate::dynamics::{forward_kinematics_pass as forward_kinematics, kinetic_energy_from_placements, potential_energy};
+use crate::dynamics::{
+    forward_kinematics_pass as forward_kinematics, kinetic_energy_from_placements, potential_energy,
+};
 use crate::model::configuration::normalize_quat;
 use crate::model::{Data, JointKind, Model};
 use crate::spatial::Force;
@@ -176,7 +178,9 @@ impl Solver {
     }
     /// The solver of a command-line name.
     pub fn from_name(s: &str) -> Option<Self> {
-        [Solver::Pgs, Solver::Newton].into_iter().find(|x| x.name() == s)
+        [Solver::Pgs, Solver::Newton]
+            .into_iter()
+            .find(|x| x.name() == s)
     }
 }
 

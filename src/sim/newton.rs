@@ -115,7 +115,8 @@ impl Newton {
                         _ => 0.0,
                     };
                     for (tangent, sign) in [(1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0)] {
-                        let w = rows.w[r] + mu * mu * rows.w[r + tangent]
+                        let w = rows.w[r]
+                            + mu * mu * rows.w[r + tangent]
                             + 2.0 * sign * mu * rows.w_block[r][tangent - 1];
                         self.facets.push(Facet {
                             row: r,
@@ -298,7 +299,11 @@ impl Newton {
                 }
                 let mut next = if h > 0.0 { alpha - g / h } else { f64::NAN };
                 if !(next > lo && next < hi) {
-                    next = if hi.is_finite() { 0.5 * (lo + hi) } else { 2.0 * alpha };
+                    next = if hi.is_finite() {
+                        0.5 * (lo + hi)
+                    } else {
+                        2.0 * alpha
+                    };
                 }
                 if (next - alpha).abs() <= 1e-12 * alpha.max(1.0) {
                     alpha = next;
@@ -319,8 +324,7 @@ impl Newton {
                     .all(|(&e, &de)| (e < 0.0) == (e + de < 0.0))
                 && self.boxes.iter().enumerate().all(|(i, &(_, d, lim))| {
                     let (e0, e1) = (self.eb[i], self.eb[i] + self.deb[i]);
-                    ((d * e0).abs() <= lim) == ((d * e1).abs() <= lim)
-                        && (e0 >= 0.0) == (e1 >= 0.0)
+                    ((d * e0).abs() <= lim) == ((d * e1).abs() <= lim) && (e0 >= 0.0) == (e1 >= 0.0)
                 });
             if same_piece {
                 break;
