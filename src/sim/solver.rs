@@ -82,7 +82,36 @@ pub struct Rows {
     is_block: Vec<bool>,
     /// Each row's velocity at its update in the last sweep.
     u_prev: Vec<f64>,
+    /// Scratch of the subspace step ([`subspace_step`]).
+    sm: Subspace,
     cap: usize,
+}
+
+/// Most rows a subspace step solves directly (its dense W_FF is this square).
+pub const SUBSPACE_MAX: usize = 48;
+
+/// Preallocated scratch of [`subspace_step`]: the free rows, their dense
+/// Delassus block and right-hand side, their Y rows scattered to full width.
+#[derive(Clone, Debug)]
+struct Subspace {
+    rows: Vec<usize>,
+    w: Vec<f64>,
+    rhs: Vec<f64>,
+    dense: Vec<f64>,
+    lam: Vec<f64>,
+}
+
+impl Subspace {
+    fn new(nv: usize, cap: usize) -> Self {
+        let m = cap.min(SUBSPACE_MAX);
+        Self {
+            rows: Vec::with_capacity(m),
+            w: vec![0.0; m * m],
+            rhs: vec![0.0; m],
+            dense: vec![0.0; m * nv],
+            lam: vec![0.0; m],
+        }
+    }
 }
 
 impl Rows {
@@ -104,6 +133,7 @@ impl Rows {
             w_block: vec![[0.0; 3]; cap],
             is_block: vec![false; cap],
             u_prev: vec![0.0; cap],
+            sm: Subspace::new(nv, cap),
             cap,
         }
     }
@@ -312,9 +342,11 @@ impl Rows {
         // Gauss–Seidel does)
         const PLAIN: usize = 3;
         let mut finishing = false;
+        let mut attempts = 0;
+        let mut polished = false;
         while it < max_iter {
             it += 1;
-            let plain = it <= PLAIN || finishing || 2 * it > max_iter || relax == 1.0;
+            let plain = it <= PLAIN || finishing || polished || 2 * it > max_iter || relax == 1.0;
             let relax = if plain { 1.0 } else { relax };
             let first = it == 1;
             let mut change: f64 = 0.0;
@@ -446,10 +478,252 @@ impl Rows {
             }
             if change <= tol {
                 finishing = true;
+            } else if it >= SUBSPACE_AFTER && attempts < SUBSPACE_TRIES && it + 1 < max_iter {
+                // slow linear convergence (coupled rows): solve the rows
+                // the sweeps left free exactly, then let plain sweeps check
+                attempts += 1;
+                let rows = Solved {
+                    n,
+                    nv,
+                    y,
+                    paths,
+                    table,
+                    kinds,
+                    contact,
+                    w,
+                    c,
+                    b,
+                };
+                if subspace_step(&mut self.sm, &rows, lambda, dv) {
+                    polished = true;
+                }
             }
         }
         it
     }
+}
+
+/// Sweeps before the first subspace step, and the most a solve takes.
+const SUBSPACE_AFTER: usize = 2;
+const SUBSPACE_TRIES: usize = 3;
+
+/// The read-only view of the rows a subspace step needs.
+struct Solved<'a> {
+    n: usize,
+    nv: usize,
+    y: &'a [f64],
+    paths: &'a [(usize, usize)],
+    table: &'a [usize],
+    kinds: &'a [RowKind],
+    contact: &'a [bool],
+    w: &'a [f64],
+    c: &'a [f64],
+    b: &'a [f64],
+}
+
+/// One subspace-minimisation step of projected Gauss–Seidel (PGS-SM,
+/// docs/theory.md §"Constraint solve"): the rows the sweeps left strictly
+/// inside their sets — positive normals and limits, sticking tangent pairs,
+/// joint friction below its bound — are solved exactly as equalities
+/// (W_FF δ = b_F − u_F, the others held), by a dense LDLᵀ of W_FF that drops
+/// rows dependent on earlier ones (redundant contacts); taken only when the
+/// result stays feasible (normals ≥ 0, tangents in their cones, friction in
+/// its box), else nothing changes. Gauss–Seidel converges linearly, at a rate
+/// that coupled rows (a light arm on a base resting on several points) make
+/// slow; when the sweeps have found the active set this step ends the solve.
+/// Returns whether the step was taken (λ and Δv' = Yᵀλ updated).
+fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut [f64]) -> bool {
+    let Solved {
+        n,
+        nv,
+        y,
+        paths,
+        table,
+        kinds,
+        contact,
+        w,
+        c,
+        b,
+    } = *rows;
+    let path = |r: usize| {
+        let (s, l) = paths[r];
+        &table[s..s + l]
+    };
+    let inside = |t1: f64, t2: f64, ln: f64, mu: f64| (t1 * t1 + t2 * t2).sqrt() < mu * ln * (1.0 - 1e-9);
+    // F: the free rows
+    sm.rows.clear();
+    let mut r = 0;
+    while r < n {
+        let live = |q: usize| w[q] > 1e-14;
+        if contact[r] {
+            let mu = match kinds[r + 1] {
+                RowKind::Tangent { mu, .. } => mu,
+                _ => 0.0,
+            };
+            if lambda[r] > 0.0 && live(r) {
+                sm.rows.push(r);
+                if inside(lambda[r + 1], lambda[r + 2], lambda[r], mu) && live(r + 1) && live(r + 2) {
+                    sm.rows.push(r + 1);
+                    sm.rows.push(r + 2);
+                }
+            }
+            r += 3;
+            continue;
+        }
+        match kinds[r] {
+            RowKind::Tangent { normal, mu } if r + 1 < n => {
+                let ln = lambda.get(normal).copied().unwrap_or(0.0);
+                if ln > 0.0 && inside(lambda[r], lambda[r + 1], ln, mu) && live(r) && live(r + 1) {
+                    sm.rows.push(r);
+                    sm.rows.push(r + 1);
+                }
+                r += 2;
+                continue;
+            }
+            RowKind::Tangent2 | RowKind::Tangent { .. } => {}
+            RowKind::Normal | RowKind::Unilateral => {
+                if lambda[r] > 0.0 && live(r) {
+                    sm.rows.push(r);
+                }
+            }
+            RowKind::Box { limit } => {
+                if lambda[r].abs() < limit * (1.0 - 1e-9) && live(r) {
+                    sm.rows.push(r);
+                }
+            }
+        }
+        r += 1;
+        if sm.rows.len() > SUBSPACE_MAX {
+            return false;
+        }
+    }
+    let m = sm.rows.len();
+    if m == 0 || m > SUBSPACE_MAX || sm.dense.len() < m * nv {
+        return false;
+    }
+    // the free rows of Y at full width, the residuals b − u, and the lower
+    // triangle of W_FF = Y_F Y_Fᵀ
+    for (a, &r) in sm.rows.iter().enumerate() {
+        let d = &mut sm.dense[a * nv..(a + 1) * nv];
+        d.fill(0.0);
+        let mut u = c[r];
+        for (t, &k) in path(r).iter().enumerate() {
+            let yt = y[r * nv + t];
+            d[k] = yt;
+            u += yt * dv[k];
+        }
+        let target = match kinds[r] {
+            RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
+            _ => b[r],
+        };
+        sm.rhs[a] = target - u;
+        for (bb, &q) in sm.rows.iter().enumerate().take(a + 1) {
+            let mut s = 0.0;
+            for (t, &k) in path(q).iter().enumerate() {
+                s += y[q * nv + t] * d[k];
+            }
+            sm.w[a * m + bb] = s;
+        }
+    }
+    // LDLᵀ in place (L unit lower below the diagonal, D on it); a pivot that
+    // lost all but 1e-10 of its diagonal is a dependent row: dropped (δ = 0)
+    for j in 0..m {
+        let diag = sm.w[j * m + j];
+        let mut dj = diag;
+        for k in 0..j {
+            let dk = sm.w[k * m + k];
+            if dk != 0.0 {
+                let l = sm.w[j * m + k];
+                dj -= l * l * dk;
+            }
+        }
+        let dj = if dj > 1e-10 * diag && dj > 0.0 { dj } else { 0.0 };
+        sm.w[j * m + j] = dj;
+        for i in j + 1..m {
+            let mut s = sm.w[i * m + j];
+            for k in 0..j {
+                let dk = sm.w[k * m + k];
+                if dk != 0.0 {
+                    s -= sm.w[i * m + k] * sm.w[j * m + k] * dk;
+                }
+            }
+            sm.w[i * m + j] = if dj != 0.0 { s / dj } else { 0.0 };
+        }
+    }
+    // δ: L z = rhs, z /= D, Lᵀ δ = z (dropped rows: δ = 0)
+    for i in 0..m {
+        let mut s = sm.rhs[i];
+        for k in 0..i {
+            s -= sm.w[i * m + k] * sm.rhs[k];
+        }
+        sm.rhs[i] = s;
+    }
+    for i in 0..m {
+        let d = sm.w[i * m + i];
+        sm.rhs[i] = if d != 0.0 { sm.rhs[i] / d } else { 0.0 };
+    }
+    for i in (0..m).rev() {
+        if sm.w[i * m + i] == 0.0 {
+            sm.rhs[i] = 0.0;
+            continue;
+        }
+        let mut s = sm.rhs[i];
+        for k in i + 1..m {
+            s -= sm.w[k * m + i] * sm.rhs[k];
+        }
+        sm.rhs[i] = s;
+    }
+    // the new impulses, feasible or not taken
+    for (a, &r) in sm.rows.iter().enumerate() {
+        let x = lambda[r] + sm.rhs[a];
+        if !x.is_finite() {
+            return false;
+        }
+        sm.lam[a] = x;
+    }
+    let new = |r: usize, sm: &Subspace| match sm.rows.iter().position(|&q| q == r) {
+        Some(a) => sm.lam[a],
+        None => lambda[r],
+    };
+    for (a, &r) in sm.rows.iter().enumerate() {
+        let ok = match kinds[r] {
+            RowKind::Normal | RowKind::Unilateral => sm.lam[a] >= 0.0,
+            RowKind::Box { limit } => sm.lam[a].abs() <= limit,
+            RowKind::Tangent { normal, mu } => {
+                let (t1, t2) = (sm.lam[a], new(r + 1, sm));
+                (t1 * t1 + t2 * t2).sqrt() <= mu * new(normal, sm)
+            }
+            RowKind::Tangent2 => true,
+        };
+        if !ok {
+            return false;
+        }
+    }
+    // a held sliding pair stays in the cone of its (free) normal
+    let mut r = 0;
+    while r < n {
+        if let RowKind::Tangent { normal, mu } = kinds[r] {
+            if r + 1 < n && !sm.rows.contains(&r) {
+                let (t1, t2) = (lambda[r], lambda[r + 1]);
+                if (t1 * t1 + t2 * t2).sqrt() > mu * new(normal, sm).max(0.0) * (1.0 + 1e-12) {
+                    return false;
+                }
+            }
+            r += 2;
+            continue;
+        }
+        r += 1;
+    }
+    for (a, &r) in sm.rows.iter().enumerate() {
+        let d = sm.lam[a] - lambda[r];
+        lambda[r] = sm.lam[a];
+        if d != 0.0 {
+            for (t, &k) in path(r).iter().enumerate() {
+                dv[k] += d * y[r * nv + t];
+            }
+        }
+    }
+    true
 }
 
 impl Rows {
