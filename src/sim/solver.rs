@@ -88,7 +88,7 @@ pub struct Rows {
 }
 
 /// Most rows a subspace step solves directly (its dense W_FF is this square).
-pub const SUBSPACE_MAX: usize = 48;
+pub const SUBSPACE_MAX: usize = 16;
 
 /// Preallocated scratch of [`subspace_step`]: the free rows, their dense
 /// Delassus block and right-hand side, their Y rows scattered to full width.
@@ -99,6 +99,8 @@ struct Subspace {
     rhs: Vec<f64>,
     dense: Vec<f64>,
     lam: Vec<f64>,
+    /// At a tangent pair's first row: it lay on its cone's boundary (sliding).
+    sliding: Vec<bool>,
 }
 
 impl Subspace {
@@ -110,6 +112,7 @@ impl Subspace {
             rhs: vec![0.0; m],
             dense: vec![0.0; m * nv],
             lam: vec![0.0; m],
+            sliding: vec![false; cap],
         }
     }
 }
@@ -525,13 +528,15 @@ struct Solved<'a> {
 /// docs/theory.md §"Constraint solve"): the rows the sweeps left strictly
 /// inside their sets — positive normals and limits, sticking tangent pairs,
 /// joint friction below its bound — are solved exactly as equalities
-/// (W_FF δ = b_F − u_F, the others held), by a dense LDLᵀ of W_FF that drops
-/// rows dependent on earlier ones (redundant contacts); taken only when the
-/// result stays feasible (normals ≥ 0, tangents in their cones, friction in
-/// its box), else nothing changes. Gauss–Seidel converges linearly, at a rate
-/// that coupled rows (a light arm on a base resting on several points) make
-/// slow; when the sweeps have found the active set this step ends the solve.
-/// Returns whether the step was taken (λ and Δv' = Yᵀλ updated).
+/// (W_FF δ = b_F − u_F, the other rows held), by a dense LDLᵀ of W_FF that
+/// drops rows dependent on earlier ones (redundant contacts). The result is
+/// projected onto the sets (normals and limits ≥ 0, friction in its box, a
+/// sticking pair into its cone) and a sliding pair, held in the solve, is put
+/// back on its cone's boundary at the new normal impulse; the sweeps that
+/// follow check it (exact when the sweeps had found the active set). Gauss–
+/// Seidel converges linearly, at a rate that coupled rows (a light arm on a
+/// base resting on several points) make slow. Returns whether a step was taken
+/// (λ and Δv' = Yᵀλ updated).
 fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut [f64]) -> bool {
     let Solved {
         n,
@@ -560,9 +565,10 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
                 RowKind::Tangent { mu, .. } => mu,
                 _ => 0.0,
             };
+            sm.sliding[r + 1] = !inside(lambda[r + 1], lambda[r + 2], lambda[r], mu);
             if lambda[r] > 0.0 && live(r) {
                 sm.rows.push(r);
-                if inside(lambda[r + 1], lambda[r + 2], lambda[r], mu) && live(r + 1) && live(r + 2) {
+                if !sm.sliding[r + 1] && live(r + 1) && live(r + 2) {
                     sm.rows.push(r + 1);
                     sm.rows.push(r + 2);
                 }
@@ -573,7 +579,8 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
         match kinds[r] {
             RowKind::Tangent { normal, mu } if r + 1 < n => {
                 let ln = lambda.get(normal).copied().unwrap_or(0.0);
-                if ln > 0.0 && inside(lambda[r], lambda[r + 1], ln, mu) && live(r) && live(r + 1) {
+                sm.sliding[r] = !inside(lambda[r], lambda[r + 1], ln, mu);
+                if ln > 0.0 && !sm.sliding[r] && live(r) && live(r + 1) {
                     sm.rows.push(r);
                     sm.rows.push(r + 1);
                 }
@@ -681,47 +688,52 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
         }
         sm.lam[a] = x;
     }
-    let new = |r: usize, sm: &Subspace| match sm.rows.iter().position(|&q| q == r) {
-        Some(a) => sm.lam[a],
-        None => lambda[r],
-    };
-    for (a, &r) in sm.rows.iter().enumerate() {
-        let ok = match kinds[r] {
-            RowKind::Normal | RowKind::Unilateral => sm.lam[a] >= 0.0,
-            RowKind::Box { limit } => sm.lam[a].abs() <= limit,
-            RowKind::Tangent { normal, mu } => {
-                let (t1, t2) = (sm.lam[a], new(r + 1, sm));
-                (t1 * t1 + t2 * t2).sqrt() <= mu * new(normal, sm)
-            }
-            RowKind::Tangent2 => true,
-        };
-        if !ok {
-            return false;
-        }
-    }
-    // a held sliding pair stays in the cone of its (free) normal
-    let mut r = 0;
-    while r < n {
-        if let RowKind::Tangent { normal, mu } = kinds[r] {
-            if r + 1 < n && !sm.rows.contains(&r) {
-                let (t1, t2) = (lambda[r], lambda[r + 1]);
-                if (t1 * t1 + t2 * t2).sqrt() > mu * new(normal, sm).max(0.0) * (1.0 + 1e-12) {
-                    return false;
-                }
-            }
-            r += 2;
-            continue;
-        }
-        r += 1;
-    }
-    for (a, &r) in sm.rows.iter().enumerate() {
-        let d = sm.lam[a] - lambda[r];
-        lambda[r] = sm.lam[a];
+    // projected onto the sets (the step is exact when nothing moves here):
+    // normals and limits ≥ 0, friction in its box; then the tangent pairs, a
+    // sticking pair into the cone of its new normal, a sliding one (held in
+    // the solve) along its direction onto that cone's boundary, μλₙ
+    let add = |r: usize, d: f64, dv: &mut [f64]| {
         if d != 0.0 {
             for (t, &k) in path(r).iter().enumerate() {
                 dv[k] += d * y[r * nv + t];
             }
         }
+    };
+    for (a, &r) in sm.rows.iter().enumerate() {
+        let x = match kinds[r] {
+            RowKind::Normal | RowKind::Unilateral => sm.lam[a].max(0.0),
+            RowKind::Box { limit } => sm.lam[a].clamp(-limit, limit),
+            _ => continue,
+        };
+        let d = x - lambda[r];
+        lambda[r] = x;
+        add(r, d, dv);
+    }
+    let mut r = 0;
+    while r + 1 < n {
+        let RowKind::Tangent { normal, mu } = kinds[r] else {
+            r += 1;
+            continue;
+        };
+        let lim = mu * lambda.get(normal).copied().unwrap_or(0.0).max(0.0);
+        let free = sm.rows.iter().position(|&q| q == r).filter(|&a| a + 1 < m);
+        let (t1, t2) = match free {
+            Some(a) => (sm.lam[a], sm.lam[a + 1]),
+            None => (lambda[r], lambda[r + 1]),
+        };
+        let norm = (t1 * t1 + t2 * t2).sqrt();
+        let s = if norm > lim || (free.is_none() && sm.sliding[r]) {
+            if norm > 0.0 { lim / norm } else { 0.0 }
+        } else {
+            1.0
+        };
+        let (n1, n2) = (t1 * s, t2 * s);
+        let (d1, d2) = (n1 - lambda[r], n2 - lambda[r + 1]);
+        lambda[r] = n1;
+        lambda[r + 1] = n2;
+        add(r, d1, dv);
+        add(r + 1, d2, dv);
+        r += 2;
     }
     true
 }
