@@ -62,6 +62,10 @@ pub struct Rows {
     pub y: Vec<f64>,
     /// Delassus diagonal Wᵣᵣ = ‖yᵣ‖² (the row's velocity per unit impulse).
     pub w: Vec<f64>,
+    /// 1 / Wᵣᵣ, and 0 where Wᵣᵣ ≤ 1e-14 (a row no impulse can move).
+    winv: Vec<f64>,
+    /// 1 where Wᵣᵣ > 1e-14, else 0 (such a row's impulse stays 0).
+    live: Vec<f64>,
     /// J v* (free velocity).
     pub c: Vec<f64>,
     /// Target (b) of each row.
@@ -127,6 +131,8 @@ impl Rows {
             j: vec![0.0; cap * nv],
             y: vec![0.0; cap * nv],
             w: vec![0.0; cap],
+            winv: vec![0.0; cap],
+            live: vec![0.0; cap],
             c: vec![0.0; cap],
             b: vec![0.0; cap],
             lambda: vec![0.0; cap],
@@ -237,6 +243,13 @@ impl Rows {
             }
             r += k;
         }
+        // which rows start a contact's block (read by every sweep)
+        for r in 0..n.min(self.is_block.len()) {
+            self.is_block[r] = self.is_contact(r);
+        }
+        for (w, (wi, l)) in self.w[..n].iter().zip(self.winv.iter_mut().zip(self.live.iter_mut())) {
+            (*wi, *l) = if *w > 1e-14 { (1.0 / w, 1.0) } else { (0.0, 0.0) };
+        }
     }
 
     /// Whether row r is a contact normal followed by its two tangent rows on
@@ -272,10 +285,6 @@ impl Rows {
         relax: f64,
     ) -> usize {
         let (nv, n) = (self.nv, self.n);
-        // which rows start a contact's block (computed once a solve)
-        for r in 0..n.min(self.is_block.len()) {
-            self.is_block[r] = self.is_contact(r);
-        }
         let table = f.table();
         if dv.len() < nv
             || self.y.len() < n * nv
@@ -293,6 +302,7 @@ impl Rows {
         let (kinds, w, c, b) = (&self.kind[..n], &self.w[..n], &self.c[..n], &self.b[..n]);
         let contact = &self.is_block[..n];
         let w_block = &self.w_block[..n];
+        let (winv, live) = (&self.winv[..n], &self.live[..n]);
         let u_prev = &mut self.u_prev[..n];
         // a row's convergence measure: its own residual |Δλ|·Wᵣᵣ, or, when
         // smaller, how much its velocity moved since the last sweep (redundant
@@ -374,11 +384,7 @@ impl Rows {
                     let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
                     let on = lambda[r];
                     let un = c[r] + dn;
-                    let nn = if wnn > 1e-14 {
-                        (on - relax * (un - b[r]) / wnn).max(0.0)
-                    } else {
-                        0.0
-                    };
+                    let nn = (on - relax * (un - b[r]) * winv[r]).max(0.0) * live[r];
                     let dln = nn - on;
                     lambda[r] = nn;
                     let mu = match kinds[r + 1] {
@@ -388,11 +394,12 @@ impl Rows {
                     let (o1, o2) = (lambda[r + 1], lambda[r + 2]);
                     let u1 = c[r + 1] + d1 + dln * wn1;
                     let u2 = c[r + 2] + d2 + dln * wn2;
-                    let mut t1 = if w11 > 1e-14 { o1 - u1 / w11 } else { 0.0 };
-                    let mut t2 = if w22 > 1e-14 { o2 - u2 / w22 } else { 0.0 };
+                    let mut t1 = (o1 - u1 * winv[r + 1]) * live[r + 1];
+                    let mut t2 = (o2 - u2 * winv[r + 2]) * live[r + 2];
                     let lim = mu * nn;
-                    let m = (t1 * t1 + t2 * t2).sqrt();
-                    if m > lim {
+                    let m2 = t1 * t1 + t2 * t2;
+                    if m2 > lim * lim {
+                        let m = m2.sqrt();
                         let s = if m > 0.0 { lim / m } else { 0.0 };
                         t1 *= s;
                         t2 *= s;
@@ -458,9 +465,9 @@ impl Rows {
                 let old = lambda[r];
                 let p = path(r);
                 let mut u = 0.0;
-                let new = if wrr > 1e-14 {
+                let new = if live[r] != 0.0 {
                     u = c[r] + rdot(y, r, nv, p, dv);
-                    let x = old - relax * (u - b[r]) / wrr;
+                    let x = old - relax * (u - b[r]) * winv[r];
                     match kind {
                         RowKind::Box { limit } => x.clamp(-limit, limit),
                         _ => x.max(0.0),
