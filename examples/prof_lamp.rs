@@ -1,7 +1,9 @@
 //! Profiling aid: the lamp drop of the README (floating base, 0.5 m, 10° about x)
 //! without any output. `prof_lamp [DURATION] [SOLVER_TOL] [REPEATS]` prints the
 //! solver's sweeps per step (a histogram), the resting state one second later,
-//! and the fastest of REPEATS runs of DURATION simulated seconds.
+//! and the fastest of REPEATS runs of DURATION simulated seconds. TILT (degrees,
+//! default 5) rotates the start about x by twice that angle (the README's lamp
+//! is TILT=5).
 use urdyn::sim::{SimOptions, Simulation};
 
 fn setup(tol: Option<f64>) -> Simulation {
@@ -70,6 +72,9 @@ fn main() {
             dur / w
         );
     }
+    // TRACE=1: one line a step on standard error (t, sweeps, rows so far,
+    // active contacts, µs)
+    let trace = std::env::var("TRACE").is_ok();
     let mut hist = [0u64; 8];
     let mut tsum = [0f64; 8];
     let mut prev = 0;
@@ -91,6 +96,16 @@ fn main() {
         };
         hist[b] += 1;
         tsum[b] += el;
+        if trace {
+            eprintln!(
+                "{:.3} {} {} {} {:.2}",
+                sim.time(),
+                sw,
+                sim.rows_total,
+                sim.active_contacts(),
+                el * 1e6
+            );
+        }
     }
     println!(
         "time per bucket (ms): {:?}",

@@ -269,9 +269,27 @@ fn mirror_blocked<T: Scalar>(a: &mut [T], n: usize) {
 /// the moves are rotations about the joint axis ([`CompositeInertia::act_ax`],
 /// `act_force_ax`).
 fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
+    crba_local_pass::<T, false>(model, data, q.as_slice());
+}
+
+/// [`crba_upper`] (sizes checked by the caller) at the q whose joint placements
+/// `data.li_m_i` already hold (forward kinematics ran at it): the local-frame
+/// pass reads them instead of recomputing each joint's transform. Returns
+/// false, computing nothing, where that variant does not run (mimic joints,
+/// long chains): the caller then calls [`crba_upper`].
+pub(crate) fn crba_upper_at_placements<T: Scalar>(model: &Model<T>, data: &mut Data<T>) -> bool {
+    if model.has_mimic || !model.topology.crba_local {
+        return false;
+    }
+    crba_local_pass::<T, true>(model, data, &[]);
+    true
+}
+
+/// The local-frame pass; `PLACED`: `data.li_m_i` holds the joint placements
+/// at q (then `q` is not read), else they are computed from `q` and stored.
+fn crba_local_pass<T: Scalar, const PLACED: bool>(model: &Model<T>, data: &mut Data<T>, q: &[T]) {
     let nb = model.nbodies;
     let nv = model.nv;
-    let q = q.as_slice();
     let joints = &model.joints[..nb];
     let placements = &model.placements[..nb];
     let inertias = &model.inertias_origin[..nb];
@@ -291,7 +309,7 @@ fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
         let (head, tail) = ic.split_at_mut(i);
         let ici = tail[0];
         let li = dispatch_joint!(&joints[i], ident[i], jm => {
-            let li = jm.placement(&placements[i], q);
+            let li = if PLACED { li_m_i[i] } else { jm.placement(&placements[i], q) };
             let k0 = jm.joint().iv;
             let end = sub_end[k0];
             // F = I^c_i S_i for the joint's own columns (body i's frame)

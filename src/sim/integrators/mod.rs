@@ -88,7 +88,14 @@ impl Simulation {
     /// tree-sparse factorisation reads).
     fn factor_mass(&mut self, c: f64) -> Result<(), SimError> {
         if self.mass.f.is_tree() {
-            crba_upper(&self.model, &mut self.data, &self.q)?;
+            // the joint placements of the last forward kinematics at this q are
+            // reused where the local-frame CRBA runs
+            let placed = self.fk_valid
+                && self.q.len() == self.model.nq
+                && crate::dynamics::crba_upper_at_placements(&self.model, &mut self.data);
+            if !placed {
+                crba_upper(&self.model, &mut self.data, &self.q)?;
+            }
         } else {
             mass_matrix(&self.model, &mut self.data, &self.q)?;
         }
