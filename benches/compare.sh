@@ -43,7 +43,9 @@ fi
 [ -n "$PIN" ] || { echo "compare.sh: pinocchio-bench not found (set PINOCCHIO_BENCH)" >&2; exit 1; }
 
 python3 benches/gen_models.py
-cargo build --release --quiet --bin urdyn
+# generic: the baseline x86-64 build (an empty RUSTFLAGS overrides the
+# target-cpu=native of .cargo/config.toml)
+RUSTFLAGS="" cargo build --release --quiet --bin urdyn --target-dir target/generic
 if [[ " $FLAVOURS " == *" native "* ]]; then
   RUSTFLAGS="-C target-cpu=native" cargo build --release --quiet --bin urdyn --target-dir target/native
 fi
@@ -63,7 +65,7 @@ for d in 4 6 8; do ROBOTS+=("tree_$d|assets/synthetic/tree_$d.urdf||yes"); done
 OUT=target/compare
 rm -rf "$OUT"; mkdir -p "$OUT"
 bench_urdyn() { # flavour key urdf flags round
-  local bin=target/release/urdyn
+  local bin=target/generic/release/urdyn
   [ "$1" = native ] && bin=target/native/release/urdyn
   # shellcheck disable=SC2086
   "$bin" bench "$3" $4 --json --samples "$SAMPLES" --budget "$BUDGET" 2>/dev/null \

@@ -261,9 +261,6 @@ fn hull_adjacency(h: &ConvexPolyhedron) -> (Vec<u32>, Vec<u32>) {
 }
 
 const CYL_SAMPLES: usize = 6;
-/// How far (m) a tilted cylinder's rim may dip below its samples before its
-/// lowest rim points are added as contact points.
-const FLAT_RIM: f64 = 1e-5;
 
 fn to_pose(m: &Se3<f64>) -> Pose {
     let r = &m.rot;
@@ -643,14 +640,7 @@ impl GroundContact {
                     // lowest point of each rim: centre + r·(−z projected off the axis)
                     let d = down - a * a.dot(&down);
                     let dn = d.norm();
-                    // a rim tilted by θ (dn = sin θ) dips r·sin θ·(1 − cos(π/N))
-                    // below its N samples: less than FLAT_RIM and the samples
-                    // alone carry it (the lowest rim point of a disc lying
-                    // nearly flat jumps around the rim with the tilt's
-                    // direction, and a point that wanders rolls the disc)
-                    if dn * radius * (1.0 - (std::f64::consts::PI / CYL_SAMPLES as f64).cos())
-                        > FLAT_RIM
-                    {
+                    if dn > 1e-9 {
                         let d = d / dn;
                         push(0, o_m_g.trans - a * half + d * radius);
                         push(1, o_m_g.trans + a * half + d * radius);

@@ -209,12 +209,19 @@ impl Rows {
         while r < n {
             let (ps, pl) = self.path[r];
             let Some(path) = table.get(ps..ps + pl) else {
+                if let Some(b) = self.is_block.get_mut(r) {
+                    *b = false;
+                }
                 r += 1;
                 continue;
             };
             // a contact's three rows share the path: gathered, then transformed
             // in one pass over the factor
-            let k = if self.is_contact(r) { 3 } else { 1 };
+            let block = self.is_contact(r);
+            let k = if block { 3 } else { 1 };
+            for q in r..(r + k).min(self.is_block.len()) {
+                self.is_block[q] = block && q == r;
+            }
             for q in r..r + k {
                 let jr = &self.j[q * nv..(q + 1) * nv];
                 let yr = &mut self.y[q * nv..q * nv + pl];
@@ -242,10 +249,6 @@ impl Rows {
                 self.w[r] = yr.iter().map(|x| x * x).sum();
             }
             r += k;
-        }
-        // which rows start a contact's block (read by every sweep)
-        for r in 0..n.min(self.is_block.len()) {
-            self.is_block[r] = self.is_contact(r);
         }
         for (w, (wi, l)) in self.w[..n].iter().zip(self.winv.iter_mut().zip(self.live.iter_mut())) {
             (*wi, *l) = if *w > 1e-14 { (1.0 / w, 1.0) } else { (0.0, 0.0) };
