@@ -214,10 +214,14 @@ pub struct GroundContact {
     /// Total number of slots.
     pub nslots: usize,
     scratch: Vec<ContactPoint>,
+    /// A hull's band vertices (indices into its `verts`) this step.
+    cand: Vec<u32>,
     /// Slots the last detection kept, as flags and as a list: a reduced
     /// manifold keeps them while they stay within the margin.
     prev_flag: Vec<bool>,
     prev_list: Vec<usize>,
+    /// Per shape, its slots in `prev_list` (a range).
+    prev_range: Vec<(usize, usize)>,
     /// The horizontal directions a reduced manifold's extremes are taken along
     /// (cos, sin), computed once ([`reduce_directions`]).
     reduce_dirs: [(f64, f64); MAX_DIRS],
@@ -452,8 +456,10 @@ impl GroundContact {
             slot_offset,
             nslots: n,
             scratch: Vec::with_capacity(cap),
+            cand: Vec::with_capacity(cap),
             prev_flag: vec![false; n],
             prev_list: Vec::with_capacity(n),
+            prev_range: vec![(0, 0); nshapes],
             reduce_dirs: reduce_directions(params.max_points_per_shape),
             last_low: vec![0; nshapes],
             visited: vec![0; n],
@@ -553,57 +559,145 @@ impl GroundContact {
                             candidate(k);
                         }
                     }
-                } else {
-                    // a hull: descend the vertex graph from the last lowest vertex
-                    // (a vertex of a convex polytope with no lower neighbour is
-                    // the lowest), then collect the vertices within the margin,
-                    // a connected set on the graph
-                    let nbrs = |k: usize| {
-                        let (a, b) = (s.adj_start[k] as usize, s.adj_start[k + 1] as usize);
-                        &s.adj[a..b]
-                    };
-                    let mut k = self.last_low[si].min(s.verts.len() - 1);
-                    let mut zk = height(&s.verts[k]);
-                    loop {
-                        let mut best = None;
-                        for &j in nbrs(k) {
-                            let zj = height(&s.verts[j as usize]);
-                            if zj < zk {
-                                zk = zj;
-                                best = Some(j as usize);
-                            }
-                        }
-                        match best {
-                            Some(j) => k = j,
-                            None => break,
+                    reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
+                    continue;
+                }
+                // a hull: descend the vertex graph from the last lowest vertex
+                // (a vertex of a convex polytope with no lower neighbour is
+                // the lowest), then collect the vertices within the margin,
+                // a connected set on the graph
+                let nbrs = |k: usize| {
+                    let (a, b) = (s.adj_start[k] as usize, s.adj_start[k + 1] as usize);
+                    &s.adj[a..b]
+                };
+                let mut k = self.last_low[si].min(s.verts.len() - 1);
+                let mut zk = height(&s.verts[k]);
+                loop {
+                    let mut best = None;
+                    for &j in nbrs(k) {
+                        let zj = height(&s.verts[j as usize]);
+                        if zj < zk {
+                            zk = zj;
+                            best = Some(j as usize);
                         }
                     }
-                    self.last_low[si] = k;
-                    if zk > margin {
-                        continue;
+                    match best {
+                        Some(j) => k = j,
+                        None => break,
                     }
-                    // the band the patch is chosen from: within BAND of the
-                    // lowest vertex (a face lying flat on the ground is all
-                    // inside it; the vertices further up a rounded edge are not
-                    // needed to span the patch)
-                    let band = margin.min(zk + BAND);
-                    self.generation = self.generation.wrapping_add(1).max(1);
-                    let gen = self.generation;
-                    self.stack.clear();
-                    self.stack.push(k as u32);
-                    self.visited[base + k] = gen;
-                    while let Some(i) = self.stack.pop() {
-                        candidate(i as usize);
-                        for &j in nbrs(i as usize) {
-                            let slot = base + j as usize;
-                            if self.visited[slot] != gen && height(&s.verts[j as usize]) <= band {
-                                self.visited[slot] = gen;
-                                self.stack.push(j);
+                }
+                self.last_low[si] = k;
+                if zk > margin {
+                    continue;
+                }
+                // the band the patch is chosen from: within BAND of the
+                // lowest vertex (a face lying flat on the ground is all
+                // inside it; the vertices further up a rounded edge are not
+                // needed to span the patch)
+                let band = margin.min(zk + BAND);
+                // the band's vertices by a search from the lowest; a vertex is
+                // marked when its height is first taken (one height a vertex,
+                // in or out of the band); a band vertex only gets its world
+                // point p and its criteria (`reduce`: −φ, cᵢ·x + sᵢ·y), their
+                // maxima kept on the way: no ContactPoint until chosen
+                let dirs = maxp.saturating_sub(1).clamp(1, MAX_DIRS);
+                let dir = &self.reduce_dirs;
+                let key = |p: &Vector3<f64>, q: usize| -> f64 {
+                    if q == 0 {
+                        -(p.z - ground)
+                    } else {
+                        let (c, sn) = dir[q - 1];
+                        c * p.x + sn * p.y
+                    }
+                };
+                let mut best = [f64::NEG_INFINITY; MAX_DIRS + 1];
+                self.generation = self.generation.wrapping_add(1).max(1);
+                let gen = self.generation;
+                let verts = &s.verts[..];
+                let visited = &mut self.visited[base..base + verts.len()];
+                let stack = &mut self.stack;
+                stack.clear();
+                stack.push(k as u32);
+                visited[k] = gen;
+                let cand = &mut self.cand;
+                cand.clear();
+                while let Some(i) = stack.pop() {
+                    let p = o_m_g.act_point(&verts[i as usize]);
+                    for (q, b) in best.iter_mut().enumerate().take(dirs + 1) {
+                        let kq = key(&p, q);
+                        if kq > *b {
+                            *b = kq;
+                        }
+                    }
+                    cand.push(i);
+                    for &j in nbrs(i as usize) {
+                        let j = j as usize;
+                        if visited[j] != gen {
+                            visited[j] = gen;
+                            if height(&verts[j]) <= band {
+                                stack.push(j as u32);
                             }
                         }
                     }
                 }
-                reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
+                let visited = &self.visited[base..base + verts.len()];
+                let point = |k: usize| {
+                    let p = o_m_g.act_point(&s.verts[k]);
+                    ContactPoint {
+                        shape: si,
+                        slot: base + k,
+                        body: s.body,
+                        point: p,
+                        gap: p.z - ground,
+                    }
+                };
+                if cand.len() <= maxp {
+                    out.extend(cand.iter().map(|&i| point(i as usize)));
+                    continue;
+                }
+                // each criterion's choice as `reduce`'s: a point kept last step
+                // (this shape's, at most maxp, looked at directly) within its
+                // hold of the best, the lowest slot; else the lowest slot within
+                // 1e-6 of the best (a scan of the band, only then)
+                let (pa, pb) = self.prev_range[si];
+                let kept = &self.prev_list[pa..pb];
+                let start = out.len();
+                for q in 0..=dirs {
+                    let hold = if q == 0 { HOLD_DEEPEST } else { HOLD_EXTREME };
+                    let mut ch = usize::MAX;
+                    for &slot in kept {
+                        let v = &s.verts[slot - base];
+                        if slot < ch
+                            && visited[slot - base] == gen
+                            && height(v) <= band
+                            && key(&o_m_g.act_point(v), q) >= best[q] - hold
+                        {
+                            ch = slot;
+                        }
+                    }
+                    let k = if ch != usize::MAX {
+                        ch - base
+                    } else {
+                        let mut kmin = usize::MAX;
+                        for &i in cand.iter() {
+                            let i = i as usize;
+                            if i < kmin && key(&o_m_g.act_point(&s.verts[i]), q) >= best[q] - 1e-6 {
+                                kmin = i;
+                            }
+                        }
+                        if kmin == usize::MAX {
+                            cand[0] as usize
+                        } else {
+                            kmin
+                        }
+                    };
+                    if out.len() - start >= maxp {
+                        break;
+                    }
+                    if !out[start..].iter().any(|p| p.slot == base + k) {
+                        out.push(point(k));
+                    }
+                }
                 continue;
             }
             // a sphere, capsule or cylinder: its manifold points are computed
@@ -666,10 +760,17 @@ impl GroundContact {
             self.prev_flag[k] = false;
         }
         self.prev_list.clear();
+        self.prev_range.fill((0, 0));
         for p in out.iter() {
             if let Some(f) = self.prev_flag.get_mut(p.slot) {
                 *f = true;
+                // a shape's points are contiguous in `out`
+                let r = &mut self.prev_range[p.shape];
+                if r.1 == 0 {
+                    r.0 = self.prev_list.len();
+                }
                 self.prev_list.push(p.slot);
+                r.1 = self.prev_list.len();
             }
         }
     }
