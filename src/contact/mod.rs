@@ -214,8 +214,6 @@ pub struct GroundContact {
     /// Total number of slots.
     pub nslots: usize,
     scratch: Vec<ContactPoint>,
-    /// A hull's band vertices (indices into its `verts`) this step.
-    cand: Vec<u32>,
     /// Slots the last detection kept, as flags and as a list: a reduced
     /// manifold keeps them while they stay within the margin.
     prev_flag: Vec<bool>,
@@ -230,6 +228,16 @@ pub struct GroundContact {
     last_low: Vec<usize>,
     visited: Vec<u32>,
     generation: u32,
+    /// Per slot of a hull searched on its graph: the generation of the
+    /// search that found it in the band, its place in the band's search order
+    /// (`band_order`, per shape `band_len` long) or among the band's rim
+    /// (`band_rim`, `rim_len` long); per shape, the generation of its band.
+    in_band: Vec<u32>,
+    band_order: Vec<u32>,
+    band_rim: Vec<u32>,
+    band_len: Vec<usize>,
+    rim_len: Vec<usize>,
+    band_gen: Vec<u32>,
     stack: Vec<u32>,
 }
 
@@ -456,7 +464,6 @@ impl GroundContact {
             slot_offset,
             nslots: n,
             scratch: Vec::with_capacity(cap),
-            cand: Vec::with_capacity(cap),
             prev_flag: vec![false; n],
             prev_list: Vec::with_capacity(n),
             prev_range: vec![(0, 0); nshapes],
@@ -464,6 +471,12 @@ impl GroundContact {
             last_low: vec![0; nshapes],
             visited: vec![0; n],
             generation: 0,
+            in_band: vec![0; n],
+            band_order: vec![0; n],
+            band_rim: vec![0; n],
+            band_len: vec![0; nshapes],
+            rim_len: vec![0; nshapes],
+            band_gen: vec![0; nshapes],
             stack: Vec::with_capacity(n),
         }))
     }
@@ -595,11 +608,62 @@ impl GroundContact {
                 // inside it; the vertices further up a rounded edge are not
                 // needed to span the patch)
                 let band = margin.min(zk + BAND);
-                // the band's vertices by a search from the lowest; a vertex is
-                // marked when its height is first taken (one height a vertex,
-                // in or out of the band); a band vertex only gets its world
-                // point p and its criteria (`reduce`: −φ, cᵢ·x + sᵢ·y), their
-                // maxima kept on the way: no ContactPoint until chosen
+                let verts = &s.verts[..];
+                let order = &mut self.band_order[base..base + verts.len()];
+                let rim = &mut self.band_rim[base..base + verts.len()];
+                // last step's band (in its search order) and its rim (the
+                // vertices next to it outside it): from the same lowest vertex,
+                // the band is the same set, searched in the same order, when
+                // every band vertex is still in it and no rim vertex is (a
+                // height a vertex, no graph walk: a patch at rest)
+                let (bl, rl) = (self.band_len[si], self.rim_len[si]);
+                let same = bl > 0
+                    && order[0] as usize == k
+                    && order[1..bl]
+                        .iter()
+                        .all(|&j| height(&verts[j as usize]) <= band)
+                    && rim[..rl]
+                        .iter()
+                        .all(|&j| !(height(&verts[j as usize]) <= band));
+                if !same {
+                    // the band's vertices by a search from the lowest; a
+                    // vertex is marked when its height is first taken (one
+                    // height a vertex, in or out of the band), the band's
+                    // stamped with this search's generation
+                    self.generation = self.generation.wrapping_add(1).max(1);
+                    let gen = self.generation;
+                    let visited = &mut self.visited[base..base + verts.len()];
+                    let in_band = &mut self.in_band[base..base + verts.len()];
+                    let stack = &mut self.stack;
+                    stack.clear();
+                    stack.push(k as u32);
+                    visited[k] = gen;
+                    let (mut bl, mut rl) = (0, 0);
+                    while let Some(i) = stack.pop() {
+                        order[bl] = i;
+                        bl += 1;
+                        in_band[i as usize] = gen;
+                        for &j in nbrs(i as usize) {
+                            let j = j as usize;
+                            if visited[j] != gen {
+                                visited[j] = gen;
+                                if height(&verts[j]) <= band {
+                                    stack.push(j as u32);
+                                } else {
+                                    rim[rl] = j as u32;
+                                    rl += 1;
+                                }
+                            }
+                        }
+                    }
+                    self.band_len[si] = bl;
+                    self.rim_len[si] = rl;
+                    self.band_gen[si] = gen;
+                }
+                let cand = &order[..self.band_len[si]];
+                // a band vertex only gets its world point p and its criteria
+                // (`reduce`: −φ, cᵢ·x + sᵢ·y), their maxima: no ContactPoint
+                // until chosen
                 let dirs = maxp.saturating_sub(1).clamp(1, MAX_DIRS);
                 let dir = &self.reduce_dirs;
                 let key = |p: &Vector3<f64>, q: usize| -> f64 {
@@ -611,17 +675,7 @@ impl GroundContact {
                     }
                 };
                 let mut best = [f64::NEG_INFINITY; MAX_DIRS + 1];
-                self.generation = self.generation.wrapping_add(1).max(1);
-                let gen = self.generation;
-                let verts = &s.verts[..];
-                let visited = &mut self.visited[base..base + verts.len()];
-                let stack = &mut self.stack;
-                stack.clear();
-                stack.push(k as u32);
-                visited[k] = gen;
-                let cand = &mut self.cand;
-                cand.clear();
-                while let Some(i) = stack.pop() {
+                for &i in cand {
                     let p = o_m_g.act_point(&verts[i as usize]);
                     for (q, b) in best.iter_mut().enumerate().take(dirs + 1) {
                         let kq = key(&p, q);
@@ -629,20 +683,9 @@ impl GroundContact {
                             *b = kq;
                         }
                     }
-                    cand.push(i);
-                    for &j in nbrs(i as usize) {
-                        let j = j as usize;
-                        if visited[j] != gen {
-                            visited[j] = gen;
-                            if height(&verts[j]) <= band {
-                                stack.push(j as u32);
-                            }
-                        }
-                    }
                 }
-                let visited = &self.visited[base..base + verts.len()];
                 let point = |k: usize| {
-                    let p = o_m_g.act_point(&s.verts[k]);
+                    let p = o_m_g.act_point(&verts[k]);
                     ContactPoint {
                         shape: si,
                         slot: base + k,
@@ -661,16 +704,15 @@ impl GroundContact {
                 // 1e-6 of the best (a scan of the band, only then)
                 let (pa, pb) = self.prev_range[si];
                 let kept = &self.prev_list[pa..pb];
+                let gen = self.band_gen[si];
                 let start = out.len();
                 for q in 0..=dirs {
                     let hold = if q == 0 { HOLD_DEEPEST } else { HOLD_EXTREME };
                     let mut ch = usize::MAX;
                     for &slot in kept {
-                        let v = &s.verts[slot - base];
                         if slot < ch
-                            && visited[slot - base] == gen
-                            && height(v) <= band
-                            && key(&o_m_g.act_point(v), q) >= best[q] - hold
+                            && self.in_band[slot] == gen
+                            && key(&o_m_g.act_point(&verts[slot - base]), q) >= best[q] - hold
                         {
                             ch = slot;
                         }
@@ -679,9 +721,9 @@ impl GroundContact {
                         ch - base
                     } else {
                         let mut kmin = usize::MAX;
-                        for &i in cand.iter() {
+                        for &i in cand {
                             let i = i as usize;
-                            if i < kmin && key(&o_m_g.act_point(&s.verts[i]), q) >= best[q] - 1e-6 {
+                            if i < kmin && key(&o_m_g.act_point(&verts[i]), q) >= best[q] - 1e-6 {
                                 kmin = i;
                             }
                         }
