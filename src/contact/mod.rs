@@ -674,16 +674,10 @@ impl GroundContact {
                         c * p.x + sn * p.y
                     }
                 };
-                let mut best = [f64::NEG_INFINITY; MAX_DIRS + 1];
-                for &i in cand {
-                    let p = o_m_g.act_point(&verts[i as usize]);
-                    for (q, b) in best.iter_mut().enumerate().take(dirs + 1) {
-                        let kq = key(&p, q);
-                        if kq > *b {
-                            *b = kq;
-                        }
-                    }
-                }
+                let best = match dirs {
+                    3 => band_best::<3>(&o_m_g, verts, cand, ground, dir),
+                    _ => band_best::<0>(&o_m_g, verts, cand, ground, dir),
+                };
                 let point = |k: usize| {
                     let p = o_m_g.act_point(&verts[k]);
                     ContactPoint {
@@ -816,6 +810,32 @@ impl GroundContact {
             }
         }
     }
+}
+
+/// The maxima of `reduce`'s criteria (−φ, then cᵢ·x + sᵢ·y for the
+/// directions `dir`) over the vertices `verts[i]`, i in `cand`, placed by `m`
+/// (φ = z − ground); `D`: the number of directions when it is known at compile
+/// time (the default 3), else 0 and every direction of `dir` is taken (the
+/// unused ones are (0, 0): their maxima are not looked at).
+#[inline(always)]
+fn band_best<const D: usize>(
+    m: &Se3<f64>,
+    verts: &[Vector3<f64>],
+    cand: &[u32],
+    ground: f64,
+    dir: &[(f64, f64); MAX_DIRS],
+) -> [f64; MAX_DIRS + 1] {
+    let nd = if D == 0 { MAX_DIRS } else { D };
+    let mut best = [f64::NEG_INFINITY; MAX_DIRS + 1];
+    for &i in cand {
+        let p = m.act_point(&verts[i as usize]);
+        best[0] = best[0].max(-(p.z - ground));
+        for q in 0..nd {
+            let (c, sn) = dir[q];
+            best[q + 1] = best[q + 1].max(c * p.x + sn * p.y);
+        }
+    }
+    best
 }
 
 /// How much shallower (m) a point kept last step may be than the deepest and
