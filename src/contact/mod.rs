@@ -622,9 +622,9 @@ impl GroundContact {
                     && order[1..bl]
                         .iter()
                         .all(|&j| height(&verts[j as usize]) <= band)
-                    && rim[..rl]
+                    && !rim[..rl]
                         .iter()
-                        .all(|&j| !(height(&verts[j as usize]) <= band));
+                        .any(|&j| height(&verts[j as usize]) <= band);
                 if !same {
                     // the band's vertices by a search from the lowest; a
                     // vertex is marked when its height is first taken (one
@@ -700,13 +700,13 @@ impl GroundContact {
                 let kept = &self.prev_list[pa..pb];
                 let gen = self.band_gen[si];
                 let start = out.len();
-                for q in 0..=dirs {
+                for (q, &bq) in best.iter().enumerate().take(dirs + 1) {
                     let hold = if q == 0 { HOLD_DEEPEST } else { HOLD_EXTREME };
                     let mut ch = usize::MAX;
                     for &slot in kept {
                         if slot < ch
                             && self.in_band[slot] == gen
-                            && key(&o_m_g.act_point(&verts[slot - base]), q) >= best[q] - hold
+                            && key(&o_m_g.act_point(&verts[slot - base]), q) >= bq - hold
                         {
                             ch = slot;
                         }
@@ -717,7 +717,7 @@ impl GroundContact {
                         let mut kmin = usize::MAX;
                         for &i in cand {
                             let i = i as usize;
-                            if i < kmin && key(&o_m_g.act_point(&verts[i]), q) >= best[q] - 1e-6 {
+                            if i < kmin && key(&o_m_g.act_point(&verts[i]), q) >= bq - 1e-6 {
                                 kmin = i;
                             }
                         }
@@ -825,14 +825,17 @@ fn band_best<const D: usize>(
     ground: f64,
     dir: &[(f64, f64); MAX_DIRS],
 ) -> [f64; MAX_DIRS + 1] {
+    // max(b, k) as `if k > b { k } else { b }`: one instruction (maxsd),
+    // a NaN k ignored as `reduce` does
+    let up = |b: f64, k: f64| if k > b { k } else { b };
     let nd = if D == 0 { MAX_DIRS } else { D };
     let mut best = [f64::NEG_INFINITY; MAX_DIRS + 1];
     for &i in cand {
         let p = m.act_point(&verts[i as usize]);
-        best[0] = best[0].max(-(p.z - ground));
+        best[0] = up(best[0], -(p.z - ground));
         for q in 0..nd {
             let (c, sn) = dir[q];
-            best[q + 1] = best[q + 1].max(c * p.x + sn * p.y);
+            best[q + 1] = up(best[q + 1], c * p.x + sn * p.y);
         }
     }
     best
