@@ -228,10 +228,12 @@ pub struct GroundContact {
     last_low: Vec<usize>,
     visited: Vec<u32>,
     generation: u32,
-    /// Per slot of a hull searched on its graph: the generation of the
-    /// search that found it in the band, its place in the band's search order
-    /// (`band_order`, per shape `band_len` long) or among the band's rim
-    /// (`band_rim`, `rim_len` long); per shape, the generation of its band.
+    /// A hull searched on its graph, from its last band search: per slot, the
+    /// generation of the search that found it in the band (`in_band`); in the
+    /// shape's slot range, the band's vertices in search order (`band_order`,
+    /// `band_len[shape]` of them) and its rim, the vertices next to the band
+    /// outside it (`band_rim`, `rim_len[shape]`); per shape, the generation
+    /// of its band (`band_gen`).
     in_band: Vec<u32>,
     band_order: Vec<u32>,
     band_rim: Vec<u32>,
