@@ -218,6 +218,8 @@ pub struct GroundContact {
     /// manifold keeps them while they stay within the margin.
     prev_flag: Vec<bool>,
     prev_list: Vec<usize>,
+    /// Per shape, its slots in `prev_list` (a range).
+    prev_range: Vec<(usize, usize)>,
     /// The horizontal directions a reduced manifold's extremes are taken along
     /// (cos, sin), computed once ([`reduce_directions`]).
     reduce_dirs: [(f64, f64); MAX_DIRS],
@@ -226,6 +228,18 @@ pub struct GroundContact {
     last_low: Vec<usize>,
     visited: Vec<u32>,
     generation: u32,
+    /// A hull searched on its graph, from its last band search: per slot, the
+    /// generation of the search that found it in the band (`in_band`); in the
+    /// shape's slot range, the band's vertices in search order (`band_order`,
+    /// `band_len[shape]` of them) and its rim, the vertices next to the band
+    /// outside it (`band_rim`, `rim_len[shape]`); per shape, the generation
+    /// of its band (`band_gen`).
+    in_band: Vec<u32>,
+    band_order: Vec<u32>,
+    band_rim: Vec<u32>,
+    band_len: Vec<usize>,
+    rim_len: Vec<usize>,
+    band_gen: Vec<u32>,
     stack: Vec<u32>,
 }
 
@@ -451,10 +465,17 @@ impl GroundContact {
             scratch: Vec::with_capacity(cap),
             prev_flag: vec![false; n],
             prev_list: Vec::with_capacity(n),
+            prev_range: vec![(0, 0); nshapes],
             reduce_dirs: reduce_directions(params.max_points_per_shape),
             last_low: vec![0; nshapes],
             visited: vec![0; n],
             generation: 0,
+            in_band: vec![0; n],
+            band_order: vec![0; n],
+            band_rim: vec![0; n],
+            band_len: vec![0; nshapes],
+            rim_len: vec![0; nshapes],
+            band_gen: vec![0; nshapes],
             stack: Vec::with_capacity(n),
         }))
     }
@@ -550,57 +571,168 @@ impl GroundContact {
                             candidate(k);
                         }
                     }
-                } else {
-                    // a hull: descend the vertex graph from the last lowest vertex
-                    // (a vertex of a convex polytope with no lower neighbour is
-                    // the lowest), then collect the vertices within the margin,
-                    // a connected set on the graph
-                    let nbrs = |k: usize| {
-                        let (a, b) = (s.adj_start[k] as usize, s.adj_start[k + 1] as usize);
-                        &s.adj[a..b]
-                    };
-                    let mut k = self.last_low[si].min(s.verts.len() - 1);
-                    let mut zk = height(&s.verts[k]);
-                    loop {
-                        let mut best = None;
-                        for &j in nbrs(k) {
-                            let zj = height(&s.verts[j as usize]);
-                            if zj < zk {
-                                zk = zj;
-                                best = Some(j as usize);
-                            }
-                        }
-                        match best {
-                            Some(j) => k = j,
-                            None => break,
+                    reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
+                    continue;
+                }
+                // a hull: descend the vertex graph from the last lowest vertex
+                // (a vertex of a convex polytope with no lower neighbour is
+                // the lowest), then collect the vertices within the margin,
+                // a connected set on the graph
+                let nbrs = |k: usize| {
+                    let (a, b) = (s.adj_start[k] as usize, s.adj_start[k + 1] as usize);
+                    &s.adj[a..b]
+                };
+                let mut k = self.last_low[si].min(s.verts.len() - 1);
+                let mut zk = height(&s.verts[k]);
+                loop {
+                    let mut best = None;
+                    for &j in nbrs(k) {
+                        let zj = height(&s.verts[j as usize]);
+                        if zj < zk {
+                            zk = zj;
+                            best = Some(j as usize);
                         }
                     }
-                    self.last_low[si] = k;
-                    if zk > margin {
-                        continue;
-                    }
-                    // the band the patch is chosen from: within BAND of the
-                    // lowest vertex (a face lying flat on the ground is all
-                    // inside it; the vertices further up a rounded edge are not
-                    // needed to span the patch)
-                    let band = margin.min(zk + BAND);
-                    self.generation = self.generation.wrapping_add(1).max(1);
-                    let gen = self.generation;
-                    self.stack.clear();
-                    self.stack.push(k as u32);
-                    self.visited[base + k] = gen;
-                    while let Some(i) = self.stack.pop() {
-                        candidate(i as usize);
-                        for &j in nbrs(i as usize) {
-                            let slot = base + j as usize;
-                            if self.visited[slot] != gen && height(&s.verts[j as usize]) <= band {
-                                self.visited[slot] = gen;
-                                self.stack.push(j);
-                            }
-                        }
+                    match best {
+                        Some(j) => k = j,
+                        None => break,
                     }
                 }
-                reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
+                self.last_low[si] = k;
+                if zk > margin {
+                    continue;
+                }
+                // the band the patch is chosen from: within BAND of the
+                // lowest vertex (a face lying flat on the ground is all
+                // inside it; the vertices further up a rounded edge are not
+                // needed to span the patch)
+                let band = margin.min(zk + BAND);
+                let verts = &s.verts[..];
+                let order = &mut self.band_order[base..base + verts.len()];
+                let rim = &mut self.band_rim[base..base + verts.len()];
+                // last step's band (in its search order) and its rim (the
+                // vertices next to it outside it): from the same lowest vertex,
+                // the band is the same set, searched in the same order, when
+                // every band vertex is still in it and no rim vertex is (a
+                // height a vertex, no graph walk: a patch at rest)
+                let (bl, rl) = (self.band_len[si], self.rim_len[si]);
+                let same = bl > 0
+                    && order[0] as usize == k
+                    && order[1..bl]
+                        .iter()
+                        .all(|&j| height(&verts[j as usize]) <= band)
+                    && !rim[..rl]
+                        .iter()
+                        .any(|&j| height(&verts[j as usize]) <= band);
+                if !same {
+                    // the band's vertices by a search from the lowest; a
+                    // vertex is marked when its height is first taken (one
+                    // height a vertex, in or out of the band), the band's
+                    // stamped with this search's generation
+                    self.generation = self.generation.wrapping_add(1).max(1);
+                    let gen = self.generation;
+                    let visited = &mut self.visited[base..base + verts.len()];
+                    let in_band = &mut self.in_band[base..base + verts.len()];
+                    let stack = &mut self.stack;
+                    stack.clear();
+                    stack.push(k as u32);
+                    visited[k] = gen;
+                    let (mut bl, mut rl) = (0, 0);
+                    while let Some(i) = stack.pop() {
+                        order[bl] = i;
+                        bl += 1;
+                        in_band[i as usize] = gen;
+                        for &j in nbrs(i as usize) {
+                            let j = j as usize;
+                            if visited[j] != gen {
+                                visited[j] = gen;
+                                if height(&verts[j]) <= band {
+                                    stack.push(j as u32);
+                                } else {
+                                    rim[rl] = j as u32;
+                                    rl += 1;
+                                }
+                            }
+                        }
+                    }
+                    self.band_len[si] = bl;
+                    self.rim_len[si] = rl;
+                    self.band_gen[si] = gen;
+                }
+                let cand = &order[..self.band_len[si]];
+                // a band vertex only gets its world point p and its criteria
+                // (`reduce`: −φ, cᵢ·x + sᵢ·y), their maxima: no ContactPoint
+                // until chosen
+                let dirs = maxp.saturating_sub(1).clamp(1, MAX_DIRS);
+                let dir = &self.reduce_dirs;
+                let key = |p: &Vector3<f64>, q: usize| -> f64 {
+                    if q == 0 {
+                        -(p.z - ground)
+                    } else {
+                        let (c, sn) = dir[q - 1];
+                        c * p.x + sn * p.y
+                    }
+                };
+                let best = match dirs {
+                    3 => band_best::<3>(&o_m_g, verts, cand, ground, dir),
+                    _ => band_best::<0>(&o_m_g, verts, cand, ground, dir),
+                };
+                let point = |k: usize| {
+                    let p = o_m_g.act_point(&verts[k]);
+                    ContactPoint {
+                        shape: si,
+                        slot: base + k,
+                        body: s.body,
+                        point: p,
+                        gap: p.z - ground,
+                    }
+                };
+                if cand.len() <= maxp {
+                    out.extend(cand.iter().map(|&i| point(i as usize)));
+                    continue;
+                }
+                // each criterion's choice as `reduce`'s: a point kept last step
+                // (this shape's, at most maxp, looked at directly) within its
+                // hold of the best, the lowest slot; else the lowest slot within
+                // 1e-6 of the best (a scan of the band, only then)
+                let (pa, pb) = self.prev_range[si];
+                let kept = &self.prev_list[pa..pb];
+                let gen = self.band_gen[si];
+                let start = out.len();
+                for (q, &bq) in best.iter().enumerate().take(dirs + 1) {
+                    let hold = if q == 0 { HOLD_DEEPEST } else { HOLD_EXTREME };
+                    let mut ch = usize::MAX;
+                    for &slot in kept {
+                        if slot < ch
+                            && self.in_band[slot] == gen
+                            && key(&o_m_g.act_point(&verts[slot - base]), q) >= bq - hold
+                        {
+                            ch = slot;
+                        }
+                    }
+                    let k = if ch != usize::MAX {
+                        ch - base
+                    } else {
+                        let mut kmin = usize::MAX;
+                        for &i in cand {
+                            let i = i as usize;
+                            if i < kmin && key(&o_m_g.act_point(&verts[i]), q) >= bq - 1e-6 {
+                                kmin = i;
+                            }
+                        }
+                        if kmin == usize::MAX {
+                            cand[0] as usize
+                        } else {
+                            kmin
+                        }
+                    };
+                    if out.len() - start >= maxp {
+                        break;
+                    }
+                    if !out[start..].iter().any(|p| p.slot == base + k) {
+                        out.push(point(k));
+                    }
+                }
                 continue;
             }
             // a sphere, capsule or cylinder: its manifold points are computed
@@ -656,13 +788,49 @@ impl GroundContact {
             self.prev_flag[k] = false;
         }
         self.prev_list.clear();
+        self.prev_range.fill((0, 0));
         for p in out.iter() {
             if let Some(f) = self.prev_flag.get_mut(p.slot) {
                 *f = true;
+                // a shape's points are contiguous in `out`
+                let r = &mut self.prev_range[p.shape];
+                if r.1 == 0 {
+                    r.0 = self.prev_list.len();
+                }
                 self.prev_list.push(p.slot);
+                r.1 = self.prev_list.len();
             }
         }
     }
+}
+
+/// The maxima of `reduce`'s criteria (−φ, then cᵢ·x + sᵢ·y for the
+/// directions `dir`) over the vertices `verts[i]`, i in `cand`, placed by `m`
+/// (φ = z − ground); `D`: the number of directions when it is known at compile
+/// time (the default 3), else 0 and every direction of `dir` is taken (the
+/// unused ones are (0, 0): their maxima are not looked at).
+#[inline(always)]
+fn band_best<const D: usize>(
+    m: &Se3<f64>,
+    verts: &[Vector3<f64>],
+    cand: &[u32],
+    ground: f64,
+    dir: &[(f64, f64); MAX_DIRS],
+) -> [f64; MAX_DIRS + 1] {
+    // max(b, k) as `if k > b { k } else { b }`: one instruction (maxsd),
+    // a NaN k ignored as `reduce` does
+    let up = |b: f64, k: f64| if k > b { k } else { b };
+    let nd = if D == 0 { MAX_DIRS } else { D };
+    let mut best = [f64::NEG_INFINITY; MAX_DIRS + 1];
+    for &i in cand {
+        let p = m.act_point(&verts[i as usize]);
+        best[0] = up(best[0], -(p.z - ground));
+        for q in 0..nd {
+            let (c, sn) = dir[q];
+            best[q + 1] = up(best[q + 1], c * p.x + sn * p.y);
+        }
+    }
+    best
 }
 
 /// How much shallower (m) a point kept last step may be than the deepest and
