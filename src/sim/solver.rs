@@ -250,8 +250,15 @@ impl Rows {
             }
             r += k;
         }
-        for (w, (wi, l)) in self.w[..n].iter().zip(self.winv.iter_mut().zip(self.live.iter_mut())) {
-            (*wi, *l) = if *w > 1e-14 { (1.0 / w, 1.0) } else { (0.0, 0.0) };
+        for (w, (wi, l)) in self.w[..n]
+            .iter()
+            .zip(self.winv.iter_mut().zip(self.live.iter_mut()))
+        {
+            (*wi, *l) = if *w > 1e-14 {
+                (1.0 / w, 1.0)
+            } else {
+                (0.0, 0.0)
+            };
         }
     }
 
@@ -564,7 +571,8 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
         let (s, l) = paths[r];
         &table[s..s + l]
     };
-    let inside = |t1: f64, t2: f64, ln: f64, mu: f64| (t1 * t1 + t2 * t2).sqrt() < mu * ln * (1.0 - 1e-9);
+    let inside =
+        |t1: f64, t2: f64, ln: f64, mu: f64| (t1 * t1 + t2 * t2).sqrt() < mu * ln * (1.0 - 1e-9);
     // F: the free rows
     sm.rows.clear();
     let mut r = 0;
@@ -654,7 +662,11 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
                 dj -= l * l * dk;
             }
         }
-        let dj = if dj > 1e-10 * diag && dj > 0.0 { dj } else { 0.0 };
+        let dj = if dj > 1e-10 * diag && dj > 0.0 {
+            dj
+        } else {
+            0.0
+        };
         sm.w[j * m + j] = dj;
         for i in j + 1..m {
             let mut s = sm.w[i * m + j];
@@ -733,7 +745,11 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
         };
         let norm = (t1 * t1 + t2 * t2).sqrt();
         let s = if norm > lim || (free.is_none() && sm.sliding[r]) {
-            if norm > 0.0 { lim / norm } else { 0.0 }
+            if norm > 0.0 {
+                lim / norm
+            } else {
+                0.0
+            }
         } else {
             1.0
         };
