@@ -349,7 +349,10 @@ impl Constraints {
                 .newton
                 .solve(rows, f, self.dv.as_mut_slice(), iterations, tol),
         };
-        if sweeps >= iterations {
+        // a solve stopped by the cap, or one that took a subspace step (whose
+        // projection of a large step is not checked by the sweeps' test
+        // alone), is held to the exact solution's energy bound
+        if sweeps >= iterations || (solver == Solver::Pgs && rows.polished) {
             // (a Newton solve stopped by the cap is scaled, never swept)
             let more = if solver == Solver::Pgs { iterations } else { 0 };
             f.apply_r(vfree.as_slice(), &mut self.a);

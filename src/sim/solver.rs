@@ -88,11 +88,13 @@ pub struct Rows {
     u_prev: Vec<f64>,
     /// Scratch of the subspace step ([`subspace_step`]).
     sm: Subspace,
+    /// The last solve took a subspace step.
+    pub polished: bool,
     cap: usize,
 }
 
 /// Most rows a subspace step solves directly (its dense W_FF is this square).
-pub const SUBSPACE_MAX: usize = 16;
+pub const SUBSPACE_MAX: usize = 32;
 
 /// Preallocated scratch of [`subspace_step`]: the free rows, their dense
 /// Delassus block and right-hand side, their Y rows scattered to full width.
@@ -143,6 +145,7 @@ impl Rows {
             is_block: vec![false; cap],
             u_prev: vec![0.0; cap],
             sm: Subspace::new(nv, cap),
+            polished: false,
             cap,
         }
     }
@@ -295,6 +298,7 @@ impl Rows {
         relax: f64,
     ) -> usize {
         let (nv, n) = (self.nv, self.n);
+        self.polished = false;
         let table = f.table();
         if dv.len() < nv
             || self.y.len() < n * nv
@@ -519,13 +523,14 @@ impl Rows {
                 }
             }
         }
+        self.polished = polished;
         it
     }
 }
 
 /// Sweeps before the first subspace step, and the most a solve takes.
-const SUBSPACE_AFTER: usize = 2;
-const SUBSPACE_TRIES: usize = 3;
+const SUBSPACE_AFTER: usize = 3;
+const SUBSPACE_TRIES: usize = 1;
 
 /// The read-only view of the rows a subspace step needs.
 struct Solved<'a> {
