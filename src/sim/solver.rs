@@ -94,7 +94,7 @@ pub struct Rows {
 }
 
 /// Most rows a subspace step solves directly (its dense W_FF is this square).
-pub const SUBSPACE_MAX: usize = 32;
+pub const SUBSPACE_MAX: usize = 16;
 
 /// Preallocated scratch of [`subspace_step`]: the free rows, their dense
 /// Delassus block and right-hand side, their Y rows scattered to full width.
@@ -529,8 +529,8 @@ impl Rows {
 }
 
 /// Sweeps before the first subspace step, and the most a solve takes.
-const SUBSPACE_AFTER: usize = 3;
-const SUBSPACE_TRIES: usize = 1;
+const SUBSPACE_AFTER: usize = 2;
+const SUBSPACE_TRIES: usize = 3;
 
 /// The read-only view of the rows a subspace step needs.
 struct Solved<'a> {
