@@ -53,7 +53,7 @@ pub struct Rows {
     pub nv: usize,
     /// Rows in use.
     pub n: usize,
-    /// Each row's kind (`n` entries).
+    /// Each row's kind (the first `n` entries in use).
     pub kind: Vec<RowKind>,
     /// Jacobians J, row-major, `nv` per row (row r: `j[r·nv .. (r+1)·nv]`).
     pub j: Vec<f64>,
@@ -129,7 +129,7 @@ impl Rows {
         Self {
             nv,
             n: 0,
-            kind: Vec::with_capacity(cap),
+            kind: vec![RowKind::Unilateral; cap],
             j: vec![0.0; cap * nv],
             y: vec![0.0; cap * nv],
             w: vec![0.0; cap],
@@ -159,19 +159,18 @@ impl Rows {
         let used = (self.n * self.nv).min(self.j.len());
         self.j[..used].fill(0.0);
         self.n = 0;
-        self.kind.clear();
     }
     /// Drops the last `k` rows (pushed, their Jacobian entries not yet written).
     pub fn pop(&mut self, k: usize) {
         let k = k.min(self.n);
         self.n -= k;
-        self.kind.truncate(self.n);
         let from = (self.n * self.nv).min(self.j.len());
         let to = ((self.n + k) * self.nv).min(self.j.len());
         self.j[from..to].fill(0.0);
     }
     /// Adds a row (zeroed Jacobian: rows are zeroed by [`Rows::clear`]) and returns
     /// its index, or `None` when full.
+    #[inline]
     pub fn push(
         &mut self,
         kind: RowKind,
@@ -184,7 +183,7 @@ impl Rows {
         }
         let r = self.n;
         self.n += 1;
-        self.kind.push(kind);
+        self.kind[r] = kind;
         self.b[r] = b;
         self.lambda[r] = warm;
         self.bpos[r] = 0.0;
