@@ -365,18 +365,29 @@ impl Recorder {
     /// A recorder for a run of `duration` seconds of `model`.
     pub fn new(model: &Model, duration: f64, with_contacts: bool) -> Self {
         let nmoving = model.nbodies.saturating_sub(1);
+        let sampler = FrameSampler::new(duration, nmoving * 40);
+        // the frames the sampler will keep (and the last), allocated here
+        // rather than grown while the simulation runs
+        let est = duration.max(0.0) / sampler.interval;
+        let frames = if est.is_finite() {
+            est.min(1e5) as usize + 3
+        } else {
+            2
+        };
+        let mut offsets = Vec::with_capacity(frames + 1);
+        offsets.push(0);
         Self {
-            sampler: FrameSampler::new(duration, nmoving * 40),
+            sampler,
             model: model.clone(),
             data: Data::new(model),
             nmoving,
             with_contacts,
-            times: Vec::new(),
-            positions: Vec::new(),
-            rotations: Vec::new(),
-            plot: Vec::new(),
-            arrows: Vec::new(),
-            offsets: vec![0],
+            times: Vec::with_capacity(frames),
+            positions: Vec::with_capacity(frames * 3 * nmoving),
+            rotations: Vec::with_capacity(frames * 4 * nmoving),
+            plot: Vec::with_capacity(frames),
+            arrows: Vec::with_capacity(if with_contacts { frames * 4 } else { 0 }),
+            offsets,
         }
     }
 
