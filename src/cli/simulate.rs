@@ -344,8 +344,8 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         .map(|_| crate::cli::view::Recorder::new(&sim.model, duration, true));
     let mut loop_body = |w: Option<&mut (dyn Write + Send)>| -> Result<Summary, SimulateError> {
         let mut max_pen = sim.penetration();
-        let mut start = Instant::now();
-        std::thread::scope(|scope| {
+        // the clock starts inside the scope, once the writer is set up
+        let start = std::thread::scope(|scope| {
             let (to_writer, from_sim) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
             let (recycle, recycled) = std::sync::mpsc::channel::<Vec<f64>>();
             // set-up, not stepping: the writer thread is started and the blocks
@@ -363,7 +363,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                 scope.spawn(|| write_rows(w, &header, (nq, nv), from_sim, recycle))
             });
             let mut block: Vec<f64> = touched();
-            start = Instant::now();
+            let start = Instant::now();
             let push_row = |sim: &mut Simulation,
                             block: &mut Vec<f64>,
                             recorder: &mut Option<crate::cli::view::Recorder>,
@@ -444,7 +444,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                 None => Ok(()),
             };
             sim_result?;
-            written
+            written.map(|()| start)
         })?;
         if let Some(pb) = &progress {
             pb.finish_and_clear();

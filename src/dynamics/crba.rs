@@ -272,12 +272,13 @@ fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     crba_local_pass::<T, false>(model, data, q.as_slice());
 }
 
-/// [`crba_upper`] (sizes checked by the caller) at the q whose joint placements
+/// [`crba`] (sizes checked by the caller) at the q whose joint placements
 /// `data.li_m_i` already hold (forward kinematics ran at it): the local-frame
-/// pass reads them instead of recomputing each joint's transform. Returns
+/// pass reads them instead of recomputing each joint's transform, and writes
+/// both triangles of H, so it serves [`crba_upper`]'s callers too. Returns
 /// false, computing nothing, where that variant does not run (mimic joints,
-/// long chains): the caller then calls [`crba_upper`].
-pub(crate) fn crba_upper_at_placements<T: Scalar>(model: &Model<T>, data: &mut Data<T>) -> bool {
+/// long chains): the caller then calls [`crba`] or [`crba_upper`].
+pub(crate) fn crba_at_placements<T: Scalar>(model: &Model<T>, data: &mut Data<T>) -> bool {
     if model.has_mimic || !model.topology.crba_local {
         return false;
     }

@@ -118,6 +118,76 @@ fn cholesky_n<const N: usize>(h: &[f64], l: &mut [f64], n: usize) -> Result<(), 
     Ok(())
 }
 
+/// `A = L D Lᵀ` in place for the symmetric positive semi-definite m × m `a`
+/// (row-major, lower triangle read): L, unit lower, below the diagonal, D on
+/// it. A pivot left with no more than `drop` of its diagonal marks a row
+/// dependent on earlier ones: its D is set to 0 and its column of L to 0, so
+/// that [`ldlt_dropping_solve`] gives it x = 0 (a consistent system stays
+/// solved on the others). Does nothing when `a` is shorter than m².
+pub fn ldlt_dropping(a: &mut [f64], m: usize, drop: f64) {
+    if a.len() < m * m {
+        return;
+    }
+    for j in 0..m {
+        let diag = a[j * m + j];
+        let mut dj = diag;
+        for k in 0..j {
+            let dk = a[k * m + k];
+            if dk != 0.0 {
+                let l = a[j * m + k];
+                dj -= l * l * dk;
+            }
+        }
+        let dj = if dj > drop * diag && dj > 0.0 {
+            dj
+        } else {
+            0.0
+        };
+        a[j * m + j] = dj;
+        for i in j + 1..m {
+            let mut s = a[i * m + j];
+            for k in 0..j {
+                let dk = a[k * m + k];
+                if dk != 0.0 {
+                    s -= a[i * m + k] * a[j * m + k] * dk;
+                }
+            }
+            a[i * m + j] = if dj != 0.0 { s / dj } else { 0.0 };
+        }
+    }
+}
+
+/// Solves `L D Lᵀ x = b` in place with the factor of [`ldlt_dropping`]; a
+/// dropped row (D = 0) gets x = 0. Does nothing when the lengths do not fit.
+pub fn ldlt_dropping_solve(a: &[f64], m: usize, x: &mut [f64]) {
+    if a.len() < m * m || x.len() < m {
+        return;
+    }
+    // L z = b, z /= D, Lᵀ x = z
+    for i in 0..m {
+        let mut s = x[i];
+        for k in 0..i {
+            s -= a[i * m + k] * x[k];
+        }
+        x[i] = s;
+    }
+    for i in 0..m {
+        let d = a[i * m + i];
+        x[i] = if d != 0.0 { x[i] / d } else { 0.0 };
+    }
+    for i in (0..m).rev() {
+        if a[i * m + i] == 0.0 {
+            x[i] = 0.0;
+            continue;
+        }
+        let mut s = x[i];
+        for k in i + 1..m {
+            s -= a[k * m + i] * x[k];
+        }
+        x[i] = s;
+    }
+}
+
 /// Solves `L Lᵀ x = b` in place, `L` in the lower triangle of the column-major
 /// `l` (n × n, from [`cholesky_fast`]), column-oriented so that both passes read
 /// contiguous columns. Does nothing when the lengths do not fit.

@@ -23,7 +23,7 @@ pub use crate::spatial::CompositeInertia;
 pub use aba::aba;
 pub use centroidal::centroidal_momentum;
 pub use com::{center_of_mass, center_of_mass_jacobian, center_of_mass_velocity};
-pub(crate) use crba::crba_upper_at_placements;
+pub(crate) use crba::crba_at_placements;
 pub use crba::{crba, crba_upper};
 pub use external::add_link_wrench;
 pub use frames::{forward_kinematics_second_order, frame_classical_acceleration, frame_velocity};

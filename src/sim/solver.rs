@@ -20,6 +20,7 @@
 //! moves q but never enters v.
 
 use super::factor::MassFactor;
+use crate::dynamics::linalg::{ldlt_dropping, ldlt_dropping_solve};
 
 /// What a row is.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,10 +63,9 @@ pub struct Rows {
     pub y: Vec<f64>,
     /// Delassus diagonal Wᵣᵣ = ‖yᵣ‖² (the row's velocity per unit impulse).
     pub w: Vec<f64>,
-    /// 1 / Wᵣᵣ, and 0 where Wᵣᵣ ≤ 1e-14 (a row no impulse can move).
+    /// 1 / Wᵣᵣ, and 0 where Wᵣᵣ ≤ 1e-14 (a row no impulse can move: its
+    /// impulse stays 0).
     winv: Vec<f64>,
-    /// 1 where Wᵣᵣ > 1e-14, else 0 (such a row's impulse stays 0).
-    live: Vec<f64>,
     /// J v* (free velocity).
     pub c: Vec<f64>,
     /// Target (b) of each row.
@@ -134,7 +134,6 @@ impl Rows {
             y: vec![0.0; cap * nv],
             w: vec![0.0; cap],
             winv: vec![0.0; cap],
-            live: vec![0.0; cap],
             c: vec![0.0; cap],
             b: vec![0.0; cap],
             lambda: vec![0.0; cap],
@@ -252,15 +251,8 @@ impl Rows {
             }
             r += k;
         }
-        for (w, (wi, l)) in self.w[..n]
-            .iter()
-            .zip(self.winv.iter_mut().zip(self.live.iter_mut()))
-        {
-            (*wi, *l) = if *w > 1e-14 {
-                (1.0 / w, 1.0)
-            } else {
-                (0.0, 0.0)
-            };
+        for (w, wi) in self.w[..n].iter().zip(self.winv.iter_mut()) {
+            *wi = if *w > 1e-14 { 1.0 / w } else { 0.0 };
         }
     }
 
@@ -315,7 +307,9 @@ impl Rows {
         let (kinds, w, c, b) = (&self.kind[..n], &self.w[..n], &self.c[..n], &self.b[..n]);
         let contact = &self.is_block[..n];
         let w_block = &self.w_block[..n];
-        let (winv, live) = (&self.winv[..n], &self.live[..n]);
+        let winv = &self.winv[..n];
+        // a row no impulse can move keeps 0
+        let live = |r: usize| if winv[r] != 0.0 { 1.0 } else { 0.0 };
         let u_prev = &mut self.u_prev[..n];
         // a row's convergence measure: its own residual |Δλ|·Wᵣᵣ, or, when
         // smaller, how much its velocity moved since the last sweep (redundant
@@ -397,7 +391,7 @@ impl Rows {
                     let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
                     let on = lambda[r];
                     let un = c[r] + dn;
-                    let nn = (on - relax * (un - b[r]) * winv[r]).max(0.0) * live[r];
+                    let nn = (on - relax * (un - b[r]) * winv[r]).max(0.0) * live(r);
                     let dln = nn - on;
                     lambda[r] = nn;
                     let mu = match kinds[r + 1] {
@@ -407,8 +401,8 @@ impl Rows {
                     let (o1, o2) = (lambda[r + 1], lambda[r + 2]);
                     let u1 = c[r + 1] + d1 + dln * wn1;
                     let u2 = c[r + 2] + d2 + dln * wn2;
-                    let mut t1 = (o1 - u1 * winv[r + 1]) * live[r + 1];
-                    let mut t2 = (o2 - u2 * winv[r + 2]) * live[r + 2];
+                    let mut t1 = (o1 - u1 * winv[r + 1]) * live(r + 1);
+                    let mut t2 = (o2 - u2 * winv[r + 2]) * live(r + 2);
                     let lim = mu * nn;
                     let m2 = t1 * t1 + t2 * t2;
                     if m2 > lim * lim {
@@ -478,7 +472,7 @@ impl Rows {
                 let old = lambda[r];
                 let p = path(r);
                 let mut u = 0.0;
-                let new = if live[r] != 0.0 {
+                let new = if winv[r] != 0.0 {
                     u = c[r] + rdot(y, r, nv, p, dv);
                     let x = old - relax * (u - b[r]) * winv[r];
                     match kind {
@@ -513,7 +507,7 @@ impl Rows {
                     table,
                     kinds,
                     contact,
-                    w,
+                    winv,
                     c,
                     b,
                 };
@@ -540,7 +534,8 @@ struct Solved<'a> {
     table: &'a [usize],
     kinds: &'a [RowKind],
     contact: &'a [bool],
-    w: &'a [f64],
+    /// 1 / Wᵣᵣ (0: a row no impulse can move).
+    winv: &'a [f64],
     c: &'a [f64],
     b: &'a [f64],
 }
@@ -567,7 +562,7 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
         table,
         kinds,
         contact,
-        w,
+        winv,
         c,
         b,
     } = *rows;
@@ -581,7 +576,7 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
     sm.rows.clear();
     let mut r = 0;
     while r < n {
-        let live = |q: usize| w[q] > 1e-14;
+        let live = |q: usize| winv[q] != 0.0;
         if contact[r] {
             let mu = match kinds[r + 1] {
                 RowKind::Tangent { mu, .. } => mu,
@@ -654,59 +649,11 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
             sm.w[a * m + bb] = s;
         }
     }
-    // LDLᵀ in place (L unit lower below the diagonal, D on it); a pivot that
-    // lost all but 1e-10 of its diagonal is a dependent row: dropped (δ = 0)
-    for j in 0..m {
-        let diag = sm.w[j * m + j];
-        let mut dj = diag;
-        for k in 0..j {
-            let dk = sm.w[k * m + k];
-            if dk != 0.0 {
-                let l = sm.w[j * m + k];
-                dj -= l * l * dk;
-            }
-        }
-        let dj = if dj > 1e-10 * diag && dj > 0.0 {
-            dj
-        } else {
-            0.0
-        };
-        sm.w[j * m + j] = dj;
-        for i in j + 1..m {
-            let mut s = sm.w[i * m + j];
-            for k in 0..j {
-                let dk = sm.w[k * m + k];
-                if dk != 0.0 {
-                    s -= sm.w[i * m + k] * sm.w[j * m + k] * dk;
-                }
-            }
-            sm.w[i * m + j] = if dj != 0.0 { s / dj } else { 0.0 };
-        }
-    }
-    // δ: L z = rhs, z /= D, Lᵀ δ = z (dropped rows: δ = 0)
-    for i in 0..m {
-        let mut s = sm.rhs[i];
-        for k in 0..i {
-            s -= sm.w[i * m + k] * sm.rhs[k];
-        }
-        sm.rhs[i] = s;
-    }
-    for i in 0..m {
-        let d = sm.w[i * m + i];
-        sm.rhs[i] = if d != 0.0 { sm.rhs[i] / d } else { 0.0 };
-    }
-    for i in (0..m).rev() {
-        if sm.w[i * m + i] == 0.0 {
-            sm.rhs[i] = 0.0;
-            continue;
-        }
-        let mut s = sm.rhs[i];
-        for k in i + 1..m {
-            s -= sm.w[k * m + i] * sm.rhs[k];
-        }
-        sm.rhs[i] = s;
-    }
-    // the new impulses, feasible or not taken
+    // W_FF = L D Lᵀ; a pivot that lost all but 1e-10 of its diagonal is a
+    // row dependent on earlier ones (redundant contacts): dropped (δ = 0)
+    ldlt_dropping(&mut sm.w[..m * m], m, 1e-10);
+    ldlt_dropping_solve(&sm.w[..m * m], m, &mut sm.rhs[..m]);
+    // the new impulses (none taken if one is not finite)
     for (a, &r) in sm.rows.iter().enumerate() {
         let x = lambda[r] + sm.rhs[a];
         if !x.is_finite() {

@@ -87,17 +87,18 @@ impl Simulation {
     /// (`data.h` is left holding H̃; its upper triangle only on a tree, all the
     /// tree-sparse factorisation reads).
     fn factor_mass(&mut self, c: f64) -> Result<(), SimError> {
-        if self.mass.f.is_tree() {
-            // the joint placements of the last forward kinematics at this q are
-            // reused where the local-frame CRBA runs
-            let placed = self.fk_valid
-                && self.q.len() == self.model.nq
-                && crate::dynamics::crba_upper_at_placements(&self.model, &mut self.data);
-            if !placed {
+        // the joint placements of the last forward kinematics at this q are
+        // reused where the local-frame CRBA runs (it fills all of H, what
+        // either factor reads)
+        let placed = self.fk_valid
+            && self.q.len() == self.model.nq
+            && crate::dynamics::crba_at_placements(&self.model, &mut self.data);
+        if !placed {
+            if self.mass.f.is_tree() {
                 crba_upper(&self.model, &mut self.data, &self.q)?;
+            } else {
+                mass_matrix(&self.model, &mut self.data, &self.q)?;
             }
-        } else {
-            mass_matrix(&self.model, &mut self.data, &self.q)?;
         }
         for k in 0..self.model.nv {
             self.data.h[(k, k)] += self.armature[k] + c * self.damping[k];
