@@ -127,7 +127,8 @@ pub(crate) fn lower(
         0
     };
 
-    // Depth-first, children in file order, iteratively (deep chains must not
+    // Depth-first, children in byte-wise order of their joints' names (Pinocchio's
+    // order, see `Checked::children`), iteratively (deep chains must not
     // overflow). A movable joint's body is numbered when its child link is visited,
     // so bodies come in depth-first pre-order: parent < child, subtrees contiguous.
     enum Via {

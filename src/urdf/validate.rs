@@ -11,7 +11,9 @@ use urdf_rs::JointType;
 pub(crate) struct Checked {
     /// The root link (index into `robot.links`): the one link no joint has as child.
     pub root: usize,
-    /// Child joints of each link, in file order.
+    /// Child joints of each link, in byte-wise order of the joints' names: urdfdom
+    /// keeps joints in a `std::map`, so `pin.buildModelFromUrdf` visits a link's
+    /// children in that order, and so does the engine (docs/theory.md §"Degrees of freedom order").
     pub children: Vec<Vec<usize>>,
     /// For each joint: Some((ultimate leader joint, multiplier, offset)) if it mimics.
     pub mimic: Vec<Option<(usize, f64, f64)>>,
@@ -380,6 +382,10 @@ pub(crate) fn validate(parsed: &Parsed, file: &str) -> Result<Checked, UrdfError
             ));
         }
         mimic[ji] = Some((leader, mult, off));
+    }
+    // Pinocchio's order: a link's children by their joints' names, byte-wise.
+    for c in &mut children {
+        c.sort_by(|&a, &b| robot.joints[a].name.as_bytes().cmp(robot.joints[b].name.as_bytes()));
     }
     Ok(Checked {
         root,
