@@ -55,6 +55,8 @@ def main():
     ap.add_argument("--tol", type=float, default=1e-10)
     ap.add_argument("fixtures", nargs="*")
     args = ap.parse_args()
+    if not Path(args.urdyn).is_file():
+        sys.exit(f"check_eval.py: --urdyn {args.urdyn}: no such file (cargo build --release --bin urdyn)")
     st_name, ex_name = ("states.json", "expected.json") if args.v2 else ("deriv_states.json", "deriv_expected.json")
     dirs = [FIX / f for f in args.fixtures] if args.fixtures else sorted(
         d for d in FIX.iterdir() if (d / ex_name).is_file())
