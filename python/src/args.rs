@@ -2,13 +2,56 @@
 //! clear `ValueError` line naming the argument otherwise.
 
 use numpy::{AllowTypeChange, PyArrayLike1, PyArrayMethods, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
 use urdyn::nalgebra::DVector;
 
 /// A `ValueError` with this message.
 pub fn value_error(msg: impl Into<String>) -> PyErr {
     PyValueError::new_err(msg.into())
+}
+
+/// A `FileNotFoundError` with this message (a URDF, mesh or scene file that does
+/// not exist; the message names the path).
+pub fn not_found_error(msg: impl Into<String>) -> PyErr {
+    PyFileNotFoundError::new_err(msg.into())
+}
+
+/// The largest distance from unit norm a base quaternion may have: the CLI's
+/// tolerance for `base.orientation_xyzw` (src/cli/state.rs).
+pub const QUATERNION_TOLERANCE: f64 = 1e-3;
+
+/// Normalises `quat` (a floating base's `[qx, qy, qz, qw]`, entries 3..7 of
+/// `name`) in place, as the CLI does; a `ValueError` with the CLI's message
+/// ("not a unit quaternion (norm N)") unless its norm is within
+/// [`QUATERNION_TOLERANCE`] of 1.
+pub fn normalize_base_quaternion(quat: &mut [f64], name: &str) -> PyResult<()> {
+    // |q| = sqrt(qx² + qy² + qz² + qw²)
+    let n = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if (n - 1.0).abs() <= QUATERNION_TOLERANCE {
+        quat.iter_mut().for_each(|x| *x /= n);
+        Ok(())
+    } else {
+        Err(value_error(format!(
+            "{name}[3:7] (the base orientation qx, qy, qz, qw): not a unit quaternion (norm {n})"
+        )))
+    }
+}
+
+/// Reads a configuration: [`read_vec`] (length nq, finite), then, with a
+/// floating base, [`normalize_base_quaternion`] on its entries 3..7. Every q of
+/// the package comes through here.
+pub fn read_q(
+    x: &Bound<'_, PyAny>,
+    name: &str,
+    floating_base: bool,
+    out: &mut DVector<f64>,
+) -> PyResult<()> {
+    read_vec(x, name, "nq", out)?;
+    if floating_base {
+        normalize_base_quaternion(&mut out.as_mut_slice()[3..7], name)?;
+    }
+    Ok(())
 }
 
 /// Copies the 1-D array-like `x` into `out` (length `n`, the model's `what`):

@@ -54,7 +54,7 @@ fn dyn_error(model: &PyModel, e: DynamicsError) -> PyErr {
 
 /// q (and v, a) into the workspace's vectors, checked.
 fn read_q(d: &mut PyData, q: &Bound<'_, PyAny>) -> PyResult<()> {
-    read_vec(q, "q", "nq", &mut d.q)
+    d.read_q(q)
 }
 
 /// The optional `fext` dict as per-body forces in `d.fext` (kinematics at `d.q`

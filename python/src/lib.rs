@@ -28,6 +28,8 @@ fn _urdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<sim::PySimulation>()?;
     m.add("SimulationError", m.py().get_type::<SimulationError>())?;
     m.add_function(wrap_pyfunction!(model::_model_from_state, m)?)?;
+    m.add_function(wrap_pyfunction!(model::to_pinocchio_q, m)?)?;
+    m.add_function(wrap_pyfunction!(model::from_pinocchio_q, m)?)?;
     dynamics::register(m)?;
     m.add_function(wrap_pyfunction!(sim::rollout, m)?)?;
     m.add_function(wrap_pyfunction!(sim::integrators, m)?)?;

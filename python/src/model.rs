@@ -1,7 +1,9 @@
 //! `urdyn.Model` (the immutable model, its names, pickling) and `urdyn.Data`
 //! (the preallocated workspace).
 
-use crate::args::{read3, value_error};
+use crate::args::{
+    normalize_base_quaternion, not_found_error, read3, read_q, read_vec, value_error,
+};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -110,6 +112,14 @@ impl PyModel {
         floating_base: bool,
         package_dirs: Option<Vec<PathBuf>>,
     ) -> PyResult<Self> {
+        // a file that does not exist: FileNotFoundError, with the CLI's line
+        if let Err(e) = std::fs::metadata(&path) {
+            let msg = format!("{}: cannot read file: {e}", path.display());
+            return Err(match e.kind() {
+                std::io::ErrorKind::NotFound => not_found_error(msg),
+                _ => value_error(msg),
+            });
+        }
         // the library's loader gives the CLI's messages for a bad file
         urdyn::load_file(&path, LoadOptions { floating_base })
             .map_err(|e| value_error(e.to_string()))?;
@@ -257,6 +267,8 @@ pub fn _model_from_state(
 #[pyclass(name = "Data", module = "urdyn")]
 pub struct PyData {
     pub data: urdyn::Data,
+    /// Whether the model has a floating base (q[3..7] a unit quaternion).
+    pub floating_base: bool,
     pub nq: usize,
     pub nv: usize,
     pub nbodies: usize,
@@ -270,6 +282,7 @@ impl PyData {
     pub fn new(model: &Model) -> Self {
         Self {
             data: urdyn::Data::new(model),
+            floating_base: model.floating_base,
             nq: model.nq,
             nv: model.nv,
             nbodies: model.nbodies,
@@ -278,6 +291,11 @@ impl PyData {
             a: DVector::zeros(model.nv),
             fext: vec![Force::zero(); model.nbodies],
         }
+    }
+    /// Reads the configuration `x` into `self.q` ([`read_q`]: length nq,
+    /// finite, a floating base's quaternion of unit norm within 1e-3).
+    pub fn read_q(&mut self, x: &Bound<'_, PyAny>) -> PyResult<()> {
+        read_q(x, "q", self.floating_base, &mut self.q)
     }
     /// A `ValueError` unless this workspace was made for a model of `model`'s shape.
     pub fn check(&self, model: &Model) -> PyResult<()> {
@@ -289,4 +307,89 @@ impl PyData {
         }
         Ok(())
     }
+}
+
+/// Where each degree of freedom's coordinate sits in Pinocchio's q: the base's 7
+/// coordinates (the same `[x, y, z, qx, qy, qz, qw]` in both), then per degree of
+/// freedom one coordinate, or two (cos θ, sin θ) for a continuous joint. Returns
+/// (the base's length, Pinocchio's nq).
+fn pinocchio_layout(model: &Model) -> (usize, usize) {
+    let base = model.nq - model.dofs.len();
+    let nq_pin = base
+        + model
+            .dofs
+            .iter()
+            .map(|d| if d.continuous { 2 } else { 1 })
+            .sum::<usize>();
+    (base, nq_pin)
+}
+
+/// Pinocchio's q of urdyn's `q`: each continuous joint's angle θ becomes the pair
+/// (cos θ, sin θ) (Pinocchio's `JointModelRUB`); every other coordinate, the
+/// floating base's included, is copied. The degrees of freedom are in the same
+/// order in both (`model.dof_names`).
+#[pyfunction]
+pub fn to_pinocchio_q<'py>(
+    py: Python<'py>,
+    model: PyRef<'py, PyModel>,
+    q: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let m = &model.model;
+    let mut qv = DVector::zeros(m.nq);
+    read_q(q, "q", m.floating_base, &mut qv)?;
+    let (base, nq_pin) = pinocchio_layout(m);
+    let mut out = Vec::with_capacity(nq_pin);
+    out.extend_from_slice(&qv.as_slice()[..base]);
+    for (d, &x) in m.dofs.iter().zip(&qv.as_slice()[base..]) {
+        if d.continuous {
+            // (cos θ, sin θ)
+            out.extend_from_slice(&[x.cos(), x.sin()]);
+        } else {
+            out.push(x);
+        }
+    }
+    Ok(PyArray1::from_vec(py, out))
+}
+
+/// urdyn's q of Pinocchio's `q_pin` (of length `nq` of the Pinocchio model of the
+/// same URDF, `pin.buildModelFromUrdf(path, mimic=True)`, where a mimic joint has
+/// no coordinate of its own, as here): each continuous joint's pair (cos θ,
+/// sin θ) becomes θ = atan2(sin θ, cos θ) in (−π, π]; every other coordinate is
+/// copied. A pair (0, 0), a wrong length, a non-finite entry or a base
+/// quaternion off unit norm is a `ValueError`.
+#[pyfunction]
+pub fn from_pinocchio_q<'py>(
+    py: Python<'py>,
+    model: PyRef<'py, PyModel>,
+    q_pin: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let m = &model.model;
+    let (base, nq_pin) = pinocchio_layout(m);
+    let mut qp = DVector::zeros(nq_pin);
+    read_vec(q_pin, "q_pin", "Pinocchio's nq", &mut qp)?;
+    if m.floating_base {
+        normalize_base_quaternion(&mut qp.as_mut_slice()[3..7], "q_pin")?;
+    }
+    let mut out = Vec::with_capacity(m.nq);
+    out.extend_from_slice(&qp.as_slice()[..base]);
+    let mut k = base;
+    for d in &m.dofs {
+        if d.continuous {
+            let (c, s) = (qp[k], qp[k + 1]);
+            if c == 0.0 && s == 0.0 {
+                return Err(value_error(format!(
+                    "q_pin[{k}:{}]: the (cos, sin) pair of continuous joint \"{}\" is (0, 0)",
+                    k + 2,
+                    d.name
+                )));
+            }
+            // θ = atan2(sin θ, cos θ)
+            out.push(s.atan2(c));
+            k += 2;
+        } else {
+            out.push(qp[k]);
+            k += 1;
+        }
+    }
+    Ok(PyArray1::from_vec(py, out))
 }

@@ -3,7 +3,9 @@
 //! [`prototype`] and [`advance`], so that a rollout's states equal, bit for bit,
 //! a `Simulation` stepped alone.
 
-use crate::args::{read_array, read_vec, value_error};
+use crate::args::{
+    normalize_base_quaternion, not_found_error, read_array, read_q, read_vec, value_error,
+};
 use crate::model::PyModel;
 use crate::SimulationError;
 use numpy::{PyArray1, PyArray3, PyArrayMethods};
@@ -11,6 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use std::path::PathBuf;
+use urdyn::contact::ContactError;
 use urdyn::nalgebra::DVector;
 use urdyn::sim::{Integrator, SimError, SimOptions, Simulation};
 
@@ -64,8 +67,14 @@ fn prototype(
         ..SimOptions::default()
     };
     opts.contact.friction = friction;
-    Simulation::new(model.model.clone(), opts)
-        .map_err(|e| value_error(format!("{}: {e}", model.file)))
+    Simulation::new(model.model.clone(), opts).map_err(|e| match e {
+        // the library's message is neutral; the hint is Python's (the CLI names its flags)
+        SimError::Contact(ContactError::MissingMesh { .. }) => not_found_error(format!(
+            "{}: {e} (give its package root with package_dirs=[...] or ROS_PACKAGE_PATH, or pass ground=None for no contact)",
+            model.file
+        )),
+        e => value_error(format!("{}: {e}", model.file)),
+    })
 }
 
 /// One step of `dt` of simulated time (an adaptive integrator may take several
@@ -143,7 +152,7 @@ impl PySimulation {
     fn set_state(&mut self, q: &Bound<'_, PyAny>, v: &Bound<'_, PyAny>) -> PyResult<()> {
         let m = &self.sim.model;
         let (mut qv, mut vv) = (DVector::zeros(m.nq), DVector::zeros(m.nv));
-        read_vec(q, "q", "nq", &mut qv)?;
+        read_q(q, "q", m.floating_base, &mut qv)?;
         read_vec(v, "v", "nv", &mut vv)?;
         self.sim
             .set_state(&qv, &vv)
@@ -250,6 +259,12 @@ pub fn rollout<'py>(
         )));
     }
     let b = qs[0];
+    let mut q0 = q0;
+    if model.model.floating_base {
+        for i in 0..b {
+            normalize_base_quaternion(&mut q0[i * nq + 3..i * nq + 7], &format!("q0[{i}]"))?;
+        }
+    }
     if vs != [b, nv] {
         return Err(value_error(format!(
             "v0 has shape {vs:?}, expected ({b}, {nv}) (B, nv)"

@@ -297,7 +297,7 @@ def test_bad_inputs_are_value_errors():
         (lambda: urdyn.frame_jacobian(model, data, q, "wrist_3_lnk"), "nearest: \"wrist_3_link\""),
         (lambda: urdyn.frame_jacobian(model, data, q, "wrist_3_link", reference="global"), "reference"),
         (lambda: urdyn.crba(model, urdyn.Model.from_urdf(LAMP).create_data(), q), "another model"),
-        (lambda: urdyn.Model.from_urdf(ROOT / "no_such.urdf"), "no_such.urdf"),
+        # (a URDF that does not exist: FileNotFoundError, test_newcomer.py)
         (lambda: urdyn.Model.from_urdf_string("<robot name='x'><link name='a'></robot>"), "<string>"),
         (lambda: urdyn.Simulation(model, dt=-1.0), "dt"),
         (lambda: urdyn.Simulation(model, integrator="leapfrog"), "integrator"),

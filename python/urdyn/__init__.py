@@ -8,10 +8,14 @@ Pinocchio's names where it has one::
     q = model.neutral(); v = np.zeros(model.nv); a = np.zeros(model.nv)
     tau = urdyn.rnea(model, data, q, v, a)
 
-Every vector is a 1-D float64 array in the engine's order (a floating base first:
-position, quaternion xyzw; velocities in the body frame). A wrong length, a
-non-finite number or an unknown name raises ValueError with the CLI's one-line
-message; a diverging simulation raises urdyn.SimulationError.
+Every vector is a 1-D float64 array in the engine's order, which is Pinocchio's (a
+floating base first: position, quaternion xyzw; velocities in the body frame; then
+the joints as pin.buildModelFromUrdf orders them). A continuous joint is one angle
+here and (cos, sin) in Pinocchio's q: from_pinocchio_q / to_pinocchio_q convert. A
+wrong length, a non-finite number, a base quaternion off unit norm (by more than
+1e-3) or an unknown name raises ValueError with the CLI's one-line message; a file
+that does not exist raises FileNotFoundError; a diverging simulation raises
+urdyn.SimulationError.
 """
 
 from ._urdyn import (  # noqa: F401
@@ -29,12 +33,14 @@ from ._urdyn import (  # noqa: F401
     frame_jacobian,
     frame_placement,
     frame_velocity,
+    from_pinocchio_q,
     integrators,
     kinetic_energy,
     nonlinear_effects,
     potential_energy,
     rnea,
     rollout,
+    to_pinocchio_q,
 )
 
 __all__ = [
@@ -52,10 +58,12 @@ __all__ = [
     "frame_jacobian",
     "frame_placement",
     "frame_velocity",
+    "from_pinocchio_q",
     "integrators",
     "kinetic_energy",
     "nonlinear_effects",
     "potential_energy",
     "rnea",
     "rollout",
+    "to_pinocchio_q",
 ]

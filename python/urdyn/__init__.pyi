@@ -99,6 +99,16 @@ class Simulation:
     def energy(self) -> float: ...
     def contact_forces(self) -> List[Dict[str, Any]]: ...
 
+def to_pinocchio_q(model: Model, q: ArrayLike) -> Vec:
+    """Pinocchio's q of urdyn's q: each continuous joint's angle as (cos, sin),
+    everything else (the floating base's [x, y, z, qx, qy, qz, qw] included) as is."""
+    ...
+
+def from_pinocchio_q(model: Model, q_pin: ArrayLike) -> Vec:
+    """urdyn's q of Pinocchio's (pin.buildModelFromUrdf(path, mimic=True)): each
+    continuous joint's (cos, sin) as atan2(sin, cos), everything else as is."""
+    ...
+
 def rollout(
     model: Model,
     q0: ArrayLike,

@@ -106,7 +106,9 @@ impl Default for ContactParams {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ContactError {
     /// A collision mesh file that no package root or path resolves to.
-    #[error("link \"{link}\": collision mesh \"{file}\" not found (give its package root with --package-path or ROS_PACKAGE_PATH, or run with --no-ground)")]
+    /// (The message names no flag: the CLI and the Python package each add how
+    /// to give a package root or turn contact off.)
+    #[error("link \"{link}\": collision mesh \"{file}\" not found")]
     MissingMesh {
         /// The URDF link whose `<collision>` names the mesh.
         link: String,
