@@ -1041,6 +1041,32 @@ mod tests {
     }
 
     #[test]
+    fn triangle_limit_fills_the_budget_from_below() {
+        // Under the budget: the per-mesh cap.
+        assert_eq!(triangle_limit(&[10, 20, 30], 100, 1000), 100);
+        // 10 and 20 kept whole; the other two share 120 - 30 = 90: L = 45,
+        // and Σ min(n, 45) = 10 + 20 + 45 + 45 = 120.
+        assert_eq!(triangle_limit(&[500, 10, 20, 80], 1000, 120), 45);
+        // The cap first: 60 000 counts as 20 000.
+        assert_eq!(triangle_limit(&[60_000, 100], 20_000, 20_100), 20_000);
+        // A tiny budget still leaves a box's worth.
+        assert_eq!(triangle_limit(&[1000, 1000], 1000, 4), 12);
+        // Brute force: the largest L with Σ min(nᵢ, L) ≤ total.
+        let counts = [3, 900, 77, 4000, 1200, 50];
+        for total in [100, 1000, 3000, 6000] {
+            let best = (0..=4000)
+                .filter(|&l| counts.iter().map(|&n: &usize| n.min(l)).sum::<usize>() <= total)
+                .max()
+                .unwrap();
+            assert_eq!(
+                triangle_limit(&counts, 4000, total),
+                best.max(12),
+                "{total}"
+            );
+        }
+    }
+
+    #[test]
     fn simplify_stays_under_the_limit_and_on_the_shape() {
         let m = sphere(200);
         assert!(m.triangles.len() > 70_000);
