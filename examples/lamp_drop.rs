@@ -75,10 +75,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let area = BitMapBackend::new(&png, (1000, 900)).into_drawing_area();
     area.fill(&WHITE)?;
     let panels = area.split_evenly((3, 1));
-    let series: [(&str, &str, &Vec<f64>, RGBColor); 3] = [
-        ("base height", "z (m)", &z, BLUE),
-        ("energy (kinetic + potential)", "E (J)", &e, RED),
-        ("active contact points", "count", &c, BLACK),
+    // base height and energy: real-valued axes; the contact count: integer ticks
+    let series: [(&str, &str, &Vec<f64>, RGBColor); 2] = [
+        ("base height", "base height z (m)", &z, BLUE),
+        ("energy (kinetic + potential)", "energy E (J)", &e, RED),
     ];
     for (panel, (title, ylabel, ys, color)) in panels.iter().zip(series.iter()) {
         let (lo, hi) = ys
@@ -90,19 +90,48 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut chart = ChartBuilder::on(panel)
             .caption(*title, ("sans-serif", 20))
             .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(60)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
             .build_cartesian_2d(0.0..3.0, (lo - pad)..(hi + pad))?;
         chart
             .configure_mesh()
-            .x_desc("t (s)")
+            .x_desc("time t (s)")
             .y_desc(*ylabel)
+            .axis_desc_style(("sans-serif", 16))
+            .label_style(("sans-serif", 13))
             .draw()?;
         chart.draw_series(LineSeries::new(
             t.iter().copied().zip(ys.iter().copied()),
             color,
         ))?;
     }
+    let cmax = c.iter().copied().fold(0.0, f64::max).max(1.0).ceil();
+    let mut chart = ChartBuilder::on(&panels[2])
+        .caption("active contact points", ("sans-serif", 20))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..3.0, -0.3..cmax + 0.3)?;
+    chart
+        .configure_mesh()
+        .x_desc("time t (s)")
+        .y_desc("contacts (count)")
+        .axis_desc_style(("sans-serif", 16))
+        .label_style(("sans-serif", 13))
+        // at most cmax + 1 labels: a step of at least 1, and only integers shown
+        .y_labels((cmax as usize + 1).min(6))
+        .y_label_formatter(&|y| {
+            if (y - y.round()).abs() < 1e-9 {
+                format!("{y:.0}")
+            } else {
+                String::new()
+            }
+        })
+        .draw()?;
+    chart.draw_series(LineSeries::new(
+        t.iter().copied().zip(c.iter().copied()),
+        BLACK,
+    ))?;
     area.present()?;
     println!(
         "wrote {}, {} and {}",

@@ -483,7 +483,12 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         None => loop_body(None),
     }?;
     if let (Some(path), Some(geometry), Some(recorder)) = (&args.html, &geometry, &recorder) {
-        crate::cli::view::write_page(path, &sim.model, geometry, recorder, ground)?;
+        let page = crate::cli::view::write_page(path, &sim.model, geometry, recorder, ground)?;
+        warn(&format!(
+            "urdyn simulate: wrote the replay page {} ({})",
+            path.display(),
+            page.to_string().trim_start_matches("view: ")
+        ));
     }
     Ok(summary)
 }

@@ -22,8 +22,15 @@
 //!   `<lookat>` above a placed geometry is an error; `<instance_controller>`
 //!   (skinned meshes) places nothing. A document whose scene places no geometry
 //!   (or that has no scene) gives every POSITION array, untransformed.
+//!
+//!   For drawing, [`load_mesh_colored`] also gives each DAE triangle the diffuse
+//!   `<color>` of its material: the primitive's `material` symbol, bound by the
+//!   placing `<instance_geometry>`'s `<instance_material symbol target>` (else
+//!   taken as a material id), the material's `<instance_effect>`, the effect's
+//!   `<diffuse><color>` (none for a `<texture>`).
 
 use nalgebra::Vector3;
+use std::collections::HashMap;
 use std::path::Path;
 
 /// Why a mesh could not be read.
@@ -56,7 +63,7 @@ pub struct TriMesh {
 /// The vertex positions of a mesh file, in the file's units times `scale`.
 /// Non-finite coordinates are an error; an empty mesh is an error.
 pub fn load_vertices(path: &Path, scale: [f64; 3]) -> Result<Vec<Vector3<f64>>, MeshError> {
-    let (raw, _) = read_raw(path, false)?;
+    let (raw, _, _) = read_raw(path, false)?;
     scaled(path, raw, scale)
 }
 
@@ -66,7 +73,22 @@ pub fn load_vertices(path: &Path, scale: [f64; 3]) -> Result<Vec<Vector3<f64>>, 
 /// `<polygons>` (fan-triangulated), OBJ faces are triangulated; an index outside
 /// the vertices is an error, and so is a mesh without vertices.
 pub fn load_mesh(path: &Path, scale: [f64; 3]) -> Result<TriMesh, MeshError> {
-    let (raw, triangles) = read_raw(path, true)?;
+    load_mesh_colored(path, scale).map(|(m, _)| m)
+}
+
+/// A triangle's colour as its mesh file gives it: red, green, blue, alpha in 0..1.
+pub type Rgba = [f64; 4];
+
+/// [`load_mesh`] and each triangle's colour where the file gives one (a DAE
+/// material's diffuse colour, see the module doc; `None` for STL and OBJ, and for
+/// DAE triangles without a material colour). The colours are as many as the
+/// triangles.
+pub fn load_mesh_colored(
+    path: &Path,
+    scale: [f64; 3],
+) -> Result<(TriMesh, Vec<Option<Rgba>>), MeshError> {
+    let (raw, triangles, mut colors) = read_raw(path, true)?;
+    colors.resize(triangles.len(), None);
     let n = raw.len();
     if let Some(t) = triangles
         .iter()
@@ -77,10 +99,13 @@ pub fn load_mesh(path: &Path, scale: [f64; 3]) -> Result<TriMesh, MeshError> {
             format!("a triangle {t:?} indexes past the {n} vertices"),
         ));
     }
-    Ok(TriMesh {
-        vertices: scaled(path, raw, scale)?,
-        triangles,
-    })
+    Ok((
+        TriMesh {
+            vertices: scaled(path, raw, scale)?,
+            triangles,
+        },
+        colors,
+    ))
 }
 
 /// Scales raw positions, refusing an empty mesh and non-finite vertices.
@@ -103,16 +128,18 @@ fn scaled(
     Ok(out)
 }
 
-/// Raw positions of a mesh file and, when `with_triangles`, its triangles.
-fn read_raw(
-    path: &Path,
-    with_triangles: bool,
-) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), MeshError> {
+/// Raw positions, triangles and triangle colours.
+type RawMesh = (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<Option<Rgba>>);
+
+/// Raw positions of a mesh file and, when `with_triangles`, its triangles and
+/// their colours (DAE only; empty otherwise).
+fn read_raw(path: &Path, with_triangles: bool) -> Result<RawMesh, MeshError> {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     let mut triangles = Vec::new();
+    let mut colors = Vec::new();
     let raw: Vec<[f64; 3]> = match ext.as_str() {
         "stl" => {
             let mut f =
@@ -158,11 +185,12 @@ fn read_raw(
         "dae" => {
             let bytes = std::fs::read(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
             let text = String::from_utf8_lossy(&bytes);
-            let (p, t) = read_dae(&text).map_err(|m| err(path, m))?;
+            let dae = read_dae_colored(&text).map_err(|m| err(path, m))?;
             if with_triangles {
-                triangles = t;
+                triangles = dae.triangles;
+                colors = dae.colors;
             }
-            p
+            dae.positions
         }
         other => {
             return Err(err(
@@ -171,7 +199,7 @@ fn read_raw(
             ))
         }
     };
-    Ok((raw, triangles))
+    Ok((raw, triangles, colors))
 }
 
 /// A 4×4 affine transform acting on column vectors (COLLADA's convention).
@@ -193,6 +221,8 @@ struct DaeNode {
     unsupported: Option<&'static str>,
     /// `<instance_geometry url>`s.
     geometries: Vec<String>,
+    /// Per `<instance_geometry>`: its `<instance_material symbol>` → `target` id.
+    bindings: Vec<HashMap<String, String>>,
     /// `<instance_node url>`s.
     instances: Vec<String>,
     children: Vec<usize>,
@@ -211,6 +241,8 @@ enum DaeText {
     Transform(&'static str, usize),
     /// A `<vcount>` or `<p>` of the primitive being read.
     Indices(&'static str),
+    /// The `<diffuse><color>` of an `<effect id>`.
+    Color(String),
 }
 
 /// A `<triangles>`, `<polylist>` or `<polygons>` element of a geometry.
@@ -221,6 +253,8 @@ struct DaePrim {
     stride: usize,
     /// The offset and `source` (a `<vertices>` id) of the VERTEX input.
     vertex: Option<(usize, String)>,
+    /// The `material` symbol.
+    material: Option<String>,
     vcount: Vec<usize>,
     /// Every `<p>`, in order (`<polygons>` has one per polygon).
     ps: Vec<Vec<u32>>,
@@ -366,11 +400,25 @@ fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
     read_dae(text).map(|(p, _)| p)
 }
 
-/// Positions of a COLLADA document (see the module doc) and, when
-/// the triangles of the placed geometries' primitives.
+/// Positions of a COLLADA document (see the module doc) and the triangles of the
+/// placed geometries' primitives.
+#[cfg(test)]
 fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
+    read_dae_colored(text).map(|d| (d.positions, d.triangles))
+}
+
+/// What [`read_dae_colored`] reads.
+struct DaeMesh {
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    /// One a triangle.
+    colors: Vec<Option<Rgba>>,
+}
+
+/// Positions, triangles and triangle colours of a COLLADA document (see the
+/// module doc).
+fn read_dae_colored(text: &str) -> Result<DaeMesh, String> {
     use quick_xml::events::Event;
-    use std::collections::HashMap;
     let mut reader = quick_xml::Reader::from_str(text);
     let mut arrays: HashMap<String, Vec<f64>> = HashMap::new();
     // source id -> float_array id
@@ -400,12 +448,20 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
     let mut geometry_prims: HashMap<String, Vec<DaePrim>> = HashMap::new();
     let mut geometry_order: Vec<String> = Vec::new();
     let mut current_prim: Option<DaePrim> = None;
+    // The `<instance_geometry>` being read: (node, index among its geometries).
+    let mut current_instance: Option<(usize, usize)> = None;
+    // material id -> effect id; effect id -> diffuse colour
+    let mut material_effect: HashMap<String, String> = HashMap::new();
+    let mut effect_color: HashMap<String, Rgba> = HashMap::new();
+    let mut current_material: Option<String> = None;
+    let mut current_effect: Option<String> = None;
     let mut unit = 1.0;
     // Ends the text being collected, `collecting`, into its array or node.
     let finish = |collecting: DaeText,
                   buf: &str,
                   arrays: &mut HashMap<String, Vec<f64>>,
-                  nodes: &mut Vec<DaeNode>|
+                  nodes: &mut Vec<DaeNode>,
+                  colors: &mut HashMap<String, Rgba>|
      -> Result<(), String> {
         match collecting {
             DaeText::Array(id) => {
@@ -424,6 +480,18 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
             }
             // (read by the caller)
             DaeText::Indices(_) => {}
+            DaeText::Color(effect) => {
+                // r g b [a]; a colour that is not numbers is no colour
+                let v: Vec<f64> = buf
+                    .split_whitespace()
+                    .filter_map(|x| x.parse::<f64>().ok())
+                    .filter(|x| x.is_finite())
+                    .collect();
+                if let [r, g, b, rest @ ..] = v.as_slice() {
+                    let a = rest.first().copied().unwrap_or(1.0);
+                    colors.insert(effect, [*r, *g, *b, a].map(|x| x.clamp(0.0, 1.0)));
+                }
+            }
         }
         Ok(())
     };
@@ -480,6 +548,7 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
                                 b"polylist" => "polylist",
                                 _ => "polygons",
                             },
+                            material: attr(b"material"),
                             ..DaePrim::default()
                         });
                     }
@@ -561,6 +630,7 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
                             local: Mat4::identity(),
                             unsupported: None,
                             geometries: Vec::new(),
+                            bindings: Vec::new(),
                             instances: Vec::new(),
                             children: Vec::new(),
                         });
@@ -597,7 +667,7 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
                                 buf.clear();
                                 collecting = Some(collect);
                             } else {
-                                finish(collect, "", &mut arrays, &mut nodes)?;
+                                finish(collect, "", &mut arrays, &mut nodes, &mut effect_color)?;
                             }
                         }
                     }
@@ -626,9 +696,37 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
                             };
                             if geometry {
                                 node.geometries.push(url);
+                                node.bindings.push(HashMap::new());
+                                if is_start {
+                                    current_instance =
+                                        top_node.map(|n| (n, node.geometries.len() - 1));
+                                }
                             } else {
                                 node.instances.push(url);
                             }
+                        }
+                    }
+                    b"instance_material" => {
+                        if let (Some((n, g)), Some(symbol), Some(target)) =
+                            (current_instance, attr(b"symbol"), attr(b"target"))
+                        {
+                            if let Some(b) = nodes.get_mut(n).and_then(|n| n.bindings.get_mut(g)) {
+                                b.insert(symbol, target.trim_start_matches('#').to_string());
+                            }
+                        }
+                    }
+                    b"material" if is_start => current_material = attr(b"id"),
+                    b"instance_effect" => {
+                        if let (Some(m), Some(url)) = (&current_material, attr(b"url")) {
+                            material_effect
+                                .insert(m.clone(), url.trim_start_matches('#').to_string());
+                        }
+                    }
+                    b"effect" if is_start => current_effect = attr(b"id"),
+                    b"color" if is_start && parent == Some(b"diffuse".as_slice()) => {
+                        if let Some(e) = &current_effect {
+                            buf.clear();
+                            collecting = Some(DaeText::Color(e.clone()));
                         }
                     }
                     _ => {}
@@ -655,6 +753,7 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
                             }
                             Some(DaeText::Transform(kind, _)) => format!("<{kind}>"),
                             Some(DaeText::Indices(kind)) => format!("<{kind}>"),
+                            Some(DaeText::Color(_)) => "<color>".to_string(),
                             None => String::new(),
                         };
                         return Err(format!(
@@ -667,12 +766,15 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
             Event::End(ref e) => {
                 open.pop();
                 match e.local_name().as_ref() {
-                    b"float_array" | b"matrix" | b"translate" | b"rotate" | b"scale" => {
+                    b"float_array" | b"matrix" | b"translate" | b"rotate" | b"scale" | b"color" => {
                         if let Some(c) = collecting.take() {
-                            finish(c, &buf, &mut arrays, &mut nodes)?;
+                            finish(c, &buf, &mut arrays, &mut nodes, &mut effect_color)?;
                             buf.clear();
                         }
                     }
+                    b"instance_geometry" => current_instance = None,
+                    b"material" => current_material = None,
+                    b"effect" => current_effect = None,
                     b"vcount" | b"p" => {
                         if let (Some(DaeText::Indices(kind)), Some(prim)) =
                             (collecting.take(), current_prim.as_mut())
@@ -715,28 +817,41 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
             .and_then(|a| arrays.get(a))
             .ok_or_else(|| format!("POSITION source \"{}\" has no float_array", dae_snippet(s)))
     };
-    // The triangles of geometry `g` whose POSITION sources start at `bases`.
-    let emit_triangles =
-        |g: &str, bases: &HashMap<&str, u32>, tris: &mut Vec<[u32; 3]>| -> Result<(), String> {
-            for prim in geometry_prims.get(g).map(Vec::as_slice).unwrap_or_default() {
-                let Some((_, vref)) = &prim.vertex else {
-                    continue;
-                };
-                let src = vertices_source
-                    .get(vref)
-                    .map(String::as_str)
-                    .unwrap_or(vref);
-                let (Some(&base), Ok(arr)) = (bases.get(src), positions_of(src)) else {
-                    return Err(format!(
-                        "<{}>: the VERTEX input \"{}\" names no POSITION source of its geometry",
-                        prim.kind,
-                        dae_snippet(vref)
-                    ));
-                };
-                prim.triangles(arr.len() / 3, tris, base)?;
-            }
-            Ok(())
-        };
+    // The colour of a primitive's material symbol under an instance's bindings.
+    let color_of = |symbol: Option<&String>, bind: &HashMap<String, String>| -> Option<Rgba> {
+        let s = symbol?;
+        let material = bind.get(s).unwrap_or(s);
+        effect_color.get(material_effect.get(material)?).copied()
+    };
+    let no_bindings = HashMap::new();
+    let mut colors: Vec<Option<Rgba>> = Vec::new();
+    // The triangles of geometry `g` whose POSITION sources start at `bases`,
+    // and their colours under the material bindings `bind`.
+    let mut emit_triangles = |g: &str,
+                              bases: &HashMap<&str, u32>,
+                              bind: &HashMap<String, String>,
+                              tris: &mut Vec<[u32; 3]>|
+     -> Result<(), String> {
+        for prim in geometry_prims.get(g).map(Vec::as_slice).unwrap_or_default() {
+            let Some((_, vref)) = &prim.vertex else {
+                continue;
+            };
+            let src = vertices_source
+                .get(vref)
+                .map(String::as_str)
+                .unwrap_or(vref);
+            let (Some(&base), Ok(arr)) = (bases.get(src), positions_of(src)) else {
+                return Err(format!(
+                    "<{}>: the VERTEX input \"{}\" names no POSITION source of its geometry",
+                    prim.kind,
+                    dae_snippet(vref)
+                ));
+            };
+            prim.triangles(arr.len() / 3, tris, base)?;
+            colors.resize(tris.len(), color_of(prim.material.as_ref(), bind));
+        }
+        Ok(())
+    };
     let mut tris: Vec<[u32; 3]> = Vec::new();
 
     // The scene `<scene><instance_visual_scene>` names, else the first one.
@@ -781,7 +896,7 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
             } else {
                 unsupported
             };
-            for url in &node.geometries {
+            for (k, url) in node.geometries.iter().enumerate() {
                 instanced = true;
                 if let Some(u) = unsupported.and_then(|u| nodes.get(u)) {
                     return Err(format!(
@@ -815,7 +930,8 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
                         }
                     }
                 }
-                emit_triangles(id, &bases, &mut tris)?;
+                let bind = node.bindings.get(k).unwrap_or(&no_bindings);
+                emit_triangles(id, &bases, bind, &mut tris)?;
                 // Only the positions its primitives index (all of them when it has
                 // none, or when they index nothing).
                 let placed = tris.get(first_triangle..).unwrap_or_default();
@@ -839,7 +955,12 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
             }
         }
         if instanced {
-            return Ok(keep_used(out, tris, &used));
+            let (positions, triangles) = keep_used(out, tris, &used);
+            return Ok(DaeMesh {
+                positions,
+                triangles,
+                colors,
+            });
         }
     }
     // No scene places a geometry: every POSITION array, untransformed.
@@ -854,9 +975,13 @@ fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
         }
     }
     for g in &geometry_order {
-        emit_triangles(g, &bases, &mut tris)?;
+        emit_triangles(g, &bases, &no_bindings, &mut tris)?;
     }
-    Ok((out, tris))
+    Ok(DaeMesh {
+        positions: out,
+        triangles: tris,
+        colors,
+    })
 }
 
 /// The positions marked `used`, and the triangles (which index only used ones)
@@ -1180,6 +1305,51 @@ mod tests {
             .unwrap();
         let (p3, t3) = read_dae(&bare).unwrap();
         assert_eq!((p3.len(), t3.len()), (10, 0), "{bare}");
+    }
+
+    #[test]
+    fn dae_triangle_colours_from_bound_materials() {
+        // Two primitives: "A" bound to material red (effect colour 1 0 0 1),
+        // "B" naming material id blue directly (no binding; effect colour without
+        // alpha), and a third whose effect has a texture (no colour).
+        let dae = r##"<COLLADA><asset><unit meter="1"/></asset>
+<library_effects>
+<effect id="red-fx"><profile_COMMON><technique sid="c"><phong>
+<emission><color>0 0 0 1</color></emission><diffuse><color sid="diffuse">1 0 0 1</color></diffuse>
+</phong></technique></profile_COMMON></effect>
+<effect id="blue-fx"><profile_COMMON><technique sid="c"><lambert><diffuse><color>0 0 0.5</color></diffuse></lambert></technique></profile_COMMON></effect>
+<effect id="tex-fx"><profile_COMMON><technique sid="c"><lambert><diffuse><texture texture="img"/></diffuse></lambert></technique></profile_COMMON></effect>
+</library_effects>
+<library_materials>
+<material id="red"><instance_effect url="#red-fx"/></material>
+<material id="blue"><instance_effect url="#blue-fx"/></material>
+<material id="tex"><instance_effect url="#tex-fx"/></material>
+</library_materials>
+<library_geometries><geometry id="g"><mesh>
+<source id="p"><float_array id="pa">0 0 0 1 0 0 1 1 0 0 1 0</float_array></source>
+<vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+<triangles material="A" count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>
+<polylist material="blue" count="1"><input semantic="VERTEX" source="#v" offset="0"/><vcount>4</vcount><p>0 1 2 3</p></polylist>
+<triangles material="tex" count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 2 3</p></triangles>
+</mesh></geometry></library_geometries>
+<library_visual_scenes><visual_scene id="S">
+<node><instance_geometry url="#g"><bind_material><technique_common>
+<instance_material symbol="A" target="#red"/><instance_material symbol="tex" target="#tex"/>
+</technique_common></bind_material></instance_geometry></node>
+<node><translate>0 0 1</translate><instance_geometry url="#g"/></node>
+</visual_scene></library_visual_scenes></COLLADA>"##;
+        let d = read_dae_colored(dae).unwrap();
+        let red = Some([1.0, 0.0, 0.0, 1.0]);
+        let blue = Some([0.0, 0.0, 0.5, 1.0]);
+        // first copy: red, blue ×2 (the quad), none; the second copy has no
+        // bindings: "A" names no material, "blue" still does, "tex" has no colour
+        assert_eq!(
+            d.colors,
+            vec![red, blue, blue, None, None, blue, blue, None]
+        );
+        assert_eq!(d.colors.len(), d.triangles.len());
+        // the same triangles as read_dae gives
+        assert_eq!(read_dae(dae).unwrap().1, d.triangles);
     }
 
     #[test]

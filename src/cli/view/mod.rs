@@ -19,7 +19,7 @@
 //! The page sets `window.urdynViewer` (cli.md) once it has drawn its first frame.
 
 use crate::cli::output::write_atomic;
-use crate::contact::mesh::{load_mesh, TriMesh};
+use crate::contact::mesh::{load_mesh_colored, Rgba, TriMesh};
 use crate::dynamics::forward_kinematics;
 use crate::model::{Data, Shape};
 use crate::spatial::Se3;
@@ -40,9 +40,11 @@ pub const FRAME_RATE: f64 = 60.0;
 /// Most bytes of body poses a page carries (longer runs are shown at a lower rate).
 pub const MAX_POSE_BYTES: usize = 12 << 20;
 /// Meshes with more triangles than this are simplified (vertex clustering).
-pub const MAX_MESH_TRIANGLES: usize = 40_000;
-/// The triangle budget of a whole page: past it, every mesh's limit is lowered.
-pub const MAX_PAGE_TRIANGLES: usize = 800_000;
+pub const MAX_MESH_TRIANGLES: usize = 20_000;
+/// The triangle budget of a whole page (about 12 bytes a triangle once
+/// quantised and in base64: 1.8 MB): past it, the largest meshes are simplified
+/// to a common limit ([`Geometry::simplify_to`]).
+pub const MAX_PAGE_TRIANGLES: usize = 150_000;
 
 /// `urdyn view`'s options (cli.md).
 #[derive(Clone, Debug)]
@@ -492,6 +494,9 @@ pub struct Visual {
 pub struct Geometry {
     /// Distinct (file, scale) meshes, simplified where they were too large.
     pub meshes: Vec<TriMesh>,
+    /// Per mesh, the colour of each triangle where its file gives one (DAE
+    /// materials; empty or `None` where it does not: the visual's colour).
+    pub mesh_colors: Vec<Vec<Option<Rgba>>>,
     /// How many of `meshes` were simplified.
     pub simplified: usize,
     /// Every drawn piece.
@@ -502,11 +507,19 @@ pub struct Geometry {
 
 /// The colour of a visual without a material, and of collision geometry.
 const DEFAULT_RGBA: [f64; 4] = [0.72, 0.74, 0.78, 1.0];
+/// The side (m) of the box drawn for a link whose visual mesh is missing and
+/// that has no collision geometry.
+pub const PLACEHOLDER_BOX: f64 = 0.05;
+/// The colour of that box (a translucent red: "something is missing here").
+const PLACEHOLDER_RGBA: [f64; 4] = [0.9, 0.25, 0.2, 0.6];
 
 impl Geometry {
     /// Reads the URDF's visual geometry (its collision geometry for a link
-    /// without visuals) and every mesh it names. Errors name the URDF, the link
-    /// and the mesh file.
+    /// without visuals) and every mesh it names. A visual mesh file that is not
+    /// found is a warning (naming the URDF, the link and the file), and the link
+    /// is drawn as its collision geometry, or as a [`PLACEHOLDER_BOX`] without any;
+    /// a collision mesh drawn that is not found, or a mesh that cannot be read, is
+    /// an error naming the URDF, the link and the mesh file.
     pub fn load(model: &Model, urdf: &Path, package_paths: &[PathBuf]) -> Result<Self, ViewError> {
         let name = urdf.display().to_string();
         let text = std::fs::read_to_string(urdf)
@@ -522,6 +535,8 @@ impl Geometry {
             ..Geometry::default()
         };
         let mut mesh_index: HashMap<(PathBuf, [u64; 3]), usize> = HashMap::new();
+        let resolve =
+            |filename: &str| crate::contact::resolve_mesh_path(filename, Some(urdf), package_paths);
         for link in &drawables.links {
             let Some(frame) = model
                 .frame_index(&link.name)
@@ -529,12 +544,49 @@ impl Geometry {
             else {
                 continue;
             };
-            let (element, pieces) = if link.visuals.is_empty() {
-                ("collision", &link.collisions)
+            // The pieces drawn: the visuals whose files exist; for any that is
+            // missing, the collision geometry (once) or a placeholder box.
+            let mut drawn: Vec<(&str, &visuals::Piece)> = Vec::new();
+            let mut missing = Vec::new();
+            if link.visuals.is_empty() {
+                drawn.extend(link.collisions.iter().map(|p| ("collision", p)));
             } else {
-                ("visual", &link.visuals)
-            };
-            for piece in pieces {
+                for piece in &link.visuals {
+                    match &piece.shape {
+                        Shape::Mesh { filename, .. } if resolve(filename).is_none() => {
+                            missing.push(filename.as_str());
+                        }
+                        _ => drawn.push(("visual", piece)),
+                    }
+                }
+            }
+            if !missing.is_empty() {
+                let instead = if link.collisions.is_empty() {
+                    "a placeholder box is drawn"
+                } else {
+                    "its collision geometry is drawn"
+                };
+                for filename in &missing {
+                    geometry.warnings.push(format!(
+                        "{name}: link \"{}\": <visual> mesh file \"{filename}\" not found \
+                         (a package:// path needs --package-path DIR): {instead}",
+                        link.name
+                    ));
+                }
+                drawn.extend(link.collisions.iter().map(|p| ("collision", p)));
+            }
+            let placeholder =
+                (!missing.is_empty() && link.collisions.is_empty()).then(|| visuals::Piece {
+                    rot: Matrix3::identity(),
+                    xyz: Vector3::zeros(),
+                    shape: Shape::Box {
+                        size: [PLACEHOLDER_BOX; 3],
+                    },
+                    material: None,
+                    color: Some(PLACEHOLDER_RGBA),
+                });
+            drawn.extend(placeholder.iter().map(|p| ("visual", p)));
+            for (element, piece) in drawn {
                 let at = || format!("{name}: link \"{}\": <{element}>", link.name);
                 let placement = frame.placement.compose(&Se3::new(piece.rot, piece.xyz));
                 let shape = match &piece.shape {
@@ -543,12 +595,7 @@ impl Geometry {
                     &Shape::Capsule { radius, length } => VisualShape::Capsule { radius, length },
                     &Shape::Sphere { radius } => VisualShape::Sphere { radius },
                     Shape::Mesh { filename, scale } => {
-                        let path = crate::contact::resolve_mesh_path(
-                            filename,
-                            Some(urdf),
-                            package_paths,
-                        )
-                        .ok_or_else(|| {
+                        let path = resolve(filename).ok_or_else(|| {
                             ViewError::Geometry(format!(
                                 "{}: mesh file \"{filename}\" not found (a package:// path needs --package-path DIR)",
                                 at()
@@ -558,9 +605,10 @@ impl Geometry {
                         let k = match mesh_index.get(&key) {
                             Some(&k) => k,
                             None => {
-                                let m = load_mesh(&path, *scale)
+                                let (m, colors) = load_mesh_colored(&path, *scale)
                                     .map_err(|e| ViewError::Geometry(format!("{}: {e}", at())))?;
                                 geometry.meshes.push(m);
+                                geometry.mesh_colors.push(colors);
                                 mesh_index.insert(key, geometry.meshes.len() - 1);
                                 geometry.meshes.len() - 1
                             }
@@ -587,25 +635,59 @@ impl Geometry {
                 });
             }
         }
-        // Simplify: every mesh to MAX_MESH_TRIANGLES, all of them to MAX_PAGE_TRIANGLES.
-        let capped: usize = geometry
-            .meshes
-            .iter()
-            .map(|m| m.triangles.len().min(MAX_MESH_TRIANGLES))
-            .sum();
-        let limit = if capped > MAX_PAGE_TRIANGLES {
-            ((MAX_MESH_TRIANGLES as f64) * MAX_PAGE_TRIANGLES as f64 / capped as f64) as usize
-        } else {
-            MAX_MESH_TRIANGLES
-        };
-        for m in geometry.meshes.iter_mut() {
-            if m.triangles.len() > limit {
-                *m = simplify(m, limit);
-                geometry.simplified += 1;
-            }
-        }
+        geometry.simplify_to(MAX_MESH_TRIANGLES, MAX_PAGE_TRIANGLES);
         Ok(geometry)
     }
+
+    /// Simplifies the meshes so that none has more than `per_mesh` triangles and
+    /// all of them together at most `total`: every mesh is kept whole up to a
+    /// common limit L (the largest with Σ min(nᵢ, L) ≤ total, at most
+    /// `per_mesh`), larger ones are simplified to L.
+    pub fn simplify_to(&mut self, per_mesh: usize, total: usize) {
+        let limit = triangle_limit(
+            &self
+                .meshes
+                .iter()
+                .map(|m| m.triangles.len())
+                .collect::<Vec<_>>(),
+            per_mesh,
+            total,
+        );
+        self.mesh_colors.resize(self.meshes.len(), Vec::new());
+        for (m, colors) in self.meshes.iter_mut().zip(self.mesh_colors.iter_mut()) {
+            if m.triangles.len() > limit {
+                let (s, kept) = simplify_keeping(m, limit);
+                if !colors.is_empty() {
+                    *colors = kept
+                        .iter()
+                        .map(|&k| colors.get(k).copied().flatten())
+                        .collect();
+                }
+                *m = s;
+                self.simplified += 1;
+            }
+        }
+    }
+}
+
+/// The largest L ≤ `per_mesh` with Σ min(nᵢ, L) ≤ `total` for triangle counts
+/// `counts` (water filling; at least 12, a box's worth, for a tiny `total`).
+fn triangle_limit(counts: &[usize], per_mesh: usize, total: usize) -> usize {
+    let mut sorted: Vec<usize> = counts.iter().map(|&n| n.min(per_mesh)).collect();
+    sorted.sort_unstable();
+    if sorted.iter().sum::<usize>() <= total {
+        return per_mesh;
+    }
+    // meshes below the level keep their count; the level is shared by the rest
+    let mut left = total;
+    for (k, &n) in sorted.iter().enumerate() {
+        let rest = sorted.len() - k;
+        if n * rest > left {
+            return (left / rest).max(12);
+        }
+        left -= n;
+    }
+    per_mesh
 }
 
 /// The mesh's bounding box (lower corner, upper corner).
@@ -627,23 +709,30 @@ fn bounds(m: &TriMesh) -> (Vector3<f64>, Vector3<f64>) {
 /// `max_triangles` triangles (each cell's vertices merged into their mean,
 /// collapsed and repeated triangles dropped).
 pub fn simplify(m: &TriMesh, max_triangles: usize) -> TriMesh {
+    simplify_keeping(m, max_triangles).0
+}
+
+/// [`simplify`], and for each triangle of the result the index of the input
+/// triangle it comes from.
+pub fn simplify_keeping(m: &TriMesh, max_triangles: usize) -> (TriMesh, Vec<usize>) {
     let (lo, hi) = bounds(m);
     let size = (hi - lo).max();
     if m.triangles.len() <= max_triangles || size <= 0.0 {
-        return m.clone();
+        return (m.clone(), (0..m.triangles.len()).collect());
     }
     let mut cells = (max_triangles as f64).sqrt() * 1.5;
     loop {
         let out = cluster(m, lo, size / cells);
-        if out.triangles.len() <= max_triangles || cells < 2.0 {
+        if out.0.triangles.len() <= max_triangles || cells < 2.0 {
             return out;
         }
         cells *= 0.8;
     }
 }
 
-/// One vertex-clustering pass with cubic cells of side `h` from `lo`.
-fn cluster(m: &TriMesh, lo: Vector3<f64>, h: f64) -> TriMesh {
+/// One vertex-clustering pass with cubic cells of side `h` from `lo`: the mesh
+/// and the input triangle each output triangle comes from.
+fn cluster(m: &TriMesh, lo: Vector3<f64>, h: f64) -> (TriMesh, Vec<usize>) {
     let mut cell_of: HashMap<[i64; 3], u32> = HashMap::new();
     let mut sums: Vec<(Vector3<f64>, f64)> = Vec::new();
     let remap: Vec<u32> = m
@@ -665,7 +754,8 @@ fn cluster(m: &TriMesh, lo: Vector3<f64>, h: f64) -> TriMesh {
         .collect();
     let mut seen = std::collections::HashSet::new();
     let mut triangles = Vec::new();
-    for t in &m.triangles {
+    let mut kept = Vec::new();
+    for (k, t) in m.triangles.iter().enumerate() {
         let [a, b, c] = t.map(|i| remap.get(i as usize).copied().unwrap_or(0));
         if a == b || b == c || a == c {
             continue;
@@ -674,12 +764,14 @@ fn cluster(m: &TriMesh, lo: Vector3<f64>, h: f64) -> TriMesh {
         key.sort_unstable();
         if seen.insert(key) {
             triangles.push([a, b, c]);
+            kept.push(k);
         }
     }
-    TriMesh {
+    let mesh = TriMesh {
         vertices: sums.into_iter().map(|(s, n)| s / n).collect(),
         triangles,
-    }
+    };
+    (mesh, kept)
 }
 
 /// Standard base64 (with padding) of `bytes`.
@@ -710,8 +802,10 @@ fn rows9(r: &Matrix3<f64>) -> Vec<f64> {
 }
 
 /// The mesh quantised: 16 bits a coordinate over its bounding box, indices as
-/// 16 bits when they fit (else 32).
-fn mesh_json(m: &TriMesh) -> Value {
+/// 16 bits when they fit (else 32). With triangle colours (`colors`, one a
+/// triangle, or empty), the triangles are ordered by colour and `groups` lists
+/// `[first index, index count, rgba or null]` per colour (null: the visual's).
+fn mesh_json(m: &TriMesh, colors: &[Option<Rgba>]) -> Value {
     let (lo, hi) = bounds(m);
     let ext = (hi - lo).map(|e| if e > 0.0 { e } else { 1.0 });
     let mut v = Vec::with_capacity(m.vertices.len() * 6);
@@ -723,24 +817,55 @@ fn mesh_json(m: &TriMesh) -> Value {
             v.extend_from_slice(&q.to_le_bytes());
         }
     }
-    let wide = m.vertices.len() > 65536;
-    let mut i = Vec::with_capacity(m.triangles.len() * if wide { 12 } else { 6 });
-    for t in &m.triangles {
-        for &k in t {
-            if wide {
-                i.extend_from_slice(&k.to_le_bytes());
-            } else {
-                i.extend_from_slice(&(k as u16).to_le_bytes());
-            }
+    // colour groups in order of first appearance
+    let key = |c: &Option<Rgba>| c.map(|c| c.map(f64::to_bits));
+    let mut group_of: HashMap<Option<[u64; 4]>, usize> = HashMap::new();
+    let mut palette: Vec<Option<Rgba>> = Vec::new();
+    let mut members: Vec<Vec<usize>> = Vec::new();
+    let colored = colors.iter().any(Option::is_some);
+    for t in 0..m.triangles.len() {
+        let c = if colored {
+            colors.get(t).copied().flatten()
+        } else {
+            None
+        };
+        let g = *group_of.entry(key(&c)).or_insert_with(|| {
+            palette.push(c);
+            members.push(Vec::new());
+            palette.len() - 1
+        });
+        if let Some(list) = members.get_mut(g) {
+            list.push(t);
         }
     }
-    json!({
+    let wide = m.vertices.len() > 65536;
+    let mut i = Vec::with_capacity(m.triangles.len() * if wide { 12 } else { 6 });
+    let mut groups = Vec::new();
+    let mut first = 0;
+    for (c, list) in palette.iter().zip(&members) {
+        for t in list.iter().filter_map(|&t| m.triangles.get(t)) {
+            for &k in t {
+                if wide {
+                    i.extend_from_slice(&k.to_le_bytes());
+                } else {
+                    i.extend_from_slice(&(k as u16).to_le_bytes());
+                }
+            }
+        }
+        groups.push(json!([first, 3 * list.len(), c]));
+        first += 3 * list.len();
+    }
+    let mut out = json!({
         "min": [lo.x, lo.y, lo.z],
         "ext": [ext.x, ext.y, ext.z],
         "v": base64(&v),
         "i": base64(&i),
         "wide": wide,
-    })
+    });
+    if colored {
+        out["groups"] = Value::Array(groups);
+    }
+    out
 }
 
 /// The page's data (one JSON object the viewer reads).
@@ -798,7 +923,12 @@ fn page_data(model: &Model, geometry: &Geometry, rec: &Recorder, ground: Option<
         "moving": rec.nmoving,
         "links": links,
         "visuals": visuals,
-        "meshes": geometry.meshes.iter().map(mesh_json).collect::<Vec<_>>(),
+        "meshes": geometry
+            .meshes
+            .iter()
+            .enumerate()
+            .map(|(k, m)| mesh_json(m, geometry.mesh_colors.get(k).map(Vec::as_slice).unwrap_or_default()))
+            .collect::<Vec<_>>(),
         "times": rec.times,
         "positions": base64(&f64s),
         "rotations": base64(&f32s),
@@ -908,6 +1038,32 @@ mod tests {
             }
         }
         m
+    }
+
+    #[test]
+    fn triangle_limit_fills_the_budget_from_below() {
+        // Under the budget: the per-mesh cap.
+        assert_eq!(triangle_limit(&[10, 20, 30], 100, 1000), 100);
+        // 10 and 20 kept whole; the other two share 120 - 30 = 90: L = 45,
+        // and Σ min(n, 45) = 10 + 20 + 45 + 45 = 120.
+        assert_eq!(triangle_limit(&[500, 10, 20, 80], 1000, 120), 45);
+        // The cap first: 60 000 counts as 20 000.
+        assert_eq!(triangle_limit(&[60_000, 100], 20_000, 20_100), 20_000);
+        // A tiny budget still leaves a box's worth.
+        assert_eq!(triangle_limit(&[1000, 1000], 1000, 4), 12);
+        // Brute force: the largest L with Σ min(nᵢ, L) ≤ total.
+        let counts = [3, 900, 77, 4000, 1200, 50];
+        for total in [100, 1000, 3000, 6000] {
+            let best = (0..=4000)
+                .filter(|&l| counts.iter().map(|&n: &usize| n.min(l)).sum::<usize>() <= total)
+                .max()
+                .unwrap();
+            assert_eq!(
+                triangle_limit(&counts, 4000, total),
+                best.max(12),
+                "{total}"
+            );
+        }
     }
 
     #[test]

@@ -320,7 +320,14 @@
         : v.kind === "cylinder" ? Math.hypot(d[0], d[1] / 2)
           : d[0] + (v.kind === "capsule" ? d[1] / 2 : 0);
     }
-    return { d, body: v.body, local: { R: v.R, p: v.p }, scale, color: v.rgba, radius };
+    // the parts drawn, each in its colour: a DAE mesh's colour groups (a group
+    // without a colour takes the visual's), else the whole drawable
+    const bytesPerIndex = d.type === gl.UNSIGNED_INT ? 4 : 2;
+    const groups = v.kind === "mesh" ? D.meshes[v.mesh].groups : null;
+    const parts = groups
+      ? groups.filter((g) => g[1] > 0).map((g) => ({ offset: g[0] * bytesPerIndex, count: g[1], color: g[2] || v.rgba }))
+      : [{ offset: 0, count: d.count, color: v.rgba }];
+    return { d, body: v.body, local: { R: v.R, p: v.p }, scale, color: v.rgba, parts, radius };
   });
   const quad = drawable(new Float32Array([-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0]), gl.FLOAT, new Uint16Array([0, 1, 2, 0, 2, 3]));
 
@@ -372,6 +379,20 @@
   const groundZ = D.ground === null || D.ground === undefined ? 0 : D.ground;
   const R0 = start.r;
   const minor = Math.pow(10, Math.floor(Math.log10(R0 / 2)));
+  // Force arrows: metres per newton, chosen so that a typical force (see
+  // maxForce) is about a third of the robot's size and a grid step stands for
+  // a round number of newtons (1, 2 or 5 × 10^k); the legend says how many.
+  let forceScale = 0, forceLegend = "";
+  if (maxForce > 0) {
+    const perGrid = maxForce * minor / (R0 * 0.35);
+    const p10 = Math.pow(10, Math.floor(Math.log10(perGrid)));
+    const nice = [1, 2, 5, 10].map((k) => k * p10).find((x) => x >= perGrid * 0.75) || 10 * p10;
+    forceScale = minor / nice;
+    forceLegend = `force arrows: ${fmtLength(minor)} = ${+nice.toPrecision(3)} N (one grid step)`;
+  }
+  function fmtLength(x) {
+    return x >= 1 ? `${+x.toPrecision(3)} m` : x >= 0.01 ? `${+(x * 100).toPrecision(3)} cm` : `${+(x * 1000).toPrecision(3)} mm`;
+  }
   // The camera looks at the robot (following it, unless "follow" is off) from
   // a distance that shows it whole; panning moves the point looked at.
   const cam = { offset: [0, 0, 0], fixed: start.c.slice(), dist: R0 * 2.5, yaw: -1.1, pitch: 0.3, target: start.c.slice() };
@@ -398,6 +419,10 @@
     forces: document.getElementById("forces"),
   };
   if (!arrows) document.getElementById("forces-label").style.display = "none";
+  const legend = document.getElementById("legend");
+  function showLegend() {
+    legend.textContent = arrows && ui.forces.checked ? forceLegend : "";
+  }
 
   function draw() {
     const dpr = window.devicePixelRatio || 1;
@@ -425,12 +450,14 @@
     gl.useProgram(progDepth.p);
     gl.uniformMatrix4fv(progDepth.u.u_light, false, light);
     for (const { v, m } of world) {
-      if (v.color[3] < 0.5) continue;
       gl.uniformMatrix4fv(progDepth.u.u_model, false, m);
       gl.uniform3fv(progDepth.u.u_qmin, v.d.qmin);
       gl.uniform3fv(progDepth.u.u_qext, v.d.qext);
       gl.bindVertexArray(v.d.vao);
-      gl.drawElements(gl.TRIANGLES, v.d.count, v.d.type, 0);
+      for (const part of v.parts) {
+        if (part.color[3] < 0.5) continue;
+        gl.drawElements(gl.TRIANGLES, part.count, v.d.type, part.offset);
+      }
     }
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
 
@@ -465,13 +492,15 @@
     for (const pass of [0, 1]) { // opaque, then translucent
       if (pass) { gl.enable(gl.BLEND); gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA); gl.depthMask(false); }
       for (const { v, m } of world) {
-        if ((v.color[3] < 0.99) !== (pass === 1)) continue;
         gl.uniformMatrix4fv(mu.u_model, false, m);
         gl.uniform3fv(mu.u_qmin, v.d.qmin);
         gl.uniform3fv(mu.u_qext, v.d.qext);
-        gl.uniform4fv(mu.u_color, v.color);
         gl.bindVertexArray(v.d.vao);
-        gl.drawElements(gl.TRIANGLES, v.d.count, v.d.type, 0);
+        for (const part of v.parts) {
+          if ((part.color[3] < 0.99) !== (pass === 1)) continue;
+          gl.uniform4fv(mu.u_color, part.color);
+          gl.drawElements(gl.TRIANGLES, part.count, v.d.type, part.offset);
+        }
       }
     }
     gl.disable(gl.BLEND);
@@ -491,7 +520,7 @@
       }
     }
     if (arrows && ui.forces.checked && f + 1 < arrowOffsets.length) {
-      const scale = maxForce > 0 ? R0 * 0.35 / maxForce : 0, mk = R0 * 0.02;
+      const scale = forceScale, mk = R0 * 0.02;
       for (let k = arrowOffsets[f]; k < arrowOffsets[f + 1]; k++) {
         const a = Array.from(arrows.subarray(6 * k, 6 * k + 6));
         const p = a.slice(0, 3), tip = [p[0] + a[3] * scale, p[1] + a[4] * scale, p[2] + a[5] * scale];
@@ -526,7 +555,7 @@
     { name: "contacts", data: D.contacts, color: "#444" },
     { name: "penetration (m)", data: D.penetration, color: "#c0392b" },
   ].filter((s) => s.data && s.data.some((x) => x !== null));
-  let plotBase = null;
+  let plotBase = null, plotLabels = [];
   function drawPlot() {
     const dpr = window.devicePixelRatio || 1;
     const w = Math.max(1, Math.round(plot.clientWidth * dpr)), h = Math.max(1, Math.round(plot.clientHeight * dpr));
@@ -534,8 +563,31 @@
     if (plot.width !== w || plot.height !== h || !plotBase) {
       plot.width = w; plot.height = h;
       ctx.clearRect(0, 0, w, h);
-      const lane = h / Math.max(series.length, 1);
+      plotLabels = [];
+      // the time axis: a strip at the bottom with ticks at round times
+      const axis = 16 * dpr;
+      const lane = (h - axis) / Math.max(series.length, 1);
       ctx.font = `${11 * dpr}px system-ui, sans-serif`;
+      if (duration > 0) {
+        const raw = duration / Math.max(2, Math.floor(w / (70 * dpr)));
+        const p10 = Math.pow(10, Math.floor(Math.log10(raw)));
+        const step = [1, 2, 5, 10].map((k) => k * p10).find((x) => x >= raw);
+        const digits = Math.max(0, -Math.floor(Math.log10(step) + 1e-9));
+        ctx.textBaseline = "alphabetic";
+        for (let k = Math.ceil(times[0] / step - 1e-9); k * step <= times[0] + duration + 1e-9 * step; k++) {
+          const t = k * step, x = (t - times[0]) / duration * w;
+          ctx.strokeStyle = "#e3e6ea"; ctx.lineWidth = 1 * dpr;
+          ctx.beginPath(); ctx.moveTo(x, 0); ctx.lineTo(x, h - axis); ctx.stroke();
+          ctx.strokeStyle = "#7a828e";
+          ctx.beginPath(); ctx.moveTo(x, h - axis); ctx.lineTo(x, h - axis + 4 * dpr); ctx.stroke();
+          const label = `${t.toFixed(digits)} s`;
+          const tw = ctx.measureText(label).width;
+          ctx.fillStyle = "#4a525e";
+          ctx.fillText(label, Math.min(Math.max(x - tw / 2, 0), w - tw), h - 3 * dpr);
+        }
+        ctx.strokeStyle = "#7a828e";
+        ctx.beginPath(); ctx.moveTo(0, h - axis); ctx.lineTo(w, h - axis); ctx.stroke();
+      }
       series.forEach((s, k) => {
         const vals = s.data.filter((x) => x !== null);
         let lo = Math.min(...vals), hi = Math.max(...vals);
@@ -554,8 +606,7 @@
           pen = true;
         });
         ctx.stroke();
-        ctx.fillStyle = s.color;
-        ctx.fillText(`${s.name}  [${fmt(lo)}, ${fmt(hi)}]`, 6 * dpr, y0 + 10 * dpr);
+        plotLabels.push({ text: `${s.name}  [${fmt(lo)}, ${fmt(hi)}]`, color: s.color, x: 6 * dpr, y: y0 + 10 * dpr });
       });
       plotBase = ctx.getImageData(0, 0, w, h);
     }
@@ -563,7 +614,16 @@
     if (nframes) {
       const x = duration > 0 ? (times[frame] - times[0]) / duration * w : 0;
       ctx.strokeStyle = "#000"; ctx.lineWidth = 1 * dpr;
-      ctx.beginPath(); ctx.moveTo(x, 0); ctx.lineTo(x, h); ctx.stroke();
+      ctx.beginPath(); ctx.moveTo(x, 0); ctx.lineTo(x, h - 16 * dpr); ctx.stroke();
+    }
+    // the series' names on top of the curves and the cursor, on a backing
+    ctx.font = `${11 * dpr}px system-ui, sans-serif`;
+    for (const l of plotLabels) {
+      const tw = ctx.measureText(l.text).width;
+      ctx.fillStyle = "rgba(247, 248, 250, 0.85)";
+      ctx.fillRect(l.x - 3 * dpr, l.y - 10 * dpr, tw + 6 * dpr, 13 * dpr);
+      ctx.fillStyle = l.color;
+      ctx.fillText(l.text, l.x, l.y);
     }
   }
   function fmt(x) { return Math.abs(x) >= 1e4 || (Math.abs(x) < 1e-3 && x !== 0) ? x.toExponential(2) : +x.toPrecision(4) + ""; }
@@ -612,7 +672,7 @@
     for (let i = 0; i < 3; i++) cam.offset[i] = cam.target[i] - c[i];
     dirty = true;
   });
-  ui.forces.addEventListener("change", () => { dirty = true; });
+  ui.forces.addEventListener("change", () => { showLegend(); dirty = true; });
   window.addEventListener("keydown", (e) => {
     if (e.code === "Space" && e.target.tagName !== "BUTTON") { e.preventDefault(); playBtn.click(); }
   });
@@ -670,6 +730,7 @@
     requestAnimationFrame(tick);
   }
 
+  showLegend();
   show(0);
   setPlaying(playing);
   draw();
