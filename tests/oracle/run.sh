@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Regenerate the reference-dynamics fixtures in tests/fixtures/ with Pinocchio.
+# Regenerate the reference-dynamics fixtures in tests/fixtures/ with Pinocchio
+# (make_fixtures.py: states/expected/meta.json; make_derivative_fixtures.py: deriv_*.json).
 # Idempotent: the venv is created (and the pinned packages installed) only when missing.
 set -euo pipefail
 
@@ -25,4 +26,5 @@ sys.exit(0 if pinocchio.__version__ == "4.1.0" and md.version("example-robot-dat
 fi
 
 cd "$ROOT"
-exec "$VENV/bin/python" "$HERE/make_fixtures.py" "$@"
+"$VENV/bin/python" "$HERE/make_fixtures.py" "$@"
+exec "$VENV/bin/python" "$HERE/make_derivative_fixtures.py"
