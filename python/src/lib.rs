@@ -6,6 +6,7 @@
 //! names are fixed by `shared/spec/python.md` (Pinocchio's where it has one).
 
 mod args;
+mod derivatives;
 mod dynamics;
 mod model;
 mod sim;
@@ -31,6 +32,7 @@ fn _urdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(model::to_pinocchio_q, m)?)?;
     m.add_function(wrap_pyfunction!(model::from_pinocchio_q, m)?)?;
     dynamics::register(m)?;
+    derivatives::register(m)?;
     m.add_function(wrap_pyfunction!(sim::rollout, m)?)?;
     m.add_function(wrap_pyfunction!(sim::integrators, m)?)?;
     Ok(())

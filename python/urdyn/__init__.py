@@ -42,6 +42,14 @@ from ._urdyn import (  # noqa: F401
     rollout,
     to_pinocchio_q,
 )
+from ._urdyn import (  # noqa: F401
+    aba_derivatives,
+    difference,
+    frame_jacobian_time_variation,
+    integrate,
+    random_configuration,
+    rnea_derivatives,
+)
 
 __all__ = [
     "Data",
@@ -66,4 +74,10 @@ __all__ = [
     "rnea",
     "rollout",
     "to_pinocchio_q",
+    "aba_derivatives",
+    "difference",
+    "frame_jacobian_time_variation",
+    "integrate",
+    "random_configuration",
+    "rnea_derivatives",
 ]
