@@ -6,6 +6,7 @@
 //! names are fixed by `shared/spec/python.md` (Pinocchio's where it has one).
 
 mod args;
+mod control;
 mod dynamics;
 mod model;
 mod sim;
@@ -31,5 +32,6 @@ fn _urdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     dynamics::register(m)?;
     m.add_function(wrap_pyfunction!(sim::rollout, m)?)?;
     m.add_function(wrap_pyfunction!(sim::integrators, m)?)?;
+    m.add_function(wrap_pyfunction!(sim::linearize, m)?)?;
     Ok(())
 }
