@@ -188,7 +188,7 @@ pub fn linearize<'py>(
         Ok(())
     };
     let r = py.detach(|| {
-        let work = move || -> Result<(), String> {
+        let mut work = move || -> Result<(), String> {
             ao.par_chunks_mut((n * n).max(1))
                 .zip(bo.par_chunks_mut((n * nv).max(1)))
                 .enumerate()
