@@ -228,3 +228,56 @@ fn bad_input_is_an_error() {
     );
     assert_eq!(JacobianMethod::from_name("backward"), None);
 }
+
+#[test]
+fn smooth_integrators_by_the_runge_kutta_chain_rule() {
+    // ur5 without contact, with servos, by rk4 and dop853 (their own smooth
+    // steps: no contact, no limit within reach, mild gains)
+    let model = load_file("assets/robots/ur5.urdf", LoadOptions::default()).unwrap();
+    let nv = model.nv;
+    for integ in [Integrator::Rk4, Integrator::Dop853] {
+        let opts = SimOptions {
+            ground: None,
+            integrator: Some(integ),
+            ..Default::default()
+        };
+        let mut sim = Simulation::new(model.clone(), opts).unwrap();
+        let mut s = 11;
+        let q = DVector::from_fn(nv, |_, _| lcg(&mut s));
+        let v = DVector::from_fn(nv, |_, _| lcg(&mut s));
+        sim.set_state(&q, &v).unwrap();
+        sim.set_gains_uniform(20.0, 0.5).unwrap();
+        sim.set_targets(&DVector::zeros(nv), None).unwrap();
+        let tau = DVector::from_fn(nv, |_, _| lcg(&mut s));
+        check(
+            &sim,
+            &tau,
+            1e-5,
+            1e-3,
+            &format!("ur5 servos {}", integ.name()),
+        );
+    }
+    // a free body spinning in flight (the quaternion inside the ODE)
+    let model = load_str(box_urdf(), "box.urdf", FLOAT).unwrap();
+    for integ in Integrator::ALL {
+        let opts = SimOptions {
+            ground: None,
+            integrator: Some(integ),
+            ..Default::default()
+        };
+        let mut sim = Simulation::new(model.clone(), opts).unwrap();
+        let mut q = sim.q().clone();
+        let (s, c) = (0.3f64.sin(), 0.3f64.cos());
+        q[3] = s;
+        q[6] = c;
+        let v = DVector::from_vec(vec![0.4, -0.2, 1.0, 3.0, -2.0, 5.0]);
+        sim.set_state(&q, &v).unwrap();
+        check(
+            &sim,
+            &DVector::zeros(6),
+            1e-5,
+            1e-3,
+            &format!("free box {}", integ.name()),
+        );
+    }
+}

@@ -88,7 +88,12 @@ impl Simulation {
         for (j, b) in t.b.iter().enumerate() {
             yraw.axpy(h * b, &ks[j], 1.0);
         }
-        let tout = self.raw_to_tangent(q1, &yraw.rows(0, nq).into_owned());
+        let tq = self.raw_to_tangent(q1, &yraw.rows(0, nq).into_owned());
+        let mut tout = DMatrix::zeros(2 * n, ny);
+        tout.view_mut((0, 0), (n, nq)).copy_from(&tq);
+        for k in 0..n {
+            tout[(n + k, nq + k)] = 1.0;
+        }
         Ok(tout * dy1)
     }
 
