@@ -256,15 +256,6 @@ impl Simulation {
                                 // λₜ = −μ λₙ û: δλₜ + μ û δλₙ + κ P δuₜ = 0
                                 let un = ut.norm();
                                 let uh = [ut.x / un, ut.y / un];
-                                if std::env::var_os("URDYN_DEBUG_JAC").is_some() {
-                                    eprintln!(
-                                        "slide: cos {:.6} |lt|/mu ln {:.9} |ut| {:.3e} ln {:.3e}",
-                                        -(l1 * uh[0] + l2 * uh[1]) / lt,
-                                        lt / (mu * ln),
-                                        un,
-                                        ln
-                                    );
-                                }
                                 let kappa = mu * ln / un;
                                 for a in 0..2 {
                                     let ra = r + 1 + a;
