@@ -314,7 +314,9 @@ impl Simulation {
         Ok(self.output_map(&vtot, &dvplus, h))
     }
 
-    /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces).
+    /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces), by
+    /// central differences of RNEA (ε = 1e-6) until the analytic
+    /// `rnea_derivatives` of issue 21 lands (then: one call here).
     pub(super) fn id_derivatives(
         &mut self,
         q: &DVector<f64>,
