@@ -7,8 +7,9 @@
 //! F is q̇'s derivative (ṗ = R(q̂) v_lin, the quaternion rate ½ q ⊗ (ω, 0),
 //! joints q̇ = v) and v̇ = (H + A)⁻¹(sat(τ + servo) + τ_c − D v − C)'s:
 //! ∂v̇/∂q = −(H + A)⁻¹(∂ID/∂q + Kp) (ID at (q̂, v, v̇), tangent space, then
-//! composed with the raw quaternion's tangent map), ∂v̇/∂v = −(H + A)⁻¹(∂ID/∂v
-//! + D + Kd), ∂v̇/∂τ = (H + A)⁻¹ on joints whose torque is not clamped. The
+//! composed with the raw quaternion's tangent map),
+//! ∂v̇/∂v = −(H + A)⁻¹(∂ID/∂v + D + Kd), ∂v̇/∂τ = (H + A)⁻¹ on joints whose
+//! torque is not clamped. The
 //! held joint friction τ_c is held in the derivative too.
 
 use crate::dynamics::linalg::{chol_solve_slice, cholesky_fast};
@@ -64,14 +65,14 @@ impl Simulation {
         let mut dy0 = DMatrix::zeros(ny, 3 * n);
         dy0.view_mut((0, 0), (ny, 2 * n)).copy_from(&tin);
         let mut dks: Vec<DMatrix<f64>> = Vec::with_capacity(ns);
-        for s in 0..ns {
+        for (s, ysv) in ys.iter().enumerate() {
             let mut dy = dy0.clone();
             for (j, a) in t.a[s].iter().enumerate() {
                 if *a != 0.0 {
                     dy += &dks[j] * (h * a);
                 }
             }
-            let (fy, ft) = self.rhs_jacobian(&ys[s], tau)?;
+            let (fy, ft) = self.rhs_jacobian(ysv, tau)?;
             let mut dk = &fy * &dy;
             let mut view = dk.view_mut((0, 2 * n), (ny, n));
             view += &ft;
