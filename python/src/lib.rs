@@ -6,6 +6,7 @@
 //! names are fixed by `shared/spec/python.md` (Pinocchio's where it has one).
 
 mod args;
+mod control;
 mod derivatives;
 mod dynamics;
 mod model;
@@ -35,5 +36,6 @@ fn _urdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     derivatives::register(m)?;
     m.add_function(wrap_pyfunction!(sim::rollout, m)?)?;
     m.add_function(wrap_pyfunction!(sim::integrators, m)?)?;
+    m.add_function(wrap_pyfunction!(sim::linearize, m)?)?;
     Ok(())
 }

@@ -8,7 +8,7 @@ use crate::args::{
 };
 use crate::model::PyModel;
 use crate::SimulationError;
-use numpy::{PyArray1, PyArray3, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
@@ -222,6 +222,80 @@ impl PySimulation {
             })
             .collect()
     }
+
+    // --- Control and sensors (python.md §"Control", §"Sensors"; control.rs) ---
+
+    /// Servo gains per degree of freedom (nv; base entries 0) or scalars.
+    fn set_gains(&mut self, kp: &Bound<'_, PyAny>, kd: &Bound<'_, PyAny>) -> PyResult<()> {
+        crate::control::set_gains(&mut self.sim, kp, kd)
+    }
+    /// Servo targets (q_ref: nq, its base part ignored; v_ref: nv, None: 0).
+    #[pyo3(signature = (q_ref, v_ref=None))]
+    fn set_targets(
+        &mut self,
+        q_ref: &Bound<'_, PyAny>,
+        v_ref: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        crate::control::set_targets(&mut self.sim, q_ref, v_ref)
+    }
+    /// A = ∂x'/∂x (2nv × 2nv), B = ∂x'/∂τ_ff (2nv × nv) of one step from the
+    /// current state (as a new Simulation would step it); `sim` is not changed.
+    #[pyo3(signature = (tau=None, method="analytic", eps=1e-6))]
+    #[allow(clippy::type_complexity)]
+    fn transition_jacobians<'py>(
+        &self,
+        py: Python<'py>,
+        tau: Option<&Bound<'py, PyAny>>,
+        method: &str,
+        eps: f64,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+        crate::control::transition_jacobians(py, &self.sim, tau, method, eps)
+    }
+    /// (gyro, accel) of a link after the last step, link coordinates.
+    #[allow(clippy::type_complexity)]
+    fn imu<'py>(
+        &mut self,
+        py: Python<'py>,
+        link: &str,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+        crate::control::pair(py, self.sim.imu(link))
+    }
+    /// (force, torque) the parent exerts on a joint's child link, child link coordinates.
+    #[allow(clippy::type_complexity)]
+    fn joint_wrench<'py>(
+        &mut self,
+        py: Python<'py>,
+        joint: &str,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+        crate::control::pair(py, self.sim.joint_wrench(joint))
+    }
+    /// (force, torque about the link origin) of the last step's contacts on a link, world.
+    #[allow(clippy::type_complexity)]
+    fn contact_wrench<'py>(
+        &mut self,
+        py: Python<'py>,
+        link: &str,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+        crate::control::pair(py, self.sim.contact_wrench(link))
+    }
+}
+
+/// A and B at each of T states of a trajectory as `sim` would step them, in
+/// parallel on `threads` cores with the GIL released (python.md §"Control").
+#[pyfunction]
+#[pyo3(signature = (sim, q, v, tau, threads=None, method="analytic", eps=1e-6))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+pub fn linearize<'py>(
+    py: Python<'py>,
+    sim: PyRef<'py, PySimulation>,
+    q: &Bound<'py, PyAny>,
+    v: &Bound<'py, PyAny>,
+    tau: &Bound<'py, PyAny>,
+    threads: Option<usize>,
+    method: &str,
+    eps: f64,
+) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
+    crate::control::linearize(py, &sim.sim, q, v, tau, threads, method, eps)
 }
 
 /// The torques of a rollout: none, constant per run (B, nv), or per step

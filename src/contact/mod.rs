@@ -201,6 +201,19 @@ pub struct ContactPoint {
     pub gap: f64,
 }
 
+impl GroundShape {
+    /// The radius of a shape whose ground contact point lies that far below a
+    /// centre moving with the link (a sphere, a capsule's end sphere); 0 for
+    /// vertex contacts (hulls, boxes, point sets) and cylinders.
+    pub fn rolling_radius(&self) -> f64 {
+        match self.manifold {
+            Manifold::Sphere(r) => r,
+            Manifold::Capsule { radius, .. } => radius,
+            _ => 0.0,
+        }
+    }
+}
+
 /// The ground plane and every shape that can touch it.
 #[derive(Clone, Debug)]
 pub struct GroundContact {
@@ -509,6 +522,22 @@ impl GroundContact {
             low = low.min(z);
         }
         low
+    }
+
+    /// Forgets what earlier detections left (the points kept from the last
+    /// one, where each hull's search starts, its band cache): the next
+    /// detection finds what a newly built one would.
+    pub fn forget_history(&mut self) {
+        self.prev_flag.fill(false);
+        self.prev_list.clear();
+        self.prev_range.fill((0, 0));
+        self.last_low.fill(0);
+        self.visited.fill(0);
+        self.generation = 0;
+        self.in_band.fill(0);
+        self.band_len.fill(0);
+        self.rim_len.fill(0);
+        self.band_gen.fill(0);
     }
 
     /// The largest number of points [`detect`](Self::detect) can return.

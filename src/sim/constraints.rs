@@ -167,6 +167,24 @@ impl Constraints {
         &self.fext
     }
 
+    /// The rows of the last assembly and their impulses after the last solve
+    /// (the step's derivatives read them, `sim/derivatives`).
+    pub fn rows_view(&self) -> &Rows {
+        &self.rows
+    }
+    /// The contact point (index into the step's points) of each contact triple.
+    pub fn row_points(&self) -> &[usize] {
+        &self.row_point
+    }
+    /// H̃⁻¹Jᵀλ of the last solve.
+    pub fn impulse_velocity(&self) -> &DVector<f64> {
+        &self.dv
+    }
+    /// The last solve's position-pass pseudo-velocity w, if it ran.
+    pub fn push_velocity(&self) -> Option<&DVector<f64>> {
+        (self.counts.violated > 0).then_some(&self.push)
+    }
+
     /// Builds the rows at (q, v) for a step `h`: joint friction and limits
     /// (within 1 mm + 2|v|h of a limit), then three rows per contact point.
     /// `o_m_i` are the world poses at q (contact Jacobians are built from them).

@@ -60,11 +60,15 @@
 //! Nothing is allocated in [`Simulation::step`]: every buffer is sized at construction.
 
 pub mod constraints;
+pub mod derivatives;
 pub mod factor;
 pub(crate) mod integrators;
 pub mod newton;
+mod sensors;
+mod servo;
 pub mod solver;
 
+pub use derivatives::{JacobianMethod, TransitionJacobians};
 pub use integrators::Integrator;
 
 use crate::contact::{ContactError, ContactParams, ContactPoint, GroundContact};
@@ -356,6 +360,8 @@ pub struct Simulation {
     row_params: RowParams,
     mass: MassWork,
     smooth: SmoothWork,
+    servo: servo::Servo,
+    sensors: sensors::Sensors,
     forcing_changed: bool,
     guard: EnergyGuard,
     /// The energy at the current state, once computed.
@@ -494,6 +500,8 @@ impl Simulation {
                 h_next: opts.dt,
                 fsal_ok: false,
             },
+            servo: servo::Servo::new(&model.neutral(), nv),
+            sensors: sensors::Sensors::new(nq, nv),
             forcing_changed: true,
             energy_now: None,
             guard: EnergyGuard {
@@ -573,6 +581,7 @@ impl Simulation {
     /// divergence reference reset (recovery first where the state violates a
     /// constraint).
     fn state_changed(&mut self) {
+        self.sensors.forget();
         self.smooth.fsal_ok = false;
         self.cons.reset_warm_start();
         self.refresh_contacts();
@@ -825,6 +834,7 @@ impl Simulation {
             return Ok(0.0);
         }
         let h_fixed = land(self.dt, remaining);
+        self.sensors.begin(&self.q, &self.v);
         // 1. the constraint rows at the start of the step (contact points were
         //    found at this q by the last step's refresh): a joint that can
         //    reach its limit within the step has a row
@@ -837,7 +847,7 @@ impl Simulation {
         let mut time_stepping =
             self.integrator == Integrator::SemiImplicitEuler || counts.touching();
         let mut h_max = f64::INFINITY;
-        if !time_stepping && self.has_damping {
+        if !time_stepping && (self.has_damping || self.servo.active) {
             let rate = self.damping_rate()?;
             let limit = integrators::explicit_limit(self.integrator);
             time_stepping = rate * h_fixed > limit;
@@ -860,6 +870,7 @@ impl Simulation {
             }
         };
         self.t = if h >= remaining { t_end } else { self.t + h };
+        self.sensors.end(h);
         self.steps += 1;
         if self.model.floating_base {
             normalize_quat(&mut self.q);
@@ -933,7 +944,7 @@ impl Simulation {
         let Some(bound) = self.opts.max_energy_rise else {
             return Ok(());
         };
-        if self.tau_applied.iter().any(|&x| x != 0.0) {
+        if self.servo.active || self.tau_applied.iter().any(|&x| x != 0.0) {
             self.guard.reference = None;
             return Ok(());
         }

@@ -26,17 +26,24 @@ impl Simulation {
     /// The damping's stiffness bound tr((H + A)⁻¹D) = Σ Dᵢ (H + A)⁻¹ᵢᵢ at the
     /// current q (s⁻¹; 0 without damping).
     pub(in crate::sim) fn damping_rate(&mut self) -> Result<f64, SimError> {
-        if !self.has_damping {
+        if !self.has_damping && !self.servo.active {
             return Ok(0.0);
         }
         self.factor_mass(0.0)?;
         let mut rate = 0.0;
+        // servos: their damping gain adds to D, their stiffness to the
+        // oscillation rate √tr((H + A)⁻¹Kp) (docs/theory.md §"Joint servos")
+        let mut stiff = 0.0;
         for i in 0..self.model.nv {
-            let d = self.damping[i];
+            let d = self.damping[i] + self.servo.kd[i];
             if d > 0.0 {
                 rate += d * self.mass.f.inverse_diagonal(i);
             }
+            let kp = self.servo.kp[i];
+            if kp > 0.0 {
+                stiff += kp * self.mass.f.inverse_diagonal(i);
+            }
         }
-        Ok(rate)
+        Ok(rate + stiff.sqrt())
     }
 }

@@ -57,6 +57,9 @@ impl Simulation {
     /// (needed for constraint rows, damping or armature), else by the engine's
     /// forward dynamics (H̃ = H). No frame-rate term.
     pub(in crate::sim) fn free_velocity(&mut self, h: f64, dense: bool) -> Result<(), SimError> {
+        if self.servo.active {
+            return self.servo_free_velocity(h);
+        }
         let nv = self.model.nv;
         let mut tau = std::mem::replace(&mut self.mass.tau, DVector::zeros(0));
         self.clamped_tau(&mut tau);

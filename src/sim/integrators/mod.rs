@@ -6,10 +6,11 @@
 mod damping;
 pub(crate) use damping::explicit_limit;
 mod dop853;
-mod dop853_tableau;
+pub(in crate::sim) mod dop853_tableau;
 mod euler;
 mod rk4;
 mod smooth;
+pub(in crate::sim) use smooth::RhsIn;
 
 use super::constraints::{Constraints, Impulses};
 use super::{MassWork, SimError, SimOptions, Simulation};
@@ -86,7 +87,7 @@ impl Simulation {
     /// H̃ = H(q) + A + c·D at the current q, factored into `mass.f`
     /// (`data.h` is left holding H̃; its upper triangle only on a tree, all the
     /// tree-sparse factorisation reads).
-    fn factor_mass(&mut self, c: f64) -> Result<(), SimError> {
+    pub(in crate::sim) fn factor_mass(&mut self, c: f64) -> Result<(), SimError> {
         // the joint placements of the last forward kinematics at this q are
         // reused where the local-frame CRBA runs (it fills all of H, what
         // either factor reads)
@@ -101,7 +102,7 @@ impl Simulation {
             }
         }
         for k in 0..self.model.nv {
-            self.data.h[(k, k)] += self.armature[k] + c * self.damping[k];
+            self.data.h[(k, k)] += self.armature[k] + c * self.damping[k] + self.servo.diag(k, c);
         }
         self.mass
             .f

@@ -34,9 +34,10 @@ impl Simulation {
         if model.floating_base {
             normalize_quat(&mut w.qn);
         }
+        let (qo, vo) = (model.joint_q_offset(), model.joint_v_offset());
         for k in 0..nv {
-            let e = self.effort[k];
-            w.tau[k] = self.tau_applied[k].clamp(-e, e) + w.tau_c[k];
+            let (t, e) = (self.tau_applied[k], self.effort[k]);
+            w.tau[k] = self.servo.rhs_torque(t, e, &w.qn, &w.vv, qo, vo, k) + w.tau_c[k];
         }
         if self.has_damping {
             for k in 0..nv {

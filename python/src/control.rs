@@ -1,0 +1,208 @@
+//! Control from Python (python.md §"Control", §"Sensors"): the work behind
+//! `Simulation.set_gains`, `set_targets`, `transition_jacobians`, the sensors
+//! and `urdyn.linearize` (the methods themselves are thin, in `sim.rs`).
+
+use crate::args::{read_array, read_vec, value_error};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
+use pyo3::prelude::*;
+use rayon::prelude::*;
+use urdyn::nalgebra::{DMatrix, DVector, Vector3};
+use urdyn::sim::{JacobianMethod, Simulation};
+
+/// Gains: a number (every joint, base entries 0) or nv numbers.
+fn read_gains(sim: &Simulation, x: &Bound<'_, PyAny>, name: &str) -> PyResult<DVector<f64>> {
+    let nv = sim.model.nv;
+    let vo = sim.model.joint_v_offset();
+    if let Ok(g) = x.extract::<f64>() {
+        if !(g.is_finite() && g >= 0.0) {
+            return Err(value_error(format!(
+                "{name} must be a finite number ≥ 0 (got {g})"
+            )));
+        }
+        return Ok(DVector::from_fn(nv, |k, _| if k < vo { 0.0 } else { g }));
+    }
+    let mut out = DVector::zeros(nv);
+    read_vec(x, name, "nv", &mut out)?;
+    Ok(out)
+}
+
+/// `sim.set_gains(kp, kd)`.
+pub fn set_gains(
+    sim: &mut Simulation,
+    kp: &Bound<'_, PyAny>,
+    kd: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let kp = read_gains(sim, kp, "kp")?;
+    let kd = read_gains(sim, kd, "kd")?;
+    sim.set_gains(&kp, &kd)
+        .map_err(|e| value_error(e.to_string()))
+}
+
+/// `sim.set_targets(q_ref, v_ref=None)`.
+pub fn set_targets(
+    sim: &mut Simulation,
+    q_ref: &Bound<'_, PyAny>,
+    v_ref: Option<&Bound<'_, PyAny>>,
+) -> PyResult<()> {
+    let (nq, nv) = (sim.model.nq, sim.model.nv);
+    let mut q = DVector::zeros(nq);
+    read_vec(q_ref, "q_ref", "nq", &mut q)?;
+    let v = match v_ref {
+        Some(x) if !x.is_none() => {
+            let mut v = DVector::zeros(nv);
+            read_vec(x, "v_ref", "nv", &mut v)?;
+            Some(v)
+        }
+        _ => None,
+    };
+    sim.set_targets(&q, v.as_ref())
+        .map_err(|e| value_error(e.to_string()))
+}
+
+/// The method of `method=`.
+pub fn method(name: &str) -> PyResult<JacobianMethod> {
+    JacobianMethod::from_name(name).ok_or_else(|| {
+        value_error(format!(
+            "method: unknown \"{name}\" (one of: analytic, forward, central)"
+        ))
+    })
+}
+
+/// A numpy copy of a matrix.
+pub fn mat_out<'py>(py: Python<'py>, m: &DMatrix<f64>) -> Bound<'py, PyArray2<f64>> {
+    let (r, c) = m.shape();
+    let a = PyArray2::<f64>::zeros(py, [r, c], false);
+    // SAFETY: a fresh C-contiguous array of r·c entries, not shared yet
+    if let Ok(s) = unsafe { a.as_slice_mut() } {
+        for i in 0..r {
+            for j in 0..c {
+                s[i * c + j] = m[(i, j)];
+            }
+        }
+    }
+    a
+}
+
+/// `sim.transition_jacobians(tau=None, method="analytic", eps=1e-6)`.
+pub fn transition_jacobians<'py>(
+    py: Python<'py>,
+    sim: &Simulation,
+    tau: Option<&Bound<'py, PyAny>>,
+    method_name: &str,
+    eps: f64,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+    let m = method(method_name)?;
+    let mut t = DVector::zeros(sim.model.nv);
+    if let Some(x) = tau.filter(|x| !x.is_none()) {
+        read_vec(x, "tau", "nv", &mut t)?;
+    }
+    if !(eps > 0.0 && eps.is_finite()) {
+        return Err(value_error(format!(
+            "eps must be a positive number (got {eps})"
+        )));
+    }
+    let j = py
+        .detach(|| sim.transition_jacobians(&t, m, eps))
+        .map_err(|e| value_error(e.to_string()))?;
+    Ok((mat_out(py, &j.a), mat_out(py, &j.b)))
+}
+
+/// A pair of 3-vectors as numpy arrays.
+pub fn pair<'py>(
+    py: Python<'py>,
+    r: Result<(Vector3<f64>, Vector3<f64>), urdyn::sim::SimError>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    let (a, b) = r.map_err(|e| value_error(e.to_string()))?;
+    Ok((
+        PyArray1::from_slice(py, a.as_slice()),
+        PyArray1::from_slice(py, b.as_slice()),
+    ))
+}
+
+/// `urdyn.linearize(sim, q, v, tau, threads=None)`: A, B at each of T states,
+/// in parallel (one workspace per rayon task), the GIL released.
+#[allow(clippy::type_complexity)]
+pub fn linearize<'py>(
+    py: Python<'py>,
+    sim: &Simulation,
+    q: &Bound<'py, PyAny>,
+    v: &Bound<'py, PyAny>,
+    tau: &Bound<'py, PyAny>,
+    threads: Option<usize>,
+    method_name: &str,
+    eps: f64,
+) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
+    let m = method(method_name)?;
+    let (nq, nv) = (sim.model.nq, sim.model.nv);
+    let (qs, qd) = read_array(q, "q")?;
+    let (vs, vd) = read_array(v, "v")?;
+    let (ts, td) = read_array(tau, "tau")?;
+    if qs.len() != 2 || qs[1] != nq {
+        return Err(value_error(format!(
+            "q has shape {qs:?}, expected (T, {nq}) (nq = {nq})"
+        )));
+    }
+    let t = qs[0];
+    if vs != [t, nv] {
+        return Err(value_error(format!(
+            "v has shape {vs:?}, expected ({t}, {nv}) (T, nv)"
+        )));
+    }
+    if ts != [t, nv] {
+        return Err(value_error(format!(
+            "tau has shape {ts:?}, expected ({t}, {nv}) (T, nv)"
+        )));
+    }
+    if threads == Some(0) {
+        return Err(value_error("threads must be at least 1 (None: all cores)"));
+    }
+    if !(eps > 0.0 && eps.is_finite()) {
+        return Err(value_error(format!(
+            "eps must be a positive number (got {eps})"
+        )));
+    }
+    let n = 2 * nv;
+    let aa = PyArray3::<f64>::zeros(py, [t, n, n], false);
+    let ba = PyArray3::<f64>::zeros(py, [t, n, nv], false);
+    // SAFETY: fresh C-contiguous arrays no Python code has seen yet; the GIL
+    // is released below but nothing else holds them.
+    let ao = unsafe { aa.as_slice_mut() }.map_err(|e| value_error(e.to_string()))?;
+    let bo = unsafe { ba.as_slice_mut() }.map_err(|e| value_error(e.to_string()))?;
+    let run = |work: &mut Simulation,
+               (i, (ao, bo)): (usize, (&mut [f64], &mut [f64]))|
+     -> Result<(), String> {
+        let qi = DVector::from_column_slice(&qd[i * nq..(i + 1) * nq]);
+        let vi = DVector::from_column_slice(&vd[i * nv..(i + 1) * nv]);
+        let ti = DVector::from_column_slice(&td[i * nv..(i + 1) * nv]);
+        let j = work
+            .transition_jacobians_at(&qi, &vi, &ti, m, eps)
+            .map_err(|e| format!("state {i}: {e}"))?;
+        for r in 0..n {
+            for c in 0..n {
+                ao[r * n + c] = j.a[(r, c)];
+            }
+            for c in 0..nv {
+                bo[r * nv + c] = j.b[(r, c)];
+            }
+        }
+        Ok(())
+    };
+    let r = py.detach(|| {
+        let mut work = move || -> Result<(), String> {
+            ao.par_chunks_mut((n * n).max(1))
+                .zip(bo.par_chunks_mut((n * nv).max(1)))
+                .enumerate()
+                .try_for_each_init(|| sim.derivative_workspace(), run)
+        };
+        match threads {
+            None => work(),
+            Some(k) => rayon::ThreadPoolBuilder::new()
+                .num_threads(k)
+                .build()
+                .map_err(|e| format!("threads: cannot start a thread pool: {e}"))
+                .and_then(|pool| pool.install(work)),
+        }
+    });
+    r.map_err(value_error)?;
+    Ok((aa, ba))
+}

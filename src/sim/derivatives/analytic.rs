@@ -1,0 +1,519 @@
+//! The analytic transition Jacobians of the time-stepping step
+//! (docs/theory.md §"Transition Jacobians"), at the step's own solution.
+//!
+//! The step is taken once, by the step's own code; its rows, impulses λ,
+//! servo saturation and factor of H̃ are then differentiated:
+//! - the velocity equation H̃ a = u − C − D v + e + Jᵀλ/h (a = (v⁺ − v)/h
+//!   less the free base's frame rate) gives
+//!   H̃ δa = −K_q δq − K_v δv + U δτ + Jᵀδλ/h with
+//!   K_q = ∂ID/∂q − ∂(Jᵀλ)/∂q / h + Kp, K_v = ∂ID/∂v + D + Kd + h Kp
+//!   (ID at (q, v, a); servo terms on the joints whose servo is not saturated);
+//! - the rows' velocities u = J(q) v⁺ vary as δu = J δv⁺ + (∂J/∂q δq) v⁺, and
+//!   the solve's active set fixes one linear equation a row: a separating
+//!   contact (and a joint-friction row at its bound) keeps δλ = 0; a sticking
+//!   contact, a pressing normal and an engaged limit keep δu = δb (b = −φ/h
+//!   while the gap φ is open); a sliding pair keeps λₜ = −μ λₙ ûₜ, linearised;
+//! - δv⁺ = δv + h δa + h ∂(ω × v_lin)/∂v δv, then the configuration update
+//!   q⁺ = q ⊕ h v⁺ and the free base's velocity rotation, differentiated in
+//!   the tangent space (right Jacobian of SO(3)).
+//!
+//! The position pass's pseudo-velocity w is held fixed (its rows are at rest
+//! when nothing penetrates deeper than the slop). Contact points are material
+//! points of their link (hull and box vertices), a sphere's and a capsule's
+//! lowest point the point below its centre.
+
+use super::smooth::Tableau;
+use super::TransitionJacobians;
+use crate::dynamics::{forward_kinematics, rnea};
+use crate::model::configuration::integrate;
+use crate::sim::integrators::dop853_tableau::{A, B, N_STAGES};
+use crate::sim::integrators::explicit_limit;
+use crate::sim::solver::RowKind;
+use crate::sim::{Integrator, SimError, Simulation};
+use crate::spatial::{axis_angle, skew, Motion};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+
+impl Simulation {
+    /// A and B through the step's own equations, from the fresh state (set by
+    /// the caller) with joint torques `tau`: the steps up to `dt` (one for a
+    /// fixed-step integrator), each differentiated by its own scheme, composed.
+    pub(in crate::sim) fn analytic_jacobians(
+        &mut self,
+        tau: &DVector<f64>,
+    ) -> Result<TransitionJacobians, SimError> {
+        let n = self.model.nv;
+        self.set_joint_torques(tau);
+        let dt = self.dt;
+        let mut jx = DMatrix::<f64>::identity(2 * n, 2 * n);
+        let mut jt = DMatrix::<f64>::zeros(2 * n, n);
+        while self.t < dt {
+            let j = self.substep_jacobian(dt, tau)?;
+            let ax = j.columns(0, 2 * n).into_owned();
+            jt = &ax * jt + j.columns(2 * n, n);
+            jx = ax * jx;
+        }
+        Ok(TransitionJacobians { a: jx, b: jt })
+    }
+
+    /// One step toward `t_end`, taken, and its Jacobian [δq'; δv'] over the
+    /// columns (δq, δv, δτ) by the scheme it took.
+    fn substep_jacobian(
+        &mut self,
+        t_end: f64,
+        tau: &DVector<f64>,
+    ) -> Result<DMatrix<f64>, SimError> {
+        let (q0, v0) = (self.q.clone(), self.v.clone());
+        let points = self.points.clone();
+        // the step's scheme, as step_until chooses it
+        let h_fixed = crate::sim::land(self.dt, t_end - self.t);
+        let counts = self.assemble_rows(h_fixed);
+        let mut implicit = self.integrator == Integrator::SemiImplicitEuler || counts.touching();
+        if !implicit && (self.has_damping || self.servo.active) {
+            implicit = self.damping_rate()? * h_fixed > explicit_limit(self.integrator);
+        }
+        let h = self.step_until(t_end)?;
+        if !implicit {
+            let q1 = self.q.clone();
+            let rk4_a: [&[f64]; 4] = [&[], &[0.5], &[0.0, 0.5], &[0.0, 0.0, 1.0]];
+            let rk4_b = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
+            let a_all: &'static [[f64; N_STAGES]; N_STAGES] = &A;
+            let dop_a: Vec<&[f64]> = (0..N_STAGES).map(|s| &a_all[s][..s]).collect();
+            let tab = match self.integrator {
+                Integrator::Rk4 => Tableau {
+                    a: &rk4_a,
+                    b: &rk4_b,
+                },
+                _ => Tableau { a: &dop_a, b: &B },
+            };
+            return self.smooth_step_jacobian(&q0, &v0, &q1, tau, h, &tab);
+        }
+        self.implicit_step_jacobian(&q0, &v0, &points, counts, h, tau)
+    }
+
+    /// The Jacobian of the time-stepping step just taken from (q0, v0) with
+    /// the contact points `points` and rows `counts`, of length `h`.
+    fn implicit_step_jacobian(
+        &mut self,
+        q0: &DVector<f64>,
+        v0: &DVector<f64>,
+        points: &[crate::contact::ContactPoint],
+        counts: crate::sim::constraints::RowCounts,
+        h: f64,
+        tau: &DVector<f64>,
+    ) -> Result<DMatrix<f64>, SimError> {
+        let n = self.model.nv;
+        let rows_used = self.cons.rows_len() > 0 && counts.total() > 0;
+        // v⁺ in the start frame (before the base velocity's rotation), w
+        let mut vplus = self.mass.vfree.clone();
+        let mut vtot = vplus.clone();
+        if rows_used {
+            vplus += self.cons.impulse_velocity();
+            vtot.copy_from(&vplus);
+            if let Some(w) = self.cons.push_velocity() {
+                vtot += w;
+            }
+        }
+        // back at the start: poses and H̃ (the step's saturation set); the
+        // step's end state is put back at the end
+        let (q1, v1) = (self.q.clone(), self.v.clone());
+        self.q.copy_from(q0);
+        self.v.copy_from(v0);
+        self.fk_valid = false;
+        self.factor_mass(h)?;
+        forward_kinematics(&self.model, &mut self.data, q0)?;
+        let floating = self.model.floating_base;
+        let vo = self.model.joint_v_offset();
+        // a = (v⁺ − v)/h − frame rate
+        let mut acc = (&vplus - v0) / h;
+        if floating {
+            let fr = omega(v0).cross(&lin(v0));
+            for i in 0..3 {
+                acc[i] -= fr[i];
+            }
+        }
+        let (mut kq, mut kv) = self.id_derivatives(q0, v0, &acc)?;
+        // servo and damping terms, the effort clamp's
+        let s = &self.servo;
+        let mut u_free = vec![0.0; n];
+        for k in 0..n {
+            kv[(k, k)] += self.damping[k];
+            if k >= vo && s.saturated[k] == 0 {
+                u_free[k] = 1.0;
+                if s.active {
+                    kq[(k, k)] += s.kp[k];
+                    kv[(k, k)] += s.kd[k] + h * s.kp[k];
+                }
+            }
+        }
+        if !self.servo.active {
+            // the plain clamp: a joint whose τ_ff passes its effort is held there
+            for k in vo..n {
+                if tau[k].abs() > self.effort[k] {
+                    u_free[k] = 0.0;
+                }
+            }
+        }
+        // the rows: Jacobian, kinds, impulses; the contact points' second-order terms
+        let rows = self.cons.rows_view();
+        let m = rows.n;
+        let jac = DMatrix::from_fn(m, n, |r, c| rows.j[r * n + c]);
+        let mut jq = DMatrix::<f64>::zeros(m, n);
+        let mut gc = DMatrix::<f64>::zeros(n, n);
+        for (ci, &pi) in self.cons.row_points().iter().enumerate() {
+            let Some(pt) = points.get(pi) else { continue };
+            let rn = 3 * ci;
+            let f = Vector3::new(rows.lambda[rn + 1], rows.lambda[rn + 2], rows.lambda[rn]);
+            let anchor = pt.point + Vector3::z() * self.rolling_radius(pt.shape);
+            let t = point_second_derivatives(self, pt.body, &pt.point, &anchor);
+            for (a, &(ca, _)) in t.cols.iter().enumerate() {
+                for (b, &(cb, _)) in t.cols.iter().enumerate() {
+                    let d = t.d[a * t.cols.len() + b];
+                    // ∂(Jᵀλ)_ca / ∂q_cb
+                    gc[(ca, cb)] += d.dot(&f);
+                    // (∂J/∂q_cb v⁺) for the rows z (normal), x, y
+                    let wd = d * vplus[ca];
+                    jq[(rn, cb)] += wd.z;
+                    jq[(rn + 1, cb)] += wd.x;
+                    jq[(rn + 2, cb)] += wd.y;
+                }
+            }
+        }
+        kq -= &gc / h;
+        // Y = H̃⁻¹Jᵀ, W = J Y
+        let mut y = DMatrix::zeros(n, m);
+        let mut col = DVector::zeros(n);
+        for r in 0..m {
+            col.copy_from(&jac.row(r).transpose());
+            self.mass.f.solve(&mut col);
+            y.column_mut(r).copy_from(&col);
+        }
+        let w = &jac * &y;
+        // Z0: δv⁺ without the impulses' variation, columns (δq, δv, δτ)
+        let mut rhs = DMatrix::zeros(n, 3 * n);
+        for k in 0..n {
+            for c in 0..n {
+                rhs[(k, c)] = -h * kq[(k, c)];
+                rhs[(k, n + c)] = -h * kv[(k, c)];
+            }
+            rhs[(k, 2 * n + k)] = h * u_free[k];
+        }
+        let mut z0 = DMatrix::zeros(n, 3 * n);
+        for c in 0..3 * n {
+            col.copy_from(&rhs.column(c));
+            self.mass.f.solve(&mut col);
+            z0.column_mut(c).copy_from(&col);
+        }
+        for k in 0..n {
+            z0[(k, n + k)] += 1.0;
+        }
+        if floating {
+            // h ∂(ω × l)/∂v = h ([ω]×, −[l]×) on the linear rows
+            let (om, l) = (skew(&omega(v0)) * h, skew(&lin(v0)) * (-h));
+            for i in 0..3 {
+                for j in 0..3 {
+                    z0[(i, n + j)] += om[(i, j)];
+                    z0[(i, n + 3 + j)] += l[(i, j)];
+                }
+            }
+        }
+        // the active set's equations M δλ = R
+        let dvplus = if m == 0 {
+            z0
+        } else {
+            let mut cq = &jac * &z0;
+            for r in 0..m {
+                for c in 0..n {
+                    cq[(r, c)] += jq[(r, c)];
+                }
+            }
+            let mut mm = DMatrix::zeros(m, m);
+            let mut rr = DMatrix::zeros(m, 3 * n);
+            let mut r = 0;
+            while r < m {
+                match rows.kind[r] {
+                    RowKind::Normal => {
+                        let (ln, l1, l2) = (rows.lambda[r], rows.lambda[r + 1], rows.lambda[r + 2]);
+                        let mu = match rows.kind[r + 1] {
+                            RowKind::Tangent { mu, .. } => mu,
+                            _ => 0.0,
+                        };
+                        if ln <= 0.0 {
+                            // separating: δλ = 0 on all three
+                            for k in r..r + 3 {
+                                mm[(k, k)] = 1.0;
+                            }
+                        } else {
+                            let ut = Vector3::new(
+                                cq_row_dot(&jac, r + 1, &vplus),
+                                cq_row_dot(&jac, r + 2, &vplus),
+                                0.0,
+                            );
+                            let lt = (l1 * l1 + l2 * l2).sqrt();
+                            let sliding = lt >= mu * ln * (1.0 - 1e-9) && ut.norm() > 1e-9;
+                            // normal: δu = δb
+                            equality_row(&mut mm, &mut rr, &w, &cq, &jac, rows.b[r], r, n, h);
+                            if sliding {
+                                // λₜ = −μ λₙ û: δλₜ + μ û δλₙ + κ P δuₜ = 0
+                                let un = ut.norm();
+                                let uh = [ut.x / un, ut.y / un];
+                                let kappa = mu * ln / un;
+                                for a in 0..2 {
+                                    let ra = r + 1 + a;
+                                    mm[(ra, ra)] += 1.0;
+                                    mm[(ra, r)] += mu * uh[a];
+                                    for b in 0..2 {
+                                        let p = if a == b { 1.0 } else { 0.0 } - uh[a] * uh[b];
+                                        let rb = r + 1 + b;
+                                        for k in 0..m {
+                                            mm[(ra, k)] += kappa * p * w[(rb, k)];
+                                        }
+                                        for c in 0..3 * n {
+                                            rr[(ra, c)] -= kappa * p * cq[(rb, c)];
+                                        }
+                                    }
+                                }
+                            } else {
+                                for k in r + 1..r + 3 {
+                                    equality_row(&mut mm, &mut rr, &w, &cq, &jac, 0.0, k, n, h);
+                                }
+                            }
+                        }
+                        r += 3;
+                    }
+                    RowKind::Box { limit } => {
+                        if rows.lambda[r].abs() >= limit * (1.0 - 1e-9) {
+                            mm[(r, r)] = 1.0;
+                        } else {
+                            equality_row(&mut mm, &mut rr, &w, &cq, &jac, 0.0, r, n, h);
+                        }
+                        r += 1;
+                    }
+                    RowKind::Unilateral => {
+                        if rows.lambda[r] <= 0.0 {
+                            mm[(r, r)] = 1.0;
+                        } else {
+                            equality_row(&mut mm, &mut rr, &w, &cq, &jac, rows.b[r], r, n, h);
+                        }
+                        r += 1;
+                    }
+                    _ => r += 1,
+                }
+            }
+            // a stick set's rows can be redundant (a flat foot's vertices): the
+            // least-norm solution, whose Jᵀδλ is the same for any solution
+            let svd = mm.svd(true, true);
+            let tol = 1e-12 * svd.singular_values.max().max(1e-300);
+            let dl = svd
+                .solve(&rr, tol)
+                .map_err(|e| SimError::Invalid(format!("transition_jacobians: {e}")))?;
+            z0 + &y * dl
+        };
+        self.q.copy_from(&q1);
+        self.v.copy_from(&v1);
+        self.fk_valid = false;
+        Ok(self.output_map(&vtot, &dvplus, h))
+    }
+
+    /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces), by
+    /// central differences of RNEA (ε = 1e-6) until the analytic
+    /// `rnea_derivatives` of issue 21 lands (then: one call here).
+    pub(super) fn id_derivatives(
+        &mut self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        a: &DVector<f64>,
+    ) -> Result<(DMatrix<f64>, DMatrix<f64>), SimError> {
+        let n = self.model.nv;
+        let mut dq = DMatrix::zeros(n, n);
+        let mut dv = DMatrix::zeros(n, n);
+        let eps = 1e-6;
+        for k in 0..n {
+            let mut e = DVector::zeros(n);
+            e[k] = eps;
+            let qp = integrate(&self.model, q, &e).map_err(|e| SimError::Invalid(e.to_string()))?;
+            let tp = rnea(&self.model, &mut self.data, &qp, v, a, None)?.clone();
+            let qm =
+                integrate(&self.model, q, &(-&e)).map_err(|e| SimError::Invalid(e.to_string()))?;
+            let tm = rnea(&self.model, &mut self.data, &qm, v, a, None)?.clone();
+            dq.column_mut(k).copy_from(&((tp - tm) / (2.0 * eps)));
+            let tp = rnea(&self.model, &mut self.data, q, &(v + &e), a, None)?.clone();
+            let tm = rnea(&self.model, &mut self.data, q, &(v - &e), a, None)?.clone();
+            dv.column_mut(k).copy_from(&((tp - tm) / (2.0 * eps)));
+        }
+        forward_kinematics(&self.model, &mut self.data, q)?;
+        Ok((dq, dv))
+    }
+
+    /// The radius of a contact shape that rolls (sphere, capsule): its contact
+    /// point is that far below the centre it moves with; 0 for vertices.
+    fn rolling_radius(&self, shape: usize) -> f64 {
+        self.contact
+            .as_ref()
+            .and_then(|c| c.shapes.get(shape))
+            .map_or(0.0, |s| s.rolling_radius())
+    }
+
+    /// [δq'; δv'] from δv⁺ (start frame) and the unperturbed total velocity
+    /// `vtot`, for the columns (δq, δv, δτ): A and B.
+    fn output_map(&self, vtot: &DVector<f64>, dvplus: &DMatrix<f64>, h: f64) -> DMatrix<f64> {
+        let n = self.model.nv;
+        let mut out = DMatrix::zeros(2 * n, 3 * n);
+        // joints: δq' = δq + h δv⁺, δv' = δv⁺
+        for c in 0..3 * n {
+            for k in 0..n {
+                let dq = if c < n && c == k { 1.0 } else { 0.0 };
+                out[(k, c)] = dq + h * dvplus[(k, c)];
+                out[(n + k, c)] = dvplus[(k, c)];
+            }
+        }
+        if self.model.floating_base {
+            // p' = p + h R l, R' = R Exp(h ω), v'_lin = Exp(h ω)ᵀ l⁺
+            let (w, l) = (omega(vtot), lin(vtot));
+            let th = (w * h).norm();
+            let e = if th > 0.0 {
+                axis_angle(&(w * h / th), th)
+            } else {
+                Matrix3::identity()
+            };
+            let et = e.transpose();
+            let jr = right_jacobian(&(w * h));
+            let vlin_new = et * l;
+            for c in 0..3 * n {
+                let dvp = column_vec(dvplus, c, n);
+                let (dl_in, dth_in) = if c < 3 {
+                    (unit(c), Vector3::zeros())
+                } else if c < 6 {
+                    (Vector3::zeros(), unit(c - 3))
+                } else {
+                    (Vector3::zeros(), Vector3::zeros())
+                };
+                let (dlv, dwv) = (lin(&dvp), omega(&dvp));
+                // δl' = Eᵀ(δl + h δθ × l + h δl⁺), δθ' = Eᵀ δθ + J_r h δω
+                let dl_out = et * (dl_in + dth_in.cross(&l) * h + dlv * h);
+                let dth_out = et * dth_in + jr * dwv * h;
+                // δv'_lin = Eᵀ δl⁺ + [v'_lin]× J_r h δω
+                let dv_out = et * dlv + vlin_new.cross(&(jr * dwv * h));
+                for i in 0..3 {
+                    out[(i, c)] = dl_out[i];
+                    out[(3 + i, c)] = dth_out[i];
+                    out[(n + i, c)] = dv_out[i];
+                }
+            }
+        }
+        out
+    }
+}
+
+/// One equality row δu_r = δb_r of the active set: W_r δλ = δb_r − C'_r, with
+/// δb = −J_r δq / h while the row's gap is open (b < 0), else 0.
+#[allow(clippy::too_many_arguments)]
+fn equality_row(
+    mm: &mut DMatrix<f64>,
+    rr: &mut DMatrix<f64>,
+    w: &DMatrix<f64>,
+    cq: &DMatrix<f64>,
+    jac: &DMatrix<f64>,
+    b: f64,
+    r: usize,
+    n: usize,
+    h: f64,
+) {
+    for k in 0..w.ncols() {
+        mm[(r, k)] = w[(r, k)];
+    }
+    for c in 0..3 * n {
+        rr[(r, c)] = -cq[(r, c)];
+    }
+    if b < 0.0 {
+        for c in 0..n {
+            rr[(r, c)] -= jac[(r, c)] / h;
+        }
+    }
+}
+
+fn cq_row_dot(jac: &DMatrix<f64>, r: usize, v: &DVector<f64>) -> f64 {
+    jac.row(r).transpose().dot(v)
+}
+
+fn omega(v: &DVector<f64>) -> Vector3<f64> {
+    Vector3::new(v[3], v[4], v[5])
+}
+fn lin(v: &DVector<f64>) -> Vector3<f64> {
+    Vector3::new(v[0], v[1], v[2])
+}
+fn unit(i: usize) -> Vector3<f64> {
+    let mut e = Vector3::zeros();
+    e[i] = 1.0;
+    e
+}
+fn column_vec(m: &DMatrix<f64>, c: usize, n: usize) -> DVector<f64> {
+    DVector::from_fn(n, |k, _| m[(k, c)])
+}
+
+/// SO(3)'s right Jacobian: Exp(x + δ) ≈ Exp(x) Exp(J_r(x) δ).
+fn right_jacobian(x: &Vector3<f64>) -> Matrix3<f64> {
+    let th = x.norm();
+    let k = skew(x);
+    if th < 1e-8 {
+        return Matrix3::identity() - k * 0.5 + k * k / 6.0;
+    }
+    Matrix3::identity() - k * ((1.0 - th.cos()) / (th * th))
+        + k * k * ((th - th.sin()) / (th * th * th))
+}
+
+/// ∂(S_c at p)/∂q_k for the columns c, k of a contact point's path (root
+/// first): `d[a·len + b]` is d/dq_{cols[b]} of column cols[a]'s point velocity.
+struct PointTerms {
+    /// (v index, depth of its joint on the path).
+    cols: Vec<(usize, usize)>,
+    d: Vec<Vector3<f64>>,
+}
+
+/// The second-order terms of a material point `p` of `body` (moving with its
+/// `anchor`: p itself for a vertex, the centre above a sphere's lowest point):
+/// the world column S_c of each ancestor dof varies as S_k × S_c for k on the
+/// same joint or an ancestor's, and the point moves by S_k at the anchor.
+fn point_second_derivatives(
+    sim: &Simulation,
+    body: usize,
+    p: &Vector3<f64>,
+    anchor: &Vector3<f64>,
+) -> PointTerms {
+    let model = &sim.model;
+    let mut chain = Vec::new();
+    let mut b = body;
+    while b != 0 {
+        chain.push(b);
+        b = model.parent[b];
+    }
+    chain.reverse();
+    let mut cols = Vec::new();
+    let mut s: Vec<Motion> = Vec::new();
+    for (depth, &b) in chain.iter().enumerate() {
+        let j = &model.joints[b];
+        let o = sim.data.o_m_i[b];
+        for c in 0..j.nv().min(6) {
+            cols.push((j.iv + c, depth));
+            s.push(o.act_motion(&j.subspace_column(c)));
+        }
+    }
+    let len = cols.len();
+    let mut d = vec![Vector3::zeros(); len * len];
+    for a in 0..len {
+        let sc = &s[a];
+        for bb in 0..len {
+            let sk = &s[bb];
+            let mut t = Vector3::zeros();
+            if cols[bb].1 <= cols[a].1 {
+                // S_k × S_c at p: (ω_k × v_c + v_k × ω_c) + (ω_k × ω_c) × p
+                let ang = sk.ang.cross(&sc.ang);
+                t += sk.ang.cross(&sc.lin) + sk.lin.cross(&sc.ang) + ang.cross(p);
+            }
+            // the point's own motion: ω_c × δp, δp = v_k + ω_k × anchor
+            let dp = sk.lin + sk.ang.cross(anchor);
+            t += sc.ang.cross(&dp);
+            d[a * len + bb] = t;
+        }
+    }
+    PointTerms { cols, d }
+}

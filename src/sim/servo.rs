@@ -1,0 +1,303 @@
+//! Joint servos: τ = τ_ff + kp (q_ref − q) + kd (v_ref − v) per degree of
+//! freedom, clamped to the URDF's `<limit effort>`, integrated implicitly as the
+//! joint damping is (docs/theory.md §"Joint servos").
+//!
+//! In the time-stepping step the servo is taken at the end of the step,
+//! q⁺ ≈ q + h v⁺ and v⁺ = v + Δv: h τ_s = h e − (h kd + h² kp) Δv with the
+//! explicit part e = kp (q_ref − q − h v) + kd (v_ref − v), so the step solves
+//! with H̃ = H + A + h D + h Kd + h² Kp and the right-hand side gains h e:
+//! stable at any gain (a servoed free joint is a damped oscillator that the
+//! scheme can only damp). A joint whose servo torque at v⁺ would pass its
+//! effort limit is *saturated*: its torque is ±effort, a constant, and its
+//! implicit term is dropped (the clamp's derivative is zero there); the set of
+//! saturated joints is found by re-solving until no free joint passes its limit.
+//! The smooth integrators (rk4, dop853) take the clamped servo torque in their
+//! right-hand side while it is mild for them (the damping's rate test with
+//! the servo added, `integrators/damping.rs`) and hand a stiff step to the
+//! implicit scheme.
+
+use crate::dynamics::{bias, bias_at_placements};
+use crate::sim::{SimError, Simulation};
+use nalgebra::DVector;
+
+/// The servos' gains and targets (all zero: no servo, nothing computed).
+#[derive(Clone, Debug)]
+pub(crate) struct Servo {
+    /// Stiffness per v coordinate (N·m/rad or N/m; base entries 0).
+    pub kp: DVector<f64>,
+    /// Damping gain per v coordinate (N·m·s/rad or N·s/m; base entries 0).
+    pub kd: DVector<f64>,
+    /// Position targets (nq; the base's part unused).
+    pub q_ref: DVector<f64>,
+    /// Velocity targets (nv).
+    pub v_ref: DVector<f64>,
+    /// Some gain is nonzero.
+    pub active: bool,
+    /// Per v coordinate: 0 free, +1 / −1 held at +effort / −effort in the last
+    /// implicit solve.
+    pub saturated: Vec<i8>,
+    /// The servo torque of each v coordinate in the last step (clamped, with τ_ff).
+    pub applied: DVector<f64>,
+}
+
+impl Servo {
+    /// No servo on a model with `nq`, `nv` coordinates; `q_ref` starts at `q0`.
+    pub fn new(q0: &DVector<f64>, nv: usize) -> Self {
+        Self {
+            kp: DVector::zeros(nv),
+            kd: DVector::zeros(nv),
+            q_ref: q0.clone(),
+            v_ref: DVector::zeros(nv),
+            active: false,
+            saturated: vec![0; nv],
+            applied: DVector::zeros(nv),
+        }
+    }
+
+    /// The implicit diagonal c·kd + c²·kp of v coordinate `k` (0 when saturated
+    /// or inactive), c the step (0: the explicit stiffness tests).
+    #[inline]
+    pub fn diag(&self, k: usize, c: f64) -> f64 {
+        if !self.active || self.saturated[k] != 0 {
+            return 0.0;
+        }
+        c * self.kd[k] + c * c * self.kp[k]
+    }
+
+    /// τ_ff + the servo torque at (q, v) of v coordinate `k`, clamped to
+    /// `effort` (the plain clamp without servos): the smooth right-hand side's
+    /// applied torque. `qo`, `vo`: the joints' offsets in q and v.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn rhs_torque(
+        &self,
+        tau_ff: f64,
+        effort: f64,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        qo: usize,
+        vo: usize,
+        k: usize,
+    ) -> f64 {
+        let mut t = tau_ff;
+        if self.active && k >= vo {
+            let iq = qo + k - vo;
+            t += self.torque(iq, k, q[iq], v[k]);
+        }
+        t.clamp(-effort, effort)
+    }
+
+    /// The unclamped servo torque of v coordinate `iv` (q coordinate `iq`) at (q, v).
+    #[inline]
+    pub fn torque(&self, iq: usize, iv: usize, q: f64, v: f64) -> f64 {
+        self.kp[iv] * (self.q_ref[iq] - q) + self.kd[iv] * (self.v_ref[iv] - v)
+    }
+}
+
+impl Simulation {
+    /// Sets the servo gains per v coordinate (nv each; a floating base's six
+    /// entries must be 0). Negative, non-finite or wrongly sized gains, or a
+    /// nonzero gain on a base entry, are an error and nothing is set. Gains
+    /// all 0 (the default) switch the servos off: the step is then bit for bit
+    /// the one without servos.
+    pub fn set_gains(&mut self, kp: &DVector<f64>, kd: &DVector<f64>) -> Result<(), SimError> {
+        let nv = self.model.nv;
+        let vo = self.model.joint_v_offset();
+        for (name, g) in [("kp", kp), ("kd", kd)] {
+            if g.len() != nv {
+                return Err(SimError::Invalid(format!(
+                    "{name} has {} entries, the model has nv = {nv}",
+                    g.len()
+                )));
+            }
+            for (k, &x) in g.iter().enumerate() {
+                if !x.is_finite() || x < 0.0 {
+                    return Err(SimError::Invalid(format!(
+                        "{name}[{k}] must be a finite number ≥ 0 (got {x})"
+                    )));
+                }
+                if k < vo && x != 0.0 {
+                    return Err(SimError::Invalid(format!(
+                        "{name}[{k}] is a floating-base entry: its gain must be 0 (got {x})"
+                    )));
+                }
+            }
+        }
+        let s = &mut self.servo;
+        s.kp.copy_from(kp);
+        s.kd.copy_from(kd);
+        s.active = kp.iter().chain(kd.iter()).any(|&x| x != 0.0);
+        s.saturated.fill(0);
+        self.forcing_changed = true;
+        self.smooth.fsal_ok = false;
+        Ok(())
+    }
+
+    /// Sets the same gains on every joint (base entries 0); see [`Simulation::set_gains`].
+    pub fn set_gains_uniform(&mut self, kp: f64, kd: f64) -> Result<(), SimError> {
+        let nv = self.model.nv;
+        let vo = self.model.joint_v_offset();
+        let fill = |g: f64| DVector::from_fn(nv, |k, _| if k < vo { 0.0 } else { g });
+        self.set_gains(&fill(kp), &fill(kd))
+    }
+
+    /// Sets the servo targets: `q_ref` (nq; a floating base's part ignored) and
+    /// `v_ref` (nv; `None`: zero). Wrong sizes or non-finite entries are an
+    /// error and nothing is set. Targets persist across [`Simulation::set_state`].
+    pub fn set_targets(
+        &mut self,
+        q_ref: &DVector<f64>,
+        v_ref: Option<&DVector<f64>>,
+    ) -> Result<(), SimError> {
+        let (nq, nv) = (self.model.nq, self.model.nv);
+        if q_ref.len() != nq {
+            return Err(SimError::Invalid(format!(
+                "q_ref has {} entries, the model has nq = {nq}",
+                q_ref.len()
+            )));
+        }
+        if let Some(k) = q_ref.iter().position(|x| !x.is_finite()) {
+            return Err(SimError::Invalid(format!(
+                "q_ref[{k}] is not a finite number ({})",
+                q_ref[k]
+            )));
+        }
+        if let Some(v) = v_ref {
+            if v.len() != nv {
+                return Err(SimError::Invalid(format!(
+                    "v_ref has {} entries, the model has nv = {nv}",
+                    v.len()
+                )));
+            }
+            if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+                return Err(SimError::Invalid(format!(
+                    "v_ref[{k}] is not a finite number ({})",
+                    v[k]
+                )));
+            }
+        }
+        let s = &mut self.servo;
+        s.q_ref.copy_from(q_ref);
+        match v_ref {
+            Some(v) => s.v_ref.copy_from(v),
+            None => s.v_ref.fill(0.0),
+        }
+        self.forcing_changed = true;
+        self.smooth.fsal_ok = false;
+        Ok(())
+    }
+
+    /// The servo gains (kp, kd), nv each.
+    pub fn gains(&self) -> (&DVector<f64>, &DVector<f64>) {
+        (&self.servo.kp, &self.servo.kd)
+    }
+    /// The servo targets (q_ref: nq, v_ref: nv).
+    pub fn targets(&self) -> (&DVector<f64>, &DVector<f64>) {
+        (&self.servo.q_ref, &self.servo.v_ref)
+    }
+    /// Whether a servo gain is nonzero.
+    pub fn has_servos(&self) -> bool {
+        self.servo.active
+    }
+
+    /// The free velocity with servos (the servo form of
+    /// [`Simulation::free_velocity`]'s dense branch):
+    /// v* = v + h H̃⁻¹(u − C − D v) with H̃ = H + A + h D + h Kd + h² Kp on the
+    /// free joints and u = τ_ff + e (e the servo's explicit part), or ±effort on
+    /// the saturated ones; the saturated set grows until no free joint's torque
+    /// at v* passes its limit.
+    pub(in crate::sim) fn servo_free_velocity(&mut self, h: f64) -> Result<(), SimError> {
+        let nv = self.model.nv;
+        let (qo, vo) = (self.model.joint_q_offset(), self.model.joint_v_offset());
+        // C(q, v), as the dense branch of free_velocity computes it
+        let mut c = std::mem::replace(&mut self.mass.vtot, DVector::zeros(0));
+        let r = if self.fk_valid && self.v.len() == nv {
+            bias_at_placements(&self.model, &mut self.data, &self.v);
+            Ok(&self.data.bias)
+        } else {
+            bias(&self.model, &mut self.data, &self.q, &self.v, None)
+        };
+        let r = r.map(|b| c.copy_from(b)).map_err(SimError::from);
+        if let Err(e) = r {
+            self.mass.vtot = c;
+            return Err(e);
+        }
+        // start with the joints whose servo has no gain and whose τ_ff passes
+        // the limit saturated (the plain clamp), every servoed joint free
+        for k in 0..nv {
+            let e = self.effort[k];
+            let t = self.tau_applied[k];
+            let servoed = self.servo.kp[k] != 0.0 || self.servo.kd[k] != 0.0;
+            self.servo.saturated[k] = if !servoed && t.abs() > e {
+                t.signum() as i8
+            } else {
+                0
+            };
+        }
+        let mut tau = std::mem::replace(&mut self.mass.tau, DVector::zeros(0));
+        let mut result = Ok(());
+        for _pass in 0..=nv.min(8) {
+            // u − C − D v, u = τ_ff + e on free joints, ±effort on saturated ones
+            for k in 0..nv {
+                let u = match self.servo.saturated[k] {
+                    0 => self.tau_applied[k] + self.servo_explicit(qo, vo, k, h),
+                    s => f64::from(s) * self.effort[k],
+                };
+                tau[k] = u - c[k] - self.damping[k] * self.v[k];
+            }
+            if let Err(e) = self.factor_mass(h) {
+                result = Err(e);
+                break;
+            }
+            self.mass.f.solve(&mut tau);
+            self.mass.vfree.copy_from(&self.v);
+            self.mass.vfree.axpy(h, &tau, 1.0);
+            // a free joint whose torque at v* passes its limit is saturated
+            let mut grew = false;
+            for k in vo..nv {
+                if self.servo.saturated[k] != 0 || !self.effort[k].is_finite() {
+                    continue;
+                }
+                let t = self.servo_torque_after(qo, vo, k, h);
+                if t.abs() > self.effort[k] {
+                    self.servo.saturated[k] = t.signum() as i8;
+                    grew = true;
+                }
+            }
+            if !grew {
+                break;
+            }
+        }
+        for k in 0..nv {
+            self.servo.applied[k] = match self.servo.saturated[k] {
+                0 if k >= vo => self.servo_torque_after(qo, vo, k, h),
+                0 => self.tau_applied[k],
+                s => f64::from(s) * self.effort[k],
+            };
+        }
+        self.mass.tau = tau;
+        self.mass.vtot = c;
+        result
+    }
+
+    /// The servo's explicit part e = kp (q_ref − q − h v) + kd (v_ref − v) of v
+    /// coordinate `k` (0 on base entries).
+    #[inline]
+    fn servo_explicit(&self, qo: usize, vo: usize, k: usize, h: f64) -> f64 {
+        if k < vo {
+            return 0.0;
+        }
+        let iq = qo + k - vo;
+        let s = &self.servo;
+        s.torque(iq, k, self.q[iq], self.v[k]) - h * s.kp[k] * self.v[k]
+    }
+
+    /// τ_ff + the servo torque of joint coordinate `k` at the end of the step,
+    /// q⁺ ≈ q + h v*, v⁺ = v* (`mass.vfree`).
+    #[inline]
+    fn servo_torque_after(&self, qo: usize, vo: usize, k: usize, h: f64) -> f64 {
+        let iq = qo + k - vo;
+        let v1 = self.mass.vfree[k];
+        self.tau_applied[k] + self.servo.torque(iq, k, self.q[iq] + h * v1, v1)
+    }
+}

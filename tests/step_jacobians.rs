@@ -1,0 +1,283 @@
+//! Transition Jacobians of a step (`Simulation::transition_jacobians`): the
+//! analytic A, B against central finite differences of the step on an arm, a
+//! damped chain, a quadruped standing (sticking), a box sliding, with servos;
+//! the finite-difference modes against each other; the call changes nothing.
+
+use nalgebra::{DMatrix, DVector};
+use urdyn::contact::ContactParams;
+use urdyn::sim::{Integrator, JacobianMethod, SimOptions, Simulation, TransitionJacobians};
+use urdyn::{load_file, load_str, LoadOptions};
+
+const FLOAT: LoadOptions = LoadOptions {
+    floating_base: true,
+};
+
+fn rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    (a - b).norm() / b.norm().max(1e-300)
+}
+
+fn jac(sim: &Simulation, tau: &DVector<f64>, m: JacobianMethod) -> TransitionJacobians {
+    sim.transition_jacobians(tau, m, 1e-6).unwrap()
+}
+
+/// Analytic against central within `tol` (Frobenius, relative), forward
+/// against central within `ftol`; returns (err A, err B).
+fn check(sim: &Simulation, tau: &DVector<f64>, tol: f64, ftol: f64, what: &str) -> (f64, f64) {
+    let an = jac(sim, tau, JacobianMethod::Analytic);
+    let ce = jac(sim, tau, JacobianMethod::Central);
+    let fw = jac(sim, tau, JacobianMethod::Forward);
+    let (ea, eb) = (rel(&an.a, &ce.a), rel(&an.b, &ce.b));
+    eprintln!(
+        "{what}: analytic vs central A {ea:.2e} B {eb:.2e}; forward vs central A {:.2e} B {:.2e}",
+        rel(&fw.a, &ce.a),
+        rel(&fw.b, &ce.b)
+    );
+    assert!(ea < tol && eb < tol, "{what}: A {ea:.3e}, B {eb:.3e}");
+    assert!(
+        rel(&fw.a, &ce.a) < ftol && rel(&fw.b, &ce.b) < ftol,
+        "{what}: forward vs central"
+    );
+    (ea, eb)
+}
+
+/// A converged contact solve: the finite differences then see the step's
+/// derivative, not the solver's stopping tolerance (1e-6 m/s by default,
+/// against perturbations of 1e-6).
+fn tight() -> SimOptions {
+    SimOptions {
+        solver_tol: 1e-13,
+        solver_iterations: 400,
+        ..Default::default()
+    }
+}
+
+/// The state lowered by 50 µm: every contact inside its slop (1e-4 m), off
+/// the kink φ = 0 of the speculative target b = −max(φ, 0)/h where a resting
+/// contact sits (docs/theory.md §"Transition Jacobians": a mode boundary).
+fn pressed(sim: &mut Simulation) {
+    let (mut q, v) = (sim.q().clone(), sim.v().clone());
+    q[2] -= 5e-5;
+    sim.set_state(&q, &v).unwrap();
+}
+
+fn lcg(seed: &mut u64) -> f64 {
+    *seed = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    ((*seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+}
+
+#[test]
+fn arm_without_contact() {
+    let model = load_file("assets/robots/ur5.urdf", LoadOptions::default()).unwrap();
+    let nv = model.nv;
+    let opts = SimOptions {
+        ground: None,
+        integrator: Some(Integrator::SemiImplicitEuler),
+        ..Default::default()
+    };
+    let mut sim = Simulation::new(model, opts).unwrap();
+    let mut s = 7;
+    let q = DVector::from_fn(nv, |_, _| lcg(&mut s));
+    let v = DVector::from_fn(nv, |_, _| 2.0 * lcg(&mut s));
+    let tau = DVector::from_fn(nv, |_, _| 5.0 * lcg(&mut s));
+    sim.set_state(&q, &v).unwrap();
+    check(&sim, &tau, 1e-5, 1e-3, "ur5 euler");
+    // the identity part: ∂q'/∂τ = h ∂v'/∂τ on a fixed base
+    let an = jac(&sim, &tau, JacobianMethod::Analytic);
+    let h = sim.dt();
+    let top = an.b.rows(0, nv).into_owned();
+    let bottom = an.b.rows(nv, nv).into_owned() * h;
+    assert!(rel(&top, &bottom) < 1e-12);
+}
+
+#[test]
+fn damped_chain() {
+    let text = std::fs::read_to_string("tests/urdf/chain20_hanging.urdf")
+        .unwrap()
+        .replace("</joint>", "<dynamics damping=\"0.02\"/></joint>");
+    let model = load_str(&text, "chain20_damped.urdf", LoadOptions::default()).unwrap();
+    let nv = model.nv;
+    let opts = SimOptions {
+        ground: None,
+        integrator: Some(Integrator::SemiImplicitEuler),
+        ..Default::default()
+    };
+    let mut sim = Simulation::new(model, opts).unwrap();
+    let mut s = 3;
+    let q = DVector::from_fn(nv, |_, _| 0.5 * lcg(&mut s));
+    let v = DVector::from_fn(nv, |_, _| lcg(&mut s));
+    sim.set_state(&q, &v).unwrap();
+    let tau = DVector::from_fn(nv, |_, _| 0.1 * lcg(&mut s));
+    check(&sim, &tau, 1e-5, 1e-3, "damped chain");
+}
+
+#[path = "common/quadruped.rs"]
+mod quadruped;
+
+#[test]
+fn quadruped_standing_with_servos() {
+    let mut sim = quadruped::standing_quadruped(tight());
+    assert_eq!(sim.active_contacts(), 4);
+    pressed(&mut sim);
+    let nv = sim.model.nv;
+    let tau = DVector::zeros(nv);
+    check(&sim, &tau, 1e-5, 1e-2, "quadruped standing");
+    // sticking feet: the feet's positions are not moved by τ, and a step from
+    // rest stays at rest: A's velocity block maps the rest state's velocities
+    let an = jac(&sim, &tau, JacobianMethod::Analytic);
+    assert!(an.a.iter().all(|x| x.is_finite()));
+}
+
+fn box_urdf() -> &'static str {
+    r#"<robot name="box"><link name="box">
+<inertial><mass value="1"/><inertia ixx="0.0042" iyy="0.0042" izz="0.0067" ixy="0" ixz="0" iyz="0"/></inertial>
+<collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision></link></robot>"#
+}
+
+#[test]
+fn box_sliding_on_the_ground() {
+    let model = load_str(box_urdf(), "box.urdf", FLOAT).unwrap();
+    let opts = SimOptions {
+        contact: ContactParams {
+            friction: 0.3,
+            ..Default::default()
+        },
+        ..tight()
+    };
+    let mut sim = Simulation::new(model, opts).unwrap();
+    let mut q = sim.q().clone();
+    q[2] = 0.05;
+    sim.set_state(&q, &DVector::zeros(6)).unwrap();
+    for _ in 0..200 {
+        sim.step().unwrap();
+    }
+    // sliding along x (no spin): every corner slides the same way
+    let (q, mut v) = (sim.q().clone(), sim.v().clone());
+    v[0] = 1.0;
+    sim.set_state(&q, &v).unwrap();
+    pressed(&mut sim);
+    check(&sim, &DVector::zeros(6), 1e-5, 1e-2, "box sliding");
+}
+
+#[test]
+fn the_call_changes_nothing() {
+    let a0 = quadruped::standing_quadruped(tight());
+    let mut a = a0.clone();
+    let mut b = a0.clone();
+    let tau = DVector::from_element(a.model.nv, 0.1);
+    a.set_torques(&tau).unwrap();
+    b.set_torques(&tau).unwrap();
+    for k in 0..30 {
+        if k % 10 == 0 {
+            for m in JacobianMethod::ALL {
+                let _ = a.transition_jacobians(&tau, m, 1e-6).unwrap();
+            }
+        }
+        a.step().unwrap();
+        b.step().unwrap();
+        assert_eq!(a.q(), b.q());
+        assert_eq!(a.v(), b.v());
+    }
+}
+
+#[test]
+fn jacobians_depend_on_the_state_alone() {
+    // the same (q, v) after different pasts: the same A, B
+    let a = quadruped::standing_quadruped(tight());
+    let mut b = a.clone();
+    for _ in 0..5 {
+        b.step().unwrap();
+    }
+    let (q, v) = (a.q().clone(), a.v().clone());
+    b.set_state(&q, &v).unwrap();
+    let tau = DVector::zeros(a.model.nv);
+    for m in JacobianMethod::ALL {
+        let ja = a.transition_jacobians(&tau, m, 1e-6).unwrap();
+        let jb = b.transition_jacobians(&tau, m, 1e-6).unwrap();
+        assert_eq!(ja, jb, "{}", m.name());
+    }
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let model = load_file("assets/robots/ur5.urdf", LoadOptions::default()).unwrap();
+    let opts = SimOptions {
+        ground: None,
+        ..Default::default()
+    };
+    let sim = Simulation::new(model, opts).unwrap();
+    let e = sim
+        .transition_jacobians(&DVector::zeros(3), JacobianMethod::Analytic, 1e-6)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("nv = 6") && !e.contains('\n'), "{e}");
+    let e = sim
+        .transition_jacobians(&DVector::zeros(6), JacobianMethod::Central, 0.0)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("eps"), "{e}");
+    let mut tau = DVector::zeros(6);
+    tau[2] = f64::NAN;
+    assert!(sim
+        .transition_jacobians(&tau, JacobianMethod::Forward, 1e-6)
+        .is_err());
+    assert_eq!(
+        JacobianMethod::from_name("central"),
+        Some(JacobianMethod::Central)
+    );
+    assert_eq!(JacobianMethod::from_name("backward"), None);
+}
+
+#[test]
+fn smooth_integrators_by_the_runge_kutta_chain_rule() {
+    // ur5 without contact, with servos, by rk4 and dop853 (their own smooth
+    // steps: no contact, no limit within reach, mild gains)
+    let model = load_file("assets/robots/ur5.urdf", LoadOptions::default()).unwrap();
+    let nv = model.nv;
+    for integ in [Integrator::Rk4, Integrator::Dop853] {
+        let opts = SimOptions {
+            ground: None,
+            integrator: Some(integ),
+            ..Default::default()
+        };
+        let mut sim = Simulation::new(model.clone(), opts).unwrap();
+        let mut s = 11;
+        let q = DVector::from_fn(nv, |_, _| lcg(&mut s));
+        let v = DVector::from_fn(nv, |_, _| lcg(&mut s));
+        sim.set_state(&q, &v).unwrap();
+        sim.set_gains_uniform(20.0, 0.5).unwrap();
+        sim.set_targets(&DVector::zeros(nv), None).unwrap();
+        let tau = DVector::from_fn(nv, |_, _| lcg(&mut s));
+        check(
+            &sim,
+            &tau,
+            1e-5,
+            1e-3,
+            &format!("ur5 servos {}", integ.name()),
+        );
+    }
+    // a free body spinning in flight (the quaternion inside the ODE)
+    let model = load_str(box_urdf(), "box.urdf", FLOAT).unwrap();
+    for integ in Integrator::ALL {
+        let opts = SimOptions {
+            ground: None,
+            integrator: Some(integ),
+            ..Default::default()
+        };
+        let mut sim = Simulation::new(model.clone(), opts).unwrap();
+        let mut q = sim.q().clone();
+        let (s, c) = (0.3f64.sin(), 0.3f64.cos());
+        q[3] = s;
+        q[6] = c;
+        let v = DVector::from_vec(vec![0.4, -0.2, 1.0, 3.0, -2.0, 5.0]);
+        sim.set_state(&q, &v).unwrap();
+        check(
+            &sim,
+            &DVector::zeros(6),
+            1e-5,
+            1e-3,
+            &format!("free box {}", integ.name()),
+        );
+    }
+}
