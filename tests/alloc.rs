@@ -1,15 +1,13 @@
 //! Zero heap allocation per call in the hot path, proven with a counting global
-//! allocator. Its own test binary (one test function) so that no other test thread
-//! allocates while a count is taken.
+//! allocator (`common/counting_alloc.rs`: per thread, so that the other tests of the
+//! binary may allocate while a count is taken).
 
 use std::path::PathBuf;
 use urdyn::cli::bench::random_states;
 use urdyn::dynamics;
 use urdyn::{Data, LoadOptions};
 
-#[path = "common/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::{allocations, measure_this_thread};
+use crate::common::counting_alloc::{allocations, measure_this_thread};
 
 fn count(f: impl FnOnce()) -> usize {
     let before = allocations();

@@ -8,9 +8,7 @@ use urdyn::dynamics::{self, center_of_mass, forward_kinematics, update_frames, R
 use urdyn::model::FrameId;
 use urdyn::{Data, LoadOptions, Model};
 
-#[path = "common/lcg.rs"]
-mod lcg;
-use lcg::Lcg;
+use crate::common::lcg::Lcg;
 
 fn load(path: &str, floating: bool) -> Model {
     let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);

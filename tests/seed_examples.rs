@@ -8,9 +8,7 @@ use urdyn::{Data, LoadOptions, Model};
 
 const G: f64 = 9.81;
 
-#[path = "common/lcg.rs"]
-mod lcg;
-use lcg::Lcg;
+use crate::common::lcg::Lcg;
 
 fn load(name: &str, floating: bool) -> Model {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

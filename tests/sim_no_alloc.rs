@@ -3,9 +3,7 @@
 
 use urdyn::sim::{Integrator, SimOptions, Simulation};
 
-#[path = "common/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::{allocations, measure_this_thread};
+use crate::common::counting_alloc::{allocations, measure_this_thread};
 
 #[test]
 fn step_loop_does_not_allocate() {

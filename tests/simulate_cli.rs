@@ -11,9 +11,7 @@ fn urdyn() -> Command {
     Command::new(env!("CARGO_BIN_EXE_urdyn"))
 }
 
-#[path = "common/csv.rs"]
-mod csv;
-use csv::read_csv;
+use crate::common::csv::read_csv;
 
 #[test]
 fn lamp_drop_acceptance() {

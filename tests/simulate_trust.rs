@@ -20,9 +20,7 @@ fn simulate(args: &[&str], out: &Path) -> Output {
         .unwrap()
 }
 
-#[path = "common/csv.rs"]
-mod csv;
-use csv::read_csv;
+use crate::common::csv::read_csv;
 
 fn col(h: &[String], n: &str) -> usize {
     h.iter()

@@ -2,14 +2,11 @@
 //! against the same algorithm run in double-double precision (`common/dd.rs`,
 //! ~32 digits), with the backward error ‖H q̈ + C − τ‖ / (‖H‖‖q̈‖ + ‖τ‖) and
 //! cond₂(H). Prints the table of docs/stress.md
-//! (`cargo test --release --test stress -- --nocapture`).
+//! (`cargo test --release --test integration stress:: -- --nocapture`).
 //!
 //! Adding an algorithm is one line in [`algorithms`].
 
-#[path = "common/dd.rs"]
-mod dd;
-
-use dd::DD;
+use crate::common::dd::DD;
 use nalgebra::{DMatrix, DVector};
 use urdyn::dynamics;
 use urdyn::spatial::Scalar;

@@ -4,10 +4,7 @@
 //! column or row, a non-zero exit and no page. (The page running in a browser is
 //! checked by tests/browser/view_check.py, which `.ci/run` runs.)
 
-#[path = "common/csv.rs"]
-mod csv;
-
-use csv::read_csv;
+use crate::common::csv::read_csv;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

@@ -1,19 +1,21 @@
-//! A counting global allocator for the zero-allocation tests (each in its own test
-//! binary). Only allocations made on a thread that called [`measure_this_thread`]
-//! count: the test harness's own threads may allocate at any time (seen under load).
+//! A counting global allocator for the zero-allocation tests. It is the allocator
+//! of the whole integration-test binary, so it counts per thread: only allocations
+//! made on a thread that called [`measure_this_thread`] count, on that thread's own
+//! counter (the harness's threads and the other tests, running in parallel, may
+//! allocate at any time).
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
 thread_local! {
-    static MEASURED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    static MEASURED: Cell<bool> = const { Cell::new(false) };
+    static ALLOCS: Cell<usize> = const { Cell::new(0) };
 }
 
 fn tally() {
     if MEASURED.try_with(|m| m.get()).unwrap_or(false) {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        let _ = ALLOCS.try_with(|n| n.set(n.get() + 1));
     }
 }
 
@@ -43,7 +45,7 @@ pub fn measure_this_thread() {
     MEASURED.with(|m| m.set(true));
 }
 
-/// Allocations counted so far.
+/// Allocations counted so far on the calling thread.
 pub fn allocations() -> usize {
-    ALLOCS.load(Ordering::SeqCst)
+    ALLOCS.with(|n| n.get())
 }

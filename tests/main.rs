@@ -1,0 +1,53 @@
+//! The integration tests: one test binary (`integration`), each `tests/NAME.rs` a
+//! module of it, so the suite is linked once instead of once a file. Cargo.toml sets
+//! `autotests = false`: a file under `tests/` is compiled only through a `mod` line
+//! below, and [`every_test_file_is_a_module`] fails for one that has none.
+//!
+//! Adding a test file `tests/NAME.rs`: one line `mod NAME;` here. Its helpers come from
+//! `use crate::common::...` (an older `#[path = "common/lcg.rs"] mod lcg;` still works,
+//! except for `counting_alloc`, the binary's one global allocator).
+//! One module alone: `cargo test --release --test integration NAME::`.
+
+mod common;
+
+mod alloc;
+mod api;
+mod bad_inputs;
+mod eval_singular;
+mod fast_dynamics;
+mod kinematics_energy;
+mod layering;
+mod output_files;
+mod pinocchio_fixtures;
+mod seed_examples;
+mod sim;
+mod sim_no_alloc;
+mod sim_trust;
+mod simulate_cli;
+mod simulate_trust;
+mod stress;
+mod view;
+
+/// Every `tests/*.rs` file is a module of this binary (with `autotests = false` a file
+/// without its `mod` line would silently never be compiled or run).
+#[test]
+fn every_test_file_is_a_module() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
+    let main = std::fs::read_to_string(dir.join("main.rs")).expect("tests/main.rs");
+    let mut missing = Vec::new();
+    for e in std::fs::read_dir(&dir).expect("tests/") {
+        let p = e.expect("entry").path();
+        let Some(stem) = p.file_stem().and_then(|s| s.to_str()) else {
+            continue;
+        };
+        if p.extension().is_some_and(|x| x == "rs")
+            && stem != "main"
+            && !main.lines().any(|l| l.trim() == format!("mod {stem};"))
+        {
+            missing.push(format!(
+                "tests/{stem}.rs: add `mod {stem};` to tests/main.rs"
+            ));
+        }
+    }
+    assert!(missing.is_empty(), "{}", missing.join("\n"));
+}
