@@ -33,7 +33,13 @@ fn hot_path_does_not_allocate() {
         let fext = vec![urdyn::spatial::Force::zero(); model.nbodies];
         for s in &states {
             let (q, v, a, tau) = (&s.q, &s.v, &s.a, &s.tau);
-            let checks: [(&str, usize); 12] = [
+            let wrenches = [dynamics::LinkWrench {
+                frame: urdyn::model::FrameId(model.frames.len() - 1),
+                force: nalgebra::Vector3::new(1.0, -2.0, 0.5),
+                torque: nalgebra::Vector3::new(0.1, 0.2, -0.3),
+            }];
+            let mut jd = nalgebra::DMatrix::zeros(6, model.nv);
+            let checks: [(&str, usize); 18] = [
                 (
                     "rnea",
                     count(|| {
@@ -116,11 +122,54 @@ fn hot_path_does_not_allocate() {
                         dynamics::update_frames(&model, &mut data);
                     }),
                 ),
+                (
+                    "rnea_derivatives",
+                    count(|| {
+                        dynamics::rnea_derivatives(&model, &mut data, q, v, a, None).unwrap();
+                    }),
+                ),
+                (
+                    "rnea_derivatives+fext",
+                    count(|| {
+                        dynamics::rnea_derivatives(&model, &mut data, q, v, a, Some(&wrenches))
+                            .unwrap();
+                    }),
+                ),
+                (
+                    "aba_derivatives",
+                    count(|| {
+                        dynamics::aba_derivatives(&model, &mut data, q, v, tau, None).unwrap();
+                    }),
+                ),
+                (
+                    "aba_derivatives+fext",
+                    count(|| {
+                        dynamics::aba_derivatives(&model, &mut data, q, v, tau, Some(&wrenches))
+                            .unwrap();
+                    }),
+                ),
+                (
+                    "frame_jacobian_time_variation",
+                    count(|| {
+                        let f = urdyn::model::FrameId(model.frames.len() - 1);
+                        let r = dynamics::Reference::Local;
+                        dynamics::frame_jacobian_time_variation(
+                            &model, &mut data, q, v, f, r, &mut jd,
+                        )
+                        .unwrap();
+                    }),
+                ),
+                (
+                    "joint_jacobians",
+                    count(|| {
+                        dynamics::joint_jacobians(&model, &mut data, q).unwrap();
+                    }),
+                ),
             ];
             for (name, n) in checks {
                 assert_eq!(n, 0, "{file}: {name} allocated {n} times");
             }
         }
-        eprintln!("{file}: 0 allocations in rnea, bias, crba, ltdl, aba, fd, fd-crba, fd-rnea, fk");
+        eprintln!("{file}: 0 allocations in rnea, bias, crba, ltdl, aba, fd, fd-crba, fd-rnea, fk, the derivatives, joint Jacobians");
     }
 }

@@ -372,6 +372,17 @@ const BAD_STATES: &[(&str, bool, &[&str])] = &[
         &["states[0].frames", "sequence"],
     ),
     ("states_misspelt_state.json", false, &["states[0].qq"]),
+    // contract v3: "derivatives" is a boolean
+    (
+        "states_derivatives_not_bool.json",
+        false,
+        &["states[1].derivatives", "true or false"],
+    ),
+    (
+        "states_derivatives_string.json",
+        true,
+        &["states[0].derivatives", "true or false"],
+    ),
     (
         "states_misspelt_base.json",
         false,

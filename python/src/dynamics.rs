@@ -29,7 +29,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-fn dyn_error(model: &PyModel, e: DynamicsError) -> PyErr {
+pub(crate) fn dyn_error(model: &PyModel, e: DynamicsError) -> PyErr {
     match e {
         DynamicsError::Mimic => {
             let name = model
@@ -53,7 +53,7 @@ fn dyn_error(model: &PyModel, e: DynamicsError) -> PyErr {
 }
 
 /// q (and v, a) into the workspace's vectors, checked.
-fn read_q(d: &mut PyData, q: &Bound<'_, PyAny>) -> PyResult<()> {
+pub(crate) fn read_q(d: &mut PyData, q: &Bound<'_, PyAny>) -> PyResult<()> {
     read_vec(q, "q", "nq", &mut d.q)
 }
 
@@ -76,7 +76,7 @@ fn vec_out<'py>(py: Python<'py>, x: &[f64]) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_slice(py, x)
 }
 
-fn mat_out<'py>(py: Python<'py>, m: &DMatrix<f64>) -> Bound<'py, PyArray2<f64>> {
+pub(crate) fn mat_out<'py>(py: Python<'py>, m: &DMatrix<f64>) -> Bound<'py, PyArray2<f64>> {
     let (r, c) = m.shape();
     let a = unsafe { PyArray2::<f64>::new(py, [r, c], false) };
     // SAFETY: a fresh C-contiguous array of r·c entries, not shared yet
@@ -265,7 +265,7 @@ pub fn frame_placement<'py>(
 }
 
 /// The reference of a Jacobian's rows.
-fn reference(s: &str) -> PyResult<Reference> {
+pub(crate) fn reference(s: &str) -> PyResult<Reference> {
     match s {
         "world_aligned" => Ok(Reference::WorldAligned),
         "local" => Ok(Reference::Local),

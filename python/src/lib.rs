@@ -6,6 +6,7 @@
 //! names are fixed by `shared/spec/python.md` (Pinocchio's where it has one).
 
 mod args;
+mod derivatives;
 mod dynamics;
 mod model;
 mod sim;
@@ -29,6 +30,7 @@ fn _urdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SimulationError", m.py().get_type::<SimulationError>())?;
     m.add_function(wrap_pyfunction!(model::_model_from_state, m)?)?;
     dynamics::register(m)?;
+    derivatives::register(m)?;
     m.add_function(wrap_pyfunction!(sim::rollout, m)?)?;
     m.add_function(wrap_pyfunction!(sim::integrators, m)?)?;
     Ok(())

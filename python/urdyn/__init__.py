@@ -36,6 +36,14 @@ from ._urdyn import (  # noqa: F401
     rnea,
     rollout,
 )
+from ._urdyn import (  # noqa: F401
+    aba_derivatives,
+    difference,
+    frame_jacobian_time_variation,
+    integrate,
+    random_configuration,
+    rnea_derivatives,
+)
 
 __all__ = [
     "Data",
@@ -58,4 +66,10 @@ __all__ = [
     "potential_energy",
     "rnea",
     "rollout",
+    "aba_derivatives",
+    "difference",
+    "frame_jacobian_time_variation",
+    "integrate",
+    "random_configuration",
+    "rnea_derivatives",
 ]

@@ -32,11 +32,18 @@ pub enum Algo {
     Fd,
     /// `fk`: forward kinematics of every body and frame.
     Fk,
+    /// `rnea-derivatives`: ∂τ/∂q, ∂τ/∂v (and H) ([`dynamics::rnea_derivatives`]).
+    RneaDerivatives,
+    /// `aba-derivatives`: ∂q̈/∂q, ∂q̈/∂v, H⁻¹ ([`dynamics::aba_derivatives`]).
+    AbaDerivatives,
+    /// `jacobians`: every body's world Jacobian ([`dynamics::joint_jacobians`],
+    /// Pinocchio's `computeJointJacobians`).
+    Jacobians,
 }
 
 impl Algo {
     /// Every algorithm, in the order `bench` times and prints them.
-    pub const ALL: [Algo; 8] = [
+    pub const ALL: [Algo; 11] = [
         Algo::Rnea,
         Algo::Bias,
         Algo::Crba,
@@ -45,6 +52,9 @@ impl Algo {
         Algo::FdCrba,
         Algo::Fd,
         Algo::Fk,
+        Algo::RneaDerivatives,
+        Algo::AbaDerivatives,
+        Algo::Jacobians,
     ];
     /// The command-line name (`--algo`, and the key in `--json`).
     pub fn name(self) -> &'static str {
@@ -57,6 +67,9 @@ impl Algo {
             Algo::FdCrba => "fd-crba",
             Algo::Fd => "fd",
             Algo::Fk => "fk",
+            Algo::RneaDerivatives => "rnea-derivatives",
+            Algo::AbaDerivatives => "aba-derivatives",
+            Algo::Jacobians => "jacobians",
         }
     }
     /// The algorithm of a command-line name; `None` for an unknown name.
@@ -69,7 +82,7 @@ impl Algo {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BenchError {
     /// An `--algo` name that is not one of [`Algo::ALL`] (the name given).
-    #[error("unknown algorithm \"{0}\" (known: rnea, bias, crba, aba, fd-rnea, fd-crba, fd, fk)")]
+    #[error("unknown algorithm \"{0}\" (known: rnea, bias, crba, aba, fd-rnea, fd-crba, fd, fk, rnea-derivatives, aba-derivatives, jacobians)")]
     UnknownAlgo(String),
     /// `--samples 0`.
     #[error("--samples must be at least 1")]
@@ -224,6 +237,19 @@ fn call(algo: Algo, model: &Model, data: &mut Data, s: &State) -> Result<f64, St
             dynamics::update_frames(model, data);
             data.o_m_f.last().map_or(0.0, |m| m.trans.x)
         }
+        Algo::RneaDerivatives => {
+            dynamics::rnea_derivatives(model, data, &s.q, &s.v, &s.a, None)
+                .map_err(|e| e.to_string())?;
+            data.dtau_dq[(0, 0)] + data.dtau_dv[(0, 0)]
+        }
+        Algo::AbaDerivatives => {
+            dynamics::aba_derivatives(model, data, &s.q, &s.v, &s.tau, None)
+                .map_err(|e| e.to_string())?;
+            data.dqdd_dq[(0, 0)] + data.dqdd_dv[(0, 0)] + data.minv[(0, 0)]
+        }
+        Algo::Jacobians => {
+            dynamics::joint_jacobians(model, data, &s.q).map_err(|e| e.to_string())?[(0, 0)]
+        }
     })
 }
 
@@ -316,7 +342,7 @@ pub fn to_json(model: &Model, results: &[(Algo, Timing)]) -> Value {
 /// A table for people.
 pub fn to_table(model: &Model, results: &[(Algo, Timing)]) -> String {
     let mut s = format!(
-        "{}: nq {}, nv {}, {} bodies, fd method {:?}\n{:<8} {:>12} {:>12} {:>8} {:>7}\n",
+        "{}: nq {}, nv {}, {} bodies, fd method {:?}\n{:<16} {:>12} {:>12} {:>8} {:>7}\n",
         model.name,
         model.nq,
         model.nv,
@@ -330,7 +356,7 @@ pub fn to_table(model: &Model, results: &[(Algo, Timing)]) -> String {
     );
     for (a, t) in results {
         s.push_str(&format!(
-            "{:<8} {:>12.1} {:>12.1} {:>8} {:>7}\n",
+            "{:<16} {:>12.1} {:>12.1} {:>8} {:>7}\n",
             a.name(),
             t.median_ns,
             t.min_ns,

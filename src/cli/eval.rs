@@ -60,6 +60,35 @@ fn kinematics(
     data: &mut Data,
     sv: &StateVectors,
 ) -> Result<Kinematics, DynamicsError> {
+    let mut kin = kinematics_v2(model, data, sv)?;
+    // contract v3: each frame's J̇ (world-aligned), after every v2 quantity
+    if let (true, Some(Value::Object(frames))) = (sv.derivatives, kin.frames.as_mut()) {
+        let mut jd = DMatrix::zeros(6, model.nv);
+        for &f in &sv.frames {
+            dynamics::frame_jacobian_time_variation(
+                model,
+                data,
+                &sv.q,
+                &sv.v,
+                f,
+                Reference::WorldAligned,
+                &mut jd,
+            )?;
+            kin.finite &= jd.iter().all(|x| x.is_finite());
+            if let Some(Value::Object(o)) = frames.get_mut(&model.frames[f.0].name) {
+                o.insert("jacobian_dot".into(), Value::Array(matrix(&jd)));
+            }
+        }
+    }
+    Ok(kin)
+}
+
+/// The v2 part of [`kinematics`].
+fn kinematics_v2(
+    model: &Model,
+    data: &mut Data,
+    sv: &StateVectors,
+) -> Result<Kinematics, DynamicsError> {
     let mut finite = true;
     let mut fin = |xs: &[f64]| finite &= xs.iter().all(|x| x.is_finite());
     dynamics::forward_kinematics_second_order(model, data, &sv.q, &sv.v, &sv.a)?;
@@ -105,6 +134,36 @@ fn kinematics(
         energy: json!({"kinetic": ke, "potential": pe}),
         finite,
     })
+}
+
+/// A state's derivatives (eval-contract.md §"Derivatives (version 3)") as JSON, and
+/// whether every number is finite.
+fn derivatives(
+    model: &Model,
+    data: &mut Data,
+    sv: &StateVectors,
+) -> Result<(Value, bool), DynamicsError> {
+    let wrenches: Vec<dynamics::LinkWrench> = sv
+        .fext
+        .iter()
+        .map(|&(frame, force, torque)| dynamics::LinkWrench {
+            frame,
+            force,
+            torque,
+        })
+        .collect();
+    let w = (!wrenches.is_empty()).then_some(wrenches.as_slice());
+    dynamics::rnea_derivatives(model, data, &sv.q, &sv.v, &sv.a, w)?;
+    let (dq, dv) = (data.dtau_dq.clone(), data.dtau_dv.clone());
+    dynamics::aba_derivatives(model, data, &sv.q, &sv.v, &sv.tau, w)?;
+    let mats = [&dq, &dv, &data.dqdd_dq, &data.dqdd_dv, &data.minv];
+    let finite = mats.iter().all(|m| m.iter().all(|x| x.is_finite()));
+    let out = json!({
+        "dtau_dq": matrix(&dq), "dtau_dv": matrix(&dv),
+        "dqdd_dq": matrix(&data.dqdd_dq), "dqdd_dv": matrix(&data.dqdd_dv),
+        "dqdd_dtau": matrix(&data.minv),
+    });
+    Ok((out, finite))
 }
 
 /// The most degrees of freedom `eval` answers: its output holds the dense nv×nv
@@ -217,6 +276,11 @@ fn evaluate_each(
             .map_err(dyn_err)?
             .clone();
         let kin = kinematics(&model, &mut data, sv).map_err(dyn_err)?;
+        let deriv = if sv.derivatives {
+            Some(derivatives(&model, &mut data, sv).map_err(dyn_err)?)
+        } else {
+            None
+        };
         // Finite inputs can still overflow (a mass of 1e300, a speed of 1e200):
         // an answer with infinities or NaN (JSON null) is an error, not output.
         let finite = |x: &nalgebra::DVector<f64>| x.iter().all(|v| v.is_finite());
@@ -226,6 +290,7 @@ fn evaluate_each(
             ("qdd", finite(&qdd)),
             ("mass_matrix", h.iter().all(|v| v.is_finite())),
             ("a frame, centre of mass, momentum or energy", kin.finite),
+            ("a derivative", deriv.as_ref().is_none_or(|d| d.1)),
         ] {
             if !ok {
                 return Err(EvalError::Dynamics {
@@ -275,6 +340,9 @@ fn evaluate_each(
         r.insert("link_poses".into(), Value::Object(poses));
         if let Some(frames) = kin.frames {
             r.insert("frames".into(), frames);
+        }
+        if let Some((d, _)) = deriv {
+            r.insert("derivatives".into(), d);
         }
         r.insert("com".into(), kin.com);
         r.insert("momentum".into(), kin.momentum);

@@ -80,6 +80,8 @@ pub struct State {
     pub fext: Option<BTreeMap<String, LinkWrench>>,
     /// URDF links whose frame kinematics the result reports.
     pub frames: Option<Vec<String>>,
+    /// Whether the result carries the derivatives (contract version 3).
+    pub derivatives: Option<bool>,
 }
 
 /// A whole `STATES.json`.
@@ -107,6 +109,8 @@ pub struct StateVectors {
     pub fext: Vec<(FrameId, Vector3<f64>, Vector3<f64>)>,
     /// The links asked for in `frames`, in the file's order.
     pub frames: Vec<FrameId>,
+    /// Whether the state asked for the derivatives (`"derivatives": true`).
+    pub derivatives: bool,
 }
 
 fn parse_json<'a, D: Deserialize<'a>>(text: &'a str, file: &str) -> Result<D, StateError> {
@@ -176,6 +180,15 @@ fn check_state_shape(v: &serde_json::Value, file: &str, key: &str) -> Result<(),
     if let Some(b) = v.get("base") {
         require_object(b, file, &sub("base"))?;
     }
+    if let Some(d) = v.get("derivatives") {
+        if !d.is_boolean() {
+            return Err(StateError::new(
+                file,
+                sub("derivatives"),
+                format!("expected true or false, found {d}"),
+            ));
+        }
+    }
     if let Some(f) = v.get("fext") {
         let fkey = sub("fext");
         require_object(f, file, &fkey)?;
@@ -212,7 +225,11 @@ pub fn parse_states(text: &str, file: &str) -> Result<StatesFile, StateError> {
 pub fn parse_state(text: &str, file: &str) -> Result<State, StateError> {
     check_state_shape(&parse_value::<State>(text, file)?, file, "(top level)")?;
     let st: State = parse_json(text, file)?;
-    for (present, key) in [(st.fext.is_some(), "fext"), (st.frames.is_some(), "frames")] {
+    for (present, key) in [
+        (st.fext.is_some(), "fext"),
+        (st.frames.is_some(), "frames"),
+        (st.derivatives.is_some(), "derivatives"),
+    ] {
         if present {
             return Err(StateError::new(
                 file,
@@ -373,6 +390,7 @@ impl State {
             tau,
             fext,
             frames,
+            derivatives: self.derivatives.unwrap_or(false),
         })
     }
 }

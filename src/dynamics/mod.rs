@@ -6,6 +6,7 @@
 //! factorisation, the articulated-body algorithm (docs/theory.md §"Forward dynamics").
 
 mod aba;
+mod aba_derivatives;
 mod centroidal;
 mod com;
 mod crba;
@@ -14,19 +15,26 @@ mod external;
 mod forward_rnea;
 mod frames;
 mod jacobian;
+mod jacobian_dot;
+mod joint_jacobians;
 mod kinematics;
 pub mod linalg;
 pub mod ltdl;
 mod rnea;
+mod rnea_derivatives;
 
 pub use crate::spatial::CompositeInertia;
 pub use aba::aba;
+pub use aba_derivatives::aba_derivatives;
 pub use centroidal::centroidal_momentum;
 pub use com::{center_of_mass, center_of_mass_jacobian, center_of_mass_velocity};
 pub(crate) use crba::crba_at_placements;
 pub use crba::{crba, crba_upper};
 pub use external::add_link_wrench;
 pub use frames::{forward_kinematics_second_order, frame_classical_acceleration, frame_velocity};
+pub use jacobian_dot::frame_jacobian_time_variation;
+pub use joint_jacobians::joint_jacobians;
+pub use rnea_derivatives::{rnea_derivatives, LinkWrench};
 
 pub use energy::{energies, kinetic_energy, kinetic_energy_from_placements, potential_energy};
 pub use forward_rnea::{forward_dynamics_rnea, mass_matrix_rnea};

@@ -5,9 +5,10 @@
 //! `[v_lin, ω]` in the base's own frame (Pinocchio's free flyer, docs/theory.md
 //! §"Floating base"); joints after it have q̇ = v.
 
+use super::JointKind;
 use super::Model;
-use crate::spatial::{axis_angle, quat_to_matrix, sin_cos};
-use nalgebra::{DVector, Vector3};
+use crate::spatial::{axis_angle, quat_to_matrix, sin_cos, skew};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3};
 
 /// q ← q ⊕ h v: p += h R v_lin, quaternion ← quaternion ⊗ exp(h ω / 2)
 /// (renormalised), joints += h v.
@@ -109,11 +110,10 @@ pub fn normalize_quat(q: &mut DVector<f64>) {
 
 use super::{DimensionError, NameError};
 
-/// `q ⊕ v`: the configuration reached from `q` by the velocity `v` held for one
-/// unit of time, as the simulator steps ([`integrate_config`] with h = 1): a free
-/// base moves by `R(q) v_lin` (world) and turns by `exp(ω)` (body frame); every
-/// other joint adds. (Pinocchio's `integrate` moves a free base along the SE(3)
-/// exponential instead; the two agree to first order.)
+/// `q ⊕ v` (Pinocchio's `integrate`): a free joint moves along SE(3)'s
+/// exponential by the body-frame twist `[v_lin; ω]`, `M ← M exp(v)` (p ← p + R V(ω)
+/// v_lin, quaternion ← quaternion ⊗ exp(ω/2), docs/theory.md §"Derivatives"); every
+/// other joint adds. Every joint through its own coordinates (`iq`, `iv`).
 pub fn integrate(
     model: &Model,
     q: &DVector<f64>,
@@ -122,13 +122,33 @@ pub fn integrate(
     DimensionError::check("q", model.nq, q.len())?;
     DimensionError::check("v", model.nv, v.len())?;
     let mut out = q.clone();
-    integrate_config(model, &mut out, v, 1.0);
+    for j in model.joints.iter().skip(1) {
+        match j.kind {
+            JointKind::Free => {
+                let (iq, iv) = (j.iq, j.iv);
+                let (r0, quat0) = base_rotation(q, iq);
+                let lin = Vector3::new(v[iv], v[iv + 1], v[iv + 2]);
+                let w = Vector3::new(v[iv + 3], v[iv + 4], v[iv + 5]);
+                let dp = r0 * so3_left_jacobian(&w) * lin;
+                let dq = UnitQuaternion::from_scaled_axis(w);
+                let q1 = quat0 * dq;
+                for k in 0..3 {
+                    out[iq + k] = q[iq + k] + dp[k];
+                }
+                let c = q1.as_ref().coords;
+                for k in 0..4 {
+                    out[iq + 3 + k] = c[k];
+                }
+            }
+            // a mimic joint's iq/iv are its leader's: assigning twice is harmless
+            _ => out[j.iq] = q[j.iq] + v[j.iv],
+        }
+    }
     Ok(out)
 }
 
-/// `q₁ ⊖ q₀`: the velocity `v` with [`integrate`]`(q₀, v) = q₁` — a free base's
-/// `v_lin = R(q₀)ᵀ (p₁ − p₀)` and `ω = log(q₀⁻¹ ⊗ q₁)` (the shorter rotation),
-/// every other joint `q₁ − q₀`.
+/// `q₁ ⊖ q₀` (Pinocchio's `difference`): the v with [`integrate`]`(q₀, v) = q₁` — a
+/// free joint's `log(M₀⁻¹ M₁)` (the shorter rotation), every other joint `q₁ − q₀`.
 pub fn difference(
     model: &Model,
     q0: &DVector<f64>,
@@ -136,42 +156,193 @@ pub fn difference(
 ) -> Result<DVector<f64>, DimensionError> {
     DimensionError::check("q0", model.nq, q0.len())?;
     DimensionError::check("q1", model.nq, q1.len())?;
-    let (qo, vo) = (model.joint_q_offset(), model.joint_v_offset());
     let mut v = DVector::zeros(model.nv);
-    if model.floating_base {
-        let n0 = (q0[3] * q0[3] + q0[4] * q0[4] + q0[5] * q0[5] + q0[6] * q0[6]).sqrt();
-        let n1 = (q1[3] * q1[3] + q1[4] * q1[4] + q1[5] * q1[5] + q1[6] * q1[6]).sqrt();
-        let (x0, y0, z0, w0) = (q0[3] / n0, q0[4] / n0, q0[5] / n0, q0[6] / n0);
-        let (x1, y1, z1, w1) = (q1[3] / n1, q1[4] / n1, q1[5] / n1, q1[6] / n1);
-        let r0 = quat_to_matrix(x0, y0, z0, w0);
-        let dp = r0.transpose() * Vector3::new(q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]);
-        // d = conj(q0) ⊗ q1
-        let mut dw = w0 * w1 + x0 * x1 + y0 * y1 + z0 * z1;
-        let mut dv = Vector3::new(
-            w0 * x1 - x0 * w1 - y0 * z1 + z0 * y1,
-            w0 * y1 + x0 * z1 - y0 * w1 - z0 * x1,
-            w0 * z1 - x0 * y1 + y0 * x1 - z0 * w1,
-        );
-        if dw < 0.0 {
-            dw = -dw;
-            dv = -dv;
+    for j in model.joints.iter().skip(1) {
+        match j.kind {
+            JointKind::Free => {
+                let (lin, w) = free_log(q0, q1, j.iq);
+                for k in 0..3 {
+                    v[j.iv + k] = lin[k];
+                    v[j.iv + 3 + k] = w[k];
+                }
+            }
+            _ => v[j.iv] = q1[j.iq] - q0[j.iq],
         }
-        let s = dv.norm();
-        // ω = 2 atan2(|d_v|, d_w) d_v / |d_v|
-        let w = if s > 1e-12 {
-            dv * (2.0 * s.atan2(dw) / s)
-        } else {
-            dv * (2.0 / dw)
-        };
-        for k in 0..3 {
-            v[k] = dp[k];
-            v[3 + k] = w[k];
-        }
-    }
-    for d in 0..model.dofs.len() {
-        v[vo + d] = q1[qo + d] - q0[qo + d];
     }
     Ok(v)
+}
+
+/// The Jacobians of [`integrate`] (Pinocchio's `dIntegrate`, tangent spaces on both
+/// sides): `(∂(q ⊕ v)/∂q, ∂(q ⊕ v)/∂v)`, nv × nv. A free joint's blocks (linear
+/// first) are `Ad(exp(v)⁻¹)` and the right Jacobian `Jexp(v)` of SE(3)
+/// (docs/theory.md §"Derivatives"); every other joint's entry is 1.
+pub fn integrate_jacobians(
+    model: &Model,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), DimensionError> {
+    DimensionError::check("q", model.nq, q.len())?;
+    DimensionError::check("v", model.nv, v.len())?;
+    let (mut jq, mut jv) = (
+        DMatrix::zeros(model.nv, model.nv),
+        DMatrix::zeros(model.nv, model.nv),
+    );
+    for j in model.joints.iter().skip(1) {
+        match j.kind {
+            JointKind::Free => {
+                let iv = j.iv;
+                let lin = Vector3::new(v[iv], v[iv + 1], v[iv + 2]);
+                let w = Vector3::new(v[iv + 3], v[iv + 4], v[iv + 5]);
+                // exp(v) = (R, p): Ad(exp(v)⁻¹) = [Rᵀ, −Rᵀ p×; 0, Rᵀ]
+                let r = *UnitQuaternion::from_scaled_axis(w)
+                    .to_rotation_matrix()
+                    .matrix();
+                let p = so3_left_jacobian(&w) * lin;
+                let rt = r.transpose();
+                jq.view_mut((iv, iv), (3, 3)).copy_from(&rt);
+                jq.view_mut((iv, iv + 3), (3, 3))
+                    .copy_from(&(-rt * skew(&p)));
+                jq.view_mut((iv + 3, iv + 3), (3, 3)).copy_from(&rt);
+                jv.view_mut((iv, iv), (6, 6))
+                    .copy_from(&se3_right_jacobian(&lin, &w));
+            }
+            _ => {
+                jq[(j.iv, j.iv)] = 1.0;
+                jv[(j.iv, j.iv)] = 1.0;
+            }
+        }
+    }
+    Ok((jq, jv))
+}
+
+/// The Jacobians of [`difference`] (Pinocchio's `dDifference`):
+/// `(∂(q₁ ⊖ q₀)/∂q₀, ∂(q₁ ⊖ q₀)/∂q₁)`, nv × nv. A free joint's blocks, with
+/// `M = M₀⁻¹ M₁`: `−Jlog(M) Ad(M⁻¹)` and `Jlog(M)`, `Jlog = Jexp(log M)⁻¹`; every
+/// other joint's entries are −1 and 1.
+pub fn difference_jacobians(
+    model: &Model,
+    q0: &DVector<f64>,
+    q1: &DVector<f64>,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), DimensionError> {
+    DimensionError::check("q0", model.nq, q0.len())?;
+    DimensionError::check("q1", model.nq, q1.len())?;
+    let (mut j0, mut j1) = (
+        DMatrix::zeros(model.nv, model.nv),
+        DMatrix::zeros(model.nv, model.nv),
+    );
+    for j in model.joints.iter().skip(1) {
+        match j.kind {
+            JointKind::Free => {
+                let iv = j.iv;
+                let (lin, w) = free_log(q0, q1, j.iq);
+                let jr = se3_right_jacobian(&lin, &w);
+                let jlog = jr.try_inverse().unwrap_or_else(Matrix6::identity);
+                // M = exp(log M) = (R, p); Ad(M⁻¹) = [Rᵀ, −Rᵀ p×; 0, Rᵀ]
+                let r = *UnitQuaternion::from_scaled_axis(w)
+                    .to_rotation_matrix()
+                    .matrix();
+                let p = so3_left_jacobian(&w) * lin;
+                let rt = r.transpose();
+                let mut ad = Matrix6::zeros();
+                ad.fixed_view_mut::<3, 3>(0, 0).copy_from(&rt);
+                ad.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-rt * skew(&p)));
+                ad.fixed_view_mut::<3, 3>(3, 3).copy_from(&rt);
+                j0.view_mut((iv, iv), (6, 6)).copy_from(&(-jlog * ad));
+                j1.view_mut((iv, iv), (6, 6)).copy_from(&jlog);
+            }
+            _ => {
+                j0[(j.iv, j.iv)] = -1.0;
+                j1[(j.iv, j.iv)] = 1.0;
+            }
+        }
+    }
+    Ok((j0, j1))
+}
+
+/// A free joint's rotation and unit quaternion from `q[iq + 3..iq + 7]` (x, y, z, w),
+/// normalised.
+fn base_rotation(q: &DVector<f64>, iq: usize) -> (Matrix3<f64>, UnitQuaternion<f64>) {
+    let uq = UnitQuaternion::from_quaternion(Quaternion::new(
+        q[iq + 6],
+        q[iq + 3],
+        q[iq + 4],
+        q[iq + 5],
+    ));
+    (*uq.to_rotation_matrix().matrix(), uq)
+}
+
+/// `log(M₀⁻¹ M₁)` of two free-joint poses at `q[iq..iq + 7]`: `(v_lin, ω)`.
+fn free_log(q0: &DVector<f64>, q1: &DVector<f64>, iq: usize) -> (Vector3<f64>, Vector3<f64>) {
+    let (r0, u0) = base_rotation(q0, iq);
+    let (_, u1) = base_rotation(q1, iq);
+    let dp = r0.transpose()
+        * Vector3::new(
+            q1[iq] - q0[iq],
+            q1[iq + 1] - q0[iq + 1],
+            q1[iq + 2] - q0[iq + 2],
+        );
+    // the shorter rotation: d and −d are one rotation
+    let mut d = u0.inverse() * u1;
+    if d.w < 0.0 {
+        d = UnitQuaternion::new_unchecked(-d.into_inner());
+    }
+    let w = d.scaled_axis();
+    let lin = so3_left_jacobian(&w)
+        .try_inverse()
+        .unwrap_or_else(Matrix3::identity)
+        * dp;
+    (lin, w)
+}
+
+/// SO(3)'s left Jacobian `V(ω) = 1 + (1 − cos θ)/θ² ω× + (θ − sin θ)/θ³ ω×²`
+/// (p = V(ω) v of SE(3)'s exponential).
+fn so3_left_jacobian(w: &Vector3<f64>) -> Matrix3<f64> {
+    let t2 = w.norm_squared();
+    let t = t2.sqrt();
+    let (a, b) = if t < 1e-4 {
+        (
+            0.5 - t2 / 24.0 + t2 * t2 / 720.0,
+            1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0,
+        )
+    } else {
+        ((1.0 - t.cos()) / t2, (t - t.sin()) / (t2 * t))
+    };
+    let k = skew(w);
+    Matrix3::identity() + k * a + k * k * b
+}
+
+/// SE(3)'s right Jacobian at the twist `[ρ; φ]` (linear first): `exp(ξ + δ) =
+/// exp(ξ) exp(Jr δ)`, `Jr(ξ) = Jl(−ξ)` with Barfoot's left Jacobian
+/// `[J(φ), Q(ρ, φ); 0, J(φ)]` (Pinocchio's `Jexp6`).
+fn se3_right_jacobian(rho: &Vector3<f64>, phi: &Vector3<f64>) -> Matrix6<f64> {
+    let (rho, phi) = (-rho, -phi);
+    let j = so3_left_jacobian(&phi);
+    let t2 = phi.norm_squared();
+    let t = t2.sqrt();
+    let (c1, c2, c3) = if t < 1e-3 {
+        (
+            1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0,
+            1.0 / 24.0 - t2 / 720.0 + t2 * t2 / 40320.0,
+            1.0 / 120.0 - t2 / 2520.0,
+        )
+    } else {
+        let (s, c) = t.sin_cos();
+        (
+            (t - s) / (t2 * t),
+            (t2 + 2.0 * c - 2.0) / (2.0 * t2 * t2),
+            (2.0 * t - 3.0 * s + t * c) / (2.0 * t2 * t2 * t),
+        )
+    };
+    let (p, r) = (skew(&phi), skew(&rho));
+    let q = r * 0.5
+        + (p * r + r * p + p * r * p) * c1
+        + (p * p * r + r * p * p - p * r * p * 3.0) * c2
+        + (p * r * p * p + p * p * r * p) * c3;
+    let mut out = Matrix6::zeros();
+    out.fixed_view_mut::<3, 3>(0, 0).copy_from(&j);
+    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&q);
+    out.fixed_view_mut::<3, 3>(3, 3).copy_from(&j);
+    out
 }
 
 /// A random configuration inside the joint limits (uniform; a continuous joint,

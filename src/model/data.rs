@@ -1,6 +1,6 @@
 use super::Model;
 use crate::spatial::{CompositeInertia, Force, Motion, Scalar, Se3};
-use nalgebra::{DMatrix, DVector, Matrix6, Vector6};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3, Vector6};
 
 /// The preallocated workspace of every algorithm: sized once from a [`Model`],
 /// then reused with no allocation in the hot path. The results and the
@@ -61,6 +61,81 @@ pub struct Data<T: Scalar = f64> {
     pub aba_uq: Vec<T>,
     /// ABA: velocity-product acceleration `c = v × S q̇` of each body.
     pub aba_c: Vec<Motion<T>>,
+
+    /// Every joint's world Jacobian, 6 × nv (`joint_jacobians`).
+    pub jacobians: DMatrix<T>,
+
+    // Derivatives (docs/theory.md §"Derivatives"). Results first.
+    /// ∂τ/∂q (nv × nv, tangent space) from `rnea_derivatives`.
+    pub dtau_dq: DMatrix<T>,
+    /// ∂τ/∂v (nv × nv) from `rnea_derivatives`.
+    pub dtau_dv: DMatrix<T>,
+    /// ∂q̈/∂q (nv × nv, tangent space) from `aba_derivatives`.
+    pub dqdd_dq: DMatrix<T>,
+    /// ∂q̈/∂v (nv × nv) from `aba_derivatives`.
+    pub dqdd_dv: DMatrix<T>,
+    /// H⁻¹ = ∂q̈/∂τ (nv × nv, whole and symmetric) from `aba_derivatives`.
+    pub minv: DMatrix<T>,
+    /// Derivatives: first column of each body's joint in the column space of the
+    /// recursion (one column per joint velocity coordinate, mimic joints their own).
+    pub deriv_col0: Vec<usize>,
+    /// Derivatives: one past the last column of each body's subtree (bodies are
+    /// in depth-first order, so a subtree's columns are contiguous).
+    pub deriv_sub_end: Vec<usize>,
+    /// Derivatives: each column's coordinate in v (a mimic joint's: its leader's).
+    pub deriv_col_iv: Vec<usize>,
+    /// Derivatives: whether the column space is v's own (no mimic joint): the
+    /// recursion then writes the results directly.
+    pub deriv_direct: bool,
+    /// Derivatives: world velocity `⁰v̂ᵢ` of each body.
+    pub deriv_ov: Vec<Motion<T>>,
+    /// Derivatives: world acceleration `⁰âᵢ` of each body, gravity included.
+    pub deriv_oa: Vec<Motion<T>>,
+    /// Derivatives: composite world inertia of each body's subtree.
+    pub deriv_oy: Vec<CompositeInertia<T>>,
+    /// Derivatives: the composite variation `Ẏ = v×*Y − Y v× + (·)×*(Y v)` (world)
+    /// of each subtree, by its parts: the symmetric 3x3 `S = ω×I_o − I_o ω× − h vᵀ
+    /// − v hᵀ + 2 (v·h) 1` (docs/theory.md §"Derivatives").
+    pub deriv_doy: Vec<Matrix3<T>>,
+    /// Derivatives: the momentum `Y v = [hₙ; h_f]` of each subtree (world), the
+    /// other parts of `Ẏ`.
+    pub deriv_hm: Vec<Force<T>>,
+    /// Derivatives: composite world force of each body's subtree.
+    pub deriv_of: Vec<Force<T>>,
+    /// Derivatives: per body, the subtree's external couples Σ t (world).
+    pub deriv_ext_t: Vec<Vector3<T>>,
+    /// Derivatives: per body, the subtree's external forces Σ f (world).
+    pub deriv_ext_f: Vec<Vector3<T>>,
+    /// Derivatives: per body, Σ p fᵀ of the subtree's external forces (world points p).
+    pub deriv_ext_p: Vec<Matrix3<T>>,
+    /// Derivatives: per body, the external wrenches as spatial forces at the world
+    /// origin (what `rnea` and forward dynamics take).
+    pub deriv_fext: Vec<Force<T>>,
+    /// Derivatives, per column: the world motion subspace `J = ⁰X̂ᵢ S`.
+    pub deriv_j: Vec<Motion<T>>,
+    /// Derivatives, per column: ∂⁰v̂/∂q of the subtree (`⁰v̂_λ × J`).
+    pub deriv_dvdq: Vec<Motion<T>>,
+    /// Derivatives, per column: ∂⁰â/∂q of the subtree.
+    pub deriv_dadq: Vec<Motion<T>>,
+    /// Derivatives, per column: ∂⁰â/∂v of the subtree.
+    pub deriv_dadv: Vec<Motion<T>>,
+    /// Derivatives, per column: ∂F/∂q of the subtree force.
+    pub deriv_dfdq: Vec<Force<T>>,
+    /// Derivatives, per column: ∂F/∂v of the subtree force.
+    pub deriv_dfdv: Vec<Force<T>>,
+    /// Derivatives, per column: `Yᶜ J` (∂F/∂a).
+    pub deriv_dfda: Vec<Force<T>>,
+    /// Derivatives, per column: `(Ẏᶜ)ᵀ J`.
+    pub deriv_ytj: Vec<Force<T>>,
+    /// Derivatives, per column: the external-force term `[e; 0]` of the lower block.
+    pub deriv_ext_e: Vec<Force<T>>,
+    /// Derivatives with mimic joints: ∂τ/∂q, ∂τ/∂v, ∂τ/∂a over the column space
+    /// (then reduced by G); empty without mimic joints.
+    pub deriv_full: [DMatrix<T>; 3],
+    /// Derivatives: a scratch nv × nv matrix (`aba_derivatives`' transposes).
+    pub deriv_scratch: DMatrix<T>,
+    /// Derivatives: a scratch vector of size nv (`aba_derivatives`' q̈).
+    pub deriv_tmp: DVector<T>,
 }
 
 impl<T: Scalar> Data<T> {
@@ -68,6 +143,14 @@ impl<T: Scalar> Data<T> {
     pub fn new(model: &Model<T>) -> Self {
         let nb = model.nbodies;
         let nv = model.nv;
+        let (col0, sub_end, ncol, direct) = derivative_columns(model);
+        let mut col_iv = vec![0; ncol];
+        for i in 1..nb {
+            for c in 0..model.joints[i].nv() {
+                col_iv[col0[i] + c] = model.joints[i].iv + c;
+            }
+        }
+        let nfull = if direct { 0 } else { ncol };
         Self {
             li_m_i: vec![Se3::identity(); nb],
             o_m_i: vec![Se3::identity(); nb],
@@ -89,6 +172,64 @@ impl<T: Scalar> Data<T> {
             aba_dinv: vec![T::zero(); nb],
             aba_uq: vec![T::zero(); nb],
             aba_c: vec![Motion::zero(); nb],
+            jacobians: DMatrix::zeros(6, nv),
+            dtau_dq: DMatrix::zeros(nv, nv),
+            dtau_dv: DMatrix::zeros(nv, nv),
+            dqdd_dq: DMatrix::zeros(nv, nv),
+            dqdd_dv: DMatrix::zeros(nv, nv),
+            minv: DMatrix::zeros(nv, nv),
+            deriv_col0: col0,
+            deriv_sub_end: sub_end,
+            deriv_col_iv: col_iv,
+            deriv_direct: direct,
+            deriv_ov: vec![Motion::zero(); nb],
+            deriv_oa: vec![Motion::zero(); nb],
+            deriv_oy: vec![CompositeInertia::zero(); nb],
+            deriv_doy: vec![Matrix3::zeros(); nb],
+            deriv_hm: vec![Force::zero(); nb],
+            deriv_of: vec![Force::zero(); nb],
+            deriv_ext_t: vec![Vector3::zeros(); nb],
+            deriv_ext_f: vec![Vector3::zeros(); nb],
+            deriv_ext_p: vec![Matrix3::zeros(); nb],
+            deriv_fext: vec![Force::zero(); nb],
+            deriv_j: vec![Motion::zero(); ncol],
+            deriv_dvdq: vec![Motion::zero(); ncol],
+            deriv_dadq: vec![Motion::zero(); ncol],
+            deriv_dadv: vec![Motion::zero(); ncol],
+            deriv_dfdq: vec![Force::zero(); ncol],
+            deriv_dfdv: vec![Force::zero(); ncol],
+            deriv_dfda: vec![Force::zero(); ncol],
+            deriv_ytj: vec![Force::zero(); ncol],
+            deriv_ext_e: vec![Force::zero(); ncol],
+            deriv_full: std::array::from_fn(|_| DMatrix::zeros(nfull, nfull)),
+            deriv_scratch: DMatrix::zeros(nv, nv),
+            deriv_tmp: DVector::zeros(nv),
         }
     }
+}
+
+/// The derivatives' column space (docs/theory.md §"Derivatives"): each body's first
+/// column (its joint's velocity coordinates counted in body order, a mimic joint
+/// its own), one past its subtree's last column, the number of columns, and
+/// whether the columns are v's own coordinates.
+fn derivative_columns<T: Scalar>(model: &Model<T>) -> (Vec<usize>, Vec<usize>, usize, bool) {
+    let nb = model.nbodies;
+    let mut col0 = vec![0; nb];
+    let mut sub_end = vec![0; nb];
+    let mut n = 0;
+    let mut direct = true;
+    for i in 1..nb {
+        col0[i] = n;
+        direct &= model.joints[i].iv == n;
+        n += model.joints[i].nv();
+        sub_end[i] = n;
+    }
+    direct &= n == model.nv;
+    for i in (1..nb).rev() {
+        let p = model.parent[i];
+        if p != 0 {
+            sub_end[p] = sub_end[p].max(sub_end[i]);
+        }
+    }
+    (col0, sub_end, n, direct)
 }

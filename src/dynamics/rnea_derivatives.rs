@@ -1,0 +1,341 @@
+//! Analytic first-order derivatives of inverse dynamics: ∂τ/∂q, ∂τ/∂v (and
+//! ∂τ/∂a = H) by one forward and one backward sweep in world coordinates
+//! (Carpentier & Mansard, RSS 2018; Pinocchio's `computeRNEADerivatives`),
+//! docs/theory.md §"Derivatives".
+
+use super::{check_sizes, DynamicsError};
+use crate::model::{dispatch_joint, Data, FrameId, JointModel, Model, NameError};
+use crate::spatial::ops::cross;
+use crate::spatial::{skew, CompositeInertia, Force, Motion, Scalar};
+use nalgebra::{DVector, Matrix3, Vector3};
+
+/// An external wrench on a URDF link (eval-contract.md "fext"): `force` acts at the
+/// link frame's origin, `torque` is a pure couple, both in world coordinates. In
+/// the derivatives it stays fixed in world coordinates and applied at the link
+/// origin, which moves with q.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinkWrench<T: Scalar = f64> {
+    /// The link.
+    pub frame: FrameId,
+    /// Force (N), world coordinates, at the link frame's origin.
+    pub force: Vector3<T>,
+    /// Couple (N·m), world coordinates.
+    pub torque: Vector3<T>,
+}
+
+/// The derivatives of inverse dynamics τ = ID(q, v, a) with the wrenches `fext`
+/// (docs/theory.md §"Derivatives"): `data.dtau_dq` = ∂τ/∂q (tangent space: column
+/// k is d/dε τ(q ⊕ ε eₖ), a free base moving by a body-frame twist, as Pinocchio's
+/// `integrate`), `data.dtau_dv` = ∂τ/∂v and `data.h` = ∂τ/∂a = H (whole,
+/// symmetric); `data.tau` holds τ. With mimic joints the reduced system's
+/// (Gᵀ ∂τ_full/∂q_full G). O(n·d) for n bodies of depth d, no allocation.
+pub fn rnea_derivatives<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+    a: &DVector<T>,
+    fext: Option<&[LinkWrench<T>]>,
+) -> Result<(), DynamicsError> {
+    check_sizes(model, q, &[("v", v), ("a", a)], None)?;
+    check_wrenches(model, fext)?;
+    rnea_derivatives_pass(model, data, q, v, a, fext);
+    Ok(())
+}
+
+/// Every wrench's link exists (else the error naming its id).
+pub(crate) fn check_wrenches<T: Scalar>(
+    model: &Model<T>,
+    fext: Option<&[LinkWrench<T>]>,
+) -> Result<(), DynamicsError> {
+    for w in fext.unwrap_or(&[]) {
+        if w.frame.0 >= model.frames.len() {
+            return Err(NameError::OutOfRange {
+                kind: "frame",
+                id: w.frame.0,
+                len: model.frames.len(),
+            }
+            .into());
+        }
+    }
+    Ok(())
+}
+
+/// [`rnea_derivatives`] for callers that checked the sizes and the frames.
+pub(crate) fn rnea_derivatives_pass<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+    a: &DVector<T>,
+    fext: Option<&[LinkWrench<T>]>,
+) {
+    match fext {
+        Some(w) if !w.is_empty() => pass::<T, true>(model, data, q, v, a, w),
+        _ => pass::<T, false>(model, data, q, v, a, &[]),
+    }
+}
+
+/// The 3x3 part `S = ω×I_o − I_o ω× − h vᵀ − v hᵀ + 2 (v·h) 1` of the variation
+/// `Ẏ = v×*Y − Y v× + (·)×*(Y v)` of the world force `Y a + v ×* Y v` with a uniform
+/// change of the subtree's velocity (docs/theory.md §"Derivatives"); with the
+/// momentum `Y v = [hₙ; h_f]`, `Ẏ x = [S xₐ − hₙ × xₐ; −2 h_f × xₐ]` and
+/// `Ẏᵀ x = [S xₐ + hₙ × xₐ + 2 h_f × x_l; 0]`.
+#[inline(always)]
+fn variation_s<T: Scalar>(y: &CompositeInertia<T>, v: &Motion<T>) -> Matrix3<T> {
+    let w = skew(&v.ang);
+    let c = w * y.io;
+    let hv = y.h * v.lin.transpose();
+    let d = y.h.dot(&v.lin);
+    // ω×I_o − I_o ω× = c + cᵀ ((ω×)ᵀ = −ω×)
+    let mut s = c + c.transpose() - hv - hv.transpose();
+    let two_d = d + d;
+    s[(0, 0)] += two_d;
+    s[(1, 1)] += two_d;
+    s[(2, 2)] += two_d;
+    s
+}
+
+/// `Ẏ x` from the parts of [`variation_s`].
+#[inline(always)]
+fn variation_mul<T: Scalar>(s: &Matrix3<T>, hm: &Force<T>, x: &Motion<T>) -> Force<T> {
+    let hf2 = hm.lin + hm.lin;
+    Force::new(
+        crate::spatial::ops::mat_vec(s, &x.ang) - cross(&hm.ang, &x.ang),
+        -cross(&hf2, &x.ang),
+    )
+}
+
+/// `Ẏᵀ x` from the parts of [`variation_s`].
+#[inline(always)]
+fn variation_tr_mul<T: Scalar>(s: &Matrix3<T>, hm: &Force<T>, x: &Motion<T>) -> Force<T> {
+    let hf2 = hm.lin + hm.lin;
+    Force::new(
+        crate::spatial::ops::mat_vec(s, &x.ang) + cross(&hm.ang, &x.ang) + cross(&hf2, &x.lin),
+        Vector3::zeros(),
+    )
+}
+
+/// The two sweeps; `F`: external wrenches present.
+fn pass<T: Scalar, const F: bool>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+    a: &DVector<T>,
+    fext: &[LinkWrench<T>],
+) {
+    let nb = model.nbodies;
+    let (q, v, a) = (q.as_slice(), v.as_slice(), a.as_slice());
+    let joints = &model.joints[..nb];
+    let parent = &model.parent[..nb];
+    let placements = &model.placements[..nb];
+    let ident = &model.placement_identity[..nb];
+    let inertias = &model.inertias_origin[..nb];
+    let Data {
+        li_m_i,
+        o_m_i,
+        tau,
+        h,
+        dtau_dq,
+        dtau_dv,
+        deriv_col0: col0,
+        deriv_sub_end: sub_end,
+        deriv_col_iv: col_iv,
+        deriv_direct: direct,
+        deriv_ov: ov,
+        deriv_oa: oa,
+        deriv_oy: oy,
+        deriv_doy: doy,
+        deriv_hm: hmom,
+        deriv_of: of,
+        deriv_ext_t: ext_t,
+        deriv_ext_f: ext_f,
+        deriv_ext_p: ext_p,
+        deriv_fext: fbody,
+        deriv_j: jcol,
+        deriv_dvdq: dvdq,
+        deriv_dadq: dadq,
+        deriv_dadv: dadv,
+        deriv_dfdq: dfdq,
+        deriv_dfdv: dfdv,
+        deriv_dfda: dfda,
+        deriv_ytj: ytj,
+        deriv_ext_e: ext_e,
+        deriv_full: full,
+        ..
+    } = data;
+    let direct = *direct;
+
+    // Sweep 1, root outwards (docs/theory.md §"Derivatives"): world velocity and
+    // acceleration, J = ⁰X̂ᵢ S and the columns' ∂v/∂q, ∂a/∂q, ∂a/∂v.
+    ov[0] = Motion::zero();
+    // â₀ = [0; −g] (docs/theory.md §"Gravity")
+    oa[0] = Motion::new(Vector3::zeros(), -model.gravity);
+    for i in 1..nb {
+        let p = parent[i];
+        let (op, ovp, oap) = (o_m_i[p], ov[p], oa[p]);
+        let c0 = col0[i];
+        let (ovi, oai) = dispatch_joint!(&joints[i], ident[i], jm => {
+            let li = jm.placement(&placements[i], q);
+            let om = jm.world_pose(&op, &li);
+            li_m_i[i] = li;
+            o_m_i[i] = om;
+            let iv = jm.joint().iv;
+            // ⁰v̂ᵢ = ⁰v̂ₚ + J q̇, ⁰âᵢ = ⁰âₚ + J q̈ + ⁰v̂ᵢ × J q̇
+            let mut vj = Motion::zero();
+            let mut aj = Motion::zero();
+            for c in 0..jm.nv() {
+                let s = jm.subspace_in(c, &om);
+                jcol[c0 + c] = s;
+                vj += s * v[iv + c];
+                aj += s * a[iv + c];
+            }
+            let ovi = ovp + vj;
+            let oai = oap + aj + ovi.cross(&vj);
+            for c in 0..jm.nv() {
+                let k = c0 + c;
+                let s = jcol[k];
+                // ∂v/∂q = v̂ₚ × J, ∂a/∂q = âₚ × J + v̂ₚ × ∂v/∂q, ∂a/∂v = v̂ᵢ × J + ∂v/∂q
+                let dv = ovp.cross(&s);
+                dvdq[k] = dv;
+                dadq[k] = oap.cross(&s) + ovp.cross(&dv);
+                dadv[k] = ovi.cross(&s) + dv;
+            }
+            (ovi, oai)
+        });
+        ov[i] = ovi;
+        oa[i] = oai;
+        // ⁰Yᵢ, the world force f = Y a + v ×* Y v and its variation Ẏ
+        let y = inertias[i].act(&o_m_i[i]);
+        let hm = y.mul_motion(&ovi);
+        of[i] = y.mul_motion(&oai) + ovi.cross_force(&hm);
+        doy[i] = variation_s(&y, &ovi);
+        hmom[i] = hm;
+        oy[i] = y;
+        if F {
+            fbody[i] = Force::zero();
+            ext_t[i] = Vector3::zeros();
+            ext_f[i] = Vector3::zeros();
+            ext_p[i] = Matrix3::zeros();
+        }
+    }
+    if F {
+        // f̂ˣ = [t + p × f; f] at the world origin, p the link origin (world)
+        for w in fext {
+            let fr = &model.frames[w.frame.0];
+            let b = fr.body;
+            if b == 0 {
+                continue;
+            }
+            let pw = o_m_i[b].act_point(&fr.placement.trans);
+            let fx = Force::new(w.torque + cross(&pw, &w.force), w.force);
+            fbody[b] += fx;
+            of[b] -= fx;
+            ext_t[b] += w.torque;
+            ext_f[b] += w.force;
+            ext_p[b] += pw * w.force.transpose();
+        }
+    }
+
+    // Sweep 2, leaves inwards: composite Y, Ẏ, F; the blocks of each body's rows
+    // and columns against its subtree.
+    tau.fill(T::zero());
+    let n = if direct { model.nv } else { col_iv.len() };
+    let [fq, fv, fa] = full;
+    let (mq, mv, ma) = if direct {
+        h.fill(T::zero());
+        (
+            dtau_dq.as_mut_slice(),
+            dtau_dv.as_mut_slice(),
+            h.as_mut_slice(),
+        )
+    } else {
+        (fq.as_mut_slice(), fv.as_mut_slice(), fa.as_mut_slice())
+    };
+    let (mq, mv, ma) = (&mut mq[..n * n], &mut mv[..n * n], &mut ma[..n * n]);
+    for i in (1..nb).rev() {
+        let p = parent[i];
+        let yi = oy[i];
+        let doyi = doy[i];
+        let hmi = hmom[i];
+        let fi = of[i];
+        let c0 = col0[i];
+        let nvi = joints[i].nv();
+        let ce = c0 + nvi;
+        let end = sub_end[i];
+        for k in c0..ce {
+            let s = jcol[k];
+            // τ = Jᵀ F
+            tau[col_iv[k]] += s.dot(&fi);
+            // ∂F/∂a = Y J, ∂F/∂q = Ẏ ∂v/∂q + Y ∂a/∂q, ∂F/∂v = Ẏ J + Y ∂a/∂v, Ẏᵀ J
+            dfda[k] = yi.mul_motion(&s);
+            dfdq[k] = variation_mul(&doyi, &hmi, &dvdq[k]) + yi.mul_motion(&dadq[k]);
+            dfdv[k] = variation_mul(&doyi, &hmi, &s) + yi.mul_motion(&dadv[k]);
+            ytj[k] = variation_tr_mul(&doyi, &hmi, &s);
+            if F {
+                // the wrenches' world-fixed correction (docs/theory.md §"Derivatives"):
+                // C = [ω × T + (tr P − Pᵀ) ω; ω × Σf], e = T × ω + (tr P − P) ω + Σf × v
+                let (t, fs, pm) = (ext_t[i], ext_f[i], ext_p[i]);
+                let tr = pm[(0, 0)] + pm[(1, 1)] + pm[(2, 2)];
+                let w = s.ang;
+                dfdq[k] += Force::new(cross(&w, &t) + w * tr - pm.transpose() * w, cross(&w, &fs));
+                ext_e[k] = Force::new(
+                    cross(&t, &w) + w * tr - pm * w + cross(&fs, &s.lin),
+                    Vector3::zeros(),
+                );
+            }
+        }
+        for r in c0..ce {
+            let s = jcol[r];
+            // rows of this joint, columns of its subtree: Jᵀ ∂F
+            for c in c0..end {
+                let at = r + c * n;
+                ma[at] = s.dot(&dfda[c]);
+                mq[at] = s.dot(&dfdq[c]);
+                mv[at] = s.dot(&dfdv[c]);
+            }
+            // rows of the strict subtree, columns of this joint
+            let (aq, av, jr) = (dadq[r], dadv[r], s);
+            let (dv, ang) = (dvdq[r], s.ang);
+            for c in ce..end {
+                let at = c + r * n;
+                let mut x = aq.dot(&dfda[c]) + dv.dot(&ytj[c]);
+                if F {
+                    x += crate::spatial::ops::dot(&ang, &ext_e[c].ang);
+                }
+                mq[at] = x;
+                mv[at] = av.dot(&dfda[c]) + jr.dot(&ytj[c]);
+                ma[at] = ma[r + c * n];
+            }
+        }
+        // the subtree moves rigidly with the joint: ∂F/∂q += J ×* F
+        for k in c0..ce {
+            dfdq[k] += jcol[k].cross_force(&fi);
+        }
+        if p != 0 {
+            oy[p].add_assign(&yi);
+            doy[p] += doyi;
+            hmom[p] += hmi;
+            of[p] += fi;
+            if F {
+                let (t, fs, pm) = (ext_t[i], ext_f[i], ext_p[i]);
+                ext_t[p] += t;
+                ext_f[p] += fs;
+                ext_p[p] += pm;
+            }
+        }
+    }
+    if !direct {
+        // The reduced system: Gᵀ M_full G (G's multipliers are inside J).
+        for (m_out, m_full) in [(dtau_dq, &*fq), (dtau_dv, &*fv), (h, &*fa)] {
+            m_out.fill(T::zero());
+            for c in 0..n {
+                for r in 0..n {
+                    let x = m_full[(r, c)];
+                    m_out[(col_iv[r], col_iv[c])] += x;
+                }
+            }
+        }
+    }
+}
