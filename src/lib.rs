@@ -60,12 +60,14 @@ pub mod dynamics;
 pub mod model;
 pub mod sim;
 pub mod spatial;
+pub mod scene;
 pub mod urdf;
 
 pub use model::{Data, Model};
 /// The nalgebra this crate is built with (its vectors and matrices are in the API):
 /// `urdyn::nalgebra::DVector` always matches.
 pub use nalgebra;
+pub use scene::{Scene, SceneError};
 pub use urdf::{load_file, load_str, LoadOptions, UrdfError};
 
 /// The README's Rust examples, compiled and run by `cargo test` (doctests).

@@ -24,6 +24,9 @@ pub struct PyModel {
     pub package_dirs: Vec<PathBuf>,
     /// Index into `model.frames` of every URDF link.
     pub links: HashMap<String, usize>,
+    /// A scene's model: the scene's JSON text, file name and folder (a pickled
+    /// scene model is rebuilt from them).
+    pub scene_state: Option<(String, String, PathBuf)>,
 }
 
 impl PyModel {
@@ -49,7 +52,27 @@ impl PyModel {
             file,
             package_dirs,
             links,
+            scene_state: None,
         })
+    }
+
+    /// The `Model` of a scene (names `MODEL/NAME`).
+    pub fn from_scene(s: &crate::scene::PyScene) -> Self {
+        let model = s.scene.model.clone();
+        let links = model
+            .frames
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.name.clone(), i))
+            .collect();
+        Self {
+            model,
+            text: String::new(),
+            file: s.scene.file.clone(),
+            package_dirs: s.package_dirs.clone(),
+            links,
+            scene_state: Some((s.text.clone(), s.scene.file.clone(), s.scene.base_dir.clone())),
+        }
     }
 
     /// The frame index of URDF link `name` (`arg` in the message).
@@ -224,6 +247,22 @@ impl PyModel {
             self.model.gravity.y,
             self.model.gravity.z,
         ];
+        if let Some((text, file, dir)) = &self.scene_state {
+            let f = py
+                .import("urdyn._urdyn")?
+                .getattr("_scene_model_from_state")?
+                .unbind();
+            let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.clone());
+            let args = (
+                text.clone(),
+                file.clone(),
+                dir.display().to_string(),
+                dirs,
+                g,
+            )
+                .into_pyobject(py)?;
+            return Ok((f, args));
+        }
         let source = self.model.source.as_ref().map(|p| p.display().to_string());
         let args = (
             self.text.clone(),
@@ -249,6 +288,21 @@ pub fn _model_from_state(
     source: Option<PathBuf>,
 ) -> PyResult<PyModel> {
     let mut m = PyModel::build(text, file, floating_base, source, package_dirs)?;
+    m.model.gravity = Vector3::new(gravity[0], gravity[1], gravity[2]);
+    Ok(m)
+}
+
+/// Rebuilds a pickled scene's `Model`.
+#[pyfunction]
+pub fn _scene_model_from_state(
+    text: String,
+    file: String,
+    base_dir: PathBuf,
+    package_dirs: Vec<PathBuf>,
+    gravity: [f64; 3],
+) -> PyResult<PyModel> {
+    let s = crate::scene::_scene_from_state(text, file, base_dir, package_dirs)?;
+    let mut m = PyModel::from_scene(&s);
     m.model.gravity = Vector3::new(gravity[0], gravity[1], gravity[2]);
     Ok(m)
 }

@@ -17,6 +17,7 @@ message; a diverging simulation raises urdyn.SimulationError.
 from ._urdyn import (  # noqa: F401
     Data,
     Model,
+    Scene,
     Simulation,
     SimulationError,
     aba,
@@ -40,6 +41,7 @@ from ._urdyn import (  # noqa: F401
 __all__ = [
     "Data",
     "Model",
+    "Scene",
     "Simulation",
     "SimulationError",
     "aba",

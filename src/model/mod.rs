@@ -10,6 +10,7 @@ mod data;
 pub(crate) mod joint;
 mod names;
 mod topology;
+mod trees;
 
 pub use names::{edit_distance, nearest, BodyId, FrameId, JointId, NameError};
 
@@ -17,6 +18,7 @@ pub use data::Data;
 pub(crate) use joint::{dispatch_joint, JointModel};
 pub use joint::{Axis, Joint, JointKind};
 pub use topology::{FdMethod, Topology};
+pub use trees::{FreeJoint, Tree};
 
 use crate::spatial::{Inertia, Scalar, Se3};
 use nalgebra::{DVector, Vector3};
@@ -177,8 +179,16 @@ pub struct Model<T: Scalar = f64> {
     pub body_link_names: Vec<String>,
     /// Gravity vector in the world frame (docs/theory.md §"Gravity": the world accelerates by −g).
     pub gravity: Vector3<T>,
-    /// The floating base, if any, is body 1 with a [`JointKind::Free`] joint.
+    /// Body 1 is a free joint at `q[0..7]`, `v[0..6]` (a floating robot, or a
+    /// scene whose first model floats). Every free joint of a scene is in
+    /// [`Model::free_joints`].
     pub floating_base: bool,
+    /// Every free (6-DoF) joint, in body order (a floating robot: body 1 at
+    /// q[0..7], v[0..6]; a scene: one per floating model).
+    pub free_joints: Vec<FreeJoint>,
+    /// The URDF models this one is made of, in q order: one tree for a lone URDF,
+    /// one per model of a scene (names `MODEL/NAME`).
+    pub trees: Vec<Tree>,
     /// Joint DoFs (excluding the base's 6) in engine order.
     pub dofs: Vec<DofInfo>,
     /// Every URDF link, in the URDF's order.
@@ -201,7 +211,9 @@ pub struct Model<T: Scalar = f64> {
 }
 
 impl<T: Scalar> Model<T> {
-    /// Index of the first joint DoF in v (6 with a free base, else 0).
+    /// Index of the first joint DoF in v (6 with a free base, else 0): a lone
+    /// URDF's joints are `v[joint_v_offset()..]`. A scene's models each have
+    /// their own ([`Tree::joint_v`], [`Model::dof_v`]).
     pub fn joint_v_offset(&self) -> usize {
         if self.floating_base {
             6
@@ -209,7 +221,9 @@ impl<T: Scalar> Model<T> {
             0
         }
     }
-    /// Index of the first joint coordinate in q (7 with a free base, else 0).
+    /// Index of the first joint coordinate in q (7 with a free base, else 0): a
+    /// lone URDF's joints are `q[joint_q_offset()..]`. A scene's models each have
+    /// their own ([`Tree::joint_q`], [`Model::dof_q`]).
     pub fn joint_q_offset(&self) -> usize {
         if self.floating_base {
             7
@@ -234,11 +248,11 @@ impl<T: Scalar> Model<T> {
     pub fn frame_index(&self, name: &str) -> Option<usize> {
         self.frames.iter().position(|f| f.name == name)
     }
-    /// The neutral configuration: zeros, identity base orientation.
+    /// The neutral configuration: zeros, identity orientation of every free joint.
     pub fn neutral(&self) -> DVector<T> {
         let mut q = DVector::zeros(self.nq);
-        if self.floating_base {
-            q[6] = T::one();
+        for f in &self.free_joints {
+            q[f.iq + 6] = T::one();
         }
         q
     }
@@ -332,6 +346,8 @@ impl Model<f64> {
             body_link_names: self.body_link_names.clone(),
             gravity: cv(&self.gravity),
             floating_base: self.floating_base,
+            free_joints: self.free_joints.clone(),
+            trees: self.trees.clone(),
             dofs: self.dofs.clone(),
             frames: self
                 .frames

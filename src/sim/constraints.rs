@@ -182,7 +182,6 @@ impl Constraints {
         f: &MassFactor,
         h: f64,
     ) -> RowCounts {
-        let (vo, qo) = (model.joint_v_offset(), model.joint_q_offset());
         let rows = &mut self.rows;
         rows.clear();
         self.joint_rows.clear();
@@ -271,7 +270,7 @@ impl Constraints {
         // joint rows: friction (|λ| ≤ F h), limits (λ ≥ 0)
         if p.joint_dynamics {
             for (d, info) in model.dofs.iter().enumerate() {
-                let (iq, iv) = (qo + d, vo + d);
+                let (iq, iv) = (model.dof_q(d), model.dof_v(d));
                 if info.friction > 0.0 {
                     let kind = RowKind::Box {
                         limit: info.friction * h,
@@ -336,7 +335,6 @@ impl Constraints {
         solver: Solver,
     ) -> Impulses<'_> {
         let nv = model.nv;
-        let vo = model.joint_v_offset();
         self.clear_forces();
         self.dv.fill(0.0);
         let rows = &mut self.rows;
@@ -374,8 +372,9 @@ impl Constraints {
             let r = self.first_joint_row + k;
             let lam = rows.lambda[r];
             self.warm_joint[d][which as usize] = lam;
-            let jv = rows.j[r * nv + vo + d];
-            self.tau_joint[vo + d] += jv * lam / h;
+            let iv = model.dof_v(d);
+            let jv = rows.j[r * nv + iv];
+            self.tau_joint[iv] += jv * lam / h;
         }
         // contact rows: warm starts by slot, forces
         for &k in &self.warm_slots {

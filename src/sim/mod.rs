@@ -72,7 +72,7 @@ use crate::dynamics::DynamicsError;
 use crate::dynamics::{
     forward_kinematics_pass as forward_kinematics, kinetic_energy_from_placements, potential_energy,
 };
-use crate::model::configuration::normalize_quat;
+use crate::model::configuration::normalize_quats;
 use crate::model::{Data, JointKind, Model};
 use crate::spatial::Force;
 use constraints::{Constraints, RowParams};
@@ -420,21 +420,21 @@ impl Simulation {
             .integrator
             .unwrap_or(Integrator::default_for(contact.is_some()));
         let (nq, nv) = (model.nq, model.nv);
-        let vo = model.joint_v_offset();
         let mut damping = DVector::zeros(nv);
         let mut armature = DVector::zeros(nv);
         let mut effort = vec![f64::INFINITY; nv];
-        for (d, info) in model.dofs.iter().enumerate() {
-            armature[vo + d] = a;
+        for (d, _, iv) in model.dof_indices() {
+            let info = &model.dofs[d];
+            armature[iv] = a;
             if opts.joint_dynamics {
-                damping[vo + d] = if info.damping.is_finite() {
+                damping[iv] = if info.damping.is_finite() {
                     info.damping.max(0.0)
                 } else {
                     0.0
                 };
                 if let Some(e) = info.limits.effort {
                     if e > 0.0 {
-                        effort[vo + d] = e;
+                        effort[iv] = e;
                     }
                 }
             }
@@ -562,9 +562,7 @@ impl Simulation {
         }
         self.q.copy_from(q);
         self.v.copy_from(v);
-        if self.model.floating_base {
-            normalize_quat(&mut self.q);
-        }
+        normalize_quats(&self.model, &mut self.q);
         self.state_changed();
         Ok(())
     }
@@ -638,12 +636,12 @@ impl Simulation {
             }
         }
         if self.opts.joint_dynamics {
-            let qo = self.model.joint_q_offset();
-            for (d, info) in self.model.dofs.iter().enumerate() {
+            for (d, iq, _) in self.model.dof_indices() {
+                let info = &self.model.dofs[d];
                 if info.continuous {
                     continue;
                 }
-                let q = self.q[qo + d];
+                let q = self.q[iq];
                 let (lower, upper, amount) = limit_excess(info, q);
                 if amount > 1e-9 {
                     out.push(Violation::Limit {
@@ -664,12 +662,12 @@ impl Simulation {
     fn worst_violation(&self) -> (f64, f64) {
         let mut excess: f64 = 0.0;
         if self.opts.joint_dynamics {
-            let qo = self.model.joint_q_offset();
-            for (d, info) in self.model.dofs.iter().enumerate() {
+            for (d, iq, _) in self.model.dof_indices() {
+                let info = &self.model.dofs[d];
                 if info.continuous {
                     continue;
                 }
-                excess = excess.max(limit_excess(info, self.q[qo + d]).2);
+                excess = excess.max(limit_excess(info, self.q[iq]).2);
             }
         }
         (self.penetration(), excess)
@@ -861,9 +859,7 @@ impl Simulation {
         };
         self.t = if h >= remaining { t_end } else { self.t + h };
         self.steps += 1;
-        if self.model.floating_base {
-            normalize_quat(&mut self.q);
-        }
+        normalize_quats(&self.model, &mut self.q);
         // 3. the new state: finite, its contacts, its energy
         self.check_finite()?;
         self.fk_valid = false;
@@ -880,12 +876,12 @@ impl Simulation {
         if !self.opts.joint_dynamics {
             return cap;
         }
-        let (qo, vo) = (self.model.joint_q_offset(), self.model.joint_v_offset());
-        for (d, info) in self.model.dofs.iter().enumerate() {
+        for (d, iq, iv) in self.model.dof_indices() {
+            let info = &self.model.dofs[d];
             if info.continuous {
                 continue;
             }
-            let (q, v) = (self.q[qo + d], self.v[vo + d]);
+            let (q, v) = (self.q[iq], self.v[iv]);
             let gap = match (v < 0.0, info.limits.lower, info.limits.upper) {
                 (true, Some(lo), _) => q - lo,
                 (false, _, Some(hi)) if v > 0.0 => hi - q,
@@ -1015,17 +1011,19 @@ fn land(dt: f64, remaining: f64) -> f64 {
 pub fn column_names(model: &Model) -> (Vec<String>, Vec<String>) {
     let mut qn = Vec::with_capacity(model.nq);
     let mut vn = Vec::with_capacity(model.nv);
-    if model.floating_base {
-        for s in ["x", "y", "z", "qx", "qy", "qz", "qw"] {
-            qn.push(format!("q:base_{s}"));
+    for t in &model.trees {
+        if let Some(f) = t.free.and_then(|i| model.free_joints.get(i)) {
+            for s in ["x", "y", "z", "qx", "qy", "qz", "qw"] {
+                qn.push(format!("q:{}_{s}", f.name));
+            }
+            for s in ["vx", "vy", "vz", "wx", "wy", "wz"] {
+                vn.push(format!("v:{}_{s}", f.name));
+            }
         }
-        for s in ["vx", "vy", "vz", "wx", "wy", "wz"] {
-            vn.push(format!("v:base_{s}"));
+        for d in &model.dofs[t.dofs.clone()] {
+            qn.push(format!("q:{}", d.name));
+            vn.push(format!("v:{}", d.name));
         }
-    }
-    for d in &model.dofs {
-        qn.push(format!("q:{}", d.name));
-        vn.push(format!("v:{}", d.name));
     }
     (qn, vn)
 }
@@ -1036,10 +1034,10 @@ pub fn supports(model: &Model) -> bool {
     model
         .joints
         .iter()
-        .skip(1)
         .enumerate()
-        .all(|(i, j)| match j.kind {
-            JointKind::Free => i == 0,
+        .skip(1)
+        .all(|(b, j)| match j.kind {
+            JointKind::Free => model.free_joints.iter().any(|f| f.body == b),
             _ => true,
         })
 }

@@ -385,6 +385,22 @@ pub(crate) fn lower(
         body_link_names,
         gravity: Vector3::new(0.0, 0.0, -9.81),
         floating_base: options.floating_base,
+        free_joints: if options.floating_base {
+            vec![crate::model::FreeJoint {
+                body: 1,
+                iq: 0,
+                iv: 0,
+                name: "base".into(),
+            }]
+        } else {
+            Vec::new()
+        },
+        trees: vec![crate::model::Tree::whole(
+            nbodies,
+            frames.len(),
+            dofs.len(),
+            options.floating_base,
+        )],
         dofs,
         frames,
         collisions,
