@@ -417,6 +417,8 @@ impl GroundContact {
                         }
                     }
                 }
+                // (a scene's terrain is welded to the world: never a moving link's)
+                Shape::HeightField { .. } => continue,
             };
             let nslots = match manifold {
                 Manifold::Vertices => verts.len(),

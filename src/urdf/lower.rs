@@ -213,6 +213,9 @@ pub(crate) fn lower(
                 body,
                 placement: b_m_l.compose(&pose(&c.origin)),
                 shape: shape(&c.geometry),
+                trimesh: false,
+                friction: 0.0,
+                model: 0,
             });
         }
         for &ji in checked.children[li].iter().rev() {
@@ -404,6 +407,13 @@ pub(crate) fn lower(
         dofs,
         frames,
         collisions,
+        // one model; self-collision off: a URDF alone keeps today's contact
+        // with the ground only (its trajectories, speed and allocation-free
+        // step); a scene turns it on per model (scene.md's default)
+        collision_filter: crate::model::CollisionFilter {
+            excluded: Vec::new(),
+            self_collision: vec![false],
+        },
         dof_parent,
         has_mimic,
         massless_joints,

@@ -584,6 +584,8 @@ impl Geometry {
                         };
                         VisualShape::Mesh(k)
                     }
+                    // a URDF has none (a scene's terrain is drawn by the scene's page)
+                    Shape::HeightField { .. } => continue,
                 };
                 let rgba = piece
                     .color
