@@ -58,9 +58,9 @@ pub mod cli;
 pub mod contact;
 pub mod dynamics;
 pub mod model;
+pub mod scene;
 pub mod sim;
 pub mod spatial;
-pub mod scene;
 pub mod urdf;
 
 pub use model::{Data, Model};

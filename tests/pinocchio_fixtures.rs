@@ -140,7 +140,10 @@ fn compare(name: &str, got: &Value, want: &Value) -> Cmp {
     let gn: Vec<String> = serde_json::from_value(got["dof_names"].clone()).unwrap();
     let wn: Vec<String> = serde_json::from_value(want["dof_names"].clone()).unwrap();
     // The engine's order is Pinocchio's (docs/theory.md §"Degrees of freedom order").
-    assert_eq!(gn, wn, "{name}: dof names or their order differ from Pinocchio's");
+    assert_eq!(
+        gn, wn,
+        "{name}: dof names or their order differ from Pinocchio's"
+    );
     let gres = got["results"].as_array().unwrap();
     let wres = want["results"].as_array().unwrap();
     assert_eq!(gres.len(), wres.len());

@@ -17,38 +17,89 @@ fn corpus(name: &str) -> PathBuf {
 const CASES: &[(&str, &[&str])] = &[
     ("unknown_top_key.json", &["colour"]),
     ("unknown_model_key.json", &["models[0]", "mass"]),
-    ("unknown_initial_key.json", &["models[0].initial.base", "velocity"]),
+    (
+        "unknown_initial_key.json",
+        &["models[0].initial.base", "velocity"],
+    ),
     ("unknown_ground_key.json", &["ground", "mu"]),
     ("unknown_obstacle_key.json", &["obstacles[0]", "colour"]),
     (
         "missing_urdf.json",
-        &["models[1].urdf: file \"nothere.urdf\" not found", "tests/bad/scene/nothere.urdf"],
+        &[
+            "models[1].urdf: file \"nothere.urdf\" not found",
+            "tests/bad/scene/nothere.urdf",
+        ],
     ),
-    ("duplicate_name.json", &["models[1].name: duplicate name \"crate\""]),
+    (
+        "duplicate_name.json",
+        &["models[1].name: duplicate name \"crate\""],
+    ),
     ("slash_name.json", &["models[0].name", "\"my/lamp\"", "'/'"]),
     ("empty_name.json", &["models[0].name", "empty name"]),
-    ("obstacle_named_as_model.json", &["obstacles[0].name: duplicate name \"lamp\""]),
-    ("bad_quaternion.json", &["models[0].orientation_xyzw", "unit quaternion", "norm 2"]),
-    ("bad_obstacle_quaternion.json", &["obstacles[0].orientation_xyzw", "unit quaternion"]),
+    (
+        "obstacle_named_as_model.json",
+        &["obstacles[0].name: duplicate name \"lamp\""],
+    ),
+    (
+        "bad_quaternion.json",
+        &["models[0].orientation_xyzw", "unit quaternion", "norm 2"],
+    ),
+    (
+        "bad_obstacle_quaternion.json",
+        &["obstacles[0].orientation_xyzw", "unit quaternion"],
+    ),
     (
         "bad_initial_quaternion.json",
         &["models[0].initial.base.orientation_xyzw", "unit quaternion"],
     ),
     ("non_finite.json", &["models[0].position"]),
-    ("empty_heightfield.json", &["obstacles[0].heightfield.heights", "empty height grid"]),
-    ("ragged_heightfield.json", &["obstacles[0].heightfield.heights[1]", "ragged"]),
-    ("two_shape_keys.json", &["obstacles[0] (step): two shape keys box, sphere"]),
-    ("no_shape_key.json", &["obstacles[0] (nothing): no shape key"]),
+    (
+        "empty_heightfield.json",
+        &["obstacles[0].heightfield.heights", "empty height grid"],
+    ),
+    (
+        "ragged_heightfield.json",
+        &["obstacles[0].heightfield.heights[1]", "ragged"],
+    ),
+    (
+        "two_shape_keys.json",
+        &["obstacles[0] (step): two shape keys box, sphere"],
+    ),
+    (
+        "no_shape_key.json",
+        &["obstacles[0] (nothing): no shape key"],
+    ),
     ("negative_box.json", &["obstacles[0].box", "-1"]),
-    ("missing_mesh.json", &["obstacles[0].mesh: file \"rock.stl\" not found"]),
-    ("unknown_exclude_link.json", &["exclude[0][0]", "\"lamp/nolink\""]),
-    ("unknown_exclude_model.json", &["exclude[0][1]", "\"robot\""]),
+    (
+        "missing_mesh.json",
+        &["obstacles[0].mesh: file \"rock.stl\" not found"],
+    ),
+    (
+        "unknown_exclude_link.json",
+        &["exclude[0][0]", "\"lamp/nolink\""],
+    ),
+    (
+        "unknown_exclude_model.json",
+        &["exclude[0][1]", "\"robot\""],
+    ),
     ("unknown_exclude_name.json", &["exclude[0][1]", "\"wall\""]),
-    ("unknown_pose.json", &["models[0].pose", "\"away\"", "nearest: \"home\""]),
+    (
+        "unknown_pose.json",
+        &["models[0].pose", "\"away\"", "nearest: \"home\""],
+    ),
     ("pose_without_srdf.json", &["models[0].pose", "srdf"]),
-    ("missing_srdf.json", &["models[0].srdf: file \"nothere.srdf\" not found"]),
-    ("unknown_initial_joint.json", &["models[0].initial.q.elbw", "nearest: \"elbow\""]),
-    ("fixed_with_initial_base.json", &["models[0].initial.base", "fixed base"]),
+    (
+        "missing_srdf.json",
+        &["models[0].srdf: file \"nothere.srdf\" not found"],
+    ),
+    (
+        "unknown_initial_joint.json",
+        &["models[0].initial.q.elbw", "nearest: \"elbow\""],
+    ),
+    (
+        "fixed_with_initial_base.json",
+        &["models[0].initial.base", "fixed base"],
+    ),
     ("not_json.json", &["not valid JSON"]),
     ("no_models.json", &["models", "at least one model"]),
     ("bad_base.json", &["models[0].base", "flying"]),
@@ -65,7 +116,10 @@ fn every_bad_scene_is_one_line_naming_the_file_and_the_key() {
         .filter(|n| n.ends_with(".json"))
         .collect();
     on_disk.sort_unstable();
-    assert_eq!(listed, on_disk, "every corpus file has its expected message");
+    assert_eq!(
+        listed, on_disk,
+        "every corpus file has its expected message"
+    );
     for (file, want) in CASES {
         let path = corpus(file);
         let err = match Scene::from_file(&path, &[]) {
@@ -103,13 +157,22 @@ fn srdf_names_the_urdf_lacks_warn_once_and_load() {
     .unwrap();
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
     let w = &s.warnings[0];
-    assert!(w.contains("no_such_link") && w.contains("wrist_extra"), "{w}");
-    assert!(!w.contains("root_joint"), "Pinocchio's root_joint is not warned about: {w}");
+    assert!(
+        w.contains("no_such_link") && w.contains("wrist_extra"),
+        "{w}"
+    );
+    assert!(
+        !w.contains("root_joint"),
+        "Pinocchio's root_joint is not warned about: {w}"
+    );
     // the pose's values, then initial.q over them; the base from the model's pose
     let m = &s.model;
     assert_eq!(s.q0[m.q_index("lamp/shoulder").unwrap()], 0.2);
     assert_eq!(s.q0[m.q_index("lamp/elbow").unwrap()], 0.1);
-    assert_eq!(s.q0.rows(0, 7).as_slice(), &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+    assert_eq!(
+        s.q0.rows(0, 7).as_slice(),
+        &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+    );
     // the SRDF pair both of whose links exist
     assert_eq!(
         s.models[0].disabled,
@@ -175,7 +238,10 @@ fn cli_refuses_per_model_options_beside_a_scene_and_writes_nothing() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success());
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    assert!(err.contains("obstacles[0] (step): two shape keys box, sphere"), "{err}");
+    assert!(
+        err.contains("obstacles[0] (step): two shape keys box, sphere"),
+        "{err}"
+    );
     assert!(!out.exists());
     // the good scene runs: MODEL/NAME columns, models in file order
     let o = urdyn()
@@ -194,6 +260,12 @@ fn cli_refuses_per_model_options_beside_a_scene_and_writes_nothing() {
     assert!(header.contains(&"v:lamp/base_wz") && header.contains(&"v:lamp/shade_tilt"));
     assert_eq!(header.last(), Some(&"penetration"));
     // the first row: the lamp at its pose
-    let row: Vec<f64> = csv.lines().nth(1).unwrap().split(',').map(|x| x.parse().unwrap()).collect();
+    let row: Vec<f64> = csv
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
     assert_eq!(&row[1..8], &[0.0, 0.0, 0.3, 0.0, 0.0, 0.0, 1.0]);
 }

@@ -189,7 +189,11 @@ fn difference_free(
     let (x1, y1, z1, w1) = quat(q1);
     let r0 = quat_to_matrix(x0, y0, z0, w0);
     let dp = r0.transpose()
-        * Vector3::new(q1[iq] - q0[iq], q1[iq + 1] - q0[iq + 1], q1[iq + 2] - q0[iq + 2]);
+        * Vector3::new(
+            q1[iq] - q0[iq],
+            q1[iq + 1] - q0[iq + 1],
+            q1[iq + 2] - q0[iq + 2],
+        );
     // d = conj(q0) ⊗ q1
     let mut dw = w0 * w1 + x0 * x1 + y0 * y1 + z0 * z1;
     let mut dv = Vector3::new(

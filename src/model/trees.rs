@@ -79,16 +79,21 @@ impl<T: Scalar> Model<T> {
     pub fn dof_indices(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
         self.trees.iter().flat_map(|t| {
             let (q0, v0) = (t.joint_q(), t.joint_v());
-            t.dofs.clone().enumerate().map(move |(k, d)| (d, q0 + k, v0 + k))
+            t.dofs
+                .clone()
+                .enumerate()
+                .map(move |(k, d)| (d, q0 + k, v0 + k))
         })
     }
     /// The index in q of the degree of freedom `dofs[d]`.
     pub fn dof_q(&self, d: usize) -> usize {
-        self.tree_of_dof(d).map_or(d, |t| t.joint_q() + d - t.dofs.start)
+        self.tree_of_dof(d)
+            .map_or(d, |t| t.joint_q() + d - t.dofs.start)
     }
     /// The index in v of the degree of freedom `dofs[d]`.
     pub fn dof_v(&self, d: usize) -> usize {
-        self.tree_of_dof(d).map_or(d, |t| t.joint_v() + d - t.dofs.start)
+        self.tree_of_dof(d)
+            .map_or(d, |t| t.joint_v() + d - t.dofs.start)
     }
     /// The degree of freedom at velocity index `iv`, if it is a joint's (not a
     /// free joint's).

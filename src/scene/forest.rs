@@ -5,7 +5,7 @@
 //! pose; a floating model's free joint starts at the world origin (its pose is
 //! its starting q). Every name becomes `MODEL/NAME`.
 
-use crate::model::{CollisionGeom, FreeJoint, Model, Topology, Tree};
+use crate::model::{CollisionFilter, CollisionGeom, FreeJoint, Model, Topology, Tree};
 use crate::spatial::Se3;
 use nalgebra::Vector3;
 
@@ -18,15 +18,21 @@ pub struct Part {
     pub model: Model,
     /// `world_M_root` of a fixed model (ignored for a floating one).
     pub pose: Se3<f64>,
+    /// Its links' friction coefficient.
+    pub friction: f64,
+    /// Contact between two of its links.
+    pub self_collision: bool,
 }
 
 fn prefixed(prefix: &str, name: &str) -> String {
     format!("{prefix}/{name}")
 }
 
-/// The forest of `parts`, in order, under gravity `g`. Mesh filenames of the
-/// collision geometry are kept as each model gave them (resolve them first:
-/// the forest has no one source file).
+/// The forest of `parts`, in order, under gravity `g`: each part's collision
+/// shapes get its index as their model and its friction; its self-collision
+/// flag goes into the collision filter. Mesh filenames of the collision
+/// geometry are kept as each model gave them (resolve them first: the forest
+/// has no one source file).
 pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
     let mut m = Model {
         name: name.to_string(),
@@ -48,6 +54,10 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
         dofs: Vec::new(),
         frames: Vec::new(),
         collisions: Vec::new(),
+        collision_filter: CollisionFilter {
+            excluded: Vec::new(),
+            self_collision: Vec::new(),
+        },
         dof_parent: Vec::new(),
         has_mimic: false,
         massless_joints: Vec::new(),
@@ -67,11 +77,7 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
         // body b > 0 of the part is b0 + b − 1 here; its body 0 is the world
         let body = |b: usize| if b == 0 { 0 } else { b0 + b - 1 };
         let floating = p.floating_base;
-        let weld = if floating {
-            Se3::identity()
-        } else {
-            part.pose
-        };
+        let weld = if floating { Se3::identity() } else { part.pose };
         for b in 1..p.nbodies {
             m.parent.push(body(p.parent[b]));
             let mut j = p.joints[b].clone();
@@ -84,7 +90,8 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
             } else {
                 p.placements[b]
             };
-            m.placement_identity.push(x.rot == nalgebra::Matrix3::identity());
+            m.placement_identity
+                .push(x.rot == nalgebra::Matrix3::identity());
             m.placements.push(x);
             m.inertias.push(p.inertias[b]);
             m.inertias_origin.push(p.inertias_origin[b]);
@@ -108,6 +115,8 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
                 c.placement = weld.compose(&c.placement);
             }
             c.body = body(c.body);
+            c.model = i;
+            c.friction = part.friction;
             m.collisions.push(c);
         }
         for d in &p.dofs {
@@ -121,12 +130,22 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
                 .map(|&k| if k == usize::MAX { k } else { k + v0 }),
         );
         m.has_mimic |= p.has_mimic;
+        m.collision_filter.self_collision.push(part.self_collision);
+        m.collision_filter.excluded.extend(
+            p.collision_filter
+                .excluded
+                .iter()
+                .map(|(a, b)| (prefixed(pre, a), prefixed(pre, b))),
+        );
         m.massless_joints
             .extend(p.massless_joints.iter().map(|j| prefixed(pre, j)));
         let report = &p.report;
-        m.report
-            .merged
-            .extend(report.merged.iter().map(|(a, b)| (prefixed(pre, a), prefixed(pre, b))));
+        m.report.merged.extend(
+            report
+                .merged
+                .iter()
+                .map(|(a, b)| (prefixed(pre, a), prefixed(pre, b))),
+        );
         m.report
             .tree
             .extend(report.tree.iter().map(|l| format!("{pre}: {l}")));

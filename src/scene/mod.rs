@@ -12,12 +12,12 @@ mod forest;
 pub mod srdf;
 
 pub use file::{
-    BaseSpec, GroundSpec, HeightFieldSpec, InitialBaseSpec, InitialSpec, ModelSpec,
-    ObstacleSpec, RoundSpec, SceneSpec,
+    BaseSpec, GroundSpec, HeightFieldSpec, InitialBaseSpec, InitialSpec, ModelSpec, ObstacleSpec,
+    RoundSpec, SceneSpec,
 };
 pub use forest::{forest, Part};
 
-use crate::model::{nearest, CollisionGeom, Model, Shape};
+use crate::model::{nearest, CollisionGeom, Model, Shape, OBSTACLE};
 use crate::spatial::{quat_to_matrix, Se3};
 use crate::urdf::{load_file, resolve_mesh_path, LoadOptions};
 use nalgebra::{DVector, Vector3};
@@ -131,11 +131,18 @@ fn read_text(path: &Path) -> Result<String, std::io::Error> {
 impl Scene {
     /// Reads and loads a SCENE.json; relative paths are taken against its folder,
     /// `package://` meshes against `package_paths` as in cli.md.
-    pub fn from_file(path: impl AsRef<Path>, package_paths: &[PathBuf]) -> Result<Self, SceneError> {
+    pub fn from_file(
+        path: impl AsRef<Path>,
+        package_paths: &[PathBuf],
+    ) -> Result<Self, SceneError> {
         let path = path.as_ref();
         let name = path.display().to_string();
         if path.is_dir() {
-            return Err(SceneError::new(&name, "(file)", "is a directory, not a scene file"));
+            return Err(SceneError::new(
+                &name,
+                "(file)",
+                "is a directory, not a scene file",
+            ));
         }
         let text = read_text(path).map_err(|e| {
             let mut err = SceneError::new(&name, "(file)", format!("cannot read: {e}"));
@@ -280,7 +287,10 @@ impl Loader<'_> {
         if name.trim() != name || name.chars().any(char::is_control) {
             return Err(self.err(
                 key,
-                format!("name \"{}\" has spaces at an end or control characters", name.escape_default()),
+                format!(
+                    "name \"{}\" has spaces at an end or control characters",
+                    name.escape_default()
+                ),
             ));
         }
         if !seen.insert(name.to_string()) {
@@ -324,8 +334,13 @@ impl Loader<'_> {
             let pose = self.pose(&key, m.position, m.orientation_xyzw)?;
             let urdf = self.existing(&format!("{key}.urdf"), &m.urdf)?;
             let floating = m.base == BaseSpec::Floating;
-            let mut model = load_file(&urdf, LoadOptions { floating_base: floating })
-                .map_err(|e| self.err(format!("{key}.urdf"), e.to_string()))?;
+            let mut model = load_file(
+                &urdf,
+                LoadOptions {
+                    floating_base: floating,
+                },
+            )
+            .map_err(|e| self.err(format!("{key}.urdf"), e.to_string()))?;
             for c in &mut model.collisions {
                 if let Shape::Mesh { filename, .. } = &mut c.shape {
                     if let Some(p) = resolve_mesh_path(filename, Some(&urdf), self.package_paths) {
@@ -340,10 +355,7 @@ impl Loader<'_> {
                     let path = self.existing(&k, s)?;
                     let text = read_text(&path)
                         .map_err(|e| self.err(&k, format!("{s}: cannot read: {e}")))?;
-                    Some(
-                        srdf::parse_srdf(&text)
-                            .map_err(|e| self.err(&k, format!("{s}: {e}")))?,
-                    )
+                    Some(srdf::parse_srdf(&text).map_err(|e| self.err(&k, format!("{s}: {e}")))?)
                 }
             };
             if m.pose.is_some() && srdf.is_none() {
@@ -403,10 +415,18 @@ impl Loader<'_> {
                         self.file,
                         m.srdf.as_deref().unwrap_or_default(),
                         unknown.len(),
-                        if unknown.len() == 1 { "element" } else { "elements" },
+                        if unknown.len() == 1 {
+                            "element"
+                        } else {
+                            "elements"
+                        },
                         m.urdf,
                         shown.join(", "),
-                        if unknown.len() > shown.len() { ", ..." } else { "" }
+                        if unknown.len() > shown.len() {
+                            ", ..."
+                        } else {
+                            ""
+                        }
                     ));
                 }
             }
@@ -424,6 +444,8 @@ impl Loader<'_> {
                 name: m.name.clone(),
                 model,
                 pose,
+                friction: models[i].friction,
+                self_collision: models[i].self_collision,
             });
         }
         let mut model = forest("scene", parts, Vector3::from(gravity));
@@ -436,7 +458,10 @@ impl Loader<'_> {
                 link: obstacle.name.clone(),
                 body: 0,
                 placement: obstacle.placement,
+                trimesh: matches!(obstacle.shape, Shape::Mesh { .. }),
                 shape: obstacle.shape.clone(),
+                friction: obstacle.friction,
+                model: OBSTACLE,
             });
             obstacles.push(obstacle);
         }
@@ -455,6 +480,18 @@ impl Loader<'_> {
             }
         }
 
+        // never in contact: the SRDFs' pairs, then `exclude`
+        for sm in &models {
+            model
+                .collision_filter
+                .excluded
+                .extend(sm.disabled.iter().cloned());
+        }
+        model
+            .collision_filter
+            .excluded
+            .extend(exclude.iter().cloned());
+
         // the starting state
         let mut q0 = model.neutral();
         let mut v0 = DVector::zeros(model.nv);
@@ -464,7 +501,8 @@ impl Loader<'_> {
             let tree = model.trees[i].clone();
             let pre = tree.prefix();
             let mut position = m.position.unwrap_or([0.0; 3]);
-            let mut orientation = self.quaternion(&format!("{key}.orientation_xyzw"), m.orientation_xyzw)?;
+            let mut orientation =
+                self.quaternion(&format!("{key}.orientation_xyzw"), m.orientation_xyzw)?;
             if let (Some(p), Some(s)) = (&m.pose, &srdfs[i]) {
                 for (j, vals) in s.pose(p).unwrap_or_default() {
                     if let (Ok(iq), [x]) = (model.q_index(&format!("{pre}{j}")), vals.as_slice()) {
@@ -512,7 +550,8 @@ impl Loader<'_> {
                         position = p;
                     }
                     if let Some(o) = b.orientation_xyzw {
-                        orientation = self.quaternion(&format!("{bk}.orientation_xyzw"), Some(o))?;
+                        orientation =
+                            self.quaternion(&format!("{bk}.orientation_xyzw"), Some(o))?;
                     }
                     let vecs = [
                         (&b.linear_velocity, "linear_velocity", 0),
@@ -536,7 +575,10 @@ impl Loader<'_> {
                 q0.rows_mut(f.iq, 3).copy_from_slice(&position);
                 q0.rows_mut(f.iq + 3, 4).copy_from_slice(&orientation);
                 let o = orientation;
-                models[i].pose = Se3::new(quat_to_matrix(o[0], o[1], o[2], o[3]), Vector3::from(position));
+                models[i].pose = Se3::new(
+                    quat_to_matrix(o[0], o[1], o[2], o[3]),
+                    Vector3::from(position),
+                );
             }
         }
         Ok(Scene {
@@ -560,7 +602,12 @@ impl Loader<'_> {
         let named = format!("{key} ({})", o.name);
         let keys = o.shape_keys();
         match keys.len() {
-            0 => return Err(self.err(named, "no shape key (one of box, sphere, cylinder, capsule, mesh, heightfield)")),
+            0 => {
+                return Err(self.err(
+                    named,
+                    "no shape key (one of box, sphere, cylinder, capsule, mesh, heightfield)",
+                ))
+            }
             1 => {}
             _ => return Err(self.err(named, format!("two shape keys {}", keys.join(", ")))),
         }
@@ -626,7 +673,10 @@ impl Loader<'_> {
             if row.len() != cols {
                 return Err(self.err(
                     format!("{hk}[{r}]"),
-                    format!("ragged height grid: row {r} has {} heights, row 0 has {cols}", row.len()),
+                    format!(
+                        "ragged height grid: row {r} has {} heights, row 0 has {cols}",
+                        row.len()
+                    ),
                 ));
             }
             for (c, x) in row.iter().enumerate() {
@@ -688,11 +738,8 @@ impl Loader<'_> {
 
 /// The height field obstacle's shape.
 fn height_field_shape(h: &HeightFieldSpec) -> Shape {
-    // until the model has a height-field shape: its bounding box stands in
-    let lo = h.heights.iter().flatten().copied().fold(f64::INFINITY, f64::min);
-    let hi = h.heights.iter().flatten().copied().fold(f64::NEG_INFINITY, f64::max);
-    let _ = (lo, hi);
-    Shape::Box {
-        size: [h.size[0], h.size[1], (hi - lo).max(1e-3)],
+    Shape::HeightField {
+        heights: h.heights.clone(),
+        size: h.size,
     }
 }

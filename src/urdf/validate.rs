@@ -385,7 +385,12 @@ pub(crate) fn validate(parsed: &Parsed, file: &str) -> Result<Checked, UrdfError
     }
     // Pinocchio's order: a link's children by their joints' names, byte-wise.
     for c in &mut children {
-        c.sort_by(|&a, &b| robot.joints[a].name.as_bytes().cmp(robot.joints[b].name.as_bytes()));
+        c.sort_by(|&a, &b| {
+            robot.joints[a]
+                .name
+                .as_bytes()
+                .cmp(robot.joints[b].name.as_bytes())
+        });
     }
     Ok(Checked {
         root,

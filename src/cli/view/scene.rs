@@ -2,7 +2,9 @@
 //! visual geometry (links `MODEL/LINK`), every obstacle on the world body, the
 //! height field as a triangulated surface.
 
-use super::{read_trajectory, write_page, Geometry, PageSummary, Recorder, ViewError, Visual, VisualShape};
+use super::{
+    read_trajectory, write_page, Geometry, PageSummary, Recorder, ViewError, Visual, VisualShape,
+};
 use crate::contact::mesh::{load_mesh, TriMesh};
 use crate::model::Shape;
 use crate::scene::{HeightFieldSpec, Scene};
@@ -66,26 +68,25 @@ impl Geometry {
             )?;
             all.append(g);
         }
-        for (o, spec) in scene.obstacles.iter().zip(&scene.spec.obstacles) {
-            let shape = if let Some(h) = &spec.heightfield {
-                all.meshes.push(height_field_mesh(h));
-                VisualShape::Mesh(all.meshes.len() - 1)
-            } else {
-                match &o.shape {
-                    Shape::Box { size } => VisualShape::Box(*size),
-                    &Shape::Cylinder { radius, length } => VisualShape::Cylinder { radius, length },
-                    &Shape::Capsule { radius, length } => VisualShape::Capsule { radius, length },
-                    &Shape::Sphere { radius } => VisualShape::Sphere { radius },
-                    Shape::Mesh { filename, scale } => {
-                        let m = load_mesh(std::path::Path::new(filename), *scale).map_err(|e| {
-                            ViewError::Geometry(format!(
-                                "{}: obstacle \"{}\": {e}",
-                                scene.file, o.name
-                            ))
-                        })?;
-                        all.meshes.push(m);
-                        VisualShape::Mesh(all.meshes.len() - 1)
-                    }
+        for o in &scene.obstacles {
+            let shape = match &o.shape {
+                Shape::Box { size } => VisualShape::Box(*size),
+                &Shape::Cylinder { radius, length } => VisualShape::Cylinder { radius, length },
+                &Shape::Capsule { radius, length } => VisualShape::Capsule { radius, length },
+                &Shape::Sphere { radius } => VisualShape::Sphere { radius },
+                Shape::Mesh { filename, scale } => {
+                    let m = load_mesh(std::path::Path::new(filename), *scale).map_err(|e| {
+                        ViewError::Geometry(format!("{}: obstacle \"{}\": {e}", scene.file, o.name))
+                    })?;
+                    all.meshes.push(m);
+                    VisualShape::Mesh(all.meshes.len() - 1)
+                }
+                Shape::HeightField { heights, size } => {
+                    all.meshes.push(height_field_mesh(&HeightFieldSpec {
+                        heights: heights.clone(),
+                        size: *size,
+                    }));
+                    VisualShape::Mesh(all.meshes.len() - 1)
                 }
             };
             all.visuals.push(Visual {
