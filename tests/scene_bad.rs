@@ -259,6 +259,29 @@ fn cli_refuses_per_model_options_beside_a_scene_and_writes_nothing() {
     assert_eq!(header[8], "q:lamp/shoulder");
     assert!(header.contains(&"v:lamp/base_wz") && header.contains(&"v:lamp/shade_tilt"));
     assert_eq!(header.last(), Some(&"penetration"));
+    // the replay pages: every model's links as MODEL/LINK
+    let page = dir.path().join("p.html");
+    let o = urdyn()
+        .args(["view", "--scene"])
+        .arg(&scene)
+        .arg(&out)
+        .arg("--out")
+        .arg(&page)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.contains("\"lamp/shade\"") && html.contains("\"table/leg_4\""));
+    let o = urdyn()
+        .args(["view", "--scene"])
+        .arg(&scene)
+        .arg(&out)
+        .arg("--floating-base")
+        .arg("--out")
+        .arg(dir.path().join("q.html"))
+        .output()
+        .unwrap();
+    assert!(!o.status.success() && !dir.path().join("q.html").exists());
     // the first row: the lamp at its pose
     let row: Vec<f64> = csv
         .lines()
