@@ -20,6 +20,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let csv = out_dir.join("lamp_drop.csv");
     let args = urdyn::cli::simulate::SimulateArgs {
         urdf: root.join("assets/lamp.urdf"),
+        scene: None,
         floating_base: true,
         duration: 3.0,
         dt: 1e-3,

@@ -71,12 +71,12 @@ pub mod solver;
 pub use derivatives::{JacobianMethod, TransitionJacobians};
 pub use integrators::Integrator;
 
-use crate::contact::{ContactError, ContactParams, ContactPoint, GroundContact};
+use crate::contact::{Collision, ContactError, ContactParams, ContactPoint, DroppedPair, NO_GEOM};
 use crate::dynamics::DynamicsError;
 use crate::dynamics::{
     forward_kinematics_pass as forward_kinematics, kinetic_energy_from_placements, potential_energy,
 };
-use crate::model::configuration::normalize_quat;
+use crate::model::configuration::normalize_quats;
 use crate::model::{Data, JointKind, Model};
 use crate::spatial::Force;
 use constraints::{Constraints, RowParams};
@@ -242,6 +242,16 @@ pub enum Violation {
         /// Its deepest point's penetration (m, positive).
         depth: f64,
     },
+    /// Two shapes of different bodies (a body and an obstacle, two models,
+    /// two links of one model that overlap by at most 1 mm) overlap by `depth` m.
+    Overlap {
+        /// One side's link.
+        a: String,
+        /// The other side's link (an obstacle: its name).
+        b: String,
+        /// The deepest overlap (m, positive).
+        depth: f64,
+    },
     /// A joint is `amount` outside its limits [lower, upper] (at `q`).
     Limit {
         /// The URDF joint.
@@ -260,6 +270,10 @@ pub enum Violation {
 impl std::fmt::Display for Violation {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
+            Violation::Overlap { a, b, depth } => write!(
+                f,
+                "links \"{a}\" and \"{b}\" start {depth:.4} m inside each other (pushed apart at a capped speed)"
+            ),
             Violation::Ground { link, depth } => write!(
                 f,
                 "link \"{link}\" starts {depth:.4} m inside the ground (pushed out at a capped speed)"
@@ -352,7 +366,7 @@ pub struct Simulation {
     has_damping: bool,
     has_armature: bool,
     data: Data,
-    contact: Option<GroundContact>,
+    contact: Option<Collision>,
     points: Vec<ContactPoint>,
     /// `data.o_m_i` holds the world poses at the current `q`.
     fk_valid: bool,
@@ -418,38 +432,42 @@ impl Simulation {
             )));
         }
         crate::dynamics::check_massless(&model)?;
-        let contact = match opts.ground {
-            Some(g) => GroundContact::build(&model, g, opts.contact, &opts.package_paths)?,
-            None => None,
+        let contact = match () {
+            // the ground, obstacles and pairs of bodies (none of them: no contact work)
+            _ => Collision::build(&model, opts.ground, opts.contact, &opts.package_paths)?,
         };
         let integrator = opts
             .integrator
             .unwrap_or(Integrator::default_for(contact.is_some()));
         let (nq, nv) = (model.nq, model.nv);
-        let vo = model.joint_v_offset();
         let mut damping = DVector::zeros(nv);
         let mut armature = DVector::zeros(nv);
         let mut effort = vec![f64::INFINITY; nv];
-        for (d, info) in model.dofs.iter().enumerate() {
-            armature[vo + d] = a;
+        for (d, _, iv) in model.dof_indices() {
+            let info = &model.dofs[d];
+            armature[iv] = a;
             if opts.joint_dynamics {
-                damping[vo + d] = if info.damping.is_finite() {
+                damping[iv] = if info.damping.is_finite() {
                     info.damping.max(0.0)
                 } else {
                     0.0
                 };
                 if let Some(e) = info.limits.effort {
                     if e > 0.0 {
-                        effort[vo + d] = e;
+                        effort[iv] = e;
                     }
                 }
             }
         }
         let max_points = contact.as_ref().map_or(0, |c| c.max_points());
+        let pair_points = contact
+            .as_ref()
+            .and_then(|c| c.pairs.as_ref())
+            .map_or(0, |p| p.max_points());
+        let mass_factor = factor::MassFactor::new(&model);
         let nslots = contact.as_ref().map_or(0, |c| c.nslots);
         let row_params = RowParams {
             joint_dynamics: opts.joint_dynamics,
-            mu: opts.contact.friction,
             restitution: opts.contact.restitution,
             gravity: model.gravity.norm(),
             beta: opts.contact.baumgarte,
@@ -476,13 +494,13 @@ impl Simulation {
             has_damping,
             has_armature,
             data: Data::new(&model),
-            cons: Constraints::new(&model, max_points, nslots),
+            cons: Constraints::new(&model, &mass_factor, max_points, pair_points, nslots),
             contact,
             points: Vec::with_capacity(max_points),
             fk_valid: false,
             row_params,
             mass: MassWork {
-                f: factor::MassFactor::new(&model),
+                f: mass_factor,
                 vfree: DVector::zeros(nv),
                 tau: DVector::zeros(nv),
                 vtot: DVector::zeros(nv),
@@ -500,7 +518,7 @@ impl Simulation {
                 h_next: opts.dt,
                 fsal_ok: false,
             },
-            servo: servo::Servo::new(&model.neutral(), nv),
+            servo: servo::Servo::new(&model, &model.neutral()),
             sensors: sensors::Sensors::new(nq, nv),
             forcing_changed: true,
             energy_now: None,
@@ -570,9 +588,7 @@ impl Simulation {
         }
         self.q.copy_from(q);
         self.v.copy_from(v);
-        if self.model.floating_base {
-            normalize_quat(&mut self.q);
-        }
+        normalize_quats(&self.model, &mut self.q);
         self.state_changed();
         Ok(())
     }
@@ -584,6 +600,9 @@ impl Simulation {
         self.sensors.forget();
         self.smooth.fsal_ok = false;
         self.cons.reset_warm_start();
+        if self.steps == 0 {
+            self.decide_start_overlaps();
+        }
         self.refresh_contacts();
         self.guard.reference = None;
         self.guard.recovering_until = if self.start_violations().is_empty() {
@@ -608,8 +627,8 @@ impl Simulation {
             )));
         }
         let low = self.lowest_point();
-        let ground = match &self.contact {
-            Some(c) => c.ground,
+        let ground = match self.contact.as_ref().and_then(|c| c.ground_height()) {
+            Some(g) => g,
             None => return Ok(false),
         };
         if !self.model.floating_base || !low.is_finite() {
@@ -628,31 +647,45 @@ impl Simulation {
     /// `limit_push_speed`).
     pub fn start_violations(&self) -> Vec<Violation> {
         let mut out = Vec::new();
-        if let Some(c) = &self.contact {
+        if self.contact.is_some() {
             let margin = self.opts.contact.margin;
             for p in &self.points {
                 if -p.gap <= margin {
                     continue;
                 }
-                let link = &c.shapes[p.shape].link;
+                let link = self.geom_link(p.geom);
+                if p.other_geom != NO_GEOM {
+                    let other = self.geom_link(p.other_geom);
+                    match out.iter_mut().find(|v: &&mut Violation| {
+                        matches!(v, Violation::Overlap { a, b, .. } if a == link && b == other)
+                    }) {
+                        Some(Violation::Overlap { depth, .. }) => *depth = depth.max(-p.gap),
+                        _ => out.push(Violation::Overlap {
+                            a: link.to_string(),
+                            b: other.to_string(),
+                            depth: -p.gap,
+                        }),
+                    }
+                    continue;
+                }
                 match out.iter_mut().find(
                     |v: &&mut Violation| matches!(v, Violation::Ground { link: l, .. } if l == link),
                 ) {
                     Some(Violation::Ground { depth, .. }) => *depth = depth.max(-p.gap),
                     _ => out.push(Violation::Ground {
-                        link: link.clone(),
+                        link: link.to_string(),
                         depth: -p.gap,
                     }),
                 }
             }
         }
         if self.opts.joint_dynamics {
-            let qo = self.model.joint_q_offset();
-            for (d, info) in self.model.dofs.iter().enumerate() {
+            for (d, iq, _) in self.model.dof_indices() {
+                let info = &self.model.dofs[d];
                 if info.continuous {
                     continue;
                 }
-                let q = self.q[qo + d];
+                let q = self.q[iq];
                 let (lower, upper, amount) = limit_excess(info, q);
                 if amount > 1e-9 {
                     out.push(Violation::Limit {
@@ -673,12 +706,12 @@ impl Simulation {
     fn worst_violation(&self) -> (f64, f64) {
         let mut excess: f64 = 0.0;
         if self.opts.joint_dynamics {
-            let qo = self.model.joint_q_offset();
-            for (d, info) in self.model.dofs.iter().enumerate() {
+            for (d, iq, _) in self.model.dof_indices() {
+                let info = &self.model.dofs[d];
                 if info.continuous {
                     continue;
                 }
-                excess = excess.max(limit_excess(info, self.q[qo + d]).2);
+                excess = excess.max(limit_excess(info, self.q[iq]).2);
             }
         }
         (self.penetration(), excess)
@@ -715,7 +748,7 @@ impl Simulation {
     /// Narrow-phase contact queries performed so far (0 for a scene with no
     /// collision geometry or no ground).
     pub fn contact_queries(&self) -> u64 {
-        self.contact.as_ref().map_or(0, |c| c.queries)
+        self.contact.as_ref().map_or(0, |c| c.queries())
     }
     /// The lowest point of the collision geometry at the current state (m; +∞
     /// without contact shapes).
@@ -743,15 +776,60 @@ impl Simulation {
     /// [`Simulation::contact_points`] or [`ContactForce::point`]); `None` for a
     /// point this simulation did not find.
     pub fn contact_link(&self, point: &ContactPoint) -> Option<&str> {
-        let c = self.contact.as_ref()?;
-        c.shapes.get(point.shape).map(|s| s.link.as_str())
+        self.contact.as_ref()?;
+        self.model
+            .collisions
+            .get(point.geom)
+            .map(|g| g.link.as_str())
+    }
+    /// The link (an obstacle: its name) on the other side of a contact point;
+    /// `None` on the ground.
+    pub fn contact_other_link(&self, point: &ContactPoint) -> Option<&str> {
+        self.model
+            .collisions
+            .get(point.other_geom)
+            .map(|g| g.link.as_str())
     }
     /// [`Simulation::contact_forces`] named by URDF link (the link whose
-    /// collision shape touched, not the merged body).
-    pub fn link_contact_forces(&self) -> impl Iterator<Item = (&str, &ContactForce)> + '_ {
-        self.contact_forces()
-            .iter()
-            .map(|f| (self.contact_link(&f.point).unwrap_or(""), f))
+    /// collision shape touched, not the merged body), on both sides: a
+    /// contact between two shapes gives the force on each (the second with
+    /// the point's sides swapped, its normal and force negated); the ground
+    /// gives one.
+    pub fn link_contact_forces(&self) -> impl Iterator<Item = (&str, ContactForce)> + '_ {
+        self.contact_forces().iter().flat_map(move |f| {
+            let a = (self.contact_link(&f.point).unwrap_or(""), *f);
+            let b = self.contact_other_link(&f.point).map(|l| {
+                let p = f.point;
+                let swapped = ContactPoint {
+                    body: p.other,
+                    other: p.body,
+                    geom: p.other_geom,
+                    other_geom: p.geom,
+                    normal: -p.normal,
+                    ..p
+                };
+                (
+                    l,
+                    ContactForce {
+                        point: swapped,
+                        force: -f.force,
+                    },
+                )
+            });
+            std::iter::once(a).chain(b)
+        })
+    }
+    /// The self pairs dropped because they overlapped at the start (scene.md
+    /// "Who touches whom" rule 4), each with its warning line (`Display`).
+    pub fn dropped_pairs(&self) -> &[DroppedPair] {
+        self.contact.as_ref().map_or(&[], |c| &c.dropped)
+    }
+    /// The link of a collision geometry ("" for none).
+    fn geom_link(&self, geom: usize) -> &str {
+        self.model
+            .collisions
+            .get(geom)
+            .map_or("", |g| g.link.as_str())
     }
     /// Number of contact points that carried force in the last step.
     pub fn active_contacts(&self) -> usize {
@@ -807,6 +885,20 @@ impl Simulation {
             + self.armature_energy();
         self.energy_now = Some(e);
         e
+    }
+
+    /// Before the first step: the self pairs overlapping at this state are
+    /// dropped (scene.md "Who touches whom" rule 4; decided anew at each state
+    /// set before the run starts).
+    fn decide_start_overlaps(&mut self) {
+        let Some(c) = self.contact.as_mut() else {
+            return;
+        };
+        if c.pairs.is_none() {
+            return;
+        }
+        forward_kinematics(&self.model, &mut self.data, &self.q);
+        c.drop_start_overlaps(&self.model, &self.data.o_m_i);
     }
 
     /// Forward kinematics and contact detection at the current q.
@@ -872,9 +964,7 @@ impl Simulation {
         self.t = if h >= remaining { t_end } else { self.t + h };
         self.sensors.end(h);
         self.steps += 1;
-        if self.model.floating_base {
-            normalize_quat(&mut self.q);
-        }
+        normalize_quats(&self.model, &mut self.q);
         // 3. the new state: finite, its contacts, its energy
         self.check_finite()?;
         self.fk_valid = false;
@@ -891,12 +981,12 @@ impl Simulation {
         if !self.opts.joint_dynamics {
             return cap;
         }
-        let (qo, vo) = (self.model.joint_q_offset(), self.model.joint_v_offset());
-        for (d, info) in self.model.dofs.iter().enumerate() {
+        for (d, iq, iv) in self.model.dof_indices() {
+            let info = &self.model.dofs[d];
             if info.continuous {
                 continue;
             }
-            let (q, v) = (self.q[qo + d], self.v[vo + d]);
+            let (q, v) = (self.q[iq], self.v[iv]);
             let gap = match (v < 0.0, info.limits.lower, info.limits.upper) {
                 (true, Some(lo), _) => q - lo,
                 (false, _, Some(hi)) if v > 0.0 => hi - q,
@@ -1026,17 +1116,19 @@ fn land(dt: f64, remaining: f64) -> f64 {
 pub fn column_names(model: &Model) -> (Vec<String>, Vec<String>) {
     let mut qn = Vec::with_capacity(model.nq);
     let mut vn = Vec::with_capacity(model.nv);
-    if model.floating_base {
-        for s in ["x", "y", "z", "qx", "qy", "qz", "qw"] {
-            qn.push(format!("q:base_{s}"));
+    for t in &model.trees {
+        if let Some(f) = t.free.and_then(|i| model.free_joints.get(i)) {
+            for s in ["x", "y", "z", "qx", "qy", "qz", "qw"] {
+                qn.push(format!("q:{}_{s}", f.name));
+            }
+            for s in ["vx", "vy", "vz", "wx", "wy", "wz"] {
+                vn.push(format!("v:{}_{s}", f.name));
+            }
         }
-        for s in ["vx", "vy", "vz", "wx", "wy", "wz"] {
-            vn.push(format!("v:base_{s}"));
+        for d in &model.dofs[t.dofs.clone()] {
+            qn.push(format!("q:{}", d.name));
+            vn.push(format!("v:{}", d.name));
         }
-    }
-    for d in &model.dofs {
-        qn.push(format!("q:{}", d.name));
-        vn.push(format!("v:{}", d.name));
     }
     (qn, vn)
 }
@@ -1047,10 +1139,10 @@ pub fn supports(model: &Model) -> bool {
     model
         .joints
         .iter()
-        .skip(1)
         .enumerate()
-        .all(|(i, j)| match j.kind {
-            JointKind::Free => i == 0,
+        .skip(1)
+        .all(|(b, j)| match j.kind {
+            JointKind::Free => model.free_joints.iter().any(|f| f.body == b),
             _ => true,
         })
 }
