@@ -22,7 +22,7 @@ def test_scene_model_names_and_start():
     assert "lamp/elbow" in m.dof_names
     assert "table/top" in m.link_names and "lamp/shade" in m.link_names
     q0 = s.q0
-    assert np.allclose(q0[:3], [0.6, 0.0, 0.95])
+    assert np.allclose(q0[:3], [0.6, 0.0, 1.25])
 
 
 def test_simulation_of_a_scene_equals_its_rollout_and_pickles():
