@@ -8,6 +8,9 @@
 //! `OUT_DIR/lamp_on_table.csv`, `OUT_DIR/lamp_on_table.png` and the 3D replay
 //! page `OUT_DIR/lamp_on_table.html` (OUT_DIR defaults to `target`).
 
+#[path = "common/png_out.rs"]
+mod png_out;
+
 use plotters::prelude::*;
 use std::path::PathBuf;
 
@@ -74,38 +77,42 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         c.push(f[cc]);
     }
     let png = out_dir.join("lamp_on_table.png");
-    let area = BitMapBackend::new(&png, (1000, 900)).into_drawing_area();
-    area.fill(&WHITE)?;
-    let panels = area.split_evenly((3, 1));
-    let series: [(&str, &str, &Vec<f64>, RGBColor); 3] = [
-        ("lamp base height (table top at 0.75 m)", "z (m)", &z, BLUE),
-        ("energy (kinetic + potential)", "E (J)", &e, RED),
-        ("active contact points", "count", &c, BLACK),
-    ];
-    for (panel, (title, ylabel, ys, color)) in panels.iter().zip(series.iter()) {
-        let (lo, hi) = ys
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
-                (a.min(y), b.max(y))
-            });
-        let pad = ((hi - lo) * 0.08).max(1e-3);
-        let mut chart = ChartBuilder::on(panel)
-            .caption(*title, ("sans-serif", 20))
-            .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..3.0, (lo - pad)..(hi + pad))?;
-        chart
-            .configure_mesh()
-            .x_desc("t (s)")
-            .y_desc(*ylabel)
-            .draw()?;
-        chart.draw_series(LineSeries::new(
-            t.iter().copied().zip(ys.iter().copied()),
-            color,
-        ))?;
+    let mut rgb = vec![0u8; 1000 * 900 * 3];
+    {
+        let area = BitMapBackend::with_buffer(&mut rgb, (1000, 900)).into_drawing_area();
+        area.fill(&WHITE)?;
+        let panels = area.split_evenly((3, 1));
+        let series: [(&str, &str, &Vec<f64>, RGBColor); 3] = [
+            ("lamp base height (table top at 0.75 m)", "z (m)", &z, BLUE),
+            ("energy (kinetic + potential)", "E (J)", &e, RED),
+            ("active contact points", "count", &c, BLACK),
+        ];
+        for (panel, (title, ylabel, ys, color)) in panels.iter().zip(series.iter()) {
+            let (lo, hi) = ys
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
+                    (a.min(y), b.max(y))
+                });
+            let pad = ((hi - lo) * 0.08).max(1e-3);
+            let mut chart = ChartBuilder::on(panel)
+                .caption(*title, ("sans-serif", 20))
+                .margin(10)
+                .x_label_area_size(35)
+                .y_label_area_size(60)
+                .build_cartesian_2d(0.0..3.0, (lo - pad)..(hi + pad))?;
+            chart
+                .configure_mesh()
+                .x_desc("t (s)")
+                .y_desc(*ylabel)
+                .draw()?;
+            chart.draw_series(LineSeries::new(
+                t.iter().copied().zip(ys.iter().copied()),
+                color,
+            ))?;
+        }
+        area.present()?;
     }
-    area.present()?;
+    png_out::write_png(&png, &rgb, (1000, 900))?;
     println!(
         "wrote {}, {} and {}",
         csv.display(),

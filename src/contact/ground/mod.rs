@@ -300,22 +300,22 @@ impl GroundContact {
                     // height a vertex, in or out of the band), the band's
                     // stamped with this search's generation
                     self.generation = self.generation.wrapping_add(1).max(1);
-                    let gen = self.generation;
+                    let stamp = self.generation;
                     let visited = &mut self.visited[base..base + verts.len()];
                     let in_band = &mut self.in_band[base..base + verts.len()];
                     let stack = &mut self.stack;
                     stack.clear();
                     stack.push(k as u32);
-                    visited[k] = gen;
+                    visited[k] = stamp;
                     let (mut bl, mut rl) = (0, 0);
                     while let Some(i) = stack.pop() {
                         order[bl] = i;
                         bl += 1;
-                        in_band[i as usize] = gen;
+                        in_band[i as usize] = stamp;
                         for &j in nbrs(i as usize) {
                             let j = j as usize;
-                            if visited[j] != gen {
-                                visited[j] = gen;
+                            if visited[j] != stamp {
+                                visited[j] = stamp;
                                 if height(&verts[j]) <= band {
                                     stack.push(j as u32);
                                 } else {
@@ -327,7 +327,7 @@ impl GroundContact {
                     }
                     self.band_len[si] = bl;
                     self.rim_len[si] = rl;
-                    self.band_gen[si] = gen;
+                    self.band_gen[si] = stamp;
                 }
                 let cand = &order[..self.band_len[si]];
                 // a band vertex only gets its world point p and its criteria
@@ -368,14 +368,14 @@ impl GroundContact {
                 // 1e-6 of the best (a scan of the band, only then)
                 let (pa, pb) = self.prev_range[si];
                 let kept = &self.prev_list[pa..pb];
-                let gen = self.band_gen[si];
+                let stamp = self.band_gen[si];
                 let start = out.len();
                 for (q, &bq) in best.iter().enumerate().take(dirs + 1) {
                     let hold = if q == 0 { HOLD_DEEPEST } else { HOLD_EXTREME };
                     let mut ch = usize::MAX;
                     for &slot in kept {
                         if slot < ch
-                            && self.in_band[slot] == gen
+                            && self.in_band[slot] == stamp
                             && key(&o_m_g.act_point(&verts[slot - base]), q) >= bq - hold
                         {
                             ch = slot;
