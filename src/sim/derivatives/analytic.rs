@@ -25,8 +25,7 @@
 use super::smooth::Tableau;
 use super::TransitionJacobians;
 use crate::contact::{tangents, ContactPoint, NO_GEOM};
-use crate::dynamics::{forward_kinematics, rnea};
-use crate::model::configuration::integrate;
+use crate::dynamics::{forward_kinematics, rnea_derivatives};
 use crate::model::Shape;
 use crate::sim::integrators::dop853_tableau::{A, B, N_STAGES};
 use crate::sim::integrators::explicit_limit;
@@ -334,32 +333,17 @@ impl Simulation {
         Ok(self.output_map(&vtot, &dvplus, h))
     }
 
-    /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces), by
-    /// central differences of RNEA (ε = 1e-6) until the analytic
-    /// `rnea_derivatives` of issue 21 lands (then: one call here).
+    /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces): the
+    /// analytic [`rnea_derivatives`] (docs/theory.md §"Derivatives"); the
+    /// simulation's kinematics are left at `q`.
     pub(super) fn id_derivatives(
         &mut self,
         q: &DVector<f64>,
         v: &DVector<f64>,
         a: &DVector<f64>,
     ) -> Result<(DMatrix<f64>, DMatrix<f64>), SimError> {
-        let n = self.model.nv;
-        let mut dq = DMatrix::zeros(n, n);
-        let mut dv = DMatrix::zeros(n, n);
-        let eps = 1e-6;
-        for k in 0..n {
-            let mut e = DVector::zeros(n);
-            e[k] = eps;
-            let qp = integrate(&self.model, q, &e).map_err(|e| SimError::Invalid(e.to_string()))?;
-            let tp = rnea(&self.model, &mut self.data, &qp, v, a, None)?.clone();
-            let qm =
-                integrate(&self.model, q, &(-&e)).map_err(|e| SimError::Invalid(e.to_string()))?;
-            let tm = rnea(&self.model, &mut self.data, &qm, v, a, None)?.clone();
-            dq.column_mut(k).copy_from(&((tp - tm) / (2.0 * eps)));
-            let tp = rnea(&self.model, &mut self.data, q, &(v + &e), a, None)?.clone();
-            let tm = rnea(&self.model, &mut self.data, q, &(v - &e), a, None)?.clone();
-            dv.column_mut(k).copy_from(&((tp - tm) / (2.0 * eps)));
-        }
+        rnea_derivatives(&self.model, &mut self.data, q, v, a, None)?;
+        let (dq, dv) = (self.data.dtau_dq.clone(), self.data.dtau_dv.clone());
         forward_kinematics(&self.model, &mut self.data, q)?;
         Ok((dq, dv))
     }
