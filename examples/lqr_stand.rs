@@ -12,12 +12,15 @@
 //! The base is then pushed to 0.5 m/s forward, with the joint rates that keep
 //! the feet where they stand (J_c δv = 0: a push that slid the feet could not
 //! be undone), and the controller brings it back.
-//! Run: `cargo run --release --example lqr_stand` (exit 1 if the base does not
-//! come back within 1 cm). Measured: back within 4.6 mm (farthest 25 mm), its
+//! Run: `cargo run --release --example lqr_stand [OUT_DIR]` (exit 1 if the base
+//! does not come back within 1 cm); writes the replay page `OUT_DIR/lqr_stand.html`
+//! (OUT_DIR defaults to `target`). Measured: back within 4.6 mm (farthest 25 mm), its
 //! velocity below 1e-5 after 1.5 s; Q = 10·I, R = 1·I (env LQR_Q, LQR_R,
 //! LQR_PUSH change them; LQR_R=1e12, the servos alone: 4.7 mm).
 
 use nalgebra::{DMatrix, DVector, Vector3};
+use std::path::PathBuf;
+use urdyn::cli::view::{write_page, Geometry, Recorder};
 use urdyn::dynamics::{self, Reference};
 use urdyn::model::configuration::difference;
 use urdyn::sim::{JacobianMethod, SimOptions, Simulation};
@@ -165,6 +168,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (&jc * &v).norm()
     );
     sim.set_state(&qs, &v)?;
+    // the replay page of the push and the recovery (3 s)
+    let mut rec = Recorder::new(&model, 3.0, true);
+    rec.offer(
+        0.0,
+        sim.q(),
+        [
+            sim.energy(),
+            sim.active_contacts() as f64,
+            sim.penetration(),
+        ],
+        &[],
+        false,
+    );
     let mut worst: f64 = 0.0;
     println!("   t (s)   base offset (mm)   |v| (m/s or rad/s)");
     for step in 1..=3000 {
@@ -177,6 +193,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         tau.rows_mut(6, n - 6).copy_from(&u.rows(6, n - 6));
         sim.set_torques(&tau)?;
         sim.step()?;
+        let plot = [
+            sim.energy(),
+            sim.active_contacts() as f64,
+            sim.penetration(),
+        ];
+        rec.offer(step as f64 * 1e-3, sim.q(), plot, &[], step == 3000);
         let off = (sim.q().rows(0, 3) - qs.rows(0, 3)).norm();
         worst = worst.max(off);
         if step % 250 == 0 {
@@ -194,6 +216,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         1e3 * off,
         1e3 * worst,
         sim.active_contacts()
+    );
+    let out_dir = std::env::args()
+        .nth(1)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join("target"));
+    std::fs::create_dir_all(&out_dir)?;
+    let page = out_dir.join("lqr_stand.html");
+    let geometry = Geometry::load(&model, &root.join("tests/urdf/quadruped.urdf"), &[])?;
+    let summary = write_page(&page, &model, &geometry, &rec, Some(0.0))?;
+    println!(
+        "wrote {} ({} frames): the push and the recovery in 3D",
+        page.display(),
+        summary.frames
     );
     if off > 0.01 {
         eprintln!("the base did not come back within 1 cm");

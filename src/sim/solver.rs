@@ -474,7 +474,7 @@ impl Rows {
                             d2 += y.get_unchecked((r + 2) * nv + t) * x;
                         }
                     }
-                    let [wn1, wn2, _] = w_block[r];
+                    let [wn1, wn2, w12] = w_block[r];
                     let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
                     let on = lambda[r];
                     let un = c[r] + dn;
@@ -491,12 +491,13 @@ impl Rows {
                     let mut t1 = (o1 - u1 * winv[r + 1]) * live(r + 1);
                     let mut t2 = (o2 - u2 * winv[r + 2]) * live(r + 2);
                     let lim = mu * nn;
-                    let m2 = t1 * t1 + t2 * t2;
-                    if m2 > lim * lim {
-                        let m = m2.sqrt();
-                        let s = if m > 0.0 { lim / m } else { 0.0 };
-                        t1 *= s;
-                        t2 *= s;
+                    if t1 * t1 + t2 * t2 > lim * lim {
+                        // w̄ = (W₁₁ + W₂₂)/2 + √(((W₁₁ − W₂₂)/2)² + W₁₂²)
+                        let half = 0.5 * (w11 - w22);
+                        let wbar = 0.5 * (w11 + w22) + (half * half + w12 * w12).sqrt();
+                        (t1, t2) = slide_onto_cone(o1, o2, u1, u2, wbar, lim);
+                        t1 *= live(r + 1);
+                        t2 *= live(r + 2);
                     }
                     lambda[r + 1] = t1;
                     lambda[r + 2] = t2;
@@ -528,11 +529,9 @@ impl Rows {
                         let mut t2 = if w22 > 1e-14 { o2 - u2 / w22 } else { 0.0 };
                         let ln = lambda.get(normal).copied().unwrap_or(0.0);
                         let lim = mu * if ln > 0.0 { ln } else { 0.0 };
-                        let m = (t1 * t1 + t2 * t2).sqrt();
-                        if m > lim {
-                            let s = if m > 0.0 { lim / m } else { 0.0 };
-                            t1 *= s;
-                            t2 *= s;
+                        if t1 * t1 + t2 * t2 > lim * lim {
+                            // the block's largest eigenvalue ≤ its trace
+                            (t1, t2) = slide_onto_cone(o1, o2, u1, u2, w11 + w22, lim);
                         }
                         lambda[r] = t1;
                         lambda[r + 1] = t2;
@@ -880,4 +879,27 @@ impl Rows {
 #[inline(always)]
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// A tangent pair's update when its Gauss–Seidel step leaves the cone (the
+/// point slides): one isotropic step, λₜ − uₜ/w̄ with `wbar` = w̄ at least the
+/// largest eigenvalue of the pair's 2 × 2 Delassus block, projected onto the disc
+/// of radius `lim`. A fixed point of it is the exact Coulomb law: λₜ = s (λₜ − uₜ/w̄)
+/// with s < 1 makes λₜ anti-parallel to the slip uₜ, ‖λₜ‖ = μλₙ (maximal
+/// dissipation; the per-row diagonal step would leave λₜ anti-parallel to
+/// D⁻¹uₜ instead, off by the block's anisotropy: docs/theory.md §"Constraint
+/// solve"). Inside the cone (sticking) the diagonal step is kept.
+#[inline]
+fn slide_onto_cone(o1: f64, o2: f64, u1: f64, u2: f64, wbar: f64, lim: f64) -> (f64, f64) {
+    if !(wbar > 1e-14) {
+        return (0.0, 0.0);
+    }
+    let (t1, t2) = (o1 - u1 / wbar, o2 - u2 / wbar);
+    let m = (t1 * t1 + t2 * t2).sqrt();
+    if m > lim {
+        let s = if m > 0.0 { lim / m } else { 0.0 };
+        (t1 * s, t2 * s)
+    } else {
+        (t1, t2)
+    }
 }
