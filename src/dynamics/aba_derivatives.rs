@@ -4,13 +4,11 @@
 //! ∂q̈/∂x = −H⁻¹ ∂ID/∂x).
 
 use super::rnea_derivatives::{check_wrenches, rnea_derivatives_pass, LinkWrench};
-use super::{check_massless, check_sizes, linalg, ltdl, DynamicsError};
+use super::{check_massless, check_sizes, linalg, minv, DynamicsError};
 use crate::model::{Data, Model};
 use crate::spatial::ops::madd;
 use crate::spatial::{Force, Scalar};
 use nalgebra::{DMatrix, DVector};
-
-const NONE: usize = usize::MAX;
 
 /// The derivatives of forward dynamics q̈ = FD(q, v, τ) with the wrenches `fext`
 /// (docs/theory.md §"Derivatives"): `data.dqdd_dq` = ∂q̈/∂q (tangent space, as
@@ -42,6 +40,39 @@ pub fn aba_derivatives<T: Scalar>(
             super::add_link_wrench(model, data, w.frame, &w.force, &w.torque, &mut fb)?;
         }
     }
+    if !model.has_mimic {
+        // q̈ and H⁻¹ by the world-frame ABA (docs/theory.md §"Derivatives",
+        // "Inverse of H")
+        let r = minv::minv_pass(model, data, q, v, tau, fext.map(|_| fb.as_slice()));
+        data.deriv_fext = fb;
+        r?;
+        // ∂τ/∂q, ∂τ/∂v at a = q̈
+        let mut a = std::mem::replace(&mut data.deriv_tmp, DVector::zeros(0));
+        a.copy_from(&data.qdd);
+        rnea_derivatives_pass(model, data, q, v, &a, fext);
+        data.deriv_tmp = a;
+        // ∂q̈/∂x = −H⁻¹ ∂τ/∂x over ∂τ/∂x's tree pattern
+        let Data {
+            minv,
+            dqdd_dq,
+            dqdd_dv,
+            dtau_dq,
+            dtau_dv,
+            deriv_dof_end: dof_end,
+            deriv_anc_runs: runs,
+            deriv_anc_run0: run0,
+            ..
+        } = data;
+        let pat = TreePattern {
+            dof_end,
+            runs,
+            run0,
+        };
+        neg_mul_tree(minv, dtau_dq, dqdd_dq, &pat);
+        neg_mul_tree(minv, dtau_dv, dqdd_dv, &pat);
+        return Ok(());
+    }
+    // mimic joints: the reduced H is not tree-shaped, the dense route
     let r =
         super::forward_dynamics(model, data, q, v, tau, fext.map(|_| fb.as_slice())).map(|_| ());
     data.deriv_fext = fb;
@@ -51,12 +82,8 @@ pub fn aba_derivatives<T: Scalar>(
     a.copy_from(&data.qdd);
     rnea_derivatives_pass(model, data, q, v, &a, fext);
     data.deriv_tmp = a;
-    // H = Lᵀ D L (tree) or L Lᵀ (mimic)
-    if model.has_mimic {
-        linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)?;
-    } else {
-        ltdl::ltdl(&data.h, &model.dof_parent, &mut data.chol).map_err(DynamicsError::Singular)?;
-    }
+    // H = L Lᵀ
+    linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)?;
     let nv = model.nv;
     let Data {
         chol,
@@ -73,28 +100,111 @@ pub fn aba_derivatives<T: Scalar>(
     for k in 0..nv {
         minv[(k, k)] = T::one();
     }
-    solve_rows(model, chol, minv.as_mut_slice());
+    chol_solve_rows(chol.as_slice(), nv, minv.as_mut_slice());
     // ∂q̈/∂x = −solve(H, ∂τ/∂x), on the transpose (H X = B ⇔ Xᵀ H = Bᵀ: every
     // elimination step is one contiguous axpy over all right-hand sides)
     for (out, b) in [(&mut *dqdd_dq, &*dtau_dq), (&mut *dqdd_dv, &*dtau_dv)] {
         b.transpose_to(xt);
-        solve_rows(model, chol, xt.as_mut_slice());
+        chol_solve_rows(chol.as_slice(), nv, xt.as_mut_slice());
         xt.transpose_to(out);
         out.neg_mut();
     }
     Ok(())
 }
 
-/// `X ← H⁻¹ X` for X (nv × nv) given by its rows, row i contiguous at
-/// `x[i nv..(i + 1) nv]` (a column-major Xᵀ), with the factor in `u`.
-fn solve_rows<T: Scalar>(model: &Model<T>, u: &DMatrix<T>, x: &mut [T]) {
-    let n = model.nv;
-    let us = u.as_slice();
-    let x = &mut x[..n * n];
-    if model.has_mimic {
-        chol_solve_rows(us, n, x);
-    } else {
-        ltdl_solve_rows(us, &model.dof_parent, x);
+/// Where the columns of ∂τ/∂x (tree-shaped: entry (r, c) only for r, c on one
+/// root path) can be non-zero: rows `[c, dof_end[c])` (c's subtree) and c's
+/// ancestors, the runs `runs[run0[c]..run0[c + 1]]`.
+struct TreePattern<'a> {
+    dof_end: &'a [usize],
+    runs: &'a [(usize, usize)],
+    run0: &'a [usize],
+}
+
+/// Rows of a register tile.
+const MR: usize = 8;
+/// Columns of a register tile.
+const NR: usize = 4;
+
+/// `x = −a b` for a dense n × n `a` and a `b` with the tree pattern `pat`
+/// (column-major): every column block reads only the rows of `b` where its
+/// columns can be non-zero. In depth-first order the ancestors of columns
+/// c₀ < c < c₀ + NR lie among c₀'s ancestors and [c₀, c), their subtrees below
+/// the block's largest subtree end: one row set for the block. Register tiles of
+/// MR × NR accumulators.
+fn neg_mul_tree<T: Scalar>(a: &DMatrix<T>, b: &DMatrix<T>, x: &mut DMatrix<T>, pat: &TreePattern) {
+    let n = a.nrows();
+    let (a, b, x) = (a.as_slice(), b.as_slice(), x.as_mut_slice());
+    let mut j0 = 0;
+    while j0 + NR <= n {
+        let anc = &pat.runs[pat.run0[j0]..pat.run0[j0 + 1]];
+        let end = pat.dof_end[j0..j0 + NR].iter().copied().max().unwrap_or(j0 + NR);
+        col_block::<T, NR>(n, a, b, x, j0, anc, (j0, end.max(j0 + NR)));
+        j0 += NR;
+    }
+    for j in j0..n {
+        let anc = &pat.runs[pat.run0[j]..pat.run0[j + 1]];
+        col_block::<T, 1>(n, a, b, x, j, anc, (j, pat.dof_end[j].max(j + 1)));
+    }
+}
+
+/// The columns `j0..j0 + C` of `x = −a b`, reading rows `anc` and `own` of b.
+#[inline(always)]
+fn col_block<T: Scalar, const C: usize>(
+    n: usize,
+    a: &[T],
+    b: &[T],
+    x: &mut [T],
+    j0: usize,
+    anc: &[(usize, usize)],
+    own: (usize, usize),
+) {
+    let mut i0 = 0;
+    while i0 + MR <= n {
+        tile::<T, MR, C>(n, a, b, x, i0, j0, anc, own);
+        i0 += MR;
+    }
+    while i0 + 2 <= n {
+        tile::<T, 2, C>(n, a, b, x, i0, j0, anc, own);
+        i0 += 2;
+    }
+    if i0 < n {
+        tile::<T, 1, C>(n, a, b, x, i0, j0, anc, own);
+    }
+}
+
+/// One R × C tile of `x = −a b`: `x[i0.., j0..] = −Σ_k a[i0.., k] b[k, j0..]`
+/// over the row runs of b.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn tile<T: Scalar, const R: usize, const C: usize>(
+    n: usize,
+    a: &[T],
+    b: &[T],
+    x: &mut [T],
+    i0: usize,
+    j0: usize,
+    anc: &[(usize, usize)],
+    own: (usize, usize),
+) {
+    let mut acc = [[T::zero(); R]; C];
+    let bcols: [&[T]; C] = std::array::from_fn(|c| &b[(j0 + c) * n..(j0 + c + 1) * n]);
+    for &(lo, hi) in anc.iter().chain(std::iter::once(&own)) {
+        for k in lo..hi {
+            let ak = &a[k * n + i0..k * n + i0 + R];
+            for c in 0..C {
+                let bk = bcols[c][k];
+                for r in 0..R {
+                    acc[c][r] = madd(ak[r], bk, acc[c][r]);
+                }
+            }
+        }
+    }
+    for c in 0..C {
+        let col = &mut x[(j0 + c) * n + i0..(j0 + c) * n + i0 + R];
+        for r in 0..R {
+            col[r] = -acc[c][r];
+        }
     }
 }
 
@@ -110,34 +220,6 @@ fn row_axpy<T: Scalar>(x: &mut [T], n: usize, a: usize, b: usize, s: T) {
     };
     for (p, &q) in ra.iter_mut().zip(rb) {
         *p = madd(-s, q, *p);
-    }
-}
-
-/// [`ltdl::ltdl_solve`] for every right-hand side at once (rows of `x`).
-fn ltdl_solve_rows<T: Scalar>(u: &[T], lambda: &[usize], x: &mut [T]) {
-    let n = lambda.len();
-    // Lᵀ y = b, leaves inwards
-    for i in (0..n).rev() {
-        let mut j = lambda[i];
-        while j != NONE {
-            row_axpy(x, n, j, i, u[j + i * n]);
-            j = lambda[j];
-        }
-    }
-    // z = D⁻¹ y
-    for i in 0..n {
-        let d = T::one() / u[i + i * n];
-        for p in &mut x[i * n..i * n + n] {
-            *p *= d;
-        }
-    }
-    // L x = z, root outwards
-    for i in 0..n {
-        let mut j = lambda[i];
-        while j != NONE {
-            row_axpy(x, n, i, j, u[j + i * n]);
-            j = lambda[j];
-        }
     }
 }
 

@@ -18,6 +18,7 @@ mod jacobian;
 mod jacobian_dot;
 mod joint_jacobians;
 mod kinematics;
+mod minv;
 pub mod linalg;
 pub mod ltdl;
 mod rnea;

@@ -136,6 +136,42 @@ pub struct Data<T: Scalar = f64> {
     pub deriv_scratch: DMatrix<T>,
     /// Derivatives: a scratch vector of size nv (`aba_derivatives`' q̈).
     pub deriv_tmp: DVector<T>,
+    /// Derivatives, per velocity coordinate: one past the last coordinate of its
+    /// subtree (the rows below it where ∂τ/∂x's column can be non-zero).
+    pub deriv_dof_end: Vec<usize>,
+    /// Derivatives: the ancestors of every velocity coordinate as runs `[lo, hi)`
+    /// of consecutive coordinates, coordinate k's at
+    /// `deriv_anc_runs[deriv_anc_run0[k]..deriv_anc_run0[k + 1]]` (the rows above
+    /// it where ∂τ/∂x's column can be non-zero).
+    pub deriv_anc_runs: Vec<(usize, usize)>,
+    /// Derivatives: where each coordinate's runs start in `deriv_anc_runs` (nv + 1).
+    pub deriv_anc_run0: Vec<usize>,
+
+    // H⁻¹ by the world-frame articulated-body recursion (`aba_derivatives`,
+    // docs/theory.md §"Derivatives").
+    /// H⁻¹, per velocity coordinate: its world motion subspace column `J = ⁰X̂ᵢ S`.
+    pub minv_j: Vec<Motion<T>>,
+    /// H⁻¹, per velocity coordinate: `U D⁻¹` (world).
+    pub minv_udinv: Vec<Force<T>>,
+    /// H⁻¹, per velocity coordinate: `u = τ − Jᵀ pᴬ`.
+    pub minv_uq: Vec<T>,
+    /// H⁻¹: articulated inertia of each body (6x6, angular first, world).
+    pub minv_ia: Vec<Matrix6<T>>,
+    /// H⁻¹: world velocity of each body.
+    pub minv_ov: Vec<Motion<T>>,
+    /// H⁻¹: velocity-product acceleration, then acceleration, of each body (world,
+    /// gravity included).
+    pub minv_agf: Vec<Motion<T>>,
+    /// H⁻¹: articulated bias force of each body (world).
+    pub minv_of: Vec<Force<T>>,
+    /// H⁻¹, per column (leaves inwards): the force a unit τ of that coordinate
+    /// passes to the current body's parent.
+    pub minv_fcol: Vec<Force<T>>,
+    /// H⁻¹, per body with children and per column c from its first coordinate on
+    /// (root outwards): the body's acceleration under a unit τ_c.
+    pub minv_acol: Vec<Motion<T>>,
+    /// H⁻¹: where each body's columns start in `minv_acol`.
+    pub minv_acol_off: Vec<usize>,
 }
 
 impl<T: Scalar> Data<T> {
@@ -151,6 +187,18 @@ impl<T: Scalar> Data<T> {
             }
         }
         let nfull = if direct { 0 } else { ncol };
+        let (dof_end, anc_runs, anc_run0) = coordinate_runs(model, &sub_end, direct);
+        // a body with children keeps one acceleration per column from its first on
+        let mut acol_off = vec![0; nb];
+        let mut acol_len = 0;
+        if direct {
+            for i in 1..nb {
+                acol_off[i] = acol_len;
+                if sub_end[i] > col0[i] + model.joints[i].nv() {
+                    acol_len += nv - col0[i];
+                }
+            }
+        }
         Self {
             li_m_i: vec![Se3::identity(); nb],
             o_m_i: vec![Se3::identity(); nb],
@@ -204,8 +252,60 @@ impl<T: Scalar> Data<T> {
             deriv_full: std::array::from_fn(|_| DMatrix::zeros(nfull, nfull)),
             deriv_scratch: DMatrix::zeros(nv, nv),
             deriv_tmp: DVector::zeros(nv),
+            deriv_dof_end: dof_end,
+            deriv_anc_runs: anc_runs,
+            deriv_anc_run0: anc_run0,
+            minv_j: vec![Motion::zero(); nv],
+            minv_udinv: vec![Force::zero(); nv],
+            minv_uq: vec![T::zero(); nv],
+            minv_ia: vec![Matrix6::zeros(); nb],
+            minv_ov: vec![Motion::zero(); nb],
+            minv_agf: vec![Motion::zero(); nb],
+            minv_of: vec![Force::zero(); nb],
+            minv_fcol: vec![Force::zero(); nv],
+            minv_acol: vec![Motion::zero(); acol_len],
+            minv_acol_off: acol_off,
         }
     }
+}
+
+/// Per velocity coordinate (a model without mimic joints): one past its subtree's
+/// last coordinate, and its ancestors as runs `[lo, hi)` of consecutive
+/// coordinates (flat, with each coordinate's start; nv + 1 starts). Empty with
+/// mimic joints.
+fn coordinate_runs<T: Scalar>(
+    model: &Model<T>,
+    sub_end: &[usize],
+    direct: bool,
+) -> (Vec<usize>, Vec<(usize, usize)>, Vec<usize>) {
+    if !direct {
+        return (Vec::new(), Vec::new(), Vec::new());
+    }
+    let nv = model.nv;
+    let lambda = &model.dof_parent;
+    let mut dof_end = vec![0; nv];
+    for i in 1..model.nbodies {
+        let j = &model.joints[i];
+        for c in 0..j.nv() {
+            dof_end[j.iv + c] = sub_end[i];
+        }
+    }
+    let mut runs = Vec::new();
+    let mut run0 = Vec::with_capacity(nv + 1);
+    for k in 0..nv {
+        run0.push(runs.len());
+        let mut j = lambda[k];
+        while j != usize::MAX {
+            let hi = j + 1;
+            while j > 0 && lambda[j] == j - 1 {
+                j -= 1;
+            }
+            runs.push((j, hi));
+            j = lambda[j];
+        }
+    }
+    run0.push(runs.len());
+    (dof_end, runs, run0)
 }
 
 /// The derivatives' column space (docs/theory.md §"Derivatives"): each body's first
