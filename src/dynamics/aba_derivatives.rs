@@ -68,8 +68,7 @@ pub fn aba_derivatives<T: Scalar>(
             runs,
             run0,
         };
-        neg_mul_tree(minv, dtau_dq, dqdd_dq, &pat);
-        neg_mul_tree(minv, dtau_dv, dqdd_dv, &pat);
+        neg_mul_tree(minv, [dtau_dq, dtau_dv], [dqdd_dq, dqdd_dv], &pat);
         return Ok(());
     }
     // mimic joints: the reduced H is not tree-shaped, the dense route
@@ -126,50 +125,81 @@ const MR: usize = 8;
 /// Columns of a register tile.
 const NR: usize = 4;
 
-/// `x = −a b` for a dense n × n `a` and a `b` with the tree pattern `pat`
-/// (column-major): every column block reads only the rows of `b` where its
+/// `xₘ = −a bₘ` for a dense n × n `a` and the `bₘ` with the tree pattern `pat`
+/// (column-major): every column block reads only the rows of `bₘ` where its
 /// columns can be non-zero. In depth-first order the ancestors of columns
 /// c₀ < c < c₀ + NR lie among c₀'s ancestors and [c₀, c), their subtrees below
 /// the block's largest subtree end: one row set for the block. Register tiles of
-/// MR × NR accumulators.
-fn neg_mul_tree<T: Scalar>(a: &DMatrix<T>, b: &DMatrix<T>, x: &mut DMatrix<T>, pat: &TreePattern) {
+/// R × NR accumulators; a panel of R rows of `a` stays in cache across every
+/// column block of both products.
+fn neg_mul_tree<T: Scalar>(
+    a: &DMatrix<T>,
+    bs: [&DMatrix<T>; 2],
+    xs: [&mut DMatrix<T>; 2],
+    pat: &TreePattern,
+) {
     let n = a.nrows();
-    let (a, b, x) = (a.as_slice(), b.as_slice(), x.as_mut_slice());
-    let mut j0 = 0;
-    while j0 + NR <= n {
-        let anc = &pat.runs[pat.run0[j0]..pat.run0[j0 + 1]];
-        let end = pat.dof_end[j0..j0 + NR].iter().copied().max().unwrap_or(j0 + NR);
-        col_block::<T, NR>(n, a, b, x, j0, anc, (j0, end.max(j0 + NR)));
-        j0 += NR;
-    }
-    for j in j0..n {
-        let anc = &pat.runs[pat.run0[j]..pat.run0[j + 1]];
-        col_block::<T, 1>(n, a, b, x, j, anc, (j, pat.dof_end[j].max(j + 1)));
+    let a = a.as_slice();
+    let bs = bs.map(|b| b.as_slice());
+    let [x0, x1] = xs;
+    let mut xs = [x0.as_mut_slice(), x1.as_mut_slice()];
+    // panels of 2 MR rows, then MR, the last one ending at n (overlapping rows get
+    // the same sums again); 4 or single rows below MR
+    if n >= MR {
+        let mut i0 = 0;
+        while i0 + 2 * MR <= n {
+            panel::<T, { 2 * MR }>(n, a, bs, &mut xs, i0, pat);
+            i0 += 2 * MR;
+        }
+        while i0 < n {
+            i0 = i0.min(n - MR);
+            panel::<T, MR>(n, a, bs, &mut xs, i0, pat);
+            i0 += MR;
+        }
+    } else if n >= 4 {
+        panel::<T, 4>(n, a, bs, &mut xs, 0, pat);
+        panel::<T, 4>(n, a, bs, &mut xs, n - 4, pat);
+    } else {
+        for i0 in 0..n {
+            panel::<T, 1>(n, a, bs, &mut xs, i0, pat);
+        }
     }
 }
 
-/// The columns `j0..j0 + C` of `x = −a b`, reading rows `anc` and `own` of b.
+/// Rows `i0..i0 + R` of both products: blocks of NR columns, the last one ending
+/// at n (overlapping its predecessor); single columns below NR.
 #[inline(always)]
-fn col_block<T: Scalar, const C: usize>(
+fn panel<T: Scalar, const R: usize>(
     n: usize,
     a: &[T],
-    b: &[T],
-    x: &mut [T],
-    j0: usize,
-    anc: &[(usize, usize)],
-    own: (usize, usize),
+    bs: [&[T]; 2],
+    xs: &mut [&mut [T]; 2],
+    i0: usize,
+    pat: &TreePattern,
 ) {
-    let mut i0 = 0;
-    while i0 + MR <= n {
-        tile::<T, MR, C>(n, a, b, x, i0, j0, anc, own);
-        i0 += MR;
+    if n < NR {
+        for j in 0..n {
+            let anc = &pat.runs[pat.run0[j]..pat.run0[j + 1]];
+            let own = (j, pat.dof_end[j].max(j + 1));
+            for (b, x) in bs.iter().zip(xs.iter_mut()) {
+                tile::<T, R, 1>(n, a, b, x, i0, j, anc, own);
+            }
+        }
+        return;
     }
-    while i0 + 2 <= n {
-        tile::<T, 2, C>(n, a, b, x, i0, j0, anc, own);
-        i0 += 2;
-    }
-    if i0 < n {
-        tile::<T, 1, C>(n, a, b, x, i0, j0, anc, own);
+    let mut j0 = 0;
+    loop {
+        let anc = &pat.runs[pat.run0[j0]..pat.run0[j0 + 1]];
+        let end = pat.dof_end[j0..j0 + NR]
+            .iter()
+            .fold(j0 + NR, |e, &d| e.max(d));
+        for (b, x) in bs.iter().zip(xs.iter_mut()) {
+            tile::<T, R, NR>(n, a, b, x, i0, j0, anc, (j0, end));
+        }
+        if j0 + NR == n {
+            break;
+        }
+        j0 = (j0 + NR).min(n - NR);
     }
 }
 

@@ -42,13 +42,24 @@ fn ff<T: Scalar>(f: &Force<T>) -> Vector6<T> {
     f.to_vector()
 }
 
-/// `f += a · s` on spatial forces.
+/// `y += a x` on slices (of one length).
 #[inline(always)]
-fn force_axpy<T: Scalar>(f: &mut Force<T>, s: T, a: &Force<T>) {
-    for r in 0..3 {
-        f.ang[r] = madd(s, a.ang[r], f.ang[r]);
-        f.lin[r] = madd(s, a.lin[r], f.lin[r]);
+fn axpy<T: Scalar>(y: &mut [T], a: T, x: &[T]) {
+    for (y, &x) in y.iter_mut().zip(x) {
+        *y = madd(a, x, *y);
     }
+}
+
+/// The six component rows `x[k w..(k + 1) w]`, each cut to `[lo, hi)`.
+#[inline(always)]
+fn rows6_mut<T>(x: &mut [T], w: usize, lo: usize, hi: usize) -> [&mut [T]; 6] {
+    let (r0, x) = x.split_at_mut(w);
+    let (r1, x) = x.split_at_mut(w);
+    let (r2, x) = x.split_at_mut(w);
+    let (r3, x) = x.split_at_mut(w);
+    let (r4, x) = x.split_at_mut(w);
+    let r5 = &mut x[..w];
+    [r0, r1, r2, r3, r4, r5].map(|r| &mut r[lo..hi])
 }
 
 /// `m += a · s` on spatial motions.
@@ -104,7 +115,6 @@ pub(crate) fn minv_pass<T: Scalar>(
     // Row r of H⁻¹'s upper triangle (columns c ≥ r) is kept as column r of `m`
     // from row r down (contiguous): `m[c + r n] = H⁻¹[r, c]`; mirrored at the end.
     let m = minv.as_mut_slice();
-    m.fill(T::zero());
 
     // Sweep 1, root outwards: ⁰Mᵢ, J = ⁰X̂ᵢ S, ⁰v̂ᵢ, the velocity-product
     // acceleration cᵢ = ⁰v̂_λ × ⁰v̂ᵢ, Yᵢ as Iᴬᵢ and the bias force pᴬᵢ.
@@ -143,6 +153,8 @@ pub(crate) fn minv_pass<T: Scalar>(
     // Sweep 2, leaves inwards: uᵢ = τᵢ − Jᵀ pᴬᵢ, U = Iᴬ J, D = Jᵀ U; the rows of
     // H⁻¹ against the subtree, H⁻¹[i, i] = D⁻¹, H⁻¹[i, sub] = −D⁻¹ Jᵀ F[sub]; the
     // columns' forces F[sub] += U H⁻¹[i, sub] and Iᵃ, pᵃ passed to the parent.
+    // F is kept by components (`fs[k nv + c]`: the loops over columns vectorise).
+    let fs = &mut fcol[..6 * nv];
     for i in (1..nb).rev() {
         let p = parent[i];
         let jt = &joints[i];
@@ -150,38 +162,78 @@ pub(crate) fn minv_pass<T: Scalar>(
         let (ce, end) = (c0 + ni, sub_end[i]);
         let fi = of[i];
         let mut iai = ia[i];
+        // the columns after the subtree start at zero (sweep 3 subtracts from them)
+        for r in c0..ce {
+            m[r * nv + end..(r + 1) * nv].fill(T::zero());
+        }
         if ni == 1 {
             let s = jcol[c0];
             let ui = tau[c0] - s.dot(&fi);
             uq[c0] = ui;
-            let u = fv(&(iai * mv(&s)));
-            let d = s.dot(&u);
+            let uvec = iai * mv(&s);
+            let d = s.dot(&fv(&uvec));
             if !(d > T::zero()) || !d.is_finite() {
                 return Err(DynamicsError::Singular(c0));
             }
             let dinv = T::one() / d;
-            let ud = u * dinv;
-            udinv[c0] = ud;
+            let udvec = uvec * dinv;
+            udinv[c0] = fv(&udvec);
+            let sv = mv(&s);
             let col = &mut m[c0 * nv..(c0 + 1) * nv];
             col[c0] = dinv;
-            // H⁻¹[i, c] = −D⁻¹ Jᵀ F_c over the strict subtree
-            for c in ce..end {
-                col[c] = -dinv * s.dot(&fcol[c]);
+            let sub = &mut col[ce..end];
+            if p != 0 {
+                // own column: F = U D⁻¹
+                for k in 0..6 {
+                    fs[k * nv + c0] = udvec[k];
+                }
+            }
+            let [f0, f1, f2, f3, f4, f5] = rows6_mut(fs, nv, ce, end);
+            let len = sub.len();
+            let (f0, f1, f2, f3, f4, f5) = (
+                &mut f0[..len],
+                &mut f1[..len],
+                &mut f2[..len],
+                &mut f3[..len],
+                &mut f4[..len],
+                &mut f5[..len],
+            );
+            let nd = -dinv;
+            for j in 0..len {
+                // H⁻¹[i, c] = −D⁻¹ Jᵀ F_c
+                let y = madd(
+                    sv[5],
+                    f5[j],
+                    madd(
+                        sv[4],
+                        f4[j],
+                        madd(
+                            sv[3],
+                            f3[j],
+                            madd(sv[2], f2[j], madd(sv[1], f1[j], sv[0] * f0[j])),
+                        ),
+                    ),
+                );
+                let x = nd * y;
+                sub[j] = x;
+                if p != 0 {
+                    // F_c += U H⁻¹[i, c]
+                    f0[j] = madd(uvec[0], x, f0[j]);
+                    f1[j] = madd(uvec[1], x, f1[j]);
+                    f2[j] = madd(uvec[2], x, f2[j]);
+                    f3[j] = madd(uvec[3], x, f3[j]);
+                    f4[j] = madd(uvec[4], x, f4[j]);
+                    f5[j] = madd(uvec[5], x, f5[j]);
+                }
             }
             if p != 0 {
-                // F_c += U H⁻¹[i, c]
-                fcol[c0] = ud;
-                for c in ce..end {
-                    force_axpy(&mut fcol[c], col[c], &u);
-                }
                 // Iᵃ = Iᴬ − U D⁻¹ Uᵀ, pᵃ = pᴬ + Iᵃ c + U D⁻¹ u
-                let (uvec, udvec) = (ff(&u), ff(&ud));
                 for cc in 0..6 {
                     for r in 0..6 {
                         iai[(r, cc)] = madd(-udvec[r], uvec[cc], iai[(r, cc)]);
                     }
                 }
-                let pa = fi + fv(&(iai * mv(&agf[i]))) + ud * ui;
+                let pa = fi + fv(&(iai * mv(&agf[i]) + udvec * ui));
                 ia[p] += iai;
                 of[p] += pa;
             }
@@ -205,21 +257,33 @@ pub(crate) fn minv_pass<T: Scalar>(
                     m[c0 + s + (c0 + r) * nv] = dinv[(r, s)];
                 }
             }
-            // H⁻¹[i, c] = −D⁻¹ Jᵀ F_c over the strict subtree
+            // H⁻¹[i, c] = −D⁻¹ Jᵀ F_c over the strict subtree: y = Jᵀ F into the
+            // rows, then x = −D⁻¹ y column by column
+            for r in 0..ni {
+                let row = &mut m[(c0 + r) * nv + ce..(c0 + r) * nv + end];
+                row.fill(T::zero());
+                for k in 0..6 {
+                    axpy(row, jm[(k, r)], &fs[k * nv + ce..k * nv + end]);
+                }
+            }
             for c in ce..end {
-                let jf = jm.transpose() * ff(&fcol[c]);
-                let x = -(dinv * jf);
+                let y = Vector6::from_fn(|r, _| m[c + (c0 + r) * nv]);
+                let x = -(dinv * y);
                 for r in 0..ni {
                     m[c + (c0 + r) * nv] = x[r];
                 }
             }
             if p != 0 {
-                for c in c0..end {
-                    let mut f = if c < ce { Force::zero() } else { fcol[c] };
-                    for r in 0..ni {
-                        force_axpy(&mut f, m[c + (c0 + r) * nv], &fv(&u.column(r).into_owned()));
+                // F_c += U H⁻¹[i, c] (own columns: F_c = U D⁻¹)
+                for k in 0..6 {
+                    for s in 0..ni {
+                        fs[k * nv + c0 + s] = ud[(k, s)];
                     }
-                    fcol[c] = f;
+                    for r in 0..ni {
+                        let (fk, row) = (k * nv, (c0 + r) * nv);
+                        let x = &m[row + ce..row + end];
+                        axpy(&mut fs[fk + ce..fk + end], u[(k, r)], x);
+                    }
                 }
                 let uvec = Vector6::from_column_slice(&uq[c0..ce]);
                 iai -= ud * u.transpose();
@@ -233,7 +297,8 @@ pub(crate) fn minv_pass<T: Scalar>(
     // Sweep 3, root outwards from â₀ = [0; −g]: a' = â_λ + cᵢ,
     // q̈ᵢ = D⁻¹ uᵢ − (U D⁻¹)ᵀ a', âᵢ = a' + J q̈ᵢ; the rows of H⁻¹ against every
     // later column, H⁻¹[i, c] −= (U D⁻¹)ᵀ A_λ[c], and the columns' accelerations
-    // Aᵢ[c] = A_λ[c] + J H⁻¹[i, c] (c ≥ i).
+    // Aᵢ[c] = A_λ[c] + J H⁻¹[i, c] (c ≥ i), by components: body i's at
+    // `acol[off_i + k wᵢ + c − cᵢ]`, wᵢ = nv − cᵢ.
     agf[0] = Motion::new(Vector3::zeros(), -model.gravity);
     for i in 1..nb {
         let p = parent[i];
@@ -254,26 +319,84 @@ pub(crate) fn minv_pass<T: Scalar>(
         }
         agf[i] = ai;
         let leaf = sub_end[i] == ce;
-        let (oi, op) = (acol_off[i], acol_off[p]);
-        let (ci0, cp0) = (c0, if p != 0 { joints[p].iv } else { 0 });
-        for c in c0..nv {
-            let ap = if p != 0 {
-                acol[op + c - cp0]
-            } else {
-                Motion::zero()
-            };
-            let mut a = ap;
-            for r in 0..ni {
-                let at = c + (c0 + r) * nv;
-                let mut x = m[at];
-                if p != 0 {
-                    x -= ap.dot(&udinv[c0 + r]);
-                    m[at] = x;
+        if p == 0 && leaf {
+            continue;
+        }
+        let w = nv - c0;
+        // A_λ's components from column c0 on (none at the root), and this body's
+        let (head, tail) = acol.split_at_mut(acol_off[i]);
+        let ap: [&[T]; 6] = if p != 0 {
+            let (cp, o) = (joints[p].iv, acol_off[p]);
+            let wp = nv - cp;
+            std::array::from_fn(|k| &head[o + k * wp + c0 - cp..o + k * wp + c0 - cp + w])
+        } else {
+            [&[]; 6]
+        };
+        let out = &mut tail[..if leaf { 0 } else { 6 * w }];
+        if ni == 1 && p != 0 && !leaf {
+            let (ud, sv) = (ff(&udinv[c0]), mv(&jcol[c0]));
+            let row = &mut m[c0 * nv + c0..(c0 + 1) * nv];
+            let [o0, o1, o2, o3, o4, o5] = rows6_mut(out, w, 0, w);
+            let [a0, a1, a2, a3, a4, a5] = ap;
+            let row = &mut row[..w];
+            let (o0, o1, o2, o3, o4, o5) = (
+                &mut o0[..w],
+                &mut o1[..w],
+                &mut o2[..w],
+                &mut o3[..w],
+                &mut o4[..w],
+                &mut o5[..w],
+            );
+            let (a0, a1, a2, a3, a4, a5) =
+                (&a0[..w], &a1[..w], &a2[..w], &a3[..w], &a4[..w], &a5[..w]);
+            for j in 0..w {
+                // H⁻¹[i, c] −= (U D⁻¹)ᵀ A_λ[c], Aᵢ[c] = A_λ[c] + J H⁻¹[i, c]
+                let y = madd(
+                    ud[5],
+                    a5[j],
+                    madd(
+                        ud[4],
+                        a4[j],
+                        madd(
+                            ud[3],
+                            a3[j],
+                            madd(ud[2], a2[j], madd(ud[1], a1[j], ud[0] * a0[j])),
+                        ),
+                    ),
+                );
+                let x = row[j] - y;
+                row[j] = x;
+                o0[j] = madd(sv[0], x, a0[j]);
+                o1[j] = madd(sv[1], x, a1[j]);
+                o2[j] = madd(sv[2], x, a2[j]);
+                o3[j] = madd(sv[3], x, a3[j]);
+                o4[j] = madd(sv[4], x, a4[j]);
+                o5[j] = madd(sv[5], x, a5[j]);
+            }
+        } else {
+            // general joints, the root, the leaves: component sweeps
+            if p != 0 {
+                for r in 0..ni {
+                    let ud = ff(&udinv[c0 + r]);
+                    let row = &mut m[(c0 + r) * nv + c0..(c0 + r + 1) * nv];
+                    for k in 0..6 {
+                        axpy(row, -ud[k], ap[k]);
+                    }
                 }
-                motion_axpy(&mut a, x, &jcol[c0 + r]);
             }
             if !leaf {
-                acol[oi + c - ci0] = a;
+                for k in 0..6 {
+                    let ok = &mut out[k * w..(k + 1) * w];
+                    if p != 0 {
+                        ok.copy_from_slice(ap[k]);
+                    } else {
+                        ok.fill(T::zero());
+                    }
+                    for r in 0..ni {
+                        let row = &m[(c0 + r) * nv + c0..(c0 + r + 1) * nv];
+                        axpy(ok, mv(&jcol[c0 + r])[k], row);
+                    }
+                }
             }
         }
     }

@@ -18,9 +18,9 @@ mod jacobian;
 mod jacobian_dot;
 mod joint_jacobians;
 mod kinematics;
-mod minv;
 pub mod linalg;
 pub mod ltdl;
+mod minv;
 mod rnea;
 mod rnea_derivatives;
 

@@ -165,11 +165,13 @@ pub struct Data<T: Scalar = f64> {
     /// H⁻¹: articulated bias force of each body (world).
     pub minv_of: Vec<Force<T>>,
     /// H⁻¹, per column (leaves inwards): the force a unit τ of that coordinate
-    /// passes to the current body's parent.
-    pub minv_fcol: Vec<Force<T>>,
-    /// H⁻¹, per body with children and per column c from its first coordinate on
-    /// (root outwards): the body's acceleration under a unit τ_c.
-    pub minv_acol: Vec<Motion<T>>,
+    /// passes to the current body's parent, by components (6 × nv: component k of
+    /// column c at `k nv + c`).
+    pub minv_fcol: Vec<T>,
+    /// H⁻¹, per body with children and per column c from its first coordinate cᵢ
+    /// on (root outwards): the body's acceleration under a unit τ_c, by
+    /// components (component k at `minv_acol_off[i] + k (nv − cᵢ) + c − cᵢ`).
+    pub minv_acol: Vec<T>,
     /// H⁻¹: where each body's columns start in `minv_acol`.
     pub minv_acol_off: Vec<usize>,
 }
@@ -195,7 +197,7 @@ impl<T: Scalar> Data<T> {
             for i in 1..nb {
                 acol_off[i] = acol_len;
                 if sub_end[i] > col0[i] + model.joints[i].nv() {
-                    acol_len += nv - col0[i];
+                    acol_len += 6 * (nv - col0[i]);
                 }
             }
         }
@@ -262,8 +264,8 @@ impl<T: Scalar> Data<T> {
             minv_ov: vec![Motion::zero(); nb],
             minv_agf: vec![Motion::zero(); nb],
             minv_of: vec![Force::zero(); nb],
-            minv_fcol: vec![Force::zero(); nv],
-            minv_acol: vec![Motion::zero(); acol_len],
+            minv_fcol: vec![T::zero(); 6 * nv],
+            minv_acol: vec![T::zero(); acol_len],
             minv_acol_off: acol_off,
         }
     }
