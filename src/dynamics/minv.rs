@@ -298,7 +298,7 @@ pub(crate) fn minv_pass<T: Scalar>(
     // q̈ᵢ = D⁻¹ uᵢ − (U D⁻¹)ᵀ a', âᵢ = a' + J q̈ᵢ; the rows of H⁻¹ against every
     // later column, H⁻¹[i, c] −= (U D⁻¹)ᵀ A_λ[c], and the columns' accelerations
     // Aᵢ[c] = A_λ[c] + J H⁻¹[i, c] (c ≥ i), by components: body i's at
-    // `acol[off_i + k wᵢ + c − cᵢ]`, wᵢ = nv − cᵢ.
+    // `acol[off_i + k nv + c]` (a buffer its children read, see `Data::minv_acol`).
     agf[0] = Motion::new(Vector3::zeros(), -model.gravity);
     for i in 1..nb {
         let p = parent[i];
@@ -324,19 +324,28 @@ pub(crate) fn minv_pass<T: Scalar>(
         }
         let w = nv - c0;
         // A_λ's components from column c0 on (none at the root), and this body's
-        let (head, tail) = acol.split_at_mut(acol_off[i]);
+        let sz = 6 * nv;
+        let (ap_buf, out): (&[T], &mut [T]) = if p != 0 {
+            let (r, o) = (acol_off[p], acol_off[i]);
+            if r < o {
+                let (lo, hi) = acol.split_at_mut(o);
+                (&lo[r..r + sz], &mut hi[..sz])
+            } else {
+                let (lo, hi) = acol.split_at_mut(r);
+                (&hi[..sz], &mut lo[o..o + sz])
+            }
+        } else {
+            (&[], &mut acol[acol_off[i]..acol_off[i] + sz])
+        };
         let ap: [&[T]; 6] = if p != 0 {
-            let (cp, o) = (joints[p].iv, acol_off[p]);
-            let wp = nv - cp;
-            std::array::from_fn(|k| &head[o + k * wp + c0 - cp..o + k * wp + c0 - cp + w])
+            std::array::from_fn(|k| &ap_buf[k * nv + c0..(k + 1) * nv])
         } else {
             [&[]; 6]
         };
-        let out = &mut tail[..if leaf { 0 } else { 6 * w }];
         if ni == 1 && p != 0 && !leaf {
             let (ud, sv) = (ff(&udinv[c0]), mv(&jcol[c0]));
             let row = &mut m[c0 * nv + c0..(c0 + 1) * nv];
-            let [o0, o1, o2, o3, o4, o5] = rows6_mut(out, w, 0, w);
+            let [o0, o1, o2, o3, o4, o5] = rows6_mut(out, nv, c0, nv);
             let [a0, a1, a2, a3, a4, a5] = ap;
             let row = &mut row[..w];
             let (o0, o1, o2, o3, o4, o5) = (
@@ -386,7 +395,7 @@ pub(crate) fn minv_pass<T: Scalar>(
             }
             if !leaf {
                 for k in 0..6 {
-                    let ok = &mut out[k * w..(k + 1) * w];
+                    let ok = &mut out[k * nv + c0..(k + 1) * nv];
                     if p != 0 {
                         ok.copy_from_slice(ap[k]);
                     } else {

@@ -168,11 +168,13 @@ pub struct Data<T: Scalar = f64> {
     /// passes to the current body's parent, by components (6 × nv: component k of
     /// column c at `k nv + c`).
     pub minv_fcol: Vec<T>,
-    /// H⁻¹, per body with children and per column c from its first coordinate cᵢ
-    /// on (root outwards): the body's acceleration under a unit τ_c, by
-    /// components (component k at `minv_acol_off[i] + k (nv − cᵢ) + c − cᵢ`).
+    /// H⁻¹, per body and per column c from its first coordinate on (root
+    /// outwards): the body's acceleration under a unit τ_c, by components
+    /// (component k at `minv_acol_off[i] + k nv + c`). Only the children read a
+    /// body's, so bodies share buffers of 6 nv: two per level of branching (an
+    /// only child takes the other one of its parent's pair).
     pub minv_acol: Vec<T>,
-    /// H⁻¹: where each body's columns start in `minv_acol`.
+    /// H⁻¹: where each body's buffer starts in `minv_acol`.
     pub minv_acol_off: Vec<usize>,
 }
 
@@ -190,15 +192,27 @@ impl<T: Scalar> Data<T> {
         }
         let nfull = if direct { 0 } else { ncol };
         let (dof_end, anc_runs, anc_run0) = coordinate_runs(model, &sub_end, direct);
-        // a body with children keeps one acceleration per column from its first on
+        // the column accelerations' buffers: an only child alternates with its
+        // parent, the children of a branching body go one pair deeper
         let mut acol_off = vec![0; nb];
         let mut acol_len = 0;
         if direct {
+            let mut nchild = vec![0usize; nb];
             for i in 1..nb {
-                acol_off[i] = acol_len;
-                if sub_end[i] > col0[i] + model.joints[i].nv() {
-                    acol_len += 6 * (nv - col0[i]);
-                }
+                nchild[model.parent[i]] += 1;
+            }
+            let mut buf = vec![0usize; nb];
+            for i in 1..nb {
+                let p = model.parent[i];
+                buf[i] = if p == 0 {
+                    0
+                } else if nchild[p] == 1 {
+                    buf[p] ^ 1
+                } else {
+                    (buf[p] | 1) + 1
+                };
+                acol_off[i] = buf[i] * 6 * nv;
+                acol_len = acol_len.max(acol_off[i] + 6 * nv);
             }
         }
         Self {
