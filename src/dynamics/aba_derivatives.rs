@@ -1,7 +1,8 @@
 //! Analytic first-order derivatives of forward dynamics: ∂q̈/∂q, ∂q̈/∂v and
 //! ∂q̈/∂τ = H⁻¹, from those of inverse dynamics at a = q̈ (docs/theory.md
 //! §"Derivatives": q̈(q, v, τ) solves ID(q, v, q̈) = τ, so
-//! ∂q̈/∂x = −H⁻¹ ∂ID/∂x).
+//! ∂q̈/∂x = −H⁻¹ ∂ID/∂x; H⁻¹ from the world-frame ABA of `minv.rs`, "Inverse of
+//! H"; the products over ∂ID/∂x's tree pattern, "The products").
 
 use super::rnea_derivatives::{check_wrenches, rnea_derivatives_pass, LinkWrench};
 use super::{check_massless, check_sizes, linalg, minv, DynamicsError};
@@ -15,10 +16,13 @@ use nalgebra::{DMatrix, DVector};
 /// [`super::rnea_derivatives`]), `data.dqdd_dv` = ∂q̈/∂v, `data.minv` = H⁻¹ = ∂q̈/∂τ
 /// (whole, symmetric; a floating base's first 6 columns are those of its body-frame
 /// wrench), `data.qdd` = q̈. Every model: fixed, floating, mimic (the reduced system).
-/// Route: q̈ by the engine's forward dynamics; ∂τ/∂q, ∂τ/∂v and H at a = q̈ by
-/// [`super::rnea_derivatives`]; H factorised (tree-sparse LTDL, dense Cholesky with
-/// mimic joints) and solved against the identity and both Jacobians. Also leaves
-/// `data.dtau_dq`, `data.dtau_dv` (at a = q̈) and `data.h`. No allocation.
+/// Route (docs/theory.md §"Derivatives", "Forward dynamics"): q̈ and H⁻¹ by the
+/// articulated-body recursion in world coordinates ("Inverse of H", O(n·nv));
+/// ∂τ/∂q, ∂τ/∂v at a = q̈ by [`super::rnea_derivatives`]; ∂q̈/∂x = −H⁻¹ ∂τ/∂x by
+/// register-tiled products that read only ∂τ/∂x's tree pattern ("The products").
+/// With mimic joints: q̈ by the engine's forward dynamics, H by the derivative
+/// sweep, dense Cholesky solves against the identity and both Jacobians. Also
+/// leaves `data.dtau_dq`, `data.dtau_dv` (at a = q̈) and `data.h`. No allocation.
 pub fn aba_derivatives<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,
@@ -113,7 +117,8 @@ pub fn aba_derivatives<T: Scalar>(
 
 /// Where the columns of ∂τ/∂x (tree-shaped: entry (r, c) only for r, c on one
 /// root path) can be non-zero: rows `[c, dof_end[c])` (c's subtree) and c's
-/// ancestors, the runs `runs[run0[c]..run0[c + 1]]`.
+/// ancestors, the runs `runs[run0[c]..run0[c + 1]]`. The derivative sweep never
+/// writes the other entries, which stay the zeros of `Data::new`.
 struct TreePattern<'a> {
     dof_end: &'a [usize],
     runs: &'a [(usize, usize)],

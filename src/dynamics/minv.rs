@@ -172,7 +172,7 @@ pub(crate) fn minv_pass<T: Scalar>(
             uq[c0] = ui;
             let uvec = iai * mv(&s);
             let d = s.dot(&fv(&uvec));
-            if !(d > T::zero()) || !d.is_finite() {
+            if d.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater) || !d.is_finite() {
                 return Err(DynamicsError::Singular(c0));
             }
             let dinv = T::one() / d;

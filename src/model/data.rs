@@ -300,10 +300,9 @@ fn coordinate_runs<T: Scalar>(
     let nv = model.nv;
     let lambda = &model.dof_parent;
     let mut dof_end = vec![0; nv];
-    for i in 1..model.nbodies {
-        let j = &model.joints[i];
+    for (j, &e) in model.joints.iter().zip(sub_end).skip(1) {
         for c in 0..j.nv() {
-            dof_end[j.iv + c] = sub_end[i];
+            dof_end[j.iv + c] = e;
         }
     }
     let mut runs = Vec::new();
