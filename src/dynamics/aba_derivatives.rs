@@ -9,7 +9,7 @@ use super::{check_massless, check_sizes, linalg, minv, DynamicsError};
 use crate::model::{Data, Model};
 use crate::spatial::ops::madd;
 use crate::spatial::{Force, Scalar};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Vector3};
 
 /// The derivatives of forward dynamics q̈ = FD(q, v, τ) with the wrenches `fext`
 /// (docs/theory.md §"Derivatives"): `data.dqdd_dq` = ∂q̈/∂q (tangent space, as
@@ -55,6 +55,11 @@ pub fn aba_derivatives<T: Scalar>(
         a.copy_from(&data.qdd);
         rnea_derivatives_pass(model, data, q, v, &a, fext);
         data.deriv_tmp = a;
+        if data.deriv_low_rank {
+            // ∂q̈/∂x = −H⁻¹ ∂τ/∂x from ∂τ/∂x's low-rank parts (long chains)
+            neg_mul_low_rank(model, data, fext.is_some());
+            return Ok(());
+        }
         // ∂q̈/∂x = −H⁻¹ ∂τ/∂x over ∂τ/∂x's tree pattern
         let Data {
             minv,
@@ -113,6 +118,190 @@ pub fn aba_derivatives<T: Scalar>(
         out.neg_mut();
     }
     Ok(())
+}
+
+/// `(xq, xv) += Σₖ cols[k n..(k + 1) n] (cq[k], cv[k])` over the first `K`
+/// columns (one load of each column for both), then negated if `neg`.
+#[inline(always)]
+fn gemv2_add<T: Scalar, const K: usize>(
+    xq: &mut [T],
+    xv: &mut [T],
+    cols: &[T],
+    cq: &[T; 12],
+    cv: &[T; 12],
+    neg: bool,
+) {
+    let n = xq.len();
+    let c: [&[T]; K] = std::array::from_fn(|k| &cols[k * n..(k + 1) * n]);
+    let xv = &mut xv[..n];
+    for i in 0..n {
+        let (mut sq, mut sv) = (xq[i], xv[i]);
+        for k in 0..K {
+            let h = c[k][i];
+            sq = madd(h, cq[k], sq);
+            sv = madd(h, cv[k], sv);
+        }
+        if neg {
+            sq = -sq;
+            sv = -sv;
+        }
+        xq[i] = sq;
+        xv[i] = sv;
+    }
+}
+
+/// `cols[k n..(k + 1) n] += h coef[k]` for the first `K` columns.
+#[inline(always)]
+fn ger_add<T: Scalar, const K: usize>(cols: &mut [T], h: &[T], coef: &[T; 12]) {
+    let n = h.len();
+    for (k, col) in cols.chunks_exact_mut(n).take(K).enumerate() {
+        let ck = coef[k];
+        for (y, &x) in col.iter_mut().zip(h) {
+            *y = madd(x, ck, *y);
+        }
+    }
+}
+
+/// The first `k` entries of `[m.ang; m.lin; a; b]` (angular first), zero-padded.
+#[inline(always)]
+fn coef12<T: Scalar>(x: [&Vector3<T>; 4]) -> [T; 12] {
+    let mut c = [T::zero(); 12];
+    for (b, v) in x.iter().enumerate() {
+        for r in 0..3 {
+            c[3 * b + r] = v[r];
+        }
+    }
+    c
+}
+
+/// `−H⁻¹ ∂τ/∂q`, `−H⁻¹ ∂τ/∂v` from the low-rank parts of ∂τ/∂x (docs/theory.md
+/// §"Derivatives", "The products"): column c of B (coordinate c on body i) is
+/// `Jᵣᵀ G_c` on the coordinates r of i's strict ancestors (G = ∂F/∂q or ∂F/∂q̇ of
+/// c's column, the subtree's rigid turn included), `αᵣᵀ β_c` on those of its
+/// strict descendants (α = [Yᶜ J; (Ẏᶜᵀ J).ang; e.ang], β = [∂a/∂q; ∂v/∂q.ang; ω]
+/// or [∂a/∂q̇; ω; 0]) and B's own block on i's joint. So
+/// `H⁻¹ B[:, c] = H⁻¹[:, i] B[i, c] + P_i G_c + S_i β_c`, with
+/// `P_i = Σ_{anc} H⁻¹[:, r] Jᵣᵀ` (root outwards) and `S_i = Σ_{desc} H⁻¹[:, r] αᵣᵀ`
+/// (leaves inwards): O(nv²) instead of O(nv³). Reads the derivative sweep's
+/// per-column vectors from `data`; `ext`: wrenches were given (e is set).
+fn neg_mul_low_rank<T: Scalar>(model: &Model<T>, data: &mut Data<T>, ext: bool) {
+    let (n, nb) = (model.nv, model.nbodies);
+    let parent = &model.parent[..nb];
+    let joints = &model.joints[..nb];
+    let Data {
+        minv,
+        dqdd_dq,
+        dqdd_dv,
+        dtau_dq,
+        dtau_dv,
+        deriv_j: jc,
+        deriv_dfda: dfda,
+        deriv_ytj: ytj,
+        deriv_ext_e: ext_e,
+        deriv_dadq: dadq,
+        deriv_dvdq: dvdq,
+        deriv_dadv: dadv,
+        deriv_dfdq: dfdq,
+        deriv_dfdv: dfdv,
+        minv_acol: pbuf,
+        minv_acol_off: poff,
+        deriv_prod_s: sbuf,
+        deriv_prod_s_off: soff,
+        ..
+    } = data;
+    let a = minv.as_slice();
+    let (xq, xv) = (dqdd_dq.as_mut_slice(), dqdd_dv.as_mut_slice());
+    let (bq, bv) = (dtau_dq.as_slice(), dtau_dv.as_slice());
+    let zero = Vector3::zeros();
+    let alpha = |r: usize| {
+        let e = if ext { &ext_e[r].ang } else { &zero };
+        coef12([&dfda[r].ang, &dfda[r].lin, &ytj[r].ang, e])
+    };
+    let sz = 12 * n;
+    sbuf.fill(T::zero());
+    // Leaves inwards: x[:, c] = H⁻¹[:, i] B[i, c] + S_i β_c; then S_i += H⁻¹[:, r] αᵣᵀ
+    // over i's coordinates and S_λ += S_i.
+    for i in (1..nb).rev() {
+        let (c0, ni) = (joints[i].iv, joints[i].nv());
+        let si = soff[i];
+        for c in c0..c0 + ni {
+            let bq_c = coef12([&dadq[c].ang, &dadq[c].lin, &dvdq[c].ang, &jc[c].ang]);
+            let bv_c = coef12([&dadv[c].ang, &dadv[c].lin, &jc[c].ang, &zero]);
+            let (xqc, xvc) = (&mut xq[c * n..(c + 1) * n], &mut xv[c * n..(c + 1) * n]);
+            for (xc, b) in [(&mut *xqc, bq), (&mut *xvc, bv)] {
+                xc.fill(T::zero());
+                for r in c0..c0 + ni {
+                    let brc = b[r + c * n];
+                    for (y, &h) in xc.iter_mut().zip(&a[r * n..(r + 1) * n]) {
+                        *y = madd(h, brc, *y);
+                    }
+                }
+            }
+            let s = &sbuf[si..si + sz];
+            if ext {
+                gemv2_add::<T, 12>(xqc, xvc, s, &bq_c, &bv_c, false);
+            } else {
+                gemv2_add::<T, 9>(xqc, xvc, s, &bq_c, &bv_c, false);
+            }
+        }
+        let s = &mut sbuf[si..si + sz];
+        for r in c0..c0 + ni {
+            let al = alpha(r);
+            let h = &a[r * n..(r + 1) * n];
+            if ext {
+                ger_add::<T, 12>(s, h, &al);
+            } else {
+                ger_add::<T, 9>(s, h, &al);
+            }
+        }
+        let p = parent[i];
+        if p == 0 || soff[p] != si {
+            if p != 0 {
+                let sp = soff[p];
+                let (lo, hi) = sbuf.split_at_mut(si);
+                for (y, &x) in lo[sp..sp + sz].iter_mut().zip(&hi[..sz]) {
+                    *y += x;
+                }
+            }
+            sbuf[si..si + sz].fill(T::zero());
+        }
+    }
+    // Root outwards: P_i = P_λ + H⁻¹[:, λ] J_λᵀ; x[:, c] = −(x[:, c] + P_i G_c).
+    let psz = 6 * n;
+    for i in 1..nb {
+        let p = parent[i];
+        let (c0, ni) = (joints[i].iv, joints[i].nv());
+        let o = poff[i];
+        if p == 0 {
+            pbuf[o..o + psz].fill(T::zero());
+        } else {
+            let r0 = poff[p];
+            let (src, dst): (&[T], &mut [T]) = if r0 < o {
+                let (lo, hi) = pbuf.split_at_mut(o);
+                (&lo[r0..r0 + psz], &mut hi[..psz])
+            } else {
+                let (lo, hi) = pbuf.split_at_mut(r0);
+                (&hi[..psz], &mut lo[o..o + psz])
+            };
+            dst.copy_from_slice(src);
+            let (cp, np) = (joints[p].iv, joints[p].nv());
+            for r in cp..cp + np {
+                let jr = coef12([&jc[r].ang, &jc[r].lin, &zero, &zero]);
+                ger_add::<T, 6>(dst, &a[r * n..(r + 1) * n], &jr);
+            }
+        }
+        let pi = &pbuf[o..o + psz];
+        for c in c0..c0 + ni {
+            let (xqc, xvc) = (&mut xq[c * n..(c + 1) * n], &mut xv[c * n..(c + 1) * n]);
+            let (gq, gv) = (&dfdq[c], &dfdv[c]);
+            let (cq, cv) = (
+                coef12([&gq.ang, &gq.lin, &zero, &zero]),
+                coef12([&gv.ang, &gv.lin, &zero, &zero]),
+            );
+            // P_i is zero at a root
+            gemv2_add::<T, 6>(xqc, xvc, pi, &cq, &cv, true);
+        }
+    }
 }
 
 /// Where the columns of ∂τ/∂x (tree-shaped: entry (r, c) only for r, c on one

@@ -176,6 +176,17 @@ pub struct Data<T: Scalar = f64> {
     pub minv_acol: Vec<T>,
     /// H⁻¹: where each body's buffer starts in `minv_acol`.
     pub minv_acol_off: Vec<usize>,
+    /// Derivatives: whether `aba_derivatives` forms −H⁻¹ ∂τ/∂x from ∂τ/∂x's
+    /// low-rank parts (long chains, docs/theory.md §"Derivatives", "The products")
+    /// rather than by the tree-pattern product; chosen here by operation counts
+    /// (either gives the same result; models with mimic joints use neither).
+    pub deriv_low_rank: bool,
+    /// Derivatives (low-rank products): per body, the subtree sums
+    /// `Σ H⁻¹[:, r] αᵣᵀ` (nv × 12 by columns) in shared buffers.
+    pub deriv_prod_s: Vec<T>,
+    /// Derivatives (low-rank products): where each body's buffer starts in
+    /// `deriv_prod_s`.
+    pub deriv_prod_s_off: Vec<usize>,
 }
 
 impl<T: Scalar> Data<T> {
@@ -213,6 +224,41 @@ impl<T: Scalar> Data<T> {
                 };
                 acol_off[i] = buf[i] * 6 * nv;
                 acol_len = acol_len.max(acol_off[i] + 6 * nv);
+            }
+        }
+        // the low-rank products: their count (47 nv² multiply-adds in axpy loops,
+        // taken at half the tiled product's rate) against the tiled product's
+        // (2 nv Σ_c rows of column c's pattern)
+        let mut s_off = vec![0; nb];
+        let mut s_len = 0;
+        let mut low_rank = false;
+        if direct && nv > 0 {
+            let rows: usize = (0..nv)
+                .map(|c| {
+                    let anc: usize = anc_runs[anc_run0[c]..anc_run0[c + 1]]
+                        .iter()
+                        .map(|(lo, hi)| hi - lo)
+                        .sum();
+                    anc + dof_end[c] - c
+                })
+                .sum();
+            low_rank = 94 * nv * nv < 2 * nv * rows;
+        }
+        if direct {
+            let mut nchild = vec![0usize; nb];
+            for i in 1..nb {
+                nchild[model.parent[i]] += 1;
+            }
+            let mut slot = vec![0usize; nb];
+            for i in 1..nb {
+                let p = model.parent[i];
+                slot[i] = if p == 0 || nchild[p] == 1 {
+                    slot[p]
+                } else {
+                    slot[p] + 1
+                };
+                s_off[i] = slot[i] * 12 * nv;
+                s_len = s_len.max(s_off[i] + 12 * nv);
             }
         }
         Self {
@@ -281,6 +327,9 @@ impl<T: Scalar> Data<T> {
             minv_fcol: vec![T::zero(); 6 * nv],
             minv_acol: vec![T::zero(); acol_len],
             minv_acol_off: acol_off,
+            deriv_low_rank: low_rank,
+            deriv_prod_s: vec![T::zero(); s_len],
+            deriv_prod_s_off: s_off,
         }
     }
 }
