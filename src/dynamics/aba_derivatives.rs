@@ -19,7 +19,8 @@ use nalgebra::{DMatrix, DVector, Vector3};
 /// Route (docs/theory.md §"Derivatives", "Forward dynamics"): q̈ and H⁻¹ by the
 /// articulated-body recursion in world coordinates ("Inverse of H", O(n·nv));
 /// ∂τ/∂q, ∂τ/∂v at a = q̈ by [`super::rnea_derivatives`]; ∂q̈/∂x = −H⁻¹ ∂τ/∂x by
-/// register-tiled products that read only ∂τ/∂x's tree pattern ("The products").
+/// register-tiled products that read only ∂τ/∂x's tree pattern, or on long chains
+/// from ∂τ/∂x's low-rank parts in O(nv²) ("The products", `data.deriv_low_rank`).
 /// With mimic joints: q̈ by the engine's forward dynamics, H by the derivative
 /// sweep, dense Cholesky solves against the identity and both Jacobians. Also
 /// leaves `data.dtau_dq`, `data.dtau_dv` (at a = q̈) and `data.h`. No allocation.
@@ -162,7 +163,7 @@ fn ger_add<T: Scalar, const K: usize>(cols: &mut [T], h: &[T], coef: &[T; 12]) {
     }
 }
 
-/// The first `k` entries of `[m.ang; m.lin; a; b]` (angular first), zero-padded.
+/// Four 3-vectors `[a; b; c; d]` as 12 coefficients.
 #[inline(always)]
 fn coef12<T: Scalar>(x: [&Vector3<T>; 4]) -> [T; 12] {
     let mut c = [T::zero(); 12];
