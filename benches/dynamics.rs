@@ -1,5 +1,5 @@
 //! Criterion benches of every algorithm on ur5, solo12 (floating), panda (mimic) and
-//! the synthetic chains/tree: `cargo bench --bench dynamics [-- FILTER]`.
+//! the synthetic chains/tree: `cargo bench --features bench --bench dynamics [-- FILTER]`.
 //! (`urdyn bench` and benches/compare.sh give the Pinocchio comparison.)
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use std::hint::black_box;

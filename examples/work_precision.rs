@@ -11,6 +11,9 @@
 //! writes `OUT_DIR/work_precision.md` and `OUT_DIR/work_precision.png` (default `target`).
 
 use nalgebra::DVector;
+#[path = "common/png_out.rs"]
+mod png_out;
+
 use plotters::prelude::*;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -163,66 +166,72 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // log-log plot of error against wall time
     let png = out_dir.join("work_precision.png");
-    let area = BitMapBackend::new(&png, (1000, 700)).into_drawing_area();
-    area.fill(&WHITE)?;
-    let fin: Vec<&Run> = runs
-        .iter()
-        .filter(|r| r.err.is_finite() && r.err > 0.0)
-        .collect();
-    let (tmin, tmax) = fin.iter().fold((f64::INFINITY, 0.0f64), |(a, b), r| {
-        (a.min(r.wall), b.max(r.wall))
-    });
-    let (emin, emax) = fin.iter().fold((f64::INFINITY, 0.0f64), |(a, b), r| {
-        (a.min(r.err), b.max(r.err))
-    });
-    let mut chart = ChartBuilder::on(&area)
-        .caption(
-            "20-link hanging chain, 2 s: final joint error vs wall time",
-            ("sans-serif", 22),
-        )
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(
-            (tmin.max(1e-6) / 2.0..tmax.max(1.0) * 2.0).log_scale(),
-            (emin.min(1e-12) / 2.0..emax.max(1e-2) * 2.0).log_scale(),
-        )?;
-    chart
-        .configure_mesh()
-        .x_desc("wall time (s)")
-        .y_desc("max joint error (rad)")
-        .y_label_formatter(&|y| format!("{y:.0e}"))
-        .x_label_formatter(&|x| format!("{x:.0e}"))
-        .draw()?;
-    let colors = [RED, BLUE, GREEN];
-    for (k, integ) in Integrator::ALL.iter().enumerate() {
-        let mut pts: Vec<(f64, f64)> = fin
+    let mut rgb = vec![0u8; 1000 * 700 * 3];
+    {
+        let area = BitMapBackend::with_buffer(&mut rgb, (1000, 700)).into_drawing_area();
+        area.fill(&WHITE)?;
+        let fin: Vec<&Run> = runs
             .iter()
-            .filter(|r| r.integ == *integ)
-            .map(|r| (r.wall, r.err))
+            .filter(|r| r.err.is_finite() && r.err > 0.0)
             .collect();
-        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let c = colors[k % 3];
+        let (tmin, tmax) = fin.iter().fold((f64::INFINITY, 0.0f64), |(a, b), r| {
+            (a.min(r.wall), b.max(r.wall))
+        });
+        let (emin, emax) = fin.iter().fold((f64::INFINITY, 0.0f64), |(a, b), r| {
+            (a.min(r.err), b.max(r.err))
+        });
+        let mut chart = ChartBuilder::on(&area)
+            .caption(
+                "20-link hanging chain, 2 s: final joint error vs wall time",
+                ("sans-serif", 22),
+            )
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(
+                (tmin.max(1e-6) / 2.0..tmax.max(1.0) * 2.0).log_scale(),
+                (emin.min(1e-12) / 2.0..emax.max(1e-2) * 2.0).log_scale(),
+            )?;
         chart
-            .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))?
-            .label(integ.name())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
-        chart.draw_series(pts.iter().map(|p| Circle::new(*p, 4, c.filled())))?;
+            .configure_mesh()
+            .x_desc("wall time (s)")
+            .y_desc("max joint error (rad)")
+            .y_label_formatter(&|y| format!("{y:.0e}"))
+            .x_label_formatter(&|x| format!("{x:.0e}"))
+            .draw()?;
+        let colors = [RED, BLUE, GREEN];
+        for (k, integ) in Integrator::ALL.iter().enumerate() {
+            let mut pts: Vec<(f64, f64)> = fin
+                .iter()
+                .filter(|r| r.integ == *integ)
+                .map(|r| (r.wall, r.err))
+                .collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let c = colors[k % 3];
+            chart
+                .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))?
+                .label(integ.name())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
+            chart.draw_series(pts.iter().map(|p| Circle::new(*p, 4, c.filled())))?;
+        }
+        let mj = [(0.21, 7e-4), (0.45, 1.7e-5)];
+        chart
+            .draw_series(
+                mj.iter()
+                    .map(|p| TriangleMarker::new(*p, 7, BLACK.filled())),
+            )?
+            .label("MuJoCo 4.0 RK4 (issue figures)")
+            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.filled()));
+        chart
+            .configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE)
+            .draw()?;
+        area.present()?;
     }
-    let mj = [(0.21, 7e-4), (0.45, 1.7e-5)];
-    chart
-        .draw_series(
-            mj.iter()
-                .map(|p| TriangleMarker::new(*p, 7, BLACK.filled())),
-        )?
-        .label("MuJoCo 4.0 RK4 (issue figures)")
-        .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.filled()));
-    chart
-        .configure_series_labels()
-        .border_style(BLACK)
-        .background_style(WHITE)
-        .draw()?;
-    area.present()?;
+    png_out::write_png(&png, &rgb, (1000, 700))?;
     println!(
         "wrote {} and {}",
         out_dir.join("work_precision.md").display(),

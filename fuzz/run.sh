@@ -6,6 +6,7 @@
 # become a file in tests/bad with a test.
 #
 # Usage: fuzz/run.sh [SECONDS_PER_TARGET (default 180)] [TARGET...]
+# (targets: urdf_eval states_eval scene_load; default the first two)
 set -euo pipefail
 cd "$(dirname "$0")"
 SECS=${1:-180}
@@ -20,7 +21,7 @@ export RUSTFLAGS="-Cpasses=sancov-module -Cllvm-args=-sanitizer-coverage-level=4
 TRIPLE=$(rustc +nightly -vV | sed -n "s/^host: //p")
 cargo +nightly build --release --target-dir target --target "$TRIPLE" --bins
 
-mkdir -p seeds/urdf_eval seeds/states_eval logs
+mkdir -p seeds/urdf_eval seeds/states_eval seeds/scene_load logs
 for f in ../tests/bad/*.urdf ../tests/urdf/*.urdf ../assets/*.urdf ../assets/robots/*.urdf; do
     [ -f "$f" ] || continue
     # 8 bytes of state seed (bit 1: floating base), then the URDF.
@@ -28,6 +29,11 @@ for f in ../tests/bad/*.urdf ../tests/urdf/*.urdf ../assets/*.urdf ../assets/rob
     { printf '\003\000\000\000\000\000\000\000'; cat "$f"; } > "seeds/urdf_eval/float_$(basename "$f")"
 done
 for f in ../tests/bad/states_* ; do cp "$f" seeds/states_eval/; done
+# scene files: the bad corpus and the assets' scenes (relative to assets/: the
+# target loads them there, so "lamp.urdf" resolves)
+for f in ../tests/bad/scene/*.json ../assets/*.json; do
+    [ -f "$f" ] && sed 's#\.\./\.\./\.\./assets/##g' "$f" > "seeds/scene_load/$(basename "$f")"
+done
 for d in ../tests/fixtures/*/; do
     [ -f "$d/states.json" ] && cp "$d/states.json" "seeds/states_eval/$(basename "$d").json"
 done

@@ -58,6 +58,7 @@ pub mod cli;
 pub mod contact;
 pub mod dynamics;
 pub mod model;
+pub mod scene;
 pub mod sim;
 pub mod spatial;
 pub mod urdf;
@@ -66,6 +67,7 @@ pub use model::{Data, Model};
 /// The nalgebra this crate is built with (its vectors and matrices are in the API):
 /// `urdyn::nalgebra::DVector` always matches.
 pub use nalgebra;
+pub use scene::{Scene, SceneError};
 pub use urdf::{load_file, load_str, LoadOptions, UrdfError};
 
 /// The README's Rust examples, compiled and run by `cargo test` (doctests).

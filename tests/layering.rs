@@ -1,6 +1,6 @@
-//! The one-way flow of the library's layers: spatial ← model ← urdf, with the
+//! The one-way flow of the library's layers: spatial ← model ← urdf ← scene, with the
 //! algorithms (dynamics, contact, sim) on top. No source file of `src/spatial`,
-//! `src/model` or `src/urdf` names a module above it (doc comments may link to
+//! `src/model`, `src/urdf` or `src/scene` names a module above it (doc comments may link to
 //! one); `src/spatial` does not name `model` or `urdf` either.
 
 use std::path::{Path, PathBuf};
@@ -47,14 +47,15 @@ fn offending_lines(layer: &str, above: &[&str]) -> Vec<String> {
 #[test]
 fn lower_layers_do_not_reach_up() {
     let mut bad = Vec::new();
-    for layer in ["spatial", "model", "urdf"] {
+    for layer in ["spatial", "model", "urdf", "scene"] {
         bad.extend(offending_lines(
             layer,
             &["dynamics", "contact", "sim", "cli"],
         ));
     }
     bad.extend(offending_lines("spatial", &["model", "urdf"]));
-    bad.extend(offending_lines("model", &["urdf"]));
+    bad.extend(offending_lines("model", &["urdf", "scene"]));
+    bad.extend(offending_lines("urdf", &["scene"]));
     assert!(bad.is_empty(), "layering broken:\n{}", bad.join("\n"));
 }
 

@@ -38,20 +38,25 @@ pub fn normalize_base_quaternion(quat: &mut [f64], name: &str) -> PyResult<()> {
     }
 }
 
-/// Reads a configuration: [`read_vec`] (length nq, finite), then, with a
-/// floating base, [`normalize_base_quaternion`] on its entries 3..7. Every q of
-/// the package comes through here.
+/// Copies q (length nq) into `out` and checks each free joint's quaternion
+/// (`quats`: their offsets in q, from [`quat_offsets`]) with
+/// [`normalize_base_quaternion`]. Every q of the package is read here.
 pub fn read_q(
     x: &Bound<'_, PyAny>,
     name: &str,
-    floating_base: bool,
+    quats: &[usize],
     out: &mut DVector<f64>,
 ) -> PyResult<()> {
     read_vec(x, name, "nq", out)?;
-    if floating_base {
-        normalize_base_quaternion(&mut out.as_mut_slice()[3..7], name)?;
+    for &at in quats {
+        normalize_base_quaternion(&mut out.as_mut_slice()[at..at + 4], name)?;
     }
     Ok(())
+}
+
+/// The offsets in q of every free joint's quaternion (`iq + 3`).
+pub fn quat_offsets(model: &urdyn::Model) -> Vec<usize> {
+    model.free_joints.iter().map(|f| f.iq + 3).collect()
 }
 
 /// Copies the 1-D array-like `x` into `out` (length `n`, the model's `what`):

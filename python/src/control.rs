@@ -12,14 +12,17 @@ use urdyn::sim::{JacobianMethod, Simulation};
 /// Gains: a number (every joint, base entries 0) or nv numbers.
 fn read_gains(sim: &Simulation, x: &Bound<'_, PyAny>, name: &str) -> PyResult<DVector<f64>> {
     let nv = sim.model.nv;
-    let vo = sim.model.joint_v_offset();
     if let Ok(g) = x.extract::<f64>() {
         if !(g.is_finite() && g >= 0.0) {
             return Err(value_error(format!(
                 "{name} must be a finite number ≥ 0 (got {g})"
             )));
         }
-        return Ok(DVector::from_fn(nv, |k, _| if k < vo { 0.0 } else { g }));
+        // a free joint's six entries 0
+        let m = &sim.model;
+        return Ok(DVector::from_fn(nv, |k, _| {
+            m.dof_at_v(k).map_or(0.0, |_| g)
+        }));
     }
     let mut out = DVector::zeros(nv);
     read_vec(x, name, "nv", &mut out)?;

@@ -78,7 +78,11 @@ pub fn rnea_derivatives<'py>(
     dynamics::rnea_derivatives(&model.model, &mut d.data, &d.q, &d.v, &d.a, wf)
         .map_err(|e| dyn_error(&model, e))?;
     let x = &d.data;
-    Ok((mat_out(py, &x.dtau_dq), mat_out(py, &x.dtau_dv), mat_out(py, &x.h)))
+    Ok((
+        mat_out(py, &x.dtau_dq),
+        mat_out(py, &x.dtau_dv),
+        mat_out(py, &x.h),
+    ))
 }
 
 /// `(dqdd_dq, dqdd_dv, Minv)`: the derivatives of forward dynamics at (q, v, tau)
@@ -105,7 +109,11 @@ pub fn aba_derivatives<'py>(
     dynamics::aba_derivatives(&model.model, &mut d.data, &d.q, &d.v, &d.a, wf)
         .map_err(|e| dyn_error(&model, e))?;
     let x = &d.data;
-    Ok((mat_out(py, &x.dqdd_dq), mat_out(py, &x.dqdd_dv), mat_out(py, &x.minv)))
+    Ok((
+        mat_out(py, &x.dqdd_dq),
+        mat_out(py, &x.dqdd_dv),
+        mat_out(py, &x.minv),
+    ))
 }
 
 /// The 6 × nv time variation of link `link`'s Jacobian at (q, v) (Pinocchio's
@@ -128,8 +136,16 @@ pub fn frame_jacobian_time_variation<'py>(
     read_vec(v, "v", "nv", &mut d.v)?;
     let i = model.link(link, "link")?;
     let mut jd = DMatrix::zeros(6, model.model.nv);
-    dynamics::frame_jacobian_time_variation(&model.model, &mut d.data, &d.q, &d.v, FrameId(i), r, &mut jd)
-        .map_err(|e| dyn_error(&model, e))?;
+    dynamics::frame_jacobian_time_variation(
+        &model.model,
+        &mut d.data,
+        &d.q,
+        &d.v,
+        FrameId(i),
+        r,
+        &mut jd,
+    )
+    .map_err(|e| dyn_error(&model, e))?;
     Ok(mat_out(py, &jd))
 }
 
@@ -149,12 +165,11 @@ pub fn integrate<'py>(
     dq: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let m = &model.model;
-    let mut q = vec_in(q, "q", "nq", m.nq)?;
-    if m.floating_base {
-        crate::args::normalize_base_quaternion(&mut q.as_mut_slice()[3..7], "q")?;
-    }
+    let quats = crate::args::quat_offsets(m);
+    let mut qv = DVector::zeros(m.nq);
+    crate::args::read_q(q, "q", &quats, &mut qv)?;
     let dq = vec_in(dq, "dq", "nv", m.nv)?;
-    let out = configuration::integrate(m, &q, &dq).map_err(|e| value_error(e.to_string()))?;
+    let out = configuration::integrate(m, &qv, &dq).map_err(|e| value_error(e.to_string()))?;
     Ok(PyArray1::from_slice(py, out.as_slice()))
 }
 
@@ -167,13 +182,11 @@ pub fn difference<'py>(
     q1: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let m = &model.model;
-    let mut q0 = vec_in(q0, "q0", "nq", m.nq)?;
-    let mut q1 = vec_in(q1, "q1", "nq", m.nq)?;
-    if m.floating_base {
-        crate::args::normalize_base_quaternion(&mut q0.as_mut_slice()[3..7], "q0")?;
-        crate::args::normalize_base_quaternion(&mut q1.as_mut_slice()[3..7], "q1")?;
-    }
-    let out = configuration::difference(m, &q0, &q1).map_err(|e| value_error(e.to_string()))?;
+    let quats = crate::args::quat_offsets(m);
+    let (mut a, mut b) = (DVector::zeros(m.nq), DVector::zeros(m.nq));
+    crate::args::read_q(q0, "q0", &quats, &mut a)?;
+    crate::args::read_q(q1, "q1", &quats, &mut b)?;
+    let out = configuration::difference(m, &a, &b).map_err(|e| value_error(e.to_string()))?;
     Ok(PyArray1::from_slice(py, out.as_slice()))
 }
 

@@ -10,6 +10,7 @@ mod control;
 mod derivatives;
 mod dynamics;
 mod model;
+mod scene;
 mod sim;
 
 use pyo3::prelude::*;
@@ -28,6 +29,9 @@ fn _urdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::PyModel>()?;
     m.add_class::<model::PyData>()?;
     m.add_class::<sim::PySimulation>()?;
+    m.add_class::<scene::PyScene>()?;
+    m.add_function(wrap_pyfunction!(scene::_scene_from_state, m)?)?;
+    m.add_function(wrap_pyfunction!(model::_scene_model_from_state, m)?)?;
     m.add("SimulationError", m.py().get_type::<SimulationError>())?;
     m.add_function(wrap_pyfunction!(model::_model_from_state, m)?)?;
     m.add_function(wrap_pyfunction!(model::to_pinocchio_q, m)?)?;

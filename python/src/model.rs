@@ -2,7 +2,7 @@
 //! (the preallocated workspace).
 
 use crate::args::{
-    normalize_base_quaternion, not_found_error, read3, read_q, read_vec, value_error,
+    normalize_base_quaternion, not_found_error, quat_offsets, read3, read_q, read_vec, value_error,
 };
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -26,6 +26,9 @@ pub struct PyModel {
     pub package_dirs: Vec<PathBuf>,
     /// Index into `model.frames` of every URDF link.
     pub links: HashMap<String, usize>,
+    /// A scene's model: the scene's JSON text, file name and folder (a pickled
+    /// scene model is rebuilt from them).
+    pub scene_state: Option<(String, String, PathBuf)>,
 }
 
 impl PyModel {
@@ -51,7 +54,31 @@ impl PyModel {
             file,
             package_dirs,
             links,
+            scene_state: None,
         })
+    }
+
+    /// The `Model` of a scene (names `MODEL/NAME`).
+    pub fn from_scene(s: &crate::scene::PyScene) -> Self {
+        let model = s.scene.model.clone();
+        let links = model
+            .frames
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.name.clone(), i))
+            .collect();
+        Self {
+            model,
+            text: String::new(),
+            file: s.scene.file.clone(),
+            package_dirs: s.package_dirs.clone(),
+            links,
+            scene_state: Some((
+                s.text.clone(),
+                s.scene.file.clone(),
+                s.scene.base_dir.clone(),
+            )),
+        }
     }
 
     /// The frame index of URDF link `name` (`arg` in the message).
@@ -234,6 +261,22 @@ impl PyModel {
             self.model.gravity.y,
             self.model.gravity.z,
         ];
+        if let Some((text, file, dir)) = &self.scene_state {
+            let f = py
+                .import("urdyn._urdyn")?
+                .getattr("_scene_model_from_state")?
+                .unbind();
+            let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.clone());
+            let args = (
+                text.clone(),
+                file.clone(),
+                dir.display().to_string(),
+                dirs,
+                g,
+            )
+                .into_pyobject(py)?;
+            return Ok((f, args));
+        }
         let source = self.model.source.as_ref().map(|p| p.display().to_string());
         let args = (
             self.text.clone(),
@@ -263,12 +306,27 @@ pub fn _model_from_state(
     Ok(m)
 }
 
+/// Rebuilds a pickled scene's `Model`.
+#[pyfunction]
+pub fn _scene_model_from_state(
+    text: String,
+    file: String,
+    base_dir: PathBuf,
+    package_dirs: Vec<PathBuf>,
+    gravity: [f64; 3],
+) -> PyResult<PyModel> {
+    let s = crate::scene::_scene_from_state(text, file, base_dir, package_dirs)?;
+    let mut m = PyModel::from_scene(&s);
+    m.model.gravity = Vector3::new(gravity[0], gravity[1], gravity[2]);
+    Ok(m)
+}
+
 /// The preallocated workspace of one model (`model.create_data()`).
 #[pyclass(name = "Data", module = "urdyn")]
 pub struct PyData {
     pub data: urdyn::Data,
-    /// Whether the model has a floating base (q[3..7] a unit quaternion).
-    pub floating_base: bool,
+    /// The offsets in q of the free joints' unit quaternions.
+    pub quats: Vec<usize>,
     pub nq: usize,
     pub nv: usize,
     pub nbodies: usize,
@@ -282,7 +340,7 @@ impl PyData {
     pub fn new(model: &Model) -> Self {
         Self {
             data: urdyn::Data::new(model),
-            floating_base: model.floating_base,
+            quats: quat_offsets(model),
             nq: model.nq,
             nv: model.nv,
             nbodies: model.nbodies,
@@ -295,7 +353,7 @@ impl PyData {
     /// Reads the configuration `x` into `self.q` ([`read_q`]: length nq,
     /// finite, a floating base's quaternion of unit norm within 1e-3).
     pub fn read_q(&mut self, x: &Bound<'_, PyAny>) -> PyResult<()> {
-        read_q(x, "q", self.floating_base, &mut self.q)
+        read_q(x, "q", &self.quats, &mut self.q)
     }
     /// A `ValueError` unless this workspace was made for a model of `model`'s shape.
     pub fn check(&self, model: &Model) -> PyResult<()> {
@@ -336,7 +394,7 @@ pub fn to_pinocchio_q<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let m = &model.model;
     let mut qv = DVector::zeros(m.nq);
-    read_q(q, "q", m.floating_base, &mut qv)?;
+    read_q(q, "q", &quat_offsets(m), &mut qv)?;
     let (base, nq_pin) = pinocchio_layout(m);
     let mut out = Vec::with_capacity(nq_pin);
     out.extend_from_slice(&qv.as_slice()[..base]);

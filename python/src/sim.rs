@@ -4,9 +4,11 @@
 //! a `Simulation` stepped alone.
 
 use crate::args::{
-    normalize_base_quaternion, not_found_error, read_array, read_q, read_vec, value_error,
+    normalize_base_quaternion, not_found_error, quat_offsets, read_array, read_q, read_vec,
+    value_error,
 };
 use crate::model::PyModel;
+use crate::scene::PyScene;
 use crate::SimulationError;
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
@@ -77,6 +79,45 @@ fn prototype(
     })
 }
 
+/// A simulation of a scene at its starting state (poses, `pose`, `initial`),
+/// with its ground, friction and obstacles; the scene's constant torques.
+fn prototype_scene(
+    scene: &PyScene,
+    dt: f64,
+    integrator: Option<&str>,
+    package_dirs: Option<Vec<PathBuf>>,
+) -> PyResult<Simulation> {
+    let s = &scene.scene;
+    let model = PyModel::from_scene(scene);
+    let ground = s.ground.map(|g| g.height);
+    let friction = s.ground.map_or(1.0, |g| g.friction);
+    let mut sim = prototype(&model, dt, integrator, ground, friction, package_dirs)?;
+    sim.set_state(&s.q0, &s.v0)
+        .map_err(|e| value_error(format!("{}: {e}", s.file)))?;
+    sim.torques_mut().copy_from(&s.tau0);
+    Ok(sim)
+}
+
+/// The simulation `Simulation(...)` / `rollout(...)` start from: of a `Model`
+/// (neutral, at rest) or of a `Scene` (its ground, friction and start; the
+/// `ground` and `friction` arguments are the file's then).
+fn prototype_any(
+    source: &Bound<'_, PyAny>,
+    dt: f64,
+    integrator: Option<&str>,
+    ground: Option<f64>,
+    friction: f64,
+    package_dirs: Option<Vec<PathBuf>>,
+) -> PyResult<Simulation> {
+    if let Ok(scene) = source.extract::<PyRef<'_, PyScene>>() {
+        return prototype_scene(&scene, dt, integrator, package_dirs);
+    }
+    let model = source
+        .extract::<PyRef<'_, PyModel>>()
+        .map_err(|_| value_error("model: expected a urdyn.Model or a urdyn.Scene".to_string()))?;
+    prototype(&model, dt, integrator, ground, friction, package_dirs)
+}
+
 /// One step of `dt` of simulated time (an adaptive integrator may take several
 /// steps of its own to get there; the last lands exactly).
 fn advance(sim: &mut Simulation, dt: f64) -> Result<(), SimError> {
@@ -87,12 +128,12 @@ fn advance(sim: &mut Simulation, dt: f64) -> Result<(), SimError> {
     Ok(())
 }
 
-/// Constant joint torques (the base's part of `tau` ignored).
+/// Constant joint torques (every free joint's part of `tau` ignored).
 fn set_torques(sim: &mut Simulation, tau: &[f64]) {
-    let vo = if sim.model.floating_base { 6 } else { 0 };
+    let free: Vec<usize> = sim.model.free_joints.iter().map(|f| f.iv).collect();
     let t = sim.torques_mut();
     for k in 0..t.len() {
-        t[k] = if k < vo {
+        t[k] = if free.iter().any(|&iv| (iv..iv + 6).contains(&k)) {
             0.0
         } else {
             tau.get(k).copied().unwrap_or(0.0)
@@ -122,6 +163,8 @@ pub struct PySimulation {
     sim: Simulation,
     dt: f64,
     tau: DVector<f64>,
+    /// `step(tau=None)`'s torques: zero, or a scene's `initial.tau`.
+    tau0: DVector<f64>,
     links: Vec<String>,
 }
 
@@ -132,18 +175,19 @@ impl PySimulation {
     #[new]
     #[pyo3(signature = (model, dt=1e-3, integrator=None, ground=Some(0.0), friction=1.0, package_dirs=None))]
     fn new(
-        model: PyRef<'_, PyModel>,
+        model: &Bound<'_, PyAny>,
         dt: f64,
         integrator: Option<&str>,
         ground: Option<f64>,
         friction: f64,
         package_dirs: Option<Vec<PathBuf>>,
     ) -> PyResult<Self> {
-        let sim = prototype(&model, dt, integrator, ground, friction, package_dirs)?;
+        let sim = prototype_any(model, dt, integrator, ground, friction, package_dirs)?;
         Ok(Self {
             dt,
-            tau: DVector::zeros(model.model.nv),
-            links: model.model.body_link_names.clone(),
+            tau: sim.torques().clone(),
+            tau0: sim.torques().clone(),
+            links: sim.model.body_link_names.clone(),
             sim,
         })
     }
@@ -152,7 +196,7 @@ impl PySimulation {
     fn set_state(&mut self, q: &Bound<'_, PyAny>, v: &Bound<'_, PyAny>) -> PyResult<()> {
         let m = &self.sim.model;
         let (mut qv, mut vv) = (DVector::zeros(m.nq), DVector::zeros(m.nv));
-        read_q(q, "q", m.floating_base, &mut qv)?;
+        read_q(q, "q", &quat_offsets(m), &mut qv)?;
         read_vec(v, "v", "nv", &mut vv)?;
         self.sim
             .set_state(&qv, &vv)
@@ -164,10 +208,13 @@ impl PySimulation {
     #[pyo3(signature = (tau=None, n=1))]
     fn step(&mut self, py: Python<'_>, tau: Option<&Bound<'_, PyAny>>, n: usize) -> PyResult<()> {
         match tau {
-            Some(t) => read_vec(t, "tau", "nv", &mut self.tau)?,
-            None => self.tau.fill(0.0),
+            Some(t) => {
+                read_vec(t, "tau", "nv", &mut self.tau)?;
+                set_torques(&mut self.sim, self.tau.as_slice());
+            }
+            // zero, or a scene's constant forces (its bases' included), as rollout
+            None => self.sim.torques_mut().copy_from(&self.tau0),
         }
-        set_torques(&mut self.sim, self.tau.as_slice());
         let (sim, dt) = (&mut self.sim, self.dt);
         let r = py.detach(|| {
             for _ in 0..n {
@@ -313,7 +360,7 @@ enum Torques {
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn rollout<'py>(
     py: Python<'py>,
-    model: PyRef<'py, PyModel>,
+    model: &Bound<'py, PyAny>,
     q0: &Bound<'py, PyAny>,
     v0: &Bound<'py, PyAny>,
     tau: Option<&Bound<'py, PyAny>>,
@@ -324,7 +371,8 @@ pub fn rollout<'py>(
     ground: Option<f64>,
     friction: f64,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
-    let (nq, nv) = (model.model.nq, model.model.nv);
+    let proto = prototype_any(model, dt, integrator, ground, friction, None)?;
+    let (nq, nv) = (proto.model.nq, proto.model.nv);
     let (qs, q0) = read_array(q0, "q0")?;
     let (vs, v0) = read_array(v0, "v0")?;
     if qs.len() != 2 || qs[1] != nq {
@@ -334,9 +382,10 @@ pub fn rollout<'py>(
     }
     let b = qs[0];
     let mut q0 = q0;
-    if model.model.floating_base {
+    for f in &proto.model.free_joints {
+        let at = f.iq + 3;
         for i in 0..b {
-            normalize_base_quaternion(&mut q0[i * nq + 3..i * nq + 7], &format!("q0[{i}]"))?;
+            normalize_base_quaternion(&mut q0[i * nq + at..i * nq + at + 4], &format!("q0[{i}]"))?;
         }
     }
     if vs != [b, nv] {
@@ -363,7 +412,6 @@ pub fn rollout<'py>(
     if threads == Some(0) {
         return Err(value_error("threads must be at least 1 (None: all cores)"));
     }
-    let proto = prototype(&model, dt, integrator, ground, friction, None)?;
     let qa = PyArray3::<f64>::zeros(py, [b, nstep + 1, nq], false);
     let va = PyArray3::<f64>::zeros(py, [b, nstep + 1, nv], false);
     let failures = {

@@ -21,6 +21,7 @@ urdyn.SimulationError.
 from ._urdyn import (  # noqa: F401
     Data,
     Model,
+    Scene,
     Simulation,
     SimulationError,
     aba,
@@ -55,6 +56,7 @@ from ._urdyn import (  # noqa: F401
 __all__ = [
     "Data",
     "Model",
+    "Scene",
     "Simulation",
     "SimulationError",
     "aba",

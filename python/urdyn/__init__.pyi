@@ -76,12 +76,43 @@ def kinetic_energy(model: Model, data: Data, q: ArrayLike, v: ArrayLike) -> floa
 def potential_energy(model: Model, data: Data, q: ArrayLike) -> float: ...
 def integrators() -> List[str]: ...
 
+class Scene:
+    """Several URDF models, obstacles and a ground (scene.md): `scene.model` is the
+    whole scene as one Model, names MODEL/NAME. Pickles."""
+
+    @staticmethod
+    def from_file(
+        path: Union[str, "PathLike[str]"],
+        package_dirs: Optional[Sequence[Union[str, "PathLike[str]"]]] = None,
+    ) -> "Scene": ...
+    @staticmethod
+    def from_json(
+        text: str,
+        base_dir: Optional[Union[str, "PathLike[str]"]] = None,
+        package_dirs: Optional[Sequence[Union[str, "PathLike[str]"]]] = None,
+    ) -> "Scene": ...
+    @property
+    def model(self) -> Model: ...
+    @property
+    def model_names(self) -> List[str]: ...
+    @property
+    def obstacle_names(self) -> List[str]: ...
+    @property
+    def q0(self) -> Vec: ...
+    @property
+    def v0(self) -> Vec: ...
+    @property
+    def ground(self) -> Optional[float]: ...
+    @property
+    def warnings(self) -> List[str]: ...
+
 class Simulation:
-    """One simulation stepped from Python. `ground=None`: no ground."""
+    """One simulation stepped from Python. `ground=None`: no ground. Of a Scene:
+    its ground, friction, obstacles and starting state (ground/friction ignored)."""
 
     def __init__(
         self,
-        model: Model,
+        model: Union[Model, Scene],
         dt: float = 1e-3,
         integrator: Optional[str] = None,
         ground: Optional[float] = 0.0,
@@ -129,7 +160,7 @@ def from_pinocchio_q(model: Model, q_pin: ArrayLike) -> Vec:
     ...
 
 def rollout(
-    model: Model,
+    model: Union[Model, Scene],
     q0: ArrayLike,
     v0: ArrayLike,
     tau: Optional[ArrayLike] = None,

@@ -60,10 +60,13 @@ enum Command {
     /// Write one self-contained HTML page that replays a trajectory CSV of `simulate`
     /// in 3D (no network, no other file; opens from disk in any current browser).
     View {
-        /// The URDF file.
-        urdf: PathBuf,
+        /// The URDF file (with --scene: the trajectory CSV).
+        urdf: Option<PathBuf>,
         /// The trajectory CSV that `simulate --out` wrote.
-        traj: PathBuf,
+        traj: Option<PathBuf>,
+        /// A scene file (scene.md) in place of the URDF: `view --scene SCENE.json TRAJ.csv`.
+        #[arg(long, value_name = "SCENE.json")]
+        scene: Option<PathBuf>,
         /// The root link has a free 6-DoF joint (as when the trajectory was simulated).
         #[arg(long)]
         floating_base: bool,
@@ -84,6 +87,11 @@ enum Command {
 struct SimulateCmd {
     /// The URDF file.
     urdf: Option<PathBuf>,
+    /// A scene file (scene.md: several models, obstacles, ground) in place of the URDF;
+    /// the per-model options (--floating-base, --initial, --above-ground, --ground,
+    /// --no-ground, --friction) live in the file.
+    #[arg(long, value_name = "SCENE.json")]
+    scene: Option<PathBuf>,
     /// Give the root link a free 6-DoF joint (unit quaternion, no Euler angles).
     #[arg(long)]
     floating_base: bool,
@@ -151,14 +159,9 @@ struct SimulateCmd {
         allow_hyphen_values = true
     )]
     gravity: Option<Vec<f64>>,
-    /// Coulomb friction coefficient between links and the ground.
-    #[arg(
-        long,
-        value_name = "MU",
-        default_value_t = 1.0,
-        allow_hyphen_values = true
-    )]
-    friction: f64,
+    /// Coulomb friction coefficient between links and the ground [default: 1.0].
+    #[arg(long, value_name = "MU", allow_hyphen_values = true)]
+    friction: Option<f64>,
     /// A root for package://NAME/... mesh paths (repeatable; ROS_PACKAGE_PATH is also read).
     #[arg(long, value_name = "DIR")]
     package_path: Vec<PathBuf>,
@@ -306,17 +309,45 @@ fn run(cli: Cli) -> Result<()> {
         Command::View {
             urdf,
             traj,
+            scene,
             floating_base,
             package_path,
             out,
         } => {
-            let summary = urdyn::cli::view::run(&urdyn::cli::view::ViewArgs {
-                urdf,
-                traj,
-                floating_base,
-                package_path,
-                out,
-            })?;
+            let summary = match (scene, urdf, traj) {
+                (Some(scene), Some(traj), None) if !floating_base => {
+                    urdyn::cli::view::run_scene(&urdyn::cli::view::SceneViewArgs {
+                        scene,
+                        traj,
+                        package_path,
+                        out,
+                    })?
+                }
+                (Some(_), _, _) if floating_base => {
+                    return Err(anyhow!(
+                        "view: --floating-base is a per-model option: with --scene it lives in the scene file"
+                    ))
+                }
+                (Some(_), _, _) => {
+                    return Err(anyhow!(
+                        "view: with --scene give the trajectory CSV only (view --scene SCENE.json TRAJ.csv --out PAGE.html)"
+                    ))
+                }
+                (None, Some(urdf), Some(traj)) => {
+                    urdyn::cli::view::run(&urdyn::cli::view::ViewArgs {
+                        urdf,
+                        traj,
+                        floating_base,
+                        package_path,
+                        out,
+                    })?
+                }
+                _ => {
+                    return Err(anyhow!(
+                        "view: expected ROBOT.urdf TRAJ.csv (or --scene SCENE.json TRAJ.csv)"
+                    ))
+                }
+            };
             for w in &summary.warnings {
                 eprintln!("warning: {w}");
             }
@@ -335,9 +366,28 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
         }
         return Ok(());
     }
-    let urdf = c
-        .urdf
-        .ok_or_else(|| anyhow!("simulate: the URDF file argument is missing"))?;
+    let urdf = match (c.urdf, &c.scene) {
+        (Some(u), None) => u,
+        (None, Some(_)) => PathBuf::new(),
+        (Some(u), Some(s)) => {
+            return Err(anyhow!(
+                "simulate: give a URDF or --scene, not both ({} and --scene {})",
+                u.display(),
+                s.display()
+            ))
+        }
+        (None, None) => {
+            return Err(anyhow!(
+                "simulate: the URDF file argument is missing (or --scene SCENE.json)"
+            ))
+        }
+    };
+    if let (Some(s), Some(_)) = (&c.scene, c.friction) {
+        return Err(anyhow!(
+            "--friction is a per-model option: with --scene it lives in the scene file {} (scene.md)",
+            s.display()
+        ));
+    }
     let gravity = match c.gravity {
         Some(g) => match g.as_slice() {
             [x, y, z] => Some([*x, *y, *z]),
@@ -350,6 +400,7 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
         .map_err(|_| anyhow!("--every must be at least 1 (got {})", c.every))?;
     let args = urdyn::cli::simulate::SimulateArgs {
         urdf,
+        scene: c.scene,
         floating_base: c.floating_base,
         duration: c.duration,
         dt: c.dt,
@@ -361,7 +412,7 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
         ground: c.ground,
         no_ground: c.no_ground,
         gravity,
-        friction: c.friction,
+        friction: c.friction.unwrap_or(1.0),
         package_path: c.package_path,
         out: c.out,
         html: c.html,

@@ -11,8 +11,13 @@ use std::time::Instant;
 /// The command's options, as cli.md lists them.
 #[derive(Clone, Debug)]
 pub struct SimulateArgs {
-    /// The URDF file.
+    /// The URDF file (unused with `scene`).
     pub urdf: PathBuf,
+    /// A scene file (scene.md) in place of the URDF: its models, obstacles,
+    /// ground, friction and starting state. The per-model options
+    /// (`floating_base`, `initial`, `above_ground`, `ground`, `no_ground`) are
+    /// then an error; `friction` is ignored (the binary refuses `--friction`).
+    pub scene: Option<PathBuf>,
     /// Give the root link a free 6-DoF joint (unit quaternion).
     pub floating_base: bool,
     /// Simulated seconds.
@@ -96,6 +101,9 @@ pub enum SimulateError {
     /// The URDF could not be imported.
     #[error(transparent)]
     Urdf(#[from] crate::UrdfError),
+    /// The scene file is malformed or names what does not exist.
+    #[error(transparent)]
+    Scene(#[from] crate::scene::SceneError),
     /// The `--initial` state is malformed.
     #[error(transparent)]
     State(#[from] state::StateError),
@@ -192,69 +200,28 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             ));
         }
     }
-    let mut model: Model = crate::load_file(
-        &args.urdf,
-        LoadOptions {
-            floating_base: args.floating_base,
-        },
-    )?;
+    if let Some(scene) = &args.scene {
+        let given = [
+            (args.floating_base, "--floating-base"),
+            (args.initial.is_some(), "--initial"),
+            (args.above_ground.is_some(), "--above-ground"),
+            (args.ground.is_some(), "--ground"),
+            (args.no_ground, "--no-ground"),
+        ];
+        if let Some((_, opt)) = given.iter().find(|(g, _)| *g) {
+            return Err(SimulateError::Option(format!(
+                "{opt} is a per-model option: with --scene it lives in the scene file {} (scene.md)",
+                scene.display()
+            )));
+        }
+    }
+    let (mut model, init, opts, geometry, urdf_name) = match &args.scene {
+        Some(path) => scene_setup(args, path, integrator)?,
+        None => urdf_setup(args, integrator)?,
+    };
     if let Some(g) = args.gravity {
         model.gravity = nalgebra::Vector3::new(g[0], g[1], g[2]);
     }
-    let urdf_name = args.urdf.display().to_string();
-    // the initial state (checked before anything is simulated)
-    let init = match &args.initial {
-        Some(p) => {
-            let name = p.display().to_string();
-            let text = state::read_text(p)?;
-            let st = state::parse_state(&text, &name)?;
-            let base_acc = st.base.as_ref().and_then(|b| {
-                if b.linear_acceleration.is_some() {
-                    Some("base.linear_acceleration")
-                } else if b.angular_acceleration.is_some() {
-                    Some("base.angular_acceleration")
-                } else {
-                    None
-                }
-            });
-            if let Some(key) = st.a.as_ref().map(|_| "a").or(base_acc) {
-                return Err(state::StateError {
-                    file: name,
-                    key: key.into(),
-                    message: "not allowed in --initial (accelerations are simulated)".into(),
-                }
-                .into());
-            }
-            Some(st.to_vectors(&model, &name, "(state)")?)
-        }
-        None => None,
-    };
-    let mut contact = crate::contact::ContactParams::default();
-    contact.friction = args.friction;
-    let opts = SimOptions {
-        dt: args.dt,
-        integrator,
-        tol: args.tol,
-        ground: if args.no_ground {
-            None
-        } else {
-            Some(args.ground.unwrap_or(0.0))
-        },
-        contact,
-        package_paths: args.package_path.clone(),
-        armature: args.armature,
-        ..SimOptions::default()
-    };
-    // The page's geometry is read before anything is simulated (a missing mesh
-    // is reported at once).
-    let geometry = match &args.html {
-        Some(_) => Some(crate::cli::view::Geometry::load(
-            &model,
-            &args.urdf,
-            &args.package_path,
-        )?),
-        None => None,
-    };
     for w in geometry.iter().flat_map(|g| &g.warnings) {
         warn(&format!("warning: {w}"));
     }
@@ -491,6 +458,126 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         ));
     }
     Ok(summary)
+}
+
+/// What a run starts from: the model, its starting state, the options, the
+/// page's geometry (with `--html`) and the name in messages.
+type Setup = (
+    Model,
+    Option<state::StateVectors>,
+    SimOptions,
+    Option<crate::cli::view::Geometry>,
+    String,
+);
+
+/// A lone URDF's run: `--floating-base`, `--initial`, the ground and friction options.
+fn urdf_setup(args: &SimulateArgs, integrator: Option<Integrator>) -> Result<Setup, SimulateError> {
+    let model: Model = crate::load_file(
+        &args.urdf,
+        LoadOptions {
+            floating_base: args.floating_base,
+        },
+    )?;
+    let urdf_name = args.urdf.display().to_string();
+    // the initial state (checked before anything is simulated)
+    let init = match &args.initial {
+        Some(p) => {
+            let name = p.display().to_string();
+            let text = state::read_text(p)?;
+            let st = state::parse_state(&text, &name)?;
+            let base_acc = st.base.as_ref().and_then(|b| {
+                if b.linear_acceleration.is_some() {
+                    Some("base.linear_acceleration")
+                } else if b.angular_acceleration.is_some() {
+                    Some("base.angular_acceleration")
+                } else {
+                    None
+                }
+            });
+            if let Some(key) = st.a.as_ref().map(|_| "a").or(base_acc) {
+                return Err(state::StateError {
+                    file: name,
+                    key: key.into(),
+                    message: "not allowed in --initial (accelerations are simulated)".into(),
+                }
+                .into());
+            }
+            Some(st.to_vectors(&model, &name, "(state)")?)
+        }
+        None => None,
+    };
+    let mut contact = crate::contact::ContactParams::default();
+    contact.friction = args.friction;
+    let opts = SimOptions {
+        dt: args.dt,
+        integrator,
+        tol: args.tol,
+        ground: if args.no_ground {
+            None
+        } else {
+            Some(args.ground.unwrap_or(0.0))
+        },
+        contact,
+        package_paths: args.package_path.clone(),
+        armature: args.armature,
+        ..SimOptions::default()
+    };
+    // The page's geometry is read before anything is simulated (a missing mesh
+    // is reported at once).
+    let geometry = match &args.html {
+        Some(_) => Some(crate::cli::view::Geometry::load(
+            &model,
+            &args.urdf,
+            &args.package_path,
+        )?),
+        None => None,
+    };
+    Ok((model, init, opts, geometry, urdf_name))
+}
+
+/// A scene's run: models, obstacles, ground, friction and the starting state
+/// from the file (scene.md).
+fn scene_setup(
+    args: &SimulateArgs,
+    path: &std::path::Path,
+    integrator: Option<Integrator>,
+) -> Result<Setup, SimulateError> {
+    let scene = crate::scene::Scene::from_file(path, &args.package_path)?;
+    for w in &scene.warnings {
+        warn(&format!("warning: {w}"));
+    }
+    let model = scene.model.clone();
+    let init = state::StateVectors {
+        q: scene.q0.clone(),
+        v: scene.v0.clone(),
+        a: nalgebra::DVector::zeros(model.nv),
+        tau: scene.tau0.clone(),
+        fext: Vec::new(),
+        frames: Vec::new(),
+        derivatives: false,
+    };
+    let mut contact = crate::contact::ContactParams::default();
+    if let Some(g) = scene.ground {
+        contact.friction = g.friction;
+    }
+    let opts = SimOptions {
+        dt: args.dt,
+        integrator,
+        tol: args.tol,
+        ground: scene.ground.map(|g| g.height),
+        contact,
+        package_paths: args.package_path.clone(),
+        armature: args.armature,
+        ..SimOptions::default()
+    };
+    let geometry = match &args.html {
+        Some(_) => Some(crate::cli::view::Geometry::load_scene(
+            &scene,
+            &args.package_path,
+        )?),
+        None => None,
+    };
+    Ok((model, Some(init), opts, geometry, scene.file.clone()))
 }
 
 /// Blocks of rows allocated for the writer before the stepping starts (the

@@ -13,32 +13,39 @@ use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Quaternion, UnitQuaternion, V
 /// q ← q ⊕ h v: p += h R v_lin, quaternion ← quaternion ⊗ exp(h ω / 2)
 /// (renormalised), joints += h v.
 pub fn integrate_config(model: &Model, q: &mut DVector<f64>, v: &DVector<f64>, h: f64) {
-    let (qo, vo) = (model.joint_q_offset(), model.joint_v_offset());
-    if model.floating_base {
-        let r = quat_to_matrix(q[3], q[4], q[5], q[6]);
-        let dp = r * Vector3::new(v[0], v[1], v[2]) * h;
-        q[0] += dp.x;
-        q[1] += dp.y;
-        q[2] += dp.z;
-        let w = Vector3::new(v[3], v[4], v[5]) * h;
-        let th = w.norm();
-        let (s, c) = if th > 1e-12 {
-            let (s, c) = sin_cos(th / 2.0);
-            (s / th, c)
-        } else {
-            (0.5 - th * th / 48.0, 1.0 - th * th / 8.0)
-        };
-        let (dx, dy, dz, dw) = (w.x * s, w.y * s, w.z * s, c);
-        let (x, y, z, ww) = (q[3], q[4], q[5], q[6]);
-        q[3] = ww * dx + x * dw + y * dz - z * dy;
-        q[4] = ww * dy - x * dz + y * dw + z * dx;
-        q[5] = ww * dz + x * dy - y * dx + z * dw;
-        q[6] = ww * dw - x * dx - y * dy - z * dz;
-        normalize_quat(q);
+    for f in &model.free_joints {
+        integrate_free(q, v, h, f.iq, f.iv);
     }
-    for d in 0..model.dofs.len() {
-        q[qo + d] += h * v[vo + d];
+    for t in &model.trees {
+        let (qo, vo) = (t.joint_q(), t.joint_v());
+        for k in 0..t.dofs.len() {
+            q[qo + k] += h * v[vo + k];
+        }
     }
+}
+
+/// One free joint's q ⊕ h v, its q at `iq..iq + 7`, its v at `iv..iv + 6`.
+fn integrate_free(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize, iv: usize) {
+    let r = quat_to_matrix(q[iq + 3], q[iq + 4], q[iq + 5], q[iq + 6]);
+    let dp = r * Vector3::new(v[iv], v[iv + 1], v[iv + 2]) * h;
+    q[iq] += dp.x;
+    q[iq + 1] += dp.y;
+    q[iq + 2] += dp.z;
+    let w = Vector3::new(v[iv + 3], v[iv + 4], v[iv + 5]) * h;
+    let th = w.norm();
+    let (s, c) = if th > 1e-12 {
+        let (s, c) = sin_cos(th / 2.0);
+        (s / th, c)
+    } else {
+        (0.5 - th * th / 48.0, 1.0 - th * th / 8.0)
+    };
+    let (dx, dy, dz, dw) = (w.x * s, w.y * s, w.z * s, c);
+    let (x, y, z, ww) = (q[iq + 3], q[iq + 4], q[iq + 5], q[iq + 6]);
+    q[iq + 3] = ww * dx + x * dw + y * dz - z * dy;
+    q[iq + 4] = ww * dy - x * dz + y * dw + z * dx;
+    q[iq + 5] = ww * dz + x * dy - y * dx + z * dw;
+    q[iq + 6] = ww * dw - x * dx - y * dy - z * dz;
+    normalize_quat_at(q, iq + 3);
 }
 
 /// Re-expresses a free base's body-frame linear velocity after its frame turned
@@ -46,17 +53,17 @@ pub fn integrate_config(model: &Model, q: &mut DVector<f64>, v: &DVector<f64>, h
 /// [`integrate_config`] this makes a semi-implicit step rotate the velocity
 /// exactly (no energy from the frame's own rotation).
 pub fn rotate_base_velocity(model: &Model, v: &mut DVector<f64>, w: &DVector<f64>, h: f64) {
-    if !model.floating_base {
-        return;
-    }
-    let wv = Vector3::new(w[3], w[4], w[5]) * h;
-    let th = wv.norm();
-    if th > 0.0 {
-        let r = axis_angle(&(wv / th), th);
-        let vl = r.transpose() * Vector3::new(v[0], v[1], v[2]);
-        v[0] = vl.x;
-        v[1] = vl.y;
-        v[2] = vl.z;
+    for f in &model.free_joints {
+        let iv = f.iv;
+        let wv = Vector3::new(w[iv + 3], w[iv + 4], w[iv + 5]) * h;
+        let th = wv.norm();
+        if th > 0.0 {
+            let r = axis_angle(&(wv / th), th);
+            let vl = r.transpose() * Vector3::new(v[iv], v[iv + 1], v[iv + 2]);
+            v[iv] = vl.x;
+            v[iv + 1] = vl.y;
+            v[iv + 2] = vl.z;
+        }
     }
 }
 
@@ -70,23 +77,26 @@ pub fn config_rate(
     v: &DVector<f64>,
     dy: &mut DVector<f64>,
 ) {
-    let (qo, vo) = (model.joint_q_offset(), model.joint_v_offset());
-    if model.floating_base {
-        let r = quat_to_matrix(qn[3], qn[4], qn[5], qn[6]);
-        let pd = r * Vector3::new(v[0], v[1], v[2]);
-        dy[0] = pd.x;
-        dy[1] = pd.y;
-        dy[2] = pd.z;
-        let (x, yy, z, ww) = (y[3], y[4], y[5], y[6]);
-        let (wx, wy, wz) = (v[3], v[4], v[5]);
+    for f in &model.free_joints {
+        let (iq, iv) = (f.iq, f.iv);
+        let r = quat_to_matrix(qn[iq + 3], qn[iq + 4], qn[iq + 5], qn[iq + 6]);
+        let pd = r * Vector3::new(v[iv], v[iv + 1], v[iv + 2]);
+        dy[iq] = pd.x;
+        dy[iq + 1] = pd.y;
+        dy[iq + 2] = pd.z;
+        let (x, yy, z, ww) = (y[iq + 3], y[iq + 4], y[iq + 5], y[iq + 6]);
+        let (wx, wy, wz) = (v[iv + 3], v[iv + 4], v[iv + 5]);
         // (q ⊗ (ω,0)): vector = w ω + qv × ω, scalar = −qv·ω
-        dy[3] = 0.5 * (ww * wx + yy * wz - z * wy);
-        dy[4] = 0.5 * (ww * wy + z * wx - x * wz);
-        dy[5] = 0.5 * (ww * wz + x * wy - yy * wx);
-        dy[6] = -0.5 * (x * wx + yy * wy + z * wz);
+        dy[iq + 3] = 0.5 * (ww * wx + yy * wz - z * wy);
+        dy[iq + 4] = 0.5 * (ww * wy + z * wx - x * wz);
+        dy[iq + 5] = 0.5 * (ww * wz + x * wy - yy * wx);
+        dy[iq + 6] = -0.5 * (x * wx + yy * wy + z * wz);
     }
-    for d in 0..model.dofs.len() {
-        dy[qo + d] = v[vo + d];
+    for t in &model.trees {
+        let (qo, vo) = (t.joint_q(), t.joint_v());
+        for k in 0..t.dofs.len() {
+            dy[qo + k] = v[vo + k];
+        }
     }
 }
 
@@ -96,9 +106,22 @@ pub fn normalize_quat(q: &mut DVector<f64>) {
     if q.len() < 7 {
         return;
     }
-    let n = (q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6]).sqrt();
+    normalize_quat_at(q, 3);
+}
+
+/// Normalises every free joint's quaternion in place (as [`normalize_quat`]).
+pub fn normalize_quats(model: &Model, q: &mut DVector<f64>) {
+    for f in &model.free_joints {
+        normalize_quat_at(q, f.iq + 3);
+    }
+}
+
+/// Normalises the quaternion `q[at..at + 4]` (a zero or non-finite one is left as is).
+fn normalize_quat_at(q: &mut DVector<f64>, at: usize) {
+    let n = (q[at] * q[at] + q[at + 1] * q[at + 1] + q[at + 2] * q[at + 2] + q[at + 3] * q[at + 3])
+        .sqrt();
     if n > 0.0 && n.is_finite() {
-        for k in 3..7 {
+        for k in at..at + 4 {
             q[k] /= n;
         }
     }
@@ -359,23 +382,23 @@ pub fn random_configuration(model: &Model, seed: u64) -> DVector<f64> {
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
     };
     let mut q = model.neutral();
-    if model.floating_base {
+    for f in &model.free_joints {
         // Shoemake's uniform unit quaternion
         let (u1, u2, u3) = (unit(), unit(), unit());
         let tau = 2.0 * std::f64::consts::PI;
         let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-        q[3] = a * (tau * u2).sin();
-        q[4] = a * (tau * u2).cos();
-        q[5] = b * (tau * u3).sin();
-        q[6] = b * (tau * u3).cos();
+        q[f.iq + 3] = a * (tau * u2).sin();
+        q[f.iq + 4] = a * (tau * u2).cos();
+        q[f.iq + 5] = b * (tau * u3).sin();
+        q[f.iq + 6] = b * (tau * u3).cos();
     }
-    let qo = model.joint_q_offset();
-    for (d, dof) in model.dofs.iter().enumerate() {
+    for (d, iq, _) in model.dof_indices() {
+        let dof = &model.dofs[d];
         let (lo, hi) = match (dof.limits.lower, dof.limits.upper) {
             (Some(lo), Some(hi)) if lo < hi && !dof.continuous => (lo, hi),
             _ => (-std::f64::consts::PI, std::f64::consts::PI),
         };
-        q[qo + d] = lo + (hi - lo) * unit();
+        q[iq] = lo + (hi - lo) * unit();
     }
     q
 }
@@ -397,12 +420,9 @@ impl Model {
     /// Every degree of freedom's position in `q` by joint name, in engine order.
     pub fn positions_by_name(&self, q: &DVector<f64>) -> Result<Vec<(&str, f64)>, DimensionError> {
         DimensionError::check("q", self.nq, q.len())?;
-        let qo = self.joint_q_offset();
         Ok(self
-            .dofs
-            .iter()
-            .enumerate()
-            .map(|(d, dof)| (dof.name.as_str(), q[qo + d]))
+            .dof_indices()
+            .map(|(d, iq, _)| (self.dofs[d].name.as_str(), q[iq]))
             .collect())
     }
 }

@@ -10,6 +10,7 @@ mod data;
 pub(crate) mod joint;
 mod names;
 mod topology;
+mod trees;
 
 pub use names::{edit_distance, nearest, BodyId, FrameId, JointId, NameError};
 
@@ -17,6 +18,7 @@ pub use data::Data;
 pub(crate) use joint::{dispatch_joint, JointModel};
 pub use joint::{Axis, Joint, JointKind};
 pub use topology::{FdMethod, Topology};
+pub use trees::{FreeJoint, Tree};
 
 use crate::spatial::{Inertia, Scalar, Se3};
 use nalgebra::{DVector, Vector3};
@@ -62,7 +64,7 @@ pub struct Frame<T: Scalar = f64> {
     pub placement: Se3<T>,
 }
 
-/// A collision shape as the URDF gives it (meshes are not read at import).
+/// A collision shape as the URDF or a scene gives it (meshes are not read at import).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
     /// A box centred at its frame.
@@ -96,10 +98,21 @@ pub enum Shape {
         /// Per-axis scale.
         scale: [f64; 3],
     },
+    /// A height field (a scene's terrain): a grid of heights over a rectangle
+    /// centred on its frame, the surface z = h(x, y) above the frame.
+    HeightField {
+        /// Rows along y from −y to +y, each row along x from −x to +x: `heights[i][j]`
+        /// is the height (m) at y = −size[1]/2 + i·size[1]/(rows − 1),
+        /// x = −size[0]/2 + j·size[0]/(columns − 1). At least 2 × 2, not ragged.
+        heights: Vec<Vec<f64>>,
+        /// Extents along x and y (m), centred on the frame.
+        size: [f64; 2],
+    },
 }
 
 impl Shape {
-    /// The shape's URDF element name (`box`, `cylinder`, `capsule`, `sphere`, `mesh`).
+    /// The shape's URDF element name (`box`, `cylinder`, `capsule`, `sphere`, `mesh`;
+    /// a scene's `heightfield`).
     pub fn kind(&self) -> &'static str {
         match self {
             Shape::Box { .. } => "box",
@@ -107,22 +120,80 @@ impl Shape {
             Shape::Capsule { .. } => "capsule",
             Shape::Sphere { .. } => "sphere",
             Shape::Mesh { .. } => "mesh",
+            Shape::HeightField { .. } => "heightfield",
         }
     }
 }
 
-/// A `<collision>` element: its shape, the link it belongs to, and its placement in
-/// the body frame (`body_M_geom`).
+/// [`CollisionGeom::model`] of a static obstacle: a shape welded to the world
+/// that belongs to no model (it touches every moving body, scene.md "Who
+/// touches whom").
+pub const OBSTACLE: usize = usize::MAX;
+
+/// A `<collision>` element (or a scene obstacle): its shape, the link it belongs
+/// to, and its placement in the body frame (`body_M_geom`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CollisionGeom {
-    /// The URDF link the element belongs to.
+    /// The URDF link the element belongs to (an obstacle: the obstacle's name).
     pub link: String,
-    /// The body that link is merged into (0: welded to the world).
+    /// The body that link is merged into (0: welded to the world — an obstacle,
+    /// or a fixed model's root and the links welded to it).
     pub body: usize,
-    /// `body_M_geom`: the shape's frame in the body frame.
+    /// `body_M_geom`: the shape's frame in the body frame (for body 0: the world).
     pub placement: Se3<f64>,
     /// The geometry.
     pub shape: Shape,
+    /// A [`Shape::Mesh`] collides as its triangle mesh (may be non-convex: a
+    /// scene obstacle's mesh) instead of its convex hull (a URDF link's mesh).
+    /// Ignored for other shapes.
+    pub trimesh: bool,
+    /// This side's Coulomb friction coefficient; a pair uses the larger of its
+    /// two sides' (as MuJoCo). The ground's side is `ContactParams::friction`.
+    /// A URDF import gives 0 (the URDF names none: the other side's
+    /// coefficient, e.g. the ground's `--friction`, is the pair's); a scene
+    /// gives its model's or obstacle's `friction` (default 1.0).
+    pub friction: f64,
+    /// Index of the scene model the shape belongs to (0 for a single URDF), or
+    /// [`OBSTACLE`] for a static obstacle.
+    pub model: usize,
+}
+
+/// Which pairs of collision shapes never touch, besides the fixed rules of
+/// scene.md "Who touches whom" (same body, both welded to the world, a body and
+/// its parent within one model), which need no data.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CollisionFilter {
+    /// Link-name pairs never in contact (SRDF `<disable_collisions>`, a scene's
+    /// `exclude`): the shapes of the one link ([`CollisionGeom::link`]; an
+    /// obstacle's name) never touch the shapes of the other, whatever body they
+    /// were merged into. Order within a pair does not matter.
+    pub excluded: Vec<(String, String)>,
+    /// Per scene model ([`CollisionGeom::model`]): contact between two links of
+    /// that model. A model without an entry has self-collision on.
+    pub self_collision: Vec<bool>,
+}
+
+impl Default for CollisionFilter {
+    /// One model, self-collision on (scene.md's default), nothing excluded.
+    fn default() -> Self {
+        Self {
+            excluded: Vec::new(),
+            self_collision: vec![true],
+        }
+    }
+}
+
+impl CollisionFilter {
+    /// Whether model `m` collides with itself (true for a model without an entry).
+    pub fn self_collides(&self, m: usize) -> bool {
+        self.self_collision.get(m).copied().unwrap_or(true)
+    }
+    /// Whether the link pair (`a`, `b`) is excluded (either order).
+    pub fn is_excluded(&self, a: &str, b: &str) -> bool {
+        self.excluded
+            .iter()
+            .any(|(x, y)| (x == a && y == b) || (x == b && y == a))
+    }
 }
 
 /// What the importer merged, ignored or found suspicious (printed by `inspect`).
@@ -177,14 +248,26 @@ pub struct Model<T: Scalar = f64> {
     pub body_link_names: Vec<String>,
     /// Gravity vector in the world frame (docs/theory.md §"Gravity": the world accelerates by −g).
     pub gravity: Vector3<T>,
-    /// The floating base, if any, is body 1 with a [`JointKind::Free`] joint.
+    /// Body 1 is a free joint at `q[0..7]`, `v[0..6]` (a floating robot, or a
+    /// scene whose first model floats). Every free joint of a scene is in
+    /// [`Model::free_joints`].
     pub floating_base: bool,
+    /// Every free (6-DoF) joint, in body order (a floating robot: body 1 at
+    /// q[0..7], v[0..6]; a scene: one per floating model).
+    pub free_joints: Vec<FreeJoint>,
+    /// The URDF models this one is made of, in q order: one tree for a lone URDF,
+    /// one per model of a scene (names `MODEL/NAME`).
+    pub trees: Vec<Tree>,
     /// Joint DoFs (excluding the base's 6) in engine order.
     pub dofs: Vec<DofInfo>,
     /// Every URDF link, in the URDF's order.
     pub frames: Vec<Frame<T>>,
-    /// Every `<collision>` element, in the URDF's order.
+    /// Every `<collision>` element, in the URDF's order (a scene: its models'
+    /// in file order, then its obstacles', on body 0 with model [`OBSTACLE`]).
     pub collisions: Vec<CollisionGeom>,
+    /// Which shape pairs never touch (SRDF, a scene's `exclude`, per-model
+    /// self-collision).
+    pub collision_filter: CollisionFilter,
     /// For the velocity coordinate k, the previous coordinate on its path to the root
     /// (`λ(k)` of the tree-sparse factorisation), or `usize::MAX` at a root.
     pub dof_parent: Vec<usize>,
@@ -201,7 +284,9 @@ pub struct Model<T: Scalar = f64> {
 }
 
 impl<T: Scalar> Model<T> {
-    /// Index of the first joint DoF in v (6 with a free base, else 0).
+    /// Index of the first joint DoF in v (6 with a free base, else 0): a lone
+    /// URDF's joints are `v[joint_v_offset()..]`. A scene's models each have
+    /// their own ([`Tree::joint_v`], [`Model::dof_v`]).
     pub fn joint_v_offset(&self) -> usize {
         if self.floating_base {
             6
@@ -209,7 +294,9 @@ impl<T: Scalar> Model<T> {
             0
         }
     }
-    /// Index of the first joint coordinate in q (7 with a free base, else 0).
+    /// Index of the first joint coordinate in q (7 with a free base, else 0): a
+    /// lone URDF's joints are `q[joint_q_offset()..]`. A scene's models each have
+    /// their own ([`Tree::joint_q`], [`Model::dof_q`]).
     pub fn joint_q_offset(&self) -> usize {
         if self.floating_base {
             7
@@ -234,11 +321,11 @@ impl<T: Scalar> Model<T> {
     pub fn frame_index(&self, name: &str) -> Option<usize> {
         self.frames.iter().position(|f| f.name == name)
     }
-    /// The neutral configuration: zeros, identity base orientation.
+    /// The neutral configuration: zeros, identity orientation of every free joint.
     pub fn neutral(&self) -> DVector<T> {
         let mut q = DVector::zeros(self.nq);
-        if self.floating_base {
-            q[6] = T::one();
+        for f in &self.free_joints {
+            q[f.iq + 6] = T::one();
         }
         q
     }
@@ -332,6 +419,8 @@ impl Model<f64> {
             body_link_names: self.body_link_names.clone(),
             gravity: cv(&self.gravity),
             floating_base: self.floating_base,
+            free_joints: self.free_joints.clone(),
+            trees: self.trees.clone(),
             dofs: self.dofs.clone(),
             frames: self
                 .frames
@@ -343,6 +432,7 @@ impl Model<f64> {
                 })
                 .collect(),
             collisions: self.collisions.clone(),
+            collision_filter: self.collision_filter.clone(),
             dof_parent: self.dof_parent.clone(),
             has_mimic: self.has_mimic,
             massless_joints: self.massless_joints.clone(),

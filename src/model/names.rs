@@ -148,7 +148,7 @@ impl<T: Scalar> Model<T> {
         })
     }
     fn dof_name_at(&self, iv: usize) -> &str {
-        iv.checked_sub(self.joint_v_offset())
+        self.dof_at_v(iv)
             .and_then(|d| self.dofs.get(d))
             .map_or("", |d| d.name.as_str())
     }
@@ -192,11 +192,11 @@ impl<T: Scalar> Model<T> {
     }
     /// The index in q of a degree of freedom (a movable, non-mimic 1-DoF joint) by name.
     pub fn q_index(&self, joint: &str) -> Result<usize, NameError> {
-        self.dof_position(joint).map(|d| self.joint_q_offset() + d)
+        self.dof_position(joint).map(|d| self.dof_q(d))
     }
     /// The index in v (and `a`, `tau`, H's rows) of a degree of freedom by name.
     pub fn v_index(&self, joint: &str) -> Result<usize, NameError> {
-        self.dof_position(joint).map(|d| self.joint_v_offset() + d)
+        self.dof_position(joint).map(|d| self.dof_v(d))
     }
     /// The position of a degree of freedom in `model.dofs` (neither a q nor a v index).
     fn dof_position(&self, joint: &str) -> Result<usize, NameError> {

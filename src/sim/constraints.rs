@@ -20,7 +20,7 @@ use super::factor::MassFactor;
 use super::newton::Newton;
 use super::solver::{self, RowKind, Rows};
 use super::{ContactForce, Solver};
-use crate::contact::ContactPoint;
+use crate::contact::{tangents, ContactPoint};
 use crate::model::Model;
 use crate::spatial::{Force, Motion, Se3};
 use nalgebra::{DVector, Vector3};
@@ -30,8 +30,6 @@ use nalgebra::{DVector, Vector3};
 pub(crate) struct RowParams {
     /// Joint friction and limits on.
     pub joint_dynamics: bool,
-    /// Coulomb friction with the ground, restitution.
-    pub mu: f64,
     /// Newton restitution coefficient e of ground impacts (0: inelastic).
     pub restitution: f64,
     /// |g| (for the restitution threshold).
@@ -114,13 +112,23 @@ pub(crate) struct Constraints {
 }
 
 impl Constraints {
-    /// Room for `max_points` contact points and every joint's three rows.
-    pub fn new(model: &Model, max_points: usize, nslots: usize) -> Self {
+    /// Room for `max_points` contact points (`pair_points` of them between
+    /// two bodies) and every joint's three rows; `f`: the factor the rows'
+    /// paths index.
+    pub fn new(
+        model: &Model,
+        f: &MassFactor,
+        max_points: usize,
+        pair_points: usize,
+        nslots: usize,
+    ) -> Self {
         let ndof = model.dofs.len();
         let cap = 3 * max_points + 3 * ndof;
         let nv = model.nv;
+        let mut rows = Rows::new(nv, cap);
+        rows.set_table(f.table(), pair_points);
         Self {
-            rows: Rows::new(nv, cap),
+            rows,
             joint_rows: Vec::with_capacity(3 * ndof),
             first_joint_row: 0,
             row_point: Vec::with_capacity(max_points),
@@ -200,7 +208,6 @@ impl Constraints {
         f: &MassFactor,
         h: f64,
     ) -> RowCounts {
-        let (vo, qo) = (model.joint_v_offset(), model.joint_q_offset());
         let rows = &mut self.rows;
         rows.clear();
         self.joint_rows.clear();
@@ -227,17 +234,29 @@ impl Constraints {
                 }
             }
             let nv = rows.nv;
+            let body_path = |b: usize| {
+                let jb = &model.joints[b];
+                f.path_of((jb.iv + jb.nv()).saturating_sub(1))
+            };
             for (pi, pt) in points.iter().enumerate() {
-                let warm = self.warm_contact.get(pt.slot).copied().unwrap_or([0.0; 3]);
-                // the body's path to the root: its joint's last dof and every ancestor
-                let jb = &model.joints[pt.body];
-                let path = f.path_of((jb.iv + jb.nv()).saturating_sub(1));
+                let warm = if pt.fresh {
+                    [0.0; 3]
+                } else {
+                    self.warm_contact.get(pt.slot).copied().unwrap_or([0.0; 3])
+                };
+                // the body's path to the root: its joint's last dof and every
+                // ancestor; against another body, the union with that body's
+                let path = if pt.other == 0 {
+                    body_path(pt.body)
+                } else {
+                    rows.union_path(body_path(pt.body), body_path(pt.other))
+                };
                 let Some(rn) = rows.push(RowKind::Normal, 0.0, warm[0], path) else {
                     break;
                 };
                 let tangent = RowKind::Tangent {
                     normal: rn,
-                    mu: p.mu,
+                    mu: pt.friction,
                 };
                 if rows.push(tangent, 0.0, warm[1], path).is_none() {
                     rows.pop(1);
@@ -249,22 +268,46 @@ impl Constraints {
                 }
                 self.row_point.push(pi);
                 counts.contacts += 1;
-                // rows n = z, t₁ = x, t₂ = y: the point velocity v_c + ω_c × p of each
-                // ancestor's world-frame subspace column c
-                let mut b = pt.body;
-                while b != 0 {
-                    let j = &model.joints[b];
-                    for c in 0..j.nv().min(6) {
-                        let s = &self.sw[b][c];
-                        let vp = s.lin + s.ang.cross(&pt.point);
-                        let col = j.iv + c;
-                        if col < nv {
-                            rows.j[rn * nv + col] += vp.z;
-                            rows.j[(rn + 1) * nv + col] += vp.x;
-                            rows.j[(rn + 2) * nv + col] += vp.y;
+                if pt.other == 0 && pt.normal == Vector3::z() {
+                    // the ground: rows n = z, t₁ = x, t₂ = y: the point velocity
+                    // v_c + ω_c × p of each ancestor's world-frame subspace column c
+                    let mut b = pt.body;
+                    while b != 0 {
+                        let j = &model.joints[b];
+                        for c in 0..j.nv().min(6) {
+                            let s = &self.sw[b][c];
+                            let vp = s.lin + s.ang.cross(&pt.point);
+                            let col = j.iv + c;
+                            if col < nv {
+                                rows.j[rn * nv + col] += vp.z;
+                                rows.j[(rn + 1) * nv + col] += vp.x;
+                                rows.j[(rn + 2) * nv + col] += vp.y;
+                            }
+                        }
+                        b = model.parent[b];
+                    }
+                } else {
+                    // two bodies: J = J_a − J_b, the relative velocity of the
+                    // point on a and on b along (n, t₁, t₂), n from b toward a
+                    // (a common ancestor's columns cancel)
+                    let (t1, t2) = tangents(&pt.normal);
+                    for (start, sign) in [(pt.body, 1.0), (pt.other, -1.0)] {
+                        let mut b = start;
+                        while b != 0 {
+                            let j = &model.joints[b];
+                            for c in 0..j.nv().min(6) {
+                                let s = &self.sw[b][c];
+                                let vp = (s.lin + s.ang.cross(&pt.point)) * sign;
+                                let col = j.iv + c;
+                                if col < nv {
+                                    rows.j[rn * nv + col] += pt.normal.dot(&vp);
+                                    rows.j[(rn + 1) * nv + col] += t1.dot(&vp);
+                                    rows.j[(rn + 2) * nv + col] += t2.dot(&vp);
+                                }
+                            }
+                            b = model.parent[b];
                         }
                     }
-                    b = model.parent[b];
                 }
                 // normal target: speculative; restitution only above the speed below
                 // which a bounce of one step under gravity could gain energy:
@@ -289,7 +332,7 @@ impl Constraints {
         // joint rows: friction (|λ| ≤ F h), limits (λ ≥ 0)
         if p.joint_dynamics {
             for (d, info) in model.dofs.iter().enumerate() {
-                let (iq, iv) = (qo + d, vo + d);
+                let (iq, iv) = (model.dof_q(d), model.dof_v(d));
                 if info.friction > 0.0 {
                     let kind = RowKind::Box {
                         limit: info.friction * h,
@@ -354,7 +397,6 @@ impl Constraints {
         solver: Solver,
     ) -> Impulses<'_> {
         let nv = model.nv;
-        let vo = model.joint_v_offset();
         self.clear_forces();
         self.dv.fill(0.0);
         let rows = &mut self.rows;
@@ -392,8 +434,9 @@ impl Constraints {
             let r = self.first_joint_row + k;
             let lam = rows.lambda[r];
             self.warm_joint[d][which as usize] = lam;
-            let jv = rows.j[r * nv + vo + d];
-            self.tau_joint[vo + d] += jv * lam / h;
+            let iv = model.dof_v(d);
+            let jv = rows.j[r * nv + iv];
+            self.tau_joint[iv] += jv * lam / h;
         }
         // contact rows: warm starts by slot, forces
         for &k in &self.warm_slots {
@@ -413,9 +456,20 @@ impl Constraints {
                 self.warm_slots.push(pt.slot);
             }
             if ln > 0.0 {
-                let f = Vector3::new(l1, l2, ln) / h;
+                // F = (λₙ n + λₜ₁ t₁ + λₜ₂ t₂)/Δt on `body`, −F on `other`
+                let f = if pt.normal == Vector3::z() {
+                    Vector3::new(l1, l2, ln) / h
+                } else {
+                    let (t1, t2) = tangents(&pt.normal);
+                    (pt.normal * ln + t1 * l1 + t2 * l2) / h
+                };
                 if let Some(fb) = self.fext.get_mut(pt.body) {
                     *fb += Force::at_point(f, &pt.point);
+                }
+                if pt.other != 0 {
+                    if let Some(fb) = self.fext.get_mut(pt.other) {
+                        *fb += Force::at_point(-f, &pt.point);
+                    }
                 }
                 self.contact_forces.push(ContactForce {
                     point: *pt,

@@ -60,10 +60,12 @@
 //! Nothing is allocated in [`Simulation::step`]: every buffer is sized at construction.
 
 pub mod constraints;
+mod contact_view;
 pub mod derivatives;
 pub mod factor;
 pub(crate) mod integrators;
 pub mod newton;
+pub use contact_view::Violation;
 mod sensors;
 mod servo;
 pub mod solver;
@@ -71,14 +73,13 @@ pub mod solver;
 pub use derivatives::{JacobianMethod, TransitionJacobians};
 pub use integrators::Integrator;
 
-use crate::contact::{ContactError, ContactParams, ContactPoint, GroundContact};
+use crate::contact::{Collision, ContactError, ContactParams, ContactPoint};
 use crate::dynamics::DynamicsError;
 use crate::dynamics::{
     forward_kinematics_pass as forward_kinematics, kinetic_energy_from_placements, potential_energy,
 };
-use crate::model::configuration::normalize_quat;
+use crate::model::configuration::normalize_quats;
 use crate::model::{Data, JointKind, Model};
-use crate::spatial::Force;
 use constraints::{Constraints, RowParams};
 use nalgebra::{DVector, Vector3};
 use std::path::PathBuf;
@@ -232,52 +233,6 @@ pub struct ContactForce {
     pub force: Vector3<f64>,
 }
 
-/// A constraint the current state violates (see [`Simulation::start_violations`]).
-#[derive(Clone, Debug, PartialEq)]
-pub enum Violation {
-    /// A link's collision geometry is `depth` m inside the ground.
-    Ground {
-        /// The URDF link.
-        link: String,
-        /// Its deepest point's penetration (m, positive).
-        depth: f64,
-    },
-    /// A joint is `amount` outside its limits [lower, upper] (at `q`).
-    Limit {
-        /// The URDF joint.
-        joint: String,
-        /// Its position (rad or m).
-        q: f64,
-        /// Lower limit (rad or m; −∞ when the URDF gives none).
-        lower: f64,
-        /// Upper limit (rad or m; +∞ when the URDF gives none).
-        upper: f64,
-        /// How far outside the limits `q` lies (rad or m, positive).
-        amount: f64,
-    },
-}
-
-impl std::fmt::Display for Violation {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Violation::Ground { link, depth } => write!(
-                f,
-                "link \"{link}\" starts {depth:.4} m inside the ground (pushed out at a capped speed)"
-            ),
-            Violation::Limit {
-                joint,
-                q,
-                lower,
-                upper,
-                amount,
-            } => write!(
-                f,
-                "joint \"{joint}\" starts {amount:.4} outside its limit [{lower}, {upper}] (q = {q}; brought back at a capped speed)"
-            ),
-        }
-    }
-}
-
 /// Dense work of the implicit mass matrix H̃ = H + A + h·D.
 #[derive(Clone, Debug)]
 pub(crate) struct MassWork {
@@ -352,7 +307,7 @@ pub struct Simulation {
     has_damping: bool,
     has_armature: bool,
     data: Data,
-    contact: Option<GroundContact>,
+    contact: Option<Collision>,
     points: Vec<ContactPoint>,
     /// `data.o_m_i` holds the world poses at the current `q`.
     fk_valid: bool,
@@ -418,38 +373,42 @@ impl Simulation {
             )));
         }
         crate::dynamics::check_massless(&model)?;
-        let contact = match opts.ground {
-            Some(g) => GroundContact::build(&model, g, opts.contact, &opts.package_paths)?,
-            None => None,
+        let contact = match () {
+            // the ground, obstacles and pairs of bodies (none of them: no contact work)
+            _ => Collision::build(&model, opts.ground, opts.contact, &opts.package_paths)?,
         };
         let integrator = opts
             .integrator
             .unwrap_or(Integrator::default_for(contact.is_some()));
         let (nq, nv) = (model.nq, model.nv);
-        let vo = model.joint_v_offset();
         let mut damping = DVector::zeros(nv);
         let mut armature = DVector::zeros(nv);
         let mut effort = vec![f64::INFINITY; nv];
-        for (d, info) in model.dofs.iter().enumerate() {
-            armature[vo + d] = a;
+        for (d, _, iv) in model.dof_indices() {
+            let info = &model.dofs[d];
+            armature[iv] = a;
             if opts.joint_dynamics {
-                damping[vo + d] = if info.damping.is_finite() {
+                damping[iv] = if info.damping.is_finite() {
                     info.damping.max(0.0)
                 } else {
                     0.0
                 };
                 if let Some(e) = info.limits.effort {
                     if e > 0.0 {
-                        effort[vo + d] = e;
+                        effort[iv] = e;
                     }
                 }
             }
         }
         let max_points = contact.as_ref().map_or(0, |c| c.max_points());
+        let pair_points = contact
+            .as_ref()
+            .and_then(|c| c.pairs.as_ref())
+            .map_or(0, |p| p.max_points());
+        let mass_factor = factor::MassFactor::new(&model);
         let nslots = contact.as_ref().map_or(0, |c| c.nslots);
         let row_params = RowParams {
             joint_dynamics: opts.joint_dynamics,
-            mu: opts.contact.friction,
             restitution: opts.contact.restitution,
             gravity: model.gravity.norm(),
             beta: opts.contact.baumgarte,
@@ -476,13 +435,13 @@ impl Simulation {
             has_damping,
             has_armature,
             data: Data::new(&model),
-            cons: Constraints::new(&model, max_points, nslots),
+            cons: Constraints::new(&model, &mass_factor, max_points, pair_points, nslots),
             contact,
             points: Vec::with_capacity(max_points),
             fk_valid: false,
             row_params,
             mass: MassWork {
-                f: factor::MassFactor::new(&model),
+                f: mass_factor,
                 vfree: DVector::zeros(nv),
                 tau: DVector::zeros(nv),
                 vtot: DVector::zeros(nv),
@@ -500,7 +459,7 @@ impl Simulation {
                 h_next: opts.dt,
                 fsal_ok: false,
             },
-            servo: servo::Servo::new(&model.neutral(), nv),
+            servo: servo::Servo::new(&model, &model.neutral()),
             sensors: sensors::Sensors::new(nq, nv),
             forcing_changed: true,
             energy_now: None,
@@ -570,9 +529,7 @@ impl Simulation {
         }
         self.q.copy_from(q);
         self.v.copy_from(v);
-        if self.model.floating_base {
-            normalize_quat(&mut self.q);
-        }
+        normalize_quats(&self.model, &mut self.q);
         self.state_changed();
         Ok(())
     }
@@ -584,6 +541,9 @@ impl Simulation {
         self.sensors.forget();
         self.smooth.fsal_ok = false;
         self.cons.reset_warm_start();
+        if self.steps == 0 {
+            self.decide_start_overlaps();
+        }
         self.refresh_contacts();
         self.guard.reference = None;
         self.guard.recovering_until = if self.start_violations().is_empty() {
@@ -596,92 +556,6 @@ impl Simulation {
         } else {
             Some(self.t + 2.0)
         };
-    }
-
-    /// Moves a floating base vertically so that the lowest point of the
-    /// collision geometry is `height` above the ground. Returns `false` (and
-    /// moves nothing) without a floating base, a ground or collision geometry.
-    pub fn lift_above_ground(&mut self, height: f64) -> Result<bool, SimError> {
-        if !height.is_finite() {
-            return Err(SimError::Invalid(format!(
-                "--above-ground must be a finite number (got {height})"
-            )));
-        }
-        let low = self.lowest_point();
-        let ground = match &self.contact {
-            Some(c) => c.ground,
-            None => return Ok(false),
-        };
-        if !self.model.floating_base || !low.is_finite() {
-            return Ok(false);
-        }
-        let (mut q, v) = (self.q.clone(), self.v.clone());
-        q[2] += ground + height - low;
-        self.set_state(&q, &v)?;
-        Ok(true)
-    }
-
-    /// The constraints the current state violates: links deeper in the ground
-    /// than the contact margin (one entry per link, its deepest point) and
-    /// joints outside their limits. The simulation recovers from them gently
-    /// (the position pass, at most `contact.max_push_speed` and
-    /// `limit_push_speed`).
-    pub fn start_violations(&self) -> Vec<Violation> {
-        let mut out = Vec::new();
-        if let Some(c) = &self.contact {
-            let margin = self.opts.contact.margin;
-            for p in &self.points {
-                if -p.gap <= margin {
-                    continue;
-                }
-                let link = &c.shapes[p.shape].link;
-                match out.iter_mut().find(
-                    |v: &&mut Violation| matches!(v, Violation::Ground { link: l, .. } if l == link),
-                ) {
-                    Some(Violation::Ground { depth, .. }) => *depth = depth.max(-p.gap),
-                    _ => out.push(Violation::Ground {
-                        link: link.clone(),
-                        depth: -p.gap,
-                    }),
-                }
-            }
-        }
-        if self.opts.joint_dynamics {
-            let qo = self.model.joint_q_offset();
-            for (d, info) in self.model.dofs.iter().enumerate() {
-                if info.continuous {
-                    continue;
-                }
-                let q = self.q[qo + d];
-                let (lower, upper, amount) = limit_excess(info, q);
-                if amount > 1e-9 {
-                    out.push(Violation::Limit {
-                        joint: info.name.clone(),
-                        q,
-                        lower,
-                        upper,
-                        amount,
-                    });
-                }
-            }
-        }
-        out
-    }
-
-    /// The deepest penetration and the largest joint-limit excess now (no
-    /// allocation: the step's recovery test).
-    fn worst_violation(&self) -> (f64, f64) {
-        let mut excess: f64 = 0.0;
-        if self.opts.joint_dynamics {
-            let qo = self.model.joint_q_offset();
-            for (d, info) in self.model.dofs.iter().enumerate() {
-                if info.continuous {
-                    continue;
-                }
-                excess = excess.max(limit_excess(info, self.q[qo + d]).2);
-            }
-        }
-        (self.penetration(), excess)
     }
 
     /// The applied generalized forces (joint torques; with a floating base the first
@@ -707,60 +581,6 @@ impl Simulation {
         }
         self.torques_mut().copy_from(tau);
         Ok(())
-    }
-    /// Whether this simulation has ground contact.
-    pub fn has_contact(&self) -> bool {
-        self.contact.is_some()
-    }
-    /// Narrow-phase contact queries performed so far (0 for a scene with no
-    /// collision geometry or no ground).
-    pub fn contact_queries(&self) -> u64 {
-        self.contact.as_ref().map_or(0, |c| c.queries)
-    }
-    /// The lowest point of the collision geometry at the current state (m; +∞
-    /// without contact shapes).
-    pub fn lowest_point(&mut self) -> f64 {
-        forward_kinematics(&self.model, &mut self.data, &self.q);
-        self.fk_valid = true;
-        match &self.contact {
-            Some(c) => c.lowest_point(&self.data.o_m_i),
-            None => f64::INFINITY,
-        }
-    }
-    /// Contact points at the current state (within the detection margin).
-    pub fn contact_points(&self) -> &[ContactPoint] {
-        &self.points
-    }
-    /// Deepest penetration into the ground at the current state (m, 0 if none).
-    pub fn penetration(&self) -> f64 {
-        self.points.iter().map(|p| -p.gap).fold(0.0, f64::max)
-    }
-    /// The contact points that carried force in the last step, with their forces.
-    pub fn contact_forces(&self) -> &[ContactForce] {
-        self.cons.contact_forces()
-    }
-    /// The URDF link whose collision shape made a contact point (a point of
-    /// [`Simulation::contact_points`] or [`ContactForce::point`]); `None` for a
-    /// point this simulation did not find.
-    pub fn contact_link(&self, point: &ContactPoint) -> Option<&str> {
-        let c = self.contact.as_ref()?;
-        c.shapes.get(point.shape).map(|s| s.link.as_str())
-    }
-    /// [`Simulation::contact_forces`] named by URDF link (the link whose
-    /// collision shape touched, not the merged body).
-    pub fn link_contact_forces(&self) -> impl Iterator<Item = (&str, &ContactForce)> + '_ {
-        self.contact_forces()
-            .iter()
-            .map(|f| (self.contact_link(&f.point).unwrap_or(""), f))
-    }
-    /// Number of contact points that carried force in the last step.
-    pub fn active_contacts(&self) -> usize {
-        self.cons.contact_forces().len()
-    }
-    /// The ground contact wrench on each body in the last step (world frame, at
-    /// the world origin; entry 0 is the world). Link names: `model.body_link_names`.
-    pub fn body_contact_forces(&self) -> &[Force] {
-        self.cons.body_forces()
     }
     /// Kinetic plus gravitational potential energy (J), the potential being
     /// −Σ mᵢ gᵀcᵢ (zero at the world origin); with an armature, its rotors'
@@ -807,6 +627,20 @@ impl Simulation {
             + self.armature_energy();
         self.energy_now = Some(e);
         e
+    }
+
+    /// Before the first step: the self pairs overlapping at this state are
+    /// dropped (scene.md "Who touches whom" rule 4; decided anew at each state
+    /// set before the run starts).
+    fn decide_start_overlaps(&mut self) {
+        let Some(c) = self.contact.as_mut() else {
+            return;
+        };
+        if c.pairs.is_none() {
+            return;
+        }
+        forward_kinematics(&self.model, &mut self.data, &self.q);
+        c.drop_start_overlaps(&self.model, &self.data.o_m_i);
     }
 
     /// Forward kinematics and contact detection at the current q.
@@ -872,9 +706,7 @@ impl Simulation {
         self.t = if h >= remaining { t_end } else { self.t + h };
         self.sensors.end(h);
         self.steps += 1;
-        if self.model.floating_base {
-            normalize_quat(&mut self.q);
-        }
+        normalize_quats(&self.model, &mut self.q);
         // 3. the new state: finite, its contacts, its energy
         self.check_finite()?;
         self.fk_valid = false;
@@ -891,12 +723,12 @@ impl Simulation {
         if !self.opts.joint_dynamics {
             return cap;
         }
-        let (qo, vo) = (self.model.joint_q_offset(), self.model.joint_v_offset());
-        for (d, info) in self.model.dofs.iter().enumerate() {
+        for (d, iq, iv) in self.model.dof_indices() {
+            let info = &self.model.dofs[d];
             if info.continuous {
                 continue;
             }
-            let (q, v) = (self.q[qo + d], self.v[vo + d]);
+            let (q, v) = (self.q[iq], self.v[iv]);
             let gap = match (v < 0.0, info.limits.lower, info.limits.upper) {
                 (true, Some(lo), _) => q - lo,
                 (false, _, Some(hi)) if v > 0.0 => hi - q,
@@ -1026,17 +858,19 @@ fn land(dt: f64, remaining: f64) -> f64 {
 pub fn column_names(model: &Model) -> (Vec<String>, Vec<String>) {
     let mut qn = Vec::with_capacity(model.nq);
     let mut vn = Vec::with_capacity(model.nv);
-    if model.floating_base {
-        for s in ["x", "y", "z", "qx", "qy", "qz", "qw"] {
-            qn.push(format!("q:base_{s}"));
+    for t in &model.trees {
+        if let Some(f) = t.free.and_then(|i| model.free_joints.get(i)) {
+            for s in ["x", "y", "z", "qx", "qy", "qz", "qw"] {
+                qn.push(format!("q:{}_{s}", f.name));
+            }
+            for s in ["vx", "vy", "vz", "wx", "wy", "wz"] {
+                vn.push(format!("v:{}_{s}", f.name));
+            }
         }
-        for s in ["vx", "vy", "vz", "wx", "wy", "wz"] {
-            vn.push(format!("v:base_{s}"));
+        for d in &model.dofs[t.dofs.clone()] {
+            qn.push(format!("q:{}", d.name));
+            vn.push(format!("v:{}", d.name));
         }
-    }
-    for d in &model.dofs {
-        qn.push(format!("q:{}", d.name));
-        vn.push(format!("v:{}", d.name));
     }
     (qn, vn)
 }
@@ -1047,10 +881,10 @@ pub fn supports(model: &Model) -> bool {
     model
         .joints
         .iter()
-        .skip(1)
         .enumerate()
-        .all(|(i, j)| match j.kind {
-            JointKind::Free => i == 0,
+        .skip(1)
+        .all(|(b, j)| match j.kind {
+            JointKind::Free => model.free_joints.iter().any(|f| f.body == b),
             _ => true,
         })
 }

@@ -95,9 +95,24 @@ impl Newton {
         max_iter: usize,
         tol: f64,
     ) -> usize {
+        let _ = f;
+        let table = rows.take_table();
+        let it = self.solve_on(rows, &table, dx, max_iter, tol);
+        rows.put_table(table);
+        it
+    }
+
+    /// [`Newton::solve`] on the rows' path table `table` (taken out of them).
+    fn solve_on(
+        &mut self,
+        rows: &mut Rows,
+        table: &[usize],
+        dx: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+    ) -> usize {
         let nv = self.nv;
         let n = rows.n;
-        let table = f.table();
         if dx.len() < nv || rows.nv != nv {
             return 0;
         }

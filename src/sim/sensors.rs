@@ -150,7 +150,7 @@ impl Simulation {
 }
 
 /// The generalized acceleration of a step from (q₀, v₀) to (q₁, v₁) of length h:
-/// (v₁ − v₀)/h on the joints; a free base's body-frame spatial acceleration,
+/// (v₁ − v₀)/h on the joints; each free joint's body-frame spatial acceleration,
 /// its linear velocity taken back into the start frame, exp(h ω₁) v₁, and the
 /// frame's own rate ω₀ × v₀ removed (the semi-implicit step's, `euler.rs`).
 fn step_acceleration(model: &Model, v0: &DVector<f64>, v1: &DVector<f64>, h: f64) -> DVector<f64> {
@@ -161,11 +161,12 @@ fn step_acceleration(model: &Model, v0: &DVector<f64>, v1: &DVector<f64>, h: f64
     a.copy_from(v1);
     a -= v0;
     a /= h;
-    if model.floating_base {
-        let w1 = Vector3::new(v1[3], v1[4], v1[5]);
-        let w0 = Vector3::new(v0[3], v0[4], v0[5]);
-        let l0 = Vector3::new(v0[0], v0[1], v0[2]);
-        let l1 = Vector3::new(v1[0], v1[1], v1[2]);
+    for f in &model.free_joints {
+        let i = f.iv;
+        let w1 = Vector3::new(v1[i + 3], v1[i + 4], v1[i + 5]);
+        let w0 = Vector3::new(v0[i + 3], v0[i + 4], v0[i + 5]);
+        let l0 = Vector3::new(v0[i], v0[i + 1], v0[i + 2]);
+        let l1 = Vector3::new(v1[i], v1[i + 1], v1[i + 2]);
         let th = (w1 * h).norm();
         let l1s = if th > 0.0 {
             crate::spatial::axis_angle(&(w1 * h / th), th) * l1
@@ -173,9 +174,9 @@ fn step_acceleration(model: &Model, v0: &DVector<f64>, v1: &DVector<f64>, h: f64
             l1
         };
         let al = (l1s - l0) / h - w0.cross(&l0);
-        a[0] = al.x;
-        a[1] = al.y;
-        a[2] = al.z;
+        a[i] = al.x;
+        a[i + 1] = al.y;
+        a[i + 2] = al.z;
     }
     a
 }

@@ -17,6 +17,7 @@
 //! implicit scheme.
 
 use crate::dynamics::{bias, bias_at_placements};
+use crate::model::Model;
 use crate::sim::{SimError, Simulation};
 use nalgebra::DVector;
 
@@ -38,12 +39,24 @@ pub(crate) struct Servo {
     pub saturated: Vec<i8>,
     /// The servo torque of each v coordinate in the last step (clamped, with τ_ff).
     pub applied: DVector<f64>,
+    /// The q index of each v coordinate's joint ([`FREE`] on a free joint's
+    /// six: no servo there).
+    pub iq: Vec<usize>,
 }
 
+/// [`Servo::iq`] of a free joint's coordinate.
+pub(crate) const FREE: usize = usize::MAX;
+
 impl Servo {
-    /// No servo on a model with `nq`, `nv` coordinates; `q_ref` starts at `q0`.
-    pub fn new(q0: &DVector<f64>, nv: usize) -> Self {
+    /// No servo on `model`; `q_ref` starts at `q0`.
+    pub fn new(model: &Model, q0: &DVector<f64>) -> Self {
+        let nv = model.nv;
+        let mut iq = vec![FREE; nv];
+        for (_, jq, jv) in model.dof_indices() {
+            iq[jv] = jq;
+        }
         Self {
+            iq,
             kp: DVector::zeros(nv),
             kd: DVector::zeros(nv),
             q_ref: q0.clone(),
@@ -66,8 +79,7 @@ impl Servo {
 
     /// τ_ff + the servo torque at (q, v) of v coordinate `k`, clamped to
     /// `effort` (the plain clamp without servos): the smooth right-hand side's
-    /// applied torque. `qo`, `vo`: the joints' offsets in q and v.
-    #[allow(clippy::too_many_arguments)]
+    /// applied torque.
     #[inline]
     pub fn rhs_torque(
         &self,
@@ -75,13 +87,11 @@ impl Servo {
         effort: f64,
         q: &DVector<f64>,
         v: &DVector<f64>,
-        qo: usize,
-        vo: usize,
         k: usize,
     ) -> f64 {
         let mut t = tau_ff;
-        if self.active && k >= vo {
-            let iq = qo + k - vo;
+        let iq = self.iq[k];
+        if self.active && iq != FREE {
             t += self.torque(iq, k, q[iq], v[k]);
         }
         t.clamp(-effort, effort)
@@ -102,7 +112,6 @@ impl Simulation {
     /// the one without servos.
     pub fn set_gains(&mut self, kp: &DVector<f64>, kd: &DVector<f64>) -> Result<(), SimError> {
         let nv = self.model.nv;
-        let vo = self.model.joint_v_offset();
         for (name, g) in [("kp", kp), ("kd", kd)] {
             if g.len() != nv {
                 return Err(SimError::Invalid(format!(
@@ -116,7 +125,7 @@ impl Simulation {
                         "{name}[{k}] must be a finite number ≥ 0 (got {x})"
                     )));
                 }
-                if k < vo && x != 0.0 {
+                if self.servo.iq[k] == FREE && x != 0.0 {
                     return Err(SimError::Invalid(format!(
                         "{name}[{k}] is a floating-base entry: its gain must be 0 (got {x})"
                     )));
@@ -136,8 +145,8 @@ impl Simulation {
     /// Sets the same gains on every joint (base entries 0); see [`Simulation::set_gains`].
     pub fn set_gains_uniform(&mut self, kp: f64, kd: f64) -> Result<(), SimError> {
         let nv = self.model.nv;
-        let vo = self.model.joint_v_offset();
-        let fill = |g: f64| DVector::from_fn(nv, |k, _| if k < vo { 0.0 } else { g });
+        let iq = &self.servo.iq;
+        let fill = |g: f64| DVector::from_fn(nv, |k, _| if iq[k] == FREE { 0.0 } else { g });
         self.set_gains(&fill(kp), &fill(kd))
     }
 
@@ -208,7 +217,6 @@ impl Simulation {
     /// at v* passes its limit.
     pub(in crate::sim) fn servo_free_velocity(&mut self, h: f64) -> Result<(), SimError> {
         let nv = self.model.nv;
-        let (qo, vo) = (self.model.joint_q_offset(), self.model.joint_v_offset());
         // C(q, v), as the dense branch of free_velocity computes it
         let mut c = std::mem::replace(&mut self.mass.vtot, DVector::zeros(0));
         let r = if self.fk_valid && self.v.len() == nv {
@@ -240,7 +248,7 @@ impl Simulation {
             // u − C − D v, u = τ_ff + e on free joints, ±effort on saturated ones
             for k in 0..nv {
                 let u = match self.servo.saturated[k] {
-                    0 => self.tau_applied[k] + self.servo_explicit(qo, vo, k, h),
+                    0 => self.tau_applied[k] + self.servo_explicit(k, h),
                     s => f64::from(s) * self.effort[k],
                 };
                 tau[k] = u - c[k] - self.damping[k] * self.v[k];
@@ -254,11 +262,14 @@ impl Simulation {
             self.mass.vfree.axpy(h, &tau, 1.0);
             // a free joint whose torque at v* passes its limit is saturated
             let mut grew = false;
-            for k in vo..nv {
-                if self.servo.saturated[k] != 0 || !self.effort[k].is_finite() {
+            for k in 0..nv {
+                if self.servo.iq[k] == FREE
+                    || self.servo.saturated[k] != 0
+                    || !self.effort[k].is_finite()
+                {
                     continue;
                 }
-                let t = self.servo_torque_after(qo, vo, k, h);
+                let t = self.servo_torque_after(k, h);
                 if t.abs() > self.effort[k] {
                     self.servo.saturated[k] = t.signum() as i8;
                     grew = true;
@@ -270,7 +281,7 @@ impl Simulation {
         }
         for k in 0..nv {
             self.servo.applied[k] = match self.servo.saturated[k] {
-                0 if k >= vo => self.servo_torque_after(qo, vo, k, h),
+                0 if self.servo.iq[k] != FREE => self.servo_torque_after(k, h),
                 0 => self.tau_applied[k],
                 s => f64::from(s) * self.effort[k],
             };
@@ -283,11 +294,11 @@ impl Simulation {
     /// The servo's explicit part e = kp (q_ref − q − h v) + kd (v_ref − v) of v
     /// coordinate `k` (0 on base entries).
     #[inline]
-    fn servo_explicit(&self, qo: usize, vo: usize, k: usize, h: f64) -> f64 {
-        if k < vo {
+    fn servo_explicit(&self, k: usize, h: f64) -> f64 {
+        let iq = self.servo.iq[k];
+        if iq == FREE {
             return 0.0;
         }
-        let iq = qo + k - vo;
         let s = &self.servo;
         s.torque(iq, k, self.q[iq], self.v[k]) - h * s.kp[k] * self.v[k]
     }
@@ -295,8 +306,8 @@ impl Simulation {
     /// τ_ff + the servo torque of joint coordinate `k` at the end of the step,
     /// q⁺ ≈ q + h v*, v⁺ = v* (`mass.vfree`).
     #[inline]
-    fn servo_torque_after(&self, qo: usize, vo: usize, k: usize, h: f64) -> f64 {
-        let iq = qo + k - vo;
+    fn servo_torque_after(&self, k: usize, h: f64) -> f64 {
+        let iq = self.servo.iq[k];
         let v1 = self.mass.vfree[k];
         self.tau_applied[k] + self.servo.torque(iq, k, self.q[iq] + h * v1, v1)
     }

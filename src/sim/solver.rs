@@ -91,6 +91,14 @@ pub struct Rows {
     /// The last solve took a subspace step.
     pub polished: bool,
     cap: usize,
+    /// The dof paths rows live on: the factor's table ([`MassFactor::table`],
+    /// every dof's path to the root, the first `static_len` entries), then the
+    /// step's unions of two paths (a contact between two bodies acts on both
+    /// bodies' paths: their union, ascending, is where its row and y live).
+    table: Vec<usize>,
+    static_len: usize,
+    /// The last union made: its two paths and where it is.
+    last_union: ((usize, usize), (usize, usize), (usize, usize)),
 }
 
 /// Most rows a subspace step solves directly (its dense W_FF is this square).
@@ -146,7 +154,66 @@ impl Rows {
             sm: Subspace::new(nv, cap),
             polished: false,
             cap,
+            table: Vec::new(),
+            static_len: 0,
+            last_union: ((0, 0), (0, 0), (0, 0)),
         }
+    }
+    /// Takes the factor's path table (`base`, [`MassFactor::table`]) with room
+    /// for `unions` two-body paths of at most nv entries each, allocated here.
+    pub fn set_table(&mut self, base: &[usize], unions: usize) {
+        self.table = Vec::with_capacity(base.len() + unions * self.nv);
+        self.table.extend_from_slice(base);
+        self.static_len = base.len();
+    }
+    /// The dof paths rows index ([`Rows::path`]).
+    pub fn table(&self) -> &[usize] {
+        &self.table
+    }
+    /// Takes the path table out (no entry moved), for a solver that mutates
+    /// the rows while reading it; [`Rows::put_table`] puts it back.
+    pub(crate) fn take_table(&mut self) -> Vec<usize> {
+        std::mem::take(&mut self.table)
+    }
+    /// Puts back the table [`Rows::take_table`] took.
+    pub(crate) fn put_table(&mut self, table: Vec<usize>) {
+        self.table = table;
+    }
+    /// The path of a row acting on the dofs of two paths `a` and `b` (entries
+    /// of the table): their union, ascending (appended to the table for this
+    /// step; the last union is reused when asked again).
+    pub fn union_path(&mut self, a: (usize, usize), b: (usize, usize)) -> (usize, usize) {
+        if a == b || b.1 == 0 {
+            return a;
+        }
+        if a.1 == 0 {
+            return b;
+        }
+        let (la, lb, at) = self.last_union;
+        if la == a && lb == b && at.0 + at.1 <= self.table.len() && at.0 >= self.static_len {
+            return at;
+        }
+        let start = self.table.len();
+        let (mut i, mut j) = (a.0, b.0);
+        let (ea, eb) = (a.0 + a.1, b.0 + b.1);
+        while i < ea || j < eb {
+            let x = if i < ea { self.table[i] } else { usize::MAX };
+            let y = if j < eb { self.table[j] } else { usize::MAX };
+            let k = if x <= y {
+                i += 1;
+                if x == y {
+                    j += 1;
+                }
+                x
+            } else {
+                j += 1;
+                y
+            };
+            self.table.push(k);
+        }
+        let at = (start, self.table.len() - start);
+        self.last_union = (a, b, at);
+        at
     }
     /// The most rows that fit.
     pub fn capacity(&self) -> usize {
@@ -158,6 +225,8 @@ impl Rows {
         let used = (self.n * self.nv).min(self.j.len());
         self.j[..used].fill(0.0);
         self.n = 0;
+        self.table.truncate(self.static_len);
+        self.last_union = ((0, 0), (0, 0), (0, 0));
     }
     /// Drops the last `k` rows (pushed, their Jacobian entries not yet written).
     pub fn pop(&mut self, k: usize) {
@@ -202,10 +271,12 @@ impl Rows {
     /// the free velocity `vfree`.
     pub fn form(&mut self, f: &MassFactor, vfree: &[f64]) {
         let (nv, n) = (self.nv, self.n);
-        let table = f.table();
         if vfree.len() < nv || self.j.len() < n * nv || self.y.len() < n * nv {
             return;
         }
+        // (the table is put back below: taking it moves no entry)
+        let table_v = std::mem::take(&mut self.table);
+        let table = &table_v[..];
         let mut r = 0;
         while r < n {
             let (ps, pl) = self.path[r];
@@ -254,6 +325,7 @@ impl Rows {
         for (w, wi) in self.w[..n].iter().zip(self.winv.iter_mut()) {
             *wi = if *w > 1e-14 { 1.0 / w } else { 0.0 };
         }
+        self.table = table_v;
     }
 
     /// Whether row r is a contact normal followed by its two tangent rows on
@@ -288,9 +360,24 @@ impl Rows {
         tol: f64,
         relax: f64,
     ) -> usize {
-        let (nv, n) = (self.nv, self.n);
         self.polished = false;
-        let table = f.table();
+        let _ = f;
+        let table_v = std::mem::take(&mut self.table);
+        let it = self.sweeps(&table_v, dv, max_iter, tol, relax);
+        self.table = table_v;
+        it
+    }
+
+    /// [`Rows::solve`] on the path table `table` (taken out of the rows).
+    fn sweeps(
+        &mut self,
+        table: &[usize],
+        dv: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+        relax: f64,
+    ) -> usize {
+        let (nv, n) = (self.nv, self.n);
         if dv.len() < nv
             || self.y.len() < n * nv
             || self.kind.len() < n
@@ -730,10 +817,25 @@ impl Rows {
         tol: f64,
     ) -> usize {
         let (nv, n) = (self.nv, self.n);
-        let table = f.table();
+        let _ = f;
         if dw.len() < nv || self.y.len() < n * nv || self.mu.len() < n || self.bpos.len() < n {
             return 0;
         }
+        let table_v = std::mem::take(&mut self.table);
+        let it = self.position_sweeps(&table_v, dw, max_iter, tol);
+        self.table = table_v;
+        it
+    }
+
+    /// [`Rows::solve_position`] on the path table `table` (taken out of the rows).
+    fn position_sweeps(
+        &mut self,
+        table: &[usize],
+        dw: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+    ) -> usize {
+        let (nv, n) = (self.nv, self.n);
         let dw = &mut dw[..nv];
         dw.iter_mut().for_each(|x| *x = 0.0);
         self.mu[..n].iter_mut().for_each(|x| *x = 0.0);

@@ -213,6 +213,9 @@ pub(crate) fn lower(
                 body,
                 placement: b_m_l.compose(&pose(&c.origin)),
                 shape: shape(&c.geometry),
+                trimesh: false,
+                friction: 0.0,
+                model: 0,
             });
         }
         for &ji in checked.children[li].iter().rev() {
@@ -385,9 +388,32 @@ pub(crate) fn lower(
         body_link_names,
         gravity: Vector3::new(0.0, 0.0, -9.81),
         floating_base: options.floating_base,
+        free_joints: if options.floating_base {
+            vec![crate::model::FreeJoint {
+                body: 1,
+                iq: 0,
+                iv: 0,
+                name: "base".into(),
+            }]
+        } else {
+            Vec::new()
+        },
+        trees: vec![crate::model::Tree::whole(
+            nbodies,
+            frames.len(),
+            dofs.len(),
+            options.floating_base,
+        )],
         dofs,
         frames,
         collisions,
+        // one model; self-collision off: a URDF alone keeps today's contact
+        // with the ground only (its trajectories, speed and allocation-free
+        // step); a scene turns it on per model (scene.md's default)
+        collision_filter: crate::model::CollisionFilter {
+            excluded: Vec::new(),
+            self_collision: vec![false],
+        },
         dof_parent,
         has_mimic,
         massless_joints,

@@ -6,7 +6,10 @@
 
 mod lower;
 mod parse;
+mod paths;
 mod validate;
+
+pub use paths::resolve_mesh_path;
 
 use crate::model::Model;
 use std::path::Path;

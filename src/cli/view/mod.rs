@@ -29,7 +29,10 @@ use serde_json::{json, Value};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+mod scene;
 mod visuals;
+
+pub use scene::{run_scene, SceneViewArgs};
 
 const PAGE_HTML: &str = include_str!("page.html");
 const VIEWER_JS: &str = include_str!("viewer.js");
@@ -264,14 +267,17 @@ pub fn read_trajectory(text: &str, file: &str, model: &Model) -> Result<Trajecto
         for (k, &c) in q_cols.iter().enumerate() {
             q[k] = num(c)?;
         }
-        if model.floating_base {
-            let n = (q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6]).sqrt();
+        for f in &model.free_joints {
+            let i = f.iq + 3;
+            let n = (q[i] * q[i] + q[i + 1] * q[i + 1] + q[i + 2] * q[i + 2] + q[i + 3] * q[i + 3])
+                .sqrt();
             if (n - 1.0).abs() > 1e-3 {
                 return Err(bad(format!(
-                    "{at}, columns \"q:base_qx\"..\"q:base_qw\": the quaternion's norm is {n}, not 1"
+                    "{at}, columns \"q:{0}_qx\"..\"q:{0}_qw\": the quaternion's norm is {n}, not 1",
+                    f.name
                 )));
             }
-            for k in 3..7 {
+            for k in i..i + 4 {
                 q[k] /= n;
             }
         }
@@ -521,6 +527,17 @@ impl Geometry {
     /// a collision mesh drawn that is not found, or a mesh that cannot be read, is
     /// an error naming the URDF, the link and the mesh file.
     pub fn load(model: &Model, urdf: &Path, package_paths: &[PathBuf]) -> Result<Self, ViewError> {
+        Self::load_prefixed(model, urdf, "", package_paths)
+    }
+
+    /// As [`Geometry::load`] for the URDF of one model of a scene, whose links
+    /// are `PREFIX` + the URDF's link name in `model`.
+    pub fn load_prefixed(
+        model: &Model,
+        urdf: &Path,
+        prefix: &str,
+        package_paths: &[PathBuf],
+    ) -> Result<Self, ViewError> {
         let name = urdf.display().to_string();
         let text = std::fs::read_to_string(urdf)
             .map_err(|e| ViewError::Geometry(format!("{name}: cannot read: {e}")))?;
@@ -539,7 +556,7 @@ impl Geometry {
             |filename: &str| crate::contact::resolve_mesh_path(filename, Some(urdf), package_paths);
         for link in &drawables.links {
             let Some(frame) = model
-                .frame_index(&link.name)
+                .frame_index(&format!("{prefix}{}", link.name))
                 .and_then(|k| model.frames.get(k))
             else {
                 continue;
@@ -615,6 +632,8 @@ impl Geometry {
                         };
                         VisualShape::Mesh(k)
                     }
+                    // a URDF has none (a scene's terrain is drawn by the scene's page)
+                    Shape::HeightField { .. } => continue,
                 };
                 let rgba = piece
                     .color
@@ -627,7 +646,7 @@ impl Geometry {
                     .map(|c| c.map(|x| x.clamp(0.0, 1.0)))
                     .unwrap_or(DEFAULT_RGBA);
                 geometry.visuals.push(Visual {
-                    link: link.name.clone(),
+                    link: format!("{prefix}{}", link.name),
                     body: frame.body,
                     placement,
                     shape,

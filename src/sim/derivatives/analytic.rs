@@ -24,8 +24,9 @@
 
 use super::smooth::Tableau;
 use super::TransitionJacobians;
-use crate::dynamics::{forward_kinematics, rnea};
-use crate::model::configuration::integrate;
+use crate::contact::{tangents, ContactPoint, NO_GEOM};
+use crate::dynamics::{forward_kinematics, rnea_derivatives};
+use crate::model::Shape;
 use crate::sim::integrators::dop853_tableau::{A, B, N_STAGES};
 use crate::sim::integrators::explicit_limit;
 use crate::sim::solver::RowKind;
@@ -37,22 +38,31 @@ impl Simulation {
     /// A and B through the step's own equations, from the fresh state (set by
     /// the caller) with joint torques `tau`: the steps up to `dt` (one for a
     /// fixed-step integrator), each differentiated by its own scheme, composed.
+    /// `None` where the analytic route does not reach (docs/theory.md
+    /// §"Transition Jacobians": several free joints, or a contact between two
+    /// bodies in the step): the caller takes central differences there.
     pub(in crate::sim) fn analytic_jacobians(
         &mut self,
         tau: &DVector<f64>,
-    ) -> Result<TransitionJacobians, SimError> {
+    ) -> Result<Option<TransitionJacobians>, SimError> {
         let n = self.model.nv;
+        let f = &self.model.free_joints;
+        if f.len() > 1 || f.first().is_some_and(|f| f.iv != 0 || f.iq != 0) {
+            return Ok(None);
+        }
         self.set_joint_torques(tau);
         let dt = self.dt;
         let mut jx = DMatrix::<f64>::identity(2 * n, 2 * n);
         let mut jt = DMatrix::<f64>::zeros(2 * n, n);
         while self.t < dt {
-            let j = self.substep_jacobian(dt, tau)?;
+            let Some(j) = self.substep_jacobian(dt, tau)? else {
+                return Ok(None);
+            };
             let ax = j.columns(0, 2 * n).into_owned();
             jt = &ax * jt + j.columns(2 * n, n);
             jx = ax * jx;
         }
-        Ok(TransitionJacobians { a: jx, b: jt })
+        Ok(Some(TransitionJacobians { a: jx, b: jt }))
     }
 
     /// One step toward `t_end`, taken, and its Jacobian [δq'; δv'] over the
@@ -61,12 +71,15 @@ impl Simulation {
         &mut self,
         t_end: f64,
         tau: &DVector<f64>,
-    ) -> Result<DMatrix<f64>, SimError> {
+    ) -> Result<Option<DMatrix<f64>>, SimError> {
         let (q0, v0) = (self.q.clone(), self.v.clone());
         let points = self.points.clone();
         // the step's scheme, as step_until chooses it
         let h_fixed = crate::sim::land(self.dt, t_end - self.t);
         let counts = self.assemble_rows(h_fixed);
+        if self.points.iter().any(|p| p.other != 0) {
+            return Ok(None);
+        }
         let mut implicit = self.integrator == Integrator::SemiImplicitEuler || counts.touching();
         if !implicit && (self.has_damping || self.servo.active) {
             implicit = self.damping_rate()? * h_fixed > explicit_limit(self.integrator);
@@ -85,9 +98,12 @@ impl Simulation {
                 },
                 _ => Tableau { a: &dop_a, b: &B },
             };
-            return self.smooth_step_jacobian(&q0, &v0, &q1, tau, h, &tab);
+            return self
+                .smooth_step_jacobian(&q0, &v0, &q1, tau, h, &tab)
+                .map(Some);
         }
         self.implicit_step_jacobian(&q0, &v0, &points, counts, h, tau)
+            .map(Some)
     }
 
     /// The Jacobian of the time-stepping step just taken from (q0, v0) with
@@ -162,8 +178,11 @@ impl Simulation {
         for (ci, &pi) in self.cons.row_points().iter().enumerate() {
             let Some(pt) = points.get(pi) else { continue };
             let rn = 3 * ci;
-            let f = Vector3::new(rows.lambda[rn + 1], rows.lambda[rn + 2], rows.lambda[rn]);
-            let anchor = pt.point + Vector3::z() * self.rolling_radius(pt.shape);
+            // the rows (n, t₁, t₂): the ground's (z, x, y), an obstacle's own
+            let (t1, t2) = tangents(&pt.normal);
+            let f =
+                pt.normal * rows.lambda[rn] + t1 * rows.lambda[rn + 1] + t2 * rows.lambda[rn + 2];
+            let anchor = pt.point + pt.normal * self.rolling_radius(pt);
             let t = point_second_derivatives(self, pt.body, &pt.point, &anchor);
             for (a, &(ca, _)) in t.cols.iter().enumerate() {
                 for (b, &(cb, _)) in t.cols.iter().enumerate() {
@@ -172,9 +191,9 @@ impl Simulation {
                     gc[(ca, cb)] += d.dot(&f);
                     // (∂J/∂q_cb v⁺) for the rows z (normal), x, y
                     let wd = d * vplus[ca];
-                    jq[(rn, cb)] += wd.z;
-                    jq[(rn + 1, cb)] += wd.x;
-                    jq[(rn + 2, cb)] += wd.y;
+                    jq[(rn, cb)] += wd.dot(&pt.normal);
+                    jq[(rn + 1, cb)] += wd.dot(&t1);
+                    jq[(rn + 2, cb)] += wd.dot(&t2);
                 }
             }
         }
@@ -314,42 +333,35 @@ impl Simulation {
         Ok(self.output_map(&vtot, &dvplus, h))
     }
 
-    /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces), by
-    /// central differences of RNEA (ε = 1e-6) until the analytic
-    /// `rnea_derivatives` of issue 21 lands (then: one call here).
+    /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces): the
+    /// analytic [`rnea_derivatives`] (docs/theory.md §"Derivatives"); the
+    /// simulation's kinematics are left at `q`.
     pub(super) fn id_derivatives(
         &mut self,
         q: &DVector<f64>,
         v: &DVector<f64>,
         a: &DVector<f64>,
     ) -> Result<(DMatrix<f64>, DMatrix<f64>), SimError> {
-        let n = self.model.nv;
-        let mut dq = DMatrix::zeros(n, n);
-        let mut dv = DMatrix::zeros(n, n);
-        let eps = 1e-6;
-        for k in 0..n {
-            let mut e = DVector::zeros(n);
-            e[k] = eps;
-            let qp = integrate(&self.model, q, &e).map_err(|e| SimError::Invalid(e.to_string()))?;
-            let tp = rnea(&self.model, &mut self.data, &qp, v, a, None)?.clone();
-            let qm =
-                integrate(&self.model, q, &(-&e)).map_err(|e| SimError::Invalid(e.to_string()))?;
-            let tm = rnea(&self.model, &mut self.data, &qm, v, a, None)?.clone();
-            dq.column_mut(k).copy_from(&((tp - tm) / (2.0 * eps)));
-            let tp = rnea(&self.model, &mut self.data, q, &(v + &e), a, None)?.clone();
-            let tm = rnea(&self.model, &mut self.data, q, &(v - &e), a, None)?.clone();
-            dv.column_mut(k).copy_from(&((tp - tm) / (2.0 * eps)));
-        }
+        rnea_derivatives(&self.model, &mut self.data, q, v, a, None)?;
+        let (dq, dv) = (self.data.dtau_dq.clone(), self.data.dtau_dv.clone());
         forward_kinematics(&self.model, &mut self.data, q)?;
         Ok((dq, dv))
     }
 
     /// The radius of a contact shape that rolls (sphere, capsule): its contact
     /// point is that far below the centre it moves with; 0 for vertices.
-    fn rolling_radius(&self, shape: usize) -> f64 {
+    fn rolling_radius(&self, pt: &ContactPoint) -> f64 {
+        if pt.other_geom != NO_GEOM {
+            // an obstacle's point: a sphere or capsule rolls on it too
+            return match self.model.collisions.get(pt.geom).map(|g| &g.shape) {
+                Some(Shape::Sphere { radius }) | Some(Shape::Capsule { radius, .. }) => *radius,
+                _ => 0.0,
+            };
+        }
         self.contact
             .as_ref()
-            .and_then(|c| c.shapes.get(shape))
+            .and_then(|c| c.ground.as_ref())
+            .and_then(|g| g.shapes.get(pt.shape))
             .map_or(0.0, |s| s.rolling_radius())
     }
 

@@ -18,7 +18,6 @@ impl Simulation {
         eps: f64,
     ) -> Result<TransitionJacobians, SimError> {
         let nv = self.model.nv;
-        let vo = self.model.joint_v_offset();
         let (q0, v0) = self.fresh_step(q, v, tau)?;
         let mut a = DMatrix::zeros(2 * nv, 2 * nv);
         let mut b = DMatrix::zeros(2 * nv, nv);
@@ -34,7 +33,7 @@ impl Simulation {
         // 3 kinds of column: δq (0), δv (1), δτ (2)
         for kind in 0..3 {
             for j in 0..nv {
-                if kind == 2 && j < vo {
+                if kind == 2 && self.servo.iq[j] == crate::sim::servo::FREE {
                     continue;
                 }
                 let mut col = DVector::zeros(2 * nv);

@@ -17,6 +17,7 @@ mod fd;
 mod smooth;
 
 use crate::model::configuration::{difference, integrate};
+use crate::sim::servo::FREE;
 use crate::sim::{SimError, Simulation};
 use nalgebra::{DMatrix, DVector};
 
@@ -115,7 +116,11 @@ impl Simulation {
         }
         self.fresh_state(q, v)?;
         match method {
-            JacobianMethod::Analytic => self.analytic_jacobians(tau),
+            JacobianMethod::Analytic => match self.analytic_jacobians(tau)? {
+                Some(j) => Ok(j),
+                // where the analytic route does not reach: central differences
+                None => self.fd_jacobians(q, v, tau, true, 1e-6),
+            },
             JacobianMethod::Forward | JacobianMethod::Central => {
                 self.fd_jacobians(q, v, tau, method == JacobianMethod::Central, eps)
             }
@@ -160,10 +165,10 @@ impl Simulation {
 
     /// The applied torques: `tau`'s joint entries, the floating base's zero.
     pub(in crate::sim) fn set_joint_torques(&mut self, tau: &DVector<f64>) {
-        let vo = self.model.joint_v_offset();
+        let free: Vec<bool> = (0..tau.len()).map(|k| self.servo.iq[k] == FREE).collect();
         let t = self.torques_mut();
         for k in 0..t.len() {
-            t[k] = if k < vo { 0.0 } else { tau[k] };
+            t[k] = if free[k] { 0.0 } else { tau[k] };
         }
     }
 }

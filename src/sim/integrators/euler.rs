@@ -18,8 +18,8 @@ impl Simulation {
         // v* = v + h H̃⁻¹(τ − C − D v); without rows, damping or armature H̃ = H
         // and the engine's forward dynamics (ABA or CRBA + LTDL) is fastest
         self.free_velocity(h, rows || self.has_damping || self.has_armature)?;
-        if self.model.floating_base {
-            add_frame_rate(&mut self.mass.vfree, &self.v, h);
+        for f in &self.model.free_joints {
+            add_frame_rate(&mut self.mass.vfree, &self.v, h, f.iv);
         }
         self.rhs_evals += 1;
         // v⁺ = v* + H̃⁻¹Jᵀλ; the configuration moves by v⁺ + w
@@ -98,11 +98,17 @@ impl Simulation {
 /// a_lin + ω × v_lin (the spatial body-frame acceleration misses the frame's own
 /// rotation); it is rotated into the new frame after the position update. Done
 /// this way the rotation of the body-frame velocity is exact and adds no energy.
-pub(in crate::sim) fn add_frame_rate(v_new: &mut DVector<f64>, v_old: &DVector<f64>, h: f64) {
-    let w = Vector3::new(v_old[3], v_old[4], v_old[5]);
-    let vl = Vector3::new(v_old[0], v_old[1], v_old[2]);
+/// `iv`: the free joint's first velocity coordinate.
+pub(in crate::sim) fn add_frame_rate(
+    v_new: &mut DVector<f64>,
+    v_old: &DVector<f64>,
+    h: f64,
+    iv: usize,
+) {
+    let w = Vector3::new(v_old[iv + 3], v_old[iv + 4], v_old[iv + 5]);
+    let vl = Vector3::new(v_old[iv], v_old[iv + 1], v_old[iv + 2]);
     let d = w.cross(&vl) * h;
-    v_new[0] += d.x;
-    v_new[1] += d.y;
-    v_new[2] += d.z;
+    v_new[iv] += d.x;
+    v_new[iv + 1] += d.y;
+    v_new[iv + 2] += d.z;
 }

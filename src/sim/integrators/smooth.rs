@@ -5,7 +5,7 @@
 use super::solve_rows;
 use crate::dynamics::linalg::{chol_solve_slice, cholesky_fast};
 use crate::dynamics::{bias, forward_dynamics, mass_matrix, DynamicsError};
-use crate::model::configuration::{config_rate, normalize_quat};
+use crate::model::configuration::{config_rate, normalize_quats};
 use crate::sim::{SimError, Simulation};
 
 /// Which state vector the right-hand side reads.
@@ -31,13 +31,10 @@ impl Simulation {
         };
         w.qn.copy_from(&y.rows(0, nq));
         w.vv.copy_from(&y.rows(nq, nv));
-        if model.floating_base {
-            normalize_quat(&mut w.qn);
-        }
-        let (qo, vo) = (model.joint_q_offset(), model.joint_v_offset());
+        normalize_quats(model, &mut w.qn);
         for k in 0..nv {
             let (t, e) = (self.tau_applied[k], self.effort[k]);
-            w.tau[k] = self.servo.rhs_torque(t, e, &w.qn, &w.vv, qo, vo, k) + w.tau_c[k];
+            w.tau[k] = self.servo.rhs_torque(t, e, &w.qn, &w.vv, k) + w.tau_c[k];
         }
         if self.has_damping {
             for k in 0..nv {
@@ -79,9 +76,7 @@ impl Simulation {
         let src = if from_new { &w.y_new } else { &w.y };
         self.q.copy_from(&src.rows(0, nq));
         self.v.copy_from(&src.rows(nq, self.model.nv));
-        if self.model.floating_base {
-            normalize_quat(&mut self.q);
-        }
+        normalize_quats(&self.model, &mut self.q);
     }
 
     /// Joint friction for a smooth step of length `h` (no contact, no limit
@@ -123,12 +118,11 @@ impl Simulation {
         if !self.opts.joint_dynamics {
             return moved;
         }
-        let (qo, vo) = (self.model.joint_q_offset(), self.model.joint_v_offset());
-        for (d, info) in self.model.dofs.iter().enumerate() {
+        for (d, iq, iv) in self.model.dof_indices() {
+            let info = &self.model.dofs[d];
             if info.continuous {
                 continue;
             }
-            let (iq, iv) = (qo + d, vo + d);
             if let Some(lo) = info.limits.lower {
                 if self.q[iq] < lo {
                     moved = true;

@@ -1,0 +1,170 @@
+//! The replay page of a scene (scene.md "Names and output"): every model's
+//! visual geometry (links `MODEL/LINK`), every obstacle on the world body, the
+//! height field as a triangulated surface.
+
+use super::{
+    read_trajectory, write_page, Geometry, PageSummary, Recorder, ViewError, Visual, VisualShape,
+    MAX_MESH_TRIANGLES, MAX_PAGE_TRIANGLES,
+};
+use crate::contact::mesh::{load_mesh, TriMesh};
+use crate::model::Shape;
+use crate::scene::{HeightFieldSpec, Scene};
+use nalgebra::Vector3;
+use std::path::PathBuf;
+
+/// The colour of obstacles (stone grey).
+const OBSTACLE_RGBA: [f64; 4] = [0.55, 0.52, 0.48, 1.0];
+
+/// `urdyn view --scene SCENE.json TRAJ.csv --out PAGE.html`'s options.
+#[derive(Clone, Debug)]
+pub struct SceneViewArgs {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// The trajectory CSV that `simulate --scene ... --out` wrote.
+    pub traj: PathBuf,
+    /// Roots for `package://NAME/...` mesh paths.
+    pub package_path: Vec<PathBuf>,
+    /// The page to write (atomically).
+    pub out: PathBuf,
+}
+
+/// Runs `urdyn view --scene`: reads the scene and the CSV, writes the page
+/// atomically (a bad input leaves no page).
+pub fn run_scene(args: &SceneViewArgs) -> Result<PageSummary, ViewError> {
+    let scene = Scene::from_file(&args.scene, &args.package_path)
+        .map_err(|e| ViewError::Geometry(e.to_string()))?;
+    let geometry = Geometry::load_scene(&scene, &args.package_path)?;
+    let csv_name = args.traj.display().to_string();
+    let text = std::fs::read(&args.traj)
+        .map_err(|e| ViewError::Csv(format!("{csv_name}: cannot read: {e}")))?;
+    let text = String::from_utf8(text)
+        .map_err(|_| ViewError::Csv(format!("{csv_name}: not UTF-8 text")))?;
+    let rows = read_trajectory(&text, &csv_name, &scene.model)?;
+    let mut recorder = Recorder::new(&scene.model, rows.duration(), false);
+    let last = rows.times.len().saturating_sub(1);
+    for (k, t) in rows.times.iter().enumerate() {
+        let plot = [rows.energy[k], rows.contacts[k], rows.penetration[k]];
+        recorder.offer(*t, &rows.q[k], plot, &[], k == last);
+    }
+    write_page(
+        &args.out,
+        &scene.model,
+        &geometry,
+        &recorder,
+        scene.ground.map(|g| g.height),
+    )
+}
+
+impl Geometry {
+    /// The drawn geometry of a scene: each model's URDF visuals (as
+    /// [`Geometry::load`], links `MODEL/LINK`) and every obstacle.
+    pub fn load_scene(scene: &Scene, package_paths: &[PathBuf]) -> Result<Self, ViewError> {
+        let mut all = Geometry::default();
+        for m in &scene.models {
+            let g = Geometry::load_prefixed(
+                &scene.model,
+                &m.urdf,
+                &format!("{}/", m.name),
+                package_paths,
+            )?;
+            all.append(g);
+        }
+        for o in &scene.obstacles {
+            let shape = match &o.shape {
+                Shape::Box { size } => VisualShape::Box(*size),
+                &Shape::Cylinder { radius, length } => VisualShape::Cylinder { radius, length },
+                &Shape::Capsule { radius, length } => VisualShape::Capsule { radius, length },
+                &Shape::Sphere { radius } => VisualShape::Sphere { radius },
+                Shape::Mesh { filename, scale } => {
+                    let m = load_mesh(std::path::Path::new(filename), *scale).map_err(|e| {
+                        ViewError::Geometry(format!("{}: obstacle \"{}\": {e}", scene.file, o.name))
+                    })?;
+                    all.meshes.push(m);
+                    VisualShape::Mesh(all.meshes.len() - 1)
+                }
+                Shape::HeightField { heights, size } => {
+                    all.meshes.push(height_field_mesh(&HeightFieldSpec {
+                        heights: heights.clone(),
+                        size: *size,
+                    }));
+                    VisualShape::Mesh(all.meshes.len() - 1)
+                }
+            };
+            all.visuals.push(Visual {
+                link: o.name.clone(),
+                body: 0,
+                placement: o.placement,
+                shape,
+                rgba: OBSTACLE_RGBA,
+            });
+        }
+        all.simplify_to(MAX_MESH_TRIANGLES, MAX_PAGE_TRIANGLES);
+        Ok(all)
+    }
+
+    /// Takes `other`'s meshes and visuals (its mesh indices moved past ours).
+    fn append(&mut self, other: Geometry) {
+        let off = self.meshes.len();
+        self.meshes.extend(other.meshes);
+        self.simplified += other.simplified;
+        self.warnings.extend(other.warnings);
+        self.visuals.extend(other.visuals.into_iter().map(|mut v| {
+            if let VisualShape::Mesh(k) = &mut v.shape {
+                *k += off;
+            }
+            v
+        }));
+    }
+}
+
+/// The height field's surface: one vertex a grid point (rows along y from −y,
+/// each along x from −x, centred on the frame), two triangles a cell, facing up.
+pub fn height_field_mesh(h: &HeightFieldSpec) -> TriMesh {
+    let (nr, nc) = (h.heights.len(), h.heights.first().map_or(0, Vec::len));
+    let mut m = TriMesh::default();
+    if nr < 2 || nc < 2 {
+        return m;
+    }
+    let (sx, sy) = (h.size[0], h.size[1]);
+    for (r, row) in h.heights.iter().enumerate() {
+        for (c, &z) in row.iter().enumerate() {
+            // x, y = −s/2 + index · s / (n − 1)
+            let x = -0.5 * sx + c as f64 * sx / (nc - 1) as f64;
+            let y = -0.5 * sy + r as f64 * sy / (nr - 1) as f64;
+            m.vertices.push(Vector3::new(x, y, z));
+        }
+    }
+    for r in 0..nr - 1 {
+        for c in 0..nc - 1 {
+            let a = (r * nc + c) as u32;
+            let (b, d, e) = (a + 1, a + nc as u32, a + nc as u32 + 1);
+            m.triangles.push([a, b, e]);
+            m.triangles.push([a, e, d]);
+        }
+    }
+    m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn height_field_surface_spans_the_grid() {
+        let h = HeightFieldSpec {
+            heights: vec![vec![0.0, 0.1, 0.2], vec![0.3, 0.4, 0.5]],
+            size: [4.0, 2.0],
+        };
+        let m = height_field_mesh(&h);
+        assert_eq!(m.vertices.len(), 6);
+        assert_eq!(m.triangles.len(), 4);
+        // corner (row 1, col 2): +x, +y, height 0.5
+        assert_eq!(m.vertices[5], Vector3::new(2.0, 1.0, 0.5));
+        assert_eq!(m.vertices[0], Vector3::new(-2.0, -1.0, 0.0));
+        // every triangle faces up (counter-clockwise seen from +z)
+        for t in &m.triangles {
+            let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+            assert!((b - a).cross(&(c - a)).z > 0.0);
+        }
+    }
+}

@@ -1,0 +1,243 @@
+//! Building the ground path's shapes from the model's collision geometry.
+
+use super::super::shapes::rot_x90;
+use super::super::{mesh, ContactError, ContactParams, ContactPoint, NO_GEOM};
+use super::reduce::reduce_directions;
+use super::{GroundContact, GroundShape, Manifold, ParryShape};
+use crate::contact::resolve_mesh_path;
+use crate::model::{Model, Shape};
+use crate::spatial::Se3;
+use nalgebra::Vector3;
+use parry3d_f64::math::Vector as PVec;
+use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder};
+use std::path::PathBuf;
+
+/// Hulls with more vertices than this are searched on their vertex graph
+/// instead of scanned whole.
+const GRAPH_SEARCH_MIN: usize = 24;
+
+const CYL_SAMPLES: usize = 6;
+
+/// The compressed adjacency of a hull's vertex graph from its edges.
+fn hull_adjacency(h: &ConvexPolyhedron) -> (Vec<u32>, Vec<u32>) {
+    let n = h.points().len();
+    let mut nb: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for e in h.edges() {
+        let [a, b] = e.vertices;
+        if (a as usize) < n && (b as usize) < n && a != b {
+            nb[a as usize].push(b);
+            nb[b as usize].push(a);
+        }
+    }
+    let mut start = Vec::with_capacity(n + 1);
+    let mut adj = Vec::new();
+    for list in &mut nb {
+        list.sort_unstable();
+        list.dedup();
+        start.push(adj.len() as u32);
+        adj.extend_from_slice(list);
+    }
+    start.push(adj.len() as u32);
+    (start, adj)
+}
+
+impl GroundContact {
+    /// Builds the contact shapes of `model` (meshes are read here). Returns `None`
+    /// when no moving link has collision geometry: such a scene does no contact work.
+    pub fn build(
+        model: &Model,
+        ground: f64,
+        params: ContactParams,
+        package_paths: &[PathBuf],
+    ) -> Result<Option<Self>, ContactError> {
+        let mut shapes = Vec::new();
+        for (gi, g) in model.collisions.iter().enumerate() {
+            if g.body == 0 {
+                continue; // welded to the world
+            }
+            let link = g.link.clone();
+            let bad = |kind| ContactError::BadSize {
+                link: link.clone(),
+                kind,
+            };
+            let pos = |x: f64| x.is_finite() && x >= 0.0;
+            let mut graph = (Vec::new(), Vec::new());
+            let (shape, manifold, verts, parry_offset) = match &g.shape {
+                Shape::Box { size } => {
+                    if !size.iter().all(|&s| pos(s)) {
+                        return Err(bad("box"));
+                    }
+                    let h = Vector3::new(size[0] / 2.0, size[1] / 2.0, size[2] / 2.0);
+                    let mut v = Vec::with_capacity(8);
+                    for k in 0..8 {
+                        let sx = if k & 1 == 0 { -1.0 } else { 1.0 };
+                        let sy = if k & 2 == 0 { -1.0 } else { 1.0 };
+                        let sz = if k & 4 == 0 { -1.0 } else { 1.0 };
+                        v.push(Vector3::new(sx * h.x, sy * h.y, sz * h.z));
+                    }
+                    (
+                        ParryShape::Cuboid(Cuboid::new(PVec::new(h.x, h.y, h.z))),
+                        Manifold::Vertices,
+                        v,
+                        Se3::identity(),
+                    )
+                }
+                Shape::Sphere { radius } => {
+                    if !pos(*radius) {
+                        return Err(bad("sphere"));
+                    }
+                    (
+                        ParryShape::Ball(Ball::new(*radius)),
+                        Manifold::Sphere(*radius),
+                        Vec::new(),
+                        Se3::identity(),
+                    )
+                }
+                Shape::Capsule { radius, length } => {
+                    if !pos(*radius) || !pos(*length) {
+                        return Err(bad("capsule"));
+                    }
+                    (
+                        ParryShape::Capsule(Capsule::new_z(length / 2.0, *radius)),
+                        Manifold::Capsule {
+                            half: length / 2.0,
+                            radius: *radius,
+                        },
+                        Vec::new(),
+                        Se3::identity(),
+                    )
+                }
+                Shape::Cylinder { radius, length } => {
+                    if !pos(*radius) || !pos(*length) {
+                        return Err(bad("cylinder"));
+                    }
+                    let half = length / 2.0;
+                    let mut v = Vec::with_capacity(2 * CYL_SAMPLES);
+                    for s in [-1.0, 1.0] {
+                        for k in 0..CYL_SAMPLES {
+                            let a = std::f64::consts::TAU * (k as f64) / (CYL_SAMPLES as f64);
+                            v.push(Vector3::new(radius * a.cos(), radius * a.sin(), s * half));
+                        }
+                    }
+                    (
+                        ParryShape::Cylinder(Cylinder::new(half, *radius)),
+                        Manifold::Cylinder {
+                            half,
+                            radius: *radius,
+                        },
+                        v,
+                        Se3::from_rotation(rot_x90()),
+                    )
+                }
+                Shape::Mesh { filename, scale } => {
+                    let path = resolve_mesh_path(filename, model.source.as_deref(), package_paths)
+                        .ok_or_else(|| ContactError::MissingMesh {
+                            link: link.clone(),
+                            file: filename.clone(),
+                        })?;
+                    let pts = mesh::load_vertices(&path, *scale).map_err(|source| {
+                        ContactError::Mesh {
+                            link: link.clone(),
+                            source,
+                        }
+                    })?;
+                    let pv: Vec<PVec> = pts.iter().map(|p| PVec::new(p.x, p.y, p.z)).collect();
+                    match ConvexPolyhedron::from_convex_hull(&pv) {
+                        Some(h) => {
+                            let v: Vec<_> = h
+                                .points()
+                                .iter()
+                                .map(|p| Vector3::new(p.x, p.y, p.z))
+                                .collect();
+                            if v.len() > GRAPH_SEARCH_MIN {
+                                graph = hull_adjacency(&h);
+                            }
+                            (ParryShape::Hull(h), Manifold::Vertices, v, Se3::identity())
+                        }
+                        None => {
+                            let mut v = pts;
+                            v.dedup();
+                            (ParryShape::Points, Manifold::Vertices, v, Se3::identity())
+                        }
+                    }
+                }
+                // (a scene's terrain is welded to the world: never a moving link's)
+                Shape::HeightField { .. } => continue,
+            };
+            let nslots = match manifold {
+                Manifold::Vertices => verts.len(),
+                Manifold::Sphere(_) => 1,
+                Manifold::Capsule { .. } => 2,
+                Manifold::Cylinder { .. } => 2 + verts.len(),
+            };
+            let bound = match manifold {
+                Manifold::Vertices => verts.iter().map(|v| v.norm()).fold(0.0, f64::max),
+                Manifold::Sphere(r) => r,
+                Manifold::Capsule { half, radius } => half + radius,
+                Manifold::Cylinder { half, radius } => half.hypot(radius),
+            };
+            shapes.push(GroundShape {
+                body: g.body,
+                geom: gi,
+                template: ContactPoint {
+                    shape: 0,
+                    slot: 0,
+                    body: g.body,
+                    point: Vector3::zeros(),
+                    gap: 0.0,
+                    geom: gi,
+                    other: 0,
+                    other_geom: NO_GEOM,
+                    normal: Vector3::z(),
+                    friction: g.friction.max(params.friction),
+                    fresh: false,
+                    key: 0,
+                },
+                link,
+                placement: g.placement,
+                parry_offset,
+                shape,
+                manifold,
+                verts,
+                adj_start: graph.0,
+                adj: graph.1,
+                nslots,
+                bound,
+            });
+        }
+        if shapes.is_empty() {
+            return Ok(None);
+        }
+        let mut slot_offset = Vec::with_capacity(shapes.len());
+        let mut n = 0;
+        for s in &shapes {
+            slot_offset.push(n);
+            n += s.nslots;
+        }
+        let cap = shapes.iter().map(|s| s.nslots).max().unwrap_or(0);
+        let nshapes = shapes.len();
+        Ok(Some(Self {
+            shapes,
+            ground,
+            params,
+            queries: 0,
+            slot_offset,
+            nslots: n,
+            scratch: Vec::with_capacity(cap),
+            prev_flag: vec![false; n],
+            prev_list: Vec::with_capacity(n),
+            prev_range: vec![(0, 0); nshapes],
+            reduce_dirs: reduce_directions(params.max_points_per_shape),
+            last_low: vec![0; nshapes],
+            visited: vec![0; n],
+            generation: 0,
+            in_band: vec![0; n],
+            band_order: vec![0; n],
+            band_rim: vec![0; n],
+            band_len: vec![0; nshapes],
+            rim_len: vec![0; nshapes],
+            band_gen: vec![0; nshapes],
+            stack: Vec::with_capacity(n),
+        }))
+    }
+}

@@ -1,0 +1,110 @@
+//! The whole contact pipeline of a simulation: the ground's fast path, then the
+//! pairs (obstacles, other bodies, self-collision).
+
+use super::filter::DroppedPair;
+use super::ground::GroundContact;
+use super::pairs::PairContact;
+use super::{ContactError, ContactParams, ContactPoint};
+use crate::model::Model;
+use crate::spatial::Se3;
+use std::path::PathBuf;
+
+/// Every shape that can touch something, and where its points go.
+#[derive(Clone, Debug)]
+pub struct Collision {
+    /// Contact with the ground plane (`None`: no ground, or no moving shape).
+    pub ground: Option<GroundContact>,
+    /// Contact between pairs of shapes (`None`: no pair may touch).
+    pub pairs: Option<PairContact>,
+    /// The pairs dropped at the start (scene.md rule 4), as last decided.
+    pub dropped: Vec<DroppedPair>,
+    /// The contact parameters it was built with.
+    pub params: ContactParams,
+    /// Total number of slots (ground first, then pairs).
+    pub nslots: usize,
+}
+
+impl Collision {
+    /// The pipeline of `model` with the ground at `ground` (`None`: no
+    /// ground); `None` when nothing can touch anything (no contact work).
+    pub fn build(
+        model: &Model,
+        ground: Option<f64>,
+        params: ContactParams,
+        package_paths: &[PathBuf],
+    ) -> Result<Option<Self>, ContactError> {
+        let g = match ground {
+            Some(h) => GroundContact::build(model, h, params, package_paths)?,
+            None => None,
+        };
+        let offset = g.as_ref().map_or(0, |g| g.nslots);
+        let pairs = PairContact::build(model, &params, package_paths, offset)?;
+        if g.is_none() && pairs.is_none() {
+            return Ok(None);
+        }
+        let nslots = offset + pairs.as_ref().map_or(0, |p| p.nslots);
+        Ok(Some(Self {
+            ground: g,
+            pairs,
+            dropped: Vec::new(),
+            params,
+            nslots,
+        }))
+    }
+
+    /// The ground height, when there is a ground.
+    pub fn ground_height(&self) -> Option<f64> {
+        self.ground.as_ref().map(|g| g.ground)
+    }
+
+    /// Narrow-phase queries so far (ground shapes and pairs).
+    pub fn queries(&self) -> u64 {
+        self.ground.as_ref().map_or(0, |g| g.queries) + self.pairs.as_ref().map_or(0, |p| p.queries)
+    }
+
+    /// The largest number of points a detection returns without allocating.
+    pub fn max_points(&self) -> usize {
+        self.ground.as_ref().map_or(0, |g| g.max_points())
+            + self.pairs.as_ref().map_or(0, |p| p.max_points())
+    }
+
+    /// The lowest point of the moving shapes (the ground path's; +∞ without).
+    pub fn lowest_point(&self, o_m_i: &[Se3<f64>]) -> f64 {
+        self.ground
+            .as_ref()
+            .map_or(f64::INFINITY, |g| g.lowest_point(o_m_i))
+    }
+
+    /// Forgets what earlier detections left (kept points, search starts,
+    /// the pairs' manifolds and slot features): the next detection finds what
+    /// a newly built pipeline would.
+    pub fn forget_history(&mut self) {
+        if let Some(g) = self.ground.as_mut() {
+            g.forget_history();
+        }
+        if let Some(p) = self.pairs.as_mut() {
+            p.forget_history();
+        }
+    }
+
+    /// Every contact point at the body poses `o_m_i`, into `out` (cleared).
+    pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>) {
+        out.clear();
+        if let Some(g) = self.ground.as_mut() {
+            g.detect(o_m_i, out);
+        }
+        if let Some(p) = self.pairs.as_mut() {
+            p.detect(o_m_i, out);
+        }
+    }
+
+    /// Decides anew which self pairs overlap at the start (scene.md rule 4)
+    /// at the body poses `o_m_i`; returns them (also kept in `dropped`).
+    pub fn drop_start_overlaps(&mut self, model: &Model, o_m_i: &[Se3<f64>]) -> &[DroppedPair] {
+        self.dropped = match self.pairs.as_mut() {
+            Some(p) => p.drop_start_overlaps(model, o_m_i),
+            None => Vec::new(),
+        };
+        &self.dropped
+    }
+}

@@ -1,0 +1,218 @@
+//! The parry3d-f64 shape of a collision geometry for pair contact, and the
+//! conversions at the boundary between the engine's nalgebra types and parry's
+//! glam types (nothing else in the crate sees glam).
+//!
+//! box → `Cuboid`, sphere → `Ball`, capsule → `Capsule` (z axis), cylinder →
+//! `Cylinder` (parry's axis is y: a fixed +90° x-rotation is folded into the
+//! shape's offset), a URDF link's mesh → the `ConvexPolyhedron` hull of its
+//! vertices, an obstacle's mesh (`trimesh`) → the `TriMesh` it is, a height
+//! field → `HeightField` (parry's grid lies in its x–z plane with heights along
+//! y: the same +90° x-rotation maps parry's (x, y, z) to the frame's (x, z, −y),
+//! so parry's row i, along +z, is the frame's row from +y: the rows are
+//! reversed).
+
+use super::mesh;
+use super::paths::resolve_mesh_path;
+use super::ContactError;
+use crate::model::{CollisionGeom, Model, Shape};
+use crate::spatial::Se3;
+use nalgebra::{Matrix3, Vector3};
+use parry3d_f64::math::{Pose, Vector as PVec};
+use parry3d_f64::shape::SharedShape;
+use std::path::PathBuf;
+
+/// A collision geometry as parry sees it.
+#[derive(Clone)]
+pub(crate) struct PairShape {
+    /// The parry shape, in its own frame.
+    pub shape: SharedShape,
+    /// `geom_M_parry`: parry's frame in the geometry frame.
+    pub offset: Se3<f64>,
+    /// Radius of a sphere about the geometry origin that holds the shape (the
+    /// broad phase's box is its centre ± this; +∞ for an unbounded shape).
+    pub bound: f64,
+    /// Centre of that sphere in the geometry frame.
+    pub centre: Vector3<f64>,
+    /// Whether parry treats it as convex (a support map).
+    pub convex: bool,
+}
+
+impl std::fmt::Debug for PairShape {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PairShape")
+            .field("shape", &self.shape.shape_type())
+            .field("bound", &self.bound)
+            .finish()
+    }
+}
+
+/// The rotation of +90° about x (y → z, z → −y).
+pub(crate) fn rot_x90() -> Matrix3<f64> {
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0)
+}
+
+/// An engine placement as a parry pose.
+pub(crate) fn to_pose(m: &Se3<f64>) -> Pose {
+    let r = &m.rot;
+    let mat = parry3d_f64::math::Mat3::from_cols_array(&[
+        r[(0, 0)],
+        r[(1, 0)],
+        r[(2, 0)],
+        r[(0, 1)],
+        r[(1, 1)],
+        r[(2, 1)],
+        r[(0, 2)],
+        r[(1, 2)],
+        r[(2, 2)],
+    ]);
+    let q = parry3d_f64::math::Rot3::from_mat3(&mat).normalize();
+    Pose::from_parts(PVec::new(m.trans.x, m.trans.y, m.trans.z), q)
+}
+
+/// A parry vector as an engine vector.
+#[inline]
+pub(crate) fn from_pvec(v: PVec) -> Vector3<f64> {
+    Vector3::new(v.x, v.y, v.z)
+}
+
+/// The vertices of a link's collision mesh (resolved, read, scaled).
+pub(crate) fn mesh_vertices(
+    g: &CollisionGeom,
+    filename: &str,
+    scale: [f64; 3],
+    model: &Model,
+    package_paths: &[PathBuf],
+) -> Result<mesh::TriMesh, ContactError> {
+    let path =
+        resolve_mesh_path(filename, model.source.as_deref(), package_paths).ok_or_else(|| {
+            ContactError::MissingMesh {
+                link: g.link.clone(),
+                file: filename.to_string(),
+            }
+        })?;
+    let wrap = |source| ContactError::Mesh {
+        link: g.link.clone(),
+        source,
+    };
+    if g.trimesh {
+        mesh::load_mesh(&path, scale).map_err(wrap)
+    } else {
+        Ok(mesh::TriMesh {
+            vertices: mesh::load_vertices(&path, scale).map_err(wrap)?,
+            triangles: Vec::new(),
+        })
+    }
+}
+
+/// The parry shape of `g`; `None` for a shape that cannot collide (a flat or
+/// empty mesh: the ground path still handles its points).
+pub(crate) fn pair_shape(
+    g: &CollisionGeom,
+    model: &Model,
+    package_paths: &[PathBuf],
+) -> Result<Option<PairShape>, ContactError> {
+    let bad = |kind| ContactError::BadSize {
+        link: g.link.clone(),
+        kind,
+    };
+    let pos = |x: f64| x.is_finite() && x >= 0.0;
+    let id = Se3::identity();
+    let (shape, offset, convex) = match &g.shape {
+        Shape::Box { size } => {
+            if !size.iter().all(|&s| pos(s)) {
+                return Err(bad("box"));
+            }
+            (
+                SharedShape::cuboid(size[0] / 2.0, size[1] / 2.0, size[2] / 2.0),
+                id,
+                true,
+            )
+        }
+        Shape::Sphere { radius } => {
+            if !pos(*radius) {
+                return Err(bad("sphere"));
+            }
+            (SharedShape::ball(*radius), id, true)
+        }
+        Shape::Capsule { radius, length } => {
+            if !pos(*radius) || !pos(*length) {
+                return Err(bad("capsule"));
+            }
+            (SharedShape::capsule_z(length / 2.0, *radius), id, true)
+        }
+        Shape::Cylinder { radius, length } => {
+            if !pos(*radius) || !pos(*length) {
+                return Err(bad("cylinder"));
+            }
+            (
+                SharedShape::cylinder(length / 2.0, *radius),
+                Se3::from_rotation(rot_x90()),
+                true,
+            )
+        }
+        Shape::Mesh { filename, scale } => {
+            let m = mesh_vertices(g, filename, *scale, model, package_paths)?;
+            let pv: Vec<PVec> = m
+                .vertices
+                .iter()
+                .map(|p| PVec::new(p.x, p.y, p.z))
+                .collect();
+            if g.trimesh && !m.triangles.is_empty() {
+                match SharedShape::trimesh(pv, m.triangles) {
+                    Ok(s) => (s, id, false),
+                    Err(e) => {
+                        return Err(ContactError::Mesh {
+                            link: g.link.clone(),
+                            source: mesh::MeshError {
+                                file: filename.clone(),
+                                message: format!("not a usable triangle mesh: {e}"),
+                            },
+                        })
+                    }
+                }
+            } else {
+                match SharedShape::convex_hull(&pv) {
+                    Some(s) => (s, id, true),
+                    None => return Ok(None),
+                }
+            }
+        }
+        Shape::HeightField { heights, size } => {
+            let rows = heights.len();
+            let cols = heights.first().map_or(0, Vec::len);
+            let finite = heights.iter().flatten().all(|h| h.is_finite());
+            if rows < 2
+                || cols < 2
+                || heights.iter().any(|r| r.len() != cols)
+                || !finite
+                || !size.iter().all(|&s| s.is_finite() && s > 0.0)
+            {
+                return Err(bad("heightfield"));
+            }
+            // parry: column-major (rows along its z = the frame's −y), so its
+            // row i is the frame's row rows − 1 − i
+            let mut data = Vec::with_capacity(rows * cols);
+            for j in 0..cols {
+                for i in 0..rows {
+                    data.push(heights[rows - 1 - i][j]);
+                }
+            }
+            let a = parry3d_f64::utils::Array2::new(rows, cols, data);
+            (
+                SharedShape::heightfield(a, PVec::new(size[0], 1.0, size[1])),
+                Se3::from_rotation(rot_x90()),
+                false,
+            )
+        }
+    };
+    // the bounding sphere in the geometry frame
+    let bs = shape.compute_local_bounding_sphere();
+    let centre = offset.act_point(&from_pvec(bs.center()));
+    Ok(Some(PairShape {
+        shape,
+        offset,
+        bound: bs.radius(),
+        centre,
+        convex,
+    }))
+}
