@@ -24,6 +24,8 @@ fn hot_path_does_not_allocate() {
         ("assets/robots/solo12.urdf", true),
         ("assets/robots/panda.urdf", false),
         ("assets/synthetic/tree_5.urdf", false),
+        // a long chain: aba_derivatives' low-rank products
+        ("assets/synthetic/chain_100.urdf", false),
     ] {
         let model = urdyn::load_file(root.join(file), LoadOptions { floating_base }).unwrap();
         let mut data = Data::new(&model);

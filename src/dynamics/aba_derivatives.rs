@@ -1,26 +1,29 @@
 //! Analytic first-order derivatives of forward dynamics: ∂q̈/∂q, ∂q̈/∂v and
 //! ∂q̈/∂τ = H⁻¹, from those of inverse dynamics at a = q̈ (docs/theory.md
 //! §"Derivatives": q̈(q, v, τ) solves ID(q, v, q̈) = τ, so
-//! ∂q̈/∂x = −H⁻¹ ∂ID/∂x).
+//! ∂q̈/∂x = −H⁻¹ ∂ID/∂x; H⁻¹ from the world-frame ABA of `minv.rs`, "Inverse of
+//! H"; the products over ∂ID/∂x's tree pattern, "The products").
 
 use super::rnea_derivatives::{check_wrenches, rnea_derivatives_pass, LinkWrench};
-use super::{check_massless, check_sizes, linalg, ltdl, DynamicsError};
+use super::{check_massless, check_sizes, linalg, minv, DynamicsError};
 use crate::model::{Data, Model};
 use crate::spatial::ops::madd;
 use crate::spatial::{Force, Scalar};
-use nalgebra::{DMatrix, DVector};
-
-const NONE: usize = usize::MAX;
+use nalgebra::{DMatrix, DVector, Vector3};
 
 /// The derivatives of forward dynamics q̈ = FD(q, v, τ) with the wrenches `fext`
 /// (docs/theory.md §"Derivatives"): `data.dqdd_dq` = ∂q̈/∂q (tangent space, as
 /// [`super::rnea_derivatives`]), `data.dqdd_dv` = ∂q̈/∂v, `data.minv` = H⁻¹ = ∂q̈/∂τ
 /// (whole, symmetric; a floating base's first 6 columns are those of its body-frame
 /// wrench), `data.qdd` = q̈. Every model: fixed, floating, mimic (the reduced system).
-/// Route: q̈ by the engine's forward dynamics; ∂τ/∂q, ∂τ/∂v and H at a = q̈ by
-/// [`super::rnea_derivatives`]; H factorised (tree-sparse LTDL, dense Cholesky with
-/// mimic joints) and solved against the identity and both Jacobians. Also leaves
-/// `data.dtau_dq`, `data.dtau_dv` (at a = q̈) and `data.h`. No allocation.
+/// Route (docs/theory.md §"Derivatives", "Forward dynamics"): q̈ and H⁻¹ by the
+/// articulated-body recursion in world coordinates ("Inverse of H", O(n·nv));
+/// ∂τ/∂q, ∂τ/∂v at a = q̈ by [`super::rnea_derivatives`]; ∂q̈/∂x = −H⁻¹ ∂τ/∂x by
+/// register-tiled products that read only ∂τ/∂x's tree pattern, or on long chains
+/// from ∂τ/∂x's low-rank parts in O(nv²) ("The products", `data.deriv_low_rank`).
+/// With mimic joints: q̈ by the engine's forward dynamics, H by the derivative
+/// sweep, dense Cholesky solves against the identity and both Jacobians. Also
+/// leaves `data.dtau_dq`, `data.dtau_dv` (at a = q̈) and `data.h`. No allocation.
 pub fn aba_derivatives<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,
@@ -42,6 +45,43 @@ pub fn aba_derivatives<T: Scalar>(
             super::add_link_wrench(model, data, w.frame, &w.force, &w.torque, &mut fb)?;
         }
     }
+    if !model.has_mimic {
+        // q̈ and H⁻¹ by the world-frame ABA (docs/theory.md §"Derivatives",
+        // "Inverse of H")
+        let r = minv::minv_pass(model, data, q, v, tau, fext.map(|_| fb.as_slice()));
+        data.deriv_fext = fb;
+        r?;
+        // ∂τ/∂q, ∂τ/∂v at a = q̈
+        let mut a = std::mem::replace(&mut data.deriv_tmp, DVector::zeros(0));
+        a.copy_from(&data.qdd);
+        rnea_derivatives_pass(model, data, q, v, &a, fext);
+        data.deriv_tmp = a;
+        if data.deriv_low_rank {
+            // ∂q̈/∂x = −H⁻¹ ∂τ/∂x from ∂τ/∂x's low-rank parts (long chains)
+            neg_mul_low_rank(model, data, fext.is_some());
+            return Ok(());
+        }
+        // ∂q̈/∂x = −H⁻¹ ∂τ/∂x over ∂τ/∂x's tree pattern
+        let Data {
+            minv,
+            dqdd_dq,
+            dqdd_dv,
+            dtau_dq,
+            dtau_dv,
+            deriv_dof_end: dof_end,
+            deriv_anc_runs: runs,
+            deriv_anc_run0: run0,
+            ..
+        } = data;
+        let pat = TreePattern {
+            dof_end,
+            runs,
+            run0,
+        };
+        neg_mul_tree(minv, [dtau_dq, dtau_dv], [dqdd_dq, dqdd_dv], &pat);
+        return Ok(());
+    }
+    // mimic joints: the reduced H is not tree-shaped, the dense route
     let r =
         super::forward_dynamics(model, data, q, v, tau, fext.map(|_| fb.as_slice())).map(|_| ());
     data.deriv_fext = fb;
@@ -51,12 +91,8 @@ pub fn aba_derivatives<T: Scalar>(
     a.copy_from(&data.qdd);
     rnea_derivatives_pass(model, data, q, v, &a, fext);
     data.deriv_tmp = a;
-    // H = Lᵀ D L (tree) or L Lᵀ (mimic)
-    if model.has_mimic {
-        linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)?;
-    } else {
-        ltdl::ltdl(&data.h, &model.dof_parent, &mut data.chol).map_err(DynamicsError::Singular)?;
-    }
+    // H = L Lᵀ
+    linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)?;
     let nv = model.nv;
     let Data {
         chol,
@@ -73,28 +109,327 @@ pub fn aba_derivatives<T: Scalar>(
     for k in 0..nv {
         minv[(k, k)] = T::one();
     }
-    solve_rows(model, chol, minv.as_mut_slice());
+    chol_solve_rows(chol.as_slice(), nv, minv.as_mut_slice());
     // ∂q̈/∂x = −solve(H, ∂τ/∂x), on the transpose (H X = B ⇔ Xᵀ H = Bᵀ: every
     // elimination step is one contiguous axpy over all right-hand sides)
     for (out, b) in [(&mut *dqdd_dq, &*dtau_dq), (&mut *dqdd_dv, &*dtau_dv)] {
         b.transpose_to(xt);
-        solve_rows(model, chol, xt.as_mut_slice());
+        chol_solve_rows(chol.as_slice(), nv, xt.as_mut_slice());
         xt.transpose_to(out);
         out.neg_mut();
     }
     Ok(())
 }
 
-/// `X ← H⁻¹ X` for X (nv × nv) given by its rows, row i contiguous at
-/// `x[i nv..(i + 1) nv]` (a column-major Xᵀ), with the factor in `u`.
-fn solve_rows<T: Scalar>(model: &Model<T>, u: &DMatrix<T>, x: &mut [T]) {
-    let n = model.nv;
-    let us = u.as_slice();
-    let x = &mut x[..n * n];
-    if model.has_mimic {
-        chol_solve_rows(us, n, x);
+/// `(xq, xv) += Σₖ cols[k n..(k + 1) n] (cq[k], cv[k])` over the first `K`
+/// columns (one load of each column for both), then negated if `neg`.
+#[inline(always)]
+fn gemv2_add<T: Scalar, const K: usize>(
+    xq: &mut [T],
+    xv: &mut [T],
+    cols: &[T],
+    cq: &[T; 12],
+    cv: &[T; 12],
+    neg: bool,
+) {
+    let n = xq.len();
+    let c: [&[T]; K] = std::array::from_fn(|k| &cols[k * n..(k + 1) * n]);
+    let xv = &mut xv[..n];
+    for i in 0..n {
+        let (mut sq, mut sv) = (xq[i], xv[i]);
+        for k in 0..K {
+            let h = c[k][i];
+            sq = madd(h, cq[k], sq);
+            sv = madd(h, cv[k], sv);
+        }
+        if neg {
+            sq = -sq;
+            sv = -sv;
+        }
+        xq[i] = sq;
+        xv[i] = sv;
+    }
+}
+
+/// `cols[k n..(k + 1) n] += h coef[k]` for the first `K` columns.
+#[inline(always)]
+fn ger_add<T: Scalar, const K: usize>(cols: &mut [T], h: &[T], coef: &[T; 12]) {
+    let n = h.len();
+    for (k, col) in cols.chunks_exact_mut(n).take(K).enumerate() {
+        let ck = coef[k];
+        for (y, &x) in col.iter_mut().zip(h) {
+            *y = madd(x, ck, *y);
+        }
+    }
+}
+
+/// Four 3-vectors `[a; b; c; d]` as 12 coefficients.
+#[inline(always)]
+fn coef12<T: Scalar>(x: [&Vector3<T>; 4]) -> [T; 12] {
+    let mut c = [T::zero(); 12];
+    for (b, v) in x.iter().enumerate() {
+        for r in 0..3 {
+            c[3 * b + r] = v[r];
+        }
+    }
+    c
+}
+
+/// `−H⁻¹ ∂τ/∂q`, `−H⁻¹ ∂τ/∂v` from the low-rank parts of ∂τ/∂x (docs/theory.md
+/// §"Derivatives", "The products"): column c of B (coordinate c on body i) is
+/// `Jᵣᵀ G_c` on the coordinates r of i's strict ancestors (G = ∂F/∂q or ∂F/∂q̇ of
+/// c's column, the subtree's rigid turn included), `αᵣᵀ β_c` on those of its
+/// strict descendants (α = [Yᶜ J; (Ẏᶜᵀ J).ang; e.ang], β = [∂a/∂q; ∂v/∂q.ang; ω]
+/// or [∂a/∂q̇; ω; 0]) and B's own block on i's joint. So
+/// `H⁻¹ B[:, c] = H⁻¹[:, i] B[i, c] + P_i G_c + S_i β_c`, with
+/// `P_i = Σ_{anc} H⁻¹[:, r] Jᵣᵀ` (root outwards) and `S_i = Σ_{desc} H⁻¹[:, r] αᵣᵀ`
+/// (leaves inwards): O(nv²) instead of O(nv³). Reads the derivative sweep's
+/// per-column vectors from `data`; `ext`: wrenches were given (e is set).
+fn neg_mul_low_rank<T: Scalar>(model: &Model<T>, data: &mut Data<T>, ext: bool) {
+    let (n, nb) = (model.nv, model.nbodies);
+    let parent = &model.parent[..nb];
+    let joints = &model.joints[..nb];
+    let Data {
+        minv,
+        dqdd_dq,
+        dqdd_dv,
+        dtau_dq,
+        dtau_dv,
+        deriv_j: jc,
+        deriv_dfda: dfda,
+        deriv_ytj: ytj,
+        deriv_ext_e: ext_e,
+        deriv_dadq: dadq,
+        deriv_dvdq: dvdq,
+        deriv_dadv: dadv,
+        deriv_dfdq: dfdq,
+        deriv_dfdv: dfdv,
+        minv_acol: pbuf,
+        minv_acol_off: poff,
+        deriv_prod_s: sbuf,
+        deriv_prod_s_off: soff,
+        ..
+    } = data;
+    let a = minv.as_slice();
+    let (xq, xv) = (dqdd_dq.as_mut_slice(), dqdd_dv.as_mut_slice());
+    let (bq, bv) = (dtau_dq.as_slice(), dtau_dv.as_slice());
+    let zero = Vector3::zeros();
+    let alpha = |r: usize| {
+        let e = if ext { &ext_e[r].ang } else { &zero };
+        coef12([&dfda[r].ang, &dfda[r].lin, &ytj[r].ang, e])
+    };
+    let sz = 12 * n;
+    sbuf.fill(T::zero());
+    // Leaves inwards: x[:, c] = H⁻¹[:, i] B[i, c] + S_i β_c; then S_i += H⁻¹[:, r] αᵣᵀ
+    // over i's coordinates and S_λ += S_i.
+    for i in (1..nb).rev() {
+        let (c0, ni) = (joints[i].iv, joints[i].nv());
+        let si = soff[i];
+        for c in c0..c0 + ni {
+            let bq_c = coef12([&dadq[c].ang, &dadq[c].lin, &dvdq[c].ang, &jc[c].ang]);
+            let bv_c = coef12([&dadv[c].ang, &dadv[c].lin, &jc[c].ang, &zero]);
+            let (xqc, xvc) = (&mut xq[c * n..(c + 1) * n], &mut xv[c * n..(c + 1) * n]);
+            for (xc, b) in [(&mut *xqc, bq), (&mut *xvc, bv)] {
+                xc.fill(T::zero());
+                for r in c0..c0 + ni {
+                    let brc = b[r + c * n];
+                    for (y, &h) in xc.iter_mut().zip(&a[r * n..(r + 1) * n]) {
+                        *y = madd(h, brc, *y);
+                    }
+                }
+            }
+            let s = &sbuf[si..si + sz];
+            if ext {
+                gemv2_add::<T, 12>(xqc, xvc, s, &bq_c, &bv_c, false);
+            } else {
+                gemv2_add::<T, 9>(xqc, xvc, s, &bq_c, &bv_c, false);
+            }
+        }
+        let s = &mut sbuf[si..si + sz];
+        for r in c0..c0 + ni {
+            let al = alpha(r);
+            let h = &a[r * n..(r + 1) * n];
+            if ext {
+                ger_add::<T, 12>(s, h, &al);
+            } else {
+                ger_add::<T, 9>(s, h, &al);
+            }
+        }
+        let p = parent[i];
+        if p == 0 || soff[p] != si {
+            if p != 0 {
+                let sp = soff[p];
+                let (lo, hi) = sbuf.split_at_mut(si);
+                for (y, &x) in lo[sp..sp + sz].iter_mut().zip(&hi[..sz]) {
+                    *y += x;
+                }
+            }
+            sbuf[si..si + sz].fill(T::zero());
+        }
+    }
+    // Root outwards: P_i = P_λ + H⁻¹[:, λ] J_λᵀ; x[:, c] = −(x[:, c] + P_i G_c).
+    let psz = 6 * n;
+    for i in 1..nb {
+        let p = parent[i];
+        let (c0, ni) = (joints[i].iv, joints[i].nv());
+        let o = poff[i];
+        if p == 0 {
+            pbuf[o..o + psz].fill(T::zero());
+        } else {
+            let r0 = poff[p];
+            let (src, dst): (&[T], &mut [T]) = if r0 < o {
+                let (lo, hi) = pbuf.split_at_mut(o);
+                (&lo[r0..r0 + psz], &mut hi[..psz])
+            } else {
+                let (lo, hi) = pbuf.split_at_mut(r0);
+                (&hi[..psz], &mut lo[o..o + psz])
+            };
+            dst.copy_from_slice(src);
+            let (cp, np) = (joints[p].iv, joints[p].nv());
+            for r in cp..cp + np {
+                let jr = coef12([&jc[r].ang, &jc[r].lin, &zero, &zero]);
+                ger_add::<T, 6>(dst, &a[r * n..(r + 1) * n], &jr);
+            }
+        }
+        let pi = &pbuf[o..o + psz];
+        for c in c0..c0 + ni {
+            let (xqc, xvc) = (&mut xq[c * n..(c + 1) * n], &mut xv[c * n..(c + 1) * n]);
+            let (gq, gv) = (&dfdq[c], &dfdv[c]);
+            let (cq, cv) = (
+                coef12([&gq.ang, &gq.lin, &zero, &zero]),
+                coef12([&gv.ang, &gv.lin, &zero, &zero]),
+            );
+            // P_i is zero at a root
+            gemv2_add::<T, 6>(xqc, xvc, pi, &cq, &cv, true);
+        }
+    }
+}
+
+/// Where the columns of ∂τ/∂x (tree-shaped: entry (r, c) only for r, c on one
+/// root path) can be non-zero: rows `[c, dof_end[c])` (c's subtree) and c's
+/// ancestors, the runs `runs[run0[c]..run0[c + 1]]`. The derivative sweep never
+/// writes the other entries, which stay the zeros of `Data::new`.
+struct TreePattern<'a> {
+    dof_end: &'a [usize],
+    runs: &'a [(usize, usize)],
+    run0: &'a [usize],
+}
+
+/// Rows of a register tile.
+const MR: usize = 8;
+/// Columns of a register tile.
+const NR: usize = 4;
+
+/// `xₘ = −a bₘ` for a dense n × n `a` and the `bₘ` with the tree pattern `pat`
+/// (column-major): every column block reads only the rows of `bₘ` where its
+/// columns can be non-zero. In depth-first order the ancestors of columns
+/// c₀ < c < c₀ + NR lie among c₀'s ancestors and [c₀, c), their subtrees below
+/// the block's largest subtree end: one row set for the block. Register tiles of
+/// R × NR accumulators; a panel of R rows of `a` stays in cache across every
+/// column block of both products.
+fn neg_mul_tree<T: Scalar>(
+    a: &DMatrix<T>,
+    bs: [&DMatrix<T>; 2],
+    xs: [&mut DMatrix<T>; 2],
+    pat: &TreePattern,
+) {
+    let n = a.nrows();
+    let a = a.as_slice();
+    let bs = bs.map(|b| b.as_slice());
+    let [x0, x1] = xs;
+    let mut xs = [x0.as_mut_slice(), x1.as_mut_slice()];
+    // panels of 2 MR rows, then MR, the last one ending at n (overlapping rows get
+    // the same sums again); 4 or single rows below MR
+    if n >= MR {
+        let mut i0 = 0;
+        while i0 + 2 * MR <= n {
+            panel::<T, { 2 * MR }>(n, a, bs, &mut xs, i0, pat);
+            i0 += 2 * MR;
+        }
+        while i0 < n {
+            i0 = i0.min(n - MR);
+            panel::<T, MR>(n, a, bs, &mut xs, i0, pat);
+            i0 += MR;
+        }
+    } else if n >= 4 {
+        panel::<T, 4>(n, a, bs, &mut xs, 0, pat);
+        panel::<T, 4>(n, a, bs, &mut xs, n - 4, pat);
     } else {
-        ltdl_solve_rows(us, &model.dof_parent, x);
+        for i0 in 0..n {
+            panel::<T, 1>(n, a, bs, &mut xs, i0, pat);
+        }
+    }
+}
+
+/// Rows `i0..i0 + R` of both products: blocks of NR columns, the last one ending
+/// at n (overlapping its predecessor); single columns below NR.
+#[inline(always)]
+fn panel<T: Scalar, const R: usize>(
+    n: usize,
+    a: &[T],
+    bs: [&[T]; 2],
+    xs: &mut [&mut [T]; 2],
+    i0: usize,
+    pat: &TreePattern,
+) {
+    if n < NR {
+        for j in 0..n {
+            let anc = &pat.runs[pat.run0[j]..pat.run0[j + 1]];
+            let own = (j, pat.dof_end[j].max(j + 1));
+            for (b, x) in bs.iter().zip(xs.iter_mut()) {
+                tile::<T, R, 1>(n, a, b, x, i0, j, anc, own);
+            }
+        }
+        return;
+    }
+    let mut j0 = 0;
+    loop {
+        let anc = &pat.runs[pat.run0[j0]..pat.run0[j0 + 1]];
+        let end = pat.dof_end[j0..j0 + NR]
+            .iter()
+            .fold(j0 + NR, |e, &d| e.max(d));
+        for (b, x) in bs.iter().zip(xs.iter_mut()) {
+            tile::<T, R, NR>(n, a, b, x, i0, j0, anc, (j0, end));
+        }
+        if j0 + NR == n {
+            break;
+        }
+        j0 = (j0 + NR).min(n - NR);
+    }
+}
+
+/// One R × C tile of `x = −a b`: `x[i0.., j0..] = −Σ_k a[i0.., k] b[k, j0..]`
+/// over the row runs of b.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn tile<T: Scalar, const R: usize, const C: usize>(
+    n: usize,
+    a: &[T],
+    b: &[T],
+    x: &mut [T],
+    i0: usize,
+    j0: usize,
+    anc: &[(usize, usize)],
+    own: (usize, usize),
+) {
+    let mut acc = [[T::zero(); R]; C];
+    let bcols: [&[T]; C] = std::array::from_fn(|c| &b[(j0 + c) * n..(j0 + c + 1) * n]);
+    for &(lo, hi) in anc.iter().chain(std::iter::once(&own)) {
+        for k in lo..hi {
+            let ak = &a[k * n + i0..k * n + i0 + R];
+            for c in 0..C {
+                let bk = bcols[c][k];
+                for r in 0..R {
+                    acc[c][r] = madd(ak[r], bk, acc[c][r]);
+                }
+            }
+        }
+    }
+    for c in 0..C {
+        let col = &mut x[(j0 + c) * n + i0..(j0 + c) * n + i0 + R];
+        for r in 0..R {
+            col[r] = -acc[c][r];
+        }
     }
 }
 
@@ -110,34 +445,6 @@ fn row_axpy<T: Scalar>(x: &mut [T], n: usize, a: usize, b: usize, s: T) {
     };
     for (p, &q) in ra.iter_mut().zip(rb) {
         *p = madd(-s, q, *p);
-    }
-}
-
-/// [`ltdl::ltdl_solve`] for every right-hand side at once (rows of `x`).
-fn ltdl_solve_rows<T: Scalar>(u: &[T], lambda: &[usize], x: &mut [T]) {
-    let n = lambda.len();
-    // Lᵀ y = b, leaves inwards
-    for i in (0..n).rev() {
-        let mut j = lambda[i];
-        while j != NONE {
-            row_axpy(x, n, j, i, u[j + i * n]);
-            j = lambda[j];
-        }
-    }
-    // z = D⁻¹ y
-    for i in 0..n {
-        let d = T::one() / u[i + i * n];
-        for p in &mut x[i * n..i * n + n] {
-            *p *= d;
-        }
-    }
-    // L x = z, root outwards
-    for i in 0..n {
-        let mut j = lambda[i];
-        while j != NONE {
-            row_axpy(x, n, i, j, u[j + i * n]);
-            j = lambda[j];
-        }
     }
 }
 

@@ -20,6 +20,7 @@ mod joint_jacobians;
 mod kinematics;
 pub mod linalg;
 pub mod ltdl;
+mod minv;
 mod rnea;
 mod rnea_derivatives;
 

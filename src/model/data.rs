@@ -136,6 +136,57 @@ pub struct Data<T: Scalar = f64> {
     pub deriv_scratch: DMatrix<T>,
     /// Derivatives: a scratch vector of size nv (`aba_derivatives`' q̈).
     pub deriv_tmp: DVector<T>,
+    /// Derivatives, per velocity coordinate: one past the last coordinate of its
+    /// subtree (the rows below it where ∂τ/∂x's column can be non-zero).
+    pub deriv_dof_end: Vec<usize>,
+    /// Derivatives: the ancestors of every velocity coordinate as runs `[lo, hi)`
+    /// of consecutive coordinates, coordinate k's at
+    /// `deriv_anc_runs[deriv_anc_run0[k]..deriv_anc_run0[k + 1]]` (the rows above
+    /// it where ∂τ/∂x's column can be non-zero).
+    pub deriv_anc_runs: Vec<(usize, usize)>,
+    /// Derivatives: where each coordinate's runs start in `deriv_anc_runs` (nv + 1).
+    pub deriv_anc_run0: Vec<usize>,
+
+    // H⁻¹ by the world-frame articulated-body recursion (`aba_derivatives`,
+    // docs/theory.md §"Derivatives").
+    /// H⁻¹, per velocity coordinate: its world motion subspace column `J = ⁰X̂ᵢ S`.
+    pub minv_j: Vec<Motion<T>>,
+    /// H⁻¹, per velocity coordinate: `U D⁻¹` (world).
+    pub minv_udinv: Vec<Force<T>>,
+    /// H⁻¹, per velocity coordinate: `u = τ − Jᵀ pᴬ`.
+    pub minv_uq: Vec<T>,
+    /// H⁻¹: articulated inertia of each body (6x6, angular first, world).
+    pub minv_ia: Vec<Matrix6<T>>,
+    /// H⁻¹: world velocity of each body.
+    pub minv_ov: Vec<Motion<T>>,
+    /// H⁻¹: velocity-product acceleration, then acceleration, of each body (world,
+    /// gravity included).
+    pub minv_agf: Vec<Motion<T>>,
+    /// H⁻¹: articulated bias force of each body (world).
+    pub minv_of: Vec<Force<T>>,
+    /// H⁻¹, per column (leaves inwards): the force a unit τ of that coordinate
+    /// passes to the current body's parent, by components (6 × nv: component k of
+    /// column c at `k nv + c`).
+    pub minv_fcol: Vec<T>,
+    /// H⁻¹, per body and per column c from its first coordinate on (root
+    /// outwards): the body's acceleration under a unit τ_c, by components
+    /// (component k at `minv_acol_off[i] + k nv + c`). Only the children read a
+    /// body's, so bodies share buffers of 6 nv: two per level of branching (an
+    /// only child takes the other one of its parent's pair).
+    pub minv_acol: Vec<T>,
+    /// H⁻¹: where each body's buffer starts in `minv_acol`.
+    pub minv_acol_off: Vec<usize>,
+    /// Derivatives: whether `aba_derivatives` forms −H⁻¹ ∂τ/∂x from ∂τ/∂x's
+    /// low-rank parts (long chains, docs/theory.md §"Derivatives", "The products")
+    /// rather than by the tree-pattern product; chosen here by operation counts
+    /// (either gives the same result; models with mimic joints use neither).
+    pub deriv_low_rank: bool,
+    /// Derivatives (low-rank products): per body, the subtree sums
+    /// `Σ H⁻¹[:, r] αᵣᵀ` (nv × 12 by columns) in shared buffers.
+    pub deriv_prod_s: Vec<T>,
+    /// Derivatives (low-rank products): where each body's buffer starts in
+    /// `deriv_prod_s`.
+    pub deriv_prod_s_off: Vec<usize>,
 }
 
 impl<T: Scalar> Data<T> {
@@ -151,6 +202,65 @@ impl<T: Scalar> Data<T> {
             }
         }
         let nfull = if direct { 0 } else { ncol };
+        let (dof_end, anc_runs, anc_run0) = coordinate_runs(model, &sub_end, direct);
+        // the column accelerations' buffers: an only child alternates with its
+        // parent, the children of a branching body go one pair deeper
+        let mut acol_off = vec![0; nb];
+        let mut acol_len = 0;
+        if direct {
+            let mut nchild = vec![0usize; nb];
+            for i in 1..nb {
+                nchild[model.parent[i]] += 1;
+            }
+            let mut buf = vec![0usize; nb];
+            for i in 1..nb {
+                let p = model.parent[i];
+                buf[i] = if p == 0 {
+                    0
+                } else if nchild[p] == 1 {
+                    buf[p] ^ 1
+                } else {
+                    (buf[p] | 1) + 1
+                };
+                acol_off[i] = buf[i] * 6 * nv;
+                acol_len = acol_len.max(acol_off[i] + 6 * nv);
+            }
+        }
+        // the low-rank products: their count (47 nv² multiply-adds in axpy loops,
+        // taken at half the tiled product's rate) against the tiled product's
+        // (2 nv Σ_c rows of column c's pattern)
+        let mut s_off = vec![0; nb];
+        let mut s_len = 0;
+        let mut low_rank = false;
+        if direct && nv > 0 {
+            let rows: usize = (0..nv)
+                .map(|c| {
+                    let anc: usize = anc_runs[anc_run0[c]..anc_run0[c + 1]]
+                        .iter()
+                        .map(|(lo, hi)| hi - lo)
+                        .sum();
+                    anc + dof_end[c] - c
+                })
+                .sum();
+            low_rank = 94 * nv * nv < 2 * nv * rows;
+        }
+        if direct {
+            let mut nchild = vec![0usize; nb];
+            for i in 1..nb {
+                nchild[model.parent[i]] += 1;
+            }
+            let mut slot = vec![0usize; nb];
+            for i in 1..nb {
+                let p = model.parent[i];
+                slot[i] = if p == 0 || nchild[p] == 1 {
+                    slot[p]
+                } else {
+                    slot[p] + 1
+                };
+                s_off[i] = slot[i] * 12 * nv;
+                s_len = s_len.max(s_off[i] + 12 * nv);
+            }
+        }
         Self {
             li_m_i: vec![Se3::identity(); nb],
             o_m_i: vec![Se3::identity(); nb],
@@ -204,8 +314,62 @@ impl<T: Scalar> Data<T> {
             deriv_full: std::array::from_fn(|_| DMatrix::zeros(nfull, nfull)),
             deriv_scratch: DMatrix::zeros(nv, nv),
             deriv_tmp: DVector::zeros(nv),
+            deriv_dof_end: dof_end,
+            deriv_anc_runs: anc_runs,
+            deriv_anc_run0: anc_run0,
+            minv_j: vec![Motion::zero(); nv],
+            minv_udinv: vec![Force::zero(); nv],
+            minv_uq: vec![T::zero(); nv],
+            minv_ia: vec![Matrix6::zeros(); nb],
+            minv_ov: vec![Motion::zero(); nb],
+            minv_agf: vec![Motion::zero(); nb],
+            minv_of: vec![Force::zero(); nb],
+            minv_fcol: vec![T::zero(); 6 * nv],
+            minv_acol: vec![T::zero(); acol_len],
+            minv_acol_off: acol_off,
+            deriv_low_rank: low_rank,
+            deriv_prod_s: vec![T::zero(); s_len],
+            deriv_prod_s_off: s_off,
         }
     }
+}
+
+/// Per velocity coordinate (a model without mimic joints): one past its subtree's
+/// last coordinate, and its ancestors as runs `[lo, hi)` of consecutive
+/// coordinates (flat, with each coordinate's start; nv + 1 starts). Empty with
+/// mimic joints.
+fn coordinate_runs<T: Scalar>(
+    model: &Model<T>,
+    sub_end: &[usize],
+    direct: bool,
+) -> (Vec<usize>, Vec<(usize, usize)>, Vec<usize>) {
+    if !direct {
+        return (Vec::new(), Vec::new(), Vec::new());
+    }
+    let nv = model.nv;
+    let lambda = &model.dof_parent;
+    let mut dof_end = vec![0; nv];
+    for (j, &e) in model.joints.iter().zip(sub_end).skip(1) {
+        for c in 0..j.nv() {
+            dof_end[j.iv + c] = e;
+        }
+    }
+    let mut runs = Vec::new();
+    let mut run0 = Vec::with_capacity(nv + 1);
+    for k in 0..nv {
+        run0.push(runs.len());
+        let mut j = lambda[k];
+        while j != usize::MAX {
+            let hi = j + 1;
+            while j > 0 && lambda[j] == j - 1 {
+                j -= 1;
+            }
+            runs.push((j, hi));
+            j = lambda[j];
+        }
+    }
+    run0.push(runs.len());
+    (dof_end, runs, run0)
 }
 
 /// The derivatives' column space (docs/theory.md §"Derivatives"): each body's first
