@@ -21,14 +21,14 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let _ = urdyn::state::parse_state(text, "state.json");
-    let Ok(states) = urdyn::state::parse_states(text, "states.json") else {
+    let _ = urdyn::cli::state::parse_state(text, "state.json");
+    let Ok(states) = urdyn::cli::state::parse_states(text, "states.json") else {
         return;
     };
     for model in models() {
         for (i, s) in states.states.iter().enumerate() {
             let _ = s.to_vectors(model, "states.json", &format!("states[{i}]"));
         }
-        let _ = urdyn::eval::evaluate_json(model, &states, "ok.urdf", "states.json");
+        let _ = urdyn::cli::eval::evaluate_json(model, &states, "ok.urdf", "states.json");
     }
 });

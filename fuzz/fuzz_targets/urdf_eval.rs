@@ -4,7 +4,7 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 use std::collections::BTreeMap;
-use urdyn::state::{BaseState, State, StatesFile};
+use urdyn::cli::state::{BaseState, State, StatesFile};
 
 fn next(s: &mut u64) -> f64 {
     *s ^= *s << 13;
@@ -30,7 +30,7 @@ fuzz_target!(|data: &[u8]| {
     else {
         return;
     };
-    let _ = urdyn::inspect::report(&model, &[]);
+    let _ = urdyn::cli::inspect::report(&model, &[]);
     if model.nv > 64 {
         return;
     }
@@ -66,5 +66,5 @@ fuzz_target!(|data: &[u8]| {
             base: Some(base),
         }],
     };
-    let _ = urdyn::eval::evaluate_json(&model, &states, "fuzz.urdf", "fuzz.json");
+    let _ = urdyn::cli::eval::evaluate_json(&model, &states, "fuzz.urdf", "fuzz.json");
 });
