@@ -1,9 +1,14 @@
-//! The integration tests: one test binary (`integration`), each `tests/NAME.rs` a
-//! module of it, so the suite is linked once instead of once a file. Cargo.toml sets
-//! `autotests = false`: a file under `tests/` is compiled only through a `mod` line
-//! below, and [`every_test_file_is_a_module`] fails for one that has none.
+//! The integration tests: two test binaries, `integration` (this file: every test
+//! file but one) and `integration-stress` (`tests/main_stress.rs`: `stress.rs`, whose
+//! double-double and 1000-link runs instantiate every algorithm for a second scalar
+//! type and take as long to compile as all the rest), each `tests/NAME.rs` a module of
+//! one of them: the suite is linked twice instead of once a file, and the two halves
+//! compile side by side on two cores. Cargo.toml sets
+//! `autotests = false`: a file under `tests/` is compiled only through a `mod` line,
+//! and [`every_test_file_is_a_module`] fails for one that has none.
 //!
-//! Adding a test file `tests/NAME.rs`: one line `mod NAME;` here. Its helpers come from
+//! Adding a test file `tests/NAME.rs`: one line `mod NAME;` here or in
+//! `main_stress.rs`. Its helpers come from
 //! `use crate::common::...` (an older `#[path = "common/lcg.rs"] mod lcg;` still works,
 //! except for `counting_alloc`, the binary's one global allocator).
 //! One module alone: `cargo test --release --test integration NAME::`.
@@ -35,7 +40,6 @@ mod sim_trust;
 mod simulate_cli;
 mod simulate_trust;
 mod step_jacobians;
-mod stress;
 mod view;
 
 /// Every `tests/*.rs` file is a module of this binary (with `autotests = false` a file
@@ -43,7 +47,8 @@ mod view;
 #[test]
 fn every_test_file_is_a_module() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
-    let main = std::fs::read_to_string(dir.join("main.rs")).expect("tests/main.rs");
+    let main = std::fs::read_to_string(dir.join("main.rs")).expect("tests/main.rs")
+        + &std::fs::read_to_string(dir.join("main_stress.rs")).expect("tests/main_stress.rs");
     let mut missing = Vec::new();
     for e in std::fs::read_dir(&dir).expect("tests/") {
         let p = e.expect("entry").path();
@@ -52,10 +57,11 @@ fn every_test_file_is_a_module() {
         };
         if p.extension().is_some_and(|x| x == "rs")
             && stem != "main"
+            && stem != "main_stress"
             && !main.lines().any(|l| l.trim() == format!("mod {stem};"))
         {
             missing.push(format!(
-                "tests/{stem}.rs: add `mod {stem};` to tests/main.rs"
+                "tests/{stem}.rs: add `mod {stem};` to tests/main.rs or tests/main_stress.rs"
             ));
         }
     }

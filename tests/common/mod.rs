@@ -1,3 +1,4 @@
+#![allow(dead_code)] // each of the two test binaries uses its own part of the helpers
 //! Helpers shared by the test modules (`use crate::common::...`).
 
 pub mod counting_alloc;
