@@ -83,9 +83,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         area.fill(&WHITE)?;
         let panels = area.split_evenly((3, 1));
         let series: [(&str, &str, &Vec<f64>, RGBColor); 3] = [
-            ("lamp base height (table top at 0.75 m)", "z (m)", &z, BLUE),
-            ("energy (kinetic + potential)", "E (J)", &e, RED),
-            ("active contact points", "count", &c, BLACK),
+            (
+                "lamp base height (table top at 0.75 m)",
+                "base height z (m)",
+                &z,
+                BLUE,
+            ),
+            ("energy (kinetic + potential)", "energy E (J)", &e, RED),
+            ("active contact points", "contacts (count)", &c, BLACK),
         ];
         for (panel, (title, ylabel, ys, color)) in panels.iter().zip(series.iter()) {
             let (lo, hi) = ys
@@ -93,18 +98,41 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
                     (a.min(y), b.max(y))
                 });
-            let pad = ((hi - lo) * 0.08).max(1e-3);
+            // the contact count: integer ticks only
+            let count = *ylabel == "contacts (count)";
+            let (lo, hi) = if count {
+                (0.0, hi.max(1.0).ceil())
+            } else {
+                (lo, hi)
+            };
+            let pad = if count {
+                0.3
+            } else {
+                ((hi - lo) * 0.08).max(1e-3)
+            };
             let mut chart = ChartBuilder::on(panel)
                 .caption(*title, ("sans-serif", 20))
                 .margin(10)
-                .x_label_area_size(35)
-                .y_label_area_size(60)
+                .x_label_area_size(40)
+                .y_label_area_size(70)
                 .build_cartesian_2d(0.0..3.0, (lo - pad)..(hi + pad))?;
-            chart
-                .configure_mesh()
-                .x_desc("t (s)")
+            let integer = |y: &f64| {
+                if (y - y.round()).abs() < 1e-9 {
+                    format!("{y:.0}")
+                } else {
+                    String::new()
+                }
+            };
+            let mut mesh = chart.configure_mesh();
+            mesh.x_desc("time t (s)")
                 .y_desc(*ylabel)
-                .draw()?;
+                .axis_desc_style(("sans-serif", 16))
+                .label_style(("sans-serif", 13));
+            if count {
+                mesh.y_labels((hi as usize + 1).min(6))
+                    .y_label_formatter(&integer);
+            }
+            mesh.draw()?;
             chart.draw_series(LineSeries::new(
                 t.iter().copied().zip(ys.iter().copied()),
                 color,
