@@ -3,7 +3,7 @@
 //! calls the library, and returns new arrays.
 
 use crate::args::{read3, read_vec, value_error};
-use crate::dynamics::{dyn_error, mat_out, read_q, reference};
+use crate::dynamics::{dyn_error, mat_out, read_qv, read_qvx, reference};
 use crate::model::{PyData, PyModel};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -69,10 +69,7 @@ pub fn rnea_derivatives<'py>(
     fext: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<(Mat<'py>, Mat<'py>, Mat<'py>)> {
     let d = &mut *data;
-    d.check(&model.model)?;
-    read_q(d, q)?;
-    read_vec(v, "v", "nv", &mut d.v)?;
-    read_vec(a, "a", "nv", &mut d.a)?;
+    read_qvx(&model, d, q, v, a, "a")?;
     let w = wrenches(&model, fext)?;
     let wf = (!w.is_empty()).then_some(w.as_slice());
     dynamics::rnea_derivatives(&model.model, &mut d.data, &d.q, &d.v, &d.a, wf)
@@ -100,10 +97,7 @@ pub fn aba_derivatives<'py>(
     fext: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<(Mat<'py>, Mat<'py>, Mat<'py>)> {
     let d = &mut *data;
-    d.check(&model.model)?;
-    read_q(d, q)?;
-    read_vec(v, "v", "nv", &mut d.v)?;
-    read_vec(tau, "tau", "nv", &mut d.a)?;
+    read_qvx(&model, d, q, v, tau, "tau")?;
     let w = wrenches(&model, fext)?;
     let wf = (!w.is_empty()).then_some(w.as_slice());
     dynamics::aba_derivatives(&model.model, &mut d.data, &d.q, &d.v, &d.a, wf)
@@ -131,9 +125,7 @@ pub fn frame_jacobian_time_variation<'py>(
 ) -> PyResult<Mat<'py>> {
     let r = self::reference(reference)?;
     let d = &mut *data;
-    d.check(&model.model)?;
-    read_q(d, q)?;
-    read_vec(v, "v", "nv", &mut d.v)?;
+    read_qv(&model, d, q, v)?;
     let i = model.link(link, "link")?;
     let mut jd = DMatrix::zeros(6, model.model.nv);
     dynamics::frame_jacobian_time_variation(

@@ -52,9 +52,35 @@ pub(crate) fn dyn_error(model: &PyModel, e: DynamicsError) -> PyErr {
     }
 }
 
-/// q (and v, a) into the workspace's vectors, checked.
+/// q into the workspace's q, checked.
 pub(crate) fn read_q(d: &mut PyData, q: &Bound<'_, PyAny>) -> PyResult<()> {
     d.read_q(q)
+}
+
+/// The prologue of every call at a state: `data` checked against `model`, q into
+/// `d.q` (every quaternion checked, [`read_q`]), v into `d.v`.
+pub(crate) fn read_qv(
+    model: &PyModel,
+    d: &mut PyData,
+    q: &Bound<'_, PyAny>,
+    v: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    d.check(&model.model)?;
+    read_q(d, q)?;
+    read_vec(v, "v", "nv", &mut d.v)
+}
+
+/// [`read_qv`] and a third nv vector (`a` or `tau`, named `name`) into `d.a`.
+pub(crate) fn read_qvx(
+    model: &PyModel,
+    d: &mut PyData,
+    q: &Bound<'_, PyAny>,
+    v: &Bound<'_, PyAny>,
+    x: &Bound<'_, PyAny>,
+    name: &str,
+) -> PyResult<()> {
+    read_qv(model, d, q, v)?;
+    read_vec(x, name, "nv", &mut d.a)
 }
 
 /// The optional `fext` dict as per-body forces in `d.fext` (kinematics at `d.q`
@@ -104,10 +130,7 @@ pub fn rnea<'py>(
     fext: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let d = &mut *data;
-    d.check(&model.model)?;
-    read_q(d, q)?;
-    read_vec(v, "v", "nv", &mut d.v)?;
-    read_vec(a, "a", "nv", &mut d.a)?;
+    read_qvx(&model, d, q, v, a, "a")?;
     let has = read_fext(&model, d, fext)?;
     let f = has.then_some(&d.fext[..]);
     let tau = dynamics::rnea(&model.model, &mut d.data, &d.q, &d.v, &d.a, f)
@@ -128,9 +151,7 @@ pub fn nonlinear_effects<'py>(
     fext: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let d = &mut *data;
-    d.check(&model.model)?;
-    read_q(d, q)?;
-    read_vec(v, "v", "nv", &mut d.v)?;
+    read_qv(&model, d, q, v)?;
     let has = read_fext(&model, d, fext)?;
     let f = has.then_some(&d.fext[..]);
     let c = dynamics::bias(&model.model, &mut d.data, &d.q, &d.v, f)
@@ -172,10 +193,7 @@ fn forward<'py>(
     fext: Option<&Bound<'py, PyDict>>,
     algo: Fd,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    d.check(&model.model)?;
-    read_q(d, q)?;
-    read_vec(v, "v", "nv", &mut d.v)?;
-    read_vec(tau, "tau", "nv", &mut d.a)?;
+    read_qvx(&model, d, q, v, tau, "tau")?;
     let has = read_fext(model, d, fext)?;
     let f = has.then_some(&d.fext[..]);
     let m = &model.model;
@@ -327,9 +345,7 @@ pub fn frame_velocity<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let local = self::reference(reference)?;
     let d = &mut *data;
-    d.check(&model.model)?;
-    read_q(d, q)?;
-    read_vec(v, "v", "nv", &mut d.v)?;
+    read_qv(&model, d, q, v)?;
     let i = model.link(link, "link")?;
     let j = jacobian(&model, d, i, local)?;
     let vel = j * &d.v;
@@ -383,9 +399,7 @@ pub fn centroidal_momentum<'py>(
     v: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let d = &mut *data;
-    d.check(&model.model)?;
-    read_q(d, q)?;
-    read_vec(v, "v", "nv", &mut d.v)?;
+    read_qv(&model, d, q, v)?;
     let (k, l) = dynamics::centroidal_momentum(&model.model, &mut d.data, &d.q, &d.v)
         .map_err(|e| dyn_error(&model, e))?;
     Ok(vec_out(py, &[l.x, l.y, l.z, k.x, k.y, k.z]))
@@ -400,9 +414,7 @@ pub fn kinetic_energy(
     v: &Bound<'_, PyAny>,
 ) -> PyResult<f64> {
     let d = &mut *data;
-    d.check(&model.model)?;
-    read_q(d, q)?;
-    read_vec(v, "v", "nv", &mut d.v)?;
+    read_qv(&model, d, q, v)?;
     dynamics::kinetic_energy(&model.model, &mut d.data, &d.q, &d.v)
         .map_err(|e| dyn_error(&model, e))
 }
