@@ -216,16 +216,8 @@ pub fn integrate_jacobians(
                 let iv = j.iv;
                 let lin = Vector3::new(v[iv], v[iv + 1], v[iv + 2]);
                 let w = Vector3::new(v[iv + 3], v[iv + 4], v[iv + 5]);
-                // exp(v) = (R, p): Ad(exp(v)⁻¹) = [Rᵀ, −Rᵀ p×; 0, Rᵀ]
-                let r = *UnitQuaternion::from_scaled_axis(w)
-                    .to_rotation_matrix()
-                    .matrix();
-                let p = so3_left_jacobian(&w) * lin;
-                let rt = r.transpose();
-                jq.view_mut((iv, iv), (3, 3)).copy_from(&rt);
-                jq.view_mut((iv, iv + 3), (3, 3))
-                    .copy_from(&(-rt * skew(&p)));
-                jq.view_mut((iv + 3, iv + 3), (3, 3)).copy_from(&rt);
+                jq.view_mut((iv, iv), (6, 6))
+                    .copy_from(&exp_ad_inverse(&lin, &w));
                 jv.view_mut((iv, iv), (6, 6))
                     .copy_from(&se3_right_jacobian(&lin, &w));
             }
@@ -260,16 +252,7 @@ pub fn difference_jacobians(
                 let (lin, w) = free_log(q0, q1, j.iq);
                 let jr = se3_right_jacobian(&lin, &w);
                 let jlog = jr.try_inverse().unwrap_or_else(Matrix6::identity);
-                // M = exp(log M) = (R, p); Ad(M⁻¹) = [Rᵀ, −Rᵀ p×; 0, Rᵀ]
-                let r = *UnitQuaternion::from_scaled_axis(w)
-                    .to_rotation_matrix()
-                    .matrix();
-                let p = so3_left_jacobian(&w) * lin;
-                let rt = r.transpose();
-                let mut ad = Matrix6::zeros();
-                ad.fixed_view_mut::<3, 3>(0, 0).copy_from(&rt);
-                ad.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-rt * skew(&p)));
-                ad.fixed_view_mut::<3, 3>(3, 3).copy_from(&rt);
+                let ad = exp_ad_inverse(&lin, &w);
                 j0.view_mut((iv, iv), (6, 6)).copy_from(&(-jlog * ad));
                 j1.view_mut((iv, iv), (6, 6)).copy_from(&jlog);
             }
@@ -315,6 +298,21 @@ fn free_log(q0: &DVector<f64>, q1: &DVector<f64>, iq: usize) -> (Vector3<f64>, V
         .unwrap_or_else(Matrix3::identity)
         * dp;
     (lin, w)
+}
+
+/// `Ad(exp(ξ)⁻¹)` for the twist `ξ = [lin; w]` (linear first): with
+/// `exp(ξ) = (R, p)`, `R = Exp(w)`, `p = V(w) lin`, it is `[Rᵀ, −Rᵀ p×; 0, Rᵀ]`.
+fn exp_ad_inverse(lin: &Vector3<f64>, w: &Vector3<f64>) -> Matrix6<f64> {
+    let r = *UnitQuaternion::from_scaled_axis(*w)
+        .to_rotation_matrix()
+        .matrix();
+    let p = so3_left_jacobian(w) * lin;
+    let rt = r.transpose();
+    let mut ad = Matrix6::zeros();
+    ad.fixed_view_mut::<3, 3>(0, 0).copy_from(&rt);
+    ad.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-rt * skew(&p)));
+    ad.fixed_view_mut::<3, 3>(3, 3).copy_from(&rt);
+    ad
 }
 
 /// SO(3)'s left Jacobian `V(ω) = 1 + (1 − cos θ)/θ² ω× + (θ − sin θ)/θ³ ω×²`
