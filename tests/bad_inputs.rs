@@ -4,6 +4,7 @@
 //! and no panic — or, for the warning cases, loads and `inspect` prints the warning.
 //! Output files are never half written.
 
+use crate::common::refusal::assert_refused;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -92,42 +93,7 @@ fn run(args: &[&str]) -> Run {
 fn assert_rejected(args: &[&str], expect: &[&str]) -> String {
     let r = run(args);
     let ctx = format!("urdyn {}", args.join(" "));
-    assert!(
-        r.code.is_some_and(|c| c != 0),
-        "{ctx}: exit status {:?}, stderr {:?}",
-        r.code,
-        r.stderr
-    );
-    assert!(
-        r.stdout.is_empty(),
-        "{ctx}: wrote to stdout: {:?}",
-        r.stdout
-    );
-    assert!(
-        !r.stderr.contains("panicked"),
-        "{ctx}: panicked: {}",
-        r.stderr
-    );
-    assert!(
-        !r.stderr.contains("internal error"),
-        "{ctx}: internal error: {}",
-        r.stderr
-    );
-    let lines: Vec<&str> = r.stderr.lines().collect();
-    assert_eq!(
-        lines.len(),
-        1,
-        "{ctx}: expected one line on stderr, got {:?}",
-        r.stderr
-    );
-    for e in expect {
-        assert!(
-            lines[0].contains(e),
-            "{ctx}: error {:?} does not contain {e:?}",
-            lines[0]
-        );
-    }
-    lines[0].to_string()
+    assert_refused(&ctx, r.code, &r.stdout, &r.stderr, expect)
 }
 
 /// Each malformed URDF with the substrings its error must contain (besides the

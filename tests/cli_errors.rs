@@ -6,6 +6,7 @@
 //! positional names the option, and a missing collision mesh names the CLI's
 //! flags (the library's own message names none).
 
+use crate::common::refusal::assert_refused;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
@@ -44,37 +45,7 @@ fn run_in(dir: &Path, args: &[&str]) -> Run {
 fn refused_in(dir: &Path, args: &[&str], expect: &[&str]) -> String {
     let r = run_in(dir, args);
     let ctx = format!("urdyn {}", args.join(" "));
-    assert!(
-        r.code.is_some_and(|c| c != 0),
-        "{ctx}: exit status {:?}, stderr {:?}",
-        r.code,
-        r.stderr
-    );
-    assert!(
-        r.stdout.is_empty(),
-        "{ctx}: wrote to stdout: {:?}",
-        r.stdout
-    );
-    assert!(
-        !r.stderr.contains("panicked"),
-        "{ctx}: panicked: {}",
-        r.stderr
-    );
-    let lines: Vec<&str> = r.stderr.lines().collect();
-    assert_eq!(
-        lines.len(),
-        1,
-        "{ctx}: expected one line, got {:?}",
-        r.stderr
-    );
-    for e in expect {
-        assert!(
-            lines[0].contains(e),
-            "{ctx}: {:?} does not contain {e:?}",
-            lines[0]
-        );
-    }
-    lines[0].to_string()
+    assert_refused(&ctx, r.code, &r.stdout, &r.stderr, expect)
 }
 
 fn refused(args: &[&str], expect: &[&str]) -> String {

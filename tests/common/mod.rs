@@ -5,3 +5,4 @@ pub mod counting_alloc;
 pub mod csv;
 pub mod dd;
 pub mod lcg;
+pub mod refusal;
