@@ -146,7 +146,7 @@ impl PartialOrd for DD {
 
 impl Add for DD {
     type Output = DD;
-    #[inline]
+    #[inline(never)]
     fn add(self, b: DD) -> DD {
         let (s, e) = two_sum(self.hi, b.hi);
         if !s.is_finite() {
@@ -169,14 +169,14 @@ impl Neg for DD {
 }
 impl Sub for DD {
     type Output = DD;
-    #[inline]
+    #[inline(never)]
     fn sub(self, b: DD) -> DD {
         self + (-b)
     }
 }
 impl Mul for DD {
     type Output = DD;
-    #[inline]
+    #[inline(never)]
     fn mul(self, b: DD) -> DD {
         let (p, e) = two_prod(self.hi, b.hi);
         if !p.is_finite() {
@@ -187,7 +187,7 @@ impl Mul for DD {
 }
 impl Div for DD {
     type Output = DD;
-    #[inline]
+    #[inline(never)]
     fn div(self, b: DD) -> DD {
         let q1 = self.hi / b.hi;
         if !q1.is_finite() || b.hi == 0.0 {
