@@ -22,6 +22,7 @@ mod cli_errors;
 mod contact_pairs;
 mod derivatives;
 mod eval_singular;
+mod example_scenes;
 mod fast_dynamics;
 mod kinematics_energy;
 mod layering;

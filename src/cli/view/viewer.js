@@ -327,7 +327,11 @@
     const parts = groups
       ? groups.filter((g) => g[1] > 0).map((g) => ({ offset: g[0] * bytesPerIndex, count: g[1], color: g[2] || v.rgba }))
       : [{ offset: 0, count: d.count, color: v.rgba }];
-    return { d, body: v.body, local: { R: v.R, p: v.p }, scale, color: v.rgba, parts, radius };
+    // the visual's local box (a mesh's bounds, a box's half extents; else none)
+    const m = v.kind === "mesh" ? D.meshes[v.mesh] : null;
+    const box = m ? { lo: m.min, hi: m.min.map((x, k) => x + m.ext[k]) }
+      : v.kind === "box" ? { lo: v.dims.map((x) => -x / 2), hi: v.dims.map((x) => x / 2) } : null;
+    return { d, body: v.body, local: { R: v.R, p: v.p }, scale, color: v.rgba, parts, radius, box };
   });
   const quad = drawable(new Float32Array([-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0]), gl.FLOAT, new Uint16Array([0, 1, 2, 0, 2, 3]));
 
@@ -362,21 +366,39 @@
 
   // ---- scene extent, camera ------------------------------------------------
   function visualWorld(f, v, a) { return compose(bodyPose(f, v.body, a || 0), v.local); }
+  // The camera, the grid step and the force arrows' scale follow what moves (the
+  // robots, not a 4 m height field under them), unless nothing does.
+  const framed = visuals.some((v) => v.body > 0) ? visuals.filter((v) => v.body > 0) : visuals;
   function sceneBounds(f, a) {
     let c = [0, 0, 0], n = 0;
-    const ps = visuals.map((v) => visualWorld(f, v, a).p);
+    const ps = framed.map((v) => visualWorld(f, v, a).p);
     for (const p of ps) { c = [c[0] + p[0], c[1] + p[1], c[2] + p[2]]; n++; }
     if (!n) {
       for (const l of links) { const p = linkPoseAt(f, l.name, a).p; c = [c[0] + p[0], c[1] + p[1], c[2] + p[2]]; n++; }
     }
     c = n ? [c[0] / n, c[1] / n, c[2] / n] : [0, 0, 0];
     let r = 0.05;
-    visuals.forEach((v, i) => { r = Math.max(r, Math.hypot(...sub(ps[i], c)) + v.radius); });
-    if (!visuals.length) for (const l of links) r = Math.max(r, Math.hypot(...sub(linkPoseAt(f, l.name, a).p, c)) + 0.05);
+    framed.forEach((v, i) => { r = Math.max(r, Math.hypot(...sub(ps[i], c)) + v.radius); });
+    if (!framed.length) for (const l of links) r = Math.max(r, Math.hypot(...sub(linkPoseAt(f, l.name, a).p, c)) + 0.05);
     return { c, r };
   }
   const start = nframes ? sceneBounds(0) : { c: [0, 0, 0], r: 1 };
-  const groundZ = D.ground === null || D.ground === undefined ? 0 : D.ground;
+  // z_min of a visual at frame 0: over its box's eight corners, else centre − radius
+  function lowestZ(v) {
+    const w = visualWorld(0, v);
+    if (!v.box) return w.p[2] - v.radius;
+    let z = Infinity;
+    for (let k = 0; k < 8; k++) {
+      const x = [0, 1, 2].map((i) => ((k >> i) & 1 ? v.box.hi[i] : v.box.lo[i]));
+      z = Math.min(z, w.p[2] + w.R[6] * x[0] + w.R[7] * x[1] + w.R[8] * x[2]);
+    }
+    return z;
+  }
+  // The grid is the ground where there is one; without one it lies under
+  // everything drawn (never through a height field or an obstacle below z = 0).
+  const groundZ = D.ground === null || D.ground === undefined
+    ? Math.min(0, ...(nframes ? visuals.map(lowestZ) : [])) - 1e-3
+    : D.ground;
   const R0 = start.r;
   const minor = Math.pow(10, Math.floor(Math.log10(R0 / 2)));
   // Force arrows: metres per newton, chosen so that a typical force (see
