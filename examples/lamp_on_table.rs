@@ -78,6 +78,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let png = out_dir.join("lamp_on_table.png");
     let mut rgb = vec![0u8; 1000 * 900 * 3];
+    png_out::register_font()?;
     {
         let area = BitMapBackend::with_buffer(&mut rgb, (1000, 900)).into_drawing_area();
         area.fill(&WHITE)?;

@@ -167,6 +167,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // log-log plot of error against wall time
     let png = out_dir.join("work_precision.png");
     let mut rgb = vec![0u8; 1000 * 700 * 3];
+    png_out::register_font()?;
     {
         let area = BitMapBackend::with_buffer(&mut rgb, (1000, 700)).into_drawing_area();
         area.fill(&WHITE)?;

@@ -1,8 +1,22 @@
 //! The examples' plots as PNG files: plotters draws into an RGB buffer
-//! (`BitMapBackend::with_buffer`), the `png` crate writes it.
+//! (`BitMapBackend::with_buffer`), the `png` crate writes it. Text is drawn in
+//! the DejaVu Sans shipped in `assets/fonts/` (plotters' pure-Rust `ab_glyph`
+//! renderer): no system font library or font is needed.
 
 use std::error::Error;
 use std::path::Path;
+
+/// Registers the shipped DejaVu Sans as plotters' `"sans-serif"` (call once,
+/// before drawing any text).
+pub fn register_font() -> Result<(), Box<dyn Error>> {
+    static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+    plotters::style::register_font(
+        "sans-serif",
+        plotters::style::FontStyle::Normal,
+        DEJAVU_SANS,
+    )
+    .map_err(|_| "assets/fonts/DejaVuSans.ttf: not a font plotters can read".into())
+}
 
 /// Writes the 8-bit RGB pixels `rgb` (`size.0 × size.1`, row by row) to `path` as
 /// a PNG: first into `path` + `.tmp`, then renamed over it, so that a failed write
