@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Projected Gauss–Seidel against the primal Newton solver, same scenes, one run.
 
-Usage: cargo build --release --example prof_lamp && python3 benches/solver_compare.py [--share DIR] [--rounds 3]
+Usage: cargo build --release --features tools --example prof_lamp && python3 benches/solver_compare.py [--share DIR] [--rounds 3]
 
 Each scene is examples/prof_lamp: the README's lamp drop (0.5 m, 10° about x), or a
 robot of example-robot-data with a floating base, joints at 0, its lowest collision

@@ -4,7 +4,7 @@
 //! box step (with the ground), a stool on a 10° height field, a ball in a
 //! non-convex bowl mesh. Prints a markdown table.
 //!
-//! `cargo run --release --example contact_scenes`
+//! `cargo run --release --features tools --example contact_scenes`
 
 use nalgebra::{DVector, Matrix3, Rotation3, Vector3};
 use std::time::Instant;

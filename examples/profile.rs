@@ -1,4 +1,4 @@
-//! Profiling driver: `cargo run --release --example profile -- ROBOT.urdf [--floating-base] ALGO N`
+//! Profiling driver: `cargo run --release --features tools --example profile -- ROBOT.urdf [--floating-base] ALGO N`
 //! calls one algorithm N times on a fixed pool of random states (for callgrind,
 //! whose instruction counts are stable on a shared, noisy machine).
 use std::hint::black_box;

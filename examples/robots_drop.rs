@@ -5,7 +5,7 @@
 //! released at rest from their neutral pose. Prints steps per second, real-time
 //! factor, final penetration, deepest penetration and the largest final speed.
 //!
-//! `cargo run --release --example robots_drop -- PACKAGE_ROOT` where PACKAGE_ROOT
+//! `cargo run --release --features tools --example robots_drop -- PACKAGE_ROOT` where PACKAGE_ROOT
 //! holds `example-robot-data/robots/...` (the meshes), e.g.
 //! `.../site-packages/cmeel.prefix/share`.
 

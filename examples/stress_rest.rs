@@ -4,7 +4,7 @@
 //! start by more than 1e-6 relative; prints steps, wall time, the largest energy
 //! excess and the final/deepest penetration.
 //!
-//! `cargo run --release --example stress_rest [URDF] [STEPS] [PACKAGE_PATH]`
+//! `cargo run --release --features tools --example stress_rest [URDF] [STEPS] [PACKAGE_PATH]`
 //! (URDF defaults to `assets/lamp.urdf`, whose collision shapes are primitives).
 //! The robot starts at its neutral configuration, at rest, its lowest collision
 //! point placed on the ground (z = 0). Exit status 1 if a check fails.

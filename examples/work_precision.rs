@@ -7,7 +7,7 @@
 //! SciPy DOP853 at 1e-13, see `tests/oracle/work_precision_ref.py`); the wall time
 //! is the best of 3 runs of the stepping loop; the energy drift is (E(2) − E(0))/|E(0)|.
 //!
-//! `cargo run --release --example work_precision [OUT_DIR]` prints the table and
+//! `cargo run --release --features tools --example work_precision [OUT_DIR]` prints the table and
 //! writes `OUT_DIR/work_precision.md` and `OUT_DIR/work_precision.png` (default `target`).
 
 use nalgebra::DVector;
