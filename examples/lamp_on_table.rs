@@ -11,7 +11,7 @@
 #[path = "common/png_out.rs"]
 mod png_out;
 
-use plotters::prelude::*;
+use plotters::style::colors::{BLACK, BLUE, RED};
 use std::path::PathBuf;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -46,102 +46,44 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let summary = urdyn::cli::simulate::run(&args)?;
     eprintln!("{summary}");
 
-    // read the trajectory back
-    let text = std::fs::read_to_string(&csv)?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    let col = |name: &str| {
-        header
-            .iter()
-            .position(|h| *h == name)
-            .ok_or(format!("no column {name}"))
-    };
-    let (ct, cz, ce, cc) = (
-        col("t")?,
-        col("q:lamp/base_z")?,
-        col("energy")?,
-        col("contacts")?,
-    );
-    let mut t = Vec::new();
-    let mut z = Vec::new();
-    let mut e = Vec::new();
-    let mut c = Vec::new();
-    for l in lines {
-        let f: Vec<f64> = l
-            .split(',')
-            .map(|x| x.parse().unwrap_or(f64::NAN))
-            .collect();
-        t.push(f[ct]);
-        z.push(f[cz]);
-        e.push(f[ce]);
-        c.push(f[cc]);
-    }
+    // read the trajectory back and plot it
+    let cols = png_out::read_columns(&csv, &["t", "q:lamp/base_z", "energy", "contacts"])?;
     let png = out_dir.join("lamp_on_table.png");
-    let mut rgb = vec![0u8; 1000 * 900 * 3];
-    png_out::register_font()?;
-    {
-        let area = BitMapBackend::with_buffer(&mut rgb, (1000, 900)).into_drawing_area();
-        area.fill(&WHITE)?;
-        let panels = area.split_evenly((3, 1));
-        let series: [(&str, &str, &Vec<f64>, RGBColor); 3] = [
-            (
+    let panel = |title, ylabel, ys, color, count| png_out::Panel {
+        title,
+        ylabel,
+        ys,
+        color,
+        count,
+    };
+    png_out::plot_panels(
+        &png,
+        &cols[0],
+        3.0,
+        &[
+            panel(
                 "lamp base height (table top at 0.75 m)",
                 "base height z (m)",
-                &z,
+                &cols[1],
                 BLUE,
+                false,
             ),
-            ("energy (kinetic + potential)", "energy E (J)", &e, RED),
-            ("active contact points", "contacts (count)", &c, BLACK),
-        ];
-        for (panel, (title, ylabel, ys, color)) in panels.iter().zip(series.iter()) {
-            let (lo, hi) = ys
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
-                    (a.min(y), b.max(y))
-                });
-            // the contact count: integer ticks only
-            let count = *ylabel == "contacts (count)";
-            let (lo, hi) = if count {
-                (0.0, hi.max(1.0).ceil())
-            } else {
-                (lo, hi)
-            };
-            let pad = if count {
-                0.3
-            } else {
-                ((hi - lo) * 0.08).max(1e-3)
-            };
-            let mut chart = ChartBuilder::on(panel)
-                .caption(*title, ("sans-serif", 20))
-                .margin(10)
-                .x_label_area_size(40)
-                .y_label_area_size(70)
-                .build_cartesian_2d(0.0..3.0, (lo - pad)..(hi + pad))?;
-            let integer = |y: &f64| {
-                if (y - y.round()).abs() < 1e-9 {
-                    format!("{y:.0}")
-                } else {
-                    String::new()
-                }
-            };
-            let mut mesh = chart.configure_mesh();
-            mesh.x_desc("time t (s)")
-                .y_desc(*ylabel)
-                .axis_desc_style(("sans-serif", 16))
-                .label_style(("sans-serif", 13));
-            if count {
-                mesh.y_labels((hi as usize + 1).min(6))
-                    .y_label_formatter(&integer);
-            }
-            mesh.draw()?;
-            chart.draw_series(LineSeries::new(
-                t.iter().copied().zip(ys.iter().copied()),
-                color,
-            ))?;
-        }
-        area.present()?;
-    }
-    png_out::write_png(&png, &rgb, (1000, 900))?;
+            panel(
+                "energy (kinetic + potential)",
+                "energy E (J)",
+                &cols[2],
+                RED,
+                false,
+            ),
+            panel(
+                "active contact points",
+                "contacts (count)",
+                &cols[3],
+                BLACK,
+                true,
+            ),
+        ],
+    )?;
     println!(
         "wrote {}, {} and {}",
         csv.display(),
