@@ -43,6 +43,17 @@ If the binary does not know `--above-ground`, floating rows are not run and say
 from their start pose with the base at z = Z (`"base": {"position": [0, 0, Z]}`) and no
 `--above-ground`, and the first-contact check is not applied (the fall height is unknown).
 
+With `--self-collision` every run is a one-model scene (`urdyn simulate --scene`,
+scene.md) instead: the same URDF, start and duration, `"self_collision": true`, and the
+robot's SRDF when example-robot-data ships one (`<pkg>/srdf/*.srdf`: the one file, else
+the one whose stem the URDF's stem starts with, longest first; its
+`<disable_collisions>` pairs excluded). A floating robot starts where
+`--above-ground H` puts it (read off a 1 ms run of the plain command), on a ground at
+z = 0; a fixed one has no ground. Links of the robot that overlap at the start are left
+out by urdyn (scene.md "Who touches whom"; listed in its warnings). The contact-time
+check becomes "first contact no later than sqrt(2H/|g|) + 0.03 s" (a link may touch
+another one before the ground).
+
 Load status: `urdyn inspect` and `urdyn eval` (empty state list) must both succeed; a
 URDF for which either fails (unparsable, no forward dynamics, ...) goes to the "does not
 load" list with the error's first line and is not simulated.
@@ -276,6 +287,8 @@ def parse_csv(path, floating):
         head = next(rd, None)
         if head is None:
             return None
+        # a one-model scene's columns are q:MODEL/NAME, v:MODEL/NAME
+        head = [re.sub(r"^([qv]):[^/]+/", r"\1:", h) for h in head]
         col = {h: i for i, h in enumerate(head)}
         ie, ic, ip = col["energy"], col["contacts"], col["penetration"]
         base = [col[k] for k in ("v:base_vx", "v:base_vy", "v:base_vz")] if floating else None
@@ -309,6 +322,65 @@ def parse_csv(path, floating):
         m["rest"] = moving_since
         m["t_end"] = t if m["rows"] else None
     return m
+
+
+def find_srdf(urdf):
+    """The SRDF example-robot-data ships beside `urdf` (`<pkg>/srdf/`), or None."""
+    pkg = os.path.dirname(os.path.dirname(urdf))
+    d = os.path.join(pkg, "srdf")
+    if not os.path.isdir(d):
+        return None
+    files = sorted(f for f in os.listdir(d) if f.endswith(".srdf"))
+    if len(files) == 1:
+        return os.path.join(d, files[0])
+    stem = os.path.splitext(os.path.basename(urdf))[0]
+    match = [f for f in files if stem.startswith(os.path.splitext(f)[0])]
+    match.sort(key=len, reverse=True)
+    return os.path.join(d, match[0]) if match else None
+
+
+def scene_command(plain, urdf, floating, state, tmp, args, r):
+    """The one-model scene run (`--self-collision`) of the plain command `plain`
+    (which ends before --package-path and --out): the start pose read off a 1 ms run
+    of it. None (with r["error"] set) when that run fails."""
+    pk = []
+    for d in args.package_paths:
+        pk += ["--package-path", d]
+    model = {"name": "r", "urdf": urdf, "base": "floating" if floating else "fixed",
+             "self_collision": True}
+    srdf = find_srdf(urdf)
+    if srdf:
+        model["srdf"] = srdf
+        r["srdf"] = os.path.relpath(srdf, os.path.dirname(os.path.dirname(os.path.dirname(urdf))))
+    if state.get("q"):
+        model["initial"] = {"q": state["q"]}
+    if floating:
+        probe = os.path.join(tmp, "start.csv")
+        cmd = [c for c in plain]
+        k = cmd.index("--duration")
+        cmd[k + 1] = "0.001"
+        rc, _, err, _ = run(cmd + pk + ["--out", probe], args.timeout)
+        if rc != 0 or not os.path.exists(probe):
+            r["error"] = "start pose: " + (first_line(err) or "exit %s" % rc)
+            r["exit"] = rc
+            return None
+        with open(probe, newline="") as fh:
+            rd = csv.reader(fh)
+            head = next(rd)
+            row = [float(x) for x in next(rd)]
+        col = {h: i for i, h in enumerate(head)}
+        model["position"] = [row[col["q:base_" + a]] for a in "xyz"]
+        model["orientation_xyzw"] = [row[col["q:base_q" + a]] for a in "xyzw"]
+    scene = {"models": [model]}
+    if floating:
+        scene["ground"] = {"height": 0.0}
+    path = os.path.join(tmp, "scene.json")
+    with open(path, "w") as fh:
+        json.dump(scene, fh)
+    cmd = [args.urdyn, "simulate", "--scene", path, "--duration", "5" if floating else "3"]
+    if args.integrator:
+        cmd += ["--integrator", args.integrator]
+    return cmd
 
 
 SUMMARY = re.compile(r"(\d+) steps (?:\((\S+)\) )?in ([0-9.eE+-]+) s wall")
@@ -370,6 +442,10 @@ def sweep_one(job, args, have_above_ground):
         if args.integrator:
             cmd += ["--integrator", args.integrator]
         trj = os.path.join(tmp, "traj.csv")
+        if args.self_collision:
+            cmd = scene_command(cmd, urdf, floating, state, tmp, args, r)
+            if cmd is None:
+                return r
         cmd += pk + ["--out", trj]
         r["command"] = " ".join(shlex.quote(c) for c in cmd)
         rc, out, err, wall = run(cmd, args.timeout)
@@ -414,7 +490,8 @@ def sweep_one(job, args, have_above_ground):
         if have_above_ground:
             expect = math.sqrt(2 * args.above_ground / G)
             r["contact_expected"] = expect
-            if abs(r["first_contact"] - expect) > CONTACT_TOL:
+            early = args.self_collision and r["first_contact"] < expect
+            if abs(r["first_contact"] - expect) > CONTACT_TOL and not early:
                 ok = False
                 why.append("contact time")
         if r.get("rest") is None:
@@ -452,6 +529,8 @@ def write_md(path, results, header):
             note = (note + "; " + w).strip("; ")
         if r["base_rule"] == "guessed":
             note = ("base guessed; " + note).strip("; ")
+        if r.get("srdf"):
+            note = ("SRDF %s; " % r["srdf"] + note).strip("; ")
         if r.get("fail_reasons") and not r["pass"]:
             note = (", ".join(r["fail_reasons"]) + ("; " + note if note else ""))
         rest = r.get("rest")
@@ -533,6 +612,8 @@ def main():
     ap.add_argument("--lift-base", type=float, default=None,
                     help="only for a binary without --above-ground: start floating robots with the base at this z")
     ap.add_argument("--loader", help="a robots_loader.py to take the free_flyer flags from")
+    ap.add_argument("--self-collision", action="store_true",
+                    help="run each robot as a one-model scene with self-collision (and its SRDF)")
     ap.add_argument("--tmpdir", default=None, help="where the CSVs go while parsed")
     ap.add_argument("--title", default="Robots sweep: example-robot-data through `urdyn simulate`")
     ap.add_argument("--note", help="a paragraph put under the title")
