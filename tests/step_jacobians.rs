@@ -269,6 +269,40 @@ fn the_call_changes_nothing() {
 }
 
 #[test]
+fn a_kept_workspace_answers_as_a_fresh_copy() {
+    // the simulation keeps the copy it computes in between calls; a clone
+    // starts without one: both answer bit for bit alike after the state, the
+    // gains and targets and the model changed
+    let mut sim = quadruped::standing_quadruped(tight());
+    let nv = sim.model.nv;
+    let tau = DVector::from_element(nv, 0.05);
+    let same = |sim: &Simulation, what: &str| {
+        for m in JacobianMethod::ALL {
+            let kept = jac(sim, &tau, m);
+            let fresh = jac(&sim.clone(), &tau, m);
+            assert_eq!(kept, fresh, "{what}: {}", m.name());
+        }
+    };
+    same(&sim, "first call");
+    for _ in 0..7 {
+        sim.step().unwrap();
+    }
+    same(&sim, "later state");
+    let mut kp = DVector::from_element(nv, 80.0);
+    kp.rows_mut(0, 6).fill(0.0);
+    sim.set_gains(&kp, &(&kp * 0.1)).unwrap();
+    let mut target = sim.q().clone();
+    target[8] += 0.1;
+    sim.set_targets(&target, None).unwrap();
+    same(&sim, "new gains and targets");
+    std::sync::Arc::make_mut(&mut sim.model).gravity.z = -5.0;
+    let moon = jac(&sim, &tau, JacobianMethod::Analytic);
+    same(&sim, "new gravity");
+    sim.set_gains_uniform(0.0, 0.0).unwrap();
+    assert_ne!(moon, jac(&sim, &tau, JacobianMethod::Analytic), "gains off");
+}
+
+#[test]
 fn jacobians_depend_on_the_state_alone() {
     // the same (q, v) after different pasts: the same A, B
     let a = quadruped::standing_quadruped(tight());
