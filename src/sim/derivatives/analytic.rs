@@ -25,7 +25,7 @@
 use super::smooth::Tableau;
 use super::TransitionJacobians;
 use crate::contact::{tangents, ContactPoint, NO_GEOM};
-use crate::dynamics::{forward_kinematics, rnea_derivatives};
+use crate::dynamics::{rnea_derivatives, DynamicsError};
 use crate::model::Shape;
 use crate::sim::integrators::dop853_tableau::{A, B, N_STAGES};
 use crate::sim::integrators::explicit_limit;
@@ -141,9 +141,6 @@ impl Simulation {
         let (q1, v1) = (self.q.clone(), self.v.clone());
         self.q.copy_from(q0);
         self.v.copy_from(v0);
-        forward_kinematics(&self.model, &mut self.data, q0)?;
-        self.fk_valid = true;
-        self.factor_mass(h)?;
         let floating = self.model.floating_base;
         let vo = self.model.joint_v_offset();
         // a = (v⁺ − v)/h − frame rate
@@ -154,8 +151,24 @@ impl Simulation {
                 acc[i] -= fr[i];
             }
         }
-        // ∂ID/∂q, ∂ID/∂v at (q, v, a) in data.dtau_dq, dtau_dv (the poses at q too)
+        // ∂ID/∂q, ∂ID/∂v at (q, v, a) in data.dtau_dq, dtau_dv, ∂ID/∂a = H in
+        // data.h, the poses at q
         rnea_derivatives(&self.model, &mut self.data, q0, v0, &acc, None)?;
+        self.fk_valid = true;
+        if self.model.has_mimic {
+            self.factor_mass(h)?;
+        } else {
+            // H̃ = H + A + hD + h Kd + h² Kp (the step's saturation set), as
+            // factor_mass adds it to its H
+            for k in 0..n {
+                self.data.h[(k, k)] +=
+                    self.armature[k] + h * self.damping[k] + self.servo.diag(k, h);
+            }
+            self.mass
+                .f
+                .factor(&self.data.h)
+                .map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)))?;
+        }
         // the diagonal terms of K_q (Kp) and K_v (D + Kd + h Kp), the effort clamp's
         let s = &self.servo;
         let mut u_free = vec![0.0; n];
@@ -215,8 +228,8 @@ impl Simulation {
             self.mass.f.solve(&mut col);
             minv.column_mut(c).copy_from(&col);
         }
-        let y = &minv * jac.transpose();
-        let w = &jac * &y;
+        let y = DMatrix::from_fn(n, m, |i, r| dot_rows(&minv, i, &jac, r));
+        let w = DMatrix::from_fn(m, m, |a, b| (0..n).map(|k| jac[(a, k)] * y[(k, b)]).sum());
         // Z0: δv⁺ without the impulses' variation, columns (δq, δv, δτ):
         // H̃⁻¹ [∂(Jᵀλ)/∂q − h K_q, −h K_v, h U] + [0, 1, 0] with K_q = ∂ID/∂q + Kp,
         // K_v = ∂ID/∂v + D + Kd + h Kp
@@ -230,7 +243,16 @@ impl Simulation {
         kk *= -h;
         kk.columns_mut(0, n).add_assign(&gc);
         let mut z0 = DMatrix::zeros(n, 3 * n);
-        z0.columns_mut(0, 2 * n).gemm(1.0, &minv, &kk, 0.0);
+        for c in 0..2 * n {
+            for k in 0..n {
+                let x = kk[(k, c)];
+                if x != 0.0 {
+                    for i in 0..n {
+                        z0[(i, c)] += minv[(i, k)] * x;
+                    }
+                }
+            }
+        }
         for k in 0..n {
             z0[(k, n + k)] += 1.0;
             if u_free[k] != 0.0 {
@@ -529,6 +551,11 @@ fn equality_row(
             rr[(r, c)] -= jac[(r, c)] / h;
         }
     }
+}
+
+/// Row i of `a` dotted with row r of `b` (as many columns).
+fn dot_rows(a: &DMatrix<f64>, i: usize, b: &DMatrix<f64>, r: usize) -> f64 {
+    (0..a.ncols()).map(|k| a[(i, k)] * b[(r, k)]).sum()
 }
 
 fn cq_row_dot(jac: &DMatrix<f64>, r: usize, v: &DVector<f64>) -> f64 {
