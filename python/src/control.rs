@@ -191,11 +191,20 @@ pub fn linearize<'py>(
         Ok(())
     };
     let r = py.detach(|| {
+        // one workspace (a copy of the simulation) per thread: each takes a
+        // contiguous run of states
         let mut work = move || -> Result<(), String> {
-            ao.par_chunks_mut((n * n).max(1))
-                .zip(bo.par_chunks_mut((n * nv).max(1)))
+            let per = t.div_ceil(rayon::current_num_threads()).max(1);
+            ao.par_chunks_mut((n * n * per).max(1))
+                .zip(bo.par_chunks_mut((n * nv * per).max(1)))
                 .enumerate()
-                .try_for_each_init(|| sim.derivative_workspace(), run)
+                .try_for_each(|(ci, (ac, bc))| {
+                    let mut w = sim.derivative_workspace();
+                    ac.chunks_mut((n * n).max(1))
+                        .zip(bc.chunks_mut((n * nv).max(1)))
+                        .enumerate()
+                        .try_for_each(|(k, pair)| run(&mut w, (ci * per + k, pair)))
+                })
         };
         match threads {
             None => work(),

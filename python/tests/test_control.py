@@ -92,16 +92,17 @@ def test_transition_jacobians_and_linearize():
     assert np.array_equal(sim.q, q0) and np.array_equal(sim.v, v0)
     # linearize along a short trajectory equals the per-state calls
     qs, vs = [], []
-    for _ in range(4):
+    # (5 states on 2 threads: runs of 3 and 2, one workspace each)
+    for _ in range(5):
         qs.append(sim.q)
         vs.append(sim.v)
         sim.step(n=3)
     qs, vs = np.array(qs), np.array(vs)
-    taus = np.zeros((4, nv))
+    taus = np.zeros((5, nv))
     taus[:, 6:] = 0.05
     As, Bs = urdyn.linearize(sim, qs, vs, taus, threads=2)
-    assert As.shape == (4, 2 * nv, 2 * nv) and Bs.shape == (4, 2 * nv, nv)
-    for t in range(4):
+    assert As.shape == (5, 2 * nv, 2 * nv) and Bs.shape == (5, 2 * nv, nv)
+    for t in range(5):
         sim.set_state(qs[t], vs[t])
         A, B = sim.transition_jacobians(taus[t])
         assert np.array_equal(As[t], A) and np.array_equal(Bs[t], B)

@@ -82,7 +82,7 @@ use crate::model::configuration::normalize_quats;
 use crate::model::{Data, JointKind, Model};
 use constraints::{Constraints, RowParams};
 use nalgebra::{DVector, Vector3};
-use std::path::PathBuf;
+use std::{path::PathBuf, sync::Arc};
 
 /// A passive run diverges when its energy rises above the reference by more
 /// than `relative · (|E_ref| + M·|g|·1 m) + absolute` (M the total mass).
@@ -285,12 +285,12 @@ struct EnergyGuard {
 /// }
 /// ```
 ///
-/// A `Simulation` clones (model, contact shapes and workspace included): a batch
-/// of runs builds its meshes' hulls once and clones the prototype.
+/// A `Simulation` clones (the model shared, contact shapes and workspace
+/// copied): a batch of runs builds its meshes' hulls once and clones the prototype.
 #[derive(Clone, Debug)]
 pub struct Simulation {
-    /// The model simulated (its joints, limits, damping, collision geometry).
-    pub model: Model,
+    /// The model simulated (joints, limits, damping, collision geometry), shared.
+    pub model: Arc<Model>,
     integrator: Integrator,
     dt: f64,
     tol: f64,
@@ -321,6 +321,7 @@ pub struct Simulation {
     guard: EnergyGuard,
     /// The energy at the current state, once computed.
     energy_now: Option<f64>,
+    deriv: derivatives::Workspace,
     /// Steps taken.
     pub steps: u64,
     /// Adaptive (`dop853`) steps rejected by the error test and retried
@@ -373,10 +374,8 @@ impl Simulation {
             )));
         }
         crate::dynamics::check_massless(&model)?;
-        let contact = match () {
-            // the ground, obstacles and pairs of bodies (none of them: no contact work)
-            _ => Collision::build(&model, opts.ground, opts.contact, &opts.package_paths)?,
-        };
+        // the ground, obstacles and pairs of bodies (none of them: no contact work)
+        let contact = Collision::build(&model, opts.ground, opts.contact, &opts.package_paths)?;
         let integrator = opts
             .integrator
             .unwrap_or(Integrator::default_for(contact.is_some()));
@@ -475,7 +474,8 @@ impl Simulation {
             pgs_sweeps: 0,
             rows_total: 0,
             opts,
-            model,
+            model: Arc::new(model),
+            deriv: Default::default(),
         };
         sim.state_changed();
         Ok(sim)

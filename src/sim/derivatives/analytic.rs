@@ -25,7 +25,7 @@
 use super::smooth::Tableau;
 use super::TransitionJacobians;
 use crate::contact::{tangents, ContactPoint, NO_GEOM};
-use crate::dynamics::{forward_kinematics, rnea_derivatives};
+use crate::dynamics::{rnea_derivatives, DynamicsError};
 use crate::model::Shape;
 use crate::sim::integrators::dop853_tableau::{A, B, N_STAGES};
 use crate::sim::integrators::explicit_limit;
@@ -33,6 +33,7 @@ use crate::sim::solver::RowKind;
 use crate::sim::{Integrator, SimError, Simulation};
 use crate::spatial::{axis_angle, skew, Motion};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use std::ops::AddAssign;
 
 impl Simulation {
     /// A and B through the step's own equations, from the fresh state (set by
@@ -45,33 +46,36 @@ impl Simulation {
         &mut self,
         tau: &DVector<f64>,
     ) -> Result<Option<TransitionJacobians>, SimError> {
-        let n = self.model.nv;
         let f = &self.model.free_joints;
         if f.len() > 1 || f.first().is_some_and(|f| f.iv != 0 || f.iq != 0) {
             return Ok(None);
         }
         self.set_joint_torques(tau);
         let dt = self.dt;
-        let mut jx = DMatrix::<f64>::identity(2 * n, 2 * n);
-        let mut jt = DMatrix::<f64>::zeros(2 * n, n);
+        let mut out: Option<TransitionJacobians> = None;
         while self.t < dt {
             let Some(j) = self.substep_jacobian(dt, tau)? else {
                 return Ok(None);
             };
-            let ax = j.columns(0, 2 * n).into_owned();
-            jt = &ax * jt + j.columns(2 * n, n);
-            jx = ax * jx;
+            out = Some(match out {
+                None => j,
+                // x'' = Aₛ x' + Bₛ τ after x' = A x + B τ
+                Some(p) => TransitionJacobians {
+                    b: &j.a * p.b + j.b,
+                    a: j.a * p.a,
+                },
+            });
         }
-        Ok(Some(TransitionJacobians { a: jx, b: jt }))
+        Ok(out)
     }
 
-    /// One step toward `t_end`, taken, and its Jacobian [δq'; δv'] over the
-    /// columns (δq, δv, δτ) by the scheme it took.
+    /// One step toward `t_end`, taken, and its Jacobians [δq'; δv'] over the
+    /// columns (δq, δv) and δτ by the scheme it took.
     fn substep_jacobian(
         &mut self,
         t_end: f64,
         tau: &DVector<f64>,
-    ) -> Result<Option<DMatrix<f64>>, SimError> {
+    ) -> Result<Option<TransitionJacobians>, SimError> {
         let (q0, v0) = (self.q.clone(), self.v.clone());
         let points = self.points.clone();
         // the step's scheme, as step_until chooses it
@@ -98,9 +102,12 @@ impl Simulation {
                 },
                 _ => Tableau { a: &dop_a, b: &B },
             };
-            return self
-                .smooth_step_jacobian(&q0, &v0, &q1, tau, h, &tab)
-                .map(Some);
+            let j = self.smooth_step_jacobian(&q0, &v0, &q1, tau, h, &tab)?;
+            let n = self.model.nv;
+            return Ok(Some(TransitionJacobians {
+                a: j.columns(0, 2 * n).into_owned(),
+                b: j.columns(2 * n, n).into_owned(),
+            }));
         }
         self.implicit_step_jacobian(&q0, &v0, &points, counts, h, tau)
             .map(Some)
@@ -116,7 +123,7 @@ impl Simulation {
         counts: crate::sim::constraints::RowCounts,
         h: f64,
         tau: &DVector<f64>,
-    ) -> Result<DMatrix<f64>, SimError> {
+    ) -> Result<TransitionJacobians, SimError> {
         let n = self.model.nv;
         let rows_used = self.cons.rows_len() > 0 && counts.total() > 0;
         // v⁺ in the start frame (before the base velocity's rotation), w
@@ -134,9 +141,6 @@ impl Simulation {
         let (q1, v1) = (self.q.clone(), self.v.clone());
         self.q.copy_from(q0);
         self.v.copy_from(v0);
-        self.fk_valid = false;
-        self.factor_mass(h)?;
-        forward_kinematics(&self.model, &mut self.data, q0)?;
         let floating = self.model.floating_base;
         let vo = self.model.joint_v_offset();
         // a = (v⁺ − v)/h − frame rate
@@ -147,17 +151,35 @@ impl Simulation {
                 acc[i] -= fr[i];
             }
         }
-        let (mut kq, mut kv) = self.id_derivatives(q0, v0, &acc)?;
-        // servo and damping terms, the effort clamp's
+        // ∂ID/∂q, ∂ID/∂v at (q, v, a) in data.dtau_dq, dtau_dv, ∂ID/∂a = H in
+        // data.h, the poses at q
+        rnea_derivatives(&self.model, &mut self.data, q0, v0, &acc, None)?;
+        self.fk_valid = true;
+        if self.model.has_mimic {
+            self.factor_mass(h)?;
+        } else {
+            // H̃ = H + A + hD + h Kd + h² Kp (the step's saturation set), as
+            // factor_mass adds it to its H
+            for k in 0..n {
+                self.data.h[(k, k)] +=
+                    self.armature[k] + h * self.damping[k] + self.servo.diag(k, h);
+            }
+            self.mass
+                .f
+                .factor(&self.data.h)
+                .map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)))?;
+        }
+        // the diagonal terms of K_q (Kp) and K_v (D + Kd + h Kp), the effort clamp's
         let s = &self.servo;
         let mut u_free = vec![0.0; n];
+        let mut kq_diag = vec![0.0; n];
+        let mut kv_diag = self.damping.as_slice().to_vec();
         for k in 0..n {
-            kv[(k, k)] += self.damping[k];
             if k >= vo && s.saturated[k] == 0 {
                 u_free[k] = 1.0;
                 if s.active {
-                    kq[(k, k)] += s.kp[k];
-                    kv[(k, k)] += s.kd[k] + h * s.kp[k];
+                    kq_diag[k] = s.kp[k];
+                    kv_diag[k] += s.kd[k] + h * s.kp[k];
                 }
             }
         }
@@ -197,33 +219,45 @@ impl Simulation {
                 }
             }
         }
-        kq -= &gc / h;
-        // Y = H̃⁻¹Jᵀ, W = J Y
-        let mut y = DMatrix::zeros(n, m);
+        // H̃⁻¹ (n solves), Y = H̃⁻¹Jᵀ, W = J Y
+        let mut minv = DMatrix::zeros(n, n);
         let mut col = DVector::zeros(n);
-        for r in 0..m {
-            col.copy_from(&jac.row(r).transpose());
+        for c in 0..n {
+            col.fill(0.0);
+            col[c] = 1.0;
             self.mass.f.solve(&mut col);
-            y.column_mut(r).copy_from(&col);
+            minv.column_mut(c).copy_from(&col);
         }
-        let w = &jac * &y;
-        // Z0: δv⁺ without the impulses' variation, columns (δq, δv, δτ)
-        let mut rhs = DMatrix::zeros(n, 3 * n);
+        let y = DMatrix::from_fn(n, m, |i, r| dot_rows(&minv, i, &jac, r));
+        let w = DMatrix::from_fn(m, m, |a, b| (0..n).map(|k| jac[(a, k)] * y[(k, b)]).sum());
+        // Z0: δv⁺ without the impulses' variation, columns (δq, δv, δτ):
+        // H̃⁻¹ [∂(Jᵀλ)/∂q − h K_q, −h K_v, h U] + [0, 1, 0] with K_q = ∂ID/∂q + Kp,
+        // K_v = ∂ID/∂v + D + Kd + h Kp
+        let mut kk = DMatrix::zeros(n, 2 * n);
+        kk.columns_mut(0, n).copy_from(&self.data.dtau_dq);
+        kk.columns_mut(n, n).copy_from(&self.data.dtau_dv);
         for k in 0..n {
-            for c in 0..n {
-                rhs[(k, c)] = -h * kq[(k, c)];
-                rhs[(k, n + c)] = -h * kv[(k, c)];
-            }
-            rhs[(k, 2 * n + k)] = h * u_free[k];
+            kk[(k, k)] += kq_diag[k];
+            kk[(k, n + k)] += kv_diag[k];
         }
+        kk *= -h;
+        kk.columns_mut(0, n).add_assign(&gc);
         let mut z0 = DMatrix::zeros(n, 3 * n);
-        for c in 0..3 * n {
-            col.copy_from(&rhs.column(c));
-            self.mass.f.solve(&mut col);
-            z0.column_mut(c).copy_from(&col);
+        for c in 0..2 * n {
+            for k in 0..n {
+                let x = kk[(k, c)];
+                if x != 0.0 {
+                    for i in 0..n {
+                        z0[(i, c)] += minv[(i, k)] * x;
+                    }
+                }
+            }
         }
         for k in 0..n {
             z0[(k, n + k)] += 1.0;
+            if u_free[k] != 0.0 {
+                z0.column_mut(2 * n + k).axpy(h, &minv.column(k), 0.0);
+            }
         }
         if floating {
             // h ∂(ω × l)/∂v = h ([ω]×, −[l]×) on the linear rows
@@ -248,6 +282,7 @@ impl Simulation {
             let mut mm = DMatrix::zeros(m, m);
             let mut rr = DMatrix::zeros(m, 3 * n);
             let mut r = 0;
+            let mut any_sliding = false;
             while r < m {
                 match rows.kind[r] {
                     RowKind::Normal => {
@@ -272,6 +307,7 @@ impl Simulation {
                             // normal: δu = δb
                             equality_row(&mut mm, &mut rr, &w, &cq, &jac, rows.b[r], r, n, h);
                             if sliding {
+                                any_sliding = true;
                                 // λₜ = −μ λₙ û: δλₜ + μ û δλₙ + κ P δuₜ = 0
                                 let un = ut.norm();
                                 let uh = [ut.x / un, ut.y / un];
@@ -318,13 +354,19 @@ impl Simulation {
                     _ => r += 1,
                 }
             }
-            // a stick set's rows can be redundant (a flat foot's vertices): the
-            // least-norm solution, whose Jᵀδλ is the same for any solution
-            let svd = mm.svd(true, true);
-            let tol = 1e-12 * svd.singular_values.max().max(1e-300);
-            let dl = svd
-                .solve(&rr, tol)
-                .map_err(|e| SimError::Invalid(format!("transition_jacobians: {e}")))?;
+            // a stick set's rows can be redundant (a flat foot's vertices, a
+            // planar leg's feet sideways): M = W there, and Jᵀδλ is the same
+            // for any solution (W's null space is Jᵀ's): a basic one. Sliding
+            // rows on redundant contacts leave it to the choice of solution
+            // (the normal impulses' split): the least-norm one (SVD)
+            let dl = if any_sliding {
+                let svd = mm.svd(true, true);
+                let tol = 1e-12 * svd.singular_values.max().max(1e-300);
+                svd.solve(&rr, tol)
+                    .map_err(|e| SimError::Invalid(format!("transition_jacobians: {e}")))?
+            } else {
+                solve_basic(mm, rr, 1e-12)
+            };
             z0 + &y * dl
         };
         self.q.copy_from(&q1);
@@ -334,8 +376,8 @@ impl Simulation {
     }
 
     /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces): the
-    /// analytic [`rnea_derivatives`] (docs/theory.md §"Derivatives"); the
-    /// simulation's kinematics are left at `q`.
+    /// analytic [`rnea_derivatives`] (docs/theory.md §"Derivatives"), which
+    /// leaves the simulation's kinematics at `q`.
     pub(super) fn id_derivatives(
         &mut self,
         q: &DVector<f64>,
@@ -343,9 +385,7 @@ impl Simulation {
         a: &DVector<f64>,
     ) -> Result<(DMatrix<f64>, DMatrix<f64>), SimError> {
         rnea_derivatives(&self.model, &mut self.data, q, v, a, None)?;
-        let (dq, dv) = (self.data.dtau_dq.clone(), self.data.dtau_dv.clone());
-        forward_kinematics(&self.model, &mut self.data, q)?;
-        Ok((dq, dv))
+        Ok((self.data.dtau_dq.clone(), self.data.dtau_dv.clone()))
     }
 
     /// The radius of a contact shape that rolls (sphere, capsule): its contact
@@ -366,16 +406,27 @@ impl Simulation {
     }
 
     /// [δq'; δv'] from δv⁺ (start frame) and the unperturbed total velocity
-    /// `vtot`, for the columns (δq, δv, δτ): A and B.
-    fn output_map(&self, vtot: &DVector<f64>, dvplus: &DMatrix<f64>, h: f64) -> DMatrix<f64> {
+    /// `vtot`, for the columns (δq, δv) (A) and δτ (B).
+    fn output_map(&self, vtot: &DVector<f64>, dvplus: &DMatrix<f64>, h: f64) -> TransitionJacobians {
         let n = self.model.nv;
-        let mut out = DMatrix::zeros(2 * n, 3 * n);
+        let mut out = TransitionJacobians {
+            a: DMatrix::zeros(2 * n, 2 * n),
+            b: DMatrix::zeros(2 * n, n),
+        };
+        // column c of [A B]
+        let put = |out: &mut TransitionJacobians, r: usize, c: usize, x: f64| {
+            if c < 2 * n {
+                out.a[(r, c)] = x;
+            } else {
+                out.b[(r, c - 2 * n)] = x;
+            }
+        };
         // joints: δq' = δq + h δv⁺, δv' = δv⁺
         for c in 0..3 * n {
             for k in 0..n {
                 let dq = if c < n && c == k { 1.0 } else { 0.0 };
-                out[(k, c)] = dq + h * dvplus[(k, c)];
-                out[(n + k, c)] = dvplus[(k, c)];
+                put(&mut out, k, c, dq + h * dvplus[(k, c)]);
+                put(&mut out, n + k, c, dvplus[(k, c)]);
             }
         }
         if self.model.floating_base {
@@ -391,7 +442,6 @@ impl Simulation {
             let jr = right_jacobian(&(w * h));
             let vlin_new = et * l;
             for c in 0..3 * n {
-                let dvp = column_vec(dvplus, c, n);
                 let (dl_in, dth_in) = if c < 3 {
                     (unit(c), Vector3::zeros())
                 } else if c < 6 {
@@ -399,21 +449,81 @@ impl Simulation {
                 } else {
                     (Vector3::zeros(), Vector3::zeros())
                 };
-                let (dlv, dwv) = (lin(&dvp), omega(&dvp));
+                let dlv = Vector3::new(dvplus[(0, c)], dvplus[(1, c)], dvplus[(2, c)]);
+                let dwv = Vector3::new(dvplus[(3, c)], dvplus[(4, c)], dvplus[(5, c)]);
                 // δl' = Eᵀ(δl + h δθ × l + h δl⁺), δθ' = Eᵀ δθ + J_r h δω
                 let dl_out = et * (dl_in + dth_in.cross(&l) * h + dlv * h);
                 let dth_out = et * dth_in + jr * dwv * h;
                 // δv'_lin = Eᵀ δl⁺ + [v'_lin]× J_r h δω
                 let dv_out = et * dlv + vlin_new.cross(&(jr * dwv * h));
                 for i in 0..3 {
-                    out[(i, c)] = dl_out[i];
-                    out[(3 + i, c)] = dth_out[i];
-                    out[(n + i, c)] = dv_out[i];
+                    put(&mut out, i, c, dl_out[i]);
+                    put(&mut out, 3 + i, c, dth_out[i]);
+                    put(&mut out, n + i, c, dv_out[i]);
                 }
             }
         }
         out
     }
+}
+
+/// M X = R by Gaussian elimination with complete pivoting (M square), stopped
+/// at the first pivot below `tol` times the first (the largest entry): the
+/// unknowns of the pivots left are 0, a basic solution where R lies in M's range.
+fn solve_basic(mut a: DMatrix<f64>, mut b: DMatrix<f64>, tol: f64) -> DMatrix<f64> {
+    let (m, nc) = (a.nrows(), b.ncols());
+    // unknown perm[k] sits in column k
+    let mut perm: Vec<usize> = (0..m).collect();
+    let (mut rank, mut first) = (0, 0.0);
+    for k in 0..m {
+        let (mut pi, mut pj, mut pv) = (k, k, 0.0);
+        for j in k..m {
+            for i in k..m {
+                if a[(i, j)].abs() > pv {
+                    (pi, pj, pv) = (i, j, a[(i, j)].abs());
+                }
+            }
+        }
+        if k == 0 {
+            first = pv;
+        }
+        if !(pv > tol * first) {
+            break;
+        }
+        a.swap_rows(k, pi);
+        b.swap_rows(k, pi);
+        a.swap_columns(k, pj);
+        perm.swap(k, pj);
+        // row i −= (a_ik / a_kk) row k below the pivot
+        for i in k + 1..m {
+            let f = a[(i, k)] / a[(k, k)];
+            if f != 0.0 {
+                for j in k..m {
+                    a[(i, j)] -= f * a[(k, j)];
+                }
+                for c in 0..nc {
+                    b[(i, c)] -= f * b[(k, c)];
+                }
+            }
+        }
+        rank = k + 1;
+    }
+    // back substitution over the kept pivots, x[perm[k]] = y[k]
+    let mut x = DMatrix::zeros(m, nc);
+    let mut y = vec![0.0; rank];
+    for c in 0..nc {
+        for k in (0..rank).rev() {
+            let mut t = b[(k, c)];
+            for j in k + 1..rank {
+                t -= a[(k, j)] * y[j];
+            }
+            y[k] = t / a[(k, k)];
+        }
+        for k in 0..rank {
+            x[(perm[k], c)] = y[k];
+        }
+    }
+    x
 }
 
 /// One equality row δu_r = δb_r of the active set: W_r δλ = δb_r − C'_r, with
@@ -443,6 +553,11 @@ fn equality_row(
     }
 }
 
+/// Row i of `a` dotted with row r of `b` (as many columns).
+fn dot_rows(a: &DMatrix<f64>, i: usize, b: &DMatrix<f64>, r: usize) -> f64 {
+    (0..a.ncols()).map(|k| a[(i, k)] * b[(r, k)]).sum()
+}
+
 fn cq_row_dot(jac: &DMatrix<f64>, r: usize, v: &DVector<f64>) -> f64 {
     jac.row(r).transpose().dot(v)
 }
@@ -457,9 +572,6 @@ fn unit(i: usize) -> Vector3<f64> {
     let mut e = Vector3::zeros();
     e[i] = 1.0;
     e
-}
-fn column_vec(m: &DMatrix<f64>, c: usize, n: usize) -> DVector<f64> {
-    DVector::from_fn(n, |k, _| m[(k, c)])
 }
 
 /// SO(3)'s right Jacobian: Exp(x + δ) ≈ Exp(x) Exp(J_r(x) δ).

@@ -10,7 +10,10 @@
 //! - [`JacobianMethod::Analytic`]: the step's own chain rule (`analytic.rs`).
 //!
 //! A step is one step of `dt` (an adaptive integrator's steps up to `dt`).
-//! Nothing of the simulation called on changes: the work is done on a copy.
+//! Nothing of the simulation called on changes: the work is done on a copy,
+//! made at the first call and kept by the simulation ([`Workspace`]) for the
+//! next ones, which copy into it only what may have changed since (the servos'
+//! gains and targets; a new model makes a new copy).
 
 mod analytic;
 mod fd;
@@ -20,6 +23,25 @@ use crate::model::configuration::{difference, integrate};
 use crate::sim::servo::FREE;
 use crate::sim::{SimError, Simulation};
 use nalgebra::{DMatrix, DVector};
+use std::sync::{Arc, Mutex, TryLockError};
+
+/// The copy of a simulation its transition Jacobians are computed in, kept
+/// between calls (a clone of the simulation starts without one; a call that
+/// finds it in use by another thread works in a copy of its own).
+#[derive(Default)]
+pub(in crate::sim) struct Workspace(Mutex<Option<Box<Simulation>>>);
+
+impl Clone for Workspace {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl std::fmt::Debug for Workspace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Workspace")
+    }
+}
 
 /// How [`Simulation::transition_jacobians`] differentiates the step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -76,9 +98,35 @@ impl Simulation {
         method: JacobianMethod,
         eps: f64,
     ) -> Result<TransitionJacobians, SimError> {
-        let mut work = self.derivative_workspace();
-        let (q, v) = (self.q.clone(), self.v.clone());
-        work.transition_jacobians_at(&q, &v, tau, method, eps)
+        // pairs of bodies decide their start overlaps at each state set before
+        // a run's first step: a copy of their own (the analytic route does not
+        // reach them anyway)
+        let pairs = self.contact.as_ref().is_some_and(|c| c.pairs.is_some());
+        let mut slot = match self.deriv.0.try_lock() {
+            Ok(s) if !pairs => s,
+            Err(TryLockError::Poisoned(p)) if !pairs => p.into_inner(),
+            _ => {
+                let mut work = self.derivative_workspace();
+                return work.transition_jacobians_at(&self.q, &self.v, tau, method, eps);
+            }
+        };
+        let work = match slot.as_mut() {
+            Some(w) if Arc::ptr_eq(&w.model, &self.model) => w,
+            _ => slot.insert(Box::new(self.derivative_workspace())),
+        };
+        work.copy_settings(self);
+        work.transition_jacobians_at(&self.q, &self.v, tau, method, eps)
+    }
+
+    /// The settings of `from` that change after construction (the servos'
+    /// gains and targets), copied into this workspace of it.
+    fn copy_settings(&mut self, from: &Simulation) {
+        let (s, f) = (&mut self.servo, &from.servo);
+        s.kp.copy_from(&f.kp);
+        s.kd.copy_from(&f.kd);
+        s.q_ref.copy_from(&f.q_ref);
+        s.v_ref.copy_from(&f.v_ref);
+        s.active = f.active;
     }
 
     /// A copy of this simulation to compute transition Jacobians in (see
@@ -137,12 +185,13 @@ impl Simulation {
     ) -> Result<(), SimError> {
         self.t = 0.0;
         self.smooth.h_next = self.dt;
+        // (without contact the state set first leaves nothing behind)
         if let Some(c) = self.contact.as_mut() {
             c.forget_history();
+            self.q = self.model.neutral();
+            self.v.fill(0.0);
+            self.state_changed();
         }
-        self.q = self.model.neutral();
-        self.v.fill(0.0);
-        self.state_changed();
         self.set_state(q, v)
     }
 
