@@ -448,7 +448,13 @@ impl Loader<'_> {
                 self_collision: models[i].self_collision,
             });
         }
-        let mut model = forest("scene", parts, Vector3::from(gravity));
+        // the forest is named after its file (`lamp_on_table` for lamp_on_table.json)
+        let name = Path::new(self.file)
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .filter(|s| !s.is_empty())
+            .unwrap_or("scene");
+        let mut model = forest(name, parts, Vector3::from(gravity));
 
         // obstacles: collision geometry on the world body
         let mut obstacles = Vec::new();
