@@ -356,6 +356,41 @@ fn a_kept_workspace_answers_as_a_fresh_copy() {
 }
 
 #[test]
+fn a_kept_workspace_answers_as_a_fresh_copy_in_a_scene() {
+    // the lamp dropped onto the table: an obstacle and the lamp's own pairs,
+    // whose start overlaps are decided at each state set before the first step
+    let s = urdyn::scene::Scene::from_file(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/assets/lamp_on_table.json"),
+        &[],
+    )
+    .unwrap();
+    let opts = SimOptions {
+        ground: s.ground.map(|g| g.height),
+        ..tight()
+    };
+    let mut sim = Simulation::new(s.model.clone(), opts).unwrap();
+    sim.set_state(&s.q0, &s.v0).unwrap();
+    let tau = DVector::zeros(sim.model.nv);
+    let same = |sim: &Simulation, what: &str| {
+        for m in JacobianMethod::ALL {
+            let kept = jac(sim, &tau, m);
+            let fresh = jac(&sim.clone(), &tau, m);
+            assert_eq!(kept, fresh, "{what}: {}", m.name());
+        }
+    };
+    same(&sim, "at the start");
+    let mut q = s.q0.clone();
+    q[2] -= 0.2;
+    sim.set_state(&q, &s.v0).unwrap();
+    same(&sim, "another start");
+    while sim.time() < 0.6 {
+        sim.step().unwrap();
+    }
+    assert!(sim.active_contacts() > 0, "the lamp on the table");
+    same(&sim, "on the table");
+}
+
+#[test]
 fn jacobians_depend_on_the_state_alone() {
     // the same (q, v) after different pasts: the same A, B
     let a = quadruped::standing_quadruped(tight());

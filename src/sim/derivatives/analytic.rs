@@ -407,7 +407,12 @@ impl Simulation {
 
     /// [δq'; δv'] from δv⁺ (start frame) and the unperturbed total velocity
     /// `vtot`, for the columns (δq, δv) (A) and δτ (B).
-    fn output_map(&self, vtot: &DVector<f64>, dvplus: &DMatrix<f64>, h: f64) -> TransitionJacobians {
+    fn output_map(
+        &self,
+        vtot: &DVector<f64>,
+        dvplus: &DMatrix<f64>,
+        h: f64,
+    ) -> TransitionJacobians {
         let n = self.model.nv;
         let mut out = TransitionJacobians {
             a: DMatrix::zeros(2 * n, 2 * n),
@@ -487,7 +492,7 @@ fn solve_basic(mut a: DMatrix<f64>, mut b: DMatrix<f64>, tol: f64) -> DMatrix<f6
         if k == 0 {
             first = pv;
         }
-        if !(pv > tol * first) {
+        if pv <= tol * first {
             break;
         }
         a.swap_rows(k, pi);

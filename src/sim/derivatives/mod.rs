@@ -11,7 +11,7 @@
 //!
 //! A step is one step of `dt` (an adaptive integrator's steps up to `dt`).
 //! Nothing of the simulation called on changes: the work is done on a copy,
-//! made at the first call and kept by the simulation ([`Workspace`]) for the
+//! made at the first call and kept by the simulation (`Workspace`) for the
 //! next ones, which copy into it only what may have changed since (the servos'
 //! gains and targets; a new model makes a new copy).
 
@@ -98,24 +98,32 @@ impl Simulation {
         method: JacobianMethod,
         eps: f64,
     ) -> Result<TransitionJacobians, SimError> {
-        // pairs of bodies decide their start overlaps at each state set before
-        // a run's first step: a copy of their own (the analytic route does not
-        // reach them anyway)
-        let pairs = self.contact.as_ref().is_some_and(|c| c.pairs.is_some());
         let mut slot = match self.deriv.0.try_lock() {
-            Ok(s) if !pairs => s,
-            Err(TryLockError::Poisoned(p)) if !pairs => p.into_inner(),
-            _ => {
+            Ok(s) => s,
+            Err(TryLockError::Poisoned(p)) => p.into_inner(),
+            Err(TryLockError::WouldBlock) => {
                 let mut work = self.derivative_workspace();
                 return work.transition_jacobians_at(&self.q, &self.v, tau, method, eps);
             }
         };
         let work = match slot.as_mut() {
-            Some(w) if Arc::ptr_eq(&w.model, &self.model) => w,
+            Some(w) if w.answers_for(self) => w,
             _ => slot.insert(Box::new(self.derivative_workspace())),
         };
         work.copy_settings(self);
         work.transition_jacobians_at(&self.q, &self.v, tau, method, eps)
+    }
+
+    /// Whether this workspace of `from` still answers as a new copy would: the
+    /// same model, and the same pairs of bodies dropped for overlapping at the
+    /// start (decided anew at each state set before the first step: a copy of
+    /// a simulation that has stepped keeps its decision, which the workspace
+    /// has when it was made after that decision).
+    fn answers_for(&self, from: &Simulation) -> bool {
+        fn dropped(s: &Simulation) -> Option<&[crate::contact::DroppedPair]> {
+            s.contact.as_ref().map(|c| &c.dropped[..])
+        }
+        Arc::ptr_eq(&self.model, &from.model) && (from.steps == 0 || dropped(self) == dropped(from))
     }
 
     /// The settings of `from` that change after construction (the servos'
@@ -127,6 +135,8 @@ impl Simulation {
         s.q_ref.copy_from(&f.q_ref);
         s.v_ref.copy_from(&f.v_ref);
         s.active = f.active;
+        // before the first step the pairs' start overlaps are decided at the state
+        self.steps = from.steps;
     }
 
     /// A copy of this simulation to compute transition Jacobians in (see
