@@ -60,6 +60,7 @@
 pub mod broad;
 pub mod filter;
 pub mod ground;
+mod hull;
 pub mod mesh;
 pub mod pairs;
 mod paths;

@@ -75,6 +75,8 @@ pub struct PairContact {
     table: Vec<u32>,
     sap: SweepAndPrune,
     overlapping: Vec<u32>,
+    /// Each member's world pose (parry's frame) at the last detection.
+    poses: Vec<Se3<f64>>,
     raw: Vec<Raw>,
     /// Members that move (their boxes are refreshed each step).
     moving: Vec<usize>,
@@ -206,11 +208,11 @@ impl PairContact {
         }
         let mut sap = SweepAndPrune::new(n);
         let mut moving = Vec::new();
+        let mut poses = Vec::with_capacity(n);
         for (k, m) in members.iter().enumerate() {
+            poses.push(m.placement);
             if m.body == 0 {
-                let w = m.placement;
-                let c = w.act_point(&m.shape.centre_parry());
-                sap.set(k, [c.x, c.y, c.z], m.shape.bound + params.margin);
+                set_box(&mut sap, k, m, &m.placement, params.margin);
             } else {
                 moving.push(k);
             }
@@ -221,6 +223,7 @@ impl PairContact {
             table,
             sap,
             overlapping: Vec::with_capacity(pairs.len()),
+            poses,
             raw: Vec::new(),
             moving,
             queries: 0,
@@ -262,8 +265,8 @@ impl PairContact {
         for &k in &self.moving {
             let m = &self.members[k];
             let w = world(m, o_m_i);
-            let c = w.act_point(&m.shape.centre_parry());
-            self.sap.set(k, [c.x, c.y, c.z], m.shape.bound + margin);
+            set_box(&mut self.sap, k, m, &w, margin);
+            self.poses[k] = w;
         }
         self.overlapping.clear();
         self.sap.overlaps(&self.table, &mut self.overlapping);
@@ -286,7 +289,7 @@ impl PairContact {
                 continue;
             }
             let (ma, mb) = (&self.members[pair.a], &self.members[pair.b]);
-            let (wa, wb) = (world(ma, o_m_i), world(mb, o_m_i));
+            let (wa, wb) = (self.poses[pair.a], self.poses[pair.b]);
             let pos12 = to_pose(&wa.inverse().compose(&wb));
             self.queries += 1;
             // the points are found anew (a generator that finds the shapes
@@ -431,12 +434,17 @@ impl PairContact {
     }
 }
 
-impl PairShape {
-    /// The bounding sphere's centre in parry's frame of the shape.
-    #[inline]
-    fn centre_parry(&self) -> Vector3<f64> {
-        self.offset.inverse().act_point(&self.centre)
-    }
+/// Sets member `k`'s broad-phase box: its shape's box at the world pose `w`
+/// boxed along the world axes (centre R·c + t, half extents |R|·h), grown by
+/// `margin`.
+#[inline]
+fn set_box(sap: &mut SweepAndPrune, k: usize, m: &Member, w: &Se3<f64>, margin: f64) {
+    let c = w.act_point(&m.shape.mid);
+    let h = &m.shape.half;
+    let r = &w.rot;
+    let e =
+        |i: usize| r[(i, 0)].abs() * h.x + r[(i, 1)].abs() * h.y + r[(i, 2)].abs() * h.z + margin;
+    sap.set(k, [c.x, c.y, c.z], [e(0), e(1), e(2)]);
 }
 
 /// Appends at most `maxp` of `raw` to `out` as `make` makes them: all when
