@@ -150,6 +150,17 @@ impl ClimbHull {
         }))
     }
 
+    /// The hull's vertices.
+    pub fn points(&self) -> &[PVec] {
+        self.hull.points()
+    }
+
+    /// The neighbours of vertex `k` on the triangulation's vertex graph.
+    #[inline]
+    pub fn neighbours(&self, k: usize) -> &[u32] {
+        &self.adj[self.adj_start[k] as usize..self.adj_start[k + 1] as usize]
+    }
+
     /// The index of a vertex maximising d·v, and d·v there.
     #[inline]
     pub fn support_index(&self, d: PVec) -> (usize, f64) {
@@ -195,10 +206,10 @@ impl ClimbHull {
         let mut m = [f64::NEG_INFINITY; 4];
         let mut i = 0;
         while i + 4 <= n {
-            for l in 0..4 {
+            for (l, ml) in m.iter_mut().enumerate() {
                 let v = dot(i + l);
-                if v > m[l] {
-                    m[l] = v;
+                if v > *ml {
+                    *ml = v;
                 }
             }
             i += 4;

@@ -70,6 +70,12 @@ pub(crate) fn to_pose(m: &Se3<f64>) -> Pose {
     Pose::from_parts(PVec::new(m.trans.x, m.trans.y, m.trans.z), q)
 }
 
+/// An engine vector as a parry vector.
+#[inline]
+pub(crate) fn to_pvec(v: &Vector3<f64>) -> PVec {
+    PVec::new(v.x, v.y, v.z)
+}
+
 /// A parry vector as an engine vector.
 #[inline]
 pub(crate) fn from_pvec(v: PVec) -> Vector3<f64> {
