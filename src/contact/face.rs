@@ -5,6 +5,9 @@
 //! face's normal and its height above the plane as the gap) instead of
 //! parry's GJK/EPA and polygon clipping, triangle by triangle.
 //!
+//! As on the ground, a large hull's points are its vertices within 2 mm of
+//! its lowest one (and within the margin): the patch is chosen among them.
+//!
 //! It applies only where the plane contact is the exact one: every hull
 //! vertex within the margin of the plane lies over the face, and a
 //! penetrating one is nearer the face than any other of the box's faces
@@ -105,6 +108,10 @@ pub(crate) struct FacePoint {
     pub gap: f64,
 }
 
+/// The points are the vertices at most this far (m) above the lowest one
+/// (and within the margin), as the ground path's patch (`BAND` there).
+const BAND: f64 = 2e-3;
+
 /// What the fast path found.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum FaceContact {
@@ -174,13 +181,14 @@ pub(crate) fn hull_on_face(
             let mut n = Vector3::zeros();
             n[i] = s;
             let (j1, j2) = ((i + 1) % 3, (i + 2) % 3);
+            let band = margin.min(sep + BAND);
             let ok = collect(
                 hull,
                 b_m_a,
                 &n,
                 e[i],
                 k0,
-                margin,
+                band,
                 out,
                 stack,
                 seen,
@@ -254,13 +262,14 @@ pub(crate) fn hull_on_face(
             if low - h > margin {
                 return FaceContact::Apart;
             }
+            let band = margin.min(low - h + BAND);
             let ok = collect(
                 hull,
                 b_m_a,
                 &n,
                 h,
                 k0,
-                margin,
+                band,
                 out,
                 stack,
                 seen,
@@ -276,7 +285,7 @@ pub(crate) fn hull_on_face(
     }
 }
 
-/// Appends the hull's vertices within `margin` of the plane n·q = h (q the
+/// Appends the hull's vertices within `margin` (the band) of the plane n·q = h (q the
 /// vertex in the face shape's frame) to `out`, from the lowest `k0` (on the
 /// vertex graph of a large hull: the vertices below a plane are connected on
 /// it); false as soon as one fails `valid(q, gap)`.
@@ -422,12 +431,16 @@ mod tests {
             let pose = at(0.05, -0.02, z, roll);
             let (c, pts) = run(&h, &pose, FaceShape::Cuboid(&b));
             assert_eq!(c, FaceContact::Plane(Vector3::z()));
-            // every vertex within the margin of the top, each its height
+            // every vertex within the band (2 mm above the lowest, within
+            // the margin) of the top, each its height
+            let height = |p: &PVec| pose.act_point(&to_v(*p)).z - 0.1;
+            let low = h.points().iter().map(height).fold(f64::INFINITY, f64::min);
             let want = h
                 .points()
                 .iter()
-                .filter(|p| pose.act_point(&to_v(**p)).z - 0.1 <= 0.005)
+                .filter(|p| height(p) <= 0.005f64.min(low + BAND))
                 .count();
+            assert!(want >= 3, "{want}");
             assert_eq!(pts.len(), want);
             for p in &pts {
                 assert!((p.gap - (p.point.z - 0.1)).abs() < 1e-15);
