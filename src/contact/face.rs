@@ -5,8 +5,9 @@
 //! face's normal and its height above the plane as the gap) instead of
 //! parry's GJK/EPA and polygon clipping, triangle by triangle.
 //!
-//! As on the ground, a large hull's points are its vertices within 2 mm of
-//! its lowest one (and within the margin): the patch is chosen among them.
+//! On a box's face, as on the ground, a large hull's points are its vertices
+//! within 2 mm of its lowest one (and within the margin): the patch is
+//! chosen among them; on a height field, every vertex within the margin.
 //!
 //! It applies only where the plane contact is the exact one: every hull
 //! vertex within the margin of the plane lies over the face, and a
@@ -262,7 +263,9 @@ pub(crate) fn hull_on_face(
             if low - h > margin {
                 return FaceContact::Apart;
             }
-            let band = margin.min(low - h + BAND);
+            // (every vertex within the margin: with the band's smaller
+            // set, solo12 on the 10° slope kept rocking, 0.14 rad/s at 3 s)
+            let band = margin;
             let ok = collect(
                 hull,
                 b_m_a,
