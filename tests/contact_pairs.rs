@@ -306,6 +306,47 @@ fn a_stool_dropped_on_a_box_step_rests_on_it() {
     assert!((on_step - 2.4 * 9.81).abs() < 1e-3, "{on_step}");
 }
 
+#[test]
+fn a_start_inside_an_obstacle_is_a_start_violation() {
+    // the stool's four foot spheres (r = 2 cm, 0.32 m below the seat) started
+    // 3 cm deep in the box step: each an overlap of 3 cm with "step"
+    let mut model = load("stool.urdf", true);
+    let h = 0.1;
+    obstacle(
+        &mut model,
+        "step",
+        Shape::Box {
+            size: [1.0, 1.0, h],
+        },
+        Se3::new(Matrix3::identity(), Vector3::new(0.0, 0.0, h / 2.0)),
+        1.0,
+    );
+    let mut sim = Simulation::new(model, SimOptions::default()).unwrap();
+    at(&mut sim, Vector3::new(0.0, 0.0, h + 0.32 - 0.03));
+    let v = sim.start_violations();
+    let overlaps: Vec<_> = v
+        .iter()
+        .filter_map(|v| match v {
+            urdyn::sim::Violation::Overlap { a, b, depth } => {
+                Some((a.as_str(), b.as_str(), *depth))
+            }
+            _ => None,
+        })
+        .collect();
+    assert_eq!(overlaps.len(), 4, "{v:?}");
+    for (a, b, depth) in overlaps {
+        assert!(a.starts_with("leg_") && b == "step", "{a} {b}");
+        assert!((depth - 0.03).abs() < 1e-9, "{depth}");
+    }
+    // and the same stool resting on the step starts clean
+    at(&mut sim, Vector3::new(0.0, 0.0, h + 0.32));
+    assert!(
+        sim.start_violations().is_empty(),
+        "{:?}",
+        sim.start_violations()
+    );
+}
+
 /// The overlap of the fold arm's post and lower link at the state of `sim`,
 /// computed independently of the pipeline: parry's contact query on the two
 /// boxes placed by forward kinematics (positive: penetration depth).

@@ -243,7 +243,8 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         }
     }
     // a start that violates a constraint: one line for the ground (its deepest
-    // link), one a joint outside its limits; the run recovers gently
+    // link), one a joint outside its limits, one a pair of shapes inside each
+    // other (a link in an obstacle or another body); the run recovers gently
     let violations = sim.start_violations();
     let in_ground: Vec<_> = violations
         .iter()
@@ -263,10 +264,12 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             sim.options().contact.max_push_speed
         ));
     }
-    for v in violations
-        .iter()
-        .filter(|v| matches!(v, crate::sim::Violation::Limit { .. }))
-    {
+    for v in violations.iter().filter(|v| {
+        matches!(
+            v,
+            crate::sim::Violation::Limit { .. } | crate::sim::Violation::Overlap { .. }
+        )
+    }) {
         warn(&format!("warning: {urdf_name}: {v}"));
     }
     let duration = args.duration;

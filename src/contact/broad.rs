@@ -1,7 +1,8 @@
 //! The broad phase: sweep and prune over world-aligned boxes.
 //!
-//! Each shape's box is its bounding sphere's (centre ± radius, grown by the
-//! detection margin), refreshed every step for the shapes that move. The shapes
+//! Each shape's box is its own box (in its frame) at its pose, boxed again
+//! along the world axes (centre R·c + t, half extents |R|·h) and grown by the
+//! detection margin, refreshed every step for the shapes that move. The shapes
 //! are kept sorted by their boxes' lower x (an insertion sort: nearly sorted
 //! from step to step, O(n)); a sweep along x meets each shape only the shapes
 //! whose x-interval overlaps its own, and keeps the pairs that also overlap in
@@ -31,11 +32,11 @@ impl SweepAndPrune {
         }
     }
 
-    /// Sets shape `i`'s box to centre ± r.
+    /// Sets shape `i`'s box to centre c ± half extents h.
     #[inline]
-    pub fn set(&mut self, i: usize, c: [f64; 3], r: f64) {
-        self.lo[i] = [c[0] - r, c[1] - r, c[2] - r];
-        self.hi[i] = [c[0] + r, c[1] + r, c[2] + r];
+    pub fn set(&mut self, i: usize, c: [f64; 3], h: [f64; 3]) {
+        self.lo[i] = [c[0] - h[0], c[1] - h[1], c[2] - h[2]];
+        self.hi[i] = [c[0] + h[0], c[1] + h[1], c[2] + h[2]];
     }
 
     /// The overlapping pairs the table allows (`table[i·n + j]` the pair index
@@ -84,7 +85,7 @@ mod tests {
         // four unit spheres on the x axis at 0, 1.5, 3, 10: 0–1 and 1–2 overlap
         let mut s = SweepAndPrune::new(4);
         for (i, x) in [10.0, 0.0, 1.5, 3.0].into_iter().enumerate() {
-            s.set(i, [x, 0.0, 0.0], 1.0);
+            s.set(i, [x, 0.0, 0.0], [1.0; 3]);
         }
         // every pair allowed, pair index = 10·min + max
         let mut table = vec![NO_PAIR; 16];
@@ -100,12 +101,12 @@ mod tests {
         out.sort();
         assert_eq!(out, vec![12, 23]);
         // moved apart in z: none
-        s.set(2, [1.5, 0.0, 5.0], 1.0);
+        s.set(2, [1.5, 0.0, 5.0], [1.0; 3]);
         out.clear();
         s.overlaps(&table, &mut out);
         assert!(out.is_empty(), "{out:?}");
         // a pair the filter forbids is not reported
-        s.set(2, [1.5, 0.0, 0.0], 1.0);
+        s.set(2, [1.5, 0.0, 0.0], [1.0; 3]);
         table[1 * 4 + 2] = NO_PAIR;
         table[2 * 4 + 1] = NO_PAIR;
         out.clear();

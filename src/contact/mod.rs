@@ -58,9 +58,12 @@
 //! unconditionally stable at any step (no stiffness).
 
 pub mod broad;
+mod face;
 pub mod filter;
 pub mod ground;
+mod hull;
 pub mod mesh;
+mod narrow;
 pub mod pairs;
 mod paths;
 mod pipeline;

@@ -15,14 +15,13 @@
 
 use super::broad::{SweepAndPrune, NO_PAIR};
 use super::filter::{is_self_pair, may_touch, DroppedPair, START_OVERLAP};
-use super::shapes::{from_pvec, pair_shape, to_pose, PairShape};
+use super::narrow::{face_kind, face_points, parry_points, reduce_pair, FaceScratch, Raw};
+use super::shapes::{from_pvec, pair_shape, to_pose, to_pvec, PairShape};
 use super::{ContactError, ContactParams, ContactPoint};
 use crate::model::Model;
 use crate::spatial::Se3;
 use nalgebra::Vector3;
-use parry3d_f64::query::{
-    ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
-};
+use parry3d_f64::query::{ContactManifold, ContactManifoldsWorkspace};
 use std::path::PathBuf;
 
 /// One shape of pair contact.
@@ -52,19 +51,16 @@ struct Pair {
     dropped: bool,
     /// A self pair (rule 4 applies).
     self_pair: bool,
+    /// A unit axis (a's frame, from a toward b) that separated the two
+    /// shapes last time, or their contact normal (zero: none).
+    axis: Vector3<f64>,
+    /// A hull and a box or height field (`Some(true)`: the hull is a): the
+    /// face path ([`hull_on_face`]) is tried first.
+    face: Option<bool>,
     friction: f64,
 }
 
 const NO_KEY: u64 = u64::MAX;
-
-/// A raw point of a manifold before the reduction.
-#[derive(Clone, Copy, Debug)]
-struct Raw {
-    point: Vector3<f64>,
-    normal: Vector3<f64>,
-    gap: f64,
-    key: u64,
-}
 
 /// Contact between pairs of shapes.
 #[derive(Clone)]
@@ -75,6 +71,10 @@ pub struct PairContact {
     table: Vec<u32>,
     sap: SweepAndPrune,
     overlapping: Vec<u32>,
+    /// Each member's world pose (parry's frame) at the last detection.
+    poses: Vec<Se3<f64>>,
+    scratch: FaceScratch,
+    stamp: u32,
     raw: Vec<Raw>,
     /// Members that move (their boxes are refreshed each step).
     moving: Vec<usize>,
@@ -197,6 +197,8 @@ impl PairContact {
                     workspace: None,
                     dropped: false,
                     self_pair: is_self_pair(&g[i], &g[j]),
+                    axis: Vector3::zeros(),
+                    face: face_kind(&members[a].shape, &members[b].shape),
                     friction: g[i].friction.max(g[j].friction),
                 });
             }
@@ -206,11 +208,11 @@ impl PairContact {
         }
         let mut sap = SweepAndPrune::new(n);
         let mut moving = Vec::new();
+        let mut poses = Vec::with_capacity(n);
         for (k, m) in members.iter().enumerate() {
+            poses.push(m.placement);
             if m.body == 0 {
-                let w = m.placement;
-                let c = w.act_point(&m.shape.centre_parry());
-                sap.set(k, [c.x, c.y, c.z], m.shape.bound + params.margin);
+                set_box(&mut sap, k, m, &m.placement, params.margin);
             } else {
                 moving.push(k);
             }
@@ -221,6 +223,9 @@ impl PairContact {
             table,
             sap,
             overlapping: Vec::with_capacity(pairs.len()),
+            poses,
+            scratch: FaceScratch::default(),
+            stamp: 0,
             raw: Vec::new(),
             moving,
             queries: 0,
@@ -262,13 +267,12 @@ impl PairContact {
         for &k in &self.moving {
             let m = &self.members[k];
             let w = world(m, o_m_i);
-            let c = w.act_point(&m.shape.centre_parry());
-            self.sap.set(k, [c.x, c.y, c.z], m.shape.bound + margin);
+            set_box(&mut self.sap, k, m, &w, margin);
+            self.poses[k] = w;
         }
         self.overlapping.clear();
         self.sap.overlaps(&self.table, &mut self.overlapping);
         // the pairs not overlapping forget their points
-        let dispatcher = DefaultQueryDispatcher;
         // (sorted: the same order every step, whatever the sweep's)
         self.overlapping.sort_unstable();
         let mut next = 0;
@@ -286,74 +290,57 @@ impl PairContact {
                 continue;
             }
             let (ma, mb) = (&self.members[pair.a], &self.members[pair.b]);
-            let (wa, wb) = (world(ma, o_m_i), world(mb, o_m_i));
-            let pos12 = to_pose(&wa.inverse().compose(&wb));
+            let (wa, wb) = (self.poses[pair.a], self.poses[pair.b]);
             self.queries += 1;
-            // the points are found anew (a generator that finds the shapes
-            // apart returns without touching them; the slots, not parry's
-            // contact data, carry the warm starts)
-            for man in pair.manifolds.iter_mut() {
-                man.points.clear();
-            }
-            let ok = dispatcher.contact_manifolds(
-                &pos12,
-                &*ma.shape.shape,
-                &*mb.shape.shape,
-                margin,
-                &mut pair.manifolds,
-                &mut pair.workspace,
-            );
             self.raw.clear();
-            if ok.is_ok() {
-                for man in &pair.manifolds {
-                    // parry's normal leaves shape a toward b: ours points from
-                    // b toward a (the direction a's impulse pushes it)
-                    let sub1 = man.subshape_pos1().copied();
-                    let ln = match sub1 {
-                        Some(s) => s.rotation * man.local_n1,
-                        None => man.local_n1,
-                    };
-                    let n = -(wa.rot * from_pvec(ln));
-                    let nn = n.norm();
-                    if !(nn > 0.5) {
-                        continue;
-                    }
-                    let n = n / nn;
-                    for c in &man.points {
-                        if c.dist > margin {
-                            continue;
-                        }
-                        let p1 = match sub1 {
-                            Some(s) => s * c.local_p1,
-                            None => c.local_p1,
-                        };
-                        let p2 = match man.subshape_pos2() {
-                            Some(s) => s * c.local_p2,
-                            None => c.local_p2,
-                        };
-                        let (p1, p2) = (wa.act_point(&from_pvec(p1)), wb.act_point(&from_pvec(p2)));
-                        let key = ((man.subshape2 as u64) << 40)
-                            ^ ((c.fid1.0 as u64) << 20)
-                            ^ (c.fid2.0 as u64)
-                            ^ ((man.subshape1 as u64) << 52);
-                        let point = (p1 + p2) * 0.5;
-                        // parry may give one point twice (a cylinder cap's square
-                        // vertex, clipped): one row a point
-                        if self
-                            .raw
-                            .iter()
-                            .any(|r| (r.point - point).norm_squared() < 1e-18)
-                        {
-                            continue;
-                        }
-                        self.raw.push(Raw {
-                            point,
-                            normal: n,
-                            gap: c.dist,
-                            key,
-                        });
-                    }
+            // a hull on a box's face or a flat height field: the plane
+            // contact where it is the exact one (`face`), else parry
+            let plane = match pair.face {
+                Some(hull_is_a) => {
+                    self.stamp = self.stamp.wrapping_add(1).max(1);
+                    face_points(
+                        &ma.shape,
+                        &mb.shape,
+                        &wa,
+                        &wb,
+                        hull_is_a,
+                        margin,
+                        &mut self.scratch,
+                        &mut self.raw,
+                        self.stamp,
+                    )
                 }
+                None => false,
+            };
+            // two convex shapes apart along last step's axis by more than
+            // the margin: no point, no parry query
+            let convex = ma.shape.convex && mb.shape.convex;
+            let apart = convex && apart_along(&pair.axis, ma, mb, &wa, &wb, margin);
+            if !plane && !apart {
+                parry_points(
+                    &ma.shape,
+                    &mb.shape,
+                    &wa,
+                    &wb,
+                    margin,
+                    &mut pair.manifolds,
+                    &mut pair.workspace,
+                    &mut self.raw,
+                );
+                // parry's last direction (a's frame, from a toward b): its
+                // separating axis when apart, else the contact normal
+                pair.axis = match pair.manifolds.first() {
+                    Some(m) if convex && pair.manifolds.len() == 1 => {
+                        let n = from_pvec(m.local_n1);
+                        let l = n.norm();
+                        if l > 0.5 && l.is_finite() {
+                            n / l
+                        } else {
+                            Vector3::zeros()
+                        }
+                    }
+                    _ => Vector3::zeros(),
+                };
             }
             let start = out.len();
             // the moving side first: a static a (an obstacle or a fixed
@@ -431,53 +418,47 @@ impl PairContact {
     }
 }
 
-impl PairShape {
-    /// The bounding sphere's centre in parry's frame of the shape.
-    #[inline]
-    fn centre_parry(&self) -> Vector3<f64> {
-        self.offset.inverse().act_point(&self.centre)
+/// Whether convex members `a` at `wa` and `b` at `wb` are apart by more
+/// than `margin` along the unit axis `u` (a's frame, from a toward b; zero:
+/// not known): min over b of u·x − max over a of u·x > margin (two support
+/// points), a lower bound of their distance.
+#[inline]
+fn apart_along(
+    u: &Vector3<f64>,
+    a: &Member,
+    b: &Member,
+    wa: &Se3<f64>,
+    wb: &Se3<f64>,
+    margin: f64,
+) -> bool {
+    if u.x == 0.0 && u.y == 0.0 && u.z == 0.0 {
+        return false;
     }
+    let (Some(sa), Some(sb)) = (
+        a.shape.shape.as_support_map(),
+        b.shape.shape.as_support_map(),
+    ) else {
+        return false;
+    };
+    // b in a's frame: x = R p + t
+    let a_m_b = wa.inverse().compose(wb);
+    let top_a = u.dot(&from_pvec(sa.local_support_point(to_pvec(u))));
+    let d = a_m_b.rot.transpose() * (-u);
+    let low_b = u.dot(&a_m_b.act_point(&from_pvec(sb.local_support_point(to_pvec(&d)))));
+    low_b - top_a > margin
 }
 
-/// Appends at most `maxp` of `raw` to `out` as `make` makes them: all when
-/// they fit, else the deepest, then the extremes along `maxp − 1` tangent
-/// directions of the deepest point's normal.
-fn reduce_pair(
-    raw: &[Raw],
-    maxp: usize,
-    out: &mut Vec<ContactPoint>,
-    make: impl Fn(&Raw) -> ContactPoint,
-) {
-    if raw.len() <= maxp {
-        out.extend(raw.iter().map(&make));
-        return;
-    }
-    let deepest = (0..raw.len())
-        .min_by(|&i, &j| {
-            raw[i]
-                .gap
-                .total_cmp(&raw[j].gap)
-                .then(raw[i].key.cmp(&raw[j].key))
-        })
-        .unwrap_or(0);
-    let start = out.len();
-    out.push(make(&raw[deepest]));
-    let (t1, t2) = tangents(&raw[deepest].normal);
-    let dirs = maxp - 1;
-    for d in 0..dirs {
-        let (s, c) = (std::f64::consts::TAU * d as f64 / dirs as f64).sin_cos();
-        let dir = t1 * c + t2 * s;
-        let best = (0..raw.len())
-            .max_by(|&i, &j| {
-                dir.dot(&raw[i].point)
-                    .total_cmp(&dir.dot(&raw[j].point))
-                    .then(raw[j].key.cmp(&raw[i].key))
-            })
-            .unwrap_or(0);
-        if !out[start..].iter().any(|p| p.key == raw[best].key) {
-            out.push(make(&raw[best]));
-        }
-    }
+/// Sets member `k`'s broad-phase box: its shape's box at the world pose `w`
+/// boxed along the world axes (centre R·c + t, half extents |R|·h), grown by
+/// `margin`.
+#[inline]
+fn set_box(sap: &mut SweepAndPrune, k: usize, m: &Member, w: &Se3<f64>, margin: f64) {
+    let c = w.act_point(&m.shape.mid);
+    let h = &m.shape.half;
+    let r = &w.rot;
+    let e =
+        |i: usize| r[(i, 0)].abs() * h.x + r[(i, 1)].abs() * h.y + r[(i, 2)].abs() * h.z + margin;
+    sap.set(k, [c.x, c.y, c.z], [e(0), e(1), e(2)]);
 }
 
 /// Puts each of a pair's points in a slot: the one that held the same

@@ -5,12 +5,13 @@
 //! box → `Cuboid`, sphere → `Ball`, capsule → `Capsule` (z axis), cylinder →
 //! `Cylinder` (parry's axis is y: a fixed +90° x-rotation is folded into the
 //! shape's offset), a URDF link's mesh → the `ConvexPolyhedron` hull of its
-//! vertices, an obstacle's mesh (`trimesh`) → the `TriMesh` it is, a height
+//! vertices (a large one as a [`ClimbHull`]), an obstacle's mesh (`trimesh`) → the `TriMesh` it is, a height
 //! field → `HeightField` (parry's grid lies in its x–z plane with heights along
 //! y: the same +90° x-rotation maps parry's (x, y, z) to the frame's (x, z, −y),
 //! so parry's row i, along +z, is the frame's row from +y: the rows are
 //! reversed).
 
+use super::hull::ClimbHull;
 use super::mesh;
 use super::paths::resolve_mesh_path;
 use super::ContactError;
@@ -28,11 +29,11 @@ pub(crate) struct PairShape {
     pub shape: SharedShape,
     /// `geom_M_parry`: parry's frame in the geometry frame.
     pub offset: Se3<f64>,
-    /// Radius of a sphere about the geometry origin that holds the shape (the
-    /// broad phase's box is its centre ± this; +∞ for an unbounded shape).
-    pub bound: f64,
-    /// Centre of that sphere in the geometry frame.
-    pub centre: Vector3<f64>,
+    /// The centre of the shape's box in parry's frame of it (the broad
+    /// phase's world box is this box at the shape's pose, boxed again).
+    pub mid: Vector3<f64>,
+    /// The half extents of that box.
+    pub half: Vector3<f64>,
     /// Whether parry treats it as convex (a support map).
     pub convex: bool,
 }
@@ -41,7 +42,7 @@ impl std::fmt::Debug for PairShape {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("PairShape")
             .field("shape", &self.shape.shape_type())
-            .field("bound", &self.bound)
+            .field("half", &self.half)
             .finish()
     }
 }
@@ -67,6 +68,12 @@ pub(crate) fn to_pose(m: &Se3<f64>) -> Pose {
     ]);
     let q = parry3d_f64::math::Rot3::from_mat3(&mat).normalize();
     Pose::from_parts(PVec::new(m.trans.x, m.trans.y, m.trans.z), q)
+}
+
+/// An engine vector as a parry vector.
+#[inline]
+pub(crate) fn to_pvec(v: &Vector3<f64>) -> PVec {
+    PVec::new(v.x, v.y, v.z)
 }
 
 /// A parry vector as an engine vector.
@@ -171,8 +178,10 @@ pub(crate) fn pair_shape(
                     }
                 }
             } else {
-                match SharedShape::convex_hull(&pv) {
-                    Some(s) => (s, id, true),
+                // a large hull climbs its vertex graph for its support points
+                match ClimbHull::of_points(&pv) {
+                    Some(Ok(h)) => (SharedShape::new(h), id, true),
+                    Some(Err(h)) => (SharedShape::new(h), id, true),
                     None => return Ok(None),
                 }
             }
@@ -205,14 +214,13 @@ pub(crate) fn pair_shape(
             )
         }
     };
-    // the bounding sphere in the geometry frame
-    let bs = shape.compute_local_bounding_sphere();
-    let centre = offset.act_point(&from_pvec(bs.center()));
+    // the box in parry's frame
+    let b = shape.compute_local_aabb();
     Ok(Some(PairShape {
+        mid: from_pvec(b.center()),
+        half: from_pvec(b.half_extents()),
         shape,
         offset,
-        bound: bs.radius(),
-        centre,
         convex,
     }))
 }

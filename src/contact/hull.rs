@@ -1,0 +1,460 @@
+//! A link mesh's convex hull for pair contact, with a support map that climbs
+//! the hull's vertex graph instead of scanning every vertex.
+//!
+//! parry's `ConvexPolyhedron` finds its support point s(d) = argmax_v d·v by
+//! a scan of all its vertices (a robot's link hull has 300–700): GJK and EPA
+//! ask for it at every iteration, and a height field's manifold asks for the
+//! shape's whole AABB first (another scan). On a convex polytope's
+//! triangulated surface, a vertex no neighbour of which has a larger d·v is a
+//! maximum of d·v over the whole polytope (the linear function's local
+//! maximum on a convex surface is global), so a steepest ascent on the
+//! triangulation's edges from a good start ends at the support point: the
+//! start is the hull's extreme vertex toward the centre of d's cell in a cube
+//! map of directions (`CELLS`), and a climb then takes a step or two. The
+//! AABB at a pose is six such support values. The support face (the face
+//! whose normal is best aligned with d) is parry's scan of every face, on
+//! the normals stored component by component so that it vectorises (a climb
+//! over faces is not exact: the best normal is not always reached by
+//! improving neighbours). Point and ray queries are the wrapped
+//! `ConvexPolyhedron`'s.
+
+use parry3d_f64::bounding_volume::{Aabb, BoundingSphere};
+use parry3d_f64::mass_properties::MassProperties;
+use parry3d_f64::math::{Pose, Real, Vector as PVec};
+use parry3d_f64::query::{PointProjection, PointQuery, Ray, RayCast, RayIntersection};
+use parry3d_f64::shape::{
+    ConvexPolyhedron, FeatureId, PackedFeatureId, PolygonalFeature, PolygonalFeatureMap, Shape,
+    ShapeType, SupportMap, TypedShape,
+};
+
+/// Hulls with at most this many vertices are scanned whole (parry's own
+/// shape): a climb's start costs about as much.
+pub(crate) const CLIMB_MIN_VERTICES: usize = 32;
+
+/// The climb's starts: a cube map of directions, `CELLS`² cells on each of
+/// the cube's 6 faces; a direction's cell is found from its largest
+/// component and the other two's ratios to it, and the cell's seed is the
+/// hull's extreme vertex toward the cell's centre direction.
+const CELLS: usize = 4;
+
+/// The cube-map cell of direction d (any length, not zero).
+#[inline]
+fn cell(d: PVec) -> usize {
+    let a = d.abs();
+    // the dominant axis and the two others (u, v) in a fixed order
+    let (axis, u, v, m) = if a.x >= a.y && a.x >= a.z {
+        (0, d.y, d.z, d.x)
+    } else if a.y >= a.z {
+        (1, d.z, d.x, d.y)
+    } else {
+        (2, d.x, d.y, d.z)
+    };
+    let face = 2 * axis + usize::from(m < 0.0);
+    let inv = 1.0 / m.abs();
+    // (u/|m| + 1)/2 ∈ [0, 1] → a cell index (NaN → 0)
+    let idx = |w: f64| (((w * inv + 1.0) * 0.5 * CELLS as f64) as usize).min(CELLS - 1);
+    (face * CELLS + idx(u)) * CELLS + idx(v)
+}
+
+/// The centre direction of cube-map cell `c`.
+fn cell_centre(c: usize) -> PVec {
+    let (face, rest) = (c / (CELLS * CELLS), c % (CELLS * CELLS));
+    let w = |i: usize| 2.0 * (i as f64 + 0.5) / CELLS as f64 - 1.0;
+    let (u, v) = (w(rest / CELLS), w(rest % CELLS));
+    let m = if face % 2 == 0 { 1.0 } else { -1.0 };
+    match face / 2 {
+        0 => PVec::new(m, u, v),
+        1 => PVec::new(v, m, u),
+        _ => PVec::new(u, v, m),
+    }
+}
+
+/// A convex hull with a graph-climbing support map (see the module doc).
+#[derive(Clone, Debug)]
+pub(crate) struct ClimbHull {
+    hull: ConvexPolyhedron,
+    /// The triangulation's vertex graph, compressed rows: the neighbours of
+    /// vertex k are `adj[adj_start[k]..adj_start[k + 1]]`.
+    adj_start: Vec<u32>,
+    adj: Vec<u32>,
+    /// Per cube-map cell, the extreme vertex toward its centre (one with
+    /// neighbours).
+    seeds: Vec<u32>,
+    /// The faces' normals, component by component (a scan that vectorises).
+    normal_x: Vec<f64>,
+    normal_y: Vec<f64>,
+    normal_z: Vec<f64>,
+}
+
+/// The compressed vertex graph of `n` vertices from triangles.
+pub(crate) fn triangle_graph(n: usize, triangles: &[[u32; 3]]) -> (Vec<u32>, Vec<u32>) {
+    let mut nb: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for t in triangles {
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            if (a as usize) < n && (b as usize) < n && a != b {
+                nb[a as usize].push(b);
+                nb[b as usize].push(a);
+            }
+        }
+    }
+    let mut start = Vec::with_capacity(n + 1);
+    let mut adj = Vec::new();
+    for list in &mut nb {
+        list.sort_unstable();
+        list.dedup();
+        start.push(adj.len() as u32);
+        adj.extend_from_slice(list);
+    }
+    start.push(adj.len() as u32);
+    (start, adj)
+}
+
+impl ClimbHull {
+    /// The hull of `points` (`None`: flat or too few points); `Ok(hull)` is
+    /// parry's plain hull when it has at most [`CLIMB_MIN_VERTICES`] vertices.
+    pub fn of_points(points: &[PVec]) -> Option<Result<Self, ConvexPolyhedron>> {
+        let (verts, tris) = parry3d_f64::transformation::try_convex_hull(points).ok()?;
+        let n = verts.len();
+        let hull = ConvexPolyhedron::from_convex_mesh(verts, &tris)?;
+        if n <= CLIMB_MIN_VERTICES || hull.points().len() != n {
+            return Some(Err(hull));
+        }
+        let (adj_start, adj) = triangle_graph(n, &tris);
+        let pts = hull.points();
+        let mut seeds: Vec<u32> = Vec::with_capacity(6 * CELLS * CELLS);
+        for c in 0..6 * CELLS * CELLS {
+            let d = cell_centre(c);
+            let mut best = usize::MAX;
+            let mut bv = f64::NEG_INFINITY;
+            for (k, p) in pts.iter().enumerate() {
+                let v = p.dot(d);
+                if v > bv && adj_start[k + 1] > adj_start[k] {
+                    bv = v;
+                    best = k;
+                }
+            }
+            if best == usize::MAX {
+                return Some(Err(hull));
+            }
+            seeds.push(best as u32);
+        }
+        let normal = |c: usize| hull.faces().iter().map(|f| f.normal[c]).collect();
+        Some(Ok(Self {
+            normal_x: normal(0),
+            normal_y: normal(1),
+            normal_z: normal(2),
+            hull,
+            adj_start,
+            adj,
+            seeds,
+        }))
+    }
+
+    /// The hull's vertices.
+    pub fn points(&self) -> &[PVec] {
+        self.hull.points()
+    }
+
+    /// The neighbours of vertex `k` on the triangulation's vertex graph.
+    #[inline]
+    pub fn neighbours(&self, k: usize) -> &[u32] {
+        &self.adj[self.adj_start[k] as usize..self.adj_start[k + 1] as usize]
+    }
+
+    /// The index of a vertex maximising d·v, and d·v there.
+    #[inline]
+    pub fn support_index(&self, d: PVec) -> (usize, f64) {
+        let pts = self.hull.points();
+        let mut k = self.seeds[cell(d)] as usize;
+        let mut best = pts[k].dot(d);
+        // steepest ascent: the best neighbour while it is better
+        loop {
+            let (a, b) = (self.adj_start[k] as usize, self.adj_start[k + 1] as usize);
+            let mut next = k;
+            for &j in &self.adj[a..b] {
+                let v = pts[j as usize].dot(d);
+                if v > best {
+                    best = v;
+                    next = j as usize;
+                }
+            }
+            if next == k {
+                return (k, best);
+            }
+            k = next;
+        }
+    }
+}
+
+impl SupportMap for ClimbHull {
+    #[inline]
+    fn local_support_point(&self, dir: PVec) -> PVec {
+        self.hull.points()[self.support_index(dir).0]
+    }
+}
+
+impl ClimbHull {
+    /// The face whose normal is best aligned with `dir` (the first of the
+    /// best, as parry's scan): a scan of the face normals kept as three
+    /// arrays, the best value first (four lanes at a time), then its first
+    /// face (the same products, bit for bit).
+    #[inline]
+    fn best_face(&self, dir: PVec) -> usize {
+        let (nx, ny, nz) = (&self.normal_x, &self.normal_y, &self.normal_z);
+        let dot = |i: usize| nx[i] * dir.x + ny[i] * dir.y + nz[i] * dir.z;
+        let n = nx.len();
+        let mut m = [f64::NEG_INFINITY; 4];
+        let mut i = 0;
+        while i + 4 <= n {
+            for (l, ml) in m.iter_mut().enumerate() {
+                let v = dot(i + l);
+                if v > *ml {
+                    *ml = v;
+                }
+            }
+            i += 4;
+        }
+        let mut best = m[0].max(m[1]).max(m[2].max(m[3]));
+        for k in i..n {
+            let v = dot(k);
+            if v > best {
+                best = v;
+            }
+        }
+        (0..n).find(|&k| dot(k) == best).unwrap_or(0)
+    }
+}
+
+impl PolygonalFeatureMap for ClimbHull {
+    /// parry's support face (the face whose normal is best aligned with
+    /// `dir`, its first 4 vertices and edges), by [`ClimbHull::best_face`].
+    fn local_support_feature(&self, dir: PVec, out_feature: &mut PolygonalFeature) {
+        let h = &self.hull;
+        let best = self.best_face(dir);
+        let face = &h.faces()[best];
+        let i1 = face.first_vertex_or_edge as usize;
+        let nv = (face.num_vertices_or_edges as usize).min(4);
+        let (vaf, eaf, pts) = (h.vertices_adj_to_face(), h.edges_adj_to_face(), h.points());
+        for i in 0..nv {
+            let (vid, eid) = (vaf[i1 + i], eaf[i1 + i]);
+            out_feature.vertices[i] = pts[vid as usize];
+            out_feature.vids[i] = PackedFeatureId::vertex(vid);
+            out_feature.eids[i] = PackedFeatureId::edge(eid);
+        }
+        out_feature.fid = PackedFeatureId::face(best as u32);
+        out_feature.num_vertices = nv;
+    }
+
+    fn is_convex_polyhedron(&self) -> bool {
+        true
+    }
+}
+
+impl PointQuery for ClimbHull {
+    fn project_local_point(&self, pt: PVec, solid: bool) -> PointProjection {
+        self.hull.project_local_point(pt, solid)
+    }
+
+    fn project_local_point_and_get_feature(&self, pt: PVec) -> (PointProjection, FeatureId) {
+        self.hull.project_local_point_and_get_feature(pt)
+    }
+}
+
+impl RayCast for ClimbHull {
+    fn cast_local_ray_and_get_normal(
+        &self,
+        ray: &Ray,
+        max_time_of_impact: Real,
+        solid: bool,
+    ) -> Option<RayIntersection> {
+        self.hull
+            .cast_local_ray_and_get_normal(ray, max_time_of_impact, solid)
+    }
+}
+
+impl Shape for ClimbHull {
+    fn compute_local_aabb(&self) -> Aabb {
+        self.hull.local_aabb()
+    }
+
+    fn compute_local_bounding_sphere(&self) -> BoundingSphere {
+        self.hull.local_bounding_sphere()
+    }
+
+    fn clone_dyn(&self) -> Box<dyn Shape> {
+        Box::new(self.clone())
+    }
+
+    fn scale_dyn(&self, scale: PVec, num_subdivisions: u32) -> Option<Box<dyn Shape>> {
+        self.hull.scale_dyn(scale, num_subdivisions)
+    }
+
+    /// Six support values: world axis i's extent is t_i ± max ±(Rᵀeᵢ)·v.
+    fn compute_aabb(&self, position: &Pose) -> Aabb {
+        let inv = position.rotation.inverse();
+        let t = position.translation;
+        let mut mins = PVec::ZERO;
+        let mut maxs = PVec::ZERO;
+        for (i, e) in [PVec::X, PVec::Y, PVec::Z].into_iter().enumerate() {
+            let d = inv * e;
+            maxs[i] = t[i] + self.support_index(d).1;
+            mins[i] = t[i] - self.support_index(-d).1;
+        }
+        Aabb::new(mins, maxs)
+    }
+
+    fn mass_properties(&self, density: Real) -> MassProperties {
+        self.hull.mass_properties(density)
+    }
+
+    fn is_convex(&self) -> bool {
+        true
+    }
+
+    fn shape_type(&self) -> ShapeType {
+        ShapeType::Custom
+    }
+
+    fn as_typed_shape(&self) -> TypedShape<'_> {
+        TypedShape::Custom(self)
+    }
+
+    fn ccd_thickness(&self) -> Real {
+        self.hull.ccd_thickness()
+    }
+
+    fn ccd_angular_thickness(&self) -> Real {
+        self.hull.ccd_angular_thickness()
+    }
+
+    fn as_support_map(&self) -> Option<&dyn SupportMap> {
+        Some(self as &dyn SupportMap)
+    }
+
+    fn as_polygonal_feature_map(&self) -> Option<(&dyn PolygonalFeatureMap, Real)> {
+        Some((self as &dyn PolygonalFeatureMap, 0.0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points on a bumpy sphere (a hull of many vertices, some faces near
+    /// coplanar) and a box's corners repeated along its edges (collinear
+    /// points on the hull's edges, coplanar ones on its faces).
+    fn clouds() -> Vec<Vec<PVec>> {
+        let mut out = Vec::new();
+        let mut s = Vec::new();
+        let (mut a, mut b) = (0.3_f64, 0.7_f64);
+        for k in 0..600 {
+            // a deterministic scatter on the sphere (golden-angle spiral)
+            let z = 1.0 - 2.0 * (k as f64 + 0.5) / 600.0;
+            let phi = k as f64 * 2.399_963_229_728_653;
+            let r = (1.0 - z * z).sqrt();
+            a = (a * 7.3 + 0.11).fract();
+            b = (b * 3.7 + 0.23).fract();
+            let rad = 1.0 + 0.05 * a;
+            s.push(PVec::new(
+                0.3 * rad * r * phi.cos(),
+                0.1 * rad * r * phi.sin() + 0.01 * b,
+                0.05 * rad * z,
+            ));
+        }
+        out.push(s);
+        // a cylinder with flat caps (coplanar cap points, a ring on each)
+        let mut bx = Vec::new();
+        for ring in 0..5 {
+            let r = 0.04 * (ring + 1) as f64 / 5.0;
+            for k in 0..48 {
+                let a = std::f64::consts::TAU * k as f64 / 48.0 + 0.1 * ring as f64;
+                for z in [-0.03, 0.03] {
+                    bx.push(PVec::new(r * a.cos(), r * a.sin(), z));
+                }
+            }
+        }
+        out.push(bx);
+        out
+    }
+
+    #[test]
+    fn climbed_support_is_the_scanned_maximum() {
+        for pts in clouds() {
+            let h = match ClimbHull::of_points(&pts) {
+                Some(Ok(h)) => h,
+                _ => panic!("a hull of many vertices"),
+            };
+            let verts = h.hull.points();
+            let mut c = 0.123_f64;
+            for _ in 0..4000 {
+                let mut r = || {
+                    c = (c * 9.17 + 0.377).fract();
+                    2.0 * c - 1.0
+                };
+                let d = PVec::new(r(), r(), r());
+                // and the axes and their mixes exactly (ties on flat faces)
+                for d in [
+                    d,
+                    PVec::new(d.x.signum(), 0.0, 0.0),
+                    PVec::new(0.0, d.y, d.z),
+                ] {
+                    let scan = verts.iter().map(|v| v.dot(d)).fold(f64::MIN, f64::max);
+                    let (_, climbed) = h.support_index(d);
+                    assert!(
+                        (scan - climbed).abs() <= 1e-15 * (1.0 + scan.abs()),
+                        "{d:?}: scan {scan}, climb {climbed}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn support_face_is_the_scanned_best_face() {
+        for pts in clouds() {
+            let Some(Ok(h)) = ClimbHull::of_points(&pts) else {
+                panic!("a hull of many vertices");
+            };
+            let faces = h.hull.faces();
+            let mut c = 0.377_f64;
+            let (mut f1, mut f2) = (PolygonalFeature::default(), PolygonalFeature::default());
+            for _ in 0..4000 {
+                let mut r = || {
+                    c = (c * 9.17 + 0.123).fract();
+                    2.0 * c - 1.0
+                };
+                let d = PVec::new(r(), r(), r()).normalize();
+                for d in [d, PVec::new(0.0, 0.0, d.z.signum())] {
+                    h.local_support_feature(d, &mut f1);
+                    h.hull.local_support_feature(d, &mut f2);
+                    let n = |f: &PolygonalFeature| {
+                        faces[f.fid.unpack().unwrap_face() as usize].normal.dot(d)
+                    };
+                    assert_eq!(f1.fid, f2.fid, "{d:?}");
+                    assert!(
+                        (n(&f1) - n(&f2)).abs() < 1e-12,
+                        "{d:?}: {} vs {}",
+                        n(&f1),
+                        n(&f2)
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn aabb_at_a_pose_is_the_point_clouds() {
+        for pts in clouds() {
+            let Some(Ok(h)) = ClimbHull::of_points(&pts) else {
+                panic!("a hull of many vertices");
+            };
+            let pose = Pose::from_parts(
+                PVec::new(0.4, -1.0, 2.5),
+                parry3d_f64::math::Rot3::from_scaled_axis(PVec::new(0.3, -0.8, 1.9)),
+            );
+            let (a, b) = (h.compute_aabb(&pose), h.hull.aabb(&pose));
+            assert!((a.mins - b.mins).abs().max_element() < 1e-14, "{a:?} {b:?}");
+            assert!((a.maxs - b.maxs).abs().max_element() < 1e-14, "{a:?} {b:?}");
+        }
+    }
+}
