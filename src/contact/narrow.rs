@@ -10,6 +10,7 @@ use super::ContactPoint;
 use crate::spatial::Se3;
 use nalgebra::Vector3;
 use parry3d_f64::math::Pose;
+use parry3d_f64::shape::ShapeType;
 use parry3d_f64::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
@@ -75,12 +76,24 @@ pub(super) fn parry_points(
         }
         dispatcher.contact_manifolds(&pos12, &*a.shape, &*b.shape, margin, manifolds, workspace)
     };
+    // a convex pair that has barely moved since parry found its points
+    // keeps them, their gaps measured anew at this pose (exact for a vertex
+    // on a face: the face's plane is fixed in a's frame): no GJK, no clipping
+    let convex = a.convex && b.convex && manifolds.len() == 1;
+    if convex
+        && polyhedral(a)
+        && polyhedral(b)
+        && manifolds[0].try_update_contacts_eps(&pos12, REUSE_COS, REUSE_SLIDE * REUSE_SLIDE) {
+        raw.clear();
+        push_points(&manifolds[..], wa, wb, margin, f64::INFINITY, raw);
+        return;
+    }
     let mut ok = query(manifolds, workspace);
     // a convex pair's depth is at most the shapes' overlap along its normal:
     // deeper, the penetration solver (EPA) has failed; asked again from
     // scratch (no cached direction), and what is still deeper is dropped
     let mut bound = f64::INFINITY;
-    if a.convex && b.convex && manifolds.len() == 1 {
+    if convex {
         bound = overlap_bound(a, b, &pos12, &manifolds[0]);
         if too_deep(&manifolds[0], bound) {
             manifolds.clear();
@@ -93,6 +106,39 @@ pub(super) fn parry_points(
     }
     raw.clear();
     if ok.is_ok() {
+        push_points(&manifolds[..], wa, wb, margin, bound, raw);
+    }
+}
+
+/// How far (m) a kept point may slide along the contact plane, and how far
+/// the normals may tilt (the cosine of 10⁻⁴ rad), since parry found the
+/// points, for them to stand (see [`parry_points`]).
+const REUSE_SLIDE: f64 = 1e-5;
+const REUSE_COS: f64 = 1.0 - 5e-9;
+
+/// Whether parry's manifold of a pair with this shape keeps its points in
+/// the pair's own order (a's points as `local_p1`, at pos12 = a⁻¹b), as
+/// its polyhedral generators do (two polygonal feature maps, two boxes);
+/// a ball's, a capsule's, a half-space's and a triangle's may store theirs
+/// flipped.
+fn polyhedral(s: &PairShape) -> bool {
+    !matches!(
+        s.shape.shape_type(),
+        ShapeType::Ball | ShapeType::Capsule | ShapeType::HalfSpace | ShapeType::Triangle
+    )
+}
+
+/// The points of `manifolds` (a at `wa`) within `margin` and no deeper than
+/// `bound`, appended to `raw` with the normal from b toward a.
+fn push_points(
+    manifolds: &[ContactManifold<(), ()>],
+    wa: &Se3<f64>,
+    wb: &Se3<f64>,
+    margin: f64,
+    bound: f64,
+    raw: &mut Vec<Raw>,
+) {
+    {
         for man in manifolds.iter() {
             // parry's normal leaves shape a toward b: ours points from
             // b toward a (the direction a's impulse pushes it)
@@ -264,5 +310,102 @@ pub(super) fn reduce_pair(
         if !out[start..].iter().any(|p| p.key == raw[best].key) {
             out.push(make(&raw[best]));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::hull::ClimbHull;
+    use nalgebra::{Rotation3, Vector3};
+    use parry3d_f64::math::Vector as PVec;
+    use parry3d_f64::shape::SharedShape;
+
+    /// A rounded slab's hull (the climbing kind: hundreds of vertices).
+    fn slab() -> PairShape {
+        let mut pts = Vec::new();
+        for i in 0..24 {
+            for j in 1..12 {
+                let (th, ph) = (
+                    std::f64::consts::TAU * i as f64 / 24.0,
+                    std::f64::consts::PI * j as f64 / 12.0,
+                );
+                let f = |c: f64| c.signum() * c.abs().powf(0.3);
+                pts.push(PVec::new(
+                    0.05 * f(ph.sin() * th.cos()),
+                    0.04 * f(ph.sin() * th.sin()),
+                    0.02 * f(ph.cos()),
+                ));
+            }
+        }
+        pts.push(PVec::new(0.0, 0.0, 0.02));
+        pts.push(PVec::new(0.0, 0.0, -0.02));
+        let Some(Ok(h)) = ClimbHull::of_points(&pts) else {
+            panic!("a large hull");
+        };
+        let shape = SharedShape::new(h);
+        let b = shape.compute_local_aabb();
+        PairShape {
+            mid: from_pvec(b.center()),
+            half: from_pvec(b.half_extents()),
+            shape,
+            offset: Se3::identity(),
+            convex: true,
+        }
+    }
+
+    fn pose(angle: f64, t: Vector3<f64>) -> Se3<f64> {
+        let r = Rotation3::from_axis_angle(&Vector3::x_axis(), angle)
+            * Rotation3::from_axis_angle(&Vector3::y_axis(), 0.5 * angle);
+        Se3::new(r.into_inner(), t)
+    }
+
+    /// The points of b at `wb` on a: from scratch, and with the manifolds
+    /// `kept` from earlier queries.
+    fn points(
+        a: &PairShape,
+        b: &PairShape,
+        wb: &Se3<f64>,
+        kept: Option<&mut Vec<ContactManifold<(), ()>>>,
+    ) -> Vec<Raw> {
+        let wa = Se3::identity();
+        let mut fresh = Vec::new();
+        let manifolds = kept.unwrap_or(&mut fresh);
+        let (mut ws, mut raw) = (None, Vec::new());
+        parry_points(a, b, &wa, wb, 0.005, manifolds, &mut ws, &mut raw);
+        raw
+    }
+
+    fn deepest(raw: &[Raw]) -> f64 {
+        raw.iter().map(|r| r.gap).fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn kept_points_measure_the_gaps_a_fresh_query_finds() {
+        let (a, b) = (slab(), slab());
+        // b lies on a, tilted a little: it touches with a corner region
+        let w0 = pose(0.03, Vector3::new(0.004, -0.002, 0.0399));
+        let mut kept = Vec::new();
+        let first = points(&a, &b, &w0, Some(&mut kept));
+        assert!(!first.is_empty() && deepest(&first) < 0.0, "{first:?}");
+        // moved well within the kept points' tolerance (µm and 10⁻⁶ rad):
+        // the points stand, the gaps are this pose's
+        for k in 1..=5 {
+            let s = k as f64;
+            let w = pose(0.03 + 1e-6 * s, Vector3::new(0.004 + 1e-6 * s, -0.002, 0.0399 - 2e-6 * s));
+            let again = points(&a, &b, &w, Some(&mut kept));
+            let fresh = points(&a, &b, &w, None);
+            let keys = |r: &[Raw]| r.iter().map(|p| p.key).collect::<Vec<_>>();
+            assert_eq!(keys(&again), keys(&first), "kept points, same features");
+            let (d1, d2) = (deepest(&again), deepest(&fresh));
+            assert!((d1 - d2).abs() < 1e-9, "step {k}: kept {d1}, fresh {d2}");
+            assert!((d1 - deepest(&first)).abs() > 1e-6, "the gaps moved with b");
+        }
+        // moved by a millimetre and tilted by 0.02 rad: found anew, as a
+        // fresh query finds them
+        let w = pose(0.05, Vector3::new(0.005, -0.002, 0.0399));
+        let again = points(&a, &b, &w, Some(&mut kept));
+        let fresh = points(&a, &b, &w, None);
+        assert!((deepest(&again) - deepest(&fresh)).abs() < 1e-9);
     }
 }
