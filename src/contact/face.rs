@@ -55,6 +55,22 @@ impl<'a> HullRef<'a> {
         }
     }
 
+    /// A point inside the hull (no vertex is lower along any direction).
+    fn inner(&self) -> PVec {
+        match self {
+            Self::Climb(h) => h.centre(),
+            Self::Small(h) => h.points()[0],
+        }
+    }
+
+    /// The box of the vertices in the hull's frame.
+    fn local_box(&self) -> Aabb {
+        match self {
+            Self::Climb(h) => h.compute_local_aabb(),
+            Self::Small(h) => h.local_aabb(),
+        }
+    }
+
     /// A vertex minimising d·v (its index) and that minimum.
     fn lowest(&self, d: PVec) -> (usize, f64) {
         match self {
@@ -162,20 +178,35 @@ pub(crate) fn hull_on_face(
     match face {
         FaceShape::Cuboid(c) => {
             let e = to_v(c.half_extents);
-            // the face of largest separation: min_q n·q − e_i
-            let mut best = (f64::NEG_INFINITY, 0, 0.0, 0usize);
-            for i in 0..3 {
-                for s in [1.0, -1.0] {
-                    let mut n = Vector3::zeros();
-                    n[i] = s;
-                    let (k, low) = lowest(&n);
-                    let sep = low - e[i];
-                    if sep > best.0 {
-                        best = (sep, i, s, k);
-                    }
+            // the face of largest separation: min_q n·q − e_i (the first of
+            // the largest in the order i = 0, 1, 2, + before −). The lowest
+            // vertex is no higher than a point inside, so n·q_in − e_i bounds
+            // a face's separation from above: the faces are tried by that
+            // bound, and those whose bound is below the best found so far
+            // are not climbed (a foot on a box's top: one climb, not six)
+            let q_in = b_m_a.act_point(&to_v(hull.inner()));
+            let mut faces = [(0.0, 0usize); 6];
+            for (f, face) in faces.iter_mut().enumerate() {
+                let (i, s) = (f / 2, if f % 2 == 0 { 1.0 } else { -1.0 });
+                *face = (s * q_in[i] - e[i], f);
+            }
+            faces.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            let mut best = (f64::NEG_INFINITY, usize::MAX, 0usize);
+            for &(bound, f) in &faces {
+                if bound < best.0 {
+                    break;
+                }
+                let (i, s) = (f / 2, if f % 2 == 0 { 1.0 } else { -1.0 });
+                let mut n = Vector3::zeros();
+                n[i] = s;
+                let (k, low) = lowest(&n);
+                let sep = low - e[i];
+                if sep > best.0 || (sep == best.0 && f < best.1) {
+                    best = (sep, f, k);
                 }
             }
-            let (sep, i, s, k0) = best;
+            let (sep, f, k0) = best;
+            let (i, s) = (f / 2, if f % 2 == 0 { 1.0 } else { -1.0 });
             if sep > margin {
                 return FaceContact::Apart;
             }
@@ -206,17 +237,15 @@ pub(crate) fn hull_on_face(
             }
         }
         FaceShape::HeightField(hf) => {
-            // the hull's box in the field's frame, grown by the margin
-            let mut lo = Vector3::repeat(f64::INFINITY);
-            let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-            for a in 0..3 {
-                let mut n = Vector3::zeros();
-                n[a] = 1.0;
-                lo[a] = lowest(&n).1 - margin;
-                n[a] = -1.0;
-                hi[a] = -lowest(&n).1 + margin;
-            }
-            let aabb = Aabb::new(to_p(&lo), to_p(&hi));
+            // a box holding the hull in the field's frame, grown by the
+            // margin: the hull's own box turned, c = R c_h + t, half
+            // extents |R| h (no climbs; a little larger than the hull's
+            // tight box, so at most a few more cells are checked)
+            let lb = hull.local_box();
+            let c = b_m_a.act_point(&to_v(lb.center()));
+            let he = to_v(lb.half_extents());
+            let half = r.abs() * he + Vector3::repeat(margin);
+            let aabb = Aabb::new(to_p(&(c - half)), to_p(&(c + half)));
             let (rows, cols) = hf.unclamped_elements_range_in_local_aabb(&aabb);
             let (nr, nc) = hf.num_cells_ij();
             if rows.start < 0
@@ -307,15 +336,16 @@ fn collect(
     valid: impl Fn(&Vector3<f64>, f64) -> bool,
 ) -> bool {
     let pts = hull.points();
-    let at = |k: usize| {
-        let q = b_m_a.act_point(&to_v(pts[k]));
-        (q, n.dot(&q) - h)
-    };
+    // a vertex's height n·(R p + t) − h = (Rᵀn)·p + (n·t − h): one dot
+    // product, the vertex itself placed only when it is within the band
+    let height = |k: usize| n.dot(&b_m_a.act_point(&to_v(pts[k]))) - h;
+    let place = |k: usize| b_m_a.act_point(&to_v(pts[k]));
     match hull {
         HullRef::Small(_) => {
             for k in 0..pts.len() {
-                let (q, gap) = at(k);
+                let gap = height(k);
                 if gap <= margin {
+                    let q = place(k);
                     if !valid(&q, gap) {
                         return false;
                     }
@@ -337,10 +367,11 @@ fn collect(
             seen[k0] = stamp;
             while let Some(k) = stack.pop() {
                 let k = k as usize;
-                let (q, gap) = at(k);
+                let gap = height(k);
                 if gap > margin {
                     continue;
                 }
+                let q = place(k);
                 if !valid(&q, gap) {
                     return false;
                 }

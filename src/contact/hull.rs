@@ -84,6 +84,10 @@ pub(crate) struct ClimbHull {
     normal_x: Vec<f64>,
     normal_y: Vec<f64>,
     normal_z: Vec<f64>,
+    /// The mean of the vertices (a point inside the hull).
+    centre: PVec,
+    /// The box of the vertices in the hull's frame.
+    local_box: Aabb,
 }
 
 /// The compressed vertex graph of `n` vertices from triangles.
@@ -139,7 +143,10 @@ impl ClimbHull {
             seeds.push(best as u32);
         }
         let normal = |c: usize| hull.faces().iter().map(|f| f.normal[c]).collect();
+        let centre = pts.iter().fold(PVec::ZERO, |s, p| s + *p) / n as f64;
         Some(Ok(Self {
+            centre,
+            local_box: hull.local_aabb(),
             normal_x: normal(0),
             normal_y: normal(1),
             normal_z: normal(2),
@@ -153,6 +160,11 @@ impl ClimbHull {
     /// The hull's vertices.
     pub fn points(&self) -> &[PVec] {
         self.hull.points()
+    }
+
+    /// A point inside the hull (the mean of its vertices).
+    pub fn centre(&self) -> PVec {
+        self.centre
     }
 
     /// The neighbours of vertex `k` on the triangulation's vertex graph.
@@ -274,7 +286,7 @@ impl RayCast for ClimbHull {
 
 impl Shape for ClimbHull {
     fn compute_local_aabb(&self) -> Aabb {
-        self.hull.local_aabb()
+        self.local_box
     }
 
     fn compute_local_bounding_sphere(&self) -> BoundingSphere {
