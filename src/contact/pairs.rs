@@ -54,6 +54,10 @@ struct Pair {
     /// A unit axis (a's frame, from a toward b) that separated the two
     /// shapes last time, or their contact normal (zero: none).
     axis: Vector3<f64>,
+    /// The last time `axis` separated the shapes by more than the margin:
+    /// the gap along it and both shapes' world poses then (see
+    /// [`still_apart`]).
+    apart: Option<(f64, Se3<f64>, Se3<f64>)>,
     /// A hull and a box or height field (`Some(true)`: the hull is a): the
     /// face path ([`hull_on_face`]) is tried first.
     face: Option<bool>,
@@ -198,6 +202,7 @@ impl PairContact {
                     dropped: false,
                     self_pair: is_self_pair(&g[i], &g[j]),
                     axis: Vector3::zeros(),
+                    apart: None,
                     face: face_kind(&members[a].shape, &members[b].shape),
                     friction: g[i].friction.max(g[j].friction),
                 });
@@ -243,6 +248,7 @@ impl PairContact {
             pair.keys.iter_mut().for_each(|k| *k = NO_KEY);
             pair.manifolds.clear();
             pair.workspace = None;
+            pair.apart = None;
         }
     }
 
@@ -283,6 +289,7 @@ impl PairContact {
             }
             let pair = &mut self.pairs[pi];
             if !hit || pair.dropped {
+                pair.apart = None;
                 if pair.keys[0] != NO_KEY || !pair.manifolds.is_empty() {
                     pair.keys.iter_mut().for_each(|k| *k = NO_KEY);
                     pair.manifolds.clear();
@@ -315,7 +322,12 @@ impl PairContact {
             // two convex shapes apart along last step's axis by more than
             // the margin: no point, no parry query
             let convex = ma.shape.convex && mb.shape.convex;
-            let apart = convex && apart_along(&pair.axis, ma, mb, &wa, &wb, margin);
+            let apart = convex
+                && (still_apart(pair.apart.as_ref(), ma, mb, &wa, &wb, margin) || {
+                    let gap = apart_along(&pair.axis, ma, mb, &wa, &wb);
+                    pair.apart = (gap > margin).then_some((gap, wa, wb));
+                    gap > margin
+                });
             if !plane && !apart {
                 parry_points(
                     &ma.shape,
@@ -418,34 +430,51 @@ impl PairContact {
     }
 }
 
-/// Whether convex members `a` at `wa` and `b` at `wb` are apart by more
-/// than `margin` along the unit axis `u` (a's frame, from a toward b; zero:
-/// not known): min over b of u·x − max over a of u·x > margin (two support
-/// points), a lower bound of their distance.
+/// The gap of convex members `a` at `wa` and `b` at `wb` along the unit
+/// axis `u` (a's frame, from a toward b; zero: not known, −∞): min over b
+/// of u·x − max over a of u·x (two support points), a lower bound of their
+/// distance when positive.
 #[inline]
-fn apart_along(
-    u: &Vector3<f64>,
-    a: &Member,
-    b: &Member,
-    wa: &Se3<f64>,
-    wb: &Se3<f64>,
-    margin: f64,
-) -> bool {
+fn apart_along(u: &Vector3<f64>, a: &Member, b: &Member, wa: &Se3<f64>, wb: &Se3<f64>) -> f64 {
     if u.x == 0.0 && u.y == 0.0 && u.z == 0.0 {
-        return false;
+        return f64::NEG_INFINITY;
     }
     let (Some(sa), Some(sb)) = (
         a.shape.shape.as_support_map(),
         b.shape.shape.as_support_map(),
     ) else {
-        return false;
+        return f64::NEG_INFINITY;
     };
     // b in a's frame: x = R p + t
     let a_m_b = wa.inverse().compose(wb);
     let top_a = u.dot(&from_pvec(sa.local_support_point(to_pvec(u))));
     let d = a_m_b.rot.transpose() * (-u);
     let low_b = u.dot(&a_m_b.act_point(&from_pvec(sb.local_support_point(to_pvec(&d)))));
-    low_b - top_a > margin
+    low_b - top_a
+}
+
+/// Whether two shapes separated by a plane with a gap g (> the margin) at
+/// the world poses `then` are still more than `margin` apart at `wa`, `wb`
+/// without a support query: no point of a shape moved farther than D =
+/// |w·c − w₀·c| + ‖R − R₀‖_F |h| (c, h its box's centre and half extents in
+/// its frame: every point lies within |h| of c), so across that plane the
+/// shapes are still g − D_a − D_b apart (conservative advancement).
+fn still_apart(
+    then: Option<&(f64, Se3<f64>, Se3<f64>)>,
+    a: &Member,
+    b: &Member,
+    wa: &Se3<f64>,
+    wb: &Se3<f64>,
+    margin: f64,
+) -> bool {
+    let Some((gap, wa0, wb0)) = then else {
+        return false;
+    };
+    let moved = |m: &Member, w0: &Se3<f64>, w: &Se3<f64>| {
+        (w.act_point(&m.shape.mid) - w0.act_point(&m.shape.mid)).norm()
+            + (w.rot - w0.rot).norm() * m.shape.half.norm()
+    };
+    gap - moved(a, wa0, wa) - moved(b, wb0, wb) > margin
 }
 
 /// Sets member `k`'s broad-phase box: its shape's box at the world pose `w`
@@ -492,5 +521,76 @@ fn assign_slots(pair: &mut Pair, pts: &mut [ContactPoint]) {
         if let Some(p) = pts.iter().find(|p| p.slot == pair.slot_base + s) {
             *key = p.key;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix3, Rotation3, Unit};
+    use parry3d_f64::shape::SharedShape;
+
+    fn member(half: [f64; 3]) -> Member {
+        let shape = SharedShape::cuboid(half[0], half[1], half[2]);
+        let b = shape.compute_local_aabb();
+        Member {
+            geom: 0,
+            body: 1,
+            placement: Se3::identity(),
+            shape: PairShape {
+                mid: from_pvec(b.center()),
+                half: from_pvec(b.half_extents()),
+                shape,
+                offset: Se3::identity(),
+                convex: true,
+            },
+        }
+    }
+
+    fn distance(a: &Member, b: &Member, wa: &Se3<f64>, wb: &Se3<f64>) -> f64 {
+        let pose = |w: &Se3<f64>| super::super::shapes::to_pose(w);
+        parry3d_f64::query::distance(&pose(wa), &*a.shape.shape, &pose(wb), &*b.shape.shape)
+            .unwrap()
+            .distance
+    }
+
+    #[test]
+    fn still_apart_is_never_wrong_and_not_vacuous() {
+        // a long bar beside a cube, 3 cm apart along x: turning the bar about
+        // its centre swings its end into the cube with no translation at all
+        let (a, b) = (member([0.02, 0.1, 0.02]), member([0.02, 0.02, 0.02]));
+        let margin = 0.005;
+        let wa0 = Se3::identity();
+        let wb0 = Se3::new(Matrix3::identity(), Vector3::new(0.07, 0.08, 0.0));
+        let gap = apart_along(&Vector3::x(), &a, &b, &wa0, &wb0);
+        assert!((gap - 0.03).abs() < 1e-12, "{gap}");
+        let then = (gap, wa0, wb0);
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let (mut kept, mut asked, mut touching) = (0, 0, 0);
+        for k in 0..4000 {
+            // turns up to 0.6 rad about axes near z, moves up to 2 cm
+            let s = (k % 10) as f64 / 10.0;
+            let mut turn = |w: &Se3<f64>, by: f64| {
+                let axis = Unit::new_normalize(Vector3::new(0.2 * rnd(), 0.2 * rnd(), 1.0));
+                let r = Rotation3::from_axis_angle(&axis, by * s * rnd()).into_inner();
+                Se3::new(r * w.rot, w.trans + Vector3::new(rnd(), rnd(), rnd()) * 0.02 * s * s)
+            };
+            let (wa, wb) = (turn(&wa0, 0.6), turn(&wb0, 0.1));
+            let d = distance(&a, &b, &wa, &wb);
+            touching += usize::from(d <= margin);
+            if still_apart(Some(&then), &a, &b, &wa, &wb, margin) {
+                kept += 1;
+                assert!(d > margin, "move {k}: still apart, but {d} m apart");
+            } else {
+                asked += 1;
+            }
+        }
+        assert!(kept > 500 && asked > 500 && touching > 100, "{kept} {asked} {touching}");
     }
 }
