@@ -12,11 +12,18 @@
 //! The base is then pushed to 0.5 m/s forward, with the joint rates that keep
 //! the feet where they stand (J_c δv = 0: a push that slid the feet could not
 //! be undone), and the controller brings it back.
+//! Only the joints are actuated: the design takes B's joint columns (B's
+//! base-wrench columns would be a force nobody applies).
 //! Run: `cargo run --release --example lqr_stand [OUT_DIR]` (exit 1 if the base
 //! does not come back within 1 cm); writes the replay page `OUT_DIR/lqr_stand.html`
 //! (OUT_DIR defaults to `target`). Measured: back within 4.6 mm (farthest 25 mm), its
 //! velocity below 1e-5 after 1.5 s; Q = 10·I, R = 1·I (env LQR_Q, LQR_R,
 //! LQR_PUSH change them; LQR_R=1e12, the servos alone: 4.7 mm).
+//! `LQR_SERVOS=0` switches the servos off once it stands and keeps their static
+//! torques τ* as a feed-forward: the stance is then open-loop unstable (spectral
+//! radius 1.0097 on the complement) and the LQR alone holds it, back within
+//! 0.04 mm after pushes up to 0.2 m/s (farthest 9.2 mm); from 0.3 m/s it falls
+//! (the linear design does not hold the feet on the ground that far out).
 
 use nalgebra::{DMatrix, DVector, Vector3};
 use std::path::PathBuf;
@@ -55,8 +62,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         vs.norm(),
         sim.active_contacts()
     );
+    // LQR_SERVOS=0: the servos off, their static torques τ* at the stance
+    // kept as a feed-forward, and the LQR alone holds it (around τ*)
+    let keep_servos = std::env::var("LQR_SERVOS").map_or(true, |s| s != "0");
+    let mut tau0 = DVector::zeros(n);
+    if !keep_servos {
+        for k in 0..n - 6 {
+            tau0[6 + k] = 60.0 * (q[7 + k] - qs[7 + k]) - 3.0 * vs[6 + k];
+        }
+        sim.set_gains_uniform(0.0, 0.0)?;
+        sim.set_state(&qs, &vs)?;
+    }
     // the step's Jacobians at the standing state
-    let tau0 = DVector::zeros(n);
     let j = sim.transition_jacobians(&tau0, JacobianMethod::Analytic, 1e-6)?;
     // the feet's contact-point Jacobian (sphere feet: the point r below the centre)
     let mut data = Data::new(&model);
@@ -117,7 +134,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     t.view_mut((0, 0), (n, k)).copy_from(&nn);
     t.view_mut((n, k), (n, k)).copy_from(&nn);
     let ar = t.transpose() * &j.a * &t;
-    let br = t.transpose() * &j.b;
+    // only the joints are actuated: B's base-wrench columns are left out
+    let br = t.transpose() * j.b.columns(6, n - 6);
     println!(
         "J_c rank {rank}: LQR on {} of {} state dimensions",
         2 * k,
@@ -131,9 +149,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .unwrap_or(d)
     };
     let qw = DMatrix::<f64>::identity(2 * k, 2 * k) * env("LQR_Q", 10.0);
-    let rw = DMatrix::<f64>::identity(n, n) * env("LQR_R", 1.0);
+    let rw = DMatrix::<f64>::identity(n - 6, n - 6) * env("LQR_R", 1.0);
     let mut p = qw.clone();
-    let mut kr = DMatrix::zeros(n, 2 * k);
+    let mut kr = DMatrix::zeros(n - 6, 2 * k);
     for it in 0..20000 {
         let s = &rw + br.transpose() * &p * &br;
         kr = s
@@ -148,6 +166,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             break;
         }
     }
+    let open_rho = ar
+        .complex_eigenvalues()
+        .iter()
+        .map(|e| e.norm())
+        .fold(0.0, f64::max);
+    println!("open-loop spectral radius on the complement: {open_rho:.6}");
     let closed = &ar - &br * &kr;
     let rho = closed
         .complex_eigenvalues()
@@ -189,8 +213,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         dx.rows_mut(0, n).copy_from(&dq);
         dx.rows_mut(n, n).copy_from(&(sim.v() - &vs));
         let u = -(&kr * (t.transpose() * dx));
-        let mut tau = DVector::zeros(n);
-        tau.rows_mut(6, n - 6).copy_from(&u.rows(6, n - 6));
+        let mut tau = tau0.clone();
+        tau.rows_mut(6, n - 6).axpy(1.0, &u, 1.0);
         sim.set_torques(&tau)?;
         sim.step()?;
         let plot = [

@@ -10,10 +10,10 @@ use super::ContactPoint;
 use crate::spatial::Se3;
 use nalgebra::Vector3;
 use parry3d_f64::math::Pose;
-use parry3d_f64::shape::ShapeType;
 use parry3d_f64::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
+use parry3d_f64::shape::ShapeType;
 
 /// The key bit of a face-path point (its vertex index below it): never a key
 /// of parry's features (those fill at most bits 0–59).
@@ -83,7 +83,8 @@ pub(super) fn parry_points(
     if convex
         && polyhedral(a)
         && polyhedral(b)
-        && manifolds[0].try_update_contacts_eps(&pos12, REUSE_COS, REUSE_SLIDE * REUSE_SLIDE) {
+        && manifolds[0].try_update_contacts_eps(&pos12, REUSE_COS, REUSE_SLIDE * REUSE_SLIDE)
+    {
         raw.clear();
         push_points(&manifolds[..], wa, wb, margin, f64::INFINITY, raw);
         return;
@@ -404,7 +405,10 @@ mod tests {
         // the points stand, the gaps are this pose's
         for k in 1..=5 {
             let s = k as f64;
-            let w = pose(0.03 + 1e-6 * s, Vector3::new(0.004 + 1e-6 * s, -0.002, 0.0399 - 2e-6 * s));
+            let w = pose(
+                0.03 + 1e-6 * s,
+                Vector3::new(0.004 + 1e-6 * s, -0.002, 0.0399 - 2e-6 * s),
+            );
             let again = points(&a, &b, &w, Some(&mut kept));
             let fresh = points(&a, &b, &w, None);
             let keys = |r: &[Raw]| r.iter().map(|p| p.key).collect::<Vec<_>>();

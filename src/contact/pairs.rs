@@ -579,7 +579,10 @@ mod tests {
             let mut turn = |w: &Se3<f64>, by: f64| {
                 let axis = Unit::new_normalize(Vector3::new(0.2 * rnd(), 0.2 * rnd(), 1.0));
                 let r = Rotation3::from_axis_angle(&axis, by * s * rnd()).into_inner();
-                Se3::new(r * w.rot, w.trans + Vector3::new(rnd(), rnd(), rnd()) * 0.02 * s * s)
+                Se3::new(
+                    r * w.rot,
+                    w.trans + Vector3::new(rnd(), rnd(), rnd()) * 0.02 * s * s,
+                )
             };
             let (wa, wb) = (turn(&wa0, 0.6), turn(&wb0, 0.1));
             let d = distance(&a, &b, &wa, &wb);
@@ -591,6 +594,9 @@ mod tests {
                 asked += 1;
             }
         }
-        assert!(kept > 500 && asked > 500 && touching > 100, "{kept} {asked} {touching}");
+        assert!(
+            kept > 500 && asked > 500 && touching > 100,
+            "{kept} {asked} {touching}"
+        );
     }
 }
