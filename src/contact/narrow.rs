@@ -79,8 +79,9 @@ pub(super) fn parry_points(
     // a convex pair that has barely moved since parry found its points
     // keeps them, their gaps measured anew at this pose (exact for a vertex
     // on a face: the face's plane is fixed in a's frame): no GJK, no clipping
-    let convex = a.convex && b.convex && manifolds.len() == 1;
+    let convex = a.convex && b.convex;
     if convex
+        && manifolds.len() == 1
         && polyhedral(a)
         && polyhedral(b)
         && manifolds[0].try_update_contacts_eps(&pos12, REUSE_COS, REUSE_SLIDE * REUSE_SLIDE)
@@ -94,7 +95,7 @@ pub(super) fn parry_points(
     // deeper, the penetration solver (EPA) has failed; asked again from
     // scratch (no cached direction), and what is still deeper is dropped
     let mut bound = f64::INFINITY;
-    if convex {
+    if convex && manifolds.len() == 1 {
         bound = overlap_bound(a, b, &pos12, &manifolds[0]);
         if too_deep(&manifolds[0], bound) {
             manifolds.clear();
