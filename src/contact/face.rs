@@ -151,6 +151,14 @@ fn to_p(v: &Vector3<f64>) -> PVec {
     PVec::new(v.x, v.y, v.z)
 }
 
+/// Face `f` (0–5) of a box: its axis i = f / 2 and outward normal ±eᵢ
+/// (+ for even f).
+fn box_face(f: usize) -> (usize, Vector3<f64>) {
+    let mut n = Vector3::zeros();
+    n[f / 2] = if f.is_multiple_of(2) { 1.0 } else { -1.0 };
+    (f / 2, n)
+}
+
 /// The contact of `hull` placed at `b_m_a` (its frame in the face shape's)
 /// with `face`, within `margin`; the points go to `out` (cleared) with
 /// `stack`/`seen` as scratch (`seen` as long as the hull has vertices).
@@ -187,8 +195,8 @@ pub(crate) fn hull_on_face(
             let q_in = b_m_a.act_point(&to_v(hull.inner()));
             let mut faces = [(0.0, 0usize); 6];
             for (f, face) in faces.iter_mut().enumerate() {
-                let (i, s) = (f / 2, if f % 2 == 0 { 1.0 } else { -1.0 });
-                *face = (s * q_in[i] - e[i], f);
+                let (i, n) = box_face(f);
+                *face = (n[i] * q_in[i] - e[i], f);
             }
             faces.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
             let mut best = (f64::NEG_INFINITY, usize::MAX, 0usize);
@@ -196,9 +204,7 @@ pub(crate) fn hull_on_face(
                 if bound < best.0 {
                     break;
                 }
-                let (i, s) = (f / 2, if f % 2 == 0 { 1.0 } else { -1.0 });
-                let mut n = Vector3::zeros();
-                n[i] = s;
+                let (i, n) = box_face(f);
                 let (k, low) = lowest(&n);
                 let sep = low - e[i];
                 if sep > best.0 || (sep == best.0 && f < best.1) {
@@ -206,12 +212,10 @@ pub(crate) fn hull_on_face(
                 }
             }
             let (sep, f, k0) = best;
-            let (i, s) = (f / 2, if f % 2 == 0 { 1.0 } else { -1.0 });
             if sep > margin {
                 return FaceContact::Apart;
             }
-            let mut n = Vector3::zeros();
-            n[i] = s;
+            let (i, n) = box_face(f);
             let (j1, j2) = ((i + 1) % 3, (i + 2) % 3);
             let band = margin.min(sep + BAND);
             let ok = collect(
@@ -336,16 +340,16 @@ fn collect(
     valid: impl Fn(&Vector3<f64>, f64) -> bool,
 ) -> bool {
     let pts = hull.points();
-    // a vertex's height n·(R p + t) − h = (Rᵀn)·p + (n·t − h): one dot
-    // product, the vertex itself placed only when it is within the band
-    let height = |k: usize| n.dot(&b_m_a.act_point(&to_v(pts[k]))) - h;
-    let place = |k: usize| b_m_a.act_point(&to_v(pts[k]));
+    // a vertex placed in the face shape's frame, and its height n·q − h
+    let at = |k: usize| {
+        let q = b_m_a.act_point(&to_v(pts[k]));
+        (q, n.dot(&q) - h)
+    };
     match hull {
         HullRef::Small(_) => {
             for k in 0..pts.len() {
-                let gap = height(k);
+                let (q, gap) = at(k);
                 if gap <= margin {
-                    let q = place(k);
                     if !valid(&q, gap) {
                         return false;
                     }
@@ -367,11 +371,10 @@ fn collect(
             seen[k0] = stamp;
             while let Some(k) = stack.pop() {
                 let k = k as usize;
-                let gap = height(k);
+                let (q, gap) = at(k);
                 if gap > margin {
                     continue;
                 }
-                let q = place(k);
                 if !valid(&q, gap) {
                     return false;
                 }
@@ -401,27 +404,7 @@ mod tests {
     /// A rounded box hull (many vertices: the climbing kind): points on a
     /// superellipsoid of half extents 0.05 × 0.03 × 0.02.
     fn rounded() -> ClimbHull {
-        let mut pts = Vec::new();
-        for i in 0..24 {
-            for j in 1..12 {
-                let (th, ph) = (
-                    std::f64::consts::TAU * i as f64 / 24.0,
-                    std::f64::consts::PI * j as f64 / 12.0,
-                );
-                let f = |c: f64| c.signum() * c.abs().powf(0.4);
-                pts.push(PVec::new(
-                    0.05 * f(ph.sin() * th.cos()),
-                    0.03 * f(ph.sin() * th.sin()),
-                    0.02 * f(ph.cos()),
-                ));
-            }
-        }
-        pts.push(PVec::new(0.0, 0.0, 0.02));
-        pts.push(PVec::new(0.0, 0.0, -0.02));
-        match ClimbHull::of_points(&pts) {
-            Some(Ok(h)) => h,
-            _ => panic!("a large hull"),
-        }
+        crate::contact::hull::superellipsoid([0.05, 0.03, 0.02], 0.4)
     }
 
     fn at(x: f64, y: f64, z: f64, roll: f64) -> Se3<f64> {

@@ -92,13 +92,26 @@ pub(crate) struct ClimbHull {
 
 /// The compressed vertex graph of `n` vertices from triangles.
 pub(crate) fn triangle_graph(n: usize, triangles: &[[u32; 3]]) -> (Vec<u32>, Vec<u32>) {
+    compressed_graph(
+        n,
+        triangles
+            .iter()
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]),
+    )
+}
+
+/// The compressed rows (start, neighbours) of the undirected graph of `n`
+/// vertices with `edges` (out-of-range ends and loops ignored, duplicates
+/// merged): the neighbours of k are `adj[start[k]..start[k + 1]]`, sorted.
+pub(crate) fn compressed_graph(
+    n: usize,
+    edges: impl Iterator<Item = (u32, u32)>,
+) -> (Vec<u32>, Vec<u32>) {
     let mut nb: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for t in triangles {
-        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-            if (a as usize) < n && (b as usize) < n && a != b {
-                nb[a as usize].push(b);
-                nb[b as usize].push(a);
-            }
+    for (a, b) in edges {
+        if (a as usize) < n && (b as usize) < n && a != b {
+            nb[a as usize].push(b);
+            nb[b as usize].push(a);
         }
     }
     let mut start = Vec::with_capacity(n + 1);
@@ -195,6 +208,33 @@ impl ClimbHull {
             }
             k = next;
         }
+    }
+}
+
+/// A test hull of the climbing kind: points on the superellipsoid of half
+/// extents `half` and exponent `power` (24 × 11 rings and both poles).
+#[cfg(test)]
+pub(crate) fn superellipsoid(half: [f64; 3], power: f64) -> ClimbHull {
+    let mut pts = Vec::new();
+    for i in 0..24 {
+        for j in 1..12 {
+            let (th, ph) = (
+                std::f64::consts::TAU * i as f64 / 24.0,
+                std::f64::consts::PI * j as f64 / 12.0,
+            );
+            let f = |c: f64| c.signum() * c.abs().powf(power);
+            pts.push(PVec::new(
+                half[0] * f(ph.sin() * th.cos()),
+                half[1] * f(ph.sin() * th.sin()),
+                half[2] * f(ph.cos()),
+            ));
+        }
+    }
+    pts.push(PVec::new(0.0, 0.0, half[2]));
+    pts.push(PVec::new(0.0, 0.0, -half[2]));
+    match ClimbHull::of_points(&pts) {
+        Some(Ok(h)) => h,
+        _ => panic!("a large hull"),
     }
 }
 

@@ -330,42 +330,14 @@ pub(super) fn reduce_pair(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::hull::ClimbHull;
+    use crate::contact::hull::superellipsoid;
     use nalgebra::{Rotation3, Vector3};
-    use parry3d_f64::math::Vector as PVec;
     use parry3d_f64::shape::SharedShape;
 
     /// A rounded slab's hull (the climbing kind: hundreds of vertices).
     fn slab() -> PairShape {
-        let mut pts = Vec::new();
-        for i in 0..24 {
-            for j in 1..12 {
-                let (th, ph) = (
-                    std::f64::consts::TAU * i as f64 / 24.0,
-                    std::f64::consts::PI * j as f64 / 12.0,
-                );
-                let f = |c: f64| c.signum() * c.abs().powf(0.3);
-                pts.push(PVec::new(
-                    0.05 * f(ph.sin() * th.cos()),
-                    0.04 * f(ph.sin() * th.sin()),
-                    0.02 * f(ph.cos()),
-                ));
-            }
-        }
-        pts.push(PVec::new(0.0, 0.0, 0.02));
-        pts.push(PVec::new(0.0, 0.0, -0.02));
-        let Some(Ok(h)) = ClimbHull::of_points(&pts) else {
-            panic!("a large hull");
-        };
-        let shape = SharedShape::new(h);
-        let b = shape.compute_local_aabb();
-        PairShape {
-            mid: from_pvec(b.center()),
-            half: from_pvec(b.half_extents()),
-            shape,
-            offset: Se3::identity(),
-            convex: true,
-        }
+        let h = superellipsoid([0.05, 0.04, 0.02], 0.3);
+        PairShape::new(SharedShape::new(h), Se3::identity(), true)
     }
 
     fn pose(angle: f64, t: Vector3<f64>) -> Se3<f64> {

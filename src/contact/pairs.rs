@@ -532,18 +532,11 @@ mod tests {
 
     fn member(half: [f64; 3]) -> Member {
         let shape = SharedShape::cuboid(half[0], half[1], half[2]);
-        let b = shape.compute_local_aabb();
         Member {
             geom: 0,
             body: 1,
             placement: Se3::identity(),
-            shape: PairShape {
-                mid: from_pvec(b.center()),
-                half: from_pvec(b.half_extents()),
-                shape,
-                offset: Se3::identity(),
-                convex: true,
-            },
+            shape: PairShape::new(shape, Se3::identity(), true),
         }
     }
 

@@ -38,6 +38,21 @@ pub(crate) struct PairShape {
     pub convex: bool,
 }
 
+impl PairShape {
+    /// A parry shape at `offset` in its geometry frame, with its box in
+    /// parry's frame.
+    pub fn new(shape: SharedShape, offset: Se3<f64>, convex: bool) -> Self {
+        let b = shape.compute_local_aabb();
+        Self {
+            mid: from_pvec(b.center()),
+            half: from_pvec(b.half_extents()),
+            shape,
+            offset,
+            convex,
+        }
+    }
+}
+
 impl std::fmt::Debug for PairShape {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("PairShape")
@@ -214,13 +229,5 @@ pub(crate) fn pair_shape(
             )
         }
     };
-    // the box in parry's frame
-    let b = shape.compute_local_aabb();
-    Ok(Some(PairShape {
-        mid: from_pvec(b.center()),
-        half: from_pvec(b.half_extents()),
-        shape,
-        offset,
-        convex,
-    }))
+    Ok(Some(PairShape::new(shape, offset, convex)))
 }

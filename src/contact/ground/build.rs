@@ -1,5 +1,6 @@
 //! Building the ground path's shapes from the model's collision geometry.
 
+use super::super::hull::compressed_graph;
 use super::super::shapes::rot_x90;
 use super::super::{mesh, ContactError, ContactParams, ContactPoint, NO_GEOM};
 use super::reduce::reduce_directions;
@@ -20,25 +21,10 @@ const CYL_SAMPLES: usize = 6;
 
 /// The compressed adjacency of a hull's vertex graph from its edges.
 fn hull_adjacency(h: &ConvexPolyhedron) -> (Vec<u32>, Vec<u32>) {
-    let n = h.points().len();
-    let mut nb: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for e in h.edges() {
-        let [a, b] = e.vertices;
-        if (a as usize) < n && (b as usize) < n && a != b {
-            nb[a as usize].push(b);
-            nb[b as usize].push(a);
-        }
-    }
-    let mut start = Vec::with_capacity(n + 1);
-    let mut adj = Vec::new();
-    for list in &mut nb {
-        list.sort_unstable();
-        list.dedup();
-        start.push(adj.len() as u32);
-        adj.extend_from_slice(list);
-    }
-    start.push(adj.len() as u32);
-    (start, adj)
+    compressed_graph(
+        h.points().len(),
+        h.edges().iter().map(|e| (e.vertices[0], e.vertices[1])),
+    )
 }
 
 impl GroundContact {
