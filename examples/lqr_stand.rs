@@ -33,6 +33,10 @@ use urdyn::model::configuration::difference;
 use urdyn::sim::{JacobianMethod, SimOptions, Simulation};
 use urdyn::{Data, LoadOptions};
 
+/// The standing servos' gains (N·m/rad, N·m·s/rad), the same on every joint.
+const KP: f64 = 60.0;
+const KD: f64 = 3.0;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let model = urdyn::load_file(
@@ -49,7 +53,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         q[7 + k] = if d.name.ends_with("hip") { 0.6 } else { -1.2 };
     }
     q[2] = 0.4 * 0.6f64.cos() + 0.021;
-    sim.set_gains_uniform(60.0, 3.0)?;
+    sim.set_gains_uniform(KP, KD)?;
     sim.set_targets(&q, None)?;
     sim.set_state(&q, &DVector::zeros(n))?;
     for _ in 0..2000 {
@@ -68,7 +72,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut tau0 = DVector::zeros(n);
     if !keep_servos {
         for k in 0..n - 6 {
-            tau0[6 + k] = 60.0 * (q[7 + k] - qs[7 + k]) - 3.0 * vs[6 + k];
+            tau0[6 + k] = KP * (q[7 + k] - qs[7 + k]) - KD * vs[6 + k];
         }
         sim.set_gains_uniform(0.0, 0.0)?;
         sim.set_state(&qs, &vs)?;
@@ -166,18 +170,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             break;
         }
     }
-    let open_rho = ar
-        .complex_eigenvalues()
-        .iter()
-        .map(|e| e.norm())
-        .fold(0.0, f64::max);
+    let radius = |m: &DMatrix<f64>| {
+        m.complex_eigenvalues()
+            .iter()
+            .map(|e| e.norm())
+            .fold(0.0, f64::max)
+    };
+    let open_rho = radius(&ar);
     println!("open-loop spectral radius on the complement: {open_rho:.6}");
-    let closed = &ar - &br * &kr;
-    let rho = closed
-        .complex_eigenvalues()
-        .iter()
-        .map(|e| e.norm())
-        .fold(0.0, f64::max);
+    let rho = radius(&(&ar - &br * &kr));
     println!("closed-loop spectral radius on the complement: {rho:.6}");
     // the push: base 0.5 m/s forward, joint rates keeping the feet in place
     let mut v = DVector::zeros(n);
