@@ -9,7 +9,10 @@ steps/s of each and B/A: a profile or code change measured against the binary be
 on the same machine in one run. example-robot-data is found in this Python's
 site-packages (pip install example-robot-data) or at $ERD.
 """
-import os, re, statistics, subprocess, sys, sysconfig
+import os, statistics, subprocess, sys, sysconfig
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from robots_sweep import SUMMARY  # noqa: E402  (urdyn's summary line)
 A, B = sys.argv[1], sys.argv[2]
 reps = int(sys.argv[3]) if len(sys.argv) > 3 else 7
 ERD = os.environ.get("ERD") or os.path.join(
@@ -21,8 +24,8 @@ def sps(b, urdf):
     p = subprocess.run([b, "simulate", f"{ERD}/{urdf}", "--floating-base", "--above-ground", "0.3",
                         "--duration", "3", "--package-path", ERD + "/..", "--out", "/tmp/ab.csv"],
                        capture_output=True, text=True)
-    m = re.search(r"(\d+) steps \(\w+\) in ([0-9.]+) s wall", p.stderr)
-    return int(m.group(1)) / float(m.group(2))
+    m = SUMMARY.search(p.stderr)
+    return int(m.group(1)) / float(m.group(3))
 for name, urdf in robots.items():
     a, b = [], []
     for _ in range(reps):
