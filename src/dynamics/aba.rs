@@ -5,7 +5,7 @@ use super::{CompositeInertia, DynamicsError};
 use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
 use crate::spatial::ops::{cross, madd, mat_mat};
 use crate::spatial::{skew, Force, Motion, Scalar, Se3};
-use nalgebra::{DVector, Matrix3, Matrix6, Vector3, Vector6};
+use nalgebra::{DVector, Matrix3, Matrix6, Matrix6x3, Vector3, Vector6};
 
 /// The 6x6 angular-first matrix of a rigid-body inertia in origin form (the
 /// model's `inertias_origin`, computed at load), docs/theory.md §"Spatial inertia":
@@ -101,6 +101,20 @@ fn act_matrix6_ax<T: Scalar>(x: &Se3<T>, ax: Option<Axis<T>>, m: &Matrix6<T>) ->
     let b = sandwich(m.fixed_view::<3, 3>(0, 3).into_owned());
     let c = sandwich(m.fixed_view::<3, 3>(3, 3).into_owned());
     translate6(&x.trans, &a, &b, &c)
+}
+
+/// A 3-DoF joint's `U = Iᴬ S` (6x3) and `D⁻¹ = (Sᵀ U)⁻¹`, `None` when D is not
+/// positive definite.
+#[inline(always)]
+fn subspace_blocks<T: Scalar, J: JointModel<T>>(
+    jm: &J,
+    ia: &Matrix6<T>,
+) -> Option<(Matrix6x3<T>, Matrix3<T>)> {
+    let s = Matrix6x3::from_fn(|r, c| mvec(&jm.subspace(c))[r]);
+    let u = ia * s;
+    let d = s.transpose() * u;
+    let dinv = d.cholesky()?.inverse();
+    dinv.iter().all(|x| x.is_finite()).then_some((u, dinv))
 }
 
 #[inline(always)]
@@ -246,6 +260,20 @@ pub fn aba<'d, T: Scalar>(
                     ia_head[p] += act_matrix6_ax(li, ax, &ia_a);
                     pa_head[p] += act_force_ax(li, ax, &vforce(&pa_a));
                 }
+            } else if jm.nv() == 3 {
+                // a 3-DoF joint (spherical, planar): U = Iᴬ S, D = Sᵀ U as 6x3, 3x3
+                let (u_mat, dinv) = subspace_blocks(&jm, &ia_tail[0])
+                    .ok_or(DynamicsError::Singular(iv))?;
+                let ui = Vector3::from_fn(|r, _| tau[iv + r] - jm.project_column(r, &pa_tail[0]));
+                uu[i] = Vector6::new(ui.x, ui.y, ui.z, T::zero(), T::zero(), T::zero());
+                if p != 0 {
+                    let ud = u_mat * dinv;
+                    let ia_a = ia_tail[0] - ud * u_mat.transpose();
+                    let pa_a = fvec(&pa_tail[0]) + ia_a * mvec(&cc[i]) + ud * ui;
+                    let ax = jm.rot_axis();
+                    ia_head[p] += act_matrix6_ax(li, ax, &ia_a);
+                    pa_head[p] += act_force_ax(li, ax, &vforce(&pa_a));
+                }
             } else {
                 let t = &tau[iv..iv + 6];
                 let tf = Force::new(Vector3::new(t[3], t[4], t[5]), Vector3::new(t[0], t[1], t[2]));
@@ -273,6 +301,16 @@ pub fn aba<'d, T: Scalar>(
                 qdd[iv] = x;
                 let mut ai = a1;
                 jm.add_subspace_scaled(&mut ai, x);
+                ai
+            } else if jm.nv() == 3 {
+                let (u_mat, dinv) = subspace_blocks(&jm, &ia[i]).ok_or(DynamicsError::Singular(iv))?;
+                let ui = Vector3::new(uu[i][0], uu[i][1], uu[i][2]);
+                let x = dinv * (ui - u_mat.transpose() * mvec(&a1));
+                let mut ai = a1;
+                for r in 0..3 {
+                    qdd[iv + r] = x[r];
+                    ai += jm.subspace(r) * x[r];
+                }
                 ai
             } else {
                 let chol = ia[i].cholesky().ok_or(DynamicsError::Singular(iv))?;
