@@ -103,6 +103,52 @@ fn act_matrix6_ax<T: Scalar>(x: &Se3<T>, ax: Option<Axis<T>>, m: &Matrix6<T>) ->
     translate6(&x.trans, &a, &b, &c)
 }
 
+/// Sweep 2's step of a 3-DoF joint (docs/theory.md §"Spherical, planar and
+/// floating joints"): `u = τ − Sᵀ pᴬ` (in the first three entries) and what the
+/// parent receives, `ᵖX*ᵢ Iᵃ ⁱXₚ` and `ᵖX*ᵢ pᵃ`; `None` when D is singular.
+#[inline(never)]
+fn aba_step3_inward<T: Scalar, J: JointModel<T>>(
+    jm: &J,
+    ia: &Matrix6<T>,
+    pa: &Force<T>,
+    c: &Motion<T>,
+    tau: &[T],
+    li: &Se3<T>,
+) -> Option<(Vector6<T>, (Matrix6<T>, Force<T>))> {
+    let iv = jm.joint().iv;
+    let (u_mat, dinv) = subspace_blocks(jm, ia)?;
+    let ui = Vector3::from_fn(|r, _| tau[iv + r] - jm.project_column(r, pa));
+    let ud = u_mat * dinv;
+    let ia_a = ia - ud * u_mat.transpose();
+    let pa_a = fvec(pa) + ia_a * mvec(c) + ud * ui;
+    let ax = jm.rot_axis();
+    Some((
+        Vector6::new(ui.x, ui.y, ui.z, T::zero(), T::zero(), T::zero()),
+        (act_matrix6_ax(li, ax, &ia_a), act_force_ax(li, ax, &vforce(&pa_a))),
+    ))
+}
+
+/// Sweep 3's step of a 3-DoF joint: `q̈ = D⁻¹ (u − Uᵀ a')` into `qdd`, and
+/// `âᵢ = a' + S q̈`.
+#[inline(never)]
+fn aba_step3_outward<T: Scalar, J: JointModel<T>>(
+    jm: &J,
+    ia: &Matrix6<T>,
+    u: &Vector6<T>,
+    a1: &Motion<T>,
+    qdd: &mut [T],
+) -> Option<Motion<T>> {
+    let iv = jm.joint().iv;
+    let (u_mat, dinv) = subspace_blocks(jm, ia)?;
+    let x = dinv * (Vector3::new(u[0], u[1], u[2]) - u_mat.transpose() * mvec(a1));
+    let mut ai = *a1;
+    for r in 0..3 {
+        qdd[iv + r] = x[r];
+        ai += jm.subspace(r) * x[r];
+    }
+    Some(ai)
+}
+
 /// A 3-DoF joint's `U = Iᴬ S` (6x3) and `D⁻¹ = (Sᵀ U)⁻¹`, `None` when D is not
 /// positive definite.
 #[inline(always)]
@@ -261,18 +307,13 @@ pub fn aba<'d, T: Scalar>(
                     pa_head[p] += act_force_ax(li, ax, &vforce(&pa_a));
                 }
             } else if jm.nv() == 3 {
-                // a 3-DoF joint (spherical, planar): U = Iᴬ S, D = Sᵀ U as 6x3, 3x3
-                let (u_mat, dinv) = subspace_blocks(&jm, &ia_tail[0])
+                // a 3-DoF joint (spherical, planar), out of line (the 1-DoF paths stay small)
+                let (ui, pass) = aba_step3_inward(&jm, &ia_tail[0], &pa_tail[0], &cc[i], tau, li)
                     .ok_or(DynamicsError::Singular(iv))?;
-                let ui = Vector3::from_fn(|r, _| tau[iv + r] - jm.project_column(r, &pa_tail[0]));
-                uu[i] = Vector6::new(ui.x, ui.y, ui.z, T::zero(), T::zero(), T::zero());
+                uu[i] = ui;
                 if p != 0 {
-                    let ud = u_mat * dinv;
-                    let ia_a = ia_tail[0] - ud * u_mat.transpose();
-                    let pa_a = fvec(&pa_tail[0]) + ia_a * mvec(&cc[i]) + ud * ui;
-                    let ax = jm.rot_axis();
-                    ia_head[p] += act_matrix6_ax(li, ax, &ia_a);
-                    pa_head[p] += act_force_ax(li, ax, &vforce(&pa_a));
+                    ia_head[p] += pass.0;
+                    pa_head[p] += pass.1;
                 }
             } else {
                 let t = &tau[iv..iv + 6];
@@ -303,15 +344,7 @@ pub fn aba<'d, T: Scalar>(
                 jm.add_subspace_scaled(&mut ai, x);
                 ai
             } else if jm.nv() == 3 {
-                let (u_mat, dinv) = subspace_blocks(&jm, &ia[i]).ok_or(DynamicsError::Singular(iv))?;
-                let ui = Vector3::new(uu[i][0], uu[i][1], uu[i][2]);
-                let x = dinv * (ui - u_mat.transpose() * mvec(&a1));
-                let mut ai = a1;
-                for r in 0..3 {
-                    qdd[iv + r] = x[r];
-                    ai += jm.subspace(r) * x[r];
-                }
-                ai
+                aba_step3_outward(&jm, &ia[i], &uu[i], &a1, qdd).ok_or(DynamicsError::Singular(iv))?
             } else {
                 let chol = ia[i].cholesky().ok_or(DynamicsError::Singular(iv))?;
                 let x = chol.solve(&uu[i]);
