@@ -104,8 +104,10 @@ fn act_matrix6_ax<T: Scalar>(x: &Se3<T>, ax: Option<Axis<T>>, m: &Matrix6<T>) ->
 }
 
 /// Sweep 2's step of a 3-DoF joint (docs/theory.md §"Spherical, planar and
-/// floating joints"): `u = τ − Sᵀ pᴬ` (in the first three entries) and what the
-/// parent receives, `ᵖX*ᵢ Iᵃ ⁱXₚ` and `ᵖX*ᵢ pᵃ`; `None` when D is singular.
+/// floating joints"): its S selects three entries `k` of an angular-first vector,
+/// so `U = Iᴬ S` is three columns of Iᴬ and `D = Sᵀ U` their rows `k`;
+/// `u = τ − Sᵀ pᴬ` (in the first three entries) and what the parent receives,
+/// `ᵖX*ᵢ Iᵃ ⁱXₚ` and `ᵖX*ᵢ pᵃ`; `None` when D is not positive definite.
 #[inline(never)]
 fn aba_step3_inward<T: Scalar, J: JointModel<T>>(
     jm: &J,
@@ -114,22 +116,27 @@ fn aba_step3_inward<T: Scalar, J: JointModel<T>>(
     c: &Motion<T>,
     tau: &[T],
     li: &Se3<T>,
+    to_parent: bool,
 ) -> Option<(Vector6<T>, (Matrix6<T>, Force<T>))> {
     let iv = jm.joint().iv;
-    let (u_mat, dinv) = subspace_blocks(jm, ia)?;
-    let ui = Vector3::from_fn(|r, _| tau[iv + r] - jm.project_column(r, pa));
+    let k = jm.subspace_rows();
+    let pav = fvec(pa);
+    let ui = Vector3::new(tau[iv] - pav[k[0]], tau[iv + 1] - pav[k[1]], tau[iv + 2] - pav[k[2]]);
+    let uq = Vector6::new(ui.x, ui.y, ui.z, T::zero(), T::zero(), T::zero());
+    let dinv = sym3_inverse(&Matrix3::from_fn(|r, s| ia[(k[r], k[s])]))?;
+    if !to_parent {
+        return Some((uq, (Matrix6::zeros(), Force::zero())));
+    }
+    let u_mat = Matrix6x3::from_fn(|r, s| ia[(r, k[s])]);
     let ud = u_mat * dinv;
     let ia_a = ia - ud * u_mat.transpose();
-    let pa_a = fvec(pa) + ia_a * mvec(c) + ud * ui;
+    let pa_a = pav + ia_a * mvec(c) + ud * ui;
     let ax = jm.rot_axis();
-    Some((
-        Vector6::new(ui.x, ui.y, ui.z, T::zero(), T::zero(), T::zero()),
-        (act_matrix6_ax(li, ax, &ia_a), act_force_ax(li, ax, &vforce(&pa_a))),
-    ))
+    Some((uq, (act_matrix6_ax(li, ax, &ia_a), act_force_ax(li, ax, &vforce(&pa_a)))))
 }
 
-/// Sweep 3's step of a 3-DoF joint: `q̈ = D⁻¹ (u − Uᵀ a')` into `qdd`, and
-/// `âᵢ = a' + S q̈`.
+/// Sweep 3's step of a 3-DoF joint: `q̈ = D⁻¹ (u − Uᵀ a')` into `qdd` (Uᵀ a' the
+/// rows `k` of Iᴬ a', Iᴬ symmetric), and `âᵢ = a' + S q̈`.
 #[inline(never)]
 fn aba_step3_outward<T: Scalar, J: JointModel<T>>(
     jm: &J,
@@ -139,28 +146,39 @@ fn aba_step3_outward<T: Scalar, J: JointModel<T>>(
     qdd: &mut [T],
 ) -> Option<Motion<T>> {
     let iv = jm.joint().iv;
-    let (u_mat, dinv) = subspace_blocks(jm, ia)?;
-    let x = dinv * (Vector3::new(u[0], u[1], u[2]) - u_mat.transpose() * mvec(a1));
-    let mut ai = *a1;
+    let k = jm.subspace_rows();
+    let dinv = sym3_inverse(&Matrix3::from_fn(|r, s| ia[(k[r], k[s])]))?;
+    let av = mvec(a1);
+    let uta = Vector3::from_fn(|r, _| ia.row(k[r]).dot(&av.transpose()));
+    let x = dinv * (Vector3::new(u[0], u[1], u[2]) - uta);
+    let mut ai = av;
     for r in 0..3 {
         qdd[iv + r] = x[r];
-        ai += jm.subspace(r) * x[r];
+        ai[k[r]] += x[r];
     }
-    Some(ai)
+    Some(Motion::new(
+        Vector3::new(ai[0], ai[1], ai[2]),
+        Vector3::new(ai[3], ai[4], ai[5]),
+    ))
 }
 
-/// A 3-DoF joint's `U = Iᴬ S` (6x3) and `D⁻¹ = (Sᵀ U)⁻¹`, `None` when D is not
-/// positive definite.
+/// The inverse of a symmetric 3x3 matrix by cofactors, `None` unless it is
+/// positive definite (leading minors positive) with a finite inverse.
 #[inline(always)]
-fn subspace_blocks<T: Scalar, J: JointModel<T>>(
-    jm: &J,
-    ia: &Matrix6<T>,
-) -> Option<(Matrix6x3<T>, Matrix3<T>)> {
-    let s = Matrix6x3::from_fn(|r, c| mvec(&jm.subspace(c))[r]);
-    let u = ia * s;
-    let d = s.transpose() * u;
-    let dinv = d.cholesky()?.inverse();
-    dinv.iter().all(|x| x.is_finite()).then_some((u, dinv))
+fn sym3_inverse<T: Scalar>(d: &Matrix3<T>) -> Option<Matrix3<T>> {
+    let c00 = d[(1, 1)] * d[(2, 2)] - d[(1, 2)] * d[(1, 2)];
+    let c01 = d[(0, 2)] * d[(1, 2)] - d[(0, 1)] * d[(2, 2)];
+    let c02 = d[(0, 1)] * d[(1, 2)] - d[(0, 2)] * d[(1, 1)];
+    let det = d[(0, 0)] * c00 + d[(0, 1)] * c01 + d[(0, 2)] * c02;
+    let m2 = d[(0, 0)] * d[(1, 1)] - d[(0, 1)] * d[(0, 1)];
+    if !(d[(0, 0)] > T::zero() && m2 > T::zero() && det > T::zero()) {
+        return None;
+    }
+    let c11 = d[(0, 0)] * d[(2, 2)] - d[(0, 2)] * d[(0, 2)];
+    let c12 = d[(0, 1)] * d[(0, 2)] - d[(0, 0)] * d[(1, 2)];
+    let c22 = m2;
+    let inv = Matrix3::new(c00, c01, c02, c01, c11, c12, c02, c12, c22) * (T::one() / det);
+    inv.iter().all(|x| x.is_finite()).then_some(inv)
 }
 
 #[inline(always)]
@@ -308,8 +326,9 @@ pub fn aba<'d, T: Scalar>(
                 }
             } else if jm.nv() == 3 {
                 // a 3-DoF joint (spherical, planar), out of line (the 1-DoF paths stay small)
-                let (ui, pass) = aba_step3_inward(&jm, &ia_tail[0], &pa_tail[0], &cc[i], tau, li)
-                    .ok_or(DynamicsError::Singular(iv))?;
+                let (ui, pass) =
+                    aba_step3_inward(&jm, &ia_tail[0], &pa_tail[0], &cc[i], tau, li, p != 0)
+                        .ok_or(DynamicsError::Singular(iv))?;
                 uu[i] = ui;
                 if p != 0 {
                     ia_head[p] += pass.0;

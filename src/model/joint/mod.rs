@@ -206,6 +206,12 @@ pub(crate) trait JointModel<T: Scalar>: Copy {
     fn subspace_dot6(&self, x: &Vector6<T>) -> T;
     /// `m += S x` for a 1-DoF joint and a scalar `x` (`mult` included).
     fn add_subspace_scaled(&self, m: &mut Motion<T>, x: T);
+    /// For a 3-DoF joint whose `S` selects three entries of an angular-first
+    /// 6-vector (spherical: ω; planar: vx, vy, ω_z): those entries, column by column.
+    #[inline(always)]
+    fn subspace_rows(&self) -> [usize; 3] {
+        [0, 1, 2]
+    }
     /// The underlying joint (for the generic paths).
     fn joint(&self) -> &Joint<T>;
 }

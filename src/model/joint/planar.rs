@@ -107,6 +107,11 @@ impl<'j, T: Scalar> JointModel<T> for PlanarJ<'j, T> {
     #[inline(always)]
     fn add_subspace_scaled(&self, _m: &mut Motion<T>, _x: T) {}
     #[inline(always)]
+    fn subspace_rows(&self) -> [usize; 3] {
+        // angular-first: lin x, lin y, ang z
+        [3, 4, 2]
+    }
+    #[inline(always)]
     fn joint(&self) -> &Joint<T> {
         self.j
     }
