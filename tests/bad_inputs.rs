@@ -226,11 +226,17 @@ const WARN: &[(&str, &[&str])] = &[
 const BAD_JOINT_STATES: &[(&str, &[&str])] = &[
     (
         "states_joint_number_for_array.json",
-        &["states[0].q.ball", "array of 4 numbers [qx, qy, qz, qw], found a number"],
+        &[
+            "states[0].q.ball",
+            "array of 4 numbers [qx, qy, qz, qw], found a number",
+        ],
     ),
     (
         "states_joint_wrong_length.json",
-        &["states[0].q.slide", "array of 3 numbers [x, y, theta], found 2"],
+        &[
+            "states[0].q.slide",
+            "array of 3 numbers [x, y, theta], found 2",
+        ],
     ),
     (
         "states_joint_v_wrong_length.json",
@@ -622,7 +628,12 @@ fn bad_states_are_rejected_naming_the_key() {
         e.extend_from_slice(expect);
         assert_rejected(&["eval", "joints_ok.urdf", "--states", file], &e);
     }
-    let r = run(&["eval", "joints_ok.urdf", "--states", "states_joints_ok.json"]);
+    let r = run(&[
+        "eval",
+        "joints_ok.urdf",
+        "--states",
+        "states_joints_ok.json",
+    ]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     // The good states files are answered, fixed and floating.
     for (fb, file) in [false, true]

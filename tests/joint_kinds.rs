@@ -86,7 +86,10 @@ fn run(fixture: &str) {
     .unwrap();
     assert_eq!(model.nq as u64, fx["nq"].as_u64().unwrap(), "nq");
     assert_eq!(model.nv as u64, fx["nv"].as_u64().unwrap(), "nv");
-    let names: Vec<&str> = model.body_joint_names[1..].iter().map(|s| s.as_str()).collect();
+    let names: Vec<&str> = model.body_joint_names[1..]
+        .iter()
+        .map(|s| s.as_str())
+        .collect();
     let want_names: Vec<&str> = fx["joint_names"]
         .as_array()
         .unwrap()
@@ -112,13 +115,17 @@ fn run(fixture: &str) {
         let e = &st["expected"];
         let mut d = Data::new(&model);
         let tag = |w: &str| format!("{fixture} state {s} {w}");
-        let got = dynamics::rnea(&model, &mut d, &q, &v, &a, None).unwrap().clone();
+        let got = dynamics::rnea(&model, &mut d, &q, &v, &a, None)
+            .unwrap()
+            .clone();
         ck.cmp(&tag("rnea"), got.as_slice(), &e["tau"], TOL);
         let h = dynamics::crba(&model, &mut d, &q).unwrap().clone();
         ck.cmp(&tag("crba"), &mat_rows(&h), &e["H"], TOL);
         dynamics::mass_matrix_rnea(&model, &mut d, &q).unwrap();
         ck.cmp(&tag("mass_matrix_rnea"), &mat_rows(&d.h), &e["H"], TOL);
-        let qdd = dynamics::aba(&model, &mut d, &q, &v, &tau, None).unwrap().clone();
+        let qdd = dynamics::aba(&model, &mut d, &q, &v, &tau, None)
+            .unwrap()
+            .clone();
         ck.cmp(&tag("aba"), qdd.as_slice(), &e["qdd"], TOL);
         let qdd = dynamics::forward_dynamics_crba(&model, &mut d, &q, &v, &tau, None)
             .unwrap()
@@ -128,7 +135,9 @@ fn run(fixture: &str) {
             .unwrap()
             .clone();
         ck.cmp(&tag("n+1 rnea"), qdd.as_slice(), &e["qdd"], TOL);
-        let b = dynamics::bias(&model, &mut d, &q, &v, None).unwrap().clone();
+        let b = dynamics::bias(&model, &mut d, &q, &v, None)
+            .unwrap()
+            .clone();
         ck.cmp(&tag("bias"), b.as_slice(), &e["bias"], TOL);
         // frames
         dynamics::forward_kinematics(&model, &mut d, &q).unwrap();
@@ -145,14 +154,29 @@ fn run(fixture: &str) {
                 }
                 hom[(r, 3)] = m.trans[r];
             }
-            ck.cmp(&tag(&format!("{f} placement")), &mat_rows(&hom), &ef["placement"], TOL);
-            for (key, reference) in [("world_aligned", Reference::WorldAligned), ("local", Reference::Local)] {
+            ck.cmp(
+                &tag(&format!("{f} placement")),
+                &mat_rows(&hom),
+                &ef["placement"],
+                TOL,
+            );
+            for (key, reference) in [
+                ("world_aligned", Reference::WorldAligned),
+                ("local", Reference::Local),
+            ] {
                 let mut j = DMatrix::zeros(6, nv);
                 dynamics::frame_jacobian(&model, &d, id, reference, &mut j).unwrap();
-                ck.cmp(&tag(&format!("{f} jacobian {key}")), &mat_rows(&j), &ef[key], TOL);
+                ck.cmp(
+                    &tag(&format!("{f} jacobian {key}")),
+                    &mat_rows(&j),
+                    &ef[key],
+                    TOL,
+                );
                 let mut jd = DMatrix::zeros(6, nv);
-                dynamics::frame_jacobian_time_variation(&model, &mut d, &q, &v, id, reference, &mut jd)
-                    .unwrap();
+                dynamics::frame_jacobian_time_variation(
+                    &model, &mut d, &q, &v, id, reference, &mut jd,
+                )
+                .unwrap();
                 ck.cmp(
                     &tag(&format!("{f} jacobian_dot {key}")),
                     &mat_rows(&jd),
@@ -169,10 +193,25 @@ fn run(fixture: &str) {
         ck.cmp(&tag("com velocity"), cv.as_slice(), &e["com_velocity"], TOL);
         let mut jc = DMatrix::zeros(3, nv);
         dynamics::center_of_mass_jacobian(&model, &d, &mut jc).unwrap();
-        ck.cmp(&tag("com jacobian"), &mat_rows(&jc), &e["com_jacobian"], TOL);
+        ck.cmp(
+            &tag("com jacobian"),
+            &mat_rows(&jc),
+            &e["com_jacobian"],
+            TOL,
+        );
         let (k, l) = dynamics::centroidal_momentum(&model, &mut d, &q, &v).unwrap();
-        ck.cmp(&tag("momentum angular"), k.as_slice(), &e["momentum_angular"], TOL);
-        ck.cmp(&tag("momentum linear"), l.as_slice(), &e["momentum_linear"], TOL);
+        ck.cmp(
+            &tag("momentum angular"),
+            k.as_slice(),
+            &e["momentum_angular"],
+            TOL,
+        );
+        ck.cmp(
+            &tag("momentum linear"),
+            l.as_slice(),
+            &e["momentum_linear"],
+            TOL,
+        );
         let (ke, pe) = dynamics::energies(&model, &q, &v).unwrap();
         ck.cmp(&tag("kinetic"), &[ke], &e["kinetic"], TOL);
         ck.cmp(&tag("potential"), &[pe], &e["potential"], TOL);
@@ -190,11 +229,31 @@ fn run(fixture: &str) {
         let dv = configuration::difference(&model, &q, &q1).unwrap();
         ck.cmp(&tag("difference"), dv.as_slice(), &e["difference"], TOL);
         let (jq, jv) = configuration::integrate_jacobians(&model, &q, &v2).unwrap();
-        ck.cmp(&tag("dintegrate_dq"), &mat_rows(&jq), &e["dintegrate_dq"], TOL);
-        ck.cmp(&tag("dintegrate_dv"), &mat_rows(&jv), &e["dintegrate_dv"], TOL);
+        ck.cmp(
+            &tag("dintegrate_dq"),
+            &mat_rows(&jq),
+            &e["dintegrate_dq"],
+            TOL,
+        );
+        ck.cmp(
+            &tag("dintegrate_dv"),
+            &mat_rows(&jv),
+            &e["dintegrate_dv"],
+            TOL,
+        );
         let (j0, j1) = configuration::difference_jacobians(&model, &q, &q1).unwrap();
-        ck.cmp(&tag("ddifference_dq0"), &mat_rows(&j0), &e["ddifference_dq0"], TOL);
-        ck.cmp(&tag("ddifference_dq1"), &mat_rows(&j1), &e["ddifference_dq1"], TOL);
+        ck.cmp(
+            &tag("ddifference_dq0"),
+            &mat_rows(&j0),
+            &e["ddifference_dq0"],
+            TOL,
+        );
+        ck.cmp(
+            &tag("ddifference_dq1"),
+            &mat_rows(&j1),
+            &e["ddifference_dq1"],
+            TOL,
+        );
     }
     assert!(
         ck.fails.is_empty(),
@@ -237,8 +296,21 @@ fn eval_v4_arrays_and_names() {
             .collect()
     };
     let q_names: Vec<String> = [
-        "ball:qx", "ball:qy", "ball:qz", "ball:qw", "hinge", "mount:x", "mount:y", "mount:z",
-        "mount:qx", "mount:qy", "mount:qz", "mount:qw", "slide:x", "slide:y", "slide:theta",
+        "ball:qx",
+        "ball:qy",
+        "ball:qz",
+        "ball:qw",
+        "hinge",
+        "mount:x",
+        "mount:y",
+        "mount:z",
+        "mount:qx",
+        "mount:qy",
+        "mount:qz",
+        "mount:qw",
+        "slide:x",
+        "slide:y",
+        "slide:theta",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -273,7 +345,9 @@ fn eval_v4_arrays_and_names() {
     let want_tau = dynamics::rnea(&model, &mut d, &q, &v, &DVector::zeros(13), None)
         .unwrap()
         .clone();
-    let want_qdd = dynamics::aba(&model, &mut d, &q, &v, &tau, None).unwrap().clone();
+    let want_qdd = dynamics::aba(&model, &mut d, &q, &v, &tau, None)
+        .unwrap()
+        .clone();
     let r = &out["results"][0];
     let mut ck = Check {
         fails: Vec::new(),
@@ -309,7 +383,11 @@ fn eval_v4_arrays_and_names() {
 #[test]
 fn simulation_with_multi_dof_joints_conserves_energy() {
     use urdyn::sim::{Integrator, SimOptions, Simulation};
-    let model = urdyn::load_file(root().join("tests/bad/joints_ok.urdf"), LoadOptions::default()).unwrap();
+    let model = urdyn::load_file(
+        root().join("tests/bad/joints_ok.urdf"),
+        LoadOptions::default(),
+    )
+    .unwrap();
     let nv = model.nv;
     for (integrator, tol) in [(Some(Integrator::Rk4), 1e-8), (None, 1e-3)] {
         let opts = SimOptions {
@@ -335,12 +413,18 @@ fn simulation_with_multi_dof_joints_conserves_energy() {
         }
         let scale = e0.abs() + model.total_mass() * 9.81;
         eprintln!("{integrator:?}: energy rise {:.3e} of {scale:.3}", worst);
-        assert!(worst <= tol * scale, "{integrator:?}: energy rose by {worst:e} (scale {scale})");
+        assert!(
+            worst <= tol * scale,
+            "{integrator:?}: energy rose by {worst:e} (scale {scale})"
+        );
         let tau = DVector::zeros(nv);
         let j = sim
             .transition_jacobians(&tau, urdyn::sim::JacobianMethod::Analytic, 1e-6)
             .unwrap();
-        assert_eq!((j.a.nrows(), j.a.ncols(), j.b.ncols()), (2 * nv, 2 * nv, nv));
+        assert_eq!(
+            (j.a.nrows(), j.a.ncols(), j.b.ncols()),
+            (2 * nv, 2 * nv, nv)
+        );
         assert!(j.a.iter().all(|x| x.is_finite()));
     }
 }

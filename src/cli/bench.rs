@@ -5,7 +5,7 @@
 //! time of a sample is batch time / batch size; outputs go through `black_box`.
 
 use crate::dynamics;
-use crate::model::{Data, Model};
+use crate::model::{Data, JointKind, Model};
 use nalgebra::DVector;
 use serde_json::{json, Map, Value};
 use std::hint::black_box;
@@ -167,13 +167,39 @@ pub fn random_state(model: &Model, rng: &mut Rng) -> State {
         q[5] = b * u3.sin();
         q[6] = b * u3.cos();
     }
-    let qo = model.joint_q_offset();
-    for (k, d) in model.dofs.iter().enumerate() {
-        let (lo, hi) = match (d.limits.lower, d.limits.upper) {
-            (Some(l), Some(u)) if l < u && l >= -PI && u <= PI => (l, u),
-            _ => (-PI, PI),
+    // joints of several degrees of freedom: a uniform rotation (and a position
+    // in [−1, 1]³ for a floating joint), a planar joint's x, y in [−1, 1], θ in [−π, π]
+    for d in &model.dofs {
+        let iq = d.iq;
+        let mut quat = |q: &mut DVector<f64>, at: usize| {
+            let (u1, u2, u3) = (rng.unit(), rng.unit() * 2.0 * PI, rng.unit() * 2.0 * PI);
+            let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+            q[at] = a * u2.sin();
+            q[at + 1] = a * u2.cos();
+            q[at + 2] = b * u3.sin();
+            q[at + 3] = b * u3.cos();
         };
-        q[qo + k] = rng.uniform(lo, hi);
+        match d.kind {
+            JointKind::Spherical => quat(&mut q, iq),
+            JointKind::Free => {
+                quat(&mut q, iq + 3);
+                for k in 0..3 {
+                    q[iq + k] = rng.uniform(-1.0, 1.0);
+                }
+            }
+            JointKind::Planar => {
+                q[iq] = rng.uniform(-1.0, 1.0);
+                q[iq + 1] = rng.uniform(-1.0, 1.0);
+                q[iq + 2] = rng.uniform(-PI, PI);
+            }
+            _ => {
+                let (lo, hi) = match (d.limits.lower, d.limits.upper) {
+                    (Some(l), Some(u)) if l < u && l >= -PI && u <= PI => (l, u),
+                    _ => (-PI, PI),
+                };
+                q[iq] = rng.uniform(lo, hi);
+            }
+        }
     }
     let mut vec = |n: usize| DVector::from_fn(n, |_, _| rng.uniform(-1.0, 1.0));
     let v = vec(model.nv);

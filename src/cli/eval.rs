@@ -182,8 +182,10 @@ pub fn evaluate(
     let names = evaluate_each(model, states, urdf_file, states_file, |r| {
         results.push(r);
     })?;
-    Ok(json!({"dof_names": names, "q_names": model.q_names(), "v_names": model.v_names(),
-        "results": results}))
+    Ok(
+        json!({"dof_names": names, "q_names": model.q_names(), "v_names": model.v_names(),
+        "results": results}),
+    )
 }
 
 /// As [`evaluate`], serialised to the JSON text of the contract (one line, no

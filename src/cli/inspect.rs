@@ -56,6 +56,9 @@ pub fn report(model: &Model, package_paths: &[PathBuf]) -> String {
     }
     for (k, d) in model.dofs.iter().enumerate() {
         let lim = match (d.limits.lower, d.limits.upper) {
+            _ if d.kind.nv() != 1 => {
+                format!("{} ({} q, {} v)", d.kind.name(), d.kind.nq(), d.kind.nv())
+            }
             (Some(l), Some(u)) => format!("[{l}, {u}]"),
             _ if d.continuous => "continuous".to_string(),
             _ => "no position limit known".to_string(),

@@ -89,7 +89,10 @@ impl<'de> Deserialize<'de> for JointValue {
             fn visit_u64<E>(self, x: u64) -> Result<JointValue, E> {
                 Ok(JointValue::Scalar(x as f64))
             }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> Result<JointValue, A::Error> {
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut a: A,
+            ) -> Result<JointValue, A::Error> {
                 let mut out = Vec::new();
                 while let Some(x) = a.next_element::<f64>()? {
                     out.push(x);
@@ -296,7 +299,11 @@ pub fn read_text(path: &std::path::Path) -> Result<String, StateError> {
 /// The coordinates `x` gives joint `dof` in `map` (`q`, `v`, `a`, `tau`): its
 /// kind's number of them, finite; a quaternion within 1e-3 of unit norm,
 /// normalised. The error says what is wrong (the caller names the key).
-fn joint_values(dof: &crate::model::DofInfo, map: &str, x: &JointValue) -> Result<Vec<f64>, String> {
+fn joint_values(
+    dof: &crate::model::DofInfo,
+    map: &str,
+    x: &JointValue,
+) -> Result<Vec<f64>, String> {
     use crate::model::JointKind;
     let kind = dof.kind;
     let n = if map == "q" { kind.nq() } else { kind.nv() };

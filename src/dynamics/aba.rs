@@ -103,6 +103,9 @@ fn act_matrix6_ax<T: Scalar>(x: &Se3<T>, ax: Option<Axis<T>>, m: &Matrix6<T>) ->
     translate6(&x.trans, &a, &b, &c)
 }
 
+/// What a joint passes to its parent: `ᵖX*ᵢ Iᵃ ⁱXₚ` and `ᵖX*ᵢ pᵃ`.
+type ParentShare<T> = (Matrix6<T>, Force<T>);
+
 /// Sweep 2's step of a 3-DoF joint (docs/theory.md §"Spherical, planar and
 /// floating joints"): its S selects three entries `k` of an angular-first vector,
 /// so `U = Iᴬ S` is three columns of Iᴬ and `D = Sᵀ U` their rows `k`;
@@ -117,11 +120,15 @@ fn aba_step3_inward<T: Scalar, J: JointModel<T>>(
     tau: &[T],
     li: &Se3<T>,
     to_parent: bool,
-) -> Option<(Vector6<T>, (Matrix6<T>, Force<T>))> {
+) -> Option<(Vector6<T>, ParentShare<T>)> {
     let iv = jm.joint().iv;
     let k = jm.subspace_rows();
     let pav = fvec(pa);
-    let ui = Vector3::new(tau[iv] - pav[k[0]], tau[iv + 1] - pav[k[1]], tau[iv + 2] - pav[k[2]]);
+    let ui = Vector3::new(
+        tau[iv] - pav[k[0]],
+        tau[iv + 1] - pav[k[1]],
+        tau[iv + 2] - pav[k[2]],
+    );
     let uq = Vector6::new(ui.x, ui.y, ui.z, T::zero(), T::zero(), T::zero());
     let dinv = sym3_inverse(&Matrix3::from_fn(|r, s| ia[(k[r], k[s])]))?;
     if !to_parent {
@@ -132,7 +139,13 @@ fn aba_step3_inward<T: Scalar, J: JointModel<T>>(
     let ia_a = ia - ud * u_mat.transpose();
     let pa_a = pav + ia_a * mvec(c) + ud * ui;
     let ax = jm.rot_axis();
-    Some((uq, (act_matrix6_ax(li, ax, &ia_a), act_force_ax(li, ax, &vforce(&pa_a)))))
+    Some((
+        uq,
+        (
+            act_matrix6_ax(li, ax, &ia_a),
+            act_force_ax(li, ax, &vforce(&pa_a)),
+        ),
+    ))
 }
 
 /// Sweep 3's step of a 3-DoF joint: `q̈ = D⁻¹ (u − Uᵀ a')` into `qdd` (Uᵀ a' the

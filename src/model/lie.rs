@@ -30,12 +30,7 @@ pub(crate) fn joint_pose(
     iq: usize,
 ) -> (Vector3<f64>, UnitQuaternion<f64>) {
     let quat = |at: usize| {
-        UnitQuaternion::from_quaternion(Quaternion::new(
-            q[at + 3],
-            q[at],
-            q[at + 1],
-            q[at + 2],
-        ))
+        UnitQuaternion::from_quaternion(Quaternion::new(q[at + 3], q[at], q[at + 1], q[at + 2]))
     };
     match kind {
         JointKind::Free => (Vector3::new(q[iq], q[iq + 1], q[iq + 2]), quat(iq + 3)),

@@ -7,8 +7,8 @@
 
 pub mod configuration;
 mod data;
-pub(crate) mod lie;
 pub(crate) mod joint;
+pub(crate) mod lie;
 mod names;
 mod topology;
 mod trees;

@@ -98,10 +98,7 @@ impl<T: Scalar> Model<T> {
     /// [`JointKind::nq`]: super::JointKind::nq
     /// [`JointKind::nv`]: super::JointKind::nv
     pub fn joint_indices(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
-        self.dofs
-            .iter()
-            .enumerate()
-            .map(|(k, d)| (k, d.iq, d.iv))
+        self.dofs.iter().enumerate().map(|(k, d)| (k, d.iq, d.iv))
     }
     /// The index in q of the (first coordinate of the) joint `dofs[d]`.
     pub fn dof_q(&self, d: usize) -> usize {

@@ -512,7 +512,10 @@ impl Loader<'_> {
             if let (Some(p), Some(s)) = (&m.pose, &srdfs[i]) {
                 for (j, vals) in s.pose(p).unwrap_or_default() {
                     let full = format!("{pre}{j}");
-                    let scalar = model.dofs.iter().any(|d| d.name == full && d.kind.nv() == 1);
+                    let scalar = model
+                        .dofs
+                        .iter()
+                        .any(|d| d.name == full && d.kind.nv() == 1);
                     if let (Ok(iq), [x], true) = (model.q_index(&full), vals.as_slice(), scalar) {
                         q0[iq] = *x;
                     }
@@ -538,16 +541,18 @@ impl Loader<'_> {
                             ));
                         };
                         self.finite(&k, &[x])?;
-                        if let Some(d) = model.dofs.iter().find(|d| d.name == full) {
-                            if d.kind.nv() != 1 {
-                                return Err(self.err(
-                                    k,
-                                    format!(
-                                        "joint \"{joint}\" is {}: a scene's initial state sets 1-DoF joints only",
-                                        d.kind.name()
-                                    ),
-                                ));
-                            }
+                        if let Some(d) = model
+                            .dofs
+                            .iter()
+                            .find(|d| d.name == full && d.kind.nv() != 1)
+                        {
+                            return Err(self.err(
+                                k,
+                                format!(
+                                    "joint \"{joint}\" is {}: a scene's initial state sets 1-DoF joints only",
+                                    d.kind.name()
+                                ),
+                            ));
                         }
                         match which {
                             "q" => q0[iq] = x,

@@ -164,15 +164,16 @@ pub(crate) fn lower(
                 // a planar joint about another axis a: R_a Planar(q) R_aᵀ, R_a into
                 // the placement and R_aᵀ onto the child's frames (docs/theory.md
                 // §"Spherical, planar and floating joints")
-                let (origin, b_m_l) = if j.joint_type == JointType::Planar && a != a.norm() * Vector3::z() {
-                    let ra = plane_rotation(&(a / a.norm()));
-                    (
-                        Se3::new(origin.rot * ra, origin.trans),
-                        Se3::new(ra.transpose(), Vector3::zeros()),
-                    )
-                } else {
-                    (origin, Se3::identity())
-                };
+                let (origin, b_m_l) =
+                    if j.joint_type == JointType::Planar && a != a.norm() * Vector3::z() {
+                        let ra = plane_rotation(&(a / a.norm()));
+                        (
+                            Se3::new(origin.rot * ra, origin.trans),
+                            Se3::new(ra.transpose(), Vector3::zeros()),
+                        )
+                    } else {
+                        (origin, Se3::identity())
+                    };
                 parent.push(pb);
                 joints.push(Joint {
                     kind,

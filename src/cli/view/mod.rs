@@ -281,6 +281,8 @@ pub fn read_trajectory(text: &str, file: &str, model: &Model) -> Result<Trajecto
                 q[k] /= n;
             }
         }
+        // spherical and floating joints inside the tree: their quaternions as written
+        crate::model::configuration::normalize_quats(model, &mut q);
         let mut plot = [f64::NAN; 3];
         for (p, c) in plot.iter_mut().zip(plot_cols) {
             if let Some(c) = c {

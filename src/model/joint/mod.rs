@@ -245,8 +245,7 @@ pub(super) fn dot6<T: Scalar>(x: &Vector6<T>, off: usize, ax: Axis<T>, mult: T) 
 macro_rules! dispatch_joint {
     ($joint:expr, $ident:expr, $jm:ident => $body:expr) => {{
         use $crate::model::joint::{
-            AxU, AxX, AxY, AxZ, Axis, FreeJ, JointKind, PlanarJ, PrismaticJ, RevoluteJ,
-            SphericalJ,
+            AxU, AxX, AxY, AxZ, Axis, FreeJ, JointKind, PlanarJ, PrismaticJ, RevoluteJ, SphericalJ,
         };
         let j__ = $joint;
         match (&j__.kind, $ident) {

@@ -43,9 +43,8 @@ impl<'j, T: Scalar> JointModel<T> for SphericalJ<'j, T> {
     }
     #[inline(always)]
     fn project_add(&self, f: &Force<T>, tau: &mut [T]) {
-        let t = &mut tau[self.j.iv..self.j.iv + 3];
-        for r in 0..3 {
-            t[r] += f.ang[r];
+        for (t, x) in tau[self.j.iv..self.j.iv + 3].iter_mut().zip(f.ang.iter()) {
+            *t += *x;
         }
     }
     #[inline(always)]

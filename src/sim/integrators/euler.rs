@@ -23,7 +23,9 @@ impl Simulation {
         }
         for d in &self.model.dofs {
             match d.kind {
-                crate::model::JointKind::Free => add_frame_rate(&mut self.mass.vfree, &self.v, h, d.iv),
+                crate::model::JointKind::Free => {
+                    add_frame_rate(&mut self.mass.vfree, &self.v, h, d.iv)
+                }
                 crate::model::JointKind::Planar => {
                     // ω = (0, 0, ω_z), v_lin = (vx, vy, 0): h ω × v_lin
                     let (vx, vy, w) = (self.v[d.iv], self.v[d.iv + 1], self.v[d.iv + 2]);
