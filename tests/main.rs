@@ -20,6 +20,7 @@ mod api;
 mod bad_inputs;
 mod cli_errors;
 mod contact_pairs;
+mod constraint_dynamics;
 mod derivatives;
 mod eval_singular;
 mod example_scenes;
