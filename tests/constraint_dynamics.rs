@@ -125,3 +125,51 @@ fn talos_hands_welded() {
 fn ur5_geared_pair() {
     check("ur5_gear");
 }
+
+/// The constrained algorithms allocate nothing per call on a preallocated
+/// workspace (solo12's four feet held; the planar four-bar's redundant row takes
+/// the pseudo-inverse route).
+#[test]
+fn constrained_hot_path_does_not_allocate() {
+    use crate::common::counting_alloc::{allocations, measure_this_thread};
+    measure_this_thread();
+    for name in ["solo12_feet", "four_bar_planar"] {
+        let path = root().join(format!("tests/fixtures/constraints/{name}.json"));
+        let fix: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let floating_base = fix["floating_base"].as_bool().unwrap();
+        let model = urdyn::load_file(
+            root().join(fix["robot"].as_str().unwrap()),
+            LoadOptions { floating_base },
+        )
+        .unwrap();
+        let mut c = Constraints::from_value(&model, &fix["constraints"]).unwrap();
+        let mut data = Data::new(&model);
+        let mut cd = ConstraintData::new(&model, &c);
+        let st = &fix["states"][1];
+        let q = DVector::from_vec(vecf(&st["q"]));
+        let v = DVector::from_vec(vecf(&st["v"]));
+        let tau = DVector::from_vec(vecf(&st["tau"]));
+        dynamics::forward_kinematics(&model, &mut data, &q).unwrap();
+        c.place_holds(&data);
+        let mut jc = DMatrix::zeros(c.rows(), model.nv);
+        let mut viol = vec![0.0; c.items.len()];
+        // warm
+        dynamics::constraint_dynamics_derivatives(&model, &mut data, &mut cd, &c, &q, &v, &tau, None)
+            .unwrap();
+        let mut counts = [0usize; 4];
+        let before = allocations();
+        dynamics::constraint_dynamics(&model, &mut data, &mut cd, &c, &q, &v, &tau, None).unwrap();
+        counts[0] = allocations() - before;
+        let before = allocations();
+        dynamics::constraint_dynamics_derivatives(&model, &mut data, &mut cd, &c, &q, &v, &tau, None)
+            .unwrap();
+        counts[1] = allocations() - before;
+        let before = allocations();
+        dynamics::constraint_jacobian(&model, &mut data, &c, &q, &mut jc).unwrap();
+        counts[2] = allocations() - before;
+        let before = allocations();
+        dynamics::constraint_violation(&model, &mut data, &c, &q, &mut viol).unwrap();
+        counts[3] = allocations() - before;
+        assert_eq!(counts, [0; 4], "{name}: allocations of dynamics, derivatives, jacobian, violation");
+    }
+}

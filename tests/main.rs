@@ -22,6 +22,7 @@ mod cli_errors;
 mod contact_pairs;
 mod constraint_dynamics;
 mod derivatives;
+mod eval_constrained;
 mod eval_singular;
 mod example_scenes;
 mod fast_dynamics;

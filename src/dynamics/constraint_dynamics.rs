@@ -12,7 +12,7 @@
 //! λ = K⁺ (−γ_c − J_c q̈₀) (least norm when rows are redundant, `kkt.rs`),
 //! q̈ = q̈₀ + Y λ.
 
-use super::kkt::KktFactor;
+use super::kkt::{mul_add, KktFactor};
 use super::{check_massless, check_sizes, forward_dynamics_crba, linalg, ltdl, DynamicsError};
 use crate::model::{Attachment, ConstraintKind, Constraints, Data, DimensionError, Model};
 use crate::spatial::{Force, Motion};
@@ -59,7 +59,8 @@ pub struct ConstraintData {
     pub dqdd_dv: DMatrix<f64>,
     /// ∂q̈/∂τ = H⁻¹ − Y K⁺ Yᵀ.
     pub dqdd_dtau: DMatrix<f64>,
-    /// Y = H⁻¹ J_cᵀ (nv × m).
+    /// Y = H⁻¹ J_cᵀ (nv × m; after [`constraint_dynamics`] on a model without
+    /// mimic joints, W = L⁻ᵀ J_cᵀ by rows of m: its columns' storage).
     pub(crate) y: DMatrix<f64>,
     /// K = J_c Y (m × m).
     pub(crate) k: DMatrix<f64>,
@@ -282,16 +283,80 @@ pub fn constraint_dynamics<'c>(
         },
         &mut cd.gamma,
     );
-    // Y = H⁻¹ J_cᵀ, one column a row
-    for r in 0..cd.rows {
-        for c in 0..model.nv {
-            cd.tmp[c] = cd.jc[(r, c)];
-        }
-        h_solve(model, data, &mut cd.tmp);
-        cd.y.set_column(r, &cd.tmp);
-    }
     cd.qdd.copy_from(&data.qdd);
-    solve_rows(cd, constraints)?;
+    if model.has_mimic {
+        // Y = H⁻¹ J_cᵀ, one column a row (dense Cholesky)
+        for r in 0..cd.rows {
+            for c in 0..model.nv {
+                cd.tmp[c] = cd.jc[(r, c)];
+            }
+            h_solve(model, data, &mut cd.tmp);
+            cd.y.set_column(r, &cd.tmp);
+        }
+        return solve_rows(cd, constraints).map(|_| &cd.qdd);
+    }
+    // H = Lᵀ D L (tree-sparse): W = L⁻ᵀ J_cᵀ keeps each row's support on its
+    // path to the root; K = Wᵀ D⁻¹ W; q̈ = q̈₀ + L⁻¹ D⁻¹ W λ
+    // (docs/theory.md §"Constrained dynamics", "Solving")
+    let (n, m) = (model.nv, cd.rows);
+    let lam = &model.dof_parent;
+    let u = data.chol.as_slice();
+    let w = cd.y.as_mut_slice();
+    for r in 0..m {
+        let wr = &mut w[r * n..(r + 1) * n];
+        for (c, x) in wr.iter_mut().enumerate() {
+            *x = cd.jc[(r, c)];
+        }
+        for i in (0..n).rev() {
+            let xi = wr[i];
+            if xi == 0.0 {
+                continue;
+            }
+            let mut j = lam[i];
+            while j != usize::MAX {
+                wr[j] -= u[j + i * n] * xi;
+                j = lam[j];
+            }
+        }
+    }
+    for k in 0..n {
+        cd.tmp[k] = 1.0 / u[k + k * n];
+    }
+    let dinv = cd.tmp.as_slice();
+    for r in 0..m {
+        let wr = &w[r * n..(r + 1) * n];
+        for s2 in 0..=r {
+            let ws = &w[s2 * n..(s2 + 1) * n];
+            let mut acc = 0.0;
+            for k in 0..n {
+                acc += wr[k] * ws[k] * dinv[k];
+            }
+            cd.k[(r, s2)] = acc;
+            cd.k[(s2, r)] = acc;
+        }
+    }
+    solve_lambda(cd, constraints)?;
+    // t = D⁻¹ W λ, then L⁻¹ t (root outwards)
+    let w = cd.y.as_slice();
+    let t = cd.tmp.as_mut_slice();
+    for k in 0..n {
+        let mut acc = 0.0;
+        for r in 0..m {
+            acc += w[r * n + k] * cd.lambda[r];
+        }
+        t[k] = acc / u[k + k * n];
+    }
+    for i in 0..n {
+        let mut s1 = t[i];
+        let mut j = lam[i];
+        while j != usize::MAX {
+            s1 -= u[j + i * n] * t[j];
+            j = lam[j];
+        }
+        t[i] = s1;
+    }
+    cd.qdd += &cd.tmp;
+    cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
     Ok(&cd.qdd)
 }
 
@@ -301,8 +366,20 @@ pub(crate) fn solve_rows(
     cd: &mut ConstraintData,
     constraints: &Constraints,
 ) -> Result<(), ConstraintDynamicsError> {
+    mul_add(&mut cd.k, 1.0, &cd.jc, &cd.y, 0.0);
+    solve_lambda(cd, constraints)?;
+    cd.qdd.gemv(1.0, &cd.y, &cd.lambda, 1.0);
+    cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
+    Ok(())
+}
+
+/// With `cd.k` = K, `cd.qdd` = q̈₀, `cd.jc`, `cd.gamma` set: K's factor, λ = K⁺ r
+/// with r = −γ_c − J_c q̈₀, and the consistency test (r in K's range).
+fn solve_lambda(
+    cd: &mut ConstraintData,
+    constraints: &Constraints,
+) -> Result<(), ConstraintDynamicsError> {
     let m = cd.rows;
-    cd.k.gemm(1.0, &cd.jc, &cd.y, 0.0);
     cd.kkt.factor(&cd.k);
     // r = −γ − J_c q̈₀
     cd.r.gemv(-1.0, &cd.jc, &cd.qdd, 0.0);
@@ -323,8 +400,6 @@ pub(crate) fn solve_rows(
         }
         return Err(ConstraintDynamicsError::Inconsistent(names));
     }
-    cd.qdd.gemv(1.0, &cd.y, &cd.lambda, 1.0);
-    cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
     Ok(())
 }
 

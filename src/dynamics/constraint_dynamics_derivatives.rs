@@ -21,6 +21,7 @@ use super::constraint_dynamics::{
     bias_rows, check_workspace, jacobian_rows, side_point, solve_rows, ConstraintData,
     ConstraintDynamicsError,
 };
+use super::kkt::mul_add;
 use super::rnea_derivatives::{check_wrenches, rnea_derivatives_pass, LinkWrench};
 use super::{check_massless, check_sizes, minv};
 use crate::model::{Attachment, ConstraintKind, Constraints, Data, Model};
@@ -92,7 +93,7 @@ pub fn constraint_dynamics_derivatives(
         let (ov, oa0) = (&data.minv_ov, &cd.oa0);
         bias_rows(data, constraints, |b| ov[b], |b| oa0[b], &mut cd.gamma);
         // Y = H⁻¹ J_cᵀ = (J_c H⁻¹)ᵀ
-        cd.z.gemm(1.0, &cd.jc, &data.minv, 0.0);
+        mul_add(&mut cd.z, 1.0, &cd.jc, &data.minv, 0.0);
         cd.z.transpose_to(&mut cd.y);
         cd.qdd.copy_from(&data.qdd);
         solve_rows(cd, constraints)?;
@@ -122,7 +123,7 @@ pub fn constraint_dynamics_derivatives(
             (&mut cd.dqdd_dq, &data.dtau_dq),
             (&mut cd.dqdd_dv, &data.dtau_dv),
         ] {
-            x.gemm(-1.0, &data.minv, g, 0.0);
+            mul_add(x, -1.0, &data.minv, g, 0.0);
         }
     } else {
         let Data {
@@ -154,11 +155,11 @@ pub fn constraint_dynamics_derivatives(
     // ∂q̈ = X − Y K⁺ (J_c X + ∂A)
     for (x, da) in [(&mut cd.dqdd_dq, &cd.aq), (&mut cd.dqdd_dv, &cd.av)] {
         cd.z.copy_from(da);
-        cd.z.gemm(1.0, &cd.jc, x, 1.0);
+        mul_add(&mut cd.z, 1.0, &cd.jc, x, 1.0);
         for col in cd.z.as_mut_slice().chunks_exact_mut(m) {
             cd.kkt.solve(col);
         }
-        x.gemm(-1.0, &cd.y, &cd.z, 1.0);
+        mul_add(x, -1.0, &cd.y, &cd.z, 1.0);
     }
     // ∂q̈/∂τ = H⁻¹ − Y K⁺ Yᵀ
     cd.y.transpose_to(&mut cd.z);
@@ -166,7 +167,7 @@ pub fn constraint_dynamics_derivatives(
         cd.kkt.solve(col);
     }
     cd.dqdd_dtau.copy_from(&data.minv);
-    cd.dqdd_dtau.gemm(-1.0, &cd.y, &cd.z, 1.0);
+    mul_add(&mut cd.dqdd_dtau, -1.0, &cd.y, &cd.z, 1.0);
     Ok(())
 }
 

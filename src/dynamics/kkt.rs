@@ -196,3 +196,29 @@ fn jacobi_eigen(v: &mut DMatrix<f64>, q: &mut DMatrix<f64>, ev: &mut DVector<f64
         ev[i] = v[(i, i)];
     }
 }
+
+/// `c ← β c + α a b` for column-major matrices, allocation-free (nalgebra's
+/// `gemm` packs through the heap for larger sizes); a zero entry of `b` skips
+/// its column of `a` (J_c's rows and columns are mostly zero).
+pub(crate) fn mul_add(c: &mut DMatrix<f64>, alpha: f64, a: &DMatrix<f64>, b: &DMatrix<f64>, beta: f64) {
+    let (m, n, kk) = (a.nrows(), b.ncols(), a.ncols());
+    debug_assert!(c.nrows() == m && c.ncols() == n && b.nrows() == kk);
+    let (a, b, c) = (a.as_slice(), b.as_slice(), c.as_mut_slice());
+    for j in 0..n {
+        let cj = &mut c[j * m..(j + 1) * m];
+        if beta == 0.0 {
+            cj.fill(0.0);
+        } else if beta != 1.0 {
+            cj.iter_mut().for_each(|x| *x *= beta);
+        }
+        for k in 0..kk {
+            let s = alpha * b[k + j * kk];
+            if s == 0.0 {
+                continue;
+            }
+            for (x, &y) in cj.iter_mut().zip(&a[k * m..(k + 1) * m]) {
+                *x += s * y;
+            }
+        }
+    }
+}
