@@ -62,8 +62,10 @@ pub struct ConstraintData {
     /// Y = H⁻¹ J_cᵀ (nv × m; after [`constraint_dynamics`] on a model without
     /// mimic joints, W = L⁻ᵀ J_cᵀ by rows of m: its columns' storage).
     pub(crate) y: DMatrix<f64>,
-    /// K = J_c Y (m × m).
+    /// K = J_c Y (m × m; K⁺ after the derivatives).
     pub(crate) k: DMatrix<f64>,
+    /// Derivatives: P = Y K⁺ (nv × m; J_cᵀ before it).
+    pub(crate) p: DMatrix<f64>,
     pub(crate) kkt: KktFactor,
     /// Scratch: m entries.
     pub(crate) r: DVector<f64>,
@@ -99,6 +101,7 @@ impl ConstraintData {
             dqdd_dtau: DMatrix::zeros(nv, nv),
             y: DMatrix::zeros(nv, m),
             k: DMatrix::zeros(m, m),
+            p: DMatrix::zeros(nv, m),
             kkt: KktFactor::new(m),
             r: DVector::zeros(m),
             r2: DVector::zeros(m),

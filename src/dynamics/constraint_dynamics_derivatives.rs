@@ -6,8 +6,8 @@
 //!
 //! ```text
 //! H ∂q̈ − J_cᵀ ∂λ = −G,   J_c ∂q̈ = −∂A,    G = ∂ID/∂x − ∂(J_cᵀ λ)/∂x
-//! ∂q̈ = X − Y K⁺ (J_c X + ∂A),   X = −H⁻¹ G,   Y = H⁻¹ J_cᵀ,   K = J_c Y
-//! ∂q̈/∂τ = H⁻¹ − Y K⁺ Yᵀ
+//! ∂q̈ = X − P (J_c X + ∂A),   X = −H⁻¹ G,   Y = H⁻¹ J_cᵀ,   K = J_c Y,   P = Y K⁺
+//! ∂q̈/∂τ = H⁻¹ − P Yᵀ
 //! ```
 //!
 //! ∂ID/∂x from [`super::rnea_derivatives`] at a = q̈, H⁻¹ from the world-frame
@@ -92,9 +92,9 @@ pub fn constraint_dynamics_derivatives(
         jacobian_rows(model, data, constraints, &mut cd.jc);
         let (ov, oa0) = (&data.minv_ov, &cd.oa0);
         bias_rows(data, constraints, |b| ov[b], |b| oa0[b], &mut cd.gamma);
-        // Y = H⁻¹ J_cᵀ = (J_c H⁻¹)ᵀ
-        mul_add(&mut cd.z, 1.0, &cd.jc, &data.minv, 0.0);
-        cd.z.transpose_to(&mut cd.y);
+        // Y = H⁻¹ J_cᵀ (J_cᵀ's zeros skipped)
+        cd.jc.transpose_to(&mut cd.p);
+        mul_add(&mut cd.y, 1.0, &data.minv, &cd.p, 0.0);
         cd.qdd.copy_from(&data.qdd);
         solve_rows(cd, constraints)?;
     }
@@ -152,22 +152,25 @@ pub fn constraint_dynamics_derivatives(
         cd.dqdd_dtau.copy_from(&data.minv);
         return Ok(());
     }
-    // ∂q̈ = X − Y K⁺ (J_c X + ∂A)
+    // P = Y K⁺ (K⁺ once, by columns of the identity)
+    cd.k.fill(0.0);
+    for i in 0..m {
+        cd.k[(i, i)] = 1.0;
+    }
+    for col in cd.k.as_mut_slice().chunks_exact_mut(m) {
+        cd.kkt.solve(col);
+    }
+    mul_add(&mut cd.p, 1.0, &cd.y, &cd.k, 0.0);
+    // ∂q̈ = X − P (J_c X + ∂A)
     for (x, da) in [(&mut cd.dqdd_dq, &cd.aq), (&mut cd.dqdd_dv, &cd.av)] {
         cd.z.copy_from(da);
         mul_add(&mut cd.z, 1.0, &cd.jc, x, 1.0);
-        for col in cd.z.as_mut_slice().chunks_exact_mut(m) {
-            cd.kkt.solve(col);
-        }
-        mul_add(x, -1.0, &cd.y, &cd.z, 1.0);
+        mul_add(x, -1.0, &cd.p, &cd.z, 1.0);
     }
-    // ∂q̈/∂τ = H⁻¹ − Y K⁺ Yᵀ
+    // ∂q̈/∂τ = H⁻¹ − P Yᵀ
     cd.y.transpose_to(&mut cd.z);
-    for col in cd.z.as_mut_slice().chunks_exact_mut(m) {
-        cd.kkt.solve(col);
-    }
     cd.dqdd_dtau.copy_from(&data.minv);
-    mul_add(&mut cd.dqdd_dtau, -1.0, &cd.y, &cd.z, 1.0);
+    mul_add(&mut cd.dqdd_dtau, -1.0, &cd.p, &cd.z, 1.0);
     Ok(())
 }
 

@@ -65,20 +65,20 @@ impl KktFactor {
     pub fn solve(&mut self, x: &mut [f64]) {
         let m = self.t.len();
         if self.full_rank {
-            let l = &self.f;
-            for i in 0..m {
-                let mut s = x[i];
-                for k in 0..i {
-                    s -= l[(i, k)] * x[k];
+            // L (column-major): L[i, k] at i + k m
+            let l = self.f.as_slice();
+            let x = &mut x[..m];
+            for k in 0..m {
+                let xk = x[k] / l[k + k * m];
+                x[k] = xk;
+                for (xi, &lik) in x[k + 1..].iter_mut().zip(&l[k * m + k + 1..(k + 1) * m]) {
+                    *xi -= lik * xk;
                 }
-                x[i] = s / l[(i, i)];
             }
             for i in (0..m).rev() {
-                let mut s = x[i];
-                for k in i + 1..m {
-                    s -= l[(k, i)] * x[k];
-                }
-                x[i] = s / l[(i, i)];
+                let col = &l[i * m + i + 1..(i + 1) * m];
+                let s: f64 = col.iter().zip(&x[i + 1..]).map(|(a, b)| a * b).sum();
+                x[i] = (x[i] - s) / l[i + i * m];
             }
             return;
         }
