@@ -35,7 +35,11 @@ fn mat(v: &Value) -> DMatrix<f64> {
 fn rel(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len());
     let s = b.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / s
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+        / s
 }
 
 fn check(name: &str) {
@@ -62,9 +66,15 @@ fn check(name: &str) {
             .unwrap()
             .clone();
         let e_qdd = rel(qdd.as_slice(), &vecf(&st["qdd"]));
-        let e_gf = rel(cd.generalized_force.as_slice(), &vecf(&st["generalized_force"]));
+        let e_gf = rel(
+            cd.generalized_force.as_slice(),
+            &vecf(&st["generalized_force"]),
+        );
         assert!(e_qdd < 1e-10, "{name} state {i}: qdd off by {e_qdd:e}");
-        assert!(e_gf < 1e-10, "{name} state {i}: J_c^T lambda off by {e_gf:e}");
+        assert!(
+            e_gf < 1e-10,
+            "{name} state {i}: J_c^T lambda off by {e_gf:e}"
+        );
         if let Some(l) = st["lambda"].as_array() {
             let l: Vec<f64> = l.iter().map(|x| x.as_f64().unwrap()).collect();
             let e = rel(cd.lambda.as_slice(), &l);
@@ -75,8 +85,10 @@ fn check(name: &str) {
         let e = rel(&viol, &vecf(&st["violation"]));
         assert!(e < 1e-10, "{name} state {i}: violation {viol:?}");
         worst[0] = worst[0].max(e_qdd.max(e_gf));
-        dynamics::constraint_dynamics_derivatives(&model, &mut data, &mut cd, &c, &q, &v, &tau, None)
-            .unwrap();
+        dynamics::constraint_dynamics_derivatives(
+            &model, &mut data, &mut cd, &c, &q, &v, &tau, None,
+        )
+        .unwrap();
         let e = rel(cd.qdd.as_slice(), &vecf(&st["qdd"]));
         assert!(e < 1e-10, "{name} state {i}: derivatives' qdd off by {e:e}");
         for (k, (got, key)) in [
@@ -90,10 +102,16 @@ fn check(name: &str) {
             let want = mat(&st[key]);
             let e = rel(got.as_slice(), want.as_slice());
             worst[k + 1] = worst[k + 1].max(e);
-            assert!(e < 1e-7, "{name} state {i}: {key} off by {e:e}\n{got}\n{want}");
+            assert!(
+                e < 1e-7,
+                "{name} state {i}: {key} off by {e:e}\n{got}\n{want}"
+            );
         }
     }
-    eprintln!("{name}: worst qdd {:.1e}, dq {:.1e}, dv {:.1e}, dtau {:.1e}", worst[0], worst[1], worst[2], worst[3]);
+    eprintln!(
+        "{name}: worst qdd {:.1e}, dq {:.1e}, dv {:.1e}, dtau {:.1e}",
+        worst[0], worst[1], worst[2], worst[3]
+    );
 }
 
 #[test]
@@ -154,15 +172,19 @@ fn constrained_hot_path_does_not_allocate() {
         let mut jc = DMatrix::zeros(c.rows(), model.nv);
         let mut viol = vec![0.0; c.items.len()];
         // warm
-        dynamics::constraint_dynamics_derivatives(&model, &mut data, &mut cd, &c, &q, &v, &tau, None)
-            .unwrap();
+        dynamics::constraint_dynamics_derivatives(
+            &model, &mut data, &mut cd, &c, &q, &v, &tau, None,
+        )
+        .unwrap();
         let mut counts = [0usize; 4];
         let before = allocations();
         dynamics::constraint_dynamics(&model, &mut data, &mut cd, &c, &q, &v, &tau, None).unwrap();
         counts[0] = allocations() - before;
         let before = allocations();
-        dynamics::constraint_dynamics_derivatives(&model, &mut data, &mut cd, &c, &q, &v, &tau, None)
-            .unwrap();
+        dynamics::constraint_dynamics_derivatives(
+            &model, &mut data, &mut cd, &c, &q, &v, &tau, None,
+        )
+        .unwrap();
         counts[1] = allocations() - before;
         let before = allocations();
         dynamics::constraint_jacobian(&model, &mut data, &c, &q, &mut jc).unwrap();
@@ -170,6 +192,9 @@ fn constrained_hot_path_does_not_allocate() {
         let before = allocations();
         dynamics::constraint_violation(&model, &mut data, &c, &q, &mut viol).unwrap();
         counts[3] = allocations() - before;
-        assert_eq!(counts, [0; 4], "{name}: allocations of dynamics, derivatives, jacobian, violation");
+        assert_eq!(
+            counts, [0; 4],
+            "{name}: allocations of dynamics, derivatives, jacobian, violation"
+        );
     }
 }

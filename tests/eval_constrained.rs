@@ -76,7 +76,10 @@ fn run(name: &str) {
         let what = format!("{name} state {i}");
         let qdd = nums(&st["qdd"]);
         let gf = nums(&st["generalized_force"]);
-        let got: Vec<f64> = names.iter().map(|n| c["qdd"][n].as_f64().unwrap()).collect();
+        let got: Vec<f64> = names
+            .iter()
+            .map(|n| c["qdd"][n].as_f64().unwrap())
+            .collect();
         close(&got, &qdd[o..], 1e-10, &format!("{what} qdd"));
         let got: Vec<f64> = names
             .iter()
@@ -87,14 +90,21 @@ fn run(name: &str) {
             let b = &c["base"];
             let mut got = nums(&b["linear_acceleration"]);
             got.extend(nums(&b["angular_acceleration"]));
-            close(&got, &qdd[..6], 1e-10, &format!("{what} base accelerations"));
+            close(
+                &got,
+                &qdd[..6],
+                1e-10,
+                &format!("{what} base accelerations"),
+            );
             let mut got = nums(&b["force"]);
             got.extend(nums(&b["torque"]));
             close(&got, &gf[..6], 1e-10, &format!("{what} base force"));
         }
         let mut row = 0;
         for (k, con) in cons.iter().enumerate() {
-            let cname = con["name"].as_str().map_or(format!("constraint_{k}"), String::from);
+            let cname = con["name"]
+                .as_str()
+                .map_or(format!("constraint_{k}"), String::from);
             let viol = c["violation"][&cname].as_f64().unwrap();
             let want = st["violation"][k].as_f64().unwrap();
             assert!((viol - want).abs() < 1e-10, "{what}: violation of {cname}");
@@ -110,7 +120,12 @@ fn run(name: &str) {
             }
             if let Some(l) = st["lambda"].as_array() {
                 let l: Vec<f64> = l.iter().map(|x| x.as_f64().unwrap()).collect();
-                close(&got, &l[row..row + got.len()], 1e-9, &format!("{what} λ of {cname}"));
+                close(
+                    &got,
+                    &l[row..row + got.len()],
+                    1e-9,
+                    &format!("{what} λ of {cname}"),
+                );
             }
             row += got.len();
         }
@@ -140,8 +155,11 @@ fn eval_constrained_talos_hands() {
 
 #[test]
 fn no_constraints_no_block() {
-    let model = urdyn::load_file(root().join("tests/urdf/four_bar_planar.urdf"), LoadOptions::default())
-        .unwrap();
+    let model = urdyn::load_file(
+        root().join("tests/urdf/four_bar_planar.urdf"),
+        LoadOptions::default(),
+    )
+    .unwrap();
     let sf = state::parse_states(r#"{"states": [{}]}"#, "s.json").unwrap();
     let out = eval::evaluate(&model, &sf, "r.urdf", "s.json").unwrap();
     assert!(out["results"][0].get("constrained").is_none());

@@ -63,7 +63,10 @@ impl Algo {
         Algo::Jacobians,
     ];
     /// The algorithms that need constraints (timed by default when some are given).
-    pub const CONSTRAINED: [Algo; 2] = [Algo::ConstraintDynamics, Algo::ConstraintDynamicsDerivatives];
+    pub const CONSTRAINED: [Algo; 2] = [
+        Algo::ConstraintDynamics,
+        Algo::ConstraintDynamicsDerivatives,
+    ];
     /// The command-line name (`--algo`, and the key in `--json`).
     pub fn name(self) -> &'static str {
         match self {
@@ -242,7 +245,9 @@ fn call(
 ) -> Result<f64, String> {
     Ok(match algo {
         Algo::ConstraintDynamics | Algo::ConstraintDynamicsDerivatives => {
-            let (c, cd) = cx.as_mut().ok_or("needs constraints: --hold, --hold6 or --weld")?;
+            let (c, cd) = cx
+                .as_mut()
+                .ok_or("needs constraints: --hold, --hold6 or --weld")?;
             if algo == Algo::ConstraintDynamics {
                 dynamics::constraint_dynamics(model, data, cd, c, &s.q, &s.v, &s.tau, None)
                     .map_err(|e| e.to_string())?[0]
@@ -302,12 +307,14 @@ pub fn time_algo(model: &Model, algo: Algo, opts: &BenchOptions) -> Result<Timin
         message: m,
     };
     let mut cx = if Algo::CONSTRAINED.contains(&algo) && !opts.constraints.is_empty() {
-        let mut c = Constraints::from_json(model, &opts.constraints).map_err(|e| BenchError::Dynamics {
-            algo: algo.name(),
-            message: e.to_string(),
-        })?;
+        let mut c =
+            Constraints::from_json(model, &opts.constraints).map_err(|e| BenchError::Dynamics {
+                algo: algo.name(),
+                message: e.to_string(),
+            })?;
         if let Some(s0) = states.first() {
-            dynamics::forward_kinematics(model, &mut data, &s0.q).map_err(|e| err(e.to_string()))?;
+            dynamics::forward_kinematics(model, &mut data, &s0.q)
+                .map_err(|e| err(e.to_string()))?;
             c.place_holds(&data);
         }
         let cd = ConstraintData::new(model, &c);
@@ -320,7 +327,16 @@ pub fn time_algo(model: &Model, algo: Algo, opts: &BenchOptions) -> Result<Timin
     let start = Instant::now();
     let mut calls = 0usize;
     while start.elapsed() < Duration::from_millis(20) || calls < 3 {
-        black_box(call(algo, model, &mut data, &mut cx, black_box(&states[calls % nstates])).map_err(err)?);
+        black_box(
+            call(
+                algo,
+                model,
+                &mut data,
+                &mut cx,
+                black_box(&states[calls % nstates]),
+            )
+            .map_err(err)?,
+        );
         calls += 1;
     }
     let per_call = start.elapsed().as_secs_f64() / calls as f64;

@@ -241,7 +241,8 @@ fn evaluate_each(
     for (i, state) in states.states.iter().enumerate() {
         vectors.push(state.to_vectors(&model, states_file, &format!("states[{i}]"))?);
     }
-    let constraints = crate::cli::eval_constrained::parse(&model, states.constraints.as_ref(), states_file)?;
+    let constraints =
+        crate::cli::eval_constrained::parse(&model, states.constraints.as_ref(), states_file)?;
     let mut data = Data::new(&model);
     let names = model.dof_names();
     let vo = model.joint_v_offset();
@@ -303,7 +304,10 @@ fn evaluate_each(
             ("mass_matrix", h.iter().all(|v| v.is_finite())),
             ("a frame, centre of mass, momentum or energy", kin.finite),
             ("a derivative", deriv.as_ref().is_none_or(|d| d.1)),
-            ("the constrained block", constrained.as_ref().is_none_or(|c| c.1)),
+            (
+                "the constrained block",
+                constrained.as_ref().is_none_or(|c| c.1),
+            ),
         ] {
             if !ok {
                 return Err(EvalError::Dynamics {

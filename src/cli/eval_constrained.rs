@@ -17,15 +17,17 @@ pub fn parse(
     let Some(v) = constraints else {
         return Ok(None);
     };
-    Constraints::from_value(model, v).map(Some).map_err(|e| StateError {
-        file: file.to_string(),
-        key: if e.key.is_empty() {
-            "constraints".into()
-        } else {
-            format!("constraints[{}].{}", e.index, e.key)
-        },
-        message: e.message,
-    })
+    Constraints::from_value(model, v)
+        .map(Some)
+        .map_err(|e| StateError {
+            file: file.to_string(),
+            key: if e.key.is_empty() {
+                "constraints".into()
+            } else {
+                format!("constraints[{}].{}", e.index, e.key)
+            },
+            message: e.message,
+        })
 }
 
 fn rows(m: &DMatrix<f64>) -> Value {

@@ -189,7 +189,11 @@ pub(crate) fn jacobian_rows(model: &Model, data: &Data, c: &Constraints, jc: &mu
 /// without gravity): p̈ = a + α × p + ω × ṗ, ṗ = v + ω × p (docs/theory.md
 /// §"Classical acceleration").
 #[inline]
-pub(crate) fn classical(ov: &Motion<f64>, oa: &Motion<f64>, p: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+pub(crate) fn classical(
+    ov: &Motion<f64>,
+    oa: &Motion<f64>,
+    p: &Vector3<f64>,
+) -> (Vector3<f64>, Vector3<f64>) {
     let pdot = ov.lin + ov.ang.cross(p);
     (oa.lin + oa.ang.cross(p) + ov.ang.cross(&pdot), oa.ang)
 }

@@ -67,8 +67,8 @@ pub fn constraint_dynamics_derivatives(
     let fbody = fext.map(|_| fb.as_slice());
     if model.has_mimic {
         // the reduced H is not tree-shaped: the dense route
-        let r = super::constraint_dynamics(model, data, cd, constraints, q, v, tau, fbody)
-            .map(|_| ());
+        let r =
+            super::constraint_dynamics(model, data, cd, constraints, q, v, tau, fbody).map(|_| ());
         data.deriv_fext = fb;
         r?;
         let nv = model.nv;

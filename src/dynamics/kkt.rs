@@ -55,7 +55,8 @@ impl KktFactor {
         // f now holds V (columns), ev the eigenvalues
         let top = self.ev.iter().fold(0.0f64, |a, &x| a.max(x));
         for x in self.ev.iter_mut() {
-            if !(*x > RANK_TOL * top) {
+            // NaN too
+            if x.is_nan() || *x <= RANK_TOL * top {
                 *x = 0.0;
             }
         }
@@ -126,7 +127,7 @@ fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>) -> bool {
         for p in 0..j {
             d -= l[(j, p)] * l[(j, p)];
         }
-        if !(d > RANK_TOL * k[(j, j)].abs()) || !d.is_finite() {
+        if d.is_nan() || d <= RANK_TOL * k[(j, j)].abs() || !d.is_finite() {
             return false;
         }
         let d = d.sqrt();
@@ -171,7 +172,8 @@ fn jacobi_eigen(v: &mut DMatrix<f64>, q: &mut DMatrix<f64>, ev: &mut DVector<f64
                 }
                 // the rotation that zeroes v[p, r]: t = tan φ, the smaller root
                 let theta = (v[(r, r)] - v[(p, p)]) / (2.0 * apr);
-                let t = if theta >= 0.0 { 1.0 } else { -1.0 } / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta >= 0.0 { 1.0 } else { -1.0 }
+                    / (theta.abs() + (theta * theta + 1.0).sqrt());
                 let c = 1.0 / (t * t + 1.0).sqrt();
                 let s = t * c;
                 for k in 0..m {
@@ -200,7 +202,13 @@ fn jacobi_eigen(v: &mut DMatrix<f64>, q: &mut DMatrix<f64>, ev: &mut DVector<f64
 /// `c ← β c + α a b` for column-major matrices, allocation-free (nalgebra's
 /// `gemm` packs through the heap for larger sizes); a zero entry of `b` skips
 /// its column of `a` (J_c's rows and columns are mostly zero).
-pub(crate) fn mul_add(c: &mut DMatrix<f64>, alpha: f64, a: &DMatrix<f64>, b: &DMatrix<f64>, beta: f64) {
+pub(crate) fn mul_add(
+    c: &mut DMatrix<f64>,
+    alpha: f64,
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    beta: f64,
+) {
     let (m, n, kk) = (a.nrows(), b.ncols(), a.ncols());
     debug_assert!(c.nrows() == m && c.ncols() == n && b.nrows() == kk);
     let (a, b, c) = (a.as_slice(), b.as_slice(), c.as_mut_slice());

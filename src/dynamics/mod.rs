@@ -18,9 +18,9 @@ mod forward_rnea;
 mod frames;
 mod jacobian;
 mod jacobian_dot;
-mod kkt;
 mod joint_jacobians;
 mod kinematics;
+mod kkt;
 pub mod linalg;
 pub mod ltdl;
 mod minv;
@@ -31,12 +31,12 @@ pub use crate::spatial::CompositeInertia;
 pub use aba::aba;
 pub use aba_derivatives::aba_derivatives;
 pub use centroidal::centroidal_momentum;
+pub use com::{center_of_mass, center_of_mass_jacobian, center_of_mass_velocity};
 pub use constraint_dynamics::{
     constraint_dynamics, constraint_jacobian, constraint_violation, ConstraintData,
     ConstraintDynamicsError,
 };
 pub use constraint_dynamics_derivatives::constraint_dynamics_derivatives;
-pub use com::{center_of_mass, center_of_mass_jacobian, center_of_mass_velocity};
 pub(crate) use crba::crba_at_placements;
 pub use crba::{crba, crba_upper};
 pub use external::add_link_wrench;

@@ -138,9 +138,13 @@ fn string<'a>(v: &'a Value, k: usize, key: &str) -> Result<&'a str, ConstraintEr
 
 /// A `frame1`/`frame2` object: `position` (origin), `orientation_xyzw` (identity).
 fn frame_object(v: &Value, k: usize, key: &str) -> Result<Se3<f64>, ConstraintError> {
-    let m = v
-        .as_object()
-        .ok_or_else(|| err(k, key, "expected an object with position and orientation_xyzw"))?;
+    let m = v.as_object().ok_or_else(|| {
+        err(
+            k,
+            key,
+            "expected an object with position and orientation_xyzw",
+        )
+    })?;
     let mut out = Se3::identity();
     for (name, x) in m {
         let sub = format!("{key}.{name}");
@@ -153,7 +157,9 @@ fn frame_object(v: &Value, k: usize, key: &str) -> Result<Se3<f64>, ConstraintEr
                     return Err(err(k, sub, format!("quaternion norm {n} is not 1")));
                 }
                 let q = nalgebra::Quaternion::new(qw, qx, qy, qz);
-                out.rot = *UnitQuaternion::from_quaternion(q).to_rotation_matrix().matrix();
+                out.rot = *UnitQuaternion::from_quaternion(q)
+                    .to_rotation_matrix()
+                    .matrix();
             }
             _ => return Err(err(k, sub, "unknown key")),
         }
@@ -279,7 +285,11 @@ impl Constraints {
             }
         };
         if let Some(bad) = m.keys().find(|key| !allowed.contains(&key.as_str())) {
-            return Err(err(k, bad.as_str(), format!("unknown key for a {kind} constraint")));
+            return Err(err(
+                k,
+                bad.as_str(),
+                format!("unknown key for a {kind} constraint"),
+            ));
         }
         let name = match get("name") {
             Some(n) => string(n, k, "name")?.to_string(),
@@ -329,7 +339,9 @@ impl Constraints {
         let local = |x: Option<&Value>, key: &str| -> Result<Se3<f64>, ConstraintError> {
             match x {
                 None => Ok(Se3::identity()),
-                Some(x) if point => Ok(Se3::from_translation(Vector3::from(array::<3>(x, k, key)?))),
+                Some(x) if point => {
+                    Ok(Se3::from_translation(Vector3::from(array::<3>(x, k, key)?)))
+                }
                 Some(x) => frame_object(x, k, key),
             }
         };
@@ -367,7 +379,11 @@ impl Constraints {
             let which = if b.body == 0 { "the world" } else { "one body" };
             return Err(err(
                 k,
-                if get("link2").is_some() { "link2" } else { "link1" },
+                if get("link2").is_some() {
+                    "link2"
+                } else {
+                    "link1"
+                },
                 format!("both sides of the constraint are welded to {which}: it holds nothing"),
             ));
         }
