@@ -9,6 +9,8 @@ mod aba;
 mod aba_derivatives;
 mod centroidal;
 mod com;
+mod constraint_dynamics;
+mod constraint_dynamics_derivatives;
 mod crba;
 mod energy;
 mod external;
@@ -18,6 +20,7 @@ mod jacobian;
 mod jacobian_dot;
 mod joint_jacobians;
 mod kinematics;
+mod kkt;
 pub mod linalg;
 pub mod ltdl;
 mod minv;
@@ -29,6 +32,11 @@ pub use aba::aba;
 pub use aba_derivatives::aba_derivatives;
 pub use centroidal::centroidal_momentum;
 pub use com::{center_of_mass, center_of_mass_jacobian, center_of_mass_velocity};
+pub use constraint_dynamics::{
+    constraint_dynamics, constraint_jacobian, constraint_violation, ConstraintData,
+    ConstraintDynamicsError,
+};
+pub use constraint_dynamics_derivatives::constraint_dynamics_derivatives;
 pub(crate) use crba::crba_at_placements;
 pub use crba::{crba, crba_upper};
 pub use external::add_link_wrench;
