@@ -57,6 +57,7 @@
 pub mod cli;
 pub mod contact;
 pub mod dynamics;
+pub mod mjcf;
 pub mod model;
 pub mod scene;
 pub mod sim;

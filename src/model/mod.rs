@@ -5,6 +5,7 @@
 //! world. A body is a movable joint plus every link welded to its child link
 //! through fixed joints; each URDF link stays addressable as a [`Frame`].
 
+mod armature;
 pub mod configuration;
 mod data;
 pub(crate) mod joint;
@@ -19,6 +20,7 @@ pub(crate) use joint::{dispatch_joint, JointModel};
 pub use joint::{Axis, Joint, JointKind};
 pub use topology::{FdMethod, Topology};
 pub use trees::{FreeJoint, Tree};
+
 
 use crate::spatial::{Inertia, Scalar, Se3};
 use nalgebra::{DVector, Vector3};
@@ -51,6 +53,27 @@ pub struct DofInfo {
     pub friction: f64,
     /// Whether the joint is continuous (unbounded angle).
     pub continuous: bool,
+    /// Rotor inertia on H's diagonal (MJCF `armature`, in H as MuJoCo's `qM`); 0
+    /// for a URDF, whose `--armature` is the simulation's option.
+    pub armature: f64,
+    /// Joint spring stiffness (MJCF `stiffness`; 0 for a URDF).
+    pub stiffness: f64,
+    /// The spring's rest position (MJCF `springref`).
+    pub springref: f64,
+}
+
+/// A link's (an MJCF body's) own mass properties as the file gives them
+/// (`inspect --json`): mass, centre of mass and inertia about it, in its frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinkMass {
+    /// The link's or body's name.
+    pub name: String,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Centre of mass in the link frame (m).
+    pub com: Vector3<f64>,
+    /// Inertia about the centre of mass in the link frame (kg·m²).
+    pub inertia: nalgebra::Matrix3<f64>,
 }
 
 /// A URDF link as a frame on its body: `placement` is `body_M_link`.
@@ -212,6 +235,8 @@ pub struct ImportReport {
     /// specification, malformed visuals and materials. `urdyn inspect --strict`
     /// makes the first one an error.
     pub warnings: Vec<String>,
+    /// Each link's own mass properties, in file order (`inspect --json`).
+    pub bodies: Vec<LinkMass>,
 }
 
 /// The immutable multibody model. Arrays indexed by body have `nbodies` entries,
