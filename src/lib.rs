@@ -57,6 +57,7 @@
 pub mod cli;
 pub mod contact;
 pub mod dynamics;
+pub mod load;
 pub mod mjcf;
 pub mod model;
 pub mod scene;
@@ -69,6 +70,7 @@ pub use model::{Data, Model};
 /// `urdyn::nalgebra::DVector` always matches.
 pub use nalgebra;
 pub use scene::{Scene, SceneError};
+pub use load::{load_model, LoadError};
 pub use urdf::{load_file, load_str, LoadOptions, UrdfError};
 
 /// The README's Rust examples, compiled and run by `cargo test` (doctests).

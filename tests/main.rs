@@ -26,6 +26,7 @@ mod example_scenes;
 mod fast_dynamics;
 mod kinematics_energy;
 mod layering;
+mod mjcf_cli;
 mod mjcf_oracle;
 mod output_files;
 mod pinocchio_derivatives;

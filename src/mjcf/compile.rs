@@ -51,6 +51,8 @@ pub struct MjJoint {
     pub stiffness: f64,
     /// Spring rest position.
     pub springref: f64,
+    /// How errors name its element (`<joint name="…">` or `<joint> (line N)`).
+    pub(crate) label: String,
 }
 
 /// MuJoCo's geom types.
@@ -497,6 +499,7 @@ fn joint(
         frictionloss: a.nonneg("frictionloss", 0.0)?,
         stiffness: a.nonneg("stiffness", 0.0)?,
         springref: conv(a.num("springref")?.unwrap_or(0.0)),
+        label: el.label(),
     };
     cx.world.joints.push(j);
     cx.world.bodies[b].joints.end = id + 1;

@@ -46,6 +46,7 @@ pub(super) fn lower(world: &World, file: &str) -> Result<Model, MjcfError> {
     let mut ub_m = vec![Se3::identity(); nb];
     let mut depth = vec![0usize; nb];
     let (mut nq, mut nv) = (0usize, 0usize);
+    let mut qpos0 = Vec::new();
     for b in 1..nb {
         let body = &world.bodies[b];
         let p = body.parent;
@@ -81,12 +82,14 @@ pub(super) fn lower(world: &World, file: &str) -> Result<Model, MjcfError> {
                         iv: nv,
                         name: jt.name.clone(),
                     });
+                    let (p, r) = (&body.pos, &body.quat);
+                    qpos0.extend([p.x, p.y, p.z, r.i, r.j, r.k, r.w]);
                     (JointKind::Free, Se3::identity(), Se3::identity(), 7, 6)
                 }
                 MjJointType::Ball => {
                     return Err(MjcfError::new(
                         file,
-                        Some(format!("<joint name=\"{}\">", jt.name)),
+                        Some(jt.label.clone()),
                         "type=\"ball\": ball joints are not supported yet (they wait for urdyn's spherical joint)",
                     ))
                 }
@@ -123,6 +126,7 @@ pub(super) fn lower(world: &World, file: &str) -> Result<Model, MjcfError> {
                 format!("{}/{}", body.name, jt.name)
             });
             if nvj == 1 {
+                qpos0.push(jt.reference);
                 let limited = jt.range.is_some();
                 dofs.push(DofInfo {
                     name: jt.name.clone(),
@@ -301,6 +305,7 @@ pub(super) fn lower(world: &World, file: &str) -> Result<Model, MjcfError> {
         topology,
         source: None,
         report,
+        qpos0: Some(qpos0),
     })
 }
 

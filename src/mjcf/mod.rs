@@ -86,7 +86,8 @@ fn dir_of(path: &Path) -> &Path {
 pub fn load_file(path: impl AsRef<Path>) -> Result<Model, MjcfError> {
     let path = path.as_ref();
     let text = read_text(path)?;
-    let mut model = load_str(&text, &path.display().to_string(), dir_of(path))?;
+    let world = compile(&text, &path.display().to_string(), dir_of(path), Some(path))?;
+    let mut model = lower::lower(&world, &path.display().to_string())?;
     model.source = Some(path.to_path_buf());
     Ok(model)
 }
@@ -101,7 +102,7 @@ pub fn load_str(text: &str, file: &str, base_dir: &Path) -> Result<Model, MjcfEr
 pub fn load_world(path: impl AsRef<Path>) -> Result<World, MjcfError> {
     let path = path.as_ref();
     let text = read_text(path)?;
-    compile_str(&text, &path.display().to_string(), dir_of(path))
+    compile(&text, &path.display().to_string(), dir_of(path), Some(path))
 }
 
 const SECTIONS: &[&str] = &[
@@ -112,7 +113,11 @@ const SECTIONS: &[&str] = &[
 
 /// Reads and compiles MJCF text into MuJoCo's compiled [`World`].
 pub fn compile_str(text: &str, file: &str, base_dir: &Path) -> Result<World, MjcfError> {
-    let root = xml::read(text, file, base_dir)?;
+    compile(text, file, base_dir, None)
+}
+
+fn compile(text: &str, file: &str, base_dir: &Path, main: Option<&Path>) -> Result<World, MjcfError> {
+    let root = xml::read(text, file, base_dir, main)?;
     for c in &root.children {
         if !SECTIONS.contains(&c.tag.as_str()) {
             return Err(c.err(format!("unknown element <{}> in <mujoco>", c.tag)));
@@ -155,14 +160,14 @@ pub fn compile_str(text: &str, file: &str, base_dir: &Path) -> Result<World, Mjc
     let mut world = cx.world;
     inertia::bodies(&mut world, &cx.set);
     for (tag, what) in [
-        ("tendon", "tendons (this phase)"),
-        ("actuator", "actuators (this phase)"),
-        ("equality", "equality constraints (this phase)"),
-        ("sensor", "sensors (urdyn has its own)"),
-        ("contact", "explicit contact pairs and exclusions (this phase)"),
+        ("tendon", "tendons: not modelled yet (MJCF simulation)"),
+        ("actuator", "actuators: not modelled yet (MJCF simulation)"),
+        ("equality", "equality constraints: not modelled yet (MJCF simulation)"),
+        ("sensor", "sensors: not modelled (urdyn has its own)"),
+        ("contact", "explicit contact pairs and exclusions: not modelled yet (MJCF simulation)"),
     ] {
         if of(tag).any(|s| !s.children.is_empty()) {
-            cx.not_modelled.push(format!("{what}: not modelled"));
+            cx.not_modelled.push(what.to_string());
         }
     }
     cx.not_modelled.sort();

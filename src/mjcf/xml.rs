@@ -45,8 +45,14 @@ impl El {
 
 /// Reads `text` (named `file` in errors) into its root element, `<include>`s
 /// expanded with files under `base_dir`.
-pub(crate) fn read(text: &str, file: &str, base_dir: &Path) -> Result<El, MjcfError> {
-    let mut stack = Vec::new();
+/// `main` is the model file itself when there is one (an include of it is a cycle).
+pub(crate) fn read(
+    text: &str,
+    file: &str,
+    base_dir: &Path,
+    main: Option<&Path>,
+) -> Result<El, MjcfError> {
+    let mut stack: Vec<PathBuf> = main.and_then(|p| std::fs::canonicalize(p).ok()).into_iter().collect();
     let root = parse_one(text, file)?;
     if root.tag != "mujoco" {
         return Err(MjcfError::new(

@@ -306,6 +306,10 @@ pub struct Model<T: Scalar = f64> {
     pub source: Option<PathBuf>,
     /// What the import merged, ignored or warned about.
     pub report: ImportReport,
+    /// The configuration the file defines (MJCF's `qpos0`: each hinge or slide at
+    /// its `ref`, each free joint at its body's defined pose), returned by
+    /// [`Model::neutral`]; `None` (a URDF, a scene): zeros and identity rotations.
+    pub qpos0: Option<Vec<f64>>,
 }
 
 impl<T: Scalar> Model<T> {
@@ -346,8 +350,12 @@ impl<T: Scalar> Model<T> {
     pub fn frame_index(&self, name: &str) -> Option<usize> {
         self.frames.iter().position(|f| f.name == name)
     }
-    /// The neutral configuration: zeros, identity orientation of every free joint.
+    /// The neutral configuration: [`Model::qpos0`] when the file defines one, else
+    /// zeros, identity orientation of every free joint.
     pub fn neutral(&self) -> DVector<T> {
+        if let Some(q0) = self.qpos0.as_ref().filter(|q0| q0.len() == self.nq) {
+            return DVector::from_iterator(self.nq, q0.iter().map(|&x| nalgebra::convert(x)));
+        }
         let mut q = DVector::zeros(self.nq);
         for f in &self.free_joints {
             q[f.iq + 6] = T::one();
@@ -464,6 +472,7 @@ impl Model<f64> {
             topology: self.topology.clone(),
             source: self.source.clone(),
             report: self.report.clone(),
+            qpos0: self.qpos0.clone(),
         }
     }
 }

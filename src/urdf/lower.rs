@@ -430,6 +430,7 @@ pub(crate) fn lower(
         topology,
         source: None,
         report,
+        qpos0: None,
     })
 }
 
