@@ -65,12 +65,12 @@ pub mod sim;
 pub mod spatial;
 pub mod urdf;
 
+pub use load::{load_model, LoadError};
 pub use model::{Data, Model};
 /// The nalgebra this crate is built with (its vectors and matrices are in the API):
 /// `urdyn::nalgebra::DVector` always matches.
 pub use nalgebra;
 pub use scene::{Scene, SceneError};
-pub use load::{load_model, LoadError};
 pub use urdf::{load_file, load_str, LoadOptions, UrdfError};
 
 /// The README's Rust examples, compiled and run by `cargo test` (doctests).

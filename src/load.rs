@@ -36,7 +36,9 @@ pub enum LoadError {
     #[error(transparent)]
     Mjcf(#[from] MjcfError),
     /// `--floating-base` given beside an MJCF file.
-    #[error("{0}: --floating-base does not apply to an MJCF file: the file says which joints are free")]
+    #[error(
+        "{0}: --floating-base does not apply to an MJCF file: the file says which joints are free"
+    )]
     FloatingBaseWithMjcf(String),
 }
 

@@ -51,9 +51,21 @@ fn eval_on_mjcf_matches_mujoco() {
     assert_eq!(ins["q_names"][6], "root:qw");
     assert_eq!(ins["v_names"][5], "root:wz");
     for (name, b) in fx["bodies"].as_object().unwrap() {
-        near(&format!("{name} mass"), f(&ins["bodies"][name]["mass"]), f(&b["mass"]), 1.0, 1e-10);
+        near(
+            &format!("{name} mass"),
+            f(&ins["bodies"][name]["mass"]),
+            f(&b["mass"]),
+            1.0,
+            1e-10,
+        );
         for k in 0..3 {
-            near("com", f(&ins["bodies"][name]["com"][k]), f(&b["com"][k]), 1.0, 1e-10);
+            near(
+                "com",
+                f(&ins["bodies"][name]["com"][k]),
+                f(&b["com"][k]),
+                1.0,
+                1e-10,
+            );
         }
     }
     let s = &fx["states"][0];
@@ -61,7 +73,11 @@ fn eval_on_mjcf_matches_mujoco() {
     let map = |k: &str| -> Value {
         // q has the free joint's 7 coordinates first, v, a and tau its 6
         let off = if k == "q" { 7 } else { 6 };
-        names.iter().enumerate().map(|(i, n)| (n.clone(), json!(at(k, off + i)))).collect()
+        names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (n.clone(), json!(at(k, off + i))))
+            .collect()
     };
     let states = json!({"states": [{
         "q": map("q"), "v": map("v"), "a": map("a"), "tau": map("tau_in"),
@@ -79,21 +95,41 @@ fn eval_on_mjcf_matches_mujoco() {
     let tmp = tempfile::tempdir().unwrap();
     let sf = tmp.path().join("states.json");
     std::fs::write(&sf, states.to_string()).unwrap();
-    let (ok, out, err) = run(&["eval", model.to_str().unwrap(), "--states", sf.to_str().unwrap()]);
+    let (ok, out, err) = run(&[
+        "eval",
+        model.to_str().unwrap(),
+        "--states",
+        sf.to_str().unwrap(),
+    ]);
     assert!(ok, "{err}");
     let r = &serde_json::from_str::<Value>(&out).unwrap()["results"][0];
     let h = s["mass_matrix"].as_array().unwrap();
-    let hs = h.iter().flat_map(|r| r.as_array().unwrap().iter().map(f)).fold(1.0f64, |m, x| m.max(x.abs()));
+    let hs = h
+        .iter()
+        .flat_map(|r| r.as_array().unwrap().iter().map(f))
+        .fold(1.0f64, |m, x| m.max(x.abs()));
     for (i, row) in h.iter().enumerate() {
         for (j, x) in row.as_array().unwrap().iter().enumerate() {
-            near(&format!("H[{i}][{j}]"), f(&r["mass_matrix"][i][j]), f(x), hs, 1e-10);
+            near(
+                &format!("H[{i}][{j}]"),
+                f(&r["mass_matrix"][i][j]),
+                f(x),
+                hs,
+                1e-10,
+            );
         }
     }
     for (key, fkey) in [("tau", "tau"), ("bias", "bias"), ("qdd", "qdd")] {
         let want: Vec<f64> = s[fkey].as_array().unwrap().iter().map(f).collect();
         let scale = want.iter().fold(1.0f64, |m, x| m.max(x.abs()));
         for (i, n) in names.iter().enumerate() {
-            near(&format!("{key} {n}"), f(&r[key][n]), want[6 + i], scale, 1e-10);
+            near(
+                &format!("{key} {n}"),
+                f(&r[key][n]),
+                want[6 + i],
+                scale,
+                1e-10,
+            );
         }
         let base = match key {
             "tau" => ["force", "torque"],
@@ -101,7 +137,13 @@ fn eval_on_mjcf_matches_mujoco() {
             _ => ["linear_acceleration", "angular_acceleration"],
         };
         for k in 0..6 {
-            near(&format!("{key} base {k}"), f(&r["base"][base[k / 3]][k % 3]), want[k], scale, 1e-10);
+            near(
+                &format!("{key} base {k}"),
+                f(&r["base"][base[k / 3]][k % 3]),
+                want[k],
+                scale,
+                1e-10,
+            );
         }
     }
     for (name, p) in s["poses"].as_object().unwrap() {
@@ -109,7 +151,13 @@ fn eval_on_mjcf_matches_mujoco() {
         for k in 0..3 {
             near("position", f(&pose["position"][k]), f(&p[k]), 1.0, 1e-12);
             for c in 0..3 {
-                near("rotation", f(&pose["rotation"][k][c]), f(&p[3 + 3 * k + c]), 1.0, 1e-12);
+                near(
+                    "rotation",
+                    f(&pose["rotation"][k][c]),
+                    f(&p[3 + 3 * k + c]),
+                    1.0,
+                    1e-12,
+                );
             }
         }
     }
@@ -126,7 +174,10 @@ fn mjcf_commands_refuse_floating_base() {
         args.push("--floating-base");
         let (ok, _, err) = run(&args);
         assert!(!ok);
-        assert!(err.contains("hopper.xml") && err.contains("--floating-base"), "{err}");
+        assert!(
+            err.contains("hopper.xml") && err.contains("--floating-base"),
+            "{err}"
+        );
         assert_eq!(err.trim().lines().count(), 1, "{err}");
     }
 }
@@ -135,35 +186,100 @@ fn mjcf_commands_refuse_floating_base() {
 #[test]
 fn malformed_mjcf_is_one_line_naming_the_element() {
     let tmp = tempfile::tempdir().unwrap();
-    let body = |inner: &str| format!("<mujoco><worldbody><body name=\"b\">{inner}</body></worldbody></mujoco>");
+    let body = |inner: &str| {
+        format!("<mujoco><worldbody><body name=\"b\">{inner}</body></worldbody></mujoco>")
+    };
     let cases: Vec<(&str, String, &str)> = vec![
-        ("unknown_element", "<mujoco><worldbody><bogus/></worldbody></mujoco>".into(), "bogus"),
-        ("unknown_attribute", body("<geom size=\"1\" colour=\"red\"/>"), "colour"),
-        ("unknown_class", body("<geom class=\"nope\" size=\"1\"/>"), "nope"),
-        ("missing_include", "<mujoco><include file=\"missing.xml\"/></mujoco>".into(), "missing.xml"),
-        ("cyclic_include", "<mujoco><include file=\"cyclic_include.xml\"/></mujoco>".into(), "cyclic"),
-        ("entity", "<!DOCTYPE m [<!ENTITY a \"b\">]><mujoco/>".into(), "DOCTYPE"),
+        (
+            "unknown_element",
+            "<mujoco><worldbody><bogus/></worldbody></mujoco>".into(),
+            "bogus",
+        ),
+        (
+            "unknown_attribute",
+            body("<geom size=\"1\" colour=\"red\"/>"),
+            "colour",
+        ),
+        (
+            "unknown_class",
+            body("<geom class=\"nope\" size=\"1\"/>"),
+            "nope",
+        ),
+        (
+            "missing_include",
+            "<mujoco><include file=\"missing.xml\"/></mujoco>".into(),
+            "missing.xml",
+        ),
+        (
+            "cyclic_include",
+            "<mujoco><include file=\"cyclic_include.xml\"/></mujoco>".into(),
+            "cyclic",
+        ),
+        (
+            "entity",
+            "<!DOCTYPE m [<!ENTITY a \"b\">]><mujoco/>".into(),
+            "DOCTYPE",
+        ),
         ("nan", body("<geom size=\"nan\"/>"), "size"),
         ("inf_mass", body("<geom size=\"1\" mass=\"inf\"/>"), "mass"),
-        ("zero_quat", body("<geom size=\"1\" quat=\"0 0 0 0\"/>"), "quat"),
-        ("two_free", body("<freejoint/><freejoint/><geom size=\"1\"/>"), "free joint"),
-        ("free_below_top", body("<geom size=\"1\"/><body><freejoint/><geom size=\"1\"/></body>"), "top-level"),
-        ("zero_axis", body("<joint axis=\"0 0 0\"/><geom size=\"1\"/>"), "axis"),
-        ("bad_range", body("<joint range=\"1 -1\"/><geom size=\"1\"/>"), "range"),
-        ("negative_mass", body("<geom size=\"1\" mass=\"-1\"/>"), "mass"),
-        ("dup_body", "<mujoco><worldbody><body name=\"a\"/><body name=\"a\"/></worldbody></mujoco>".into(), "duplicate"),
+        (
+            "zero_quat",
+            body("<geom size=\"1\" quat=\"0 0 0 0\"/>"),
+            "quat",
+        ),
+        (
+            "two_free",
+            body("<freejoint/><freejoint/><geom size=\"1\"/>"),
+            "free joint",
+        ),
+        (
+            "free_below_top",
+            body("<geom size=\"1\"/><body><freejoint/><geom size=\"1\"/></body>"),
+            "top-level",
+        ),
+        (
+            "zero_axis",
+            body("<joint axis=\"0 0 0\"/><geom size=\"1\"/>"),
+            "axis",
+        ),
+        (
+            "bad_range",
+            body("<joint range=\"1 -1\"/><geom size=\"1\"/>"),
+            "range",
+        ),
+        (
+            "negative_mass",
+            body("<geom size=\"1\" mass=\"-1\"/>"),
+            "mass",
+        ),
+        (
+            "dup_body",
+            "<mujoco><worldbody><body name=\"a\"/><body name=\"a\"/></worldbody></mujoco>".into(),
+            "duplicate",
+        ),
         ("not_xml", "this is not xml <".into(), "XML"),
         ("empty", String::new(), "empty"),
         ("bad_number", body("<geom size=\"1x\"/>"), "size"),
-        ("ball_not_yet", body("<joint type=\"ball\"/><geom size=\"1\"/>"), "ball"),
-        ("two_orientations", body("<geom size=\"1\" quat=\"1 0 0 0\" euler=\"0 0 0\"/>"), "orientation"),
+        (
+            "ball_not_yet",
+            body("<joint type=\"ball\"/><geom size=\"1\"/>"),
+            "ball",
+        ),
+        (
+            "two_orientations",
+            body("<geom size=\"1\" quat=\"1 0 0 0\" euler=\"0 0 0\"/>"),
+            "orientation",
+        ),
     ];
     for (name, text, needle) in &cases {
         let path = tmp.path().join(format!("{name}.xml"));
         std::fs::write(&path, text).unwrap();
         // "not_xml" and "empty" are not <mujoco> files: read as MJCF by the library
         let err = urdyn::mjcf::load_file(&path).expect_err(name).to_string();
-        assert!(err.contains(&format!("{name}.xml")) && err.contains(needle), "{name}: {err}");
+        assert!(
+            err.contains(&format!("{name}.xml")) && err.contains(needle),
+            "{name}: {err}"
+        );
         assert_eq!(err.lines().count(), 1, "{name}: {err}");
         if text.contains("<mujoco") && !text.contains("DOCTYPE") {
             let (ok, _, stderr) = run(&["inspect", path.to_str().unwrap()]);

@@ -23,12 +23,18 @@ fn vecf(v: &Value) -> Vec<f64> {
 
 fn close(what: &str, got: &[f64], want: &[f64], tol: f64) -> Result<(), String> {
     if got.len() != want.len() {
-        return Err(format!("{what}: {} entries, MuJoCo {}", got.len(), want.len()));
+        return Err(format!(
+            "{what}: {} entries, MuJoCo {}",
+            got.len(),
+            want.len()
+        ));
     }
     let scale = want.iter().fold(1.0f64, |m, x| m.max(x.abs()));
     for (k, (g, w)) in got.iter().zip(want).enumerate() {
-        if !((g - w).abs() <= tol * scale) {
-            return Err(format!("{what}[{k}]: urdyn {g}, MuJoCo {w} (scale {scale})"));
+        if (g - w).abs() > tol * scale || g.is_nan() {
+            return Err(format!(
+                "{what}[{k}]: urdyn {g}, MuJoCo {w} (scale {scale})"
+            ));
         }
     }
     Ok(())
@@ -39,17 +45,44 @@ fn check(fixture: &Path) -> Result<usize, String> {
     let fx: Value = serde_json::from_str(&std::fs::read_to_string(fixture).unwrap()).unwrap();
     let file = dir().join(fx["model"].as_str().unwrap());
     let model = urdyn::mjcf::load_file(&file).map_err(|e| e.to_string())?;
-    if model.nq != fx["nq"].as_u64().unwrap() as usize || model.nv != fx["nv"].as_u64().unwrap() as usize {
-        return Err(format!("nq, nv = {}, {}; MuJoCo {}, {}", model.nq, model.nv, fx["nq"], fx["nv"]));
+    if model.nq != fx["nq"].as_u64().unwrap() as usize
+        || model.nv != fx["nv"].as_u64().unwrap() as usize
+    {
+        return Err(format!(
+            "nq, nv = {}, {}; MuJoCo {}, {}",
+            model.nq, model.nv, fx["nq"], fx["nv"]
+        ));
     }
     let mut checks = 0;
     for (name, b) in fx["bodies"].as_object().unwrap() {
-        let own = model.report.bodies.iter().find(|l| &l.name == name)
+        let own = model
+            .report
+            .bodies
+            .iter()
+            .find(|l| &l.name == name)
             .ok_or_else(|| format!("body {name} missing"))?;
-        close(&format!("{name} mass"), &[own.mass], &[b["mass"].as_f64().unwrap()], 1e-10)?;
-        close(&format!("{name} com"), own.com.as_slice(), &vecf(&b["com"]), 1e-10)?;
-        let want: Vec<f64> = b["inertia"].as_array().unwrap().iter().flat_map(vecf).collect();
-        let got: Vec<f64> = (0..3).flat_map(|r| (0..3).map(move |c| (r, c))).map(|(r, c)| own.inertia[(r, c)]).collect();
+        close(
+            &format!("{name} mass"),
+            &[own.mass],
+            &[b["mass"].as_f64().unwrap()],
+            1e-10,
+        )?;
+        close(
+            &format!("{name} com"),
+            own.com.as_slice(),
+            &vecf(&b["com"]),
+            1e-10,
+        )?;
+        let want: Vec<f64> = b["inertia"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(vecf)
+            .collect();
+        let got: Vec<f64> = (0..3)
+            .flat_map(|r| (0..3).map(move |c| (r, c)))
+            .map(|(r, c)| own.inertia[(r, c)])
+            .collect();
         close(&format!("{name} inertia"), &got, &want, 1e-10)?;
         checks += 1;
     }
@@ -60,27 +93,55 @@ fn check(fixture: &Path) -> Result<usize, String> {
         let v = DVector::from_vec(vecf(&s["v"]));
         let a = DVector::from_vec(vecf(&s["a"]));
         let tau_in = DVector::from_vec(vecf(&s["tau_in"]));
-        let mut h = dynamics::mass_matrix(&model, &mut data, &q).map_err(|e| e.to_string())?.clone();
+        let mut h = dynamics::mass_matrix(&model, &mut data, &q)
+            .map_err(|e| e.to_string())?
+            .clone();
         for k in 0..model.nv {
             h[(k, k)] += arm[k];
         }
-        let want_h: Vec<f64> = s["mass_matrix"].as_array().unwrap().iter().flat_map(vecf).collect();
+        let want_h: Vec<f64> = s["mass_matrix"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(vecf)
+            .collect();
         let got_h: Vec<f64> = h.transpose().iter().copied().collect();
         close(&format!("state {i} H"), &got_h, &want_h, 1e-10)?;
-        let bias = dynamics::bias(&model, &mut data, &q, &v, None).map_err(|e| e.to_string())?.clone();
-        close(&format!("state {i} bias"), bias.as_slice(), &vecf(&s["bias"]), 1e-10)?;
-        let tau = dynamics::rnea(&model, &mut data, &q, &v, &a, None).map_err(|e| e.to_string())?.clone()
+        let bias = dynamics::bias(&model, &mut data, &q, &v, None)
+            .map_err(|e| e.to_string())?
+            .clone();
+        close(
+            &format!("state {i} bias"),
+            bias.as_slice(),
+            &vecf(&s["bias"]),
+            1e-10,
+        )?;
+        let tau = dynamics::rnea(&model, &mut data, &q, &v, &a, None)
+            .map_err(|e| e.to_string())?
+            .clone()
             + arm.component_mul(&a);
-        close(&format!("state {i} tau"), tau.as_slice(), &vecf(&s["tau"]), 1e-10)?;
+        close(
+            &format!("state {i} tau"),
+            tau.as_slice(),
+            &vecf(&s["tau"]),
+            1e-10,
+        )?;
         let mut l = DMatrix::zeros(model.nv, model.nv);
         dynamics::linalg::cholesky(&h, &mut l).map_err(|k| format!("H singular at {k}"))?;
         let mut qdd = &tau_in - &bias;
         dynamics::linalg::cholesky_solve(&l, &mut qdd);
-        close(&format!("state {i} qdd"), qdd.as_slice(), &vecf(&s["qdd"]), 1e-10)?;
+        close(
+            &format!("state {i} qdd"),
+            qdd.as_slice(),
+            &vecf(&s["qdd"]),
+            1e-10,
+        )?;
         dynamics::forward_kinematics(&model, &mut data, &q).map_err(|e| e.to_string())?;
         dynamics::update_frames(&model, &mut data);
         for (name, p) in s["poses"].as_object().unwrap() {
-            let f = model.frame_index(name).ok_or_else(|| format!("no frame {name}"))?;
+            let f = model
+                .frame_index(name)
+                .ok_or_else(|| format!("no frame {name}"))?;
             let m = &data.o_m_f[f];
             let mut got = m.trans.as_slice().to_vec();
             for r in 0..3 {
@@ -90,8 +151,10 @@ fn check(fixture: &Path) -> Result<usize, String> {
             }
             let want = vecf(p);
             for (k, (g, w)) in got.iter().zip(&want).enumerate() {
-                if !((g - w).abs() <= 1e-12) {
-                    return Err(format!("state {i} pose of {name}[{k}]: urdyn {g}, MuJoCo {w}"));
+                if (g - w).abs() > 1e-12 || g.is_nan() {
+                    return Err(format!(
+                        "state {i} pose of {name}[{k}]: urdyn {g}, MuJoCo {w}"
+                    ));
                 }
             }
         }
@@ -117,7 +180,13 @@ fn mjcf_models_match_mujoco() {
             Err(e) => bad.push(format!("{stem}: {e}")),
         }
     }
-    assert!(bad.is_empty(), "{} of {} models differ from MuJoCo:\n{}", bad.len(), fixtures.len(), bad.join("\n"));
+    assert!(
+        bad.is_empty(),
+        "{} of {} models differ from MuJoCo:\n{}",
+        bad.len(),
+        fixtures.len(),
+        bad.join("\n")
+    );
 }
 
 /// The comparison sees what it checks: Gymnasium's ant without its armature (1.0 on
@@ -133,11 +202,23 @@ fn mjcf_comparison_sees_a_difference() {
     let mut data = urdyn::Data::new(&model);
     let s = &fx["states"][0];
     let q = DVector::from_vec(vecf(&s["q"]));
-    let h = dynamics::mass_matrix(&model, &mut data, &q).unwrap().clone();
-    let want: Vec<f64> = s["mass_matrix"].as_array().unwrap().iter().flat_map(vecf).collect();
+    let h = dynamics::mass_matrix(&model, &mut data, &q)
+        .unwrap()
+        .clone();
+    let want: Vec<f64> = s["mass_matrix"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(vecf)
+        .collect();
     let got: Vec<f64> = h.transpose().iter().copied().collect();
     assert!(close("H", &got, &want, 1e-10).is_err());
-    let torso = model.report.bodies.iter().find(|b| b.name == "torso").unwrap();
+    let torso = model
+        .report
+        .bodies
+        .iter()
+        .find(|b| b.name == "torso")
+        .unwrap();
     let m = fx["bodies"]["torso"]["mass"].as_f64().unwrap();
     assert!(close("mass", &[torso.mass], &[m], 1e-10).is_ok());
     assert!(close("mass", &[torso.mass * (1.0 + 1e-9)], &[m], 1e-10).is_err());

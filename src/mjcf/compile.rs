@@ -11,132 +11,7 @@ use super::MjcfError;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use std::collections::HashSet;
 
-/// A joint kind of MJCF.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MjJointType {
-    /// 6 DoF, `<freejoint>` or `type="free"`.
-    Free,
-    /// 3 rotational DoF.
-    Ball,
-    /// Translation along `axis`.
-    Slide,
-    /// Rotation about `axis` through `pos`.
-    Hinge,
-}
-
-/// A compiled joint (MuJoCo's `jnt_*` and `dof_*` of one joint).
-#[derive(Clone, Debug, PartialEq)]
-pub struct MjJoint {
-    /// Its name (`joint_K` when unnamed, K its MuJoCo id).
-    pub name: String,
-    /// Its kind.
-    pub kind: MjJointType,
-    /// Its MuJoCo body.
-    pub body: usize,
-    /// Anchor in the body frame.
-    pub pos: Vector3<f64>,
-    /// Unit axis in the body frame.
-    pub axis: Vector3<f64>,
-    /// Position limits (rad or m) when limited.
-    pub range: Option<(f64, f64)>,
-    /// `ref` (rad or m): qpos0 of a hinge or slide.
-    pub reference: f64,
-    /// Rotor inertia added to H's diagonal.
-    pub armature: f64,
-    /// Viscous damping.
-    pub damping: f64,
-    /// Dry friction.
-    pub frictionloss: f64,
-    /// Spring stiffness.
-    pub stiffness: f64,
-    /// Spring rest position.
-    pub springref: f64,
-    /// How errors name its element (`<joint name="…">` or `<joint> (line N)`).
-    pub(crate) label: String,
-}
-
-/// MuJoCo's geom types.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MjGeomType {
-    /// Half-space (infinite plane facing +z).
-    Plane,
-    /// Height field.
-    Hfield,
-    /// Sphere.
-    Sphere,
-    /// Capsule along z.
-    Capsule,
-    /// Ellipsoid.
-    Ellipsoid,
-    /// Cylinder along z.
-    Cylinder,
-    /// Box (half sizes).
-    Box,
-    /// Mesh asset.
-    Mesh,
-}
-
-/// A compiled geom.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MjGeom {
-    /// Its name (`geom_K` when unnamed).
-    pub name: String,
-    /// Its MuJoCo body (0: the world).
-    pub body: usize,
-    /// Its type.
-    pub kind: MjGeomType,
-    /// MuJoCo's `size` (half lengths), `fromto` applied.
-    pub size: [f64; 3],
-    /// Position in the body frame.
-    pub pos: Vector3<f64>,
-    /// Orientation in the body frame.
-    pub quat: UnitQuaternion<f64>,
-    /// Mass (kg), from `mass` or density × volume (0 outside inertiagrouprange).
-    pub mass: f64,
-    /// Principal moments about its centre in its own frame.
-    pub inertia: [f64; 3],
-    /// `contype`, `conaffinity`, `condim`, `priority`, `group`.
-    pub contype: i64,
-    /// See `contype`.
-    pub conaffinity: i64,
-    /// Contact dimensionality.
-    pub condim: i64,
-    /// Contact priority.
-    pub priority: i64,
-    /// Visual group.
-    pub group: i64,
-    /// Sliding, torsional, rolling friction.
-    pub friction: [f64; 3],
-    /// Colour.
-    pub rgba: [f64; 4],
-    /// The mesh or height field asset it names.
-    pub asset: Option<String>,
-}
-
-/// A compiled body: its frame in its parent's and its mass properties.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MjBody {
-    /// Its name (`world` for body 0, `body_K` when unnamed).
-    pub name: String,
-    /// Its parent body (0 for the world's children and the world).
-    pub parent: usize,
-    /// Position in the parent's frame (MuJoCo's `body_pos`).
-    pub pos: Vector3<f64>,
-    /// Orientation in the parent's frame (`body_quat`).
-    pub quat: UnitQuaternion<f64>,
-    /// Its joints, MuJoCo ids (contiguous, in file order).
-    pub joints: std::ops::Range<usize>,
-    /// Mass (kg).
-    pub mass: f64,
-    /// Centre of mass in the body frame (`body_ipos`).
-    pub com: Vector3<f64>,
-    /// Inertia about the centre of mass in the body frame (`body_iquat`·diag(`body_inertia`)).
-    pub inertia: Matrix3<f64>,
-    /// Sites: name and pose in the body frame.
-    pub sites: Vec<(String, Vector3<f64>, UnitQuaternion<f64>)>,
-    /// Whether the body has an `<inertial>` element.
-    pub(crate) explicit: Option<(f64, Vector3<f64>, Matrix3<f64>)>,
-}
+pub use super::world::{MjBody, MjGeom, MjGeomType, MjJoint, MjJointType, World};
 
 /// The `<compiler>` settings that decide numbers.
 #[derive(Clone, Debug)]
@@ -151,25 +26,6 @@ pub(crate) struct Settings {
     pub balanceinertia: bool,
     pub boundmass: f64,
     pub boundinertia: f64,
-}
-
-/// MuJoCo's compiled world.
-#[derive(Clone, Debug)]
-pub struct World {
-    /// `<mujoco model>`.
-    pub name: String,
-    /// Bodies, the world (0) first, in MuJoCo's order (depth-first, file order).
-    pub bodies: Vec<MjBody>,
-    /// Joints in MuJoCo's order.
-    pub joints: Vec<MjJoint>,
-    /// Geoms in MuJoCo's order (the world's among them).
-    pub geoms: Vec<MjGeom>,
-    /// `<option gravity>` (zero under `<flag gravity="disable">`).
-    pub gravity: Vector3<f64>,
-    /// `<option timestep>`.
-    pub timestep: f64,
-    /// What urdyn does not model, one line a kind.
-    pub warnings: Vec<String>,
 }
 
 const POSE: [&str; 6] = ["pos", "quat", "axisangle", "xyaxes", "zaxis", "euler"];
@@ -192,10 +48,7 @@ impl Ctx<'_> {
         }
     }
     /// The element's orientation (one form at most) and position.
-    pub fn pose(
-        &self,
-        a: &Attrs,
-    ) -> Result<(Vector3<f64>, UnitQuaternion<f64>), MjcfError> {
+    pub fn pose(&self, a: &Attrs) -> Result<(Vector3<f64>, UnitQuaternion<f64>), MjcfError> {
         let pos = Vector3::from(a.arr::<3>("pos")?.unwrap_or([0.0; 3]));
         let given: Vec<&str> = POSE[1..]
             .iter()
@@ -230,12 +83,16 @@ impl Ctx<'_> {
             }
             Some("xyaxes") => {
                 let v = a.arr::<6>("xyaxes")?.unwrap_or_default();
-                orient::xy_axes(Vector3::new(v[0], v[1], v[2]), Vector3::new(v[3], v[4], v[5]))
-                    .ok_or_else(|| a.err("xyaxes", "is degenerate"))?
+                orient::xy_axes(
+                    Vector3::new(v[0], v[1], v[2]),
+                    Vector3::new(v[3], v[4], v[5]),
+                )
+                .ok_or_else(|| a.err("xyaxes", "is degenerate"))?
             }
             _ => {
                 let v = a.arr::<3>("zaxis")?.unwrap_or_default();
-                orient::z_axis(Vector3::from(v)).ok_or_else(|| a.err("zaxis", "is a zero vector"))?
+                orient::z_axis(Vector3::from(v))
+                    .ok_or_else(|| a.err("zaxis", "is a zero vector"))?
             }
         };
         Ok((pos, q))
@@ -270,30 +127,114 @@ fn compose(
 }
 
 const BODY_ATTRS: &[&str] = &[
-    "name", "childclass", "pos", "quat", "axisangle", "xyaxes", "zaxis", "euler", "mocap",
-    "gravcomp", "user", "sleep",
+    "name",
+    "childclass",
+    "pos",
+    "quat",
+    "axisangle",
+    "xyaxes",
+    "zaxis",
+    "euler",
+    "mocap",
+    "gravcomp",
+    "user",
+    "sleep",
 ];
 const JOINT_ATTRS: &[&str] = &[
-    "name", "type", "group", "pos", "axis", "springdamper", "limited", "actuatorfrclimited",
-    "solreflimit", "solimplimit", "solreffriction", "solimpfriction", "stiffness", "range",
-    "actuatorfrcrange", "actuatorgravcomp", "margin", "ref", "springref", "armature", "damping",
-    "frictionloss", "user",
+    "name",
+    "type",
+    "group",
+    "pos",
+    "axis",
+    "springdamper",
+    "limited",
+    "actuatorfrclimited",
+    "solreflimit",
+    "solimplimit",
+    "solreffriction",
+    "solimpfriction",
+    "stiffness",
+    "range",
+    "actuatorfrcrange",
+    "actuatorgravcomp",
+    "margin",
+    "ref",
+    "springref",
+    "armature",
+    "damping",
+    "frictionloss",
+    "user",
 ];
 const GEOM_ATTRS: &[&str] = &[
-    "name", "type", "contype", "conaffinity", "condim", "group", "priority", "size", "material",
-    "friction", "mass", "density", "shellinertia", "solmix", "solref", "solimp", "margin", "gap",
-    "fromto", "pos", "quat", "axisangle", "xyaxes", "zaxis", "euler", "hfield", "mesh",
-    "fitscale", "rgba", "fluidshape", "fluidcoef", "user",
+    "name",
+    "type",
+    "contype",
+    "conaffinity",
+    "condim",
+    "group",
+    "priority",
+    "size",
+    "material",
+    "friction",
+    "mass",
+    "density",
+    "shellinertia",
+    "solmix",
+    "solref",
+    "solimp",
+    "margin",
+    "gap",
+    "fromto",
+    "pos",
+    "quat",
+    "axisangle",
+    "xyaxes",
+    "zaxis",
+    "euler",
+    "hfield",
+    "mesh",
+    "fitscale",
+    "rgba",
+    "fluidshape",
+    "fluidcoef",
+    "user",
 ];
 const SITE_ATTRS: &[&str] = &[
-    "name", "type", "group", "material", "rgba", "size", "fromto", "pos", "quat", "axisangle",
-    "xyaxes", "zaxis", "euler", "user",
+    "name",
+    "type",
+    "group",
+    "material",
+    "rgba",
+    "size",
+    "fromto",
+    "pos",
+    "quat",
+    "axisangle",
+    "xyaxes",
+    "zaxis",
+    "euler",
+    "user",
 ];
 const INERTIAL_ATTRS: &[&str] = &[
-    "pos", "quat", "axisangle", "xyaxes", "zaxis", "euler", "mass", "diaginertia", "fullinertia",
+    "pos",
+    "quat",
+    "axisangle",
+    "xyaxes",
+    "zaxis",
+    "euler",
+    "mass",
+    "diaginertia",
+    "fullinertia",
 ];
 const FRAME_ATTRS: &[&str] = &[
-    "name", "childclass", "pos", "quat", "axisangle", "xyaxes", "zaxis", "euler",
+    "name",
+    "childclass",
+    "pos",
+    "quat",
+    "axisangle",
+    "xyaxes",
+    "zaxis",
+    "euler",
 ];
 
 /// Walks the children of body `b` (an element `<worldbody>`, `<body>` or
@@ -406,7 +347,13 @@ fn body(
     if !cx.defaults.classes.contains_key(cc) {
         return Err(el.err(format!("childclass=\"{cc}\": unknown default class")));
     }
-    walk_children(cx, el, id, cc, (Vector3::zeros(), UnitQuaternion::identity()))
+    walk_children(
+        cx,
+        el,
+        id,
+        cc,
+        (Vector3::zeros(), UnitQuaternion::identity()),
+    )
 }
 
 impl Defaults {
@@ -445,15 +392,17 @@ fn joint(
     let body = &cx.world.bodies[b];
     if kind == MjJointType::Free {
         if body.parent != 0 {
-            return Err(el.err("a free joint is allowed only in a top-level body (a child of <worldbody>)"));
+            return Err(
+                el.err("a free joint is allowed only in a top-level body (a child of <worldbody>)")
+            );
         }
         if !body.joints.is_empty() {
             return Err(el.err("a body with a free joint has no other joint"));
         }
-    } else if let Some(j) = body.joints.clone().next() {
-        if cx.world.joints[j].kind == MjJointType::Free {
-            return Err(el.err("a body with a free joint has no other joint"));
-        }
+    } else if let Some(j) = body.joints.clone().next()
+        && cx.world.joints[j].kind == MjJointType::Free
+    {
+        return Err(el.err("a body with a free joint has no other joint"));
     }
     let (pos, axis) = if kind == MjJointType::Free {
         (Vector3::zeros(), Vector3::z())
@@ -461,7 +410,7 @@ fn joint(
         let p = Vector3::from(a.arr::<3>("pos")?.unwrap_or([0.0; 3]));
         let ax = Vector3::from(a.arr::<3>("axis")?.unwrap_or([0.0, 0.0, 1.0]));
         let n = ax.norm();
-        if !(n >= 1e-10) {
+        if n.is_nan() || n < 1e-10 {
             return Err(a.err("axis", "is a zero axis"));
         }
         (frame.0 + frame.1 * p, frame.1 * (ax / n))
@@ -492,7 +441,11 @@ fn joint(
         body: b,
         pos,
         axis,
-        range: if kind == MjJointType::Free { None } else { range },
+        range: if kind == MjJointType::Free {
+            None
+        } else {
+            range
+        },
         reference: conv(a.num("ref")?.unwrap_or(0.0)),
         armature: a.nonneg("armature", 0.0)?,
         damping: a.nonneg("damping", 0.0)?,
@@ -534,7 +487,10 @@ fn geom(
     }
     let (mut pos, mut quat) = cx.pose(&a)?;
     if let Some(ft) = a.arr::<6>("fromto")? {
-        let (p0, p1) = (Vector3::new(ft[0], ft[1], ft[2]), Vector3::new(ft[3], ft[4], ft[5]));
+        let (p0, p1) = (
+            Vector3::new(ft[0], ft[1], ft[2]),
+            Vector3::new(ft[3], ft[4], ft[5]),
+        );
         let d = p1 - p0;
         match kind {
             MjGeomType::Capsule | MjGeomType::Cylinder => size[1] = d.norm() / 2.0,
@@ -542,7 +498,12 @@ fn geom(
                 size[1] = size[0];
                 size[2] = d.norm() / 2.0;
             }
-            _ => return Err(a.err("fromto", "applies to capsules, cylinders, boxes and ellipsoids")),
+            _ => {
+                return Err(a.err(
+                    "fromto",
+                    "applies to capsules, cylinders, boxes and ellipsoids",
+                ))
+            }
         }
         pos = (p0 + p1) / 2.0;
         quat = orient::z_axis(d).ok_or_else(|| a.err("fromto", "has equal ends"))?;
@@ -555,11 +516,20 @@ fn geom(
         cx.note("condim 4/6 (torsional and rolling friction)".into());
     }
     if a.flag("shellinertia")? == Some(true) {
-        return Err(a.err("shellinertia", "shell inertia is not supported by urdyn yet"));
+        return Err(a.err(
+            "shellinertia",
+            "shell inertia is not supported by urdyn yet",
+        ));
     }
     let asset = match kind {
-        MjGeomType::Mesh => Some(a.get("mesh").ok_or_else(|| el.err("a mesh geom needs mesh"))?),
-        MjGeomType::Hfield => Some(a.get("hfield").ok_or_else(|| el.err("an hfield geom needs hfield"))?),
+        MjGeomType::Mesh => Some(
+            a.get("mesh")
+                .ok_or_else(|| el.err("a mesh geom needs mesh"))?,
+        ),
+        MjGeomType::Hfield => Some(
+            a.get("hfield")
+                .ok_or_else(|| el.err("an hfield geom needs hfield"))?,
+        ),
         _ => None,
     }
     .map(str::to_string);

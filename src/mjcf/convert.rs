@@ -23,7 +23,10 @@ fn rot_wxyz(q: &[f64]) -> UnitQuaternion<f64> {
 }
 
 /// urdyn's q from MuJoCo's qpos.
-pub fn from_mujoco_qpos(model: &Model, qpos: &DVector<f64>) -> Result<DVector<f64>, DimensionError> {
+pub fn from_mujoco_qpos(
+    model: &Model,
+    qpos: &DVector<f64>,
+) -> Result<DVector<f64>, DimensionError> {
     DimensionError::check("qpos", model.nq, qpos.len())?;
     let mut q = qpos.clone();
     for (iq, _) in free_joints(model) {

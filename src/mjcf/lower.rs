@@ -284,7 +284,10 @@ pub(super) fn lower(world: &World, file: &str) -> Result<Model, MjcfError> {
             .map(|p| p.rot == Matrix3::identity())
             .collect(),
         placements,
-        inertias_origin: inertias.iter().map(CompositeInertia::from_inertia).collect(),
+        inertias_origin: inertias
+            .iter()
+            .map(CompositeInertia::from_inertia)
+            .collect(),
         inertias,
         body_joint_names,
         body_link_names,

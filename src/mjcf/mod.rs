@@ -22,6 +22,7 @@ mod convert;
 mod inertia;
 mod lower;
 mod orient;
+mod world;
 mod xml;
 
 pub use compile::{MjBody, MjGeom, MjGeomType, MjJoint, MjJointType, World};
@@ -69,7 +70,11 @@ fn read_text(path: &Path) -> Result<String, MjcfError> {
     let meta = std::fs::metadata(path)
         .map_err(|e| MjcfError::new(&name, None, format!("cannot read file: {e}")))?;
     if meta.is_dir() {
-        return Err(MjcfError::new(&name, None, "is a directory, not an MJCF file"));
+        return Err(MjcfError::new(
+            &name,
+            None,
+            "is a directory, not an MJCF file",
+        ));
     }
     let bytes = std::fs::read(path)
         .map_err(|e| MjcfError::new(&name, None, format!("cannot read file: {e}")))?;
@@ -106,8 +111,22 @@ pub fn load_world(path: impl AsRef<Path>) -> Result<World, MjcfError> {
 }
 
 const SECTIONS: &[&str] = &[
-    "compiler", "option", "size", "visual", "statistic", "default", "extension", "custom",
-    "asset", "worldbody", "contact", "equality", "deformable", "tendon", "actuator", "sensor",
+    "compiler",
+    "option",
+    "size",
+    "visual",
+    "statistic",
+    "default",
+    "extension",
+    "custom",
+    "asset",
+    "worldbody",
+    "contact",
+    "equality",
+    "deformable",
+    "tendon",
+    "actuator",
+    "sensor",
     "keyframe",
 ];
 
@@ -116,7 +135,12 @@ pub fn compile_str(text: &str, file: &str, base_dir: &Path) -> Result<World, Mjc
     compile(text, file, base_dir, None)
 }
 
-fn compile(text: &str, file: &str, base_dir: &Path, main: Option<&Path>) -> Result<World, MjcfError> {
+fn compile(
+    text: &str,
+    file: &str,
+    base_dir: &Path,
+    main: Option<&Path>,
+) -> Result<World, MjcfError> {
     let root = xml::read(text, file, base_dir, main)?;
     for c in &root.children {
         if !SECTIONS.contains(&c.tag.as_str()) {
@@ -162,9 +186,15 @@ fn compile(text: &str, file: &str, base_dir: &Path, main: Option<&Path>) -> Resu
     for (tag, what) in [
         ("tendon", "tendons: not modelled yet (MJCF simulation)"),
         ("actuator", "actuators: not modelled yet (MJCF simulation)"),
-        ("equality", "equality constraints: not modelled yet (MJCF simulation)"),
+        (
+            "equality",
+            "equality constraints: not modelled yet (MJCF simulation)",
+        ),
         ("sensor", "sensors: not modelled (urdyn has its own)"),
-        ("contact", "explicit contact pairs and exclusions: not modelled yet (MJCF simulation)"),
+        (
+            "contact",
+            "explicit contact pairs and exclusions: not modelled yet (MJCF simulation)",
+        ),
     ] {
         if of(tag).any(|s| !s.children.is_empty()) {
             cx.not_modelled.push(what.to_string());
@@ -176,10 +206,27 @@ fn compile(text: &str, file: &str, base_dir: &Path, main: Option<&Path>) -> Resu
 }
 
 const COMPILER_ATTRS: &[&str] = &[
-    "autolimits", "boundmass", "boundinertia", "settotalmass", "balanceinertia", "strippath",
-    "coordinate", "angle", "fitaabb", "eulerseq", "meshdir", "texturedir", "assetdir",
-    "discardvisual", "usethread", "fusestatic", "inertiafromgeom", "inertiagrouprange",
-    "saveinertial", "alignfree", "convexhull",
+    "autolimits",
+    "boundmass",
+    "boundinertia",
+    "settotalmass",
+    "balanceinertia",
+    "strippath",
+    "coordinate",
+    "angle",
+    "fitaabb",
+    "eulerseq",
+    "meshdir",
+    "texturedir",
+    "assetdir",
+    "discardvisual",
+    "usethread",
+    "fusestatic",
+    "inertiafromgeom",
+    "inertiagrouprange",
+    "saveinertial",
+    "alignfree",
+    "convexhull",
 ];
 
 fn settings(els: &[&xml::El], defaults: &attrs::Defaults) -> Result<Settings, MjcfError> {
@@ -204,10 +251,10 @@ fn settings(els: &[&xml::El], defaults: &attrs::Defaults) -> Result<Settings, Mj
                 _ => return Err(a.err("angle", "must be degree or radian")),
             };
         }
-        if let Some(v) = a.get("coordinate") {
-            if v != "local" {
-                return Err(a.err("coordinate", "only local coordinates exist in MuJoCo 4"));
-            }
+        if let Some(v) = a.get("coordinate")
+            && v != "local"
+        {
+            return Err(a.err("coordinate", "only local coordinates exist in MuJoCo 4"));
         }
         if let Some(v) = a.get("eulerseq") {
             let b = v.as_bytes();
@@ -260,8 +307,9 @@ fn options(cx: &mut Ctx, els: &[&xml::El]) -> Result<(), MjcfError> {
             cx.world.timestep = t;
         }
         if let Some(i) = a.get("integrator") {
-            cx.not_modelled
-                .push(format!("<option integrator=\"{i}\">: urdyn integrates with its own"));
+            cx.not_modelled.push(format!(
+                "<option integrator=\"{i}\">: urdyn integrates with its own"
+            ));
         }
         for f in el.children.iter().filter(|c| c.tag == "flag") {
             if f.attr("gravity") == Some("disable") {

@@ -20,7 +20,9 @@ pub(crate) fn axis_angle(axis: Vector3<f64>, angle: f64) -> Option<UnitQuaternio
     }
     let (s, c) = (angle / 2.0).sin_cos();
     let a = axis / n * s;
-    Some(UnitQuaternion::new_unchecked(Quaternion::new(c, a.x, a.y, a.z)))
+    Some(UnitQuaternion::new_unchecked(Quaternion::new(
+        c, a.x, a.y, a.z,
+    )))
 }
 
 /// Euler angles (rad) in MuJoCo's `eulerseq`: lower-case letters rotate about the

@@ -52,7 +52,10 @@ pub(crate) fn read(
     base_dir: &Path,
     main: Option<&Path>,
 ) -> Result<El, MjcfError> {
-    let mut stack: Vec<PathBuf> = main.and_then(|p| std::fs::canonicalize(p).ok()).into_iter().collect();
+    let mut stack: Vec<PathBuf> = main
+        .and_then(|p| std::fs::canonicalize(p).ok())
+        .into_iter()
+        .collect();
     let root = parse_one(text, file)?;
     if root.tag != "mujoco" {
         return Err(MjcfError::new(
@@ -87,8 +90,12 @@ fn expand(
             )));
         }
         let path = base_dir.join(name);
-        let canon = std::fs::canonicalize(&path)
-            .map_err(|e| c.err(format!("file=\"{name}\": cannot read {}: {e}", path.display())))?;
+        let canon = std::fs::canonicalize(&path).map_err(|e| {
+            c.err(format!(
+                "file=\"{name}\": cannot read {}: {e}",
+                path.display()
+            ))
+        })?;
         if stack.contains(&canon) {
             return Err(c.err(format!("file=\"{name}\": cyclic include")));
         }

@@ -21,7 +21,6 @@ pub use joint::{Axis, Joint, JointKind};
 pub use topology::{FdMethod, Topology};
 pub use trees::{FreeJoint, Tree};
 
-
 use crate::spatial::{Inertia, Scalar, Se3};
 use nalgebra::{DVector, Vector3};
 use std::path::PathBuf;
