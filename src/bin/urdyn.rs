@@ -286,8 +286,7 @@ fn run(cli: Cli) -> Result<()> {
                 }
             }
             let text = if json {
-                let mjcf = urdyn::load::file_format(&urdf) == urdyn::load::Format::Mjcf;
-                let mut j = serde_json::to_string(&inspect::json(&model, mjcf, &package_path))?;
+                let mut j = serde_json::to_string(&inspect::json(&model, &package_path))?;
                 j.push('\n');
                 j
             } else {

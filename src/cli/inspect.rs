@@ -114,33 +114,9 @@ pub fn report(model: &Model, package_paths: &[PathBuf]) -> String {
     s
 }
 
-/// The names of q and v in engine order (mechanisms.md): a free joint's
-/// `J:x … J:qw` / `J:vx … J:wz` (with `--floating-base`, the URDF base's
-/// `base_x … base_qw` / `base_vx … base_wz`), then each joint's name.
-pub fn q_v_names(model: &Model, mjcf: bool) -> (Vec<String>, Vec<String>) {
-    let sep = if mjcf { ":" } else { "_" };
-    let mut qn = Vec::with_capacity(model.nq);
-    let mut vn = Vec::with_capacity(model.nv);
-    for t in &model.trees {
-        if let Some(f) = t.free.and_then(|i| model.free_joints.get(i)) {
-            for s in ["x", "y", "z", "qx", "qy", "qz", "qw"] {
-                qn.push(format!("{}{sep}{s}", f.name));
-            }
-            for s in ["vx", "vy", "vz", "wx", "wy", "wz"] {
-                vn.push(format!("{}{sep}{s}", f.name));
-            }
-        }
-        for d in &model.dofs[t.dofs.clone()] {
-            qn.push(d.name.clone());
-            vn.push(d.name.clone());
-        }
-    }
-    (qn, vn)
-}
-
 /// `inspect --json` (mjcf.md): each link's (MJCF body's) own mass, centre of mass
 /// and inertia about it in its frame, the q and v names, the warnings.
-pub fn json(model: &Model, mjcf: bool, package_paths: &[PathBuf]) -> serde_json::Value {
+pub fn json(model: &Model, package_paths: &[PathBuf]) -> serde_json::Value {
     let mut bodies = serde_json::Map::new();
     for b in &model.report.bodies {
         let i = &b.inertia;
@@ -150,7 +126,7 @@ pub fn json(model: &Model, mjcf: bool, package_paths: &[PathBuf]) -> serde_json:
             serde_json::json!({"mass": b.mass, "com": [b.com.x, b.com.y, b.com.z], "inertia": rows}),
         );
     }
-    let (qn, vn) = q_v_names(model, mjcf);
+    let (qn, vn) = (model.q_names(), model.v_names());
     serde_json::json!({
         "bodies": bodies,
         "q_names": qn,

@@ -415,7 +415,7 @@ fn joint(
         }
         (frame.0 + frame.1 * p, frame.1 * (ax / n))
     };
-    let angular = kind == MjJointType::Hinge;
+    let angular = matches!(kind, MjJointType::Hinge | MjJointType::Ball);
     let conv = |x: f64| if angular { cx.angle(x) } else { x };
     let range = a.arr::<2>("range")?;
     let limited = match a.get("limited").unwrap_or("auto") {
@@ -426,6 +426,9 @@ fn joint(
         _ => return Err(a.err("limited", "must be true, false or auto")),
     };
     let range = match (limited, range) {
+        (true, Some([lo, _])) if kind == MjJointType::Ball && lo != 0.0 => {
+            return Err(a.err("range", "a ball joint's range starts at 0 (a cone angle)"));
+        }
         (true, Some([lo, hi])) => {
             if lo > hi {
                 return Err(a.err("range", "lower bound above upper bound"));

@@ -3,8 +3,8 @@
 //! w-first in MuJoCo (`[x y z qw qx qy qz]`) and `[x y z qx qy qz qw]` in urdyn,
 //! and its linear velocity is world-frame in MuJoCo's qvel, body-frame in urdyn's
 //! v (v_lin = Rᵀ qvel_lin, R the body's orientation; the angular part is
-//! body-frame in both). A ball joint (when urdyn has one) swaps its quaternion
-//! the same way and keeps its velocity.
+//! body-frame in both). A ball joint swaps its quaternion the same way and keeps
+//! its velocity (body-frame angular in both).
 
 use crate::model::{DimensionError, JointKind, Model};
 use nalgebra::{DVector, Quaternion, UnitQuaternion, Vector3};
@@ -15,6 +15,15 @@ fn free_joints(model: &Model) -> impl Iterator<Item = (usize, usize)> + '_ {
         .iter()
         .filter(|j| matches!(j.kind, JointKind::Free))
         .map(|j| (j.iq, j.iv))
+}
+
+/// Where each quaternion starts in q: a free joint's at `iq + 3`, a ball joint's at `iq`.
+fn quaternions(model: &Model) -> impl Iterator<Item = usize> + '_ {
+    model.joints[1..].iter().filter_map(|j| match j.kind {
+        JointKind::Free => Some(j.iq + 3),
+        JointKind::Spherical => Some(j.iq),
+        _ => None,
+    })
 }
 
 /// The rotation of a w-first quaternion at `q[at..at + 4]` (normalised).
@@ -29,12 +38,11 @@ pub fn from_mujoco_qpos(
 ) -> Result<DVector<f64>, DimensionError> {
     DimensionError::check("qpos", model.nq, qpos.len())?;
     let mut q = qpos.clone();
-    for (iq, _) in free_joints(model) {
-        let w = qpos[iq + 3];
+    for at in quaternions(model) {
         for k in 0..3 {
-            q[iq + 3 + k] = qpos[iq + 4 + k];
+            q[at + k] = qpos[at + 1 + k];
         }
-        q[iq + 6] = w;
+        q[at + 3] = qpos[at];
     }
     Ok(q)
 }
@@ -43,10 +51,10 @@ pub fn from_mujoco_qpos(
 pub fn to_mujoco_qpos(model: &Model, q: &DVector<f64>) -> Result<DVector<f64>, DimensionError> {
     DimensionError::check("q", model.nq, q.len())?;
     let mut qpos = q.clone();
-    for (iq, _) in free_joints(model) {
-        qpos[iq + 3] = q[iq + 6];
+    for at in quaternions(model) {
+        qpos[at] = q[at + 3];
         for k in 0..3 {
-            qpos[iq + 4 + k] = q[iq + 3 + k];
+            qpos[at + 1 + k] = q[at + k];
         }
     }
     Ok(qpos)

@@ -12,8 +12,8 @@
 use super::compile::{MjGeomType, MjJointType, World};
 use super::MjcfError;
 use crate::model::{
-    Axis, CollisionFilter, CollisionGeom, DofInfo, Frame, FreeJoint, ImportReport, Joint,
-    JointKind, JointLimits, LinkMass, Model, Shape, Topology, Tree, OBSTACLE,
+    Axis, CollisionFilter, CollisionGeom, DofInfo, Frame, ImportReport, Joint, JointKind,
+    JointLimits, LinkMass, Model, Shape, Topology, Tree, OBSTACLE,
 };
 use crate::spatial::{CompositeInertia, Inertia, Se3};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
@@ -22,7 +22,7 @@ fn se3(p: &Vector3<f64>, q: &UnitQuaternion<f64>) -> Se3<f64> {
     Se3::new(q.to_rotation_matrix().into_inner(), *p)
 }
 
-pub(super) fn lower(world: &World, file: &str) -> Result<Model, MjcfError> {
+pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
     let nb = world.bodies.len();
     let mut parent = vec![0usize];
     let mut joints = vec![Joint {
@@ -37,7 +37,6 @@ pub(super) fn lower(world: &World, file: &str) -> Result<Model, MjcfError> {
     let mut body_joint_names = vec!["universe".to_string()];
     let mut body_link_names = vec!["world".to_string()];
     let mut dofs = Vec::new();
-    let mut free_joints = Vec::new();
     let mut frames = Vec::new();
     let mut trees: Vec<Tree> = Vec::new();
     let mut report = ImportReport::default();
@@ -72,42 +71,40 @@ pub(super) fn lower(world: &World, file: &str) -> Result<Model, MjcfError> {
         for j in body.joints.clone() {
             let jt = &world.joints[j];
             names.push(jt.name.clone());
-            let (kind, placement, after, nqj, nvj) = match jt.kind {
+            let (kind, placement, after) = match jt.kind {
                 MjJointType::Free => {
-                    let t = trees.last_mut().expect("a top-level body opened a tree");
-                    t.free = Some(free_joints.len());
-                    free_joints.push(FreeJoint {
-                        body: parent.len(),
-                        iq: nq,
-                        iv: nv,
-                        name: jt.name.clone(),
-                    });
+                    // q is the body's world pose (MuJoCo's qpos): identity placement
                     let (p, r) = (&body.pos, &body.quat);
                     qpos0.extend([p.x, p.y, p.z, r.i, r.j, r.k, r.w]);
-                    (JointKind::Free, Se3::identity(), Se3::identity(), 7, 6)
+                    (JointKind::Free, Se3::identity(), Se3::identity())
                 }
                 MjJointType::Ball => {
-                    return Err(MjcfError::new(
-                        file,
-                        Some(jt.label.clone()),
-                        "type=\"ball\": ball joints are not supported yet (they wait for urdyn's spherical joint)",
-                    ))
+                    // a rotation about the anchor, as a hinge's
+                    qpos0.extend([0.0, 0.0, 0.0, 1.0]);
+                    if jt.range.is_some() {
+                        report.warnings.push(format!(
+                            "joint \"{}\": a ball joint's range (a cone limit) is not modelled",
+                            jt.name
+                        ));
+                    }
+                    (
+                        JointKind::Spherical,
+                        cur.compose(&Se3::from_translation(jt.pos)),
+                        Se3::from_translation(-jt.pos),
+                    )
                 }
                 MjJointType::Hinge => (
                     JointKind::Revolute(Axis::from_unit(jt.axis)),
                     cur.compose(&Se3::from_translation(jt.pos)),
                     Se3::from_translation(-jt.pos),
-                    1,
-                    1,
                 ),
                 MjJointType::Slide => (
                     JointKind::Prismatic(Axis::from_unit(jt.axis)),
                     cur,
                     Se3::identity(),
-                    1,
-                    1,
                 ),
             };
+            let (nqj, nvj) = (kind.nq(), kind.nv());
             parent.push(at);
             joints.push(Joint {
                 kind,
@@ -127,28 +124,26 @@ pub(super) fn lower(world: &World, file: &str) -> Result<Model, MjcfError> {
             });
             if nvj == 1 {
                 qpos0.push(jt.reference);
-                let limited = jt.range.is_some();
-                dofs.push(DofInfo {
-                    name: jt.name.clone(),
-                    limits: JointLimits {
-                        lower: jt.range.map(|r| r.0),
-                        upper: jt.range.map(|r| r.1),
-                        effort: None,
-                        velocity: None,
-                    },
-                    damping: jt.damping,
-                    friction: jt.frictionloss,
-                    continuous: jt.kind == MjJointType::Hinge && !limited,
-                    armature: jt.armature,
-                    stiffness: jt.stiffness,
-                    springref: jt.springref,
-                });
-            } else if jt.armature != 0.0 || jt.damping != 0.0 || jt.stiffness != 0.0 {
-                report.warnings.push(format!(
-                    "joint \"{}\": armature, damping and stiffness of a free joint are not modelled",
-                    jt.name
-                ));
             }
+            let one_dof = nvj == 1;
+            dofs.push(DofInfo {
+                name: jt.name.clone(),
+                kind,
+                iq: nq,
+                iv: nv,
+                limits: JointLimits {
+                    lower: jt.range.filter(|_| one_dof).map(|r| r.0),
+                    upper: jt.range.filter(|_| one_dof).map(|r| r.1),
+                    effort: None,
+                    velocity: None,
+                },
+                damping: jt.damping,
+                friction: jt.frictionloss,
+                continuous: jt.kind == MjJointType::Hinge && jt.range.is_none(),
+                armature: jt.armature,
+                stiffness: jt.stiffness,
+                springref: jt.springref,
+            });
             nq += nqj;
             nv += nvj;
             at = parent.len() - 1;
@@ -271,7 +266,6 @@ pub(super) fn lower(world: &World, file: &str) -> Result<Model, MjcfError> {
         ));
     }
     let topology = Topology::new(&dof_parent, nbodies, false);
-    let floating_base = free_joints.first().is_some_and(|f: &FreeJoint| f.body == 1);
     Ok(Model {
         name: world.name.clone(),
         nq,
@@ -292,8 +286,8 @@ pub(super) fn lower(world: &World, file: &str) -> Result<Model, MjcfError> {
         body_joint_names,
         body_link_names,
         gravity: world.gravity,
-        floating_base,
-        free_joints,
+        floating_base: false,
+        free_joints: Vec::new(),
         trees,
         dofs,
         frames,

@@ -92,7 +92,7 @@ pub fn load_file(path: impl AsRef<Path>) -> Result<Model, MjcfError> {
     let path = path.as_ref();
     let text = read_text(path)?;
     let world = compile(&text, &path.display().to_string(), dir_of(path), Some(path))?;
-    let mut model = lower::lower(&world, &path.display().to_string())?;
+    let mut model = lower::lower(&world)?;
     model.source = Some(path.to_path_buf());
     Ok(model)
 }
@@ -100,7 +100,7 @@ pub fn load_file(path: impl AsRef<Path>) -> Result<Model, MjcfError> {
 /// Imports MJCF text; `file` names it in errors, includes are read under `base_dir`.
 pub fn load_str(text: &str, file: &str, base_dir: &Path) -> Result<Model, MjcfError> {
     let world = compile_str(text, file, base_dir)?;
-    lower::lower(&world, file)
+    lower::lower(&world)
 }
 
 /// MuJoCo's compiled world of an MJCF file (bodies, joints, geoms in MuJoCo's ids).

@@ -6,15 +6,18 @@ use super::Model;
 use nalgebra::DVector;
 
 impl Model<f64> {
-    /// A (nv): each joint degree of freedom's armature at its v index, 0 for free
-    /// joints; `None` when every entry is 0 (H is then the rigid bodies' alone).
+    /// A (nv): each joint's armature on each of its velocity coordinates (MuJoCo's
+    /// `dof_armature`), 0 for a free base; `None` when every entry is 0 (H is then
+    /// the rigid bodies' alone).
     pub fn armature(&self) -> Option<DVector<f64>> {
         if self.dofs.iter().all(|d| d.armature == 0.0) {
             return None;
         }
         let mut a = DVector::zeros(self.nv);
-        for (d, _, iv) in self.dof_indices() {
-            a[iv] = self.dofs[d].armature;
+        for d in &self.dofs {
+            for k in 0..d.kind.nv() {
+                a[d.iv + k] = d.armature;
+            }
         }
         Some(a)
     }

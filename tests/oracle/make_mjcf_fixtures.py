@@ -1,7 +1,7 @@
 """MuJoCo 4.0's numbers for urdyn's MJCF import (tests/mjcf_oracle.rs).
 
-For every model under tests/fixtures/mjcf/{gymnasium,dm_control}/*.xml that MuJoCo
-compiles: per body its compiled mass, centre of mass and inertia about it in the
+For every model under tests/fixtures/mjcf/{gymnasium,dm_control,synthetic}/*.xml that
+MuJoCo compiles: per body its compiled mass, centre of mass and inertia about it in the
 body frame (body_mass, body_ipos, body_iquat·diag(body_inertia)·body_iquatᵀ), and
 at 5 random states, in urdyn's coordinates (mjcf.md §"In `eval`"): the mass matrix
 with armature H = Tᵀ qM T, bias = Tᵀ (qfrc_bias + qM Ṫ v), tau = Tᵀ (mj_rne(qacc) +
@@ -69,15 +69,16 @@ def fixture(path, rng):
         }
     frees = [(m.jnt_qposadr[j], m.jnt_dofadr[j]) for j in range(m.njnt)
              if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE]
-    assert all(m.jnt_type[j] != mujoco.mjtJoint.mjJNT_BALL for j in range(m.njnt))
+    balls = [m.jnt_qposadr[j] for j in range(m.njnt)
+             if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_BALL]
     disable_all_but_dynamics(m)
     states = []
     for _ in range(NSTATES):
         qpos = m.qpos0.copy()
         qpos += rng.uniform(-1, 1, m.nq)
-        for qa, _ in frees:
+        for qa in [qa + 3 for qa, _ in frees] + balls:
             q = rng.normal(size=4)
-            qpos[qa + 3:qa + 7] = q / np.linalg.norm(q)
+            qpos[qa:qa + 4] = q / np.linalg.norm(q)
         qvel = rng.uniform(-1, 1, m.nv)
         a = rng.uniform(-1, 1, m.nv)
         tau_in = rng.uniform(-1, 1, m.nv)
@@ -88,8 +89,9 @@ def fixture(path, rng):
             R = quat_mat(qpos[qa + 3:qa + 7])
             T[da:da + 3, da:da + 3] = R
             Td[da:da + 3, da:da + 3] = R @ skew(qvel[da + 3:da + 6])
-            q_u[qa + 3:qa + 6] = qpos[qa + 4:qa + 7]
-            q_u[qa + 6] = qpos[qa + 3]
+        for qa in [qa + 3 for qa, _ in frees] + balls:  # w-first to w-last
+            q_u[qa:qa + 3] = qpos[qa + 1:qa + 4]
+            q_u[qa + 3] = qpos[qa]
         v = np.linalg.solve(T, qvel)
         d.qpos[:] = qpos
         d.qvel[:] = qvel
@@ -129,7 +131,7 @@ def main():
     os.makedirs(OUT, exist_ok=True)
     rng = np.random.default_rng(29)
     made = []
-    for suite in ["gymnasium", "dm_control"]:
+    for suite in ["gymnasium", "dm_control", "synthetic"]:
         for path in sorted(glob.glob(os.path.join(ROOT, suite, "*.xml"))):
             stem = os.path.splitext(os.path.basename(path))[0]
             try:
