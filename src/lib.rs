@@ -57,12 +57,15 @@
 pub mod cli;
 pub mod contact;
 pub mod dynamics;
+pub mod load;
+pub mod mjcf;
 pub mod model;
 pub mod scene;
 pub mod sim;
 pub mod spatial;
 pub mod urdf;
 
+pub use load::{load_model, LoadError};
 pub use model::{Data, Model};
 /// The nalgebra this crate is built with (its vectors and matrices are in the API):
 /// `urdyn::nalgebra::DVector` always matches.

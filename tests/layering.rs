@@ -47,14 +47,15 @@ fn offending_lines(layer: &str, above: &[&str]) -> Vec<String> {
 #[test]
 fn lower_layers_do_not_reach_up() {
     let mut bad = Vec::new();
-    for layer in ["spatial", "model", "urdf", "scene"] {
+    for layer in ["spatial", "model", "urdf", "mjcf", "scene"] {
         bad.extend(offending_lines(
             layer,
             &["dynamics", "contact", "sim", "cli"],
         ));
     }
     bad.extend(offending_lines("spatial", &["model", "urdf"]));
-    bad.extend(offending_lines("model", &["urdf", "scene"]));
+    bad.extend(offending_lines("model", &["urdf", "mjcf", "scene"]));
+    bad.extend(offending_lines("mjcf", &["urdf", "scene"]));
     bad.extend(offending_lines("urdf", &["scene"]));
     assert!(bad.is_empty(), "layering broken:\n{}", bad.join("\n"));
 }

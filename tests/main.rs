@@ -29,6 +29,8 @@ mod fast_dynamics;
 mod joint_kinds;
 mod kinematics_energy;
 mod layering;
+mod mjcf_cli;
+mod mjcf_oracle;
 mod output_files;
 mod pinocchio_derivatives;
 mod pinocchio_fixtures;

@@ -35,6 +35,10 @@ enum Command {
         /// Treat every warning as an error: fail (non-zero exit) with the first one.
         #[arg(long)]
         strict: bool,
+        /// Print one JSON object (mass properties per link or MJCF body, q and v
+        /// names, warnings) instead of the report.
+        #[arg(long)]
+        json: bool,
     },
     /// Evaluate inverse dynamics, forward dynamics, C(q, v), H(q) and link poses for a
     /// batch of states (JSON in, JSON out; see eval-contract.md).
@@ -236,7 +240,7 @@ fn bench(a: BenchArgs) -> Result<()> {
             ))
         }
     };
-    let model = urdyn::load_file(
+    let model = urdyn::load_model(
         &a.urdf,
         LoadOptions {
             floating_base: a.floating_base,
@@ -322,14 +326,21 @@ fn run(cli: Cli) -> Result<()> {
             floating_base,
             package_path,
             strict,
+            json,
         } => {
-            let model = urdyn::load_file(&urdf, LoadOptions { floating_base })?;
+            let model = urdyn::load_model(&urdf, LoadOptions { floating_base })?;
             if strict {
                 if let Some(w) = inspect::warnings(&model, &package_path).first() {
                     anyhow::bail!("{}: {w} (--strict: warnings are errors)", urdf.display());
                 }
             }
-            let text = inspect::report(&model, &package_path);
+            let text = if json {
+                let mut j = serde_json::to_string(&inspect::json(&model, &package_path))?;
+                j.push('\n');
+                j
+            } else {
+                inspect::report(&model, &package_path)
+            };
             std::io::stdout().write_all(text.as_bytes())?;
         }
         Command::Eval {
@@ -338,7 +349,7 @@ fn run(cli: Cli) -> Result<()> {
             floating_base,
             output,
         } => {
-            let model = urdyn::load_file(&urdf, LoadOptions { floating_base })?;
+            let model = urdyn::load_model(&urdf, LoadOptions { floating_base })?;
             let states_name = states.display().to_string();
             let text = state::read_text(&states)?;
             let parsed = state::parse_states(&text, &states_name)?;

@@ -250,6 +250,7 @@ fn evaluate_each(
     let mut data = Data::new(&model);
     let names = model.dof_names();
     let mut fext = vec![Force::zero(); model.nbodies];
+    let armature = model.armature();
     for (i, sv) in vectors.iter().enumerate() {
         let key = format!("states[{i}]");
         let dyn_err = |e: DynamicsError| EvalError::Dynamics {
@@ -263,23 +264,45 @@ fn evaluate_each(
             dynamics::add_link_wrench(&model, &data, *link, f, t, &mut fext).map_err(dyn_err)?;
         }
         let fx = (!sv.fext.is_empty()).then_some(fext.as_slice());
-        let tau = dynamics::rnea(&model, &mut data, &sv.q, &sv.v, &sv.a, fx)
+        let mut tau = dynamics::rnea(&model, &mut data, &sv.q, &sv.v, &sv.a, fx)
             .map_err(dyn_err)?
             .clone();
         let bias = dynamics::bias(&model, &mut data, &sv.q, &sv.v, fx)
             .map_err(dyn_err)?
             .clone();
-        let h = dynamics::mass_matrix(&model, &mut data, &sv.q)
+        let mut h = dynamics::mass_matrix(&model, &mut data, &sv.q)
             .map_err(dyn_err)?
             .clone();
+        // An MJCF joint's armature is in H (MuJoCo's qM): H + A, tau + A a,
+        // qdd = (H + A)⁻¹ (τ − bias) by the Cholesky factor below.
+        if let Some(arm) = &armature {
+            for k in 0..model.nv {
+                h[(k, k)] += arm[k];
+            }
+            tau += arm.component_mul(&sv.a);
+        }
         // The contract's singularity test is on H itself (a pivot at most 64 ε of its
         // diagonal), whichever algorithm the engine's fd then uses.
         if let Err(k) = dynamics::linalg::cholesky(&h, &mut data.chol) {
             return Err(dyn_err(DynamicsError::Singular(k)));
         }
-        let qdd = dynamics::forward_dynamics(&model, &mut data, &sv.q, &sv.v, &sv.tau, fx)
-            .map_err(dyn_err)?
-            .clone();
+        let qdd = if armature.is_some() {
+            let mut x = &sv.tau - &bias;
+            dynamics::linalg::cholesky_solve(&data.chol, &mut x);
+            x
+        } else {
+            dynamics::forward_dynamics(&model, &mut data, &sv.q, &sv.v, &sv.tau, fx)
+                .map_err(dyn_err)?
+                .clone()
+        };
+        if armature.is_some() && sv.derivatives {
+            return Err(EvalError::Dynamics {
+                file: states_file.to_string(),
+                message: format!(
+                    "{key}: derivatives of a model with joint armature are not supported yet"
+                ),
+            });
+        }
         let kin = kinematics(&model, &mut data, sv).map_err(dyn_err)?;
         let constrained = match &constraints {
             Some(c) => Some(

@@ -116,3 +116,24 @@ pub fn report(model: &Model, package_paths: &[PathBuf]) -> String {
     }
     s
 }
+
+/// `inspect --json` (mjcf.md): each link's (MJCF body's) own mass, centre of mass
+/// and inertia about it in its frame, the q and v names, the warnings.
+pub fn json(model: &Model, package_paths: &[PathBuf]) -> serde_json::Value {
+    let mut bodies = serde_json::Map::new();
+    for b in &model.report.bodies {
+        let i = &b.inertia;
+        let rows: Vec<[f64; 3]> = (0..3).map(|r| [i[(r, 0)], i[(r, 1)], i[(r, 2)]]).collect();
+        bodies.insert(
+            b.name.clone(),
+            serde_json::json!({"mass": b.mass, "com": [b.com.x, b.com.y, b.com.z], "inertia": rows}),
+        );
+    }
+    let (qn, vn) = (model.q_names(), model.v_names());
+    serde_json::json!({
+        "bodies": bodies,
+        "q_names": qn,
+        "v_names": vn,
+        "warnings": warnings(model, package_paths),
+    })
+}

@@ -475,6 +475,12 @@ type Setup = (
 
 /// A lone URDF's run: `--floating-base`, `--initial`, the ground and friction options.
 fn urdf_setup(args: &SimulateArgs, integrator: Option<Integrator>) -> Result<Setup, SimulateError> {
+    if crate::load::file_format(&args.urdf) == crate::load::Format::Mjcf {
+        return Err(SimulateError::Option(format!(
+            "{}: simulating an MJCF world (its contacts, actuators, tendons and equalities) is not supported yet; inspect, eval and bench read it",
+            args.urdf.display()
+        )));
+    }
     let model: Model = crate::load_file(
         &args.urdf,
         LoadOptions {

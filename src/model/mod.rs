@@ -5,6 +5,7 @@
 //! world. A body is a movable joint plus every link welded to its child link
 //! through fixed joints; each URDF link stays addressable as a [`Frame`].
 
+mod armature;
 pub mod configuration;
 mod constraints;
 mod data;
@@ -64,6 +65,27 @@ pub struct DofInfo {
     pub friction: f64,
     /// Whether the joint is continuous (unbounded angle).
     pub continuous: bool,
+    /// Rotor inertia on H's diagonal (MJCF `armature`, in H as MuJoCo's `qM`); 0
+    /// for a URDF, whose `--armature` is the simulation's option.
+    pub armature: f64,
+    /// Joint spring stiffness (MJCF `stiffness`; 0 for a URDF).
+    pub stiffness: f64,
+    /// The spring's rest position (MJCF `springref`).
+    pub springref: f64,
+}
+
+/// A link's (an MJCF body's) own mass properties as the file gives them
+/// (`inspect --json`): mass, centre of mass and inertia about it, in its frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinkMass {
+    /// The link's or body's name.
+    pub name: String,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Centre of mass in the link frame (m).
+    pub com: Vector3<f64>,
+    /// Inertia about the centre of mass in the link frame (kg·m²).
+    pub inertia: nalgebra::Matrix3<f64>,
 }
 
 /// A URDF link as a frame on its body: `placement` is `body_M_link`.
@@ -225,6 +247,8 @@ pub struct ImportReport {
     /// specification, malformed visuals and materials. `urdyn inspect --strict`
     /// makes the first one an error.
     pub warnings: Vec<String>,
+    /// Each link's own mass properties, in file order (`inspect --json`).
+    pub bodies: Vec<LinkMass>,
 }
 
 /// The immutable multibody model. Arrays indexed by body have `nbodies` entries,
@@ -296,6 +320,10 @@ pub struct Model<T: Scalar = f64> {
     pub source: Option<PathBuf>,
     /// What the import merged, ignored or warned about.
     pub report: ImportReport,
+    /// The configuration the file defines (MJCF's `qpos0`: each hinge or slide at
+    /// its `ref`, each free joint at its body's defined pose), returned by
+    /// [`Model::neutral`]; `None` (a URDF, a scene): zeros and identity rotations.
+    pub qpos0: Option<Vec<f64>>,
 }
 
 impl<T: Scalar> Model<T> {
@@ -336,9 +364,12 @@ impl<T: Scalar> Model<T> {
     pub fn frame_index(&self, name: &str) -> Option<usize> {
         self.frames.iter().position(|f| f.name == name)
     }
-    /// The neutral configuration: zeros, identity orientation of every free and
-    /// spherical joint.
+    /// The neutral configuration: [`Model::qpos0`] when the file defines one, else
+    /// zeros, identity orientation of every free and spherical joint.
     pub fn neutral(&self) -> DVector<T> {
+        if let Some(q0) = self.qpos0.as_ref().filter(|q0| q0.len() == self.nq) {
+            return DVector::from_iterator(self.nq, q0.iter().map(|&x| nalgebra::convert(x)));
+        }
         let mut q = DVector::zeros(self.nq);
         for f in &self.free_joints {
             q[f.iq + 6] = T::one();
@@ -468,6 +499,7 @@ impl Model<f64> {
             topology: self.topology.clone(),
             source: self.source.clone(),
             report: self.report.clone(),
+            qpos0: self.qpos0.clone(),
         }
     }
 }

@@ -64,6 +64,7 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
         topology: Topology::default(),
         source: None,
         report: Default::default(),
+        qpos0: None,
     };
     for (i, part) in parts.into_iter().enumerate() {
         let p = &part.model;

@@ -219,8 +219,15 @@ pub(crate) fn lower(
             body,
             placement: b_m_l,
         });
+        let own = link_inertia(link);
+        report.bodies.push(crate::model::LinkMass {
+            name: link.name.clone(),
+            mass: own.mass,
+            com: own.com,
+            inertia: own.inertia_c,
+        });
         if body != 0 {
-            let inertia = b_m_l.act_inertia(&link_inertia(link));
+            let inertia = b_m_l.act_inertia(&own);
             inertias[body] = inertias[body].add(&inertia);
         }
         for c in &link.collision {
@@ -306,6 +313,9 @@ pub(crate) fn lower(
                     damping: j.dynamics.as_ref().map_or(0.0, |d| d.damping),
                     friction: j.dynamics.as_ref().map_or(0.0, |d| d.friction),
                     continuous: j.joint_type == JointType::Continuous,
+                    armature: 0.0,
+                    stiffness: 0.0,
+                    springref: 0.0,
                 });
                 nq += kind.nq();
                 nv += kind.nv();
@@ -446,6 +456,7 @@ pub(crate) fn lower(
         topology,
         source: None,
         report,
+        qpos0: None,
     })
 }
 

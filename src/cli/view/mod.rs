@@ -115,6 +115,12 @@ pub enum ViewError {
 /// Runs `urdyn view`: reads the URDF and the CSV, writes the page atomically (a
 /// bad input leaves no page).
 pub fn run(args: &ViewArgs) -> Result<PageSummary, ViewError> {
+    if crate::load::file_format(&args.urdf) == crate::load::Format::Mjcf {
+        return Err(ViewError::Geometry(format!(
+            "{}: replaying an MJCF world is not supported yet (it comes with MJCF simulation)",
+            args.urdf.display()
+        )));
+    }
     let model = crate::load_file(
         &args.urdf,
         LoadOptions {
