@@ -434,7 +434,14 @@ impl Simulation {
             has_damping,
             has_armature,
             data: Data::new(&model),
-            cons: Constraints::new(&model, &mass_factor, max_points, pair_points, nslots),
+            cons: Constraints::new(
+                &model,
+                &mass_factor,
+                max_points,
+                pair_points,
+                nslots,
+                opts.solver == Solver::Newton,
+            ),
             contact,
             points: Vec::with_capacity(max_points),
             fk_valid: false,
@@ -546,7 +553,7 @@ impl Simulation {
         }
         self.refresh_contacts();
         self.guard.reference = None;
-        self.guard.recovering_until = if self.start_violations().is_empty() {
+        self.guard.recovering_until = if !self.violates() {
             let e = self.update_energy();
             if e.is_finite() {
                 self.guard.reference = Some(e);
@@ -556,6 +563,14 @@ impl Simulation {
         } else {
             Some(self.t + 2.0)
         };
+    }
+
+    /// Whether the state violates a constraint ([`Simulation::start_violations`]
+    /// non-empty), found without building the list (a scene's models all at
+    /// the origin at construction overlap pairwise).
+    fn violates(&self) -> bool {
+        let (depth, excess) = self.worst_violation();
+        (self.contact.is_some() && depth > self.opts.contact.margin) || excess > 1e-9
     }
 
     /// The applied generalized forces (joint torques; with a floating base the first
