@@ -276,7 +276,18 @@ impl PairContact {
 
     /// Appends the contact points of every pair to `out`, given every body's
     /// world pose.
-    pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>) {
+    /// Bounding spheres of the moving members: (body, centre in the body
+    /// frame, radius).
+    pub fn member_spheres(&self) -> impl Iterator<Item = (usize, Vector3<f64>, f64)> + '_ {
+        self.members
+            .iter()
+            .filter(|m| m.body != 0)
+            .map(|m| (m.body, m.placement.act_point(&m.shape.mid), m.shape.half.norm()))
+    }
+
+    /// Pairs whose two bodies are flagged in `asleep` (or static) keep what
+    /// they held and are not queried.
+    pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
         let margin = self.margin;
         for &k in &self.moving {
             let m = &self.members[k];
@@ -320,6 +331,10 @@ impl PairContact {
                 continue;
             }
             self.live.push(pi as u32);
+            let still = |b: usize| b == 0 || asleep.get(b) == Some(&true);
+            if still(self.members[pair.a].body) && still(self.members[pair.b].body) {
+                continue;
+            }
             let (ma, mb) = (&self.members[pair.a], &self.members[pair.b]);
             let (wa, wb) = (self.poses[pair.a], self.poses[pair.b]);
             self.queries += 1;
