@@ -107,7 +107,7 @@ impl Sleep {
             has_dof[t] = !tree.v.is_empty();
             never[t] = tree.free.is_none()
                 || tree.v.is_empty()
-                || never_names.iter().any(|n| *n == tree.name);
+                || never_names.contains(&tree.name);
         }
         let mut has_sphere = vec![false; model.nbodies];
         for s in &spheres {
@@ -230,7 +230,7 @@ impl Sleep {
     /// now and cannot sleep). Sleeping trees' v are set to zero and their q
     /// kept; their points and forces move to the frozen lists (removed from
     /// `points`). Returns whether an island fell asleep.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
     pub fn after_step(
         &mut self,
         model: &Model,
