@@ -35,6 +35,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         above_ground: None,
         ground: None,
         no_ground: false,
+        no_sleep: false,
+        threads: None,
         gravity: None,
         friction: 1.0,
         package_path: vec![],

@@ -45,6 +45,7 @@ mod sim_no_alloc;
 mod sim_trust;
 mod simulate_cli;
 mod simulate_trust;
+mod sleep;
 mod step_jacobians;
 mod view;
 

@@ -258,7 +258,7 @@ fn cli_refuses_per_model_options_beside_a_scene_and_writes_nothing() {
     assert_eq!(header[7], "q:lamp/base_qw");
     assert_eq!(header[8], "q:lamp/shoulder");
     assert!(header.contains(&"v:lamp/base_wz") && header.contains(&"v:lamp/shade_tilt"));
-    assert_eq!(header.last(), Some(&"penetration"));
+    assert_eq!(header.last(), Some(&"awake"));
     // the replay pages: every model's links as MODEL/LINK
     let page = dir.path().join("p.html");
     let o = urdyn()

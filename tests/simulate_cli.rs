@@ -102,6 +102,7 @@ fn csv_header_last_step_and_every() {
         "energy",
         "contacts",
         "penetration",
+        "awake",
     ];
     assert_eq!(h, expect_head);
     // steps of 1 ms, the 11th shortened to 0.5 ms; rows at 0, 4, 8 ms and the final state

@@ -155,6 +155,12 @@ struct SimulateCmd {
     /// No ground plane: no contact at all.
     #[arg(long)]
     no_ground: bool,
+    /// No island sleeps (sleep is on by default: still islands stop costing).
+    #[arg(long)]
+    no_sleep: bool,
+    /// Threads the islands are solved on (0: every core; default the scene's, else 1).
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
     /// Gravity vector.
     #[arg(
         long,
@@ -478,6 +484,8 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
         html: c.html,
         every,
         progress: std::io::stderr().is_terminal(),
+        no_sleep: c.no_sleep,
+        threads: c.threads,
     };
     let summary = urdyn::cli::simulate::run(&args)?;
     eprintln!("urdyn {summary}");

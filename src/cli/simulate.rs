@@ -54,6 +54,10 @@ pub struct SimulateArgs {
     pub every: usize,
     /// Show a progress bar (the binary sets this when standard error is a terminal).
     pub progress: bool,
+    /// `--no-sleep`: no island sleeps (scene.md §"Large scenes").
+    pub no_sleep: bool,
+    /// `--threads N` (0: every core; `None`: the scene's, else 1).
+    pub threads: Option<usize>,
 }
 
 /// What a run did (the summary line).
@@ -77,20 +81,23 @@ pub struct Summary {
     pub integrator: &'static str,
     /// Narrow-phase contact queries made.
     pub contact_queries: u64,
+    /// The mean number of awake models with degrees of freedom over the steps.
+    pub mean_awake: f64,
 }
 
 impl std::fmt::Display for Summary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "simulate: {} steps ({}) in {:.4} s wall, real-time factor {:.1}, energy {:.9e} J -> {:.9e} J, deepest penetration {:.3e} m",
+            "simulate: {} steps ({}) in {:.4} s wall, real-time factor {:.1}, energy {:.9e} J -> {:.9e} J, deepest penetration {:.3e} m, mean awake {:.2}",
             self.steps,
             self.integrator,
             self.wall_seconds,
             self.real_time_factor,
             self.energy_start,
             self.energy_end,
-            self.max_penetration
+            self.max_penetration,
+            self.mean_awake
         )
     }
 }
@@ -303,7 +310,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             h.push(',');
             h.push_str(n);
         }
-        h.push_str(",energy,contacts,penetration\n");
+        h.push_str(",energy,contacts,penetration,awake\n");
         h
     };
     let block_rows = 256usize;
@@ -346,6 +353,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                 block.push(e);
                 block.push(sim.active_contacts() as f64);
                 block.push(sim.penetration());
+                block.push(sim.awake() as f64);
                 if let Some(r) = recorder {
                     let plot = [e, sim.active_contacts() as f64, sim.penetration()];
                     r.offer_with(sim.time(), sim.q(), plot, last, |out| {
@@ -435,6 +443,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             max_penetration: max_pen,
             integrator: sim.integrator().name(),
             contact_queries: sim.contact_queries(),
+            mean_awake: sim.mean_awake(),
         })
     };
     let summary = match &args.out {
@@ -529,6 +538,8 @@ fn urdf_setup(args: &SimulateArgs, integrator: Option<Integrator>) -> Result<Set
         contact,
         package_paths: args.package_path.clone(),
         armature: args.armature,
+        sleep: !args.no_sleep,
+        threads: args.threads.unwrap_or(1),
         ..SimOptions::default()
     };
     // The page's geometry is read before anything is simulated (a missing mesh
@@ -577,6 +588,17 @@ fn scene_setup(
         contact,
         package_paths: args.package_path.clone(),
         armature: args.armature,
+        sleep: !args.no_sleep && scene.spec.sleep.unwrap_or(true),
+        sleep_velocity: scene.spec.sleep_velocity.unwrap_or(1e-3),
+        sleep_time: scene.spec.sleep_time.unwrap_or(0.5),
+        threads: args.threads.or(scene.spec.threads).unwrap_or(1),
+        never_sleep: scene
+            .spec
+            .models
+            .iter()
+            .filter(|m| m.sleep == Some(false))
+            .map(|m| m.name.clone())
+            .collect(),
         ..SimOptions::default()
     };
     let geometry = match &args.html {
@@ -599,9 +621,9 @@ fn warn(line: &str) {
 }
 
 /// Numbers in one raw row handed to the writer: t, q (nq), v (nv), energy,
-/// contacts, penetration.
+/// contacts, penetration, awake.
 fn row_width(nq: usize, nv: usize) -> usize {
-    1 + nq + nv + 3
+    1 + nq + nv + 4
 }
 
 /// The writer thread: the header, then the CSV line of every row.
@@ -624,10 +646,11 @@ fn write_rows(
             let (qs, rest) = rest.split_at(nq);
             let (vs, rest) = rest.split_at(nv);
             let t = t.first().copied().unwrap_or(0.0);
-            let (e, contacts, pen) = (
+            let (e, contacts, pen, awake) = (
                 rest.first().copied().unwrap_or(0.0),
                 rest.get(1).copied().unwrap_or(0.0),
                 rest.get(2).copied().unwrap_or(0.0),
+                rest.get(3).copied().unwrap_or(0.0),
             );
             line.clear();
             line.push_str(rb.format(t));
@@ -642,6 +665,8 @@ fn write_rows(
             let _ = write!(line, "{}", contacts as u64);
             line.push(',');
             line.push_str(rb.format(pen));
+            line.push(',');
+            let _ = write!(line, "{}", awake as u64);
             line.push('\n');
             w.write_all(line.as_bytes()).map_err(io)?;
         }

@@ -75,6 +75,12 @@ pub struct PairContact {
     table: Vec<u32>,
     sap: SweepAndPrune,
     overlapping: Vec<u32>,
+    /// The pairs holding anything after the last detection (points, manifolds,
+    /// a separating axis), ascending: with the overlapping ones, the only pairs
+    /// a detection visits (never all pairs: their count is the square of the scene's).
+    live: Vec<u32>,
+    /// The pairs a detection visits (overlapping ∪ live), ascending.
+    visit: Vec<u32>,
     /// Each member's world pose (parry's frame) at the last detection.
     poses: Vec<Se3<f64>>,
     scratch: FaceScratch,
@@ -227,7 +233,9 @@ impl PairContact {
             members,
             table,
             sap,
-            overlapping: Vec::with_capacity(pairs.len()),
+            overlapping: Vec::new(),
+            live: Vec::new(),
+            visit: Vec::new(),
             poses,
             scratch: FaceScratch::default(),
             stamp: 0,
@@ -268,7 +276,18 @@ impl PairContact {
 
     /// Appends the contact points of every pair to `out`, given every body's
     /// world pose.
-    pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>) {
+    /// Bounding spheres of the moving members: (body, centre in the body
+    /// frame, radius).
+    pub fn member_spheres(&self) -> impl Iterator<Item = (usize, Vector3<f64>, f64)> + '_ {
+        self.members
+            .iter()
+            .filter(|m| m.body != 0)
+            .map(|m| (m.body, m.placement.act_point(&m.shape.mid), m.shape.half.norm()))
+    }
+
+    /// Pairs whose two bodies are flagged in `asleep` (or static) keep what
+    /// they held and are not queried.
+    pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
         let margin = self.margin;
         for &k in &self.moving {
             let m = &self.members[k];
@@ -281,19 +300,39 @@ impl PairContact {
         // the pairs not overlapping forget their points
         // (sorted: the same order every step, whatever the sweep's)
         self.overlapping.sort_unstable();
+        // visited: the overlapping pairs and those that held anything
+        self.visit.clear();
+        let (mut i, mut j) = (0, 0);
+        let (ov, live) = (&self.overlapping, &self.live);
+        while i < ov.len() || j < live.len() {
+            let x = ov.get(i).copied().unwrap_or(u32::MAX);
+            let y = live.get(j).copied().unwrap_or(u32::MAX);
+            self.visit.push(x.min(y));
+            i += usize::from(x <= y);
+            j += usize::from(y <= x);
+        }
+        self.live.clear();
         let mut next = 0;
-        for pi in 0..self.pairs.len() {
+        for vi in 0..self.visit.len() {
+            let pi = self.visit[vi] as usize;
             let hit = next < self.overlapping.len() && self.overlapping[next] as usize == pi;
             if hit {
                 next += 1;
             }
-            let pair = &mut self.pairs[pi];
+            let Some(pair) = self.pairs.get_mut(pi) else {
+                continue;
+            };
             if !hit || pair.dropped {
                 pair.apart = None;
                 if pair.keys[0] != NO_KEY || !pair.manifolds.is_empty() {
                     pair.keys.iter_mut().for_each(|k| *k = NO_KEY);
                     pair.manifolds.clear();
                 }
+                continue;
+            }
+            self.live.push(pi as u32);
+            let still = |b: usize| b == 0 || asleep.get(b) == Some(&true);
+            if still(self.members[pair.a].body) && still(self.members[pair.b].body) {
                 continue;
             }
             let (ma, mb) = (&self.members[pair.a], &self.members[pair.b]);

@@ -88,14 +88,32 @@ impl Collision {
     }
 
     /// Every contact point at the body poses `o_m_i`, into `out` (cleared).
-    pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>) {
+    /// Bodies flagged in `asleep` (indexed by body; empty: none) are not
+    /// searched against the static world or each other (a sleeping island's
+    /// contacts are frozen, `sim::sleep`).
+    pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
         out.clear();
         if let Some(g) = self.ground.as_mut() {
-            g.detect(o_m_i, out);
+            g.detect(o_m_i, out, asleep);
         }
         if let Some(p) = self.pairs.as_mut() {
-            p.detect(o_m_i, out);
+            p.detect(o_m_i, out, asleep);
         }
+    }
+
+    /// Bounding spheres of every moving collision shape: (body, centre in the
+    /// body frame, radius).
+    pub fn body_spheres(&self) -> Vec<(usize, nalgebra::Vector3<f64>, f64)> {
+        let mut out = Vec::new();
+        if let Some(g) = &self.ground {
+            for s in &g.shapes {
+                out.push((s.body, s.placement.trans, s.bound));
+            }
+        }
+        if let Some(p) = &self.pairs {
+            out.extend(p.member_spheres());
+        }
+        out
     }
 
     /// Decides anew which self pairs overlap at the start (scene.md rule 4)

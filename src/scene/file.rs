@@ -24,6 +24,18 @@ pub struct SceneSpec {
     /// Pairs never in contact: `MODEL/LINK`, `MODEL` or an obstacle's name on each side.
     #[serde(default)]
     pub exclude: Vec<[String; 2]>,
+    /// Still islands sleep (default true; scene.md §"Large scenes").
+    #[serde(default)]
+    pub sleep: Option<bool>,
+    /// The speed under which a shape's points count as still (m/s, default 1e-3).
+    #[serde(default)]
+    pub sleep_velocity: Option<f64>,
+    /// How long an island is still before it sleeps (s, default 0.5).
+    #[serde(default)]
+    pub sleep_time: Option<f64>,
+    /// Threads the islands are solved on (0: every core; default 1).
+    #[serde(default)]
+    pub threads: Option<usize>,
 }
 
 /// The ground plane `z = height`.
@@ -81,6 +93,9 @@ pub struct ModelSpec {
     /// This model's links' friction coefficient (default 1.0).
     #[serde(default)]
     pub friction: Option<f64>,
+    /// `false`: this model never sleeps (wins over the scene's `"sleep": true`).
+    #[serde(default)]
+    pub sleep: Option<bool>,
 }
 
 /// A model's starting state: joint maps keyed by the URDF's joint names (without

@@ -18,7 +18,7 @@
 
 use super::factor::MassFactor;
 use super::newton::Newton;
-use super::solver::{self, RowKind, Rows};
+use super::solver::{RowKind, Rows};
 use super::{ContactForce, Solver};
 use crate::contact::{tangents, ContactPoint};
 use crate::model::Model;
@@ -109,23 +109,29 @@ pub(crate) struct Constraints {
     /// R v* (the energy-safe exit's work).
     a: Vec<f64>,
     newton: Newton,
+    /// Dense scratch of a contact's three Jacobian rows (3·nv, all zero
+    /// between contacts: [`Rows::gather`] zeroes what it reads).
+    jd: Vec<f64>,
 }
 
 impl Constraints {
     /// Room for `max_points` contact points (`pair_points` of them between
     /// two bodies) and every joint's three rows; `f`: the factor the rows'
-    /// paths index.
+    /// paths index; `newton`: the Newton solver's dense work is needed (nv²).
     pub fn new(
         model: &Model,
         f: &MassFactor,
         max_points: usize,
         pair_points: usize,
         nslots: usize,
+        newton: bool,
     ) -> Self {
         let ndof = model.dofs.len();
         let cap = 3 * max_points + 3 * ndof;
         let nv = model.nv;
-        let mut rows = Rows::new(nv, cap);
+        // a row's room: two bodies' paths to the root (a dense factor's are nv long)
+        let longest = (0..nv).map(|d| f.path_of(d).1).max().unwrap_or(0);
+        let mut rows = Rows::new(nv, cap, 2 * longest);
         rows.set_table(f.table(), pair_points);
         Self {
             rows,
@@ -143,7 +149,8 @@ impl Constraints {
             fext: vec![Force::zero(); model.nbodies],
             contact_forces: Vec::with_capacity(max_points),
             a: vec![0.0; nv],
-            newton: Newton::new(nv, cap),
+            jd: vec![0.0; 3 * nv],
+            newton: Newton::new(if newton { nv } else { 0 }, if newton { cap } else { 0 }),
         }
     }
 
@@ -279,9 +286,9 @@ impl Constraints {
                             let vp = s.lin + s.ang.cross(&pt.point);
                             let col = j.iv + c;
                             if col < nv {
-                                rows.j[rn * nv + col] += vp.z;
-                                rows.j[(rn + 1) * nv + col] += vp.x;
-                                rows.j[(rn + 2) * nv + col] += vp.y;
+                                self.jd[col] += vp.z;
+                                self.jd[nv + col] += vp.x;
+                                self.jd[2 * nv + col] += vp.y;
                             }
                         }
                         b = model.parent[b];
@@ -300,22 +307,28 @@ impl Constraints {
                                 let vp = (s.lin + s.ang.cross(&pt.point)) * sign;
                                 let col = j.iv + c;
                                 if col < nv {
-                                    rows.j[rn * nv + col] += pt.normal.dot(&vp);
-                                    rows.j[(rn + 1) * nv + col] += t1.dot(&vp);
-                                    rows.j[(rn + 2) * nv + col] += t2.dot(&vp);
+                                    self.jd[col] += pt.normal.dot(&vp);
+                                    self.jd[nv + col] += t1.dot(&vp);
+                                    self.jd[2 * nv + col] += t2.dot(&vp);
                                 }
                             }
                             b = model.parent[b];
                         }
                     }
                 }
+                // the dense rows onto the rows' paths (the scratch left zero)
+                let (j0, rest) = self.jd.split_at_mut(nv);
+                let (j1, j2) = rest.split_at_mut(nv);
+                rows.gather(rn, j0);
+                rows.gather(rn + 1, j1);
+                rows.gather(rn + 2, j2);
                 // normal target: speculative; restitution only above the speed below
                 // which a bounce of one step under gravity could gain energy:
                 // |u| > 4 g h e / (1 − e²)
                 let mut bn = speculative(pt.gap);
                 let e = p.restitution;
                 if e > 0.0 && e < 1.0 {
-                    let un = solver::dot(rows.jrow(rn), v.as_slice());
+                    let un = rows.jdot(rn, v.as_slice());
                     let vmin = (4.0 * p.gravity * h * e / (1.0 - e * e).max(1e-12)).max(1e-3);
                     if un < -vmin && pt.gap < -un * h {
                         bn = bn.max(-e * un);
@@ -343,7 +356,7 @@ impl Constraints {
                     };
                     let path = f.path_of(iv);
                     if let Some(r) = rows.push(kind, 0.0, self.warm_joint[d][0], path) {
-                        rows.jrow_mut(r)[iv] = 1.0;
+                        rows.add_entry(r, iv, 1.0);
                         self.joint_rows.push((d, 0));
                         counts.friction += 1;
                     }
@@ -367,7 +380,7 @@ impl Constraints {
                     let w = self.warm_joint[d][which as usize];
                     let path = f.path_of(iv);
                     if let Some(r) = rows.push(RowKind::Unilateral, speculative(gap), w, path) {
-                        rows.jrow_mut(r)[iv] = sign;
+                        rows.add_entry(r, iv, sign);
                         rows.bpos[r] = pos_target(gap, p.limit_slop, p.limit_push_cap);
                         if rows.bpos[r] > 0.0 {
                             counts.violated += 1;
@@ -400,7 +413,6 @@ impl Constraints {
         relaxation: f64,
         solver: Solver,
     ) -> Impulses<'_> {
-        let nv = model.nv;
         self.clear_forces();
         self.dv.fill(0.0);
         let rows = &mut self.rows;
@@ -439,7 +451,7 @@ impl Constraints {
             let lam = rows.lambda[r];
             self.warm_joint[d][which as usize] = lam;
             let iv = model.dof_v(d);
-            let jv = rows.j[r * nv + iv];
+            let jv = rows.entry(r, iv);
             self.tau_joint[iv] += jv * lam / h;
         }
         // contact rows: warm starts by slot, forces

@@ -194,11 +194,12 @@ impl Simulation {
     }
     /// Deepest penetration into the ground at the current state (m, 0 if none).
     pub fn penetration(&self) -> f64 {
-        self.points.iter().map(|p| -p.gap).fold(0.0, f64::max)
+        let frozen = &self.sleep.frozen_points;
+        self.points.iter().chain(frozen).map(|p| -p.gap).fold(0.0, f64::max)
     }
     /// The contact points that carried force in the last step, with their forces.
     pub fn contact_forces(&self) -> &[ContactForce] {
-        self.cons.contact_forces()
+        self.sleep.forces(self.cons.contact_forces())
     }
     /// The URDF link whose collision shape made a contact point (a point of
     /// [`Simulation::contact_points`] or [`ContactForce::point`]); `None` for a
@@ -261,11 +262,11 @@ impl Simulation {
     }
     /// Number of contact points that carried force in the last step.
     pub fn active_contacts(&self) -> usize {
-        self.cons.contact_forces().len()
+        self.contact_forces().len()
     }
     /// The ground contact wrench on each body in the last step (world frame, at
     /// the world origin; entry 0 is the world). Link names: `model.body_link_names`.
     pub fn body_contact_forces(&self) -> &[Force] {
-        self.cons.body_forces()
+        self.sleep.body_forces(self.cons.body_forces())
     }
 }

@@ -68,6 +68,7 @@ pub mod newton;
 pub use contact_view::Violation;
 mod sensors;
 mod servo;
+mod sleep;
 pub mod solver;
 
 pub use derivatives::{JacobianMethod, TransitionJacobians};
@@ -137,6 +138,16 @@ pub struct SimOptions {
     pub limit_push_speed: f64,
     /// The divergence test of passive runs (`None`: off).
     pub max_energy_rise: Option<EnergyBound>,
+    /// Still islands sleep (scene.md §"Large scenes"; default on).
+    pub sleep: bool,
+    /// The speed under which a shape's points count as still (m/s, 1e-3).
+    pub sleep_velocity: f64,
+    /// How long an island is still before it sleeps (s, 0.5).
+    pub sleep_time: f64,
+    /// Threads the islands are solved on (0: every core; 1 the default).
+    pub threads: usize,
+    /// Scene models that never sleep (their own `"sleep": false`), by name.
+    pub never_sleep: Vec<String>,
 }
 
 impl Default for SimOptions {
@@ -159,6 +170,11 @@ impl Default for SimOptions {
                 relative: 1e-2,
                 absolute: 1e-2,
             }),
+            sleep: true,
+            sleep_velocity: 1e-3,
+            sleep_time: 0.5,
+            threads: 1,
+            never_sleep: Vec::new(),
         }
     }
 }
@@ -322,6 +338,9 @@ pub struct Simulation {
     /// The energy at the current state, once computed.
     energy_now: Option<f64>,
     deriv: derivatives::Workspace,
+    sleep: sleep::Sleep,
+    /// Per tree: driven now (scratch of the sleep test).
+    sleep_forced: Vec<bool>,
     /// Steps taken.
     pub steps: u64,
     /// Adaptive (`dop853`) steps rejected by the error test and retried
@@ -355,6 +374,13 @@ impl Simulation {
         positive(opts.tol, "--tol")?;
         positive(opts.limit_push_speed, "limit_push_speed")?;
         positive(opts.contact.max_push_speed, "contact.max_push_speed")?;
+        positive(opts.sleep_velocity, "sleep_velocity")?;
+        if !(opts.sleep_time.is_finite() && opts.sleep_time >= 0.0) {
+            return Err(SimError::Invalid(format!(
+                "sleep_time must be a non-negative number (got {})",
+                opts.sleep_time
+            )));
+        }
         let w = opts.solver_relaxation;
         if !(w > 0.0 && w < 2.0) {
             return Err(SimError::Invalid(format!(
@@ -420,7 +446,18 @@ impl Simulation {
         let scale = total_mass * model.gravity.norm();
         let has_damping = damping.iter().any(|&d| d > 0.0);
         let has_armature = a > 0.0 && !model.dofs.is_empty();
+        let spheres = contact.as_ref().map_or(Vec::new(), |c| c.body_spheres());
+        let sleep = sleep::Sleep::new(
+            &model,
+            opts.sleep,
+            opts.sleep_velocity,
+            opts.sleep_time,
+            spheres,
+            &opts.never_sleep,
+        );
         let mut sim = Self {
+            sleep,
+            sleep_forced: vec![false; model.trees.len()],
             integrator,
             dt: opts.dt,
             tol: opts.tol,
@@ -434,7 +471,14 @@ impl Simulation {
             has_damping,
             has_armature,
             data: Data::new(&model),
-            cons: Constraints::new(&model, &mass_factor, max_points, pair_points, nslots),
+            cons: Constraints::new(
+                &model,
+                &mass_factor,
+                max_points,
+                pair_points,
+                nslots,
+                opts.solver == Solver::Newton,
+            ),
             contact,
             points: Vec::with_capacity(max_points),
             fk_valid: false,
@@ -541,12 +585,13 @@ impl Simulation {
         self.sensors.forget();
         self.smooth.fsal_ok = false;
         self.cons.reset_warm_start();
+        self.sleep.wake_all(&self.model);
         if self.steps == 0 {
             self.decide_start_overlaps();
         }
         self.refresh_contacts();
         self.guard.reference = None;
-        self.guard.recovering_until = if self.start_violations().is_empty() {
+        self.guard.recovering_until = if !self.violates() {
             let e = self.update_energy();
             if e.is_finite() {
                 self.guard.reference = Some(e);
@@ -558,11 +603,20 @@ impl Simulation {
         };
     }
 
+    /// Whether the state violates a constraint ([`Simulation::start_violations`]
+    /// non-empty), found without building the list (a scene's models all at
+    /// the origin at construction overlap pairwise).
+    fn violates(&self) -> bool {
+        let (depth, excess) = self.worst_violation();
+        (self.contact.is_some() && depth > self.opts.contact.margin) || excess > 1e-9
+    }
+
     /// The applied generalized forces (joint torques; with a floating base the first
     /// six are the base force and torque, body frame). Joint entries are clamped to
     /// their effort limits when used.
     pub fn torques_mut(&mut self) -> &mut DVector<f64> {
         self.forcing_changed = true;
+        self.sleep.wake_pending = true;
         &mut self.tau_applied
     }
     /// The applied generalized forces (nv) as set, before clamping to effort limits.
@@ -649,7 +703,7 @@ impl Simulation {
         self.energy_now = None;
         if let Some(c) = self.contact.as_mut() {
             forward_kinematics(&self.model, &mut self.data, &self.q);
-            c.detect(&self.data.o_m_i, &mut self.points);
+            c.detect(&self.data.o_m_i, &mut self.points, &self.sleep.body_asleep);
             self.fk_valid = true;
         }
     }
@@ -668,7 +722,18 @@ impl Simulation {
             return Ok(0.0);
         }
         let h_fixed = land(self.dt, remaining);
+        if self.sleep.wake_pending {
+            self.wake();
+        }
         self.sensors.begin(&self.q, &self.v);
+        if self.sleep.all_asleep() {
+            // everything sleeps: the state stands, time passes
+            self.t = if h_fixed >= remaining { t_end } else { self.t + h_fixed };
+            self.sensors.end(h_fixed);
+            self.steps += 1;
+            self.sleep.count_idle_step();
+            return Ok(h_fixed);
+        }
         // 1. the constraint rows at the start of the step (contact points were
         //    found at this q by the last step's refresh): a joint that can
         //    reach its limit within the step has a row
@@ -706,11 +771,13 @@ impl Simulation {
         self.t = if h >= remaining { t_end } else { self.t + h };
         self.sensors.end(h);
         self.steps += 1;
+        self.sleep.hold(&self.model, &mut self.q, &mut self.v);
         normalize_quats(&self.model, &mut self.q);
         // 3. the new state: finite, its contacts, its energy
         self.check_finite()?;
         self.fk_valid = false;
         self.refresh_contacts();
+        self.update_sleep(h);
         self.check_energy()?;
         Ok(h)
     }

@@ -175,7 +175,7 @@ impl Newton {
             let l = rows.lambda[r];
             if l != 0.0 {
                 for (t, &k) in path(r).iter().enumerate() {
-                    x[k] += l * rows.y[r * nv + t];
+                    x[k] += l * rows.y[r * rows.stride + t];
                 }
             }
         }
@@ -183,12 +183,13 @@ impl Newton {
         let facet_y = |fa: &Facet, out: &mut [f64]| -> f64 {
             let r = fa.row;
             let l = rows.path[r].1;
-            let (yn, rest) = rows.y[r * nv..].split_at(nv);
+            let st = rows.stride;
+            let (yn, rest) = rows.y[r * st..].split_at(st);
             out[..l].copy_from_slice(&yn[..l]);
             let mut c = rows.c[r] - rows.b[r];
             if fa.tangent > 0 {
                 let k = fa.tangent;
-                let yt = &rest[(k - 1) * nv..(k - 1) * nv + l];
+                let yt = &rest[(k - 1) * st..(k - 1) * st + l];
                 let s = fa.sign * fa.mu;
                 for (o, &y) in out[..l].iter_mut().zip(yt) {
                     *o += s * y;
@@ -237,7 +238,7 @@ impl Newton {
             self.eb.clear();
             for &(r, d, lim) in &self.boxes {
                 let p = path(r);
-                let y = &rows.y[r * nv..r * nv + p.len()];
+                let y = &rows.y[r * rows.stride..r * rows.stride + p.len()];
                 let e = rows.c[r] - rows.b[r] + dot(y, p, x);
                 self.eb.push(e);
                 let quad = (d * e).abs() <= lim;
@@ -274,7 +275,7 @@ impl Newton {
             self.deb.clear();
             for &(r, _, _) in &self.boxes {
                 let p = path(r);
-                let y = &rows.y[r * nv..r * nv + p.len()];
+                let y = &rows.y[r * rows.stride..r * rows.stride + p.len()];
                 self.deb.push(dot(y, p, &self.delta));
             }
             let xd: f64 = x.iter().zip(&self.delta).map(|(a, b)| a * b).sum();
@@ -355,7 +356,7 @@ impl Newton {
         self.eb.clear();
         for &(r, _, _) in &self.boxes {
             let p = path(r);
-            let y = &rows.y[r * nv..r * nv + p.len()];
+            let y = &rows.y[r * rows.stride..r * rows.stride + p.len()];
             self.eb.push(rows.c[r] - rows.b[r] + dot(y, p, x));
         }
         for r in 0..n {

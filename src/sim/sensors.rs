@@ -111,7 +111,7 @@ impl Simulation {
         } else {
             (&self.q, &self.v)
         };
-        let fext = self.cons.body_forces();
+        let fext = self.sleep.body_forces(self.cons.body_forces());
         rnea(model, data, q, v, &a, Some(fext))?;
         // body frame → the child link's frame (bMf)
         let f = model.frames[child.0].placement.inv_act_force(&data.f[body]);

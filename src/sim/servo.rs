@@ -138,6 +138,7 @@ impl Simulation {
         s.active = kp.iter().chain(kd.iter()).any(|&x| x != 0.0);
         s.saturated.fill(0);
         self.forcing_changed = true;
+        self.sleep.wake_pending = true;
         self.smooth.fsal_ok = false;
         Ok(())
     }
@@ -192,6 +193,7 @@ impl Simulation {
             None => s.v_ref.fill(0.0),
         }
         self.forcing_changed = true;
+        self.sleep.wake_pending = true;
         self.smooth.fsal_ok = false;
         Ok(())
     }

@@ -46,19 +46,24 @@ pub enum RowKind {
     Unilateral,
 }
 
-/// Preallocated rows: Jacobians (row-major, `nv` wide), Y = J R⁻ᵀ, diag W,
-/// targets. Every per-row vector holds `capacity()` entries, the first `n` in use.
+/// Preallocated rows: Jacobians and Y = J R⁻ᵀ (each row compact over its dof
+/// path, `stride` apart), diag W, targets. Every per-row vector holds `capacity()` entries, the first `n` in use.
 #[derive(Clone, Debug)]
 pub struct Rows {
-    /// Width of a row: the model's nv.
+    /// The model's nv (the length of velocity vectors).
     pub nv: usize,
+    /// Room of a row in `j` and `y`: the longest path a row can have (two
+    /// bodies' paths to the root; nv for a dense factor), so that storage
+    /// grows with rows × path length, never rows × nv.
+    pub stride: usize,
     /// Rows in use.
     pub n: usize,
     /// Each row's kind (the first `n` entries in use).
     pub kind: Vec<RowKind>,
-    /// Jacobians J, row-major, `nv` per row (row r: `j[r·nv .. (r+1)·nv]`).
+    /// Jacobians J, `stride` apart, each row compact over its path (entry t of
+    /// row r, `j[r·stride + t]`, belongs to dof `path[t]`; J is zero elsewhere).
     pub j: Vec<f64>,
-    /// Rows of Y = J R⁻ᵀ (H̃ = RᵀR), `nv` apart, each held compactly over its
+    /// Rows of Y = J R⁻ᵀ (H̃ = RᵀR), `stride` apart, each held compactly over its
     /// path (entry t belongs to dof `path[t]`); filled by [`Rows::form`].
     pub y: Vec<f64>,
     /// Delassus diagonal Wᵣᵣ = ‖yᵣ‖² (the row's velocity per unit impulse).
@@ -133,13 +138,15 @@ impl Subspace {
 
 impl Rows {
     /// Room for `cap` rows of width `nv`, all allocated here (none in a step).
-    pub fn new(nv: usize, cap: usize) -> Self {
+    pub fn new(nv: usize, cap: usize, stride: usize) -> Self {
+        let stride = stride.clamp(1, nv.max(1));
         Self {
             nv,
+            stride,
             n: 0,
             kind: vec![RowKind::Unilateral; cap],
-            j: vec![0.0; cap * nv],
-            y: vec![0.0; cap * nv],
+            j: vec![0.0; cap * stride],
+            y: vec![0.0; cap * stride],
             w: vec![0.0; cap],
             winv: vec![0.0; cap],
             c: vec![0.0; cap],
@@ -162,7 +169,7 @@ impl Rows {
     /// Takes the factor's path table (`base`, [`MassFactor::table`]) with room
     /// for `unions` two-body paths of at most nv entries each, allocated here.
     pub fn set_table(&mut self, base: &[usize], unions: usize) {
-        self.table = Vec::with_capacity(base.len() + unions * self.nv);
+        self.table = Vec::with_capacity(base.len() + unions * self.stride);
         self.table.extend_from_slice(base);
         self.static_len = base.len();
     }
@@ -220,10 +227,10 @@ impl Rows {
         self.cap
     }
     /// Empties the rows; their Jacobian entries are zeroed here, once, so that
-    /// every row pushed after starts from zeros.
+    /// every row pushed after starts from zeros (a row holds its path's
+    /// entries only: the cost follows the rows' path lengths, never rows × nv).
     pub fn clear(&mut self) {
-        let used = (self.n * self.nv).min(self.j.len());
-        self.j[..used].fill(0.0);
+        self.zero_rows(0, self.n);
         self.n = 0;
         self.table.truncate(self.static_len);
         self.last_union = ((0, 0), (0, 0), (0, 0));
@@ -232,9 +239,15 @@ impl Rows {
     pub fn pop(&mut self, k: usize) {
         let k = k.min(self.n);
         self.n -= k;
-        let from = (self.n * self.nv).min(self.j.len());
-        let to = ((self.n + k) * self.nv).min(self.j.len());
-        self.j[from..to].fill(0.0);
+        self.zero_rows(self.n, self.n + k);
+    }
+    /// Zeroes the Jacobian entries of rows `from..to`.
+    fn zero_rows(&mut self, from: usize, to: usize) {
+        let st = self.stride;
+        for r in from..to.min(self.cap) {
+            let pl = self.path[r].1.min(st);
+            self.j[r * st..r * st + pl].fill(0.0);
+        }
     }
     /// Adds a row (zeroed Jacobian: rows are zeroed by [`Rows::clear`]) and returns
     /// its index, or `None` when full.
@@ -258,20 +271,61 @@ impl Rows {
         self.path[r] = path;
         Some(r)
     }
-    /// Row `r` of J (`nv` entries), to be written.
-    pub fn jrow_mut(&mut self, r: usize) -> &mut [f64] {
-        &mut self.j[r * self.nv..(r + 1) * self.nv]
+    /// Where dof `d` lies on row `r`'s path (`None`: off it, J is 0 there).
+    fn slot_of(&self, r: usize, d: usize) -> Option<usize> {
+        let (ps, pl) = self.path[r];
+        self.table.get(ps..ps + pl)?.iter().position(|&k| k == d)
     }
-    /// Row `r` of J (`nv` entries).
-    pub fn jrow(&self, r: usize) -> &[f64] {
-        &self.j[r * self.nv..(r + 1) * self.nv]
+    /// Adds `x` to J's entry of row `r` at dof `d` (on the row's path; a dof
+    /// off the path is ignored: the row cannot act there).
+    pub fn add_entry(&mut self, r: usize, d: usize, x: f64) {
+        if let Some(t) = self.slot_of(r, d) {
+            self.j[r * self.stride + t] += x;
+        }
+    }
+    /// J's entry of row `r` at dof `d` (0 off its path).
+    pub fn entry(&self, r: usize, d: usize) -> f64 {
+        self.slot_of(r, d)
+            .map_or(0.0, |t| self.j[r * self.stride + t])
+    }
+    /// Row `r` of J written from a dense row `dense` (nv entries, J's
+    /// entries on the row's path; zero elsewhere), whose path entries are
+    /// zeroed after (the caller's scratch is left all zeros).
+    pub fn gather(&mut self, r: usize, dense: &mut [f64]) {
+        let (ps, pl) = self.path[r];
+        let st = self.stride;
+        let Some(path) = self.table.get(ps..ps + pl) else {
+            return;
+        };
+        for (t, &d) in path.iter().enumerate().take(st) {
+            if let Some(x) = dense.get_mut(d) {
+                self.j[r * st + t] = *x;
+                *x = 0.0;
+            }
+        }
+    }
+    /// J's row `r` times `x` (nv entries).
+    pub fn jdot(&self, r: usize, x: &[f64]) -> f64 {
+        let (ps, pl) = self.path[r];
+        let Some(path) = self.table.get(ps..ps + pl) else {
+            return 0.0;
+        };
+        let jr = &self.j[r * self.stride..r * self.stride + pl.min(self.stride)];
+        jr.iter().zip(path).map(|(a, &k)| a * x.get(k).copied().unwrap_or(0.0)).sum()
+    }
+    /// Row `r` of J as (dof, entry) pairs over its path.
+    pub fn jrow(&self, r: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let (ps, pl) = self.path[r];
+        let path = self.table.get(ps..ps + pl).unwrap_or(&[]);
+        let jr = &self.j[r * self.stride..r * self.stride + path.len().min(self.stride)];
+        path.iter().copied().zip(jr.iter().copied())
     }
     /// Fills y with the rows of Y = J R⁻ᵀ (H̃ = RᵀR, [`MassFactor`]), each over
     /// its path, the Delassus diagonal Wᵣᵣ = jᵣ·H̃⁻¹jᵣ = ‖yᵣ‖² and c = J v* for
     /// the free velocity `vfree`.
     pub fn form(&mut self, f: &MassFactor, vfree: &[f64]) {
-        let (nv, n) = (self.nv, self.n);
-        if vfree.len() < nv || self.j.len() < n * nv || self.y.len() < n * nv {
+        let (nv, n, st) = (self.nv, self.n, self.stride);
+        if vfree.len() < nv || self.j.len() < n * st || self.y.len() < n * st {
             return;
         }
         // (the table is put back below: taking it moves no entry)
@@ -280,7 +334,7 @@ impl Rows {
         let mut r = 0;
         while r < n {
             let (ps, pl) = self.path[r];
-            let Some(path) = table.get(ps..ps + pl) else {
+            let Some(path) = table.get(ps..ps + pl).filter(|p| p.len() <= st) else {
                 if let Some(b) = self.is_block.get_mut(r) {
                     *b = false;
                 }
@@ -295,19 +349,18 @@ impl Rows {
                 self.is_block[q] = block && q == r;
             }
             for q in r..r + k {
-                let jr = &self.j[q * nv..(q + 1) * nv];
-                let yr = &mut self.y[q * nv..q * nv + pl];
+                let jr = &self.j[q * st..q * st + pl];
+                let yr = &mut self.y[q * st..q * st + pl];
                 let mut cq = 0.0;
-                for (yt, &d) in yr.iter_mut().zip(path) {
-                    let jk = jr[d];
+                for ((yt, &d), &jk) in yr.iter_mut().zip(path).zip(jr) {
                     *yt = jk;
                     cq += jk * vfree[d];
                 }
                 self.c[q] = cq;
             }
             if k == 3 {
-                let (a, rest) = self.y[r * nv..].split_at_mut(nv);
-                let (b, c) = rest.split_at_mut(nv);
+                let (a, rest) = self.y[r * st..].split_at_mut(st);
+                let (b, c) = rest.split_at_mut(st);
                 let (y0, y1, y2) = (&mut a[..pl], &mut b[..pl], &mut c[..pl]);
                 f.row_transform3(path, y0, y1, y2);
                 let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
@@ -316,7 +369,7 @@ impl Rows {
                 self.w[r + 2] = dot(y2, y2);
                 self.w_block[r] = [dot(y0, y1), dot(y0, y2), dot(y1, y2)];
             } else {
-                let yr = &mut self.y[r * nv..r * nv + pl];
+                let yr = &mut self.y[r * st..r * st + pl];
                 f.row_transform(path, yr);
                 self.w[r] = yr.iter().map(|x| x * x).sum();
             }
@@ -377,15 +430,15 @@ impl Rows {
         tol: f64,
         relax: f64,
     ) -> usize {
-        let (nv, n) = (self.nv, self.n);
+        let (nv, n, st) = (self.nv, self.n, self.stride);
         if dv.len() < nv
-            || self.y.len() < n * nv
+            || self.y.len() < n * st
             || self.kind.len() < n
             || self
                 .path
                 .iter()
                 .take(n)
-                .any(|&(s, l)| s + l > table.len() || l > nv)
+                .any(|&(s, l)| s + l > table.len() || l > st)
         {
             return 0;
         }
@@ -414,20 +467,20 @@ impl Rows {
         }
         let lambda = &mut self.lambda[..n];
         // SAFETY (unchecked reads in rdot/raxpy): every path lies in `table`
-        // (checked above) and holds dof indices < nv; y holds n·nv entries and
-        // a path is at most nv long.
+        // (checked above) and holds dof indices < nv; y holds n·stride entries and
+        // a path is at most stride long.
         #[inline(always)]
-        fn rdot(y: &[f64], r: usize, nv: usize, p: &[usize], x: &[f64]) -> f64 {
+        fn rdot(y: &[f64], r: usize, st: usize, p: &[usize], x: &[f64]) -> f64 {
             let mut s = 0.0;
             for (t, &k) in p.iter().enumerate() {
-                s += unsafe { y.get_unchecked(r * nv + t) * x.get_unchecked(k) };
+                s += unsafe { y.get_unchecked(r * st + t) * x.get_unchecked(k) };
             }
             s
         }
         #[inline(always)]
-        fn raxpy(a: f64, y: &[f64], r: usize, nv: usize, p: &[usize], x: &mut [f64]) {
+        fn raxpy(a: f64, y: &[f64], r: usize, st: usize, p: &[usize], x: &mut [f64]) {
             for (t, &k) in p.iter().enumerate() {
-                unsafe { *x.get_unchecked_mut(k) += a * y.get_unchecked(r * nv + t) };
+                unsafe { *x.get_unchecked_mut(k) += a * y.get_unchecked(r * st + t) };
             }
         }
         let path = |r: usize| {
@@ -439,7 +492,7 @@ impl Rows {
         for r in 0..n {
             let l = lambda[r];
             if l != 0.0 {
-                raxpy(l, y, r, nv, path(r), dv);
+                raxpy(l, y, r, st, path(r), dv);
             }
         }
         let mut it = 0;
@@ -469,9 +522,9 @@ impl Rows {
                     for (t, &k) in p.iter().enumerate() {
                         let x = unsafe { *dv.get_unchecked(k) };
                         unsafe {
-                            dn += y.get_unchecked(r * nv + t) * x;
-                            d1 += y.get_unchecked((r + 1) * nv + t) * x;
-                            d2 += y.get_unchecked((r + 2) * nv + t) * x;
+                            dn += y.get_unchecked(r * st + t) * x;
+                            d1 += y.get_unchecked((r + 1) * st + t) * x;
+                            d2 += y.get_unchecked((r + 2) * st + t) * x;
                         }
                     }
                     let [wn1, wn2, w12] = w_block[r];
@@ -505,9 +558,9 @@ impl Rows {
                     if dln != 0.0 || dl1 != 0.0 || dl2 != 0.0 {
                         for (t, &k) in p.iter().enumerate() {
                             unsafe {
-                                *dv.get_unchecked_mut(k) += dln * y.get_unchecked(r * nv + t)
-                                    + dl1 * y.get_unchecked((r + 1) * nv + t)
-                                    + dl2 * y.get_unchecked((r + 2) * nv + t);
+                                *dv.get_unchecked_mut(k) += dln * y.get_unchecked(r * st + t)
+                                    + dl1 * y.get_unchecked((r + 1) * st + t)
+                                    + dl2 * y.get_unchecked((r + 2) * st + t);
                             }
                         }
                     }
@@ -522,8 +575,8 @@ impl Rows {
                     RowKind::Tangent { normal, mu } if r + 1 < n => {
                         let (p1, p2) = (path(r), path(r + 1));
                         let (w11, w22) = (w[r], w[r + 1]);
-                        let u1 = c[r] + rdot(y, r, nv, p1, dv);
-                        let u2 = c[r + 1] + rdot(y, r + 1, nv, p2, dv);
+                        let u1 = c[r] + rdot(y, r, st, p1, dv);
+                        let u2 = c[r + 1] + rdot(y, r + 1, st, p2, dv);
                         let (o1, o2) = (lambda[r], lambda[r + 1]);
                         let mut t1 = if w11 > 1e-14 { o1 - u1 / w11 } else { 0.0 };
                         let mut t2 = if w22 > 1e-14 { o2 - u2 / w22 } else { 0.0 };
@@ -537,10 +590,10 @@ impl Rows {
                         lambda[r + 1] = t2;
                         let (d1, d2) = (t1 - o1, t2 - o2);
                         if d1 != 0.0 {
-                            raxpy(d1, y, r, nv, p1, dv);
+                            raxpy(d1, y, r, st, p1, dv);
                         }
                         if d2 != 0.0 {
-                            raxpy(d2, y, r + 1, nv, p2, dv);
+                            raxpy(d2, y, r + 1, st, p2, dv);
                         }
                         change = change
                             .max(measure(first, (d1 * w11).abs(), u1, &mut u_prev[r]))
@@ -559,7 +612,7 @@ impl Rows {
                 let p = path(r);
                 let mut u = 0.0;
                 let new = if winv[r] != 0.0 {
-                    u = c[r] + rdot(y, r, nv, p, dv);
+                    u = c[r] + rdot(y, r, st, p, dv);
                     let x = old - relax * (u - b[r]) * winv[r];
                     match kind {
                         RowKind::Box { limit } => x.clamp(-limit, limit),
@@ -571,7 +624,7 @@ impl Rows {
                 lambda[r] = new;
                 let d = new - old;
                 if d != 0.0 {
-                    raxpy(d, y, r, nv, p, dv);
+                    raxpy(d, y, r, st, p, dv);
                 }
                 change = change.max(measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
                 r += 1;
@@ -588,6 +641,7 @@ impl Rows {
                 let rows = Solved {
                     n,
                     nv,
+                    st,
                     y,
                     paths,
                     table,
@@ -615,6 +669,8 @@ const SUBSPACE_TRIES: usize = 3;
 struct Solved<'a> {
     n: usize,
     nv: usize,
+    /// Room of a row in `y`.
+    st: usize,
     y: &'a [f64],
     paths: &'a [(usize, usize)],
     table: &'a [usize],
@@ -643,6 +699,7 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
     let Solved {
         n,
         nv,
+        st,
         y,
         paths,
         table,
@@ -718,7 +775,7 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
         d.fill(0.0);
         let mut u = c[r];
         for (t, &k) in path(r).iter().enumerate() {
-            let yt = y[r * nv + t];
+            let yt = y[r * st + t];
             d[k] = yt;
             u += yt * dv[k];
         }
@@ -730,7 +787,7 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
         for (bb, &q) in sm.rows.iter().enumerate().take(a + 1) {
             let mut s = 0.0;
             for (t, &k) in path(q).iter().enumerate() {
-                s += y[q * nv + t] * d[k];
+                s += y[q * st + t] * d[k];
             }
             sm.w[a * m + bb] = s;
         }
@@ -754,7 +811,7 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
     let add = |r: usize, d: f64, dv: &mut [f64]| {
         if d != 0.0 {
             for (t, &k) in path(r).iter().enumerate() {
-                dv[k] += d * y[r * nv + t];
+                dv[k] += d * y[r * st + t];
             }
         }
     };
@@ -817,7 +874,7 @@ impl Rows {
     ) -> usize {
         let (nv, n) = (self.nv, self.n);
         let _ = f;
-        if dw.len() < nv || self.y.len() < n * nv || self.mu.len() < n || self.bpos.len() < n {
+        if dw.len() < nv || self.y.len() < n * self.stride || self.mu.len() < n || self.bpos.len() < n {
             return 0;
         }
         let table_v = std::mem::take(&mut self.table);
@@ -834,7 +891,7 @@ impl Rows {
         max_iter: usize,
         tol: f64,
     ) -> usize {
-        let (nv, n) = (self.nv, self.n);
+        let (nv, n, st) = (self.nv, self.n, self.stride);
         let dw = &mut dw[..nv];
         dw.iter_mut().for_each(|x| *x = 0.0);
         self.mu[..n].iter_mut().for_each(|x| *x = 0.0);
@@ -851,7 +908,7 @@ impl Rows {
                     continue;
                 }
                 let (ps, pl) = self.path[r];
-                let (Some(p), Some(yr)) = (table.get(ps..ps + pl), self.y.get(r * nv..r * nv + pl))
+                let (Some(p), Some(yr)) = (table.get(ps..ps + pl), self.y.get(r * st..r * st + pl))
                 else {
                     continue;
                 };

@@ -189,7 +189,8 @@ impl GroundContact {
     /// Finds the contact points given every body's world pose `o_m_i`, appending
     /// them to `out` (cleared first). No allocation once `out` has
     /// [`max_points`](Self::max_points) capacity.
-    pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>) {
+    /// Shapes of bodies flagged in `asleep` are skipped.
+    pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
         out.clear();
         let ground = self.ground;
         let margin = self.params.margin;
@@ -198,6 +199,9 @@ impl GroundContact {
             let Some(o_m_b) = o_m_i.get(s.body) else {
                 continue;
             };
+            if asleep.get(s.body) == Some(&true) {
+                continue;
+            }
             // broad phase: the bounding sphere clear of the plane (the height of
             // the geometry origin alone, before the whole pose is composed)
             let r = &o_m_b.rot;

@@ -198,7 +198,12 @@ impl Simulation {
         // the rows: Jacobian, kinds, impulses; the contact points' second-order terms
         let rows = self.cons.rows_view();
         let m = rows.n;
-        let jac = DMatrix::from_fn(m, n, |r, c| rows.j[r * n + c]);
+        let mut jac = DMatrix::<f64>::zeros(m, n);
+        for r in 0..m {
+            for (c, x) in rows.jrow(r) {
+                jac[(r, c)] = x;
+            }
+        }
         let mut jq = DMatrix::<f64>::zeros(m, n);
         let mut gc = DMatrix::<f64>::zeros(n, n);
         for (ci, &pi) in self.cons.row_points().iter().enumerate() {

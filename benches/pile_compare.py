@@ -1,0 +1,165 @@
+#!/usr/bin/env python3
+"""Piles dropped into a bin (benches/pile_gen.py) in urdyn and in MuJoCo 4.0, in one run: steps/s.
+
+Usage:
+    /work/venv/bin/python benches/pile_compare.py --urdyn BIN [--kinds boxes,mixed]
+        [--sizes 16,64,256,1024] [--duration 4] [--duration-1024 2] [--md benches/pile_results.md]
+        [--settled 256]
+
+Each scene (benches/scenes/pile_KIND_N.json) is run
+- by urdyn: `urdyn simulate --scene FILE --duration T --dt 0.001` with sleep (the default) and
+  with `--no-sleep`; steps/s from its summary line (the stepping loop only);
+- by MuJoCo 4.0: the same file built with mujoco.MjSpec exactly as benches/scene_compare.py builds
+  its scenes (build_mujoco), dt 1 ms, islands on (MuJoCo's default), for each of Euler and
+  implicitfast with sleep off and on (mjENBL_SLEEP); perf_counter around a Python loop of mj_step.
+The ratio is urdyn's faster run (sleep on, its default) over MuJoCo's fastest of the four.
+Growth: the step time ratio from 64 to 1024 objects (≤ 16: no faster than linear).
+
+--settled N: the N-box pile's steps/s over its first 0.5 s (falling) and, from a state saved at
+4 s, over 0.5 s more (settled), urdyn with sleep on (the CSV of a 4.5 s run, timed per segment
+through two runs: 0.5 s, and 4.5 s minus 4 s).
+"""
+import argparse
+import datetime
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from scene_compare import resolve_scene, build_mujoco, run_urdyn, find_share, uptime  # noqa: E402
+from sim_compare import machine, commit  # noqa: E402
+
+import mujoco  # noqa: E402
+
+INTEG = {"euler": mujoco.mjtIntegrator.mjINT_EULER,
+         "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST}
+
+
+def time_mj(model, qpos, qvel, integ, sleep, steps):
+    model.opt.integrator = INTEG[integ]
+    if sleep:
+        model.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_SLEEP)
+    else:
+        model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_SLEEP)
+    d = mujoco.MjData(model)
+    d.qpos[:], d.qvel[:] = qpos, qvel
+    mujoco.mj_forward(model, d)
+    step = mujoco.mj_step
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        step(model, d)
+    return steps / (time.perf_counter() - t0)
+
+
+def urdyn(args, path, dur, extra=()):
+    cmd = [args.urdyn, "simulate", "--scene", path, "--duration", repr(dur), "--dt", "0.001",
+           "--out", os.devnull] + list(extra)
+    r = run_urdyn(cmd)
+    if r.get("exit") != 0 or "steps_per_s" not in r:
+        raise RuntimeError("urdyn failed: %s: %s" % (" ".join(cmd), r.get("stderr_other")))
+    return r
+
+
+def one(args, kind, n, tmp):
+    sc, path = resolve_scene(os.path.join(HERE, "scenes", "pile_%s_%d.json" % (kind, n)), "", tmp)
+    dur = args.duration_1024 if n >= 1024 else args.duration
+    steps = int(round(dur / 0.001))
+    row = {"kind": kind, "n": n, "duration": dur}
+    ur = urdyn(args, path, dur)
+    row["urdyn_sleep"] = ur["steps_per_s"]
+    row["urdyn_awake_mean"] = ur["summary"].rsplit("mean awake", 1)[-1].strip() if "mean awake" in ur["summary"] else ""
+    row["urdyn_nosleep"] = urdyn(args, path, dur, ["--no-sleep"])["steps_per_s"] if not args.no_nosleep else None
+    model, qpos, qvel, _ = build_mujoco(sc, [], 0.001)
+    mj = {}
+    for integ in INTEG:
+        for sleep in (False, True):
+            mj["%s%s" % (integ, "+sleep" if sleep else "")] = time_mj(model, qpos, qvel, integ, sleep, steps)
+    row["mujoco"] = mj
+    best = max(mj, key=mj.get)
+    row["mujoco_best"], row["mujoco_best_cfg"] = mj[best], best
+    row["ratio"] = max(row["urdyn_sleep"], row["urdyn_nosleep"] or 0) / mj[best]
+    print("%s %d: urdyn %.0f (no sleep %s), MuJoCo %.0f (%s), ratio %.2f" % (
+        kind, n, row["urdyn_sleep"], row["urdyn_nosleep"] and "%.0f" % row["urdyn_nosleep"],
+        mj[best], best, row["ratio"]), file=sys.stderr, flush=True)
+    return row
+
+
+def settled(args, n, tmp):
+    """Falling (0–0.5 s) against settled (4–4.5 s) steps/s of urdyn, sleep on."""
+    _, path = resolve_scene(os.path.join(HERE, "scenes", "pile_boxes_%d.json" % n), "", tmp)
+    a = urdyn(args, path, 0.5)
+    b = urdyn(args, path, 4.0)
+    c = urdyn(args, path, 4.5)
+    falling = a["steps_per_s"]
+    settled_sps = 500 / max(c["wall"] - b["wall"], 1e-9)
+    return {"n": n, "falling": falling, "settled": settled_sps, "ratio": settled_sps / falling}
+
+
+def write_md(path, rows, meta, st):
+    out = ["# Piles in a bin: urdyn and MuJoCo 4.0.0", "",
+           "Made by `%s` on %s (%.0f s wall), urdyn commit %s, %s. Load at the start: `%s`; at the end: `%s`."
+           % (meta["cmd"], meta["date"], meta["wall"], meta["commit"], meta["machine"], meta["load0"], meta["load1"]),
+           "The script's docstring says how each engine gets the scene.", "",
+           "dt = 0.001 s; 4 s per run (1024 objects: 2 s). urdyn: sleep on (default) and `--no-sleep`; "
+           "MuJoCo: Euler and implicitfast, sleep off and on, islands on; ratio = urdyn (faster of its two) / "
+           "MuJoCo's fastest.", "",
+           "| pile | objects | urdyn steps/s (sleep) | urdyn --no-sleep | mean awake | MuJoCo euler | euler+sleep | implicitfast | implicitfast+sleep | ratio |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        mj = r["mujoco"]
+        out.append("| %s | %d | %.0f | %s | %s | %.0f | %.0f | %.0f | %.0f | %.2f |" % (
+            r["kind"], r["n"], r["urdyn_sleep"], "%.0f" % r["urdyn_nosleep"] if r["urdyn_nosleep"] else "-",
+            r["urdyn_awake_mean"] or "-", mj["euler"], mj["euler+sleep"], mj["implicitfast"],
+            mj["implicitfast+sleep"], r["ratio"]))
+    out.append("")
+    for kind in sorted({r["kind"] for r in rows}):
+        by = {r["n"]: r for r in rows if r["kind"] == kind}
+        if 64 in by and 1024 in by:
+            g_u = by[64]["urdyn_sleep"] / by[1024]["urdyn_sleep"]
+            g_un = (by[64]["urdyn_nosleep"] / by[1024]["urdyn_nosleep"]) if by[64]["urdyn_nosleep"] else float("nan")
+            g_m = by[64]["mujoco_best"] / by[1024]["mujoco_best"]
+            out.append("- %s, step time 1024 / 64 objects (16× the objects): urdyn %.1f× (no sleep %.1f×), MuJoCo %.1f×."
+                       % (kind, g_u, g_un, g_m))
+    if st:
+        out.append("- settled %d-box pile: %.0f steps/s falling (0–0.5 s), %.0f settled (4–4.5 s): %.1f×."
+                   % (st["n"], st["falling"], st["settled"], st["ratio"]))
+    out.append("")
+    with open(path, "w") as fh:
+        fh.write("\n".join(out))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--urdyn", required=True)
+    ap.add_argument("--kinds", default="boxes,mixed")
+    ap.add_argument("--sizes", default="16,64,256,1024")
+    ap.add_argument("--duration", type=float, default=4.0)
+    ap.add_argument("--duration-1024", type=float, default=2.0)
+    ap.add_argument("--settled", type=int, default=0)
+    ap.add_argument("--no-nosleep", action="store_true", help="skip urdyn's --no-sleep runs")
+    ap.add_argument("--md", default="")
+    args = ap.parse_args()
+    t0 = time.time()
+    load0 = uptime()
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for kind in args.kinds.split(","):
+            for n in [int(x) for x in args.sizes.split(",")]:
+                rows.append(one(args, kind, n, tmp))
+        st = settled(args, args.settled, tmp) if args.settled else None
+    if st:
+        print("settled %d: falling %.0f, settled %.0f steps/s (%.1fx)" % (st["n"], st["falling"], st["settled"], st["ratio"]), file=sys.stderr)
+    if args.md:
+        meta = {"cmd": "python benches/pile_compare.py " + " ".join(sys.argv[1:]),
+                "date": datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC"),
+                "wall": time.time() - t0, "commit": commit(), "machine": machine(),
+                "load0": load0, "load1": uptime()}
+        write_md(args.md, rows, meta, st)
+
+
+if __name__ == "__main__":
+    main()

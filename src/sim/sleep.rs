@@ -1,0 +1,528 @@
+//! Islands and sleep (scene.md §"Large scenes: islands and sleep").
+//!
+//! The models of a scene (the trees of the model) are grouped each step into
+//! islands: two trees are in one island when a contact point of the last
+//! detection (a point within the contact margin) joins their bodies; the
+//! world, obstacles and trees without degrees of freedom join nothing. An
+//! island sleeps when, for `sleep_time` without a break, every point of every
+//! collision shape of its trees moved slower than `sleep_velocity`: the speed
+//! of a shape's points is bounded by |v_c| + |ω| r over the shape's bounding
+//! sphere (centre c, radius r; a body without shapes: its centre of mass and
+//! r = 0.1 m), so the test never lets an island sleep early. A sleeping
+//! tree's q is frozen and its v is exactly zero; its shapes are not searched
+//! for contact among themselves or with the static world (its last contact
+//! points are kept, frozen, for `contacts` and `penetration`). It wakes,
+//! whole, when a contact point joins one of its bodies to an awake body, or
+//! when the forcing or the state is set. A tree with a fixed base, a nonzero
+//! applied torque or wrench, a servo, or its own `"sleep": false` never
+//! sleeps, nor does an island holding one.
+
+use super::ContactForce;
+use crate::contact::ContactPoint;
+use crate::model::Model;
+use crate::spatial::Force;
+use nalgebra::{DVector, Vector3};
+
+/// "No tree": the world body.
+const WORLD: usize = usize::MAX;
+
+/// The sleep state of a simulation's trees.
+#[derive(Clone, Debug)]
+pub(crate) struct Sleep {
+    /// Sleep is on (`SimOptions::sleep`).
+    pub on: bool,
+    /// m/s.
+    v_tol: f64,
+    /// s.
+    t_tol: f64,
+    /// Each body's tree (`WORLD` for body 0).
+    pub tree_of_body: Vec<usize>,
+    /// Per tree: it never sleeps (fixed base, no dofs, its own `"sleep": false`).
+    never: Vec<bool>,
+    /// Per tree: it has degrees of freedom (it counts in `awake`).
+    has_dof: Vec<bool>,
+    /// Bounding spheres of the collision shapes: (body, centre in the body
+    /// frame, radius); bodies without one use their centre of mass and 0.1 m.
+    spheres: Vec<(usize, Vector3<f64>, f64)>,
+    has_sphere: Vec<bool>,
+    /// Per tree: how long it has been still (s).
+    still: Vec<f64>,
+    /// Per tree: asleep.
+    pub asleep: Vec<bool>,
+    /// Per body: its tree is asleep (the detection's skip mask).
+    pub body_asleep: Vec<bool>,
+    /// Union-find parents (per tree) of this step's islands.
+    parent: Vec<usize>,
+    /// Per tree: the island it fell asleep in (its root tree).
+    island: Vec<usize>,
+    /// Per tree: its largest point speed this step (m/s).
+    speed: Vec<f64>,
+    /// The configuration the sleeping trees are held at.
+    pub q_frozen: DVector<f64>,
+    /// The sleeping islands' last contact points and forces.
+    pub frozen_points: Vec<ContactPoint>,
+    pub frozen_forces: Vec<ContactForce>,
+    /// The sleeping bodies' last contact wrenches (per body).
+    frozen_body: Vec<Force>,
+    /// The last solve's contact forces and wrenches with the frozen ones
+    /// (in use while anything sleeps).
+    all_forces: Vec<ContactForce>,
+    all_body: Vec<Force>,
+    /// v plus the position pass's pseudo-velocity (scratch: a point pushed out
+    /// of a penetration is moving).
+    pub vw: DVector<f64>,
+    /// Awake trees with dofs at the end of the last step.
+    pub awake: usize,
+    /// Σ awake over the steps, and the steps.
+    pub awake_sum: f64,
+    pub steps: u64,
+    /// Everything wakes at the next step (the forcing or the state was set).
+    pub wake_pending: bool,
+    any_asleep: bool,
+    /// Per island root: it may sleep (scratch).
+    may: Vec<bool>,
+}
+
+impl Sleep {
+    /// The sleep state of `model`: `spheres` the collision shapes' bounding
+    /// spheres, `never_names` the scene models that never sleep.
+    pub fn new(
+        model: &Model,
+        on: bool,
+        v_tol: f64,
+        t_tol: f64,
+        spheres: Vec<(usize, Vector3<f64>, f64)>,
+        never_names: &[String],
+    ) -> Self {
+        let nt = model.trees.len();
+        let mut tree_of_body = vec![WORLD; model.nbodies];
+        let mut never = vec![false; nt];
+        let mut has_dof = vec![false; nt];
+        for (t, tree) in model.trees.iter().enumerate() {
+            for b in tree.bodies.clone() {
+                if let Some(x) = tree_of_body.get_mut(b) {
+                    *x = t;
+                }
+            }
+            has_dof[t] = !tree.v.is_empty();
+            never[t] = tree.free.is_none()
+                || tree.v.is_empty()
+                || never_names.contains(&tree.name);
+        }
+        let mut has_sphere = vec![false; model.nbodies];
+        for s in &spheres {
+            if let Some(h) = has_sphere.get_mut(s.0) {
+                *h = true;
+            }
+        }
+        let awake = has_dof.iter().filter(|&&d| d).count();
+        Self {
+            on,
+            v_tol,
+            t_tol,
+            tree_of_body,
+            never,
+            has_dof,
+            spheres,
+            has_sphere,
+            still: vec![0.0; nt],
+            asleep: vec![false; nt],
+            body_asleep: vec![false; model.nbodies],
+            parent: (0..nt).collect(),
+            island: vec![0; nt],
+            speed: vec![0.0; nt],
+            q_frozen: DVector::zeros(model.nq),
+            frozen_points: Vec::new(),
+            frozen_forces: Vec::new(),
+            frozen_body: vec![Force::zero(); model.nbodies],
+            all_forces: Vec::new(),
+            all_body: vec![Force::zero(); model.nbodies],
+            vw: DVector::zeros(model.nv),
+            awake,
+            awake_sum: 0.0,
+            steps: 0,
+            wake_pending: false,
+            any_asleep: false,
+            may: vec![true; nt],
+        }
+    }
+
+    /// The awake trees with dofs now.
+    fn count_awake(&self) -> usize {
+        (0..self.asleep.len())
+            .filter(|&t| self.has_dof[t] && !self.asleep[t])
+            .count()
+    }
+
+    /// Wakes every sleeping tree; true when one woke.
+    pub fn wake_all(&mut self, model: &Model) -> bool {
+        self.wake_pending = false;
+        let mut woke = false;
+        for t in 0..self.asleep.len() {
+            if self.asleep[t] {
+                self.wake_tree(model, t);
+                woke = true;
+            }
+        }
+        self.frozen_points.clear();
+        self.frozen_forces.clear();
+        self.any_asleep = false;
+        self.awake = self.count_awake();
+        woke
+    }
+
+    fn wake_tree(&mut self, model: &Model, t: usize) {
+        self.asleep[t] = false;
+        self.still[t] = 0.0;
+        for b in model.trees[t].bodies.clone() {
+            self.body_asleep[b] = false;
+        }
+    }
+
+    /// Wakes the sleeping islands that a point joins to an awake body (the
+    /// point's other side awake, or a body of an awake tree); true when one woke.
+    pub fn wake_touched(&mut self, model: &Model, points: &[ContactPoint]) -> bool {
+        if !self.any_asleep {
+            return false;
+        }
+        let mut woke = false;
+        for p in points {
+            let (ta, tb) = (self.tree(p.body), self.tree(p.other));
+            for (s, o) in [(ta, tb), (tb, ta)] {
+                if s != WORLD && self.asleep[s] && (o == WORLD || !self.asleep[o]) {
+                    let isl = self.island[s];
+                    for t in 0..self.asleep.len() {
+                        if self.asleep[t] && self.island[t] == isl {
+                            self.wake_tree(model, t);
+                        }
+                    }
+                    woke = true;
+                }
+            }
+        }
+        if woke {
+            let asleep = &self.body_asleep;
+            let keep = |b: usize| asleep.get(b) == Some(&true);
+            self.frozen_points.retain(|p| keep(p.body));
+            self.frozen_forces.retain(|f| keep(f.point.body));
+            self.any_asleep = self.asleep.iter().any(|&a| a);
+            self.awake = self.count_awake();
+        }
+        woke
+    }
+
+    fn tree(&self, body: usize) -> usize {
+        self.tree_of_body.get(body).copied().unwrap_or(WORLD)
+    }
+
+    fn find(&mut self, mut t: usize) -> usize {
+        while self.parent[t] != t {
+            self.parent[t] = self.parent[self.parent[t]];
+            t = self.parent[t];
+        }
+        t
+    }
+
+    /// One step's bookkeeping after a step of `h` (s): each awake tree's largest
+    /// point speed from the bodies' velocities `body_v` (body frame: linear at
+    /// the body origin, angular), the islands of `points`, and the islands
+    /// still for `sleep_time` put to sleep (`forced[t]`: tree t is driven
+    /// now and cannot sleep). Sleeping trees' v are set to zero and their q
+    /// kept; their points and forces move to the frozen lists (removed from
+    /// `points`). Returns whether an island fell asleep.
+    #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
+    pub fn after_step(
+        &mut self,
+        model: &Model,
+        h: f64,
+        body_v: &[crate::spatial::Motion<f64>],
+        forced: &[bool],
+        q: &DVector<f64>,
+        v: &mut DVector<f64>,
+        points: &mut Vec<ContactPoint>,
+        forces: &[ContactForce],
+        body_forces: &[Force],
+    ) -> bool {
+        self.steps += 1;
+        if !self.on {
+            self.awake_sum += self.awake as f64;
+            return false;
+        }
+        // each awake tree's largest point speed
+        self.speed.iter_mut().for_each(|s| *s = 0.0);
+        for &(b, c, r) in &self.spheres {
+            let t = self.tree(b);
+            if t == WORLD || self.asleep[t] {
+                continue;
+            }
+            if let Some(m) = body_v.get(b) {
+                let s = (m.lin + m.ang.cross(&c)).norm() + m.ang.norm() * r;
+                self.speed[t] = self.speed[t].max(s);
+            }
+        }
+        for (b, m) in body_v.iter().enumerate().skip(1) {
+            if self.has_sphere[b] {
+                continue;
+            }
+            let t = self.tree(b);
+            if t == WORLD || self.asleep[t] {
+                continue;
+            }
+            let c = model.inertias[b].com;
+            let s = (m.lin + m.ang.cross(&c)).norm() + m.ang.norm() * 0.1;
+            self.speed[t] = self.speed[t].max(s);
+        }
+        let nt = self.asleep.len();
+        for t in 0..nt {
+            if self.asleep[t] {
+                continue;
+            }
+            self.still[t] = if self.speed[t] < self.v_tol && !forced[t] {
+                self.still[t] + h
+            } else {
+                0.0
+            };
+            self.parent[t] = t;
+        }
+        // islands: trees joined by a contact point
+        for p in points.iter() {
+            let (ta, tb) = (self.tree(p.body), self.tree(p.other));
+            if ta == WORLD || tb == WORLD || ta == tb {
+                continue;
+            }
+            let (ra, rb) = (self.find(ta), self.find(tb));
+            if ra != rb {
+                let (lo, hi) = (ra.min(rb), ra.max(rb));
+                self.parent[hi] = lo;
+            }
+        }
+        // an island sleeps when every tree in it may: the root collects the
+        // verdict (true: may sleep)
+        let mut may = std::mem::take(&mut self.may);
+        may.clear();
+        may.resize(nt, true);
+        for t in 0..nt {
+            if self.asleep[t] {
+                continue;
+            }
+            let r = self.find(t);
+            if self.never[t] || forced[t] || self.still[t] < self.t_tol {
+                may[r] = false;
+            }
+        }
+        let mut slept = false;
+        for t in 0..nt {
+            if self.asleep[t] || !self.has_dof[t] {
+                continue;
+            }
+            let r = self.find(t);
+            if !may[r] {
+                continue;
+            }
+            slept = true;
+            self.asleep[t] = true;
+            self.island[t] = r;
+            let tree = &model.trees[t];
+            for k in tree.v.clone() {
+                v[k] = 0.0;
+            }
+            for k in tree.q.clone() {
+                self.q_frozen[k] = q[k];
+            }
+            for b in tree.bodies.clone() {
+                self.body_asleep[b] = true;
+                self.frozen_body[b] = body_forces.get(b).copied().unwrap_or(Force::zero());
+            }
+        }
+        self.may = may;
+        if slept {
+            self.any_asleep = true;
+            let asleep = &self.body_asleep;
+            let sleeping = |b: usize| asleep.get(b) == Some(&true);
+            for f in forces {
+                if sleeping(f.point.body) {
+                    self.frozen_forces.push(*f);
+                }
+            }
+            let frozen = &mut self.frozen_points;
+            points.retain(|p| {
+                if sleeping(p.body) {
+                    frozen.push(*p);
+                    false
+                } else {
+                    true
+                }
+            });
+            self.awake = self.count_awake();
+        }
+        self.awake_sum += self.awake as f64;
+        slept
+    }
+
+    /// Holds the sleeping trees where they fell asleep, at rest.
+    pub fn hold(&self, model: &Model, q: &mut DVector<f64>, v: &mut DVector<f64>) {
+        if !self.any_asleep {
+            return;
+        }
+        for (t, tree) in model.trees.iter().enumerate() {
+            if !self.asleep[t] {
+                continue;
+            }
+            for k in tree.v.clone() {
+                v[k] = 0.0;
+            }
+            for k in tree.q.clone() {
+                q[k] = self.q_frozen[k];
+            }
+        }
+    }
+
+    /// Every tree with dofs sleeps: a step has nothing to do.
+    pub fn all_asleep(&self) -> bool {
+        self.on && self.any_asleep && self.awake == 0
+    }
+
+    /// Counts a step that had nothing to do.
+    pub fn count_idle_step(&mut self) {
+        self.steps += 1;
+        self.awake_sum += self.awake as f64;
+    }
+
+    /// The last solve's contact forces and body wrenches joined with the
+    /// sleeping islands' frozen ones.
+    pub fn compose(&mut self, forces: &[ContactForce], body: &[Force]) {
+        if !self.any_asleep {
+            return;
+        }
+        self.all_forces.clear();
+        // (the last solve's forces on islands that fell asleep after it are
+        // the frozen ones already)
+        let asleep = &self.body_asleep;
+        let awake = |b: usize| asleep.get(b) != Some(&true);
+        self.all_forces
+            .extend(forces.iter().filter(|f| awake(f.point.body)));
+        self.all_forces.extend_from_slice(&self.frozen_forces);
+        for (b, out) in self.all_body.iter_mut().enumerate() {
+            let f = body.get(b).copied().unwrap_or(Force::zero());
+            *out = if self.body_asleep[b] { self.frozen_body[b] } else { f };
+        }
+    }
+    /// The contact forces to report: `awake` (the last solve's) joined with
+    /// the frozen ones while anything sleeps.
+    pub fn forces<'a>(&'a self, awake: &'a [ContactForce]) -> &'a [ContactForce] {
+        if self.any_asleep {
+            &self.all_forces
+        } else {
+            awake
+        }
+    }
+    /// The body contact wrenches to report (as [`Sleep::forces`]).
+    pub fn body_forces<'a>(&'a self, awake: &'a [Force]) -> &'a [Force] {
+        if self.any_asleep {
+            &self.all_body
+        } else {
+            awake
+        }
+    }
+
+    /// Whether tree `t` sleeps.
+    pub fn tree_asleep(&self, t: usize) -> bool {
+        self.asleep.get(t).copied().unwrap_or(false)
+    }
+
+    /// The mean awake count over the steps (the count now before any step).
+    pub fn mean_awake(&self) -> f64 {
+        if self.steps == 0 {
+            self.awake as f64
+        } else {
+            self.awake_sum / self.steps as f64
+        }
+    }
+}
+
+impl super::Simulation {
+    /// The awake models with degrees of freedom now (cli.md's `awake`).
+    pub fn awake(&self) -> usize {
+        self.sleep.awake
+    }
+    /// The mean of [`Simulation::awake`] over the steps taken.
+    pub fn mean_awake(&self) -> f64 {
+        self.sleep.mean_awake()
+    }
+    /// Whether the scene model `name` sleeps (`None`: no such model; a lone
+    /// URDF's one model is named "").
+    pub fn sleeping(&self, name: &str) -> Option<bool> {
+        let t = self.model.trees.iter().position(|t| t.name == name)?;
+        Some(self.sleep.tree_asleep(t))
+    }
+    /// Wakes every sleeping island now (their contacts are found anew).
+    pub fn wake(&mut self) {
+        if self.sleep.wake_all(&self.model) {
+            self.refresh_contacts();
+        }
+    }
+
+    /// Sleep's work at the end of a step of `h`: islands that an awake body
+    /// touches woken (their contacts found), then the still islands put to sleep.
+    pub(super) fn update_sleep(&mut self, h: f64) {
+        if !self.sleep.on {
+            self.sleep.after_step(
+                &self.model,
+                h,
+                &[],
+                &[],
+                &self.q,
+                &mut self.v,
+                &mut self.points,
+                &[],
+                &[],
+            );
+            return;
+        }
+        while self.sleep.wake_touched(&self.model, &self.points) {
+            self.refresh_contacts();
+        }
+        if !self.fk_valid {
+            crate::dynamics::forward_kinematics_pass(&self.model, &mut self.data, &self.q);
+            self.fk_valid = true;
+        }
+        // body velocities (body frame) from the poses' joint transforms, the
+        // position pass's push included (a point pushed out moves)
+        let model = &self.model;
+        let data = &mut self.data;
+        self.sleep.vw.copy_from(&self.v);
+        if let Some(w) = self.cons.push_velocity() {
+            self.sleep.vw += w;
+        }
+        data.v[0] = crate::spatial::Motion::zero();
+        for i in 1..model.nbodies {
+            let mut vi = data.li_m_i[i].inv_act_motion(&data.v[model.parent[i]]);
+            model.joints[i].add_motion(&mut vi, &self.sleep.vw);
+            data.v[i] = vi;
+        }
+        // trees driven now: a nonzero applied force, or a servo on one of its dofs
+        self.sleep_forced.iter_mut().for_each(|f| *f = false);
+        for (t, tree) in model.trees.iter().enumerate() {
+            self.sleep_forced[t] = tree.v.clone().any(|k| {
+                self.tau_applied[k] != 0.0
+                    || (self.servo.active && (self.servo.kp[k] != 0.0 || self.servo.kd[k] != 0.0))
+            });
+        }
+        let slept = self.sleep.after_step(
+            model,
+            h,
+            &data.v,
+            &self.sleep_forced,
+            &self.q,
+            &mut self.v,
+            &mut self.points,
+            self.cons.contact_forces(),
+            self.cons.body_forces(),
+        );
+        if slept {
+            self.energy_now = None;
+        }
+        self.sleep
+            .compose(self.cons.contact_forces(), self.cons.body_forces());
+    }
+}
