@@ -70,12 +70,15 @@ def main(out):
         q_ref[lift] = 0.2 * min(max((t - 0.3) / 0.9, 0.0), 1.0)  # then lift 0.2 m
         sim.set_targets(q_ref)
         sim.step()
+        if k == 299:  # gripped, before the lift: the cube's height relative to the fingers
+            held = sim.q[2] - sim.q[lift][0]
     sim.record(False)
     frames = sim.write_html(out)
     gained = sim.q[2] - z0
-    slip = sim.q[lift][0] - gained
-    print(f"cube lifted {gained * 1000:.1f} mm (gripper {sim.q[lift][0] * 1000:.1f} mm, slip "
-          f"{slip * 1000:.3f} mm); {len(sim.contacts())} contact points; wrote {out} ({frames} frames)")
+    slip = held - (sim.q[2] - sim.q[lift][0])
+    print(f"cube lifted {gained * 1000:.1f} mm (gripper {sim.q[lift][0] * 1000:.1f} mm), slipped "
+          f"{slip * 1000:.3f} mm down the fingers; {len(sim.contacts())} contact points; wrote {out} "
+          f"({frames} frames)")
 
 
 if __name__ == "__main__":
