@@ -149,5 +149,6 @@ pub fn per_dof(model: &Model, fill: f64, f: impl Fn(&urdyn::model::DofInfo) -> f
 
 /// `slice(range.start, range.end)` (step None, as Python's own).
 pub fn py_slice<'py>(py: Python<'py>, r: &Range<usize>) -> PyResult<Bound<'py, PyAny>> {
-    py.get_type::<pyo3::types::PySlice>().call1((r.start, r.end))
+    py.get_type::<pyo3::types::PySlice>()
+        .call1((r.start, r.end))
 }

@@ -6,11 +6,11 @@
 //! names are fixed by `shared/spec/python.md` (Pinocchio's where it has one).
 
 mod args;
+mod contacts;
 mod control;
 mod derivatives;
 mod dynamics;
 mod introspect;
-mod contacts;
 mod model;
 mod rollout;
 mod scene;

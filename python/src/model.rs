@@ -1,10 +1,10 @@
 //! `urdyn.Model` (the immutable model, its names, pickling) and `urdyn.Data`
 //! (the preallocated workspace).
 
-use crate::introspect::{self, link_inertials, py_slice, LinkInertial};
 use crate::args::{
     normalize_base_quaternion, not_found_error, quat_offsets, read3, read_q, read_vec, value_error,
 };
+use crate::introspect::{self, link_inertials, py_slice, LinkInertial};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -258,7 +258,10 @@ impl PyModel {
     /// The models in q order: a scene's names, ["robot"] for a lone URDF.
     #[getter]
     fn models(&self) -> Vec<String> {
-        introspect::models(&self.model).into_iter().map(|m| m.0).collect()
+        introspect::models(&self.model)
+            .into_iter()
+            .map(|m| m.0)
+            .collect()
     }
     /// (nq,) lower position limits: -inf where none, on continuous joints and the base.
     #[getter]
@@ -275,7 +278,10 @@ impl PyModel {
     #[getter]
     fn effort_limits<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         let e = introspect::per_dof(&self.model, f64::INFINITY, |d| {
-            d.limits.effort.filter(|&e| e > 0.0).unwrap_or(f64::INFINITY)
+            d.limits
+                .effort
+                .filter(|&e| e > 0.0)
+                .unwrap_or(f64::INFINITY)
         });
         PyArray1::from_vec(py, e)
     }
@@ -291,7 +297,11 @@ impl PyModel {
     #[getter]
     fn damping<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         let e = introspect::per_dof(&self.model, 0.0, |d| {
-            if d.damping.is_finite() { d.damping.max(0.0) } else { 0.0 }
+            if d.damping.is_finite() {
+                d.damping.max(0.0)
+            } else {
+                0.0
+            }
         });
         PyArray1::from_vec(py, e)
     }
@@ -322,8 +332,12 @@ impl PyModel {
         let (c, i) = self
             .inertials
             .get(link)
-            .map_or((Vector3::zeros(), urdyn::nalgebra::Matrix3::zeros()), |l| (l.com, l.inertia));
-        let rows: Vec<Vec<f64>> = (0..3).map(|r| (0..3).map(|k| i[(r, k)]).collect()).collect();
+            .map_or((Vector3::zeros(), urdyn::nalgebra::Matrix3::zeros()), |l| {
+                (l.com, l.inertia)
+            });
+        let rows: Vec<Vec<f64>> = (0..3)
+            .map(|r| (0..3).map(|k| i[(r, k)]).collect())
+            .collect();
         let m = PyArray2::from_vec2(py, &rows).map_err(|e| value_error(e.to_string()))?;
         Ok((PyArray1::from_slice(py, c.as_slice()), m))
     }

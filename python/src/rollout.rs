@@ -5,7 +5,9 @@
 //! (the same [`prototype_any`], [`set_torques`], `set_gains`, `set_targets`
 //! and [`advance`]).
 
-use crate::args::{normalize_quaternion_at, read_array, read_count, read_threads, value_error, Given};
+use crate::args::{
+    normalize_quaternion_at, read_array, read_count, read_threads, value_error, Given,
+};
 use crate::sim::{advance, prototype_any, set_torques, sim_error};
 use numpy::{PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
@@ -21,7 +23,13 @@ enum PerRun {
 
 impl PerRun {
     /// Reads `x` ((B, n) or (B, nstep, n); None: none).
-    fn read(x: Option<&Bound<'_, PyAny>>, name: &str, b: usize, nstep: usize, n: usize) -> PyResult<Self> {
+    fn read(
+        x: Option<&Bound<'_, PyAny>>,
+        name: &str,
+        b: usize,
+        nstep: usize,
+        n: usize,
+    ) -> PyResult<Self> {
         let Some(x) = x.filter(|x| !x.is_none()) else {
             return Ok(PerRun::None);
         };
@@ -138,7 +146,11 @@ pub fn rollout<'py>(
     for f in &proto.model.free_joints {
         let at = f.iq + 3;
         for i in 0..b {
-            normalize_quaternion_at(&mut q0[i * nq + at..i * nq + at + 4], &format!("q0[{i}]"), at)?;
+            normalize_quaternion_at(
+                &mut q0[i * nq + at..i * nq + at + 4],
+                &format!("q0[{i}]"),
+                at,
+            )?;
         }
     }
     if vs != [b, nv] {
@@ -156,7 +168,9 @@ pub fn rollout<'py>(
         if k == 0 && (kp.is_some() || kd.is_some()) {
             let zero = vec![0.0; nv];
             let row = |g: &Option<Vec<f64>>| {
-                DVector::from_column_slice(g.as_ref().map_or(&zero[..], |g| &g[i * nv..(i + 1) * nv]))
+                DVector::from_column_slice(
+                    g.as_ref().map_or(&zero[..], |g| &g[i * nv..(i + 1) * nv]),
+                )
             };
             sim.set_gains(&row(&kp), &row(&kd))
                 .map_err(|e| format!("kp[{i}], kd[{i}]: {e}"))?;

@@ -6,12 +6,12 @@
 use crate::args::value_error;
 use crate::introspect::link_inertials;
 use crate::model::PyModel;
-use urdyn::nalgebra::Vector3;
 use numpy::PyArray1;
 use pyo3::exceptions::PyFileNotFoundError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use std::path::PathBuf;
+use urdyn::nalgebra::Vector3;
 use urdyn::scene::{Scene, SceneError};
 
 /// A scene (`Scene.from_file(path)`, `Scene.from_json(text, base_dir=None)`).

@@ -125,7 +125,14 @@ pub(crate) fn prototype_any(
         .extract::<PyRef<'_, PyModel>>()
         .map_err(|_| value_error("model: expected a urdyn.Model or a urdyn.Scene".to_string()))?;
     let py = source.py();
-    prototype(&model, dt, integrator, ground.ground(py)?, friction.friction(py)?, package_dirs)
+    prototype(
+        &model,
+        dt,
+        integrator,
+        ground.ground(py)?,
+        friction.friction(py)?,
+        package_dirs,
+    )
 }
 
 /// One step of `dt` of simulated time (an adaptive integrator may take several
@@ -222,7 +229,9 @@ impl PySimulation {
     /// ValueError: the file decides).
     #[new]
     #[pyo3(signature = (model, dt=1e-3, integrator=None, ground=Given::Omitted, friction=Given::Omitted, package_dirs=None))]
-    #[pyo3(text_signature = "(model, dt=1e-3, integrator=None, ground=0.0, friction=1.0, package_dirs=None)")]
+    #[pyo3(
+        text_signature = "(model, dt=1e-3, integrator=None, ground=0.0, friction=1.0, package_dirs=None)"
+    )]
     fn new(
         model: &Bound<'_, PyAny>,
         dt: f64,
@@ -268,7 +277,9 @@ impl PySimulation {
         read_vec(v, "v", "nv", &mut vv)?;
         if let Some(t) = time {
             if !t.is_finite() {
-                return Err(value_error(format!("time must be a finite number (got {t})")));
+                return Err(value_error(format!(
+                    "time must be a finite number (got {t})"
+                )));
             }
         }
         self.sim
@@ -276,9 +287,6 @@ impl PySimulation {
             .map_err(|e| value_error(e.to_string()))?;
         if let Some(t) = time {
             self.sim.set_time(t);
-        }
-        if self.recording {
-            self.record_frame();
         }
         Ok(())
     }
@@ -296,9 +304,6 @@ impl PySimulation {
             .and_then(|_| sim.set_targets(&q_ref, Some(&v_ref)))
             .map_err(|e| value_error(e.to_string()))?;
         self.sim = sim;
-        if self.recording {
-            self.record_frame();
-        }
         Ok(())
     }
 
