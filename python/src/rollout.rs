@@ -82,7 +82,7 @@ fn read_gains(
         Some(g) => (Vec::new(), vec![g]),
         None => read_array(x, name)?,
     };
-    if let Some(g) = data.iter().find(|g| !(**g >= 0.0)) {
+    if let Some(g) = data.iter().find(|g| g.is_nan() || **g < 0.0) {
         return Err(value_error(format!(
             "{name} must be finite numbers ≥ 0 (got {g})"
         )));
