@@ -154,7 +154,14 @@ const BAD_URDF: &[(&str, &[&str])] = &[
     ),
     ("reversed_limit.urdf", &["joint \"j1\" <limit>"]),
     ("unknown_joint_type.urdf", &["joint \"j1\"", "\"hinge\""]),
-    ("floating_joint_type.urdf", &["joint \"j1\"", "floating"]),
+    (
+        "mimic_spherical.urdf",
+        &["joint \"j2\" <mimic>", "spherical joint cannot mimic"],
+    ),
+    (
+        "mimic_spherical_leader.urdf",
+        &["joint \"j2\" <mimic>", "several degrees of freedom"],
+    ),
     ("nonnumeric_origin.urdf", &["joint \"j1\" <origin>", "xyz"]),
     ("short_origin.urdf", &["joint \"j1\" <origin>", "xyz"]),
     ("joint_no_type.urdf", &["joint \"j1\"", "type"]),
@@ -212,6 +219,40 @@ const WARN: &[(&str, &[&str])] = &[
         ],
     ),
     ("ok.urdf", &[]),
+];
+
+/// States files on joints_ok.urdf (a spherical "ball", a revolute "hinge", a
+/// floating "mount", a planar "slide") with what their error must name.
+const BAD_JOINT_STATES: &[(&str, &[&str])] = &[
+    (
+        "states_joint_number_for_array.json",
+        &["states[0].q.ball", "array of 4 numbers [qx, qy, qz, qw], found a number"],
+    ),
+    (
+        "states_joint_wrong_length.json",
+        &["states[0].q.slide", "array of 3 numbers [x, y, theta], found 2"],
+    ),
+    (
+        "states_joint_v_wrong_length.json",
+        &["states[0].v.mount", "array of 6 numbers", "found 3"],
+    ),
+    (
+        "states_joint_quat_nonunit.json",
+        &["states[0].q.ball", "not a unit quaternion"],
+    ),
+    (
+        "states_joint_mount_quat_nonunit.json",
+        &["states[0].q.mount", "not a unit quaternion (norm 2"],
+    ),
+    (
+        "states_joint_array_for_number.json",
+        &["states[0].v.hinge", "takes a number, found an array"],
+    ),
+    (
+        "states_joint_string_in_array.json",
+        &["states[0].a.ball", "string"],
+    ),
+    ("states_joint_nonfinite.json", &["states[0].tau.slide"]),
 ];
 
 /// States files (on ok.urdf) with the key their error must name; `true`: with
@@ -574,6 +615,15 @@ fn bad_states_are_rejected_naming_the_key() {
         e.extend_from_slice(expect);
         assert_rejected(&args, &e);
     }
+    // Joints of several degrees of freedom (mechanisms.md "In `eval` (version 4)"):
+    // each error names the joint.
+    for (file, expect) in BAD_JOINT_STATES {
+        let mut e: Vec<&str> = vec![file];
+        e.extend_from_slice(expect);
+        assert_rejected(&["eval", "joints_ok.urdf", "--states", file], &e);
+    }
+    let r = run(&["eval", "joints_ok.urdf", "--states", "states_joints_ok.json"]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
     // The good states files are answered, fixed and floating.
     for (fb, file) in [false, true]
         .into_iter()

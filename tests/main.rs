@@ -24,6 +24,7 @@ mod derivatives;
 mod eval_singular;
 mod example_scenes;
 mod fast_dynamics;
+mod joint_kinds;
 mod kinematics_energy;
 mod layering;
 mod output_files;

@@ -182,7 +182,8 @@ pub fn evaluate(
     let names = evaluate_each(model, states, urdf_file, states_file, |r| {
         results.push(r);
     })?;
-    Ok(json!({"dof_names": names, "results": results}))
+    Ok(json!({"dof_names": names, "q_names": model.q_names(), "v_names": model.v_names(),
+        "results": results}))
 }
 
 /// As [`evaluate`], serialised to the JSON text of the contract (one line, no
@@ -201,11 +202,12 @@ pub fn evaluate_json(
         }
         body.push_str(&r.to_string());
     })?;
-    // Key order as serde_json writes the object of `evaluate` (sorted, or insertion
-    // order: both put "dof_names" first).
+    // Key order as serde_json writes the object of `evaluate` (sorted).
     Ok(format!(
-        "{{\"dof_names\":{},\"results\":[{body}]}}",
-        Value::from(names)
+        "{{\"dof_names\":{},\"q_names\":{},\"results\":[{body}],\"v_names\":{}}}",
+        Value::from(names),
+        Value::from(model.q_names()),
+        Value::from(model.v_names())
     ))
 }
 
@@ -243,7 +245,6 @@ fn evaluate_each(
     }
     let mut data = Data::new(&model);
     let names = model.dof_names();
-    let vo = model.joint_v_offset();
     let mut fext = vec![Force::zero(); model.nbodies];
     for (i, sv) in vectors.iter().enumerate() {
         let key = format!("states[{i}]");
@@ -313,10 +314,17 @@ fn evaluate_each(
             });
         }
 
+        // a joint of several degrees of freedom gives an array (mechanisms.md)
         let by_name = |x: &nalgebra::DVector<f64>| -> Value {
             let mut m = Map::new();
-            for (k, n) in names.iter().enumerate() {
-                m.insert((*n).to_string(), json!(x[vo + k]));
+            for d in &model.dofs {
+                let n = d.kind.nv();
+                let val = if n == 1 {
+                    json!(x[d.iv])
+                } else {
+                    json!(x.as_slice()[d.iv..d.iv + n])
+                };
+                m.insert(d.name.clone(), val);
             }
             Value::Object(m)
         };

@@ -61,19 +61,60 @@ pub struct LinkWrench {
     pub torque: Option<[f64; 3]>,
 }
 
+/// A joint's value in a state's `q`, `v`, `a` or `tau`: a number for a 1-DoF joint,
+/// an array for a joint of several degrees of freedom (mechanisms.md "In `eval`
+/// (version 4)").
+#[derive(Debug, Clone, PartialEq)]
+pub enum JointValue {
+    /// One number (revolute, continuous, prismatic).
+    Scalar(f64),
+    /// Several numbers (spherical, planar, floating).
+    Array(Vec<f64>),
+}
+
+impl<'de> Deserialize<'de> for JointValue {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = JointValue;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or an array of numbers")
+            }
+            fn visit_f64<E>(self, x: f64) -> Result<JointValue, E> {
+                Ok(JointValue::Scalar(x))
+            }
+            fn visit_i64<E>(self, x: i64) -> Result<JointValue, E> {
+                Ok(JointValue::Scalar(x as f64))
+            }
+            fn visit_u64<E>(self, x: u64) -> Result<JointValue, E> {
+                Ok(JointValue::Scalar(x as f64))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> Result<JointValue, A::Error> {
+                let mut out = Vec::new();
+                while let Some(x) = a.next_element::<f64>()? {
+                    out.push(x);
+                }
+                Ok(JointValue::Array(out))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
 /// One state: joint maps keyed by URDF joint name, the base, external wrenches by
 /// link and the links whose kinematics the result reports.
 #[derive(Debug, Clone, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct State {
-    /// Joint positions by joint name (rad or m).
-    pub q: Option<BTreeMap<String, f64>>,
+    /// Joint positions by joint name (rad or m; an array for a joint of several
+    /// degrees of freedom).
+    pub q: Option<BTreeMap<String, JointValue>>,
     /// Joint velocities by joint name.
-    pub v: Option<BTreeMap<String, f64>>,
+    pub v: Option<BTreeMap<String, JointValue>>,
     /// Joint accelerations by joint name.
-    pub a: Option<BTreeMap<String, f64>>,
+    pub a: Option<BTreeMap<String, JointValue>>,
     /// Joint efforts by joint name (N·m or N).
-    pub tau: Option<BTreeMap<String, f64>>,
+    pub tau: Option<BTreeMap<String, JointValue>>,
     /// The floating base (read with `--floating-base` only).
     pub base: Option<BaseState>,
     /// External wrenches keyed by URDF link name.
@@ -252,6 +293,67 @@ pub fn read_text(path: &std::path::Path) -> Result<String, StateError> {
     String::from_utf8(bytes).map_err(|_| StateError::new(&name, "(file)", "not UTF-8 text"))
 }
 
+/// The coordinates `x` gives joint `dof` in `map` (`q`, `v`, `a`, `tau`): its
+/// kind's number of them, finite; a quaternion within 1e-3 of unit norm,
+/// normalised. The error says what is wrong (the caller names the key).
+fn joint_values(dof: &crate::model::DofInfo, map: &str, x: &JointValue) -> Result<Vec<f64>, String> {
+    use crate::model::JointKind;
+    let kind = dof.kind;
+    let n = if map == "q" { kind.nq() } else { kind.nv() };
+    let layout = match (kind, map == "q") {
+        (JointKind::Spherical, true) => "[qx, qy, qz, qw]",
+        (JointKind::Spherical, false) => "[wx, wy, wz]",
+        (JointKind::Planar, true) => "[x, y, theta]",
+        (JointKind::Planar, false) => "[vx, vy, wz]",
+        (JointKind::Free, true) => "[x, y, z, qx, qy, qz, qw]",
+        (JointKind::Free, false) => "[vx, vy, vz, wx, wy, wz]",
+        _ => "",
+    };
+    let mut vals = match (x, n) {
+        (JointValue::Scalar(x), 1) => vec![*x],
+        (JointValue::Array(_), 1) => {
+            return Err(format!(
+                "a {} joint takes a number, found an array",
+                kind.name()
+            ))
+        }
+        (JointValue::Scalar(_), _) => {
+            return Err(format!(
+                "a {} joint takes an array of {n} numbers {layout}, found a number",
+                kind.name()
+            ))
+        }
+        (JointValue::Array(a), _) if a.len() != n => {
+            return Err(format!(
+                "a {} joint takes an array of {n} numbers {layout}, found {}",
+                kind.name(),
+                a.len()
+            ))
+        }
+        (JointValue::Array(a), _) => a.clone(),
+    };
+    if vals.iter().any(|x| !x.is_finite()) {
+        return Err("non-finite number".into());
+    }
+    let quat = match (kind, map) {
+        (JointKind::Spherical, "q") => Some(0),
+        (JointKind::Free, "q") => Some(3),
+        _ => None,
+    };
+    if let Some(at) = quat {
+        let norm = vals[at..at + 4].iter().map(|x| x * x).sum::<f64>().sqrt();
+        if (norm - 1.0).abs() > 1e-3 {
+            return Err(format!(
+                "not a unit quaternion (norm {norm}; within 1e-3 of 1 is normalised)"
+            ));
+        }
+        for x in &mut vals[at..at + 4] {
+            *x /= norm;
+        }
+    }
+    Ok(vals)
+}
+
 impl State {
     /// The engine's vectors for this state. `key` prefixes error keys (e.g. `states[3]`).
     pub fn to_vectors(
@@ -260,7 +362,6 @@ impl State {
         file: &str,
         key: &str,
     ) -> Result<StateVectors, StateError> {
-        let (qo, vo) = (model.joint_q_offset(), model.joint_v_offset());
         let mut q = model.neutral();
         let mut v = DVector::zeros(model.nv);
         let mut a = DVector::zeros(model.nv);
@@ -273,9 +374,9 @@ impl State {
         ];
         for (map, name) in maps {
             let Some(map) = map else { continue };
-            for (joint, &x) in map {
+            for (joint, x) in map {
                 let k = format!("{key}.{name}.{joint}");
-                let Ok(iv) = model.v_index(joint) else {
+                let Some(dof) = model.dofs.iter().find(|d| &d.name == joint) else {
                     let why = if model.body_joint_names.iter().any(|n| n == joint) {
                         "is a mimic joint (it follows its leader and is not a key)".to_string()
                     } else {
@@ -288,16 +389,14 @@ impl State {
                     };
                     return Err(StateError::new(file, k, why));
                 };
-                let d = iv - vo;
-                if !x.is_finite() {
-                    return Err(StateError::new(file, k, "non-finite number"));
-                }
-                match name {
-                    "q" => q[qo + d] = x,
-                    "v" => v[vo + d] = x,
-                    "a" => a[vo + d] = x,
-                    _ => tau[vo + d] = x,
-                }
+                let vals = joint_values(dof, name, x).map_err(|m| StateError::new(file, &k, m))?;
+                let (dst, at) = match name {
+                    "q" => (&mut q, dof.iq),
+                    "v" => (&mut v, dof.iv),
+                    "a" => (&mut a, dof.iv),
+                    _ => (&mut tau, dof.iv),
+                };
+                dst.rows_mut(at, vals.len()).copy_from_slice(&vals);
             }
         }
         if let (Some(b), true) = (&self.base, model.floating_base) {

@@ -5,7 +5,7 @@ use super::{CompositeInertia, DynamicsError};
 use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
 use crate::spatial::ops::{cross, madd, mat_mat};
 use crate::spatial::{skew, Force, Motion, Scalar, Se3};
-use nalgebra::{DVector, Matrix3, Matrix6, Vector3, Vector6};
+use nalgebra::{DVector, Matrix3, Matrix6, Matrix6x3, Vector3, Vector6};
 
 /// The 6x6 angular-first matrix of a rigid-body inertia in origin form (the
 /// model's `inertias_origin`, computed at load), docs/theory.md §"Spatial inertia":
@@ -101,6 +101,66 @@ fn act_matrix6_ax<T: Scalar>(x: &Se3<T>, ax: Option<Axis<T>>, m: &Matrix6<T>) ->
     let b = sandwich(m.fixed_view::<3, 3>(0, 3).into_owned());
     let c = sandwich(m.fixed_view::<3, 3>(3, 3).into_owned());
     translate6(&x.trans, &a, &b, &c)
+}
+
+/// Sweep 2's step of a 3-DoF joint (docs/theory.md §"Spherical, planar and
+/// floating joints"): `u = τ − Sᵀ pᴬ` (in the first three entries) and what the
+/// parent receives, `ᵖX*ᵢ Iᵃ ⁱXₚ` and `ᵖX*ᵢ pᵃ`; `None` when D is singular.
+#[inline(never)]
+fn aba_step3_inward<T: Scalar, J: JointModel<T>>(
+    jm: &J,
+    ia: &Matrix6<T>,
+    pa: &Force<T>,
+    c: &Motion<T>,
+    tau: &[T],
+    li: &Se3<T>,
+) -> Option<(Vector6<T>, (Matrix6<T>, Force<T>))> {
+    let iv = jm.joint().iv;
+    let (u_mat, dinv) = subspace_blocks(jm, ia)?;
+    let ui = Vector3::from_fn(|r, _| tau[iv + r] - jm.project_column(r, pa));
+    let ud = u_mat * dinv;
+    let ia_a = ia - ud * u_mat.transpose();
+    let pa_a = fvec(pa) + ia_a * mvec(c) + ud * ui;
+    let ax = jm.rot_axis();
+    Some((
+        Vector6::new(ui.x, ui.y, ui.z, T::zero(), T::zero(), T::zero()),
+        (act_matrix6_ax(li, ax, &ia_a), act_force_ax(li, ax, &vforce(&pa_a))),
+    ))
+}
+
+/// Sweep 3's step of a 3-DoF joint: `q̈ = D⁻¹ (u − Uᵀ a')` into `qdd`, and
+/// `âᵢ = a' + S q̈`.
+#[inline(never)]
+fn aba_step3_outward<T: Scalar, J: JointModel<T>>(
+    jm: &J,
+    ia: &Matrix6<T>,
+    u: &Vector6<T>,
+    a1: &Motion<T>,
+    qdd: &mut [T],
+) -> Option<Motion<T>> {
+    let iv = jm.joint().iv;
+    let (u_mat, dinv) = subspace_blocks(jm, ia)?;
+    let x = dinv * (Vector3::new(u[0], u[1], u[2]) - u_mat.transpose() * mvec(a1));
+    let mut ai = *a1;
+    for r in 0..3 {
+        qdd[iv + r] = x[r];
+        ai += jm.subspace(r) * x[r];
+    }
+    Some(ai)
+}
+
+/// A 3-DoF joint's `U = Iᴬ S` (6x3) and `D⁻¹ = (Sᵀ U)⁻¹`, `None` when D is not
+/// positive definite.
+#[inline(always)]
+fn subspace_blocks<T: Scalar, J: JointModel<T>>(
+    jm: &J,
+    ia: &Matrix6<T>,
+) -> Option<(Matrix6x3<T>, Matrix3<T>)> {
+    let s = Matrix6x3::from_fn(|r, c| mvec(&jm.subspace(c))[r]);
+    let u = ia * s;
+    let d = s.transpose() * u;
+    let dinv = d.cholesky()?.inverse();
+    dinv.iter().all(|x| x.is_finite()).then_some((u, dinv))
 }
 
 #[inline(always)]
@@ -246,6 +306,15 @@ pub fn aba<'d, T: Scalar>(
                     ia_head[p] += act_matrix6_ax(li, ax, &ia_a);
                     pa_head[p] += act_force_ax(li, ax, &vforce(&pa_a));
                 }
+            } else if jm.nv() == 3 {
+                // a 3-DoF joint (spherical, planar), out of line (the 1-DoF paths stay small)
+                let (ui, pass) = aba_step3_inward(&jm, &ia_tail[0], &pa_tail[0], &cc[i], tau, li)
+                    .ok_or(DynamicsError::Singular(iv))?;
+                uu[i] = ui;
+                if p != 0 {
+                    ia_head[p] += pass.0;
+                    pa_head[p] += pass.1;
+                }
             } else {
                 let t = &tau[iv..iv + 6];
                 let tf = Force::new(Vector3::new(t[3], t[4], t[5]), Vector3::new(t[0], t[1], t[2]));
@@ -274,6 +343,8 @@ pub fn aba<'d, T: Scalar>(
                 let mut ai = a1;
                 jm.add_subspace_scaled(&mut ai, x);
                 ai
+            } else if jm.nv() == 3 {
+                aba_step3_outward(&jm, &ia[i], &uu[i], &a1, qdd).ok_or(DynamicsError::Singular(iv))?
             } else {
                 let chol = ia[i].cholesky().ok_or(DynamicsError::Singular(iv))?;
                 let x = chol.solve(&uu[i]);

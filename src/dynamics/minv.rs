@@ -238,14 +238,19 @@ pub(crate) fn minv_pass<T: Scalar>(
                 of[p] += pa;
             }
         } else {
-            // a free joint (6 coordinates): J, U = Iᴬ J and D = Jᵀ U as 6x6 blocks
+            // a joint of 3 or 6 coordinates: J, U = Iᴬ J and D = Jᵀ U as 6x6 blocks
+            // (zero columns past the joint's)
             let mut jm = Matrix6::<T>::zeros();
             for r in 0..ni {
                 jm.set_column(r, &mv(&jcol[c0 + r]));
                 uq[c0 + r] = tau[c0 + r] - jcol[c0 + r].dot(&fi);
             }
             let u = iai * jm;
-            let d = jm.transpose() * u;
+            let mut d = jm.transpose() * u;
+            // fewer than 6 coordinates (spherical, planar): the unused block is 1
+            for r in ni..6 {
+                d[(r, r)] = T::one();
+            }
             let dinv = d
                 .cholesky()
                 .map(|ch| ch.inverse())
@@ -267,7 +272,13 @@ pub(crate) fn minv_pass<T: Scalar>(
                 }
             }
             for c in ce..end {
-                let y = Vector6::from_fn(|r, _| m[c + (c0 + r) * nv]);
+                let y = Vector6::from_fn(|r, _| {
+                    if r < ni {
+                        m[c + (c0 + r) * nv]
+                    } else {
+                        T::zero()
+                    }
+                });
                 let x = -(dinv * y);
                 for r in 0..ni {
                     m[c + (c0 + r) * nv] = x[r];
@@ -285,7 +296,7 @@ pub(crate) fn minv_pass<T: Scalar>(
                         axpy(&mut fs[fk + ce..fk + end], u[(k, r)], x);
                     }
                 }
-                let uvec = Vector6::from_column_slice(&uq[c0..ce]);
+                let uvec = Vector6::from_fn(|r, _| if r < ni { uq[c0 + r] } else { T::zero() });
                 iai -= ud * u.transpose();
                 let pa = fi + fv(&(iai * mv(&agf[i]) + ud * uvec));
                 ia[p] += iai;

@@ -1,25 +1,49 @@
-//! The configuration manifold: q ⊕ h v (the free joint's unit quaternion and
-//! body-frame velocity, every other joint additive) and its rate q̇(q, v).
+//! The configuration manifold: q ⊕ h v (free and spherical joints' unit
+//! quaternions, planar joints' SE(2), body-frame velocities, every other joint
+//! additive) and its rate q̇(q, v).
 //!
-//! A free base's q is `[p (world), quaternion (x, y, z, w)]` and its v is
-//! `[v_lin, ω]` in the base's own frame (Pinocchio's free flyer, docs/theory.md
-//! §"Floating base"); joints after it have q̇ = v.
+//! A free joint's q is `[p, quaternion (x, y, z, w)]` and its v is `[v_lin, ω]` in
+//! the child's own frame (Pinocchio's free flyer, docs/theory.md §"Floating
+//! base"); a spherical joint's q is a quaternion, its v ω in the child frame; a
+//! planar joint's q is `[x, y, θ]`, its v `[vx, vy, ω]` in the child frame
+//! (docs/theory.md §"Spherical, planar and floating joints"); 1-DoF joints have
+//! q̇ = v.
 
+use super::lie::{
+    exp_ad_inverse, joint_pose, joint_twist, se3_integrate, se3_log, se3_right_jacobian,
+    tangent_rows,
+};
 use super::JointKind;
 use super::Model;
-use crate::spatial::{axis_angle, quat_to_matrix, sin_cos, skew};
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3};
+use crate::spatial::{axis_angle, quat_to_matrix, sin_cos};
+use nalgebra::{DMatrix, DVector, Matrix6, Vector3};
 
-/// q ← q ⊕ h v: p += h R v_lin, quaternion ← quaternion ⊗ exp(h ω / 2)
-/// (renormalised), joints += h v.
+/// Every joint that owns coordinates, free roots included: `(kind, iq, iv)`.
+fn coordinate_joints(model: &Model) -> impl Iterator<Item = (JointKind, usize, usize)> + '_ {
+    model
+        .free_joints
+        .iter()
+        .map(|f| (JointKind::Free, f.iq, f.iv))
+        .chain(model.dofs.iter().map(|d| (d.kind, d.iq, d.iv)))
+}
+
+/// q ← q ⊕ h v, the semi-implicit step's: a free joint's p += h R v_lin and
+/// quaternion ← quaternion ⊗ exp(h ω / 2) (renormalised); a spherical joint's
+/// quaternion likewise; a planar joint's (x, y) += h R(θ) (vx, vy), θ += h ω;
+/// 1-DoF joints += h v.
 pub fn integrate_config(model: &Model, q: &mut DVector<f64>, v: &DVector<f64>, h: f64) {
-    for f in &model.free_joints {
-        integrate_free(q, v, h, f.iq, f.iv);
-    }
-    for t in &model.trees {
-        let (qo, vo) = (t.joint_q(), t.joint_v());
-        for k in 0..t.dofs.len() {
-            q[qo + k] += h * v[vo + k];
+    for (kind, iq, iv) in coordinate_joints(model) {
+        match kind {
+            JointKind::Free => integrate_free(q, v, h, iq, iv),
+            JointKind::Spherical => integrate_quat(q, v, h, iq, iv),
+            JointKind::Planar => {
+                let (s, c) = sin_cos(q[iq + 2]);
+                let (vx, vy) = (v[iv], v[iv + 1]);
+                q[iq] += h * (c * vx - s * vy);
+                q[iq + 1] += h * (s * vx + c * vy);
+                q[iq + 2] += h * v[iv + 2];
+            }
+            _ => q[iq] += h * v[iv],
         }
     }
 }
@@ -31,7 +55,13 @@ fn integrate_free(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize, iv:
     q[iq] += dp.x;
     q[iq + 1] += dp.y;
     q[iq + 2] += dp.z;
-    let w = Vector3::new(v[iv + 3], v[iv + 4], v[iv + 5]) * h;
+    integrate_quat(q, v, h, iq + 3, iv + 3);
+}
+
+/// The quaternion `q[iq..iq + 4]` ← itself ⊗ exp(h ω / 2), ω = `v[iv..iv + 3]`
+/// (renormalised).
+fn integrate_quat(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize, iv: usize) {
+    let w = Vector3::new(v[iv], v[iv + 1], v[iv + 2]) * h;
     let th = w.norm();
     let (s, c) = if th > 1e-12 {
         let (s, c) = sin_cos(th / 2.0);
@@ -40,36 +70,41 @@ fn integrate_free(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize, iv:
         (0.5 - th * th / 48.0, 1.0 - th * th / 8.0)
     };
     let (dx, dy, dz, dw) = (w.x * s, w.y * s, w.z * s, c);
-    let (x, y, z, ww) = (q[iq + 3], q[iq + 4], q[iq + 5], q[iq + 6]);
-    q[iq + 3] = ww * dx + x * dw + y * dz - z * dy;
-    q[iq + 4] = ww * dy - x * dz + y * dw + z * dx;
-    q[iq + 5] = ww * dz + x * dy - y * dx + z * dw;
-    q[iq + 6] = ww * dw - x * dx - y * dy - z * dz;
-    normalize_quat_at(q, iq + 3);
+    let (x, y, z, ww) = (q[iq], q[iq + 1], q[iq + 2], q[iq + 3]);
+    q[iq] = ww * dx + x * dw + y * dz - z * dy;
+    q[iq + 1] = ww * dy - x * dz + y * dw + z * dx;
+    q[iq + 2] = ww * dz + x * dy - y * dx + z * dw;
+    q[iq + 3] = ww * dw - x * dx - y * dy - z * dz;
+    normalize_quat_at(q, iq);
 }
 
-/// Re-expresses a free base's body-frame linear velocity after its frame turned
-/// by exp(h ω) (ω = `w[3..6]`): v_lin ← exp(−h ω) v_lin. With
+/// Re-expresses a free or planar joint's child-frame linear velocity after its
+/// frame turned by exp(h ω) (ω from `w`): v_lin ← exp(−h ω) v_lin. With
 /// [`integrate_config`] this makes a semi-implicit step rotate the velocity
 /// exactly (no energy from the frame's own rotation).
 pub fn rotate_base_velocity(model: &Model, v: &mut DVector<f64>, w: &DVector<f64>, h: f64) {
-    for f in &model.free_joints {
-        let iv = f.iv;
-        let wv = Vector3::new(w[iv + 3], w[iv + 4], w[iv + 5]) * h;
+    for (kind, _, iv) in coordinate_joints(model) {
+        let (wv, n) = match kind {
+            JointKind::Free => (Vector3::new(w[iv + 3], w[iv + 4], w[iv + 5]) * h, 3),
+            JointKind::Planar => (Vector3::new(0.0, 0.0, w[iv + 2] * h), 2),
+            _ => continue,
+        };
         let th = wv.norm();
         if th > 0.0 {
             let r = axis_angle(&(wv / th), th);
-            let vl = r.transpose() * Vector3::new(v[iv], v[iv + 1], v[iv + 2]);
-            v[iv] = vl.x;
-            v[iv + 1] = vl.y;
-            v[iv + 2] = vl.z;
+            let vl = r.transpose()
+                * Vector3::new(v[iv], v[iv + 1], if n == 3 { v[iv + 2] } else { 0.0 });
+            for k in 0..n {
+                v[iv + k] = vl[k];
+            }
         }
     }
 }
 
-/// Writes q̇ into `dy[0..nq]`: ṗ = R(q̂) v_lin (q̂ = `qn`, normalised), quaternion
-/// rate ½ q ⊗ (ω, 0) with q read from `y` unnormalised (the exact derivative of
-/// the ODE state), joints q̇ = v.
+/// Writes q̇ into `dy[0..nq]`: a free joint's ṗ = R(q̂) v_lin (q̂ = `qn`,
+/// normalised), a quaternion's rate ½ q ⊗ (ω, 0) with q read from `y`
+/// unnormalised (the exact derivative of the ODE state), a planar joint's
+/// (ẋ, ẏ) = R(θ) (vx, vy), θ̇ = ω; 1-DoF joints q̇ = v.
 pub fn config_rate(
     model: &Model,
     qn: &DVector<f64>,
@@ -77,27 +112,38 @@ pub fn config_rate(
     v: &DVector<f64>,
     dy: &mut DVector<f64>,
 ) {
-    for f in &model.free_joints {
-        let (iq, iv) = (f.iq, f.iv);
-        let r = quat_to_matrix(qn[iq + 3], qn[iq + 4], qn[iq + 5], qn[iq + 6]);
-        let pd = r * Vector3::new(v[iv], v[iv + 1], v[iv + 2]);
-        dy[iq] = pd.x;
-        dy[iq + 1] = pd.y;
-        dy[iq + 2] = pd.z;
-        let (x, yy, z, ww) = (y[iq + 3], y[iq + 4], y[iq + 5], y[iq + 6]);
-        let (wx, wy, wz) = (v[iv + 3], v[iv + 4], v[iv + 5]);
-        // (q ⊗ (ω,0)): vector = w ω + qv × ω, scalar = −qv·ω
-        dy[iq + 3] = 0.5 * (ww * wx + yy * wz - z * wy);
-        dy[iq + 4] = 0.5 * (ww * wy + z * wx - x * wz);
-        dy[iq + 5] = 0.5 * (ww * wz + x * wy - yy * wx);
-        dy[iq + 6] = -0.5 * (x * wx + yy * wy + z * wz);
-    }
-    for t in &model.trees {
-        let (qo, vo) = (t.joint_q(), t.joint_v());
-        for k in 0..t.dofs.len() {
-            dy[qo + k] = v[vo + k];
+    for (kind, iq, iv) in coordinate_joints(model) {
+        match kind {
+            JointKind::Free => {
+                let r = quat_to_matrix(qn[iq + 3], qn[iq + 4], qn[iq + 5], qn[iq + 6]);
+                let pd = r * Vector3::new(v[iv], v[iv + 1], v[iv + 2]);
+                dy[iq] = pd.x;
+                dy[iq + 1] = pd.y;
+                dy[iq + 2] = pd.z;
+                quat_rate(y, v, dy, iq + 3, iv + 3);
+            }
+            JointKind::Spherical => quat_rate(y, v, dy, iq, iv),
+            JointKind::Planar => {
+                let (s, c) = sin_cos(qn[iq + 2]);
+                let (vx, vy) = (v[iv], v[iv + 1]);
+                dy[iq] = c * vx - s * vy;
+                dy[iq + 1] = s * vx + c * vy;
+                dy[iq + 2] = v[iv + 2];
+            }
+            _ => dy[iq] = v[iv],
         }
     }
+}
+
+/// The quaternion rate ½ q ⊗ (ω, 0) of `y[iq..iq + 4]`, ω = `v[iv..iv + 3]`.
+fn quat_rate(y: &DVector<f64>, v: &DVector<f64>, dy: &mut DVector<f64>, iq: usize, iv: usize) {
+    let (x, yy, z, ww) = (y[iq], y[iq + 1], y[iq + 2], y[iq + 3]);
+    let (wx, wy, wz) = (v[iv], v[iv + 1], v[iv + 2]);
+    // (q ⊗ (ω,0)): vector = w ω + qv × ω, scalar = −qv·ω
+    dy[iq] = 0.5 * (ww * wx + yy * wz - z * wy);
+    dy[iq + 1] = 0.5 * (ww * wy + z * wx - x * wz);
+    dy[iq + 2] = 0.5 * (ww * wz + x * wy - yy * wx);
+    dy[iq + 3] = -0.5 * (x * wx + yy * wy + z * wz);
 }
 
 /// Normalises a free base's quaternion `q[3..7]` in place (a zero or non-finite
@@ -109,10 +155,15 @@ pub fn normalize_quat(q: &mut DVector<f64>) {
     normalize_quat_at(q, 3);
 }
 
-/// Normalises every free joint's quaternion in place (as [`normalize_quat`]).
+/// Normalises every free and spherical joint's quaternion in place (as
+/// [`normalize_quat`]).
 pub fn normalize_quats(model: &Model, q: &mut DVector<f64>) {
-    for f in &model.free_joints {
-        normalize_quat_at(q, f.iq + 3);
+    for (kind, iq, _) in coordinate_joints(model) {
+        match kind {
+            JointKind::Free => normalize_quat_at(q, iq + 3),
+            JointKind::Spherical => normalize_quat_at(q, iq),
+            _ => {}
+        }
     }
 }
 
@@ -135,8 +186,9 @@ use super::{DimensionError, NameError};
 
 /// `q ⊕ v` (Pinocchio's `integrate`): a free joint moves along SE(3)'s
 /// exponential by the body-frame twist `[v_lin; ω]`, `M ← M exp(v)` (p ← p + R V(ω)
-/// v_lin, quaternion ← quaternion ⊗ exp(ω/2), docs/theory.md §"Derivatives"); every
-/// other joint adds. Every joint through its own coordinates (`iq`, `iv`).
+/// v_lin, quaternion ← quaternion ⊗ exp(ω/2), docs/theory.md §"Derivatives"); a
+/// spherical joint along SO(3)'s, a planar joint along SE(2)'s (θ ← θ + ω, not
+/// wrapped); every other joint adds. Every joint through its own coordinates.
 pub fn integrate(
     model: &Model,
     q: &DVector<f64>,
@@ -145,33 +197,42 @@ pub fn integrate(
     DimensionError::check("q", model.nq, q.len())?;
     DimensionError::check("v", model.nv, v.len())?;
     let mut out = q.clone();
-    for j in model.joints.iter().skip(1) {
-        match j.kind {
+    for (kind, iq, iv) in coordinate_joints(model) {
+        if tangent_rows(&kind).is_none() {
+            out[iq] = q[iq] + v[iv];
+            continue;
+        }
+        let (p0, u0) = joint_pose(&kind, q, iq);
+        let (lin, w) = joint_twist(&kind, v, iv);
+        let (p1, u1) = se3_integrate(&p0, &u0, &lin, &w);
+        let c = u1.as_ref().coords;
+        match kind {
             JointKind::Free => {
-                let (iq, iv) = (j.iq, j.iv);
-                let (r0, quat0) = base_rotation(q, iq);
-                let lin = Vector3::new(v[iv], v[iv + 1], v[iv + 2]);
-                let w = Vector3::new(v[iv + 3], v[iv + 4], v[iv + 5]);
-                let dp = r0 * so3_left_jacobian(&w) * lin;
-                let dq = UnitQuaternion::from_scaled_axis(w);
-                let q1 = quat0 * dq;
                 for k in 0..3 {
-                    out[iq + k] = q[iq + k] + dp[k];
+                    out[iq + k] = p1[k];
                 }
-                let c = q1.as_ref().coords;
                 for k in 0..4 {
                     out[iq + 3 + k] = c[k];
                 }
             }
-            // a mimic joint's iq/iv are its leader's: assigning twice is harmless
-            _ => out[j.iq] = q[j.iq] + v[j.iv],
+            JointKind::Spherical => {
+                for k in 0..4 {
+                    out[iq + k] = c[k];
+                }
+            }
+            _ => {
+                out[iq] = p1.x;
+                out[iq + 1] = p1.y;
+                out[iq + 2] = q[iq + 2] + v[iv + 2];
+            }
         }
     }
     Ok(out)
 }
 
 /// `q₁ ⊖ q₀` (Pinocchio's `difference`): the v with [`integrate`]`(q₀, v) = q₁` — a
-/// free joint's `log(M₀⁻¹ M₁)` (the shorter rotation), every other joint `q₁ − q₀`.
+/// free, spherical or planar joint's `log(M₀⁻¹ M₁)` (the shorter rotation), every
+/// other joint `q₁ − q₀`.
 pub fn difference(
     model: &Model,
     q0: &DVector<f64>,
@@ -180,25 +241,47 @@ pub fn difference(
     DimensionError::check("q0", model.nq, q0.len())?;
     DimensionError::check("q1", model.nq, q1.len())?;
     let mut v = DVector::zeros(model.nv);
-    for j in model.joints.iter().skip(1) {
-        match j.kind {
-            JointKind::Free => {
-                let (lin, w) = free_log(q0, q1, j.iq);
-                for k in 0..3 {
-                    v[j.iv + k] = lin[k];
-                    v[j.iv + 3 + k] = w[k];
-                }
-            }
-            _ => v[j.iv] = q1[j.iq] - q0[j.iq],
+    for (kind, iq, iv) in coordinate_joints(model) {
+        let Some(rows) = tangent_rows(&kind) else {
+            v[iv] = q1[iq] - q0[iq];
+            continue;
+        };
+        let (lin, w) = joint_log(&kind, q0, q1, iq);
+        let x = [lin.x, lin.y, lin.z, w.x, w.y, w.z];
+        for (k, &r) in rows.iter().enumerate() {
+            v[iv + k] = x[r];
         }
     }
     Ok(v)
 }
 
+/// `log(M₀⁻¹ M₁)` of a multi-coordinate joint at `q[iq..]`.
+fn joint_log(
+    kind: &JointKind,
+    q0: &DVector<f64>,
+    q1: &DVector<f64>,
+    iq: usize,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let (p0, u0) = joint_pose(kind, q0, iq);
+    let (p1, u1) = joint_pose(kind, q1, iq);
+    se3_log(&p0, &u0, &p1, &u1)
+}
+
+/// Writes a joint's rows and columns of the 6x6 `m` (SE(3)'s tangent) into `out`
+/// at `(iv, iv)`.
+fn put_block(out: &mut DMatrix<f64>, iv: usize, rows: &[usize], m: &Matrix6<f64>) {
+    for (a, &r) in rows.iter().enumerate() {
+        for (b, &c) in rows.iter().enumerate() {
+            out[(iv + a, iv + b)] = m[(r, c)];
+        }
+    }
+}
+
 /// The Jacobians of [`integrate`] (Pinocchio's `dIntegrate`, tangent spaces on both
 /// sides): `(∂(q ⊕ v)/∂q, ∂(q ⊕ v)/∂v)`, nv × nv. A free joint's blocks (linear
 /// first) are `Ad(exp(v)⁻¹)` and the right Jacobian `Jexp(v)` of SE(3)
-/// (docs/theory.md §"Derivatives"); every other joint's entry is 1.
+/// (docs/theory.md §"Derivatives"); a spherical or planar joint's are their rows
+/// and columns of these; every other joint's entry is 1.
 pub fn integrate_jacobians(
     model: &Model,
     q: &DVector<f64>,
@@ -210,30 +293,24 @@ pub fn integrate_jacobians(
         DMatrix::zeros(model.nv, model.nv),
         DMatrix::zeros(model.nv, model.nv),
     );
-    for j in model.joints.iter().skip(1) {
-        match j.kind {
-            JointKind::Free => {
-                let iv = j.iv;
-                let lin = Vector3::new(v[iv], v[iv + 1], v[iv + 2]);
-                let w = Vector3::new(v[iv + 3], v[iv + 4], v[iv + 5]);
-                jq.view_mut((iv, iv), (6, 6))
-                    .copy_from(&exp_ad_inverse(&lin, &w));
-                jv.view_mut((iv, iv), (6, 6))
-                    .copy_from(&se3_right_jacobian(&lin, &w));
-            }
-            _ => {
-                jq[(j.iv, j.iv)] = 1.0;
-                jv[(j.iv, j.iv)] = 1.0;
-            }
-        }
+    for (kind, _, iv) in coordinate_joints(model) {
+        let Some(rows) = tangent_rows(&kind) else {
+            jq[(iv, iv)] = 1.0;
+            jv[(iv, iv)] = 1.0;
+            continue;
+        };
+        let (lin, w) = joint_twist(&kind, v, iv);
+        put_block(&mut jq, iv, rows, &exp_ad_inverse(&lin, &w));
+        put_block(&mut jv, iv, rows, &se3_right_jacobian(&lin, &w));
     }
     Ok((jq, jv))
 }
 
 /// The Jacobians of [`difference`] (Pinocchio's `dDifference`):
 /// `(∂(q₁ ⊖ q₀)/∂q₀, ∂(q₁ ⊖ q₀)/∂q₁)`, nv × nv. A free joint's blocks, with
-/// `M = M₀⁻¹ M₁`: `−Jlog(M) Ad(M⁻¹)` and `Jlog(M)`, `Jlog = Jexp(log M)⁻¹`; every
-/// other joint's entries are −1 and 1.
+/// `M = M₀⁻¹ M₁`: `−Jlog(M) Ad(M⁻¹)` and `Jlog(M)`, `Jlog = Jexp(log M)⁻¹`; a
+/// spherical or planar joint's are their rows and columns of these; every other
+/// joint's entries are −1 and 1.
 pub fn difference_jacobians(
     model: &Model,
     q0: &DVector<f64>,
@@ -245,130 +322,27 @@ pub fn difference_jacobians(
         DMatrix::zeros(model.nv, model.nv),
         DMatrix::zeros(model.nv, model.nv),
     );
-    for j in model.joints.iter().skip(1) {
-        match j.kind {
-            JointKind::Free => {
-                let iv = j.iv;
-                let (lin, w) = free_log(q0, q1, j.iq);
-                let jr = se3_right_jacobian(&lin, &w);
-                let jlog = jr.try_inverse().unwrap_or_else(Matrix6::identity);
-                let ad = exp_ad_inverse(&lin, &w);
-                j0.view_mut((iv, iv), (6, 6)).copy_from(&(-jlog * ad));
-                j1.view_mut((iv, iv), (6, 6)).copy_from(&jlog);
-            }
-            _ => {
-                j0[(j.iv, j.iv)] = -1.0;
-                j1[(j.iv, j.iv)] = 1.0;
-            }
-        }
+    for (kind, iq, iv) in coordinate_joints(model) {
+        let Some(rows) = tangent_rows(&kind) else {
+            j0[(iv, iv)] = -1.0;
+            j1[(iv, iv)] = 1.0;
+            continue;
+        };
+        let (lin, w) = joint_log(&kind, q0, q1, iq);
+        let jr = se3_right_jacobian(&lin, &w);
+        let jlog = jr.try_inverse().unwrap_or_else(Matrix6::identity);
+        let ad = exp_ad_inverse(&lin, &w);
+        put_block(&mut j0, iv, rows, &(-jlog * ad));
+        put_block(&mut j1, iv, rows, &jlog);
     }
     Ok((j0, j1))
 }
 
-/// A free joint's rotation and unit quaternion from `q[iq + 3..iq + 7]` (x, y, z, w),
-/// normalised.
-fn base_rotation(q: &DVector<f64>, iq: usize) -> (Matrix3<f64>, UnitQuaternion<f64>) {
-    let uq = UnitQuaternion::from_quaternion(Quaternion::new(
-        q[iq + 6],
-        q[iq + 3],
-        q[iq + 4],
-        q[iq + 5],
-    ));
-    (*uq.to_rotation_matrix().matrix(), uq)
-}
-
-/// `log(M₀⁻¹ M₁)` of two free-joint poses at `q[iq..iq + 7]`: `(v_lin, ω)`.
-fn free_log(q0: &DVector<f64>, q1: &DVector<f64>, iq: usize) -> (Vector3<f64>, Vector3<f64>) {
-    let (r0, u0) = base_rotation(q0, iq);
-    let (_, u1) = base_rotation(q1, iq);
-    let dp = r0.transpose()
-        * Vector3::new(
-            q1[iq] - q0[iq],
-            q1[iq + 1] - q0[iq + 1],
-            q1[iq + 2] - q0[iq + 2],
-        );
-    // the shorter rotation: d and −d are one rotation
-    let mut d = u0.inverse() * u1;
-    if d.w < 0.0 {
-        d = UnitQuaternion::new_unchecked(-d.into_inner());
-    }
-    let w = d.scaled_axis();
-    let lin = so3_left_jacobian(&w)
-        .try_inverse()
-        .unwrap_or_else(Matrix3::identity)
-        * dp;
-    (lin, w)
-}
-
-/// `Ad(exp(ξ)⁻¹)` for the twist `ξ = [lin; w]` (linear first): with
-/// `exp(ξ) = (R, p)`, `R = Exp(w)`, `p = V(w) lin`, it is `[Rᵀ, −Rᵀ p×; 0, Rᵀ]`.
-fn exp_ad_inverse(lin: &Vector3<f64>, w: &Vector3<f64>) -> Matrix6<f64> {
-    let r = *UnitQuaternion::from_scaled_axis(*w)
-        .to_rotation_matrix()
-        .matrix();
-    let p = so3_left_jacobian(w) * lin;
-    let rt = r.transpose();
-    let mut ad = Matrix6::zeros();
-    ad.fixed_view_mut::<3, 3>(0, 0).copy_from(&rt);
-    ad.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-rt * skew(&p)));
-    ad.fixed_view_mut::<3, 3>(3, 3).copy_from(&rt);
-    ad
-}
-
-/// SO(3)'s left Jacobian `V(ω) = 1 + (1 − cos θ)/θ² ω× + (θ − sin θ)/θ³ ω×²`
-/// (p = V(ω) v of SE(3)'s exponential).
-fn so3_left_jacobian(w: &Vector3<f64>) -> Matrix3<f64> {
-    let t2 = w.norm_squared();
-    let t = t2.sqrt();
-    let (a, b) = if t < 1e-4 {
-        (
-            0.5 - t2 / 24.0 + t2 * t2 / 720.0,
-            1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0,
-        )
-    } else {
-        ((1.0 - t.cos()) / t2, (t - t.sin()) / (t2 * t))
-    };
-    let k = skew(w);
-    Matrix3::identity() + k * a + k * k * b
-}
-
-/// SE(3)'s right Jacobian at the twist `[ρ; φ]` (linear first): `exp(ξ + δ) =
-/// exp(ξ) exp(Jr δ)`, `Jr(ξ) = Jl(−ξ)` with Barfoot's left Jacobian
-/// `[J(φ), Q(ρ, φ); 0, J(φ)]` (Pinocchio's `Jexp6`).
-fn se3_right_jacobian(rho: &Vector3<f64>, phi: &Vector3<f64>) -> Matrix6<f64> {
-    let (rho, phi) = (-rho, -phi);
-    let j = so3_left_jacobian(&phi);
-    let t2 = phi.norm_squared();
-    let t = t2.sqrt();
-    let (c1, c2, c3) = if t < 1e-3 {
-        (
-            1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0,
-            1.0 / 24.0 - t2 / 720.0 + t2 * t2 / 40320.0,
-            1.0 / 120.0 - t2 / 2520.0,
-        )
-    } else {
-        let (s, c) = t.sin_cos();
-        (
-            (t - s) / (t2 * t),
-            (t2 + 2.0 * c - 2.0) / (2.0 * t2 * t2),
-            (2.0 * t - 3.0 * s + t * c) / (2.0 * t2 * t2 * t),
-        )
-    };
-    let (p, r) = (skew(&phi), skew(&rho));
-    let q = r * 0.5
-        + (p * r + r * p + p * r * p) * c1
-        + (p * p * r + r * p * p - p * r * p * 3.0) * c2
-        + (p * r * p * p + p * p * r * p) * c3;
-    let mut out = Matrix6::zeros();
-    out.fixed_view_mut::<3, 3>(0, 0).copy_from(&j);
-    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&q);
-    out.fixed_view_mut::<3, 3>(3, 3).copy_from(&j);
-    out
-}
-
 /// A random configuration inside the joint limits (uniform; a continuous joint,
 /// or one without limits, in [−π, π]; a free base at the origin with a uniformly
-/// random orientation), reproducible from `seed`.
+/// random orientation; a spherical joint a uniformly random rotation, a floating
+/// joint one and a position in [−1, 1]³ m; a planar joint x, y in [−1, 1] m and
+/// θ in [−π, π]), reproducible from `seed`.
 pub fn random_configuration(model: &Model, seed: u64) -> DVector<f64> {
     let mut state = seed ^ 0x9E37_79B9_7F4A_7C15;
     // splitmix64: a uniform number in [0, 1)
@@ -380,23 +354,42 @@ pub fn random_configuration(model: &Model, seed: u64) -> DVector<f64> {
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
     };
     let mut q = model.neutral();
-    for f in &model.free_joints {
-        // Shoemake's uniform unit quaternion
+    let pi = std::f64::consts::PI;
+    // Shoemake's uniform unit quaternion at q[at..at + 4]
+    let quat = |q: &mut DVector<f64>, at: usize, unit: &mut dyn FnMut() -> f64| {
         let (u1, u2, u3) = (unit(), unit(), unit());
-        let tau = 2.0 * std::f64::consts::PI;
         let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-        q[f.iq + 3] = a * (tau * u2).sin();
-        q[f.iq + 4] = a * (tau * u2).cos();
-        q[f.iq + 5] = b * (tau * u3).sin();
-        q[f.iq + 6] = b * (tau * u3).cos();
+        q[at] = a * (2.0 * pi * u2).sin();
+        q[at + 1] = a * (2.0 * pi * u2).cos();
+        q[at + 2] = b * (2.0 * pi * u3).sin();
+        q[at + 3] = b * (2.0 * pi * u3).cos();
+    };
+    for f in &model.free_joints {
+        quat(&mut q, f.iq + 3, &mut unit);
     }
-    for (d, iq, _) in model.dof_indices() {
-        let dof = &model.dofs[d];
-        let (lo, hi) = match (dof.limits.lower, dof.limits.upper) {
-            (Some(lo), Some(hi)) if lo < hi && !dof.continuous => (lo, hi),
-            _ => (-std::f64::consts::PI, std::f64::consts::PI),
-        };
-        q[iq] = lo + (hi - lo) * unit();
+    for dof in &model.dofs {
+        let iq = dof.iq;
+        match dof.kind {
+            JointKind::Free => {
+                for k in 0..3 {
+                    q[iq + k] = 2.0 * unit() - 1.0;
+                }
+                quat(&mut q, iq + 3, &mut unit);
+            }
+            JointKind::Spherical => quat(&mut q, iq, &mut unit),
+            JointKind::Planar => {
+                q[iq] = 2.0 * unit() - 1.0;
+                q[iq + 1] = 2.0 * unit() - 1.0;
+                q[iq + 2] = pi * (2.0 * unit() - 1.0);
+            }
+            _ => {
+                let (lo, hi) = match (dof.limits.lower, dof.limits.upper) {
+                    (Some(lo), Some(hi)) if lo < hi && !dof.continuous => (lo, hi),
+                    _ => (-pi, pi),
+                };
+                q[iq] = lo + (hi - lo) * unit();
+            }
+        }
     }
     q
 }
@@ -404,7 +397,8 @@ pub fn random_configuration(model: &Model, seed: u64) -> DVector<f64> {
 impl Model {
     /// The configuration with the named joints at the given positions and every
     /// other at [`Model::neutral`]. Keys are degrees of freedom (movable, non-mimic
-    /// joints); an unknown name is an error naming it and the nearest known one.
+    /// joints; a joint of several coordinates gets the value in its first); an
+    /// unknown name is an error naming it and the nearest known one.
     pub fn configuration_from_names<'a>(
         &self,
         values: impl IntoIterator<Item = (&'a str, f64)>,
@@ -415,7 +409,7 @@ impl Model {
         }
         Ok(q)
     }
-    /// Every degree of freedom's position in `q` by joint name, in engine order.
+    /// Every 1-DoF joint's position in `q` by joint name, in engine order.
     pub fn positions_by_name(&self, q: &DVector<f64>) -> Result<Vec<(&str, f64)>, DimensionError> {
         DimensionError::check("q", self.nq, q.len())?;
         Ok(self

@@ -7,6 +7,7 @@
 
 pub mod configuration;
 mod data;
+pub(crate) mod lie;
 pub(crate) mod joint;
 mod names;
 mod topology;
@@ -38,11 +39,21 @@ pub struct JointLimits {
     pub velocity: Option<f64>,
 }
 
-/// Per-DoF data kept for simulation (not used by the rigid-body algorithms).
+/// Per-joint data of every joint that owns coordinates (a movable, non-mimic
+/// URDF joint; not a `--floating-base` root), in engine order: one entry a
+/// joint, of 1 (revolute, continuous, prismatic), 3 (spherical, planar) or 6
+/// (floating) velocity coordinates. Limits, damping and friction are read for
+/// 1-DoF joints only.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DofInfo {
     /// The URDF joint's name.
     pub name: String,
+    /// The joint's kind (its axis included).
+    pub kind: JointKind,
+    /// Its first coordinate in q ([`JointKind::nq`] of them).
+    pub iq: usize,
+    /// Its first coordinate in v ([`JointKind::nv`] of them).
+    pub iv: usize,
     /// From `<limit>` (a continuous joint has no position limits).
     pub limits: JointLimits,
     /// Viscous damping (N·m·s/rad or N·s/m) from `<dynamics damping>`.
@@ -220,9 +231,11 @@ pub struct ImportReport {
 pub struct Model<T: Scalar = f64> {
     /// The `<robot name>`.
     pub name: String,
-    /// Dimension of the configuration vector q (7 for a free base, then 1 per DoF).
+    /// Dimension of the configuration vector q (7 for a free base, then each
+    /// joint's [`JointKind::nq`]).
     pub nq: usize,
-    /// Dimension of the velocity vector v (6 for a free base, then 1 per DoF).
+    /// Dimension of the velocity vector v (6 for a free base, then each joint's
+    /// [`JointKind::nv`]).
     pub nv: usize,
     /// Bodies, the world (0) included: links merged through fixed joints count once.
     pub nbodies: usize,
@@ -258,7 +271,7 @@ pub struct Model<T: Scalar = f64> {
     /// The URDF models this one is made of, in q order: one tree for a lone URDF,
     /// one per model of a scene (names `MODEL/NAME`).
     pub trees: Vec<Tree>,
-    /// Joint DoFs (excluding the base's 6) in engine order.
+    /// The joints that own coordinates (excluding a free base), in engine order.
     pub dofs: Vec<DofInfo>,
     /// Every URDF link, in the URDF's order.
     pub frames: Vec<Frame<T>>,
@@ -321,13 +334,25 @@ impl<T: Scalar> Model<T> {
     pub fn frame_index(&self, name: &str) -> Option<usize> {
         self.frames.iter().position(|f| f.name == name)
     }
-    /// The neutral configuration: zeros, identity orientation of every free joint.
+    /// The neutral configuration: zeros, identity orientation of every free and
+    /// spherical joint.
     pub fn neutral(&self) -> DVector<T> {
         let mut q = DVector::zeros(self.nq);
         for f in &self.free_joints {
             q[f.iq + 6] = T::one();
         }
+        for d in &self.dofs {
+            match d.kind {
+                JointKind::Free => q[d.iq + 6] = T::one(),
+                JointKind::Spherical => q[d.iq + 3] = T::one(),
+                _ => {}
+            }
+        }
         q
+    }
+    /// Whether every joint that owns coordinates is a 1-DoF one (the free base aside).
+    pub fn all_dofs_scalar(&self) -> bool {
+        self.dofs.iter().all(|d| d.kind.nv() == 1)
     }
     /// Total mass of the bodies that move (the world excluded).
     pub fn total_mass(&self) -> T {
@@ -384,6 +409,8 @@ impl Model<f64> {
         let cj = |j: &Joint<T>| Joint {
             kind: match j.kind {
                 JointKind::Free => JointKind::Free,
+                JointKind::Spherical => JointKind::Spherical,
+                JointKind::Planar => JointKind::Planar,
                 JointKind::Revolute(a) => JointKind::Revolute(cast_axis(a, &cv)),
                 JointKind::Prismatic(a) => JointKind::Prismatic(cast_axis(a, &cv)),
             },

@@ -152,21 +152,12 @@ impl<T: Scalar> Model<T> {
             .and_then(|d| self.dofs.get(d))
             .map_or("", |d| d.name.as_str())
     }
-    /// The joint's configuration coordinates: `q[range]` (7 for the free base:
-    /// position then quaternion x, y, z, w; 1 for a revolute or prismatic joint).
+    /// The joint's configuration coordinates: `q[range]` (7 for a free joint:
+    /// position then quaternion x, y, z, w; 4 for a spherical joint's quaternion;
+    /// 3 for a planar joint's x, y, θ; 1 for a revolute or prismatic joint).
     /// A mimic joint owns none: its range is empty. The universe's is empty.
     pub fn joint_q_range(&self, id: JointId) -> Result<Range<usize>, NameError> {
-        // a free joint's q is position and quaternion: 7
-        self.joint_range(id, |j| {
-            (
-                j.iq,
-                if matches!(j.kind, JointKind::Free) {
-                    7
-                } else {
-                    1
-                },
-            )
-        })
+        self.joint_range(id, |j| (j.iq, j.nq()))
     }
     /// The joint's velocity coordinates: `v[range]` (and `a`, `tau`; 6 for the free
     /// base: body-frame linear then angular; 1 for a revolute or prismatic joint).
@@ -189,6 +180,48 @@ impl<T: Scalar> Model<T> {
         }
         let (start, n) = f(j);
         Ok(start..start + n)
+    }
+    /// The name of every entry of q in engine order (mechanisms.md "In `eval`"): a
+    /// 1-DoF joint is its name; a spherical joint `J:qx, J:qy, J:qz, J:qw`; a
+    /// planar joint `J:x, J:y, J:theta`; a floating joint `J:x, J:y, J:z, J:qx,
+    /// J:qy, J:qz, J:qw`; a free base `base_x … base_qw` (`MODEL/base_x` in a scene).
+    pub fn q_names(&self) -> Vec<String> {
+        self.coordinate_names(true)
+    }
+    /// The name of every entry of v (and `a`, `tau`, H's rows) in engine order: a
+    /// 1-DoF joint is its name; a spherical joint `J:wx, J:wy, J:wz`; a planar
+    /// joint `J:vx, J:vy, J:wz`; a floating joint `J:vx, J:vy, J:vz, J:wx, J:wy,
+    /// J:wz`; a free base `base_vx … base_wz`.
+    pub fn v_names(&self) -> Vec<String> {
+        self.coordinate_names(false)
+    }
+    fn coordinate_names(&self, q: bool) -> Vec<String> {
+        const FREE_Q: [&str; 7] = ["x", "y", "z", "qx", "qy", "qz", "qw"];
+        const FREE_V: [&str; 6] = ["vx", "vy", "vz", "wx", "wy", "wz"];
+        let mut out = Vec::with_capacity(if q { self.nq } else { self.nv });
+        for t in &self.trees {
+            if let Some(f) = t.free.and_then(|i| self.free_joints.get(i)) {
+                let s: &[&str] = if q { &FREE_Q } else { &FREE_V };
+                out.extend(s.iter().map(|s| format!("{}_{s}", f.name)));
+            }
+            for d in &self.dofs[t.dofs.clone()] {
+                let s: &[&str] = match (d.kind, q) {
+                    (JointKind::Free, true) => &FREE_Q,
+                    (JointKind::Free, false) => &FREE_V,
+                    (JointKind::Spherical, true) => &["qx", "qy", "qz", "qw"],
+                    (JointKind::Spherical, false) => &["wx", "wy", "wz"],
+                    (JointKind::Planar, true) => &["x", "y", "theta"],
+                    (JointKind::Planar, false) => &["vx", "vy", "wz"],
+                    _ => &[],
+                };
+                if s.is_empty() {
+                    out.push(d.name.clone());
+                } else {
+                    out.extend(s.iter().map(|s| format!("{}:{s}", d.name)));
+                }
+            }
+        }
+        out
     }
     /// The index in q of a degree of freedom (a movable, non-mimic 1-DoF joint) by name.
     pub fn q_index(&self, joint: &str) -> Result<usize, NameError> {

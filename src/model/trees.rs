@@ -28,16 +28,23 @@ pub struct Tree {
 }
 
 impl Tree {
-    /// A one-tree model's tree: every body, frame and coordinate.
-    pub fn whole(nbodies: usize, nframes: usize, ndofs: usize, floating: bool) -> Self {
-        let (bq, bv) = if floating { (7, 6) } else { (0, 0) };
+    /// A one-tree model's tree: every body, frame and coordinate (`nq`, `nv`: the
+    /// model's, a free base's included).
+    pub fn whole(
+        nbodies: usize,
+        nframes: usize,
+        ndofs: usize,
+        nq: usize,
+        nv: usize,
+        floating: bool,
+    ) -> Self {
         Tree {
             name: String::new(),
             bodies: 1..nbodies,
             frames: 0..nframes,
             dofs: 0..ndofs,
-            q: 0..bq + ndofs,
-            v: 0..bv + ndofs,
+            q: 0..nq,
+            v: 0..nv,
             free: floating.then_some(0),
         }
     }
@@ -74,36 +81,42 @@ pub struct FreeJoint {
 }
 
 impl<T: Scalar> Model<T> {
-    /// Every degree of freedom as `(d, iq, iv)`: its position in [`Model::dofs`]
-    /// and its indices in q and v, in engine order.
+    /// Every 1-DoF joint as `(d, iq, iv)`: its position in [`Model::dofs`] and
+    /// its indices in q and v, in engine order. Joints of several degrees of
+    /// freedom (spherical, planar, floating) are left out: see
+    /// [`Model::joint_indices`].
     pub fn dof_indices(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
-        self.trees.iter().flat_map(|t| {
-            let (q0, v0) = (t.joint_q(), t.joint_v());
-            t.dofs
-                .clone()
-                .enumerate()
-                .map(move |(k, d)| (d, q0 + k, v0 + k))
-        })
+        self.dofs
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| d.kind.nv() == 1)
+            .map(|(k, d)| (k, d.iq, d.iv))
     }
-    /// The index in q of the degree of freedom `dofs[d]`.
+    /// Every joint that owns coordinates as `(d, iq, iv)`, whatever its number of
+    /// coordinates ([`JointKind::nq`], [`JointKind::nv`] of `dofs[d].kind`).
+    ///
+    /// [`JointKind::nq`]: super::JointKind::nq
+    /// [`JointKind::nv`]: super::JointKind::nv
+    pub fn joint_indices(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+        self.dofs
+            .iter()
+            .enumerate()
+            .map(|(k, d)| (k, d.iq, d.iv))
+    }
+    /// The index in q of the (first coordinate of the) joint `dofs[d]`.
     pub fn dof_q(&self, d: usize) -> usize {
-        self.tree_of_dof(d)
-            .map_or(d, |t| t.joint_q() + d - t.dofs.start)
+        self.dofs[d].iq
     }
-    /// The index in v of the degree of freedom `dofs[d]`.
+    /// The index in v of the (first coordinate of the) joint `dofs[d]`.
     pub fn dof_v(&self, d: usize) -> usize {
-        self.tree_of_dof(d)
-            .map_or(d, |t| t.joint_v() + d - t.dofs.start)
+        self.dofs[d].iv
     }
-    /// The degree of freedom at velocity index `iv`, if it is a joint's (not a
-    /// free joint's).
+    /// The joint (in [`Model::dofs`]) whose velocity coordinates hold `iv`, if it
+    /// is a joint's (not a free base's).
     pub fn dof_at_v(&self, iv: usize) -> Option<usize> {
-        let t = self.trees.iter().find(|t| t.v.contains(&iv))?;
-        let k = iv.checked_sub(t.joint_v())?;
-        (k < t.dofs.len()).then_some(t.dofs.start + k)
-    }
-    fn tree_of_dof(&self, d: usize) -> Option<&Tree> {
-        self.trees.iter().find(|t| t.dofs.contains(&d))
+        let k = self.dofs.partition_point(|d| d.iv <= iv).checked_sub(1)?;
+        let d = &self.dofs[k];
+        (iv < d.iv + d.kind.nv()).then_some(k)
     }
     /// The tree (model) body `b` belongs to (`None` for the world).
     pub fn tree_of_body(&self, b: usize) -> Option<usize> {

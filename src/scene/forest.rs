@@ -122,6 +122,8 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
         for d in &p.dofs {
             let mut d = d.clone();
             d.name = prefixed(pre, &d.name);
+            d.iq += q0;
+            d.iv += v0;
             m.dofs.push(d);
         }
         m.dof_parent.extend(

@@ -511,7 +511,9 @@ impl Loader<'_> {
                 self.quaternion(&format!("{key}.orientation_xyzw"), m.orientation_xyzw)?;
             if let (Some(p), Some(s)) = (&m.pose, &srdfs[i]) {
                 for (j, vals) in s.pose(p).unwrap_or_default() {
-                    if let (Ok(iq), [x]) = (model.q_index(&format!("{pre}{j}")), vals.as_slice()) {
+                    let full = format!("{pre}{j}");
+                    let scalar = model.dofs.iter().any(|d| d.name == full && d.kind.nv() == 1);
+                    if let (Ok(iq), [x], true) = (model.q_index(&full), vals.as_slice(), scalar) {
                         q0[iq] = *x;
                     }
                 }
@@ -536,6 +538,17 @@ impl Loader<'_> {
                             ));
                         };
                         self.finite(&k, &[x])?;
+                        if let Some(d) = model.dofs.iter().find(|d| d.name == full) {
+                            if d.kind.nv() != 1 {
+                                return Err(self.err(
+                                    k,
+                                    format!(
+                                        "joint \"{joint}\" is {}: a scene's initial state sets 1-DoF joints only",
+                                        d.kind.name()
+                                    ),
+                                ));
+                            }
+                        }
                         match which {
                             "q" => q0[iq] = x,
                             "v" => v0[iv] = x,

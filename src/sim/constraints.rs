@@ -332,6 +332,10 @@ impl Constraints {
         // joint rows: friction (|λ| ≤ F h), limits (λ ≥ 0)
         if p.joint_dynamics {
             for (d, info) in model.dofs.iter().enumerate() {
+                // friction and limits of 1-DoF joints only
+                if info.kind.nv() != 1 {
+                    continue;
+                }
                 let (iq, iv) = (model.dof_q(d), model.dof_v(d));
                 if info.friction > 0.0 {
                     let kind = RowKind::Box {

@@ -853,26 +853,15 @@ fn land(dt: f64, remaining: f64) -> f64 {
     }
 }
 
-/// The trajectory column names of q and v (cli.md): a floating base first
-/// (`q:base_x … q:base_qw`, `v:base_vx … v:base_wz`), then `q:NAME`/`v:NAME` per DoF.
+/// The trajectory column names of q and v (cli.md, mechanisms.md): `q:` and `v:`
+/// before each of [`Model::q_names`] and [`Model::v_names`] (a floating base
+/// first: `q:base_x … q:base_qw`, `v:base_vx … v:base_wz`; a spherical joint
+/// `q:J:qx …`, `v:J:wx …`).
 pub fn column_names(model: &Model) -> (Vec<String>, Vec<String>) {
-    let mut qn = Vec::with_capacity(model.nq);
-    let mut vn = Vec::with_capacity(model.nv);
-    for t in &model.trees {
-        if let Some(f) = t.free.and_then(|i| model.free_joints.get(i)) {
-            for s in ["x", "y", "z", "qx", "qy", "qz", "qw"] {
-                qn.push(format!("q:{}_{s}", f.name));
-            }
-            for s in ["vx", "vy", "vz", "wx", "wy", "wz"] {
-                vn.push(format!("v:{}_{s}", f.name));
-            }
-        }
-        for d in &model.dofs[t.dofs.clone()] {
-            qn.push(format!("q:{}", d.name));
-            vn.push(format!("v:{}", d.name));
-        }
-    }
-    (qn, vn)
+    (
+        model.q_names().iter().map(|n| format!("q:{n}")).collect(),
+        model.v_names().iter().map(|n| format!("v:{n}")).collect(),
+    )
 }
 
 /// Whether a model's joint kinds are all supported by
@@ -884,7 +873,10 @@ pub fn supports(model: &Model) -> bool {
         .enumerate()
         .skip(1)
         .all(|(b, j)| match j.kind {
-            JointKind::Free => model.free_joints.iter().any(|f| f.body == b),
+            JointKind::Free => {
+                model.free_joints.iter().any(|f| f.body == b)
+                    || model.dofs.iter().any(|d| d.iv == j.iv && d.kind == j.kind)
+            }
             _ => true,
         })
 }

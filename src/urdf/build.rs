@@ -227,6 +227,10 @@ impl Ctx<'_> {
                         .ok_or_else(|| self.err(&label, "<axis> without xyz"))?,
                 ),
             },
+            // a planar joint's default plane is xy (mechanisms.md), URDF's axis x
+            None if joint_type == JointType::Planar => Axis {
+                xyz: Vec3([0.0, 0.0, 1.0]),
+            },
             None => Axis::default(),
         };
         let limit = match el.child("limit") {

@@ -156,7 +156,22 @@ pub(crate) fn lower(
                 let axis = Axis::from_unit(a / a.norm());
                 let kind = match j.joint_type {
                     JointType::Prismatic => JointKind::Prismatic(axis),
+                    JointType::Spherical => JointKind::Spherical,
+                    JointType::Planar => JointKind::Planar,
+                    JointType::Floating => JointKind::Free,
                     _ => JointKind::Revolute(axis),
+                };
+                // a planar joint about another axis a: R_a Planar(q) R_aᵀ, R_a into
+                // the placement and R_aᵀ onto the child's frames (docs/theory.md
+                // §"Spherical, planar and floating joints")
+                let (origin, b_m_l) = if j.joint_type == JointType::Planar && a != a.norm() * Vector3::z() {
+                    let ra = plane_rotation(&(a / a.norm()));
+                    (
+                        Se3::new(origin.rot * ra, origin.trans),
+                        Se3::new(ra.transpose(), Vector3::zeros()),
+                    )
+                } else {
+                    (origin, Se3::identity())
                 };
                 parent.push(pb);
                 joints.push(Joint {
@@ -171,7 +186,7 @@ pub(crate) fn lower(
                 body_joint_names.push(j.name.clone());
                 body_link_names.push(j.child.link.clone());
                 body_urdf_joint.push(Some(ji));
-                (parent.len() - 1, Se3::identity())
+                (parent.len() - 1, b_m_l)
             }
         };
         let mass = link.inertial.mass.value;
@@ -241,6 +256,9 @@ pub(crate) fn lower(
             let kind_name = match j.joint_type {
                 JointType::Prismatic => "prismatic",
                 JointType::Continuous => "continuous",
+                JointType::Spherical => "spherical",
+                JointType::Planar => "planar",
+                JointType::Floating => "floating",
                 _ => "revolute",
             };
             let mimic = checked.mimic[ji].map_or(String::new(), |(l, m, o)| {
@@ -268,21 +286,28 @@ pub(crate) fn lower(
     };
     let mut dofs = Vec::new();
     let mut dof_of_joint: Vec<Option<usize>> = vec![None; robot.joints.len()];
+    let (mut nq, mut nv) = (qoff, voff);
     for b in 1..nbodies {
         if let Some(ji) = body_urdf_joint[b] {
             if checked.mimic[ji].is_none() {
                 let j = &robot.joints[ji];
                 let k = dofs.len();
                 dof_of_joint[ji] = Some(k);
-                joints[b].iq = qoff + k;
-                joints[b].iv = voff + k;
+                joints[b].iq = nq;
+                joints[b].iv = nv;
+                let kind = joints[b].kind;
                 dofs.push(DofInfo {
                     name: j.name.clone(),
+                    kind,
+                    iq: nq,
+                    iv: nv,
                     limits: limits(j),
                     damping: j.dynamics.as_ref().map_or(0.0, |d| d.damping),
                     friction: j.dynamics.as_ref().map_or(0.0, |d| d.friction),
                     continuous: j.joint_type == JointType::Continuous,
                 });
+                nq += kind.nq();
+                nv += kind.nv();
             }
         }
     }
@@ -299,15 +324,13 @@ pub(crate) fn lower(
                     "leader is not a degree of freedom",
                 )
             })?;
-            joints[b].iq = qoff + k;
-            joints[b].iv = voff + k;
+            joints[b].iq = dofs[k].iq;
+            joints[b].iv = dofs[k].iv;
             joints[b].mult = mult;
             joints[b].offset = off;
             has_mimic = true;
         }
     }
-    let nv = voff + dofs.len();
-    let nq = qoff + dofs.len();
 
     // λ: the previous velocity coordinate on the path to the root.
     let mut last_v = vec![usize::MAX; nbodies];
@@ -316,7 +339,7 @@ pub(crate) fn lower(
         let inherited = last_v[parent[b]];
         let j = &joints[b];
         let own = match j.kind {
-            JointKind::Free => true,
+            _ if b == root_body => true,
             _ => body_urdf_joint[b].is_some_and(|ji| checked.mimic[ji].is_none()),
         };
         if own {
@@ -402,6 +425,8 @@ pub(crate) fn lower(
             nbodies,
             frames.len(),
             dofs.len(),
+            nq,
+            nv,
             options.floating_base,
         )],
         dofs,
@@ -421,6 +446,19 @@ pub(crate) fn lower(
         source: None,
         report,
     })
+}
+
+/// The smallest rotation taking z onto the unit vector `a` (a half turn about x
+/// for a = −z): a planar joint's plane rotation R_a (mechanisms.md).
+fn plane_rotation(a: &Vector3<f64>) -> Matrix3<f64> {
+    let z = Vector3::z();
+    if *a == z {
+        return Matrix3::identity();
+    }
+    match nalgebra::Rotation3::rotation_between(&z, a) {
+        Some(r) if a.dot(&z) > -1.0 + 1e-12 => *r.matrix(),
+        _ => Matrix3::new(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, -1.0),
+    }
 }
 
 /// A revolute joint about x, y or z whose placement rotation is itself a rotation

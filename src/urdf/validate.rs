@@ -30,6 +30,19 @@ fn finite3(v: &[f64; 3]) -> bool {
 pub(crate) fn is_movable(t: &JointType) -> bool {
     matches!(
         t,
+        JointType::Revolute
+            | JointType::Continuous
+            | JointType::Prismatic
+            | JointType::Floating
+            | JointType::Planar
+            | JointType::Spherical
+    )
+}
+
+/// Whether a joint type moves one coordinate (revolute, continuous, prismatic).
+pub(crate) fn is_scalar(t: &JointType) -> bool {
+    matches!(
+        t,
         JointType::Revolute | JointType::Continuous | JointType::Prismatic
     )
 }
@@ -195,23 +208,10 @@ pub(crate) fn validate(parsed: &Parsed, file: &str) -> Result<Checked, UrdfError
         }
         parent_joint[c] = Some(ji);
         children[p].push(ji);
-        match j.joint_type {
-            JointType::Floating | JointType::Planar | JointType::Spherical => {
-                return Err(err(
-                    el,
-                    format!(
-                        "joint type \"{:?}\" is not supported inside a URDF (use --floating-base for a free root)",
-                        j.joint_type
-                    )
-                    .to_lowercase(),
-                ));
-            }
-            _ => {}
-        }
         if !finite3(&j.origin.xyz.0) || !finite3(&j.origin.rpy.0) {
             return Err(err(el, "non-finite <origin>".into()));
         }
-        if is_movable(&j.joint_type) {
+        if is_scalar(&j.joint_type) || j.joint_type == JointType::Planar {
             let a = j.axis.xyz.0;
             if !finite3(&a) {
                 return Err(err(el, "non-finite <axis>".into()));
@@ -219,6 +219,8 @@ pub(crate) fn validate(parsed: &Parsed, file: &str) -> Result<Checked, UrdfError
             if a.iter().map(|x| x * x).sum::<f64>().sqrt() <= 1e-12 {
                 return Err(err(el, "zero <axis>".into()));
             }
+        }
+        if is_scalar(&j.joint_type) {
             let l = &j.limit;
             for (v, n) in [
                 (l.lower, "lower"),
@@ -337,6 +339,15 @@ pub(crate) fn validate(parsed: &Parsed, file: &str) -> Result<Checked, UrdfError
             ));
             continue;
         }
+        if !is_scalar(&j.joint_type) {
+            return Err(err(
+                el,
+                format!(
+                    "a {} joint cannot mimic (only revolute, continuous and prismatic joints can)",
+                    format!("{:?}", j.joint_type).to_lowercase()
+                ),
+            ));
+        }
         let leader = *joint_index.get(m.joint.as_str()).ok_or_else(|| {
             err(
                 el.clone(),
@@ -347,6 +358,15 @@ pub(crate) fn validate(parsed: &Parsed, file: &str) -> Result<Checked, UrdfError
             return Err(err(
                 el,
                 format!("leader joint \"{}\" is not movable", m.joint),
+            ));
+        }
+        if !is_scalar(&robot.joints[leader].joint_type) {
+            return Err(err(
+                el,
+                format!(
+                    "leader joint \"{}\" has several degrees of freedom",
+                    m.joint
+                ),
             ));
         }
         let mult = m.multiplier.unwrap_or(1.0);

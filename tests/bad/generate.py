@@ -49,7 +49,8 @@ files["inf_limit_effort.urdf"] = robot(link("base") + link("l1") + joint("j1","b
 files["reversed_limit.urdf"] = robot(link("base") + link("l1") + joint("j1","base","l1", limit='<limit lower="1" upper="-1" effort="10" velocity="5"/>'))
 files["nan_mimic_multiplier.urdf"] = robot(link("base") + link("l1") + link("l2") + joint("j1","base","l1") + joint("j2","l1","l2", extra='<mimic joint="j1" multiplier="nan"/>'))
 files["unknown_joint_type.urdf"] = robot(link("base") + link("l1") + joint("j1","base","l1", t="hinge"))
-files["floating_joint_type.urdf"] = robot(link("base") + link("l1") + joint("j1","base","l1", t="floating"))
+files["mimic_spherical.urdf"] = robot(link("base") + link("l1") + link("l2") + joint("j1","base","l1", t="spherical", limit=None) + joint("j2","l1","l2", t="spherical", limit=None, extra='<mimic joint="j1"/>'))
+files["mimic_spherical_leader.urdf"] = robot(link("base") + link("l1") + link("l2") + joint("j1","base","l1", t="spherical", limit=None) + joint("j2","l1","l2", extra='<mimic joint="j1"/>'))
 files["nonnumeric_origin.urdf"] = robot(link("base") + link("l1") + joint("j1","base","l1", origin='<origin xyz="0 zero 0.5"/>'))
 files["short_origin.urdf"] = robot(link("base") + link("l1") + joint("j1","base","l1", origin='<origin xyz="0 0.5"/>'))
 files["joint_no_type.urdf"] = robot(link("base") + link("l1") + '  <joint name="j1"><parent link="base"/><child link="l1"/></joint>\n')
@@ -139,3 +140,24 @@ for k, v in {
     "states_one.json": '{"states": [{}]}\n',
 }.items():
     open(os.path.join(D, k), "w").write(v)
+# Joints of several degrees of freedom (mechanisms.md "In `eval` (version 4)"):
+# a spherical "ball", a planar "slide", a floating "mount" and a revolute "hinge".
+open(os.path.join(D, "joints_ok.urdf"), "w").write(robot(
+    link("base") + link("l1") + link("l2") + link("l3") + link("l4")
+    + joint("ball", "base", "l1", t="spherical", axis=None, limit=None)
+    + joint("hinge", "l1", "l2", axis="1 0 0")
+    + joint("mount", "l2", "l3", t="floating", axis=None, limit=None)
+    + joint("slide", "l3", "l4", t="planar", axis=None, limit=None), "joints_ok"))
+for k, v in {
+    "states_joints_ok.json": {"states": [{"q": {"ball": [0, 0, 0.6, 0.8], "hinge": 0.3, "mount": [0.1, 0, 0.2, 0, 0, 0, 1.0005], "slide": [0.1, 0.2, 0.3]},
+                                           "v": {"ball": [0.1, 0.2, 0.3], "slide": [1, 0, 0.5]}, "tau": {"mount": [0, 0, 1, 0, 0, 0]}, "derivatives": True}, {}]},
+    "states_joint_number_for_array.json": {"states": [{"q": {"ball": 0.3}}]},
+    "states_joint_wrong_length.json": {"states": [{"q": {"slide": [0.1, 0.2]}}]},
+    "states_joint_v_wrong_length.json": {"states": [{"v": {"mount": [0.1, 0.2, 0.3]}}]},
+    "states_joint_quat_nonunit.json": {"states": [{"q": {"ball": [0, 0, 0, 0.9]}}]},
+    "states_joint_mount_quat_nonunit.json": {"states": [{"q": {"mount": [0, 0, 0, 0, 0, 0, 2]}}]},
+    "states_joint_array_for_number.json": {"states": [{"v": {"hinge": [1, 2]}}]},
+    "states_joint_string_in_array.json": {"states": [{"a": {"ball": [1, "x", 2]}}]},
+}.items():
+    open(os.path.join(D, k), "w").write(json.dumps(v, indent=1) + "\n")
+open(os.path.join(D, "states_joint_nonfinite.json"), "w").write('{"states": [{"tau": {"slide": [0, 1e999, 0]}}]}\n')

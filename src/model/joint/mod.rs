@@ -1,7 +1,8 @@
 //! Joint kinds and everything that depends on them: the joint transform `X_J(q)`,
 //! the motion subspace `S` (docs/theory.md §"Joints and motion subspace"), the
 //! joint velocity `S q̇` and the projection `Sᵀ f` (docs/theory.md §"Joint-force
-//! projection"). One file a joint kind (`revolute.rs`, `prismatic.rs`, `free.rs`),
+//! projection"). One file a joint kind (`revolute.rs`, `prismatic.rs`, `free.rs`,
+//! `spherical.rs`, `planar.rs`),
 //! each implementing [`JointModel`]; the kind is matched in one place,
 //! [`dispatch_joint!`], and [`Joint`]'s methods run the same implementations.
 //!
@@ -11,14 +12,18 @@
 //! constant axis and transform shape, with no further `match`.
 
 mod free;
+mod planar;
 mod prismatic;
 mod revolute;
+mod spherical;
 
 pub use crate::spatial::Axis;
 pub(crate) use crate::spatial::{AxU, AxX, AxY, AxZ};
 pub(crate) use free::FreeJ;
+pub(crate) use planar::PlanarJ;
 pub(crate) use prismatic::PrismaticJ;
 pub(crate) use revolute::RevoluteJ;
+pub(crate) use spherical::SphericalJ;
 
 use crate::spatial::{CompositeInertia, Force, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix6, Vector6};
@@ -34,6 +39,44 @@ pub enum JointKind<T: Scalar = f64> {
     Revolute(Axis<T>),
     /// Translation along an axis: `ŝ = [0; u]` (docs/theory.md §"Joints and motion subspace").
     Prismatic(Axis<T>),
+    /// 3-DoF ball joint: q = unit quaternion xyzw (4), v = ω in the body frame (3),
+    /// as Pinocchio's `JointModelSpherical`.
+    Spherical,
+    /// 3-DoF planar joint in the joint frame's xy plane: q = [x, y, θ], v = [vx, vy, ω]
+    /// in the body frame, as Pinocchio's `JointModelPlanar` (another plane is folded
+    /// into the placement at import).
+    Planar,
+}
+
+impl<T: Scalar> JointKind<T> {
+    /// Number of configuration coordinates (7 free, 4 spherical, 3 planar, else 1).
+    pub fn nq(&self) -> usize {
+        match self {
+            JointKind::Free => 7,
+            JointKind::Spherical => 4,
+            JointKind::Planar => 3,
+            _ => 1,
+        }
+    }
+    /// Number of velocity coordinates (6 free, 3 spherical and planar, else 1).
+    pub fn nv(&self) -> usize {
+        match self {
+            JointKind::Free => 6,
+            JointKind::Spherical | JointKind::Planar => 3,
+            _ => 1,
+        }
+    }
+    /// The kind's name as URDF writes it: `floating`, `spherical`, `planar`,
+    /// `revolute`, `prismatic`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            JointKind::Free => "floating",
+            JointKind::Spherical => "spherical",
+            JointKind::Planar => "planar",
+            JointKind::Revolute(_) => "revolute",
+            JointKind::Prismatic(_) => "prismatic",
+        }
+    }
 }
 
 /// A body's joint: its kind, where its coordinates live, and how a mimic joint
@@ -58,10 +101,15 @@ impl<T: Scalar> Joint<T> {
     // Every operation below runs the joint model's own (the one the dynamics'
     // hot loops use), so each exists once, in revolute.rs, prismatic.rs, free.rs.
 
-    /// Number of velocity coordinates this joint moves (1, or 6 for a free joint).
+    /// Number of velocity coordinates this joint moves (1; 3 spherical, planar; 6 free).
     #[inline(always)]
     pub fn nv(&self) -> usize {
         dispatch_joint!(self, false, jm => jm.nv())
+    }
+    /// Number of configuration coordinates (1; 4 spherical; 3 planar; 7 free).
+    #[inline(always)]
+    pub fn nq(&self) -> usize {
+        self.kind.nq()
     }
     /// The joint transform `X_J(q)` (from the body frame to the joint's frame on the
     /// parent) and the joint velocity `v_J = S q̇` (body frame), docs/theory.md
@@ -191,7 +239,8 @@ pub(super) fn dot6<T: Scalar>(x: &Vector6<T>, off: usize, ax: Axis<T>, mult: T) 
 macro_rules! dispatch_joint {
     ($joint:expr, $ident:expr, $jm:ident => $body:expr) => {{
         use $crate::model::joint::{
-            AxU, AxX, AxY, AxZ, Axis, FreeJ, JointKind, PrismaticJ, RevoluteJ,
+            AxU, AxX, AxY, AxZ, Axis, FreeJ, JointKind, PlanarJ, PrismaticJ, RevoluteJ,
+            SphericalJ,
         };
         let j__ = $joint;
         match (&j__.kind, $ident) {
@@ -247,6 +296,14 @@ macro_rules! dispatch_joint {
             }
             (JointKind::Free, _) => {
                 let $jm = FreeJ { j: j__ };
+                $body
+            }
+            (JointKind::Spherical, _) => {
+                let $jm = SphericalJ { j: j__ };
+                $body
+            }
+            (JointKind::Planar, _) => {
+                let $jm = PlanarJ { j: j__ };
                 $body
             }
         }

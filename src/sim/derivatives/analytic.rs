@@ -47,7 +47,11 @@ impl Simulation {
         tau: &DVector<f64>,
     ) -> Result<Option<TransitionJacobians>, SimError> {
         let f = &self.model.free_joints;
-        if f.len() > 1 || f.first().is_some_and(|f| f.iv != 0 || f.iq != 0) {
+        // joints of several degrees of freedom inside the tree: central differences
+        if f.len() > 1
+            || f.first().is_some_and(|f| f.iv != 0 || f.iq != 0)
+            || !self.model.all_dofs_scalar()
+        {
             return Ok(None);
         }
         self.set_joint_torques(tau);

@@ -21,6 +21,18 @@ impl Simulation {
         for f in &self.model.free_joints {
             add_frame_rate(&mut self.mass.vfree, &self.v, h, f.iv);
         }
+        for d in &self.model.dofs {
+            match d.kind {
+                crate::model::JointKind::Free => add_frame_rate(&mut self.mass.vfree, &self.v, h, d.iv),
+                crate::model::JointKind::Planar => {
+                    // ω = (0, 0, ω_z), v_lin = (vx, vy, 0): h ω × v_lin
+                    let (vx, vy, w) = (self.v[d.iv], self.v[d.iv + 1], self.v[d.iv + 2]);
+                    self.mass.vfree[d.iv] -= h * w * vy;
+                    self.mass.vfree[d.iv + 1] += h * w * vx;
+                }
+                _ => {}
+            }
+        }
         self.rhs_evals += 1;
         // v⁺ = v* + H̃⁻¹Jᵀλ; the configuration moves by v⁺ + w
         if rows {
