@@ -90,17 +90,15 @@ pub fn model_ranges(model: &Model, name: &str) -> PyResult<(Range<usize>, Range<
 }
 
 /// The q and v ranges of joint `name`: a floating base's free joint (`"base"`,
-/// a scene's `"MODEL/base"`) 7 and 6 entries, a degree of freedom one each. A
-/// mimic joint (no coordinate of its own) or an unknown name is a `ValueError`.
+/// a scene's `"MODEL/base"`) 7 and 6 entries, any other joint its own
+/// (mechanisms.md: a 1-DoF joint one each, a spherical 4 and 3, ...). A mimic
+/// joint (no coordinate of its own) or an unknown name is a `ValueError`.
 pub fn joint_ranges(model: &Model, name: &str) -> PyResult<(Range<usize>, Range<usize>)> {
     if let Some(f) = model.free_joints.iter().find(|f| f.name == name) {
         return Ok((f.iq..f.iq + 7, f.iv..f.iv + 6));
     }
-    if let Some((_, iq, iv)) = model
-        .dof_indices()
-        .find(|&(d, _, _)| model.dofs[d].name == name)
-    {
-        return Ok((iq..iq + 1, iv..iv + 1));
+    if let Some(d) = model.dofs.iter().find(|d| d.name == name) {
+        return Ok((d.iq..d.iq + d.kind.nq(), d.iv..d.iv + d.kind.nv()));
     }
     if let Ok(id) = model.joint_id(name) {
         if model.is_mimic(id) {

@@ -186,6 +186,17 @@ impl PyModel {
     fn nv(&self) -> usize {
         self.model.nv
     }
+    /// The name of every entry of q, as eval's (a floating base's `base_x` …
+    /// `base_qw` first; mechanisms.md).
+    #[getter]
+    fn q_names(&self) -> Vec<String> {
+        self.model.q_names()
+    }
+    /// The name of every entry of v (and a, tau), as eval's (`base_vx` … first).
+    #[getter]
+    fn v_names(&self) -> Vec<String> {
+        self.model.v_names()
+    }
     /// The joint degrees of freedom in engine order (the base's 6 not included).
     #[getter]
     fn dof_names(&self) -> Vec<String> {

@@ -178,6 +178,8 @@ def test_scene_model_slices_and_names(tmp_path):
     assert m.model_q_slice("cube") == slice(0, 7) and m.model_v_slice("cube") == slice(0, 6)
     assert m.model_q_slice("gripper") == slice(7, 9) and m.model_v_slice("gripper") == slice(6, 8)
     assert m.joint_q_slice("cube/base") == slice(0, 7)
+    assert m.q_names[:3] == ["cube/base_x", "cube/base_y", "cube/base_z"] and len(m.q_names) == m.nq
+    assert m.v_names[m.joint_v_slice("gripper/left_slide")] == ["gripper/left_slide"]
     assert m.joint_q_slice("gripper/right_slide") == slice(8, 9)
     assert m.link_mass("gripper/left") == 0.1 and m.link_mass("gripper/palm") == 0.0
     with pytest.raises(ValueError, match="unknown joint"):
