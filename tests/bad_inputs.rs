@@ -406,6 +406,17 @@ const BAD_STATES: &[(&str, bool, &[&str])] = &[
         false,
         &["duplicate field `states`"],
     ),
+    // loop constraints (mechanisms.md §"Loop constraints"): one line naming constraints[K] and the key
+    ("states_constraint_unknown_link.json", false, &["constraints[0].link1", "\"nolink\""]),
+    ("states_constraint_mimic_joint.json", false, &["constraints[0].joint1", "mimic"]),
+    ("states_constraint_multi_dof.json", true, &["constraints[0].joint2", "degrees of freedom"]),
+    ("states_constraint_one_body.json", false, &["constraints[0].link2", "one body"]),
+    ("states_constraint_world_both.json", false, &["constraints[0].link1", "world"]),
+    ("states_constraint_nonfinite.json", false, &["constraints[0].point1[1]"]),
+    ("states_constraint_unknown_key.json", false, &["constraints[0].pont2", "unknown key"]),
+    ("states_constraint_duplicate_name.json", false, &["constraints[1].name", "duplicate"]),
+    ("states_constraint_bad_quaternion.json", false, &["constraints[0].frame1.orientation_xyzw"]),
+    ("states_constraint_inconsistent.json", false, &["states[0]", "\"tip\"", "inconsistent"]),
 ];
 
 #[test]

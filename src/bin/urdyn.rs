@@ -211,6 +211,16 @@ struct BenchArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
+    /// A `point` constraint holding LINK's origin where it is in the first sampled
+    /// state (repeatable; for constraint-dynamics, mechanisms.md).
+    #[arg(long = "hold", value_name = "LINK")]
+    hold: Vec<String>,
+    /// A `frame` constraint holding LINK's frame where it is in the first sampled state.
+    #[arg(long = "hold6", value_name = "LINK")]
+    hold6: Vec<String>,
+    /// A `frame` constraint welding two links' frames together (L1,L2).
+    #[arg(long = "weld", value_name = "L1,L2")]
+    weld: Vec<String>,
 }
 
 fn bench(a: BenchArgs) -> Result<()> {
@@ -244,10 +254,49 @@ fn bench(a: BenchArgs) -> Result<()> {
     // (0 is refused by the library, naming --samples)
     let samples = usize::try_from(a.samples)
         .map_err(|_| anyhow!("--samples must be at least 1 (got {})", a.samples))?;
+    let mut constraints = Vec::new();
+    for l in &a.hold {
+        constraints.push(serde_json::json!({"kind": "point", "link1": l}));
+    }
+    for l in &a.hold6 {
+        constraints.push(serde_json::json!({"kind": "frame", "link1": l}));
+    }
+    for w in &a.weld {
+        let (l1, l2) = w
+            .split_once(',')
+            .ok_or_else(|| anyhow!("--weld: expected L1,L2 (two link names), got {w:?}"))?;
+        constraints.push(serde_json::json!({"kind": "frame", "link1": l1, "link2": l2}));
+    }
+    // the constraints are checked before timing (an unknown link names its option)
+    if !constraints.is_empty() {
+        urdyn::model::Constraints::from_json(&model, &constraints).map_err(|e| {
+            let opt = ["--hold", "--hold6", "--weld"]
+                .into_iter()
+                .zip([a.hold.len(), a.hold6.len(), a.weld.len()])
+                .scan(0, |acc, (o, n)| {
+                    *acc += n;
+                    Some((o, *acc))
+                })
+                .find(|&(_, end)| e.index < end)
+                .map_or("--hold", |(o, _)| o);
+            anyhow!("{opt}: {}", e.message)
+        })?;
+    }
+    let algos = if a.algos.is_empty() && !constraints.is_empty() {
+        Algo::ALL.into_iter().chain(Algo::CONSTRAINED).collect()
+    } else {
+        algos
+    };
+    if constraints.is_empty() && algos.iter().any(|x| Algo::CONSTRAINED.contains(x)) {
+        return Err(anyhow!(
+            "--algo: constraint-dynamics needs constraints: --hold LINK, --hold6 LINK or --weld L1,L2"
+        ));
+    }
     let opts = BenchOptions {
         algos,
         samples,
         budget,
+        constraints,
     };
     let (results, notes) =
         bench::run(&model, &opts).map_err(|e| anyhow!("{}: {e}", a.urdf.display()))?;

@@ -4,8 +4,8 @@
 //! time a batch of calls (sized to about 50 µs) cycling over the pool; the per-call
 //! time of a sample is batch time / batch size; outputs go through `black_box`.
 
-use crate::dynamics;
-use crate::model::{Data, JointKind, Model};
+use crate::dynamics::{self, ConstraintData};
+use crate::model::{Constraints, Data, JointKind, Model};
 use nalgebra::DVector;
 use serde_json::{json, Map, Value};
 use std::hint::black_box;
@@ -39,6 +39,12 @@ pub enum Algo {
     /// `jacobians`: every body's world Jacobian ([`dynamics::joint_jacobians`],
     /// Pinocchio's `computeJointJacobians`).
     Jacobians,
+    /// `constraint-dynamics`: q̈ and λ under the loop constraints
+    /// ([`dynamics::constraint_dynamics`]; needs constraints, cli.md `--hold`).
+    ConstraintDynamics,
+    /// `constraint-dynamics-derivatives`: the constrained q̈ and its derivatives
+    /// together ([`dynamics::constraint_dynamics_derivatives`]).
+    ConstraintDynamicsDerivatives,
 }
 
 impl Algo {
@@ -56,6 +62,8 @@ impl Algo {
         Algo::AbaDerivatives,
         Algo::Jacobians,
     ];
+    /// The algorithms that need constraints (timed by default when some are given).
+    pub const CONSTRAINED: [Algo; 2] = [Algo::ConstraintDynamics, Algo::ConstraintDynamicsDerivatives];
     /// The command-line name (`--algo`, and the key in `--json`).
     pub fn name(self) -> &'static str {
         match self {
@@ -70,11 +78,16 @@ impl Algo {
             Algo::RneaDerivatives => "rnea-derivatives",
             Algo::AbaDerivatives => "aba-derivatives",
             Algo::Jacobians => "jacobians",
+            Algo::ConstraintDynamics => "constraint-dynamics",
+            Algo::ConstraintDynamicsDerivatives => "constraint-dynamics-derivatives",
         }
     }
     /// The algorithm of a command-line name; `None` for an unknown name.
     pub fn from_name(s: &str) -> Option<Algo> {
-        Algo::ALL.into_iter().find(|a| a.name() == s)
+        Algo::ALL
+            .into_iter()
+            .chain(Algo::CONSTRAINED)
+            .find(|a| a.name() == s)
     }
 }
 
@@ -82,7 +95,7 @@ impl Algo {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BenchError {
     /// An `--algo` name that is not one of [`Algo::ALL`] (the name given).
-    #[error("unknown algorithm \"{0}\" (known: rnea, bias, crba, aba, fd-rnea, fd-crba, fd, fk, rnea-derivatives, aba-derivatives, jacobians)")]
+    #[error("unknown algorithm \"{0}\" (known: rnea, bias, crba, aba, fd-rnea, fd-crba, fd, fk, rnea-derivatives, aba-derivatives, jacobians, constraint-dynamics, constraint-dynamics-derivatives)")]
     UnknownAlgo(String),
     /// `--samples 0`.
     #[error("--samples must be at least 1")]
@@ -223,6 +236,10 @@ pub struct BenchOptions {
     pub samples: usize,
     /// Soft time limit per algorithm.
     pub budget: Duration,
+    /// The loop constraints of the constrained algorithms, as the contract's
+    /// JSON objects (mechanisms.md); world anchors left out are placed where
+    /// their link is in the first sampled state.
+    pub constraints: Vec<Value>,
 }
 
 impl Default for BenchOptions {
@@ -231,6 +248,7 @@ impl Default for BenchOptions {
             algos: Algo::ALL.to_vec(),
             samples: 300,
             budget: Duration::from_millis(1500),
+            constraints: Vec::new(),
         }
     }
 }
@@ -241,8 +259,27 @@ const SEED: u64 = 0x5EED_0DD5;
 /// One call of `algo` on `s`; returns a number derived from the output (kept alive
 /// through `black_box`).
 #[inline(never)]
-fn call(algo: Algo, model: &Model, data: &mut Data, s: &State) -> Result<f64, String> {
+fn call(
+    algo: Algo,
+    model: &Model,
+    data: &mut Data,
+    cx: &mut Option<(Constraints, ConstraintData)>,
+    s: &State,
+) -> Result<f64, String> {
     Ok(match algo {
+        Algo::ConstraintDynamics | Algo::ConstraintDynamicsDerivatives => {
+            let (c, cd) = cx.as_mut().ok_or("needs constraints: --hold, --hold6 or --weld")?;
+            if algo == Algo::ConstraintDynamics {
+                dynamics::constraint_dynamics(model, data, cd, c, &s.q, &s.v, &s.tau, None)
+                    .map_err(|e| e.to_string())?[0]
+            } else {
+                dynamics::constraint_dynamics_derivatives(
+                    model, data, cd, c, &s.q, &s.v, &s.tau, None,
+                )
+                .map_err(|e| e.to_string())?;
+                cd.dqdd_dq[(0, 0)] + cd.dqdd_dv[(0, 0)] + cd.dqdd_dtau[(0, 0)]
+            }
+        }
         Algo::Rnea => {
             dynamics::rnea(model, data, &s.q, &s.v, &s.a, None).map_err(|e| e.to_string())?[0]
         }
@@ -290,12 +327,26 @@ pub fn time_algo(model: &Model, algo: Algo, opts: &BenchOptions) -> Result<Timin
         algo: algo.name(),
         message: m,
     };
+    let mut cx = if Algo::CONSTRAINED.contains(&algo) && !opts.constraints.is_empty() {
+        let mut c = Constraints::from_json(model, &opts.constraints).map_err(|e| BenchError::Dynamics {
+            algo: algo.name(),
+            message: e.to_string(),
+        })?;
+        if let Some(s0) = states.first() {
+            dynamics::forward_kinematics(model, &mut data, &s0.q).map_err(|e| err(e.to_string()))?;
+            c.place_holds(&data);
+        }
+        let cd = ConstraintData::new(model, &c);
+        Some((c, cd))
+    } else {
+        None
+    };
     let nstates = states.len();
     // Warm-up (at least 20 ms) and a first estimate of the per-call time.
     let start = Instant::now();
     let mut calls = 0usize;
     while start.elapsed() < Duration::from_millis(20) || calls < 3 {
-        black_box(call(algo, model, &mut data, black_box(&states[calls % nstates])).map_err(err)?);
+        black_box(call(algo, model, &mut data, &mut cx, black_box(&states[calls % nstates])).map_err(err)?);
         calls += 1;
     }
     let per_call = start.elapsed().as_secs_f64() / calls as f64;
@@ -317,7 +368,7 @@ pub fn time_algo(model: &Model, algo: Algo, opts: &BenchOptions) -> Result<Timin
             if k == nstates {
                 k = 0;
             }
-            black_box(call(algo, model, &mut data, s).map_err(err)?);
+            black_box(call(algo, model, &mut data, &mut cx, s).map_err(err)?);
         }
         per.push(t0.elapsed().as_nanos() as f64 / batch as f64);
     }

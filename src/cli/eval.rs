@@ -245,6 +245,7 @@ fn evaluate_each(
     for (i, state) in states.states.iter().enumerate() {
         vectors.push(state.to_vectors(&model, states_file, &format!("states[{i}]"))?);
     }
+    let constraints = crate::cli::eval_constrained::parse(&model, states.constraints.as_ref(), states_file)?;
     let mut data = Data::new(&model);
     let names = model.dof_names();
     let mut fext = vec![Force::zero(); model.nbodies];
@@ -279,6 +280,17 @@ fn evaluate_each(
             .map_err(dyn_err)?
             .clone();
         let kin = kinematics(&model, &mut data, sv).map_err(dyn_err)?;
+        let constrained = match &constraints {
+            Some(c) => Some(
+                crate::cli::eval_constrained::block(&model, &mut data, c, sv, fx).map_err(|m| {
+                    EvalError::Dynamics {
+                        file: states_file.to_string(),
+                        message: format!("{key}: {m}"),
+                    }
+                })?,
+            ),
+            None => None,
+        };
         let deriv = if sv.derivatives {
             Some(derivatives(&model, &mut data, sv).map_err(dyn_err)?)
         } else {
@@ -294,6 +306,7 @@ fn evaluate_each(
             ("mass_matrix", h.iter().all(|v| v.is_finite())),
             ("a frame, centre of mass, momentum or energy", kin.finite),
             ("a derivative", deriv.as_ref().is_none_or(|d| d.1)),
+            ("the constrained block", constrained.as_ref().is_none_or(|c| c.1)),
         ] {
             if !ok {
                 return Err(EvalError::Dynamics {
@@ -353,6 +366,9 @@ fn evaluate_each(
         }
         if let Some((d, _)) = deriv {
             r.insert("derivatives".into(), d);
+        }
+        if let Some((c, _)) = constrained {
+            r.insert("constrained".into(), c);
         }
         r.insert("com".into(), kin.com);
         r.insert("momentum".into(), kin.momentum);

@@ -8,6 +8,7 @@
 //! who wants the engine alone builds with `default-features = false`).
 pub mod bench;
 pub mod eval;
+pub mod eval_constrained;
 pub mod inspect;
 pub mod output;
 pub mod simulate;

@@ -136,6 +136,9 @@ pub struct StatesFile {
     pub gravity: Option<[f64; 3]>,
     /// The states to evaluate.
     pub states: Vec<State>,
+    /// Loop constraints for every state (mechanisms.md §"In `eval` (version 4)").
+    #[serde(default)]
+    pub constraints: Option<serde_json::Value>,
 }
 
 /// The vectors of one state, in engine order.

@@ -309,10 +309,10 @@ fn neg_mul_low_rank<T: Scalar>(model: &Model<T>, data: &mut Data<T>, ext: bool) 
 /// root path) can be non-zero: rows `[c, dof_end[c])` (c's subtree) and c's
 /// ancestors, the runs `runs[run0[c]..run0[c + 1]]`. The derivative sweep never
 /// writes the other entries, which stay the zeros of `Data::new`.
-struct TreePattern<'a> {
-    dof_end: &'a [usize],
-    runs: &'a [(usize, usize)],
-    run0: &'a [usize],
+pub(super) struct TreePattern<'a> {
+    pub(super) dof_end: &'a [usize],
+    pub(super) runs: &'a [(usize, usize)],
+    pub(super) run0: &'a [usize],
 }
 
 /// Rows of a register tile.
@@ -327,7 +327,7 @@ const NR: usize = 4;
 /// the block's largest subtree end: one row set for the block. Register tiles of
 /// R × NR accumulators; a panel of R rows of `a` stays in cache across every
 /// column block of both products.
-fn neg_mul_tree<T: Scalar>(
+pub(super) fn neg_mul_tree<T: Scalar>(
     a: &DMatrix<T>,
     bs: [&DMatrix<T>; 2],
     xs: [&mut DMatrix<T>; 2],

@@ -9,6 +9,8 @@ mod aba;
 mod aba_derivatives;
 mod centroidal;
 mod com;
+mod constraint_dynamics;
+mod constraint_dynamics_derivatives;
 mod crba;
 mod energy;
 mod external;
@@ -16,6 +18,7 @@ mod forward_rnea;
 mod frames;
 mod jacobian;
 mod jacobian_dot;
+mod kkt;
 mod joint_jacobians;
 mod kinematics;
 pub mod linalg;
@@ -28,6 +31,11 @@ pub use crate::spatial::CompositeInertia;
 pub use aba::aba;
 pub use aba_derivatives::aba_derivatives;
 pub use centroidal::centroidal_momentum;
+pub use constraint_dynamics::{
+    constraint_dynamics, constraint_jacobian, constraint_violation, ConstraintData,
+    ConstraintDynamicsError,
+};
+pub use constraint_dynamics_derivatives::constraint_dynamics_derivatives;
 pub use com::{center_of_mass, center_of_mass_jacobian, center_of_mass_velocity};
 pub(crate) use crba::crba_at_placements;
 pub use crba::{crba, crba_upper};

@@ -6,6 +6,7 @@
 //! through fixed joints; each URDF link stays addressable as a [`Frame`].
 
 pub mod configuration;
+mod constraints;
 mod data;
 pub(crate) mod joint;
 pub(crate) mod lie;
@@ -15,6 +16,7 @@ mod trees;
 
 pub use names::{edit_distance, nearest, BodyId, FrameId, JointId, NameError};
 
+pub use constraints::{Attachment, Constraint, ConstraintError, ConstraintKind, Constraints};
 pub use data::Data;
 pub(crate) use joint::{dispatch_joint, JointModel};
 pub use joint::{Axis, Joint, JointKind};

@@ -1,0 +1,439 @@
+//! Constrained forward dynamics (mechanisms.md §"Semantics"; docs/theory.md
+//! §"Constrained dynamics"): q̈ and λ of
+//!
+//! ```text
+//! H q̈ + C = τ + Σ Jᵀ w_ext + J_cᵀ λ,     J_c q̈ + γ_c = 0,
+//! ```
+//!
+//! with the rows the classical accelerations of the constraints in world
+//! coordinates (`point`: p̈₁ − p̈₂; `frame`: also ω̇₁ − ω̇₂; `joint`:
+//! q̈₁ − ratio · q̈₂). By the range-space route: q̈₀ = H⁻¹(τ − C) and
+//! Y = H⁻¹ J_cᵀ from H's tree-sparse factor (`ltdl.rs`), K = J_c Y,
+//! λ = K⁺ (−γ_c − J_c q̈₀) (least norm when rows are redundant, `kkt.rs`),
+//! q̈ = q̈₀ + Y λ.
+
+use super::kkt::{mul_add, KktFactor};
+use super::{check_massless, check_sizes, forward_dynamics_crba, linalg, ltdl, DynamicsError};
+use crate::model::{Attachment, ConstraintKind, Constraints, Data, DimensionError, Model};
+use crate::spatial::{Force, Motion};
+use nalgebra::{DMatrix, DVector, Vector3};
+
+/// Why constrained dynamics has no answer.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConstraintDynamicsError {
+    /// The unconstrained dynamics has none (singular H, sizes, names).
+    #[error(transparent)]
+    Dynamics(#[from] DynamicsError),
+    /// The rows J_c q̈ = −γ_c have no solution (names the constraints whose rows
+    /// are left unsatisfied).
+    #[error("the constraints {} are inconsistent: their rows J_c q̈ + γ_c = 0 have no solution in this state", .0.iter().map(|n| format!("\"{n}\"")).collect::<Vec<_>>().join(", "))]
+    Inconsistent(Vec<String>),
+}
+
+impl From<DimensionError> for ConstraintDynamicsError {
+    fn from(e: DimensionError) -> Self {
+        Self::Dynamics(e.into())
+    }
+}
+
+/// The workspace and results of the constrained algorithms for one model and
+/// one constraint set (m rows): sized once, no allocation per call.
+#[derive(Clone, Debug)]
+pub struct ConstraintData {
+    /// Number of rows m.
+    pub rows: usize,
+    /// J_c (m × nv, columns as v).
+    pub jc: DMatrix<f64>,
+    /// γ_c = J̇_c v (m).
+    pub gamma: DVector<f64>,
+    /// λ (m), stacked in constraint order (point: force; frame: force then
+    /// torque; joint: the generalized force on joint1), world coordinates.
+    pub lambda: DVector<f64>,
+    /// The constrained q̈ (nv).
+    pub qdd: DVector<f64>,
+    /// J_cᵀ λ (nv).
+    pub generalized_force: DVector<f64>,
+    /// ∂q̈/∂q (nv × nv, tangent space) from the derivatives.
+    pub dqdd_dq: DMatrix<f64>,
+    /// ∂q̈/∂v.
+    pub dqdd_dv: DMatrix<f64>,
+    /// ∂q̈/∂τ = H⁻¹ − Y K⁺ Yᵀ.
+    pub dqdd_dtau: DMatrix<f64>,
+    /// Y = H⁻¹ J_cᵀ (nv × m; after [`constraint_dynamics`] on a model without
+    /// mimic joints, W = L⁻ᵀ J_cᵀ by rows of m: its columns' storage).
+    pub(crate) y: DMatrix<f64>,
+    /// K = J_c Y (m × m; K⁺ after the derivatives).
+    pub(crate) k: DMatrix<f64>,
+    /// Derivatives: P = Y K⁺ (nv × m; J_cᵀ before it).
+    pub(crate) p: DMatrix<f64>,
+    pub(crate) kkt: KktFactor,
+    /// Scratch: m entries.
+    pub(crate) r: DVector<f64>,
+    /// Scratch: m entries.
+    pub(crate) r2: DVector<f64>,
+    /// Scratch: nv entries.
+    pub(crate) tmp: DVector<f64>,
+    /// Derivatives: ∂(J_c a + γ_c)/∂q at a = q̈ (m × nv).
+    pub(crate) aq: DMatrix<f64>,
+    /// Derivatives: ∂(J_c a + γ_c)/∂v (m × nv).
+    pub(crate) av: DMatrix<f64>,
+    /// Derivatives: m × nv scratch.
+    pub(crate) z: DMatrix<f64>,
+    /// Derivatives: the world columns of one side's path (scratch).
+    pub(crate) path: Vec<(usize, usize, Motion<f64>)>,
+    /// Derivatives: per body, the world velocity-product acceleration.
+    pub(crate) oa0: Vec<Motion<f64>>,
+}
+
+impl ConstraintData {
+    /// The workspace for `model` and `constraints`.
+    pub fn new(model: &Model, constraints: &Constraints) -> Self {
+        let (m, nv) = (constraints.rows(), model.nv);
+        Self {
+            rows: m,
+            jc: DMatrix::zeros(m, nv),
+            gamma: DVector::zeros(m),
+            lambda: DVector::zeros(m),
+            qdd: DVector::zeros(nv),
+            generalized_force: DVector::zeros(nv),
+            dqdd_dq: DMatrix::zeros(nv, nv),
+            dqdd_dv: DMatrix::zeros(nv, nv),
+            dqdd_dtau: DMatrix::zeros(nv, nv),
+            y: DMatrix::zeros(nv, m),
+            k: DMatrix::zeros(m, m),
+            p: DMatrix::zeros(nv, m),
+            kkt: KktFactor::new(m),
+            r: DVector::zeros(m),
+            r2: DVector::zeros(m),
+            tmp: DVector::zeros(nv),
+            aq: DMatrix::zeros(m, nv),
+            av: DMatrix::zeros(m, nv),
+            z: DMatrix::zeros(m, nv),
+            path: Vec::with_capacity(model.nv),
+            oa0: vec![Motion::zero(); model.nbodies],
+        }
+    }
+}
+
+/// `data.o_m_i` from `data.li_m_i` (the passes that leave world poses out).
+pub(crate) fn world_poses(model: &Model, data: &mut Data) {
+    for i in 1..model.nbodies {
+        data.o_m_i[i] = data.o_m_i[model.parent[i]].compose(&data.li_m_i[i]);
+    }
+}
+
+/// A side's world pose.
+#[inline]
+pub(crate) fn side_point(data: &Data, s: &Attachment) -> Vector3<f64> {
+    data.o_m_i[s.body].act_point(&s.local.trans)
+}
+
+/// Adds `sign` times the side's rows (3 linear; with `frame` 3 angular) at
+/// `row` of `jc`: column k of each joint on the body's path is the world
+/// motion `⁰X̂ S` read at the side's point p, `[v + ω × p; ω]`
+/// (docs/theory.md §"Frame Jacobian").
+fn add_side_rows(
+    model: &Model,
+    data: &Data,
+    s: &Attachment,
+    sign: f64,
+    frame: bool,
+    row: usize,
+    jc: &mut DMatrix<f64>,
+) {
+    let p = side_point(data, s);
+    let mut b = s.body;
+    while b != 0 {
+        let joint = &model.joints[b];
+        for k in 0..joint.nv() {
+            let sw = data.o_m_i[b].act_motion(&joint.subspace_column(k));
+            let lin = sw.lin + sw.ang.cross(&p);
+            let col = joint.iv + k;
+            for r in 0..3 {
+                jc[(row + r, col)] += sign * lin[r];
+                if frame {
+                    jc[(row + 3 + r, col)] += sign * sw.ang[r];
+                }
+            }
+        }
+        b = model.parent[b];
+    }
+}
+
+/// J_c into `jc` (zeroed first) from `data.o_m_i`.
+pub(crate) fn jacobian_rows(model: &Model, data: &Data, c: &Constraints, jc: &mut DMatrix<f64>) {
+    jc.fill(0.0);
+    let mut row = 0;
+    for con in &c.items {
+        match &con.kind {
+            ConstraintKind::Joint {
+                v1, second, ratio, ..
+            } => {
+                jc[(row, *v1)] += 1.0;
+                if let Some((_, v2)) = second {
+                    jc[(row, *v2)] -= ratio;
+                }
+            }
+            kind => {
+                let frame = *kind == ConstraintKind::Frame;
+                add_side_rows(model, data, &con.a, 1.0, frame, row, jc);
+                add_side_rows(model, data, &con.b, -1.0, frame, row, jc);
+            }
+        }
+        row += con.rows();
+    }
+}
+
+/// The classical acceleration `[p̈; ω̇]` of a side's point p from its body's
+/// world velocity `ov` and acceleration `oa` (spatial, at the world origin,
+/// without gravity): p̈ = a + α × p + ω × ṗ, ṗ = v + ω × p (docs/theory.md
+/// §"Classical acceleration").
+#[inline]
+pub(crate) fn classical(ov: &Motion<f64>, oa: &Motion<f64>, p: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let pdot = ov.lin + ov.ang.cross(p);
+    (oa.lin + oa.ang.cross(p) + ov.ang.cross(&pdot), oa.ang)
+}
+
+/// γ_c into `gamma` from each body's world velocity `ov` and velocity-product
+/// acceleration `oa0` (q̈ = 0, no gravity), given through closures.
+pub(crate) fn bias_rows(
+    data: &Data,
+    c: &Constraints,
+    ov: impl Fn(usize) -> Motion<f64>,
+    oa0: impl Fn(usize) -> Motion<f64>,
+    gamma: &mut DVector<f64>,
+) {
+    let mut row = 0;
+    for con in &c.items {
+        match con.kind {
+            ConstraintKind::Joint { .. } => gamma[row] = 0.0,
+            ref kind => {
+                let frame = *kind == ConstraintKind::Frame;
+                let side = |s: &Attachment| {
+                    if s.body == 0 {
+                        return (Vector3::zeros(), Vector3::zeros());
+                    }
+                    classical(&ov(s.body), &oa0(s.body), &side_point(data, s))
+                };
+                let (l1, a1) = side(&con.a);
+                let (l2, a2) = side(&con.b);
+                for r in 0..3 {
+                    gamma[row + r] = l1[r] - l2[r];
+                    if frame {
+                        gamma[row + 3 + r] = a1[r] - a2[r];
+                    }
+                }
+            }
+        }
+        row += con.rows();
+    }
+}
+
+/// `x ← H⁻¹ x` with the factor in `data.chol` (LTDL, or dense Cholesky with
+/// mimic joints).
+fn h_solve(model: &Model, data: &Data, x: &mut DVector<f64>) {
+    if model.has_mimic {
+        linalg::cholesky_solve(&data.chol, x);
+    } else {
+        ltdl::ltdl_solve(&data.chol, &model.dof_parent, x);
+    }
+}
+
+/// Sizes and the workspace's rows.
+pub(crate) fn check_workspace(
+    model: &Model,
+    cd: &ConstraintData,
+    c: &Constraints,
+) -> Result<(), DimensionError> {
+    DimensionError::check("constraint rows", cd.rows, c.rows())?;
+    DimensionError::check("constraint workspace columns", model.nv, cd.jc.ncols())
+}
+
+/// The constrained forward dynamics (mechanisms.md §"Semantics"): `cd.qdd` = q̈,
+/// `cd.lambda` = λ (least norm with redundant rows), `cd.generalized_force` =
+/// J_cᵀ λ, `cd.jc`, `cd.gamma`; `fext` as [`super::forward_dynamics`] takes it
+/// (per body, world, at the origin). Inconsistent rows are
+/// [`ConstraintDynamicsError::Inconsistent`]. No allocation.
+#[allow(clippy::too_many_arguments)]
+pub fn constraint_dynamics<'c>(
+    model: &Model,
+    data: &mut Data,
+    cd: &'c mut ConstraintData,
+    constraints: &Constraints,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+    tau: &DVector<f64>,
+    fext: Option<&[Force<f64>]>,
+) -> Result<&'c DVector<f64>, ConstraintDynamicsError> {
+    check_sizes(model, q, &[("v", v), ("tau", tau)], fext)?;
+    check_massless(model)?;
+    check_workspace(model, cd, constraints)?;
+    // q̈₀, C (with body velocities and velocity-product accelerations), H's factor
+    forward_dynamics_crba(model, data, q, v, tau, fext)?;
+    world_poses(model, data);
+    jacobian_rows(model, data, constraints, &mut cd.jc);
+    let g = model.gravity;
+    let d: &Data = data;
+    bias_rows(
+        d,
+        constraints,
+        |b| d.o_m_i[b].act_motion(&d.v[b]),
+        |b| {
+            // the pass's accelerations carry the world's −g: removed
+            let mut a = d.o_m_i[b].act_motion(&d.a[b]);
+            a.lin += g;
+            a
+        },
+        &mut cd.gamma,
+    );
+    cd.qdd.copy_from(&data.qdd);
+    if model.has_mimic {
+        // Y = H⁻¹ J_cᵀ, one column a row (dense Cholesky)
+        for r in 0..cd.rows {
+            for c in 0..model.nv {
+                cd.tmp[c] = cd.jc[(r, c)];
+            }
+            h_solve(model, data, &mut cd.tmp);
+            cd.y.set_column(r, &cd.tmp);
+        }
+        return solve_rows(cd, constraints).map(|_| &cd.qdd);
+    }
+    // H = Lᵀ D L (tree-sparse): W = L⁻ᵀ J_cᵀ keeps each row's support on its
+    // path to the root; K = Wᵀ D⁻¹ W; q̈ = q̈₀ + L⁻¹ D⁻¹ W λ
+    // (docs/theory.md §"Constrained dynamics", "Solving")
+    let (n, m) = (model.nv, cd.rows);
+    let lam = &model.dof_parent;
+    let u = data.chol.as_slice();
+    let w = cd.y.as_mut_slice();
+    for r in 0..m {
+        let wr = &mut w[r * n..(r + 1) * n];
+        for (c, x) in wr.iter_mut().enumerate() {
+            *x = cd.jc[(r, c)];
+        }
+        for i in (0..n).rev() {
+            let xi = wr[i];
+            if xi == 0.0 {
+                continue;
+            }
+            let mut j = lam[i];
+            while j != usize::MAX {
+                wr[j] -= u[j + i * n] * xi;
+                j = lam[j];
+            }
+        }
+    }
+    for k in 0..n {
+        cd.tmp[k] = 1.0 / u[k + k * n];
+    }
+    let dinv = cd.tmp.as_slice();
+    for r in 0..m {
+        let wr = &w[r * n..(r + 1) * n];
+        for s2 in 0..=r {
+            let ws = &w[s2 * n..(s2 + 1) * n];
+            let mut acc = 0.0;
+            for k in 0..n {
+                acc += wr[k] * ws[k] * dinv[k];
+            }
+            cd.k[(r, s2)] = acc;
+            cd.k[(s2, r)] = acc;
+        }
+    }
+    solve_lambda(cd, constraints)?;
+    // t = D⁻¹ W λ, then L⁻¹ t (root outwards)
+    let w = cd.y.as_slice();
+    let t = cd.tmp.as_mut_slice();
+    for k in 0..n {
+        let mut acc = 0.0;
+        for r in 0..m {
+            acc += w[r * n + k] * cd.lambda[r];
+        }
+        t[k] = acc / u[k + k * n];
+    }
+    for i in 0..n {
+        let mut s1 = t[i];
+        let mut j = lam[i];
+        while j != usize::MAX {
+            s1 -= u[j + i * n] * t[j];
+            j = lam[j];
+        }
+        t[i] = s1;
+    }
+    cd.qdd += &cd.tmp;
+    cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
+    Ok(&cd.qdd)
+}
+
+/// With `cd.qdd` = q̈₀, `cd.jc`, `cd.gamma`, `cd.y` set: K, its factor, λ, the
+/// consistency test, q̈ = q̈₀ + Y λ and J_cᵀ λ.
+pub(crate) fn solve_rows(
+    cd: &mut ConstraintData,
+    constraints: &Constraints,
+) -> Result<(), ConstraintDynamicsError> {
+    mul_add(&mut cd.k, 1.0, &cd.jc, &cd.y, 0.0);
+    solve_lambda(cd, constraints)?;
+    cd.qdd.gemv(1.0, &cd.y, &cd.lambda, 1.0);
+    cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
+    Ok(())
+}
+
+/// With `cd.k` = K, `cd.qdd` = q̈₀, `cd.jc`, `cd.gamma` set: K's factor, λ = K⁺ r
+/// with r = −γ_c − J_c q̈₀, and the consistency test (r in K's range).
+fn solve_lambda(
+    cd: &mut ConstraintData,
+    constraints: &Constraints,
+) -> Result<(), ConstraintDynamicsError> {
+    let m = cd.rows;
+    cd.kkt.factor(&cd.k);
+    // r = −γ − J_c q̈₀
+    cd.r.gemv(-1.0, &cd.jc, &cd.qdd, 0.0);
+    let scale = cd.r.amax() + cd.gamma.amax();
+    cd.r -= &cd.gamma;
+    cd.lambda.copy_from(&cd.r);
+    cd.kkt.solve(cd.lambda.as_mut_slice());
+    cd.kkt.out_of_range(cd.r.as_slice(), cd.r2.as_mut_slice());
+    let tol = 1e-7 * scale.max(f64::MIN_POSITIVE);
+    if m > 0 && cd.r2.amax() > tol {
+        let mut names = Vec::new();
+        let mut row = 0;
+        for con in &constraints.items {
+            if (row..row + con.rows()).any(|i| cd.r2[i].abs() > tol) {
+                names.push(con.name.clone());
+            }
+            row += con.rows();
+        }
+        return Err(ConstraintDynamicsError::Inconsistent(names));
+    }
+    Ok(())
+}
+
+/// J_c (rows × nv, columns as v) at q into `out` (mechanisms.md §"Semantics").
+pub fn constraint_jacobian(
+    model: &Model,
+    data: &mut Data,
+    constraints: &Constraints,
+    q: &DVector<f64>,
+    out: &mut DMatrix<f64>,
+) -> Result<(), DynamicsError> {
+    check_sizes(model, q, &[], None)?;
+    DimensionError::check("constraint jacobian rows", constraints.rows(), out.nrows())?;
+    DimensionError::check("constraint jacobian columns", model.nv, out.ncols())?;
+    super::forward_kinematics_pass(model, data, q);
+    jacobian_rows(model, data, constraints, out);
+    Ok(())
+}
+
+/// Each constraint's violation at q (mechanisms.md: m for `point`, the larger of
+/// distance and angle for `frame`, the signed residual for `joint`) into `out`.
+pub fn constraint_violation(
+    model: &Model,
+    data: &mut Data,
+    constraints: &Constraints,
+    q: &DVector<f64>,
+    out: &mut [f64],
+) -> Result<(), DynamicsError> {
+    check_sizes(model, q, &[], None)?;
+    DimensionError::check("violation entries", constraints.items.len(), out.len())?;
+    super::forward_kinematics_pass(model, data, q);
+    constraints.violation(data, q.as_slice(), out);
+    Ok(())
+}

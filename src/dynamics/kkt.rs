@@ -1,0 +1,224 @@
+//! The least-norm solve of the constraint rows' operator `K = J_c H⁻¹ J_cᵀ`
+//! (symmetric positive semi-definite, m × m), docs/theory.md §"Constrained
+//! dynamics", "Redundant rows": a Cholesky factor when K is well inside full
+//! rank, else K's eigendecomposition by cyclic Jacobi rotations and the
+//! pseudo-inverse `K⁺ = V Λ⁺ Vᵀ`, which gives the least-norm λ of a consistent
+//! system. No allocation: every buffer is sized once.
+
+use nalgebra::{DMatrix, DVector};
+
+/// An eigenvalue (or Cholesky pivot) at most this fraction of the largest
+/// (of its diagonal entry) marks a dependent row.
+const RANK_TOL: f64 = 1e-10;
+
+/// The factor of K and the buffers of its solves.
+#[derive(Clone, Debug)]
+pub(crate) struct KktFactor {
+    /// m × m: the Cholesky factor (lower) or the eigenvectors (columns).
+    f: DMatrix<f64>,
+    /// m × m: K, rotated to its eigenvalues (eigen route only).
+    w: DMatrix<f64>,
+    /// The eigenvalues, with 0 where dropped (eigen route only).
+    ev: DVector<f64>,
+    /// Scratch of size m.
+    t: DVector<f64>,
+    /// Whether `f` is a Cholesky factor (K of full rank).
+    pub full_rank: bool,
+}
+
+impl KktFactor {
+    /// Buffers for m rows.
+    pub fn new(m: usize) -> Self {
+        Self {
+            f: DMatrix::zeros(m, m),
+            w: DMatrix::zeros(m, m),
+            ev: DVector::zeros(m),
+            t: DVector::zeros(m),
+            full_rank: true,
+        }
+    }
+
+    /// Factorises K (its lower triangle is read).
+    pub fn factor(&mut self, k: &DMatrix<f64>) {
+        let m = k.nrows();
+        self.full_rank = cholesky(k, &mut self.f);
+        if self.full_rank {
+            return;
+        }
+        self.w.copy_from(k);
+        for i in 0..m {
+            for j in i + 1..m {
+                self.w[(i, j)] = self.w[(j, i)];
+            }
+        }
+        jacobi_eigen(&mut self.w, &mut self.f, &mut self.ev);
+        // f now holds V (columns), ev the eigenvalues
+        let top = self.ev.iter().fold(0.0f64, |a, &x| a.max(x));
+        for x in self.ev.iter_mut() {
+            if !(*x > RANK_TOL * top) {
+                *x = 0.0;
+            }
+        }
+    }
+
+    /// `x ← K⁺ x` (K⁻¹ x at full rank).
+    pub fn solve(&mut self, x: &mut [f64]) {
+        let m = self.t.len();
+        if self.full_rank {
+            // L (column-major): L[i, k] at i + k m
+            let l = self.f.as_slice();
+            let x = &mut x[..m];
+            for k in 0..m {
+                let xk = x[k] / l[k + k * m];
+                x[k] = xk;
+                for (xi, &lik) in x[k + 1..].iter_mut().zip(&l[k * m + k + 1..(k + 1) * m]) {
+                    *xi -= lik * xk;
+                }
+            }
+            for i in (0..m).rev() {
+                let col = &l[i * m + i + 1..(i + 1) * m];
+                let s: f64 = col.iter().zip(&x[i + 1..]).map(|(a, b)| a * b).sum();
+                x[i] = (x[i] - s) / l[i + i * m];
+            }
+            return;
+        }
+        // V Λ⁺ Vᵀ x
+        for j in 0..m {
+            let e = self.ev[j];
+            self.t[j] = if e > 0.0 {
+                (0..m).map(|i| self.f[(i, j)] * x[i]).sum::<f64>() / e
+            } else {
+                0.0
+            };
+        }
+        for (i, xi) in x.iter_mut().enumerate().take(m) {
+            *xi = (0..m).map(|j| self.f[(i, j)] * self.t[j]).sum();
+        }
+    }
+
+    /// The part of `r` outside K's range (the eigen route's dropped directions),
+    /// as a vector in `out` (zero at full rank): J_c q̈ = −γ_c is consistent iff
+    /// this is zero.
+    pub fn out_of_range(&mut self, r: &[f64], out: &mut [f64]) {
+        let m = self.t.len();
+        out[..m].fill(0.0);
+        if self.full_rank {
+            return;
+        }
+        for j in 0..m {
+            if self.ev[j] > 0.0 {
+                continue;
+            }
+            let c: f64 = (0..m).map(|i| self.f[(i, j)] * r[i]).sum();
+            for (i, o) in out.iter_mut().enumerate().take(m) {
+                *o += c * self.f[(i, j)];
+            }
+        }
+    }
+}
+
+/// `k = L Lᵀ` into `l` (lower triangle); false when a pivot is at most
+/// [`RANK_TOL`] of its diagonal entry (or not finite).
+fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>) -> bool {
+    let m = k.nrows();
+    for j in 0..m {
+        let mut d = k[(j, j)];
+        for p in 0..j {
+            d -= l[(j, p)] * l[(j, p)];
+        }
+        if !(d > RANK_TOL * k[(j, j)].abs()) || !d.is_finite() {
+            return false;
+        }
+        let d = d.sqrt();
+        l[(j, j)] = d;
+        for i in j + 1..m {
+            let mut s = k[(i, j)];
+            for p in 0..j {
+                s -= l[(i, p)] * l[(j, p)];
+            }
+            l[(i, j)] = s / d;
+        }
+    }
+    true
+}
+
+/// The eigendecomposition of the symmetric `v` by cyclic Jacobi rotations: `v`
+/// is rotated towards its diagonal (the eigenvalues, written to `ev`) and `q`
+/// receives the eigenvectors as columns.
+fn jacobi_eigen(v: &mut DMatrix<f64>, q: &mut DMatrix<f64>, ev: &mut DVector<f64>) {
+    let m = v.nrows();
+    q.fill(0.0);
+    for i in 0..m {
+        q[(i, i)] = 1.0;
+    }
+    for _sweep in 0..64 {
+        let mut off = 0.0;
+        let mut diag = 0.0;
+        for i in 0..m {
+            diag += v[(i, i)] * v[(i, i)];
+            for j in i + 1..m {
+                off += v[(i, j)] * v[(i, j)];
+            }
+        }
+        if off <= 1e-34 * diag || off == 0.0 {
+            break;
+        }
+        for p in 0..m {
+            for r in p + 1..m {
+                let apr = v[(p, r)];
+                if apr == 0.0 {
+                    continue;
+                }
+                // the rotation that zeroes v[p, r]: t = tan φ, the smaller root
+                let theta = (v[(r, r)] - v[(p, p)]) / (2.0 * apr);
+                let t = if theta >= 0.0 { 1.0 } else { -1.0 } / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                for k in 0..m {
+                    let (x, y) = (v[(k, p)], v[(k, r)]);
+                    v[(k, p)] = c * x - s * y;
+                    v[(k, r)] = s * x + c * y;
+                }
+                for k in 0..m {
+                    let (x, y) = (v[(p, k)], v[(r, k)]);
+                    v[(p, k)] = c * x - s * y;
+                    v[(r, k)] = s * x + c * y;
+                }
+                for k in 0..m {
+                    let (x, y) = (q[(k, p)], q[(k, r)]);
+                    q[(k, p)] = c * x - s * y;
+                    q[(k, r)] = s * x + c * y;
+                }
+            }
+        }
+    }
+    for i in 0..m {
+        ev[i] = v[(i, i)];
+    }
+}
+
+/// `c ← β c + α a b` for column-major matrices, allocation-free (nalgebra's
+/// `gemm` packs through the heap for larger sizes); a zero entry of `b` skips
+/// its column of `a` (J_c's rows and columns are mostly zero).
+pub(crate) fn mul_add(c: &mut DMatrix<f64>, alpha: f64, a: &DMatrix<f64>, b: &DMatrix<f64>, beta: f64) {
+    let (m, n, kk) = (a.nrows(), b.ncols(), a.ncols());
+    debug_assert!(c.nrows() == m && c.ncols() == n && b.nrows() == kk);
+    let (a, b, c) = (a.as_slice(), b.as_slice(), c.as_mut_slice());
+    for j in 0..n {
+        let cj = &mut c[j * m..(j + 1) * m];
+        if beta == 0.0 {
+            cj.fill(0.0);
+        } else if beta != 1.0 {
+            cj.iter_mut().for_each(|x| *x *= beta);
+        }
+        for k in 0..kk {
+            let s = alpha * b[k + j * kk];
+            if s == 0.0 {
+                continue;
+            }
+            for (x, &y) in cj.iter_mut().zip(&a[k * m..(k + 1) * m]) {
+                *x += s * y;
+            }
+        }
+    }
+}
