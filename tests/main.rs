@@ -46,6 +46,7 @@ mod simulate_trust;
 mod step_jacobians;
 mod view;
 mod four_bar;
+mod luxo;
 mod quadruped_held;
 
 /// Every `tests/*.rs` file is a module of this binary (with `autotests = false` a file
