@@ -30,7 +30,10 @@ fn main() -> Result<(), Box<dyn Error>> {
     let wall = start.elapsed().as_secs_f64();
     let csv = out_dir.join("four_bar.csv");
     let mut f = std::io::BufWriter::new(std::fs::File::create(&csv)?);
-    writeln!(f, "t,q:crank_joint,q:coupler_joint,q:rocker_joint,energy,violation")?;
+    writeln!(
+        f,
+        "t,q:crank_joint,q:coupler_joint,q:rocker_joint,energy,violation"
+    )?;
     for s in &samples {
         writeln!(
             f,
@@ -40,7 +43,10 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
     drop(f);
     let e0 = samples[0].energy;
-    let drift = samples.iter().map(|s| (s.energy - e0).abs()).fold(0.0, f64::max);
+    let drift = samples
+        .iter()
+        .map(|s| (s.energy - e0).abs())
+        .fold(0.0, f64::max);
     let viol = samples.iter().map(|s| s.violation).fold(0.0, f64::max);
     let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
     let crank: Vec<f64> = samples.iter().map(|s| s.q[0]).collect();
@@ -79,7 +85,10 @@ fn main() -> Result<(), Box<dyn Error>> {
             ),
         ],
     )?;
-    for s in samples.iter().filter(|s| (s.t * 2.0 - (s.t * 2.0).round()).abs() < 1e-9 && s.t > 0.0) {
+    for s in samples
+        .iter()
+        .filter(|s| (s.t * 2.0 - (s.t * 2.0).round()).abs() < 1e-9 && s.t > 0.0)
+    {
         println!("t = {:.1} s: crank {:.9} rad", s.t, s.q[0]);
     }
     println!(

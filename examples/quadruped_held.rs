@@ -41,8 +41,18 @@ fn main() -> Result<(), Box<dyn Error>> {
         writeln!(
             f,
             "{},{},{},{},{},{},{},{},{},{},{},{}",
-            x.t, x.z.0, x.z.1, x.y.0, x.y.1, x.error, x.normal[0], x.normal[1], x.normal[2],
-            x.normal[3], x.tau_max, x.violation
+            x.t,
+            x.z.0,
+            x.z.1,
+            x.y.0,
+            x.y.1,
+            x.error,
+            x.normal[0],
+            x.normal[1],
+            x.normal[2],
+            x.normal[3],
+            x.tau_max,
+            x.violation
         )?;
     }
     drop(f);
@@ -50,23 +60,61 @@ fn main() -> Result<(), Box<dyn Error>> {
     let z: Vec<f64> = s.iter().map(|x| x.z.0 * 1e3).collect();
     let y: Vec<f64> = s.iter().map(|x| x.y.0 * 1e3).collect();
     let err: Vec<f64> = s.iter().map(|x| x.error.max(1e-16).log10()).collect();
-    let fmin: Vec<f64> = s.iter().map(|x| x.normal.iter().cloned().fold(f64::INFINITY, f64::min)).collect();
+    let fmin: Vec<f64> = s
+        .iter()
+        .map(|x| x.normal.iter().cloned().fold(f64::INFINITY, f64::min))
+        .collect();
     let fsum: Vec<f64> = s.iter().map(|x| x.normal.iter().sum()).collect();
-    let panel = |title, ylabel, ys, color| png_out::Panel { title, ylabel, ys, color, count: false };
+    let panel = |title, ylabel, ys, color| png_out::Panel {
+        title,
+        ylabel,
+        ys,
+        color,
+        count: false,
+    };
     let png = out_dir.join("quadruped_held.png");
     png_out::plot_panels(
         &png,
         &t,
         t_end,
         &[
-            panel("base height z (tracks 1.5 cm at 1 Hz)", "mm", &z, RGBColor(200, 40, 30)),
-            panel("base sway y (tracks 2 cm at 0.5 Hz)", "mm", &y, RGBColor(30, 90, 200)),
-            panel("tracking error log10 |p - p_ref| (m)", "log10 m", &err, RGBColor(120, 60, 160)),
-            panel("smallest foot normal force (N)", "N", &fmin, RGBColor(30, 150, 60)),
-            panel("sum of the feet's normal forces (N)", "N", &fsum, RGBColor(90, 90, 90)),
+            panel(
+                "base height z (tracks 1.5 cm at 1 Hz)",
+                "mm",
+                &z,
+                RGBColor(200, 40, 30),
+            ),
+            panel(
+                "base sway y (tracks 2 cm at 0.5 Hz)",
+                "mm",
+                &y,
+                RGBColor(30, 90, 200),
+            ),
+            panel(
+                "tracking error log10 |p - p_ref| (m)",
+                "log10 m",
+                &err,
+                RGBColor(120, 60, 160),
+            ),
+            panel(
+                "smallest foot normal force (N)",
+                "N",
+                &fmin,
+                RGBColor(30, 150, 60),
+            ),
+            panel(
+                "sum of the feet's normal forces (N)",
+                "N",
+                &fsum,
+                RGBColor(90, 90, 90),
+            ),
         ],
     )?;
-    let late = s.iter().filter(|x| x.t >= 1.0).map(|x| x.error).fold(0.0, f64::max);
+    let late = s
+        .iter()
+        .filter(|x| x.t >= 1.0)
+        .map(|x| x.error)
+        .fold(0.0, f64::max);
     let first = s.iter().map(|x| x.error).fold(0.0, f64::max);
     let fmin_all = fmin.iter().cloned().fold(f64::INFINITY, f64::min);
     let tau_max = s.iter().map(|x| x.tau_max).fold(0.0, f64::max);

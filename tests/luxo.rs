@@ -22,12 +22,17 @@ fn root() -> PathBuf {
 }
 
 fn load(floating_base: bool) -> (Model, Constraints, DVector<f64>) {
-    let model = urdyn::load_file(root().join("assets/luxo.urdf"), LoadOptions { floating_base }).unwrap();
+    let model = urdyn::load_file(
+        root().join("assets/luxo.urdf"),
+        LoadOptions { floating_base },
+    )
+    .unwrap();
     let text = std::fs::read_to_string(root().join("assets/luxo_constraints.json")).unwrap();
     let c = Constraints::from_value(&model, &serde_json::from_str(&text).unwrap()).unwrap();
-    let start: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(root().join("assets/luxo_start.json")).unwrap())
-            .unwrap();
+    let start: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(root().join("assets/luxo_start.json")).unwrap(),
+    )
+    .unwrap();
     let mut q = model.neutral();
     let mut set = 0;
     for (name, x) in model.q_names().iter().zip(q.iter_mut()) {
@@ -42,7 +47,9 @@ fn load(floating_base: bool) -> (Model, Constraints, DVector<f64>) {
 
 /// A small deterministic generator in [−1, 1].
 fn lcg(state: &mut u64) -> f64 {
-    *state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    *state = state
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
     ((*state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
 }
 
@@ -53,7 +60,10 @@ fn check(floating_base: bool) {
     let mut data = Data::new(&model);
     let mut viol = [0.0; 2];
     dynamics::constraint_violation(&model, &mut data, &c, &q, &mut viol).unwrap();
-    assert!(viol.iter().all(|v| *v < 1e-9), "start violates the loops: {viol:?}");
+    assert!(
+        viol.iter().all(|v| *v < 1e-9),
+        "start violates the loops: {viol:?}"
+    );
     let mut cd = ConstraintData::new(&model, &c);
     let mut seed = 7u64;
     let mut worst = [0.0f64; 3];
@@ -71,7 +81,9 @@ fn check(floating_base: bool) {
             .unwrap()
             .clone();
         let (jc, gamma, lam) = (cd.jc.clone(), cd.gamma.clone(), cd.lambda.clone());
-        let f = dynamics::rnea(&model, &mut data, &q, &v, &qdd, None).unwrap().clone();
+        let f = dynamics::rnea(&model, &mut data, &q, &v, &qdd, None)
+            .unwrap()
+            .clone();
         let r1 = (&f - &tau - jc.transpose() * &lam).amax() / f.amax().max(1.0);
         let r2 = (&jc * &qdd + &gamma).amax() / gamma.amax().max(1.0);
         assert!(r1 < 1e-9, "H qdd + C - tau - Jc^T lambda = {r1:e}");
@@ -102,7 +114,10 @@ fn luxo_loops_close_and_constrained_dynamics_holds_fixed() {
     let v = DVector::from_element(model.nv, 1.0);
     let tau = DVector::zeros(model.nv);
     let e = dynamics::constraint_dynamics(&model, &mut data, &mut cd, &c, &q, &v, &tau, None);
-    assert!(e.is_err(), "a swivelling, opening parallelogram must be inconsistent");
+    assert!(
+        e.is_err(),
+        "a swivelling, opening parallelogram must be inconsistent"
+    );
 }
 
 #[test]

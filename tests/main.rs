@@ -45,9 +45,7 @@ mod simulate_cli;
 mod simulate_trust;
 mod step_jacobians;
 mod view;
-mod four_bar;
-mod luxo;
-mod quadruped_held;
+mod mechanism_examples;
 
 /// Every `tests/*.rs` file is a module of this binary (with `autotests = false` a file
 /// without its `mod` line would silently never be compiled or run).

@@ -23,6 +23,10 @@ use urdyn::dynamics::{self, ConstraintData};
 use urdyn::model::{ConstraintKind, Constraints};
 use urdyn::{Data, Model};
 
+/// The joint torques of a state: `tau(system, q, v, t)`.
+pub type TorqueFn<'a> =
+    dyn FnMut(&mut Constrained, &DVector<f64>, &DVector<f64>, f64) -> DVector<f64> + 'a;
+
 /// The model, its workspaces and the constraint set.
 pub struct Constrained {
     /// The model.
@@ -122,7 +126,7 @@ impl Constrained {
         v: &mut DVector<f64>,
         t: f64,
         h: f64,
-        tau: &mut dyn FnMut(&mut Self, &DVector<f64>, &DVector<f64>, f64) -> DVector<f64>,
+        tau: &mut TorqueFn<'_>,
     ) {
         let mut f = |s: &mut Self, dq: &DVector<f64>, vs: &DVector<f64>, ts: f64| {
             let qs = dynamics_integrate(&s.model, q, dq);

@@ -44,7 +44,11 @@ pub fn reference(p0: &Vector3<f64>, t: f64) -> (Vector3<f64>, Vector3<f64>, Vect
     let (wy, wz) = (2.0 * PI * fy, 2.0 * PI * fz);
     let p = p0 + Vector3::new(0.0, ay * (wy * t).sin(), az * (wz * t).sin());
     let v = Vector3::new(0.0, ay * wy * (wy * t).cos(), az * wz * (wz * t).cos());
-    let a = Vector3::new(0.0, -ay * wy * wy * (wy * t).sin(), -az * wz * wz * (wz * t).sin());
+    let a = Vector3::new(
+        0.0,
+        -ay * wy * wy * (wy * t).sin(),
+        -az * wz * wz * (wz * t).sin(),
+    );
     (p, v, a)
 }
 
@@ -184,7 +188,9 @@ pub fn run(h: f64, t_end: f64, every: usize) -> Vec<Sample> {
     out.push(sample(&mut sys, &q, &v, 0.0));
     for k in 0..n {
         let t = k as f64 * h;
-        sys.rk4_step(&mut q, &mut v, t, h, &mut |s, qs, vs, ts| control(s, &p0, qs, vs, ts).0);
+        sys.rk4_step(&mut q, &mut v, t, h, &mut |s, qs, vs, ts| {
+            control(s, &p0, qs, vs, ts).0
+        });
         if (k + 1) % every == 0 {
             out.push(sample(&mut sys, &q, &v, (k + 1) as f64 * h));
         }
