@@ -7,7 +7,7 @@
 //! Run: `cargo run --release --example four_bar [OUT_DIR]`; writes
 //! `OUT_DIR/four_bar.csv` (t, q of the three joints, energy, violation) and
 //! `OUT_DIR/four_bar.png` (crank angle, violation, energy), OUT_DIR defaults to
-//! `target`. tests/four_bar.rs checks the same run against an independent
+//! `target`. tests/mechanism_examples/four_bar.rs checks the same run against an independent
 //! minimal-coordinate integration (tests/fixtures/four_bar_reference.json).
 
 #[path = "common/constrained.rs"]

@@ -9,7 +9,7 @@
 //! Run: `cargo run --release --example quadruped_held [OUT_DIR]`; writes
 //! `OUT_DIR/quadruped_held.csv` and `OUT_DIR/quadruped_held.png` (base height
 //! and sway against the reference, tracking error, the feet's normal forces),
-//! OUT_DIR defaults to `target`. tests/quadruped_held.rs checks the tracking and
+//! OUT_DIR defaults to `target`. tests/mechanism_examples/quadruped_held.rs checks the tracking and
 //! the weight carried at rest.
 
 #[path = "common/constrained.rs"]

@@ -5,13 +5,10 @@
 
 #[path = "../examples/common/constrained.rs"]
 mod constrained;
-#[path = "four_bar.rs"]
 mod four_bar;
 #[path = "../examples/common/four_bar_setup.rs"]
 mod four_bar_setup;
-#[path = "luxo.rs"]
 mod luxo;
-#[path = "quadruped_held.rs"]
 mod quadruped_held;
 #[path = "../examples/common/quadruped_setup.rs"]
 mod quadruped_setup;

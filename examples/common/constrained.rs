@@ -1,5 +1,5 @@
 //! A high-accuracy integrator of the constrained ODE for the mechanism examples
-//! (examples/four_bar.rs, examples/quadruped_held.rs, tests/four_bar.rs):
+//! (examples/four_bar.rs, examples/quadruped_held.rs, tests/mechanism_examples/four_bar.rs):
 //! classical RK4 on (q, v) with v̇ = q̈ of urdyn's `constraint_dynamics`
 //! (mechanisms.md §"Semantics": H q̈ + C = τ + J_cᵀλ, J_c q̈ + γ_c = 0), each
 //! stage's configuration q ⊕ h·Σ aᵢⱼ vⱼ (exact RK4 on vector joints; on a free

@@ -1,5 +1,5 @@
 //! The four-bar of assets/four_bar.urdf + assets/four_bar_constraints.json
-//! (examples/four_bar.rs, tests/four_bar.rs): the model, its loop, and the start
+//! (examples/four_bar.rs, tests/mechanism_examples/four_bar.rs): the model, its loop, and the start
 //! configuration on the loop's upper branch for a crank angle θ₀ (closed form:
 //! the coupler's tip B is where the circles of radius l₂ about the crank's tip A
 //! and l₃ about the rocker's pivot meet; in the xz plane a rotation by a about

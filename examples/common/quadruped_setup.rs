@@ -2,7 +2,7 @@
 //! feet held by `point` constraints (urdyn's `constraint_dynamics` as the contact
 //! model, as Crocoddyl's contact models use Pinocchio's), driven by a computed-
 //! torque controller through the constrained dynamics (examples/quadruped_held.rs,
-//! tests/quadruped_held.rs).
+//! tests/mechanism_examples/quadruped_held.rs).
 //!
 //! Controller, at every RK4 stage: the base's desired world acceleration
 //! p̈* = p̈_ref + K_d (ṗ_ref − ṗ) + K_p (p_ref − p), its rotation held level
