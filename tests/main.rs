@@ -48,6 +48,7 @@ mod simulate_trust;
 mod sleep;
 mod step_jacobians;
 mod view;
+mod mechanism_examples;
 
 /// Every `tests/*.rs` file is a module of this binary (with `autotests = false` a file
 /// without its `mod` line would silently never be compiled or run).
