@@ -63,6 +63,8 @@ pub mod constraints;
 mod contact_view;
 pub mod derivatives;
 pub mod factor;
+mod loops;
+pub use loops::LoopForce;
 pub(crate) mod integrators;
 pub mod newton;
 pub use contact_view::Violation;
@@ -808,12 +810,29 @@ impl Simulation {
 
     /// The constraint rows at the current state for a step `h`.
     fn assemble_rows(&mut self, h: f64) -> constraints::RowCounts {
-        self.cons.assemble(
+        let counts = self.cons.assemble(
             &self.model,
             &self.data.o_m_i,
             &self.q,
             &self.v,
             &self.points,
+            &self.row_params,
+            &self.mass.f,
+            h,
+        );
+        if self.cons.loops.is_none() {
+            return counts;
+        }
+        // loop rows: after every other row, from the world poses at q
+        if !self.fk_valid {
+            forward_kinematics(&self.model, &mut self.data, &self.q);
+            self.fk_valid = true;
+        }
+        self.cons.assemble_loops(
+            &self.model,
+            &self.data,
+            &self.q,
+            &self.v,
             &self.row_params,
             &self.mass.f,
             h,
