@@ -54,6 +54,11 @@ pub(crate) struct Loops {
     ov: Vec<Motion<f64>>,
     oa0: Vec<Motion<f64>>,
     dense: Vec<f64>,
+    /// The passive run's reference energy (None: not yet, or driven, or
+    /// closing a violated start).
+    e_ref: Option<f64>,
+    /// Scratch: each constraint's violation.
+    viol: Vec<f64>,
 }
 
 impl Loops {
@@ -77,6 +82,8 @@ impl Loops {
             ov: vec![Motion::zero(); model.nbodies],
             oa0: vec![Motion::zero(); model.nbodies],
             dense: vec![0.0; model.nv],
+            e_ref: None,
+            viol: vec![0.0; set.items.len()],
             set,
         }
     }
@@ -302,8 +309,12 @@ impl super::Simulation {
         self.sleep.joins = self.loop_body_pairs();
         let mut out = vec![0.0; self.loop_count()];
         let mut lines = Vec::new();
-        if let Some(l) = self.cons.loops.as_ref() {
-            l.violation(&self.data, &self.q, &mut out);
+        self.energy_now = None;
+        let e0 = self.energy();
+        if let Some(l) = self.cons.loops.as_mut() {
+            if l.violation(&self.data, &self.q, &mut out) <= 1e-6 {
+                l.e_ref = Some(e0);
+            }
             for (c, x) in l.set.items.iter().zip(&out) {
                 if x.abs() > 1e-3 {
                     lines.push(format!(
@@ -370,6 +381,46 @@ impl super::Simulation {
             .loops
             .as_ref()
             .map_or(0.0, |l| l.violation(&self.data, &self.q, &mut out))
+    }
+
+    /// A passive run with loops keeps its energy at or below the reference
+    /// (docs/theory.md §"Loops in the simulation"): the time-stepping scheme's
+    /// O(h) energy oscillation, which a closed chain's coupled rows do not damp,
+    /// is clipped by scaling v (J v = 0 kept: the rows are linear in v) so that
+    /// T + V never exceeds the energy of the first closed state. The
+    /// reference is dropped while driven (servo, torques) or while a violated
+    /// start closes (violation above 1e-6), and taken afresh after.
+    pub(super) fn clip_loop_energy(&mut self) {
+        let passive = !self.servo.active && self.tau_applied.iter().all(|&x| x == 0.0);
+        if !self.fk_valid {
+            crate::dynamics::forward_kinematics_pass(&self.model, &mut self.data, &self.q);
+            self.fk_valid = true;
+        }
+        let armature = self.armature_energy();
+        let Some(l) = self.cons.loops.as_mut() else {
+            return;
+        };
+        let mut viol = std::mem::take(&mut l.viol);
+        let worst = l.violation(&self.data, &self.q, &mut viol);
+        l.viol = viol;
+        if !passive || worst > 1e-6 {
+            l.e_ref = None;
+            return;
+        }
+        let ke =
+            crate::dynamics::kinetic_energy_from_placements(&self.model, &mut self.data, &self.v)
+                .unwrap_or(f64::NAN)
+                + armature;
+        let pe = crate::dynamics::potential_energy(&self.model, &self.data);
+        let Some(e_ref) = l.e_ref else {
+            l.e_ref = Some(ke + pe);
+            return;
+        };
+        if ke + pe > e_ref && ke > 0.0 {
+            let s = ((e_ref - pe).max(0.0) / ke).sqrt();
+            self.v *= s;
+            self.energy_now = None;
+        }
     }
 
     /// The trees (models of a scene) each active loop constraint joins, for

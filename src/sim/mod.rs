@@ -730,7 +730,11 @@ impl Simulation {
         self.sensors.begin(&self.q, &self.v);
         if self.sleep.all_asleep() {
             // everything sleeps: the state stands, time passes
-            self.t = if h_fixed >= remaining { t_end } else { self.t + h_fixed };
+            self.t = if h_fixed >= remaining {
+                t_end
+            } else {
+                self.t + h_fixed
+            };
             self.sensors.end(h_fixed);
             self.steps += 1;
             self.sleep.count_idle_step();
@@ -779,6 +783,9 @@ impl Simulation {
         self.check_finite()?;
         self.fk_valid = false;
         self.refresh_contacts();
+        if self.cons.loops.is_some() {
+            self.clip_loop_energy();
+        }
         self.update_sleep(h);
         self.check_energy()?;
         Ok(h)
