@@ -29,6 +29,7 @@ mod fast_dynamics;
 mod joint_kinds;
 mod kinematics_energy;
 mod layering;
+mod loops_sim;
 mod mjcf_cli;
 mod mjcf_oracle;
 mod output_files;

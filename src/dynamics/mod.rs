@@ -9,7 +9,7 @@ mod aba;
 mod aba_derivatives;
 mod centroidal;
 mod com;
-mod constraint_dynamics;
+pub(crate) mod constraint_dynamics;
 mod constraint_dynamics_derivatives;
 mod crba;
 mod energy;

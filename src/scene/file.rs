@@ -36,6 +36,10 @@ pub struct SceneSpec {
     /// Threads the islands are solved on (0: every core; default 1).
     #[serde(default)]
     pub threads: Option<usize>,
+    /// Loop constraints (mechanisms.md §"Loop constraints"), links and joints
+    /// named `MODEL/NAME`.
+    #[serde(default)]
+    pub constraints: Vec<serde_json::Value>,
 }
 
 /// The ground plane `z = height`.

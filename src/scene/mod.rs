@@ -120,6 +120,9 @@ pub struct Scene {
     pub tau0: DVector<f64>,
     /// What loaded but deserves a line (SRDF names the URDF lacks, ...).
     pub warnings: Vec<String>,
+    /// The loop constraints (`"constraints"`), built against `model`; give
+    /// them to [`crate::sim::Simulation::set_constraints`] after its start state.
+    pub constraints: crate::model::Constraints,
 }
 
 fn read_text(path: &Path) -> Result<String, std::io::Error> {
@@ -605,7 +608,12 @@ impl Loader<'_> {
                 );
             }
         }
+        // loop constraints against the forest (`MODEL/NAME`); held world
+        // anchors are placed by the simulation at its start
+        let constraints = crate::model::Constraints::from_json(&model, &spec.constraints)
+            .map_err(|e| self.err(format!("constraints[{}].{}", e.index, e.key), e.message))?;
         Ok(Scene {
+            constraints,
             spec,
             file: self.file.to_string(),
             base_dir: self.base_dir.to_path_buf(),

@@ -17,6 +17,7 @@
 //! - position pass: b_pos = min(β(−φ − slop)/Δt, cap) where φ < −slop.
 
 use super::factor::MassFactor;
+use super::loops::Loops;
 use super::newton::Newton;
 use super::solver::{RowKind, Rows};
 use super::{ContactForce, Solver};
@@ -57,17 +58,19 @@ pub(crate) struct RowCounts {
     pub contacts: usize,
     /// Rows whose constraint is violated (position pass needed).
     pub violated: usize,
+    /// Loop-constraint rows (bilateral).
+    pub loops: usize,
 }
 
 impl RowCounts {
     /// All rows: friction + limits + 3 · contacts.
     pub fn total(&self) -> usize {
-        self.friction + self.limits + 3 * self.contacts
+        self.friction + self.limits + 3 * self.contacts + self.loops
     }
     /// Whether the step touches anything (a contact point or a joint limit):
     /// such a step is taken by the time-stepping scheme.
     pub fn touching(&self) -> bool {
-        self.limits + self.contacts > 0
+        self.limits + self.contacts + self.loops > 0
     }
 }
 
@@ -112,6 +115,8 @@ pub(crate) struct Constraints {
     /// Dense scratch of a contact's three Jacobian rows (3·nv, all zero
     /// between contacts: [`Rows::gather`] zeroes what it reads).
     jd: Vec<f64>,
+    /// The loop constraints (none: a run without loops, untouched).
+    pub loops: Option<Loops>,
 }
 
 impl Constraints {
@@ -126,8 +131,21 @@ impl Constraints {
         nslots: usize,
         newton: bool,
     ) -> Self {
+        Self::with_loops(model, f, max_points, pair_points, nslots, newton, None)
+    }
+
+    /// [`Constraints::new`] with room for the rows of `loops` too.
+    pub fn with_loops(
+        model: &Model,
+        f: &MassFactor,
+        max_points: usize,
+        pair_points: usize,
+        nslots: usize,
+        newton: bool,
+        loops: Option<Loops>,
+    ) -> Self {
         let ndof = model.dofs.len();
-        let cap = 3 * max_points + 3 * ndof;
+        let cap = 3 * max_points + 3 * ndof + loops.as_ref().map_or(0, |l| l.rows());
         let nv = model.nv;
         // a row's room: two bodies' paths to the root (a dense factor's are nv long)
         let longest = (0..nv).map(|d| f.path_of(d).1).max().unwrap_or(0);
@@ -151,12 +169,16 @@ impl Constraints {
             a: vec![0.0; nv],
             jd: vec![0.0; 3 * nv],
             newton: Newton::new(if newton { nv } else { 0 }, if newton { cap } else { 0 }),
+            loops,
         }
     }
 
     /// Forgets the warm starts (a new state was set).
     pub fn reset_warm_start(&mut self) {
         self.warm_contact.iter_mut().for_each(|w| *w = [0.0; 3]);
+        if let Some(l) = self.loops.as_mut() {
+            l.reset_warm_start();
+        }
         self.warm_joint.iter_mut().for_each(|w| *w = [0.0; 3]);
         self.warm_slots.clear();
     }
@@ -395,6 +417,30 @@ impl Constraints {
         counts
     }
 
+    /// Appends the loop constraints' rows (after every other row, so that a
+    /// run without loops is untouched) at (q, v); `data.o_m_i`: world poses at q.
+    #[allow(clippy::too_many_arguments)]
+    pub fn assemble_loops(
+        &mut self,
+        model: &Model,
+        data: &crate::model::Data,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        p: &RowParams,
+        f: &MassFactor,
+        h: f64,
+    ) -> RowCounts {
+        if let Some(l) = self.loops.as_mut() {
+            let cap = p.contact_push_cap.max(p.limit_push_cap);
+            let (n, violated) = l.assemble(&mut self.rows, model, data, q, v, f, h, cap);
+            self.counts.loops = n;
+            if violated {
+                self.counts.violated += 1;
+            }
+        }
+        self.counts
+    }
+
     /// Solves the assembled rows given the factor `l` of H̃ (column-major, lower
     /// triangle) and the free velocity `vfree`, for a step `h`: the velocity
     /// impulses λ (warm-started), then, where a row is violated, the position
@@ -441,6 +487,9 @@ impl Constraints {
         if pushing {
             rows.solve_position(f, self.push.as_mut_slice(), iterations, tol);
             f.half_solve(self.push.as_mut_slice());
+        }
+        if let Some(l) = self.loops.as_mut() {
+            l.read(rows);
         }
         // joint rows: warm starts and generalized force
         for w in self.warm_joint.iter_mut() {

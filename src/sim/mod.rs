@@ -63,6 +63,8 @@ pub mod constraints;
 mod contact_view;
 pub mod derivatives;
 pub mod factor;
+mod loops;
+pub use loops::LoopForce;
 pub(crate) mod integrators;
 pub mod newton;
 pub use contact_view::Violation;
@@ -728,7 +730,11 @@ impl Simulation {
         self.sensors.begin(&self.q, &self.v);
         if self.sleep.all_asleep() {
             // everything sleeps: the state stands, time passes
-            self.t = if h_fixed >= remaining { t_end } else { self.t + h_fixed };
+            self.t = if h_fixed >= remaining {
+                t_end
+            } else {
+                self.t + h_fixed
+            };
             self.sensors.end(h_fixed);
             self.steps += 1;
             self.sleep.count_idle_step();
@@ -777,6 +783,9 @@ impl Simulation {
         self.check_finite()?;
         self.fk_valid = false;
         self.refresh_contacts();
+        if self.cons.loops.is_some() {
+            self.clip_loop_energy();
+        }
         self.update_sleep(h);
         self.check_energy()?;
         Ok(h)
@@ -808,12 +817,29 @@ impl Simulation {
 
     /// The constraint rows at the current state for a step `h`.
     fn assemble_rows(&mut self, h: f64) -> constraints::RowCounts {
-        self.cons.assemble(
+        let counts = self.cons.assemble(
             &self.model,
             &self.data.o_m_i,
             &self.q,
             &self.v,
             &self.points,
+            &self.row_params,
+            &self.mass.f,
+            h,
+        );
+        if self.cons.loops.is_none() {
+            return counts;
+        }
+        // loop rows: after every other row, from the world poses at q
+        if !self.fk_valid {
+            forward_kinematics(&self.model, &mut self.data, &self.q);
+            self.fk_valid = true;
+        }
+        self.cons.assemble_loops(
+            &self.model,
+            &self.data,
+            &self.q,
+            &self.v,
             &self.row_params,
             &self.mass.f,
             h,

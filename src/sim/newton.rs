@@ -160,6 +160,13 @@ impl Newton {
                         self.boxes.push((r, 1.0 / (RHO * w), limit));
                     }
                 }
+                RowKind::Bilateral => {
+                    // a loop row: a box without bounds
+                    let w = rows.w[r];
+                    if w > 1e-14 {
+                        self.boxes.push((r, 1.0 / (RHO * w), f64::INFINITY));
+                    }
+                }
                 _ => {}
             }
             r += 1;

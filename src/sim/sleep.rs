@@ -53,6 +53,8 @@ pub(crate) struct Sleep {
     pub body_asleep: Vec<bool>,
     /// Union-find parents (per tree) of this step's islands.
     parent: Vec<usize>,
+    /// Pairs of bodies an active loop constraint joins (one island).
+    pub joins: Vec<(usize, usize)>,
     /// Per tree: the island it fell asleep in (its root tree).
     island: Vec<usize>,
     /// Per tree: its largest point speed this step (m/s).
@@ -105,9 +107,7 @@ impl Sleep {
                 }
             }
             has_dof[t] = !tree.v.is_empty();
-            never[t] = tree.free.is_none()
-                || tree.v.is_empty()
-                || never_names.contains(&tree.name);
+            never[t] = tree.free.is_none() || tree.v.is_empty() || never_names.contains(&tree.name);
         }
         let mut has_sphere = vec![false; model.nbodies];
         for s in &spheres {
@@ -129,6 +129,7 @@ impl Sleep {
             asleep: vec![false; nt],
             body_asleep: vec![false; model.nbodies],
             parent: (0..nt).collect(),
+            joins: Vec::new(),
             island: vec![0; nt],
             speed: vec![0.0; nt],
             q_frozen: DVector::zeros(model.nq),
@@ -284,9 +285,11 @@ impl Sleep {
             };
             self.parent[t] = t;
         }
-        // islands: trees joined by a contact point
-        for p in points.iter() {
-            let (ta, tb) = (self.tree(p.body), self.tree(p.other));
+        // islands: trees joined by a contact point or a loop constraint
+        let joins = std::mem::take(&mut self.joins);
+        let pairs = points.iter().map(|p| (p.body, p.other));
+        for (a, b) in pairs.chain(joins.iter().copied()) {
+            let (ta, tb) = (self.tree(a), self.tree(b));
             if ta == WORLD || tb == WORLD || ta == tb {
                 continue;
             }
@@ -296,6 +299,7 @@ impl Sleep {
                 self.parent[hi] = lo;
             }
         }
+        self.joins = joins;
         // an island sleeps when every tree in it may: the root collects the
         // verdict (true: may sleep)
         let mut may = std::mem::take(&mut self.may);
@@ -404,7 +408,11 @@ impl Sleep {
         self.all_forces.extend_from_slice(&self.frozen_forces);
         for (b, out) in self.all_body.iter_mut().enumerate() {
             let f = body.get(b).copied().unwrap_or(Force::zero());
-            *out = if self.body_asleep[b] { self.frozen_body[b] } else { f };
+            *out = if self.body_asleep[b] {
+                self.frozen_body[b]
+            } else {
+                f
+            };
         }
     }
     /// The contact forces to report: `awake` (the last solve's) joined with

@@ -44,6 +44,8 @@ pub enum RowKind {
     },
     /// Joint limit: λ ≥ 0.
     Unilateral,
+    /// Loop constraint (mechanisms.md §"Simulation"): bilateral, λ free.
+    Bilateral,
 }
 
 /// Preallocated rows: Jacobians and Y = J R⁻ᵀ (each row compact over its dof
@@ -311,7 +313,10 @@ impl Rows {
             return 0.0;
         };
         let jr = &self.j[r * self.stride..r * self.stride + pl.min(self.stride)];
-        jr.iter().zip(path).map(|(a, &k)| a * x.get(k).copied().unwrap_or(0.0)).sum()
+        jr.iter()
+            .zip(path)
+            .map(|(a, &k)| a * x.get(k).copied().unwrap_or(0.0))
+            .sum()
     }
     /// Row `r` of J as (dof, entry) pairs over its path.
     pub fn jrow(&self, r: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
@@ -616,6 +621,7 @@ impl Rows {
                     let x = old - relax * (u - b[r]) * winv[r];
                     match kind {
                         RowKind::Box { limit } => x.clamp(-limit, limit),
+                        RowKind::Bilateral => x,
                         _ => x.max(0.0),
                     }
                 } else {
@@ -758,6 +764,11 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
                     sm.rows.push(r);
                 }
             }
+            RowKind::Bilateral => {
+                if live(r) {
+                    sm.rows.push(r);
+                }
+            }
         }
         r += 1;
         if sm.rows.len() > SUBSPACE_MAX {
@@ -819,6 +830,7 @@ fn subspace_step(sm: &mut Subspace, rows: &Solved, lambda: &mut [f64], dv: &mut 
         let x = match kinds[r] {
             RowKind::Normal | RowKind::Unilateral => sm.lam[a].max(0.0),
             RowKind::Box { limit } => sm.lam[a].clamp(-limit, limit),
+            RowKind::Bilateral => sm.lam[a],
             _ => continue,
         };
         let d = x - lambda[r];
@@ -874,7 +886,11 @@ impl Rows {
     ) -> usize {
         let (nv, n) = (self.nv, self.n);
         let _ = f;
-        if dw.len() < nv || self.y.len() < n * self.stride || self.mu.len() < n || self.bpos.len() < n {
+        if dw.len() < nv
+            || self.y.len() < n * self.stride
+            || self.mu.len() < n
+            || self.bpos.len() < n
+        {
             return 0;
         }
         let table_v = std::mem::take(&mut self.table);
@@ -900,7 +916,8 @@ impl Rows {
             it += 1;
             let mut change: f64 = 0.0;
             for r in 0..n {
-                if !matches!(self.kind[r], RowKind::Normal | RowKind::Unilateral) {
+                let bilateral = self.kind[r] == RowKind::Bilateral;
+                if !bilateral && !matches!(self.kind[r], RowKind::Normal | RowKind::Unilateral) {
                     continue;
                 }
                 let wrr = self.w[r];
@@ -914,7 +931,8 @@ impl Rows {
                 };
                 let u: f64 = yr.iter().zip(p).map(|(a, &k)| a * dw[k]).sum();
                 let old = self.mu[r];
-                let new = (old - (u - self.bpos[r]) / wrr).max(0.0);
+                let x = old - (u - self.bpos[r]) / wrr;
+                let new = if bilateral { x } else { x.max(0.0) };
                 let d = new - old;
                 if d != 0.0 {
                     self.mu[r] = new;

@@ -1,0 +1,453 @@
+//! Loop constraints in a simulation (mechanisms.md §"Simulation"): each
+//! `point`, `frame` or `joint` constraint adds bilateral rows (λ unbounded) to
+//! the same impulse solve as contact and joint limits ([`super::solver`]), at
+//! the velocity level (target J v⁺ = 0), and the position pass removes their
+//! drift as it removes penetration (docs/theory.md §"Loops in the simulation").
+//!
+//! Position target of a loop row (w the position pass's pseudo-velocity,
+//! q⁺ = q ⊕ h(v⁺ + w)): the step's configuration change leaves the row's
+//! residual φ(q⁺) ≈ φ + h J(v⁺ + w) + ½h² γ with γ = J̇ v (the rows' velocity
+//! product, the same γ_c as the constrained dynamics'); with J v⁺ = 0 the
+//! target J w = −φ/h − ½hγ leaves a third-order residual. The −φ/h part is
+//! capped (a start far off the constraint closes at a capped rate: gently,
+//! without entering v).
+
+use super::factor::MassFactor;
+use super::solver::{RowKind, Rows};
+use crate::dynamics::constraint_dynamics::{bias_rows, jacobian_rows};
+use crate::model::{ConstraintKind, Constraints as LoopSet, Data, Model};
+use crate::spatial::Motion;
+use nalgebra::{DMatrix, DVector, Vector3};
+
+/// The force a loop constraint exerted in the last step (world frame): on
+/// `link1` at its point (the reaction on `link2`), or the generalized force on
+/// `joint1` of a `joint` constraint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopForce {
+    /// The constraint's name.
+    pub name: String,
+    /// Force (N), world axes (zero for a `joint` constraint).
+    pub force: Vector3<f64>,
+    /// Torque (N·m), world axes (`frame` only; zero for `point`).
+    pub torque: Vector3<f64>,
+    /// A `joint` constraint's generalized force on joint1 (N·m or N).
+    pub generalized: f64,
+}
+
+/// The loop constraints of a simulation and their per-step work.
+#[derive(Clone, Debug)]
+pub(crate) struct Loops {
+    /// The constraints (held world anchors placed at the start).
+    pub set: LoopSet,
+    /// Whether each constraint takes part.
+    pub active: Vec<bool>,
+    jc: DMatrix<f64>,
+    gamma: DVector<f64>,
+    /// Each constraint's first row in the step's rows (None: inactive).
+    row_of: Vec<Option<usize>>,
+    /// Each constraint's first row in `jc`.
+    first: Vec<usize>,
+    /// Warm start and last impulse of each of the set's rows.
+    lambda: Vec<f64>,
+    /// The last step's length (for forces λ/h).
+    h: f64,
+    ov: Vec<Motion<f64>>,
+    oa0: Vec<Motion<f64>>,
+    dense: Vec<f64>,
+    /// The passive run's reference energy (None: not yet, or driven, or
+    /// closing a violated start).
+    e_ref: Option<f64>,
+    /// Scratch: each constraint's violation.
+    viol: Vec<f64>,
+}
+
+impl Loops {
+    /// The loops of `set` on `model`.
+    pub fn new(model: &Model, set: LoopSet) -> Self {
+        let m = set.rows();
+        let mut first = Vec::with_capacity(set.items.len());
+        let mut r = 0;
+        for c in &set.items {
+            first.push(r);
+            r += c.rows();
+        }
+        Self {
+            active: vec![true; set.items.len()],
+            row_of: vec![None; set.items.len()],
+            first,
+            jc: DMatrix::zeros(m, model.nv),
+            gamma: DVector::zeros(m),
+            lambda: vec![0.0; m],
+            h: 0.0,
+            ov: vec![Motion::zero(); model.nbodies],
+            oa0: vec![Motion::zero(); model.nbodies],
+            dense: vec![0.0; model.nv],
+            e_ref: None,
+            viol: vec![0.0; set.items.len()],
+            set,
+        }
+    }
+
+    /// Rows the set can add to a step.
+    pub fn rows(&self) -> usize {
+        self.set.rows()
+    }
+
+    /// Forgets the warm starts.
+    pub fn reset_warm_start(&mut self) {
+        self.lambda.iter_mut().for_each(|x| *x = 0.0);
+    }
+
+    /// Each body's world spatial velocity and velocity-product acceleration
+    /// (q̈ = 0, no gravity) at (q, v), from `data.o_m_i`: v_i = v_λ + S_i q̇_i,
+    /// a_i = a_λ + v_i × S_i q̇_i (world-frame S_i moves with body i).
+    fn velocities(&mut self, model: &Model, data: &Data, v: &DVector<f64>) {
+        for i in 1..model.nbodies {
+            let j = &model.joints[i];
+            let mut sv = Motion::zero();
+            for k in 0..j.nv() {
+                let s = data.o_m_i[i].act_motion(&j.subspace_column(k));
+                let x = v[j.iv + k];
+                sv.lin += s.lin * x;
+                sv.ang += s.ang * x;
+            }
+            let p = model.parent[i];
+            let mut vi = self.ov[p];
+            vi.lin += sv.lin;
+            vi.ang += sv.ang;
+            let c = vi.cross(&sv);
+            let mut ai = self.oa0[p];
+            ai.lin += c.lin;
+            ai.ang += c.ang;
+            self.ov[i] = vi;
+            self.oa0[i] = ai;
+        }
+    }
+
+    /// The rows of the active constraints appended to `rows` at (q, v) for a
+    /// step `h` (`data.o_m_i`: world poses at q): J, target 0, position target
+    /// (module doc). `cap`: the largest rate (m/s, rad/s) at which a violation
+    /// is closed. Returns (rows added, whether any position target is set).
+    #[allow(clippy::too_many_arguments)]
+    pub fn assemble(
+        &mut self,
+        rows: &mut Rows,
+        model: &Model,
+        data: &Data,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        f: &MassFactor,
+        h: f64,
+        cap: f64,
+    ) -> (usize, bool) {
+        self.h = h;
+        jacobian_rows(model, data, &self.set, &mut self.jc);
+        self.velocities(model, data, v);
+        let (ov, oa0) = (&self.ov, &self.oa0);
+        bias_rows(data, &self.set, |b| ov[b], |b| oa0[b], &mut self.gamma);
+        let body_path = |b: usize| {
+            if b == 0 {
+                return (0, 0);
+            }
+            let jb = &model.joints[b];
+            f.path_of((jb.iv + jb.nv()).saturating_sub(1))
+        };
+        let (mut added, mut violated) = (0, false);
+        for (k, c) in self.set.items.iter().enumerate() {
+            self.row_of[k] = None;
+            if !self.active[k] {
+                continue;
+            }
+            let path = match &c.kind {
+                ConstraintKind::Joint { v1, second, .. } => {
+                    let a = f.path_of(*v1);
+                    match second {
+                        Some((_, v2)) => rows.union_path(a, f.path_of(*v2)),
+                        None => a,
+                    }
+                }
+                _ => rows.union_path(body_path(c.a.body), body_path(c.b.body)),
+            };
+            // the residual φ of each row
+            let mut phi = [0.0; 6];
+            match &c.kind {
+                ConstraintKind::Joint {
+                    q1,
+                    second,
+                    ratio,
+                    offset,
+                    ..
+                } => phi[0] = q[*q1] - second.map_or(0.0, |(q2, _)| ratio * q[q2]) - offset,
+                kind => {
+                    let m1 = data.o_m_i[c.a.body].compose(&c.a.local);
+                    let m2 = data.o_m_i[c.b.body].compose(&c.b.local);
+                    let d = m1.trans - m2.trans;
+                    phi[..3].copy_from_slice(d.as_slice());
+                    if *kind == ConstraintKind::Frame {
+                        // the rotation error R₁R₂ᵀ's axis · angle (world)
+                        let r = m1.rot * m2.rot.transpose();
+                        let e = nalgebra::Rotation3::from_matrix_unchecked(r).scaled_axis();
+                        phi[3..].copy_from_slice(e.as_slice());
+                    }
+                }
+            }
+            let first = self.first[k];
+            let start = rows.n;
+            let mut full = true;
+            for t in 0..c.rows() {
+                let row = first + t;
+                let Some(r) = rows.push(RowKind::Bilateral, 0.0, self.lambda[row], path) else {
+                    full = false;
+                    break;
+                };
+                for (d, x) in self.dense.iter_mut().enumerate() {
+                    *x = self.jc[(row, d)];
+                }
+                rows.gather(r, &mut self.dense);
+                let close = (-phi[t] / h).clamp(-cap, cap);
+                rows.bpos[r] = close - 0.5 * h * self.gamma[row];
+                violated |= rows.bpos[r] != 0.0;
+            }
+            if !full {
+                rows.pop(rows.n - start);
+                break;
+            }
+            self.row_of[k] = Some(start);
+            added += c.rows();
+        }
+        (added, violated)
+    }
+
+    /// Reads the step's impulses back (warm starts, forces).
+    pub fn read(&mut self, rows: &Rows) {
+        for (k, c) in self.set.items.iter().enumerate() {
+            let first = self.first[k];
+            for t in 0..c.rows() {
+                self.lambda[first + t] = match self.row_of[k] {
+                    Some(r) => rows.lambda[r + t],
+                    None => 0.0,
+                };
+            }
+        }
+    }
+
+    /// The force of each constraint in the last step (λ/h, world).
+    pub fn forces(&self) -> Vec<LoopForce> {
+        let h = if self.h > 0.0 { self.h } else { 1.0 };
+        self.set
+            .items
+            .iter()
+            .enumerate()
+            .map(|(k, c)| {
+                let l = &self.lambda[self.first[k]..self.first[k] + c.rows()];
+                let mut out = LoopForce {
+                    name: c.name.clone(),
+                    force: Vector3::zeros(),
+                    torque: Vector3::zeros(),
+                    generalized: 0.0,
+                };
+                match c.kind {
+                    ConstraintKind::Joint { .. } => out.generalized = l[0] / h,
+                    ConstraintKind::Point => out.force = Vector3::new(l[0], l[1], l[2]) / h,
+                    ConstraintKind::Frame => {
+                        out.force = Vector3::new(l[0], l[1], l[2]) / h;
+                        out.torque = Vector3::new(l[3], l[4], l[5]) / h;
+                    }
+                }
+                out
+            })
+            .collect()
+    }
+
+    /// The largest violation over the active constraints at the state whose
+    /// forward kinematics `data` holds (mechanisms.md's measure).
+    pub fn violation(&self, data: &Data, q: &DVector<f64>, out: &mut [f64]) -> f64 {
+        self.set.violation(data, q.as_slice(), out);
+        out.iter()
+            .zip(&self.active)
+            .filter(|(_, a)| **a)
+            .fold(0.0, |m, (x, _)| m.max(x.abs()))
+    }
+}
+
+impl super::Simulation {
+    /// Adds the loop constraints `set` (built against this simulation's model)
+    /// to the run: held world anchors are placed where their side is in the
+    /// current state (set the start first). Replaces any earlier set. Returns
+    /// one line for each constraint the current state violates by more than
+    /// 1 mm (mechanisms.md §"Simulation": the run closes it gently).
+    pub fn set_constraints(&mut self, mut set: LoopSet) -> Result<Vec<String>, super::SimError> {
+        for c in &set.items {
+            let bodies = [c.a.body, c.b.body];
+            if bodies.iter().any(|&b| b >= self.model.nbodies) {
+                return Err(super::SimError::Invalid(format!(
+                    "constraint \"{}\" names a body this model does not have",
+                    c.name
+                )));
+            }
+        }
+        crate::dynamics::forward_kinematics_pass(&self.model, &mut self.data, &self.q);
+        self.fk_valid = true;
+        set.place_holds(&self.data);
+        let loops = Loops::new(&self.model, set);
+        let max_points = self.contact.as_ref().map_or(0, |c| c.max_points());
+        let pair_points = self
+            .contact
+            .as_ref()
+            .and_then(|c| c.pairs.as_ref())
+            .map_or(0, |p| p.max_points());
+        let nslots = self.contact.as_ref().map_or(0, |c| c.nslots);
+        self.cons = super::constraints::Constraints::with_loops(
+            &self.model,
+            &self.mass.f,
+            max_points,
+            pair_points,
+            nslots,
+            self.opts.solver == super::Solver::Newton,
+            Some(loops),
+        );
+        self.sleep.joins = self.loop_body_pairs();
+        let mut out = vec![0.0; self.loop_count()];
+        let mut lines = Vec::new();
+        self.energy_now = None;
+        let e0 = self.energy();
+        if let Some(l) = self.cons.loops.as_mut() {
+            if l.violation(&self.data, &self.q, &mut out) <= 1e-6 {
+                l.e_ref = Some(e0);
+            }
+            for (c, x) in l.set.items.iter().zip(&out) {
+                if x.abs() > 1e-3 {
+                    lines.push(format!(
+                        "constraint \"{}\" ({}) is violated by {:.3e} at the start: the run closes it gently",
+                        c.name,
+                        c.kind_name(),
+                        x.abs()
+                    ));
+                }
+            }
+        }
+        Ok(lines)
+    }
+
+    /// The loop constraints of the run, if any.
+    pub fn constraints(&self) -> Option<&LoopSet> {
+        self.cons.loops.as_ref().map(|l| &l.set)
+    }
+
+    fn loop_count(&self) -> usize {
+        self.cons.loops.as_ref().map_or(0, |l| l.set.items.len())
+    }
+
+    /// Whether the run has loop constraints.
+    pub fn has_constraints(&self) -> bool {
+        self.loop_count() > 0
+    }
+
+    /// Each loop constraint's force in the last step (world; λ/Δt), in the
+    /// set's order; an inactive constraint's is zero.
+    pub fn constraint_forces(&self) -> Vec<LoopForce> {
+        self.cons.loops.as_ref().map_or(Vec::new(), |l| l.forces())
+    }
+
+    /// Switches the loop constraint `name` on or off (an unknown name is an
+    /// error naming it). Switching one on wakes the run.
+    pub fn set_constraint_active(&mut self, name: &str, on: bool) -> Result<(), super::SimError> {
+        let l = self.cons.loops.as_mut().ok_or_else(|| {
+            super::SimError::Invalid(format!("no constraint named \"{name}\": the run has none"))
+        })?;
+        let k = l
+            .set
+            .index(name)
+            .ok_or_else(|| super::SimError::Invalid(format!("no constraint named \"{name}\"")))?;
+        l.active[k] = on;
+        self.sleep.joins = self.loop_body_pairs();
+        self.wake();
+        Ok(())
+    }
+
+    /// The largest violation over the active loop constraints now (m, rad; 0
+    /// without constraints), and each constraint's in `out` when given.
+    pub fn constraint_violation(&mut self) -> f64 {
+        let n = self.loop_count();
+        if n == 0 {
+            return 0.0;
+        }
+        if !self.fk_valid {
+            crate::dynamics::forward_kinematics_pass(&self.model, &mut self.data, &self.q);
+            self.fk_valid = true;
+        }
+        let mut out = vec![0.0; n];
+        self.cons
+            .loops
+            .as_ref()
+            .map_or(0.0, |l| l.violation(&self.data, &self.q, &mut out))
+    }
+
+    /// A passive run with loops keeps its energy at or below the reference
+    /// (docs/theory.md §"Loops in the simulation"): the time-stepping scheme's
+    /// O(h) energy oscillation, which a closed chain's coupled rows do not damp,
+    /// is clipped by scaling v (J v = 0 kept: the rows are linear in v) so that
+    /// T + V never exceeds the energy of the first closed state. The
+    /// reference is dropped while driven (servo, torques) or while a violated
+    /// start closes (violation above 1e-6), and taken afresh after.
+    pub(super) fn clip_loop_energy(&mut self) {
+        let passive = !self.servo.active && self.tau_applied.iter().all(|&x| x == 0.0);
+        if !self.fk_valid {
+            crate::dynamics::forward_kinematics_pass(&self.model, &mut self.data, &self.q);
+            self.fk_valid = true;
+        }
+        let armature = self.armature_energy();
+        let Some(l) = self.cons.loops.as_mut() else {
+            return;
+        };
+        let mut viol = std::mem::take(&mut l.viol);
+        let worst = l.violation(&self.data, &self.q, &mut viol);
+        l.viol = viol;
+        if !passive || worst > 1e-6 {
+            l.e_ref = None;
+            return;
+        }
+        let ke =
+            crate::dynamics::kinetic_energy_from_placements(&self.model, &mut self.data, &self.v)
+                .unwrap_or(f64::NAN)
+                + armature;
+        let pe = crate::dynamics::potential_energy(&self.model, &self.data);
+        let Some(e_ref) = l.e_ref else {
+            l.e_ref = Some(ke + pe);
+            return;
+        };
+        if ke + pe > e_ref && ke > 0.0 {
+            let s = ((e_ref - pe).max(0.0) / ke).sqrt();
+            self.v *= s;
+            self.energy_now = None;
+        }
+    }
+
+    /// The trees (models of a scene) each active loop constraint joins, for
+    /// the islands: pairs of bodies.
+    pub(super) fn loop_body_pairs(&self) -> Vec<(usize, usize)> {
+        let Some(l) = self.cons.loops.as_ref() else {
+            return Vec::new();
+        };
+        l.set
+            .items
+            .iter()
+            .zip(&l.active)
+            .filter(|(_, a)| **a)
+            .map(|(c, _)| match c.kind {
+                ConstraintKind::Joint { v1, second, .. } => {
+                    let body = |iv: usize| {
+                        (1..self.model.nbodies)
+                            .find(|&b| {
+                                let j = &self.model.joints[b];
+                                iv >= j.iv && iv < j.iv + j.nv()
+                            })
+                            .unwrap_or(0)
+                    };
+                    (body(v1), second.map_or(0, |(_, v2)| body(v2)))
+                }
+                _ => (c.a.body, c.b.body),
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,237 @@
+//! Simulation with loop constraints (mechanisms.md §"Simulation"): bilateral
+//! rows of the impulse solve, drift removed by the position pass. Truth from
+//! outside: the closed loop's geometry (violation), the energy of a passive
+//! mechanism that must not rise, a gear's ratio, a hanging pendulum's m·g.
+
+use nalgebra::DVector;
+use serde_json::json;
+use urdyn::model::Constraints;
+use urdyn::sim::{SimOptions, Simulation};
+use urdyn::{load_file, load_str, LoadOptions};
+
+const FIXED: LoadOptions = LoadOptions {
+    floating_base: false,
+};
+
+fn fixture(name: &str) -> String {
+    format!("{}/tests/fixtures/loops/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The four-bar closed at q = (60°, θ₂, θ₃) (solved in scene.json's comment-free
+/// numbers: crank 0.1, coupler 0.3, rocker 0.2, ground 0.3).
+const Q0: [f64; 3] = [1.0471975511965976, -0.66694634450362, 1.4274487578896633];
+
+fn four_bar(rocker_offset: f64) -> (Simulation, Vec<String>) {
+    let model = load_file(fixture("four_bar.urdf"), FIXED).unwrap();
+    let c = Constraints::from_json(
+        &model,
+        &[
+            json!({"name": "loop", "kind": "point", "link1": "coupler", "point1": [0.3, 0.0, 0.0],
+                  "link2": "rocker", "point2": [0.2, 0.0, 0.0]}),
+        ],
+    )
+    .unwrap();
+    let opts = SimOptions {
+        ground: None,
+        ..Default::default()
+    };
+    let mut sim = Simulation::new(model, opts).unwrap();
+    let q = DVector::from_row_slice(&[Q0[0], Q0[1], Q0[2] + rocker_offset]);
+    sim.set_state(&q, &DVector::zeros(3)).unwrap();
+    let warnings = sim.set_constraints(c).unwrap();
+    (sim, warnings)
+}
+
+#[test]
+fn passive_four_bar_stays_closed_and_never_gains_energy() {
+    let (mut sim, warnings) = four_bar(0.0);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert!(sim.constraint_violation() < 1e-12);
+    let e0 = sim.energy();
+    let scale = 1e-6 * (e0.abs() + 3.0 * 9.81 * 1.0);
+    let (mut worst_v, mut worst_e) = (0.0f64, f64::NEG_INFINITY);
+    let mut crank_turns = 0.0f64;
+    while sim.time() < 10.0 - 1e-9 {
+        sim.step().unwrap();
+        let v = sim.constraint_violation();
+        if sim.time() > 0.1 {
+            worst_v = worst_v.max(v);
+        }
+        worst_e = worst_e.max(sim.energy() - e0);
+        crank_turns = crank_turns.max((sim.q()[0] - Q0[0]).abs());
+    }
+    eprintln!(
+        "four-bar 10 s: violation {worst_v:.3e}, energy rise {worst_e:.3e} (bound {scale:.3e}), energy lost {:.3e} of E0 = {e0:.4} J, crank swing {crank_turns:.3}",
+        e0 - sim.energy()
+    );
+    assert!(crank_turns > 0.5, "the mechanism moved: {crank_turns}");
+    assert!(worst_v < 1e-6, "violation {worst_v}");
+    assert!(worst_e <= scale, "energy rose by {worst_e} > {scale}");
+}
+
+#[test]
+fn violated_start_warns_and_closes_gently() {
+    // the rocker turned by 0.025 rad: its tip (0.2 m out) is 5.0 mm off the coupler's
+    let (mut sim, warnings) = four_bar(0.025);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    let w = &warnings[0];
+    assert!(
+        w.contains("constraint") && w.contains("\"loop\"") && w.contains("5.0"),
+        "{w}"
+    );
+    let v0 = sim.constraint_violation();
+    assert!((v0 - 5.0e-3).abs() < 1e-4, "{v0}");
+    // the closed mechanism's fastest joint over 0.5 s
+    let (mut closed, _) = four_bar(0.0);
+    let mut v_closed = 0.0f64;
+    while closed.time() < 0.5 - 1e-9 {
+        closed.step().unwrap();
+        v_closed = v_closed.max(closed.v().amax());
+    }
+    let mut v_max = 0.0f64;
+    while sim.time() < 0.5 - 1e-9 {
+        sim.step().unwrap();
+        v_max = v_max.max(sim.v().amax());
+    }
+    let v_end = sim.constraint_violation();
+    eprintln!("5 mm start: violation at 0.5 s {v_end:.3e}; fastest joint {v_max:.3} rad/s (closed run {v_closed:.3})");
+    assert!(v_end < 1e-6, "{v_end}");
+    assert!(v_max <= 2.0 * v_closed, "{v_max} > 2 × {v_closed}");
+}
+
+/// Two wheels about z (gravity does no work), the gear q_b = −2 q_a, a torque
+/// τ on a: q̈_a = τ / (I_a + 4 I_b) (the gear's kinetic energy), closed form.
+#[test]
+fn gear_constraint_holds_and_follows_its_closed_form() {
+    let urdf = r#"<robot name="gears"><link name="base"/>
+<link name="a"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.02" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<link name="b"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.005" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="wheel_a" type="continuous"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint>
+<joint name="wheel_b" type="continuous"><parent link="base"/><child link="b"/><origin xyz="0.3 0 0"/><axis xyz="0 0 1"/></joint>
+</robot>"#;
+    let model = load_str(urdf, "gears.urdf", FIXED).unwrap();
+    let c = Constraints::from_json(
+        &model,
+        &[json!({"name": "gear", "kind": "joint", "joint1": "wheel_b", "joint2": "wheel_a", "ratio": -2.0})],
+    )
+    .unwrap();
+    let opts = SimOptions {
+        ground: None,
+        ..Default::default()
+    };
+    let mut sim = Simulation::new(model, opts).unwrap();
+    assert!(sim.set_constraints(c).unwrap().is_empty());
+    let tau = 0.3;
+    sim.torques_mut()[0] = tau;
+    while sim.time() < 1.0 - 1e-9 {
+        sim.step().unwrap();
+        let (qa, qb) = (sim.q()[0], sim.q()[1]);
+        assert!(
+            (qb + 2.0 * qa).abs() < 1e-6,
+            "gear slipped at t = {}: {qa} {qb}",
+            sim.time()
+        );
+    }
+    let alpha = tau / (0.02 + 4.0 * 0.005);
+    // semi-implicit Euler's exact sequence: q_N = α h² N(N+1)/2 (½ α t² + α h t/2)
+    let (h, n) = (sim.dt(), sim.steps as f64);
+    let expected = 0.5 * alpha * h * h * n * (n + 1.0);
+    let qa = sim.q()[0];
+    eprintln!(
+        "gear: q_a(1 s) = {qa:.6} (closed form {expected:.6}), λ/h = {:?}",
+        sim.constraint_forces()[0].generalized
+    );
+    assert!(
+        (qa - expected).abs() < 1e-9 * expected,
+        "{qa} vs {expected}"
+    );
+    // the gear's torque on b: I_b q̈_b = λ (q̈_b = −2α)
+    let g = sim.constraint_forces()[0].generalized;
+    assert!((g - 0.005 * (-2.0 * alpha)).abs() < 1e-6, "{g}");
+}
+
+/// A free rod hanging from a world point at its top end, at rest: the point
+/// carries its weight, m·g upward.
+#[test]
+fn pendulum_held_by_a_world_point_carries_its_weight() {
+    let m = 2.0;
+    let urdf = format!(
+        r#"<robot name="rod"><link name="rod"><inertial><origin xyz="0 0 -0.5"/><mass value="{m}"/>
+<inertia ixx="0.17" iyy="0.17" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>"#
+    );
+    let model = load_str(
+        &urdf,
+        "rod.urdf",
+        LoadOptions {
+            floating_base: true,
+        },
+    )
+    .unwrap();
+    let c = Constraints::from_json(
+        &model,
+        &[json!({"name": "pivot", "kind": "point", "link1": "rod"})],
+    )
+    .unwrap();
+    let opts = SimOptions {
+        ground: None,
+        sleep: false,
+        ..Default::default()
+    };
+    let mut sim = Simulation::new(model, opts).unwrap();
+    let q0 = sim.q().clone();
+    sim.set_constraints(c).unwrap();
+    for _ in 0..200 {
+        sim.step().unwrap();
+    }
+    let f = &sim.constraint_forces()[0];
+    let g = 9.81;
+    eprintln!("pivot force {:?} (m g = {})", f.force, m * g);
+    assert!((f.force.z - m * g).abs() < 1e-6 * m * g, "{:?}", f.force);
+    assert!(
+        f.force.x.abs() < 1e-9 && f.force.y.abs() < 1e-9,
+        "{:?}",
+        f.force
+    );
+    assert!((sim.q() - q0).amax() < 1e-9);
+}
+
+#[test]
+fn scene_constraints_parse_and_close_the_loop() {
+    let scene = urdyn::scene::Scene::from_file(fixture("scene.json"), &[]).unwrap();
+    assert_eq!(scene.constraints.items.len(), 1);
+    assert_eq!(scene.constraints.items[0].name, "loop");
+    let opts = SimOptions {
+        ground: None,
+        ..Default::default()
+    };
+    let mut sim = Simulation::new(scene.model.clone(), opts).unwrap();
+    sim.set_state(&scene.q0, &scene.v0).unwrap();
+    assert!(sim
+        .set_constraints(scene.constraints.clone())
+        .unwrap()
+        .is_empty());
+    let e0 = sim.energy();
+    while sim.time() < 1.0 - 1e-9 {
+        sim.step().unwrap();
+        assert!(sim.constraint_violation() < 1e-6);
+    }
+    assert!(sim.energy() <= e0 + 1e-6 * (e0.abs() + 3.0 * 9.81));
+    // a bad link: one line naming constraints[0] and the key
+    let text = std::fs::read_to_string(fixture("scene.json"))
+        .unwrap()
+        .replace("fb/rocker", "fb/nope");
+    let bad = std::env::temp_dir().join("urdyn_loops_bad_scene.json");
+    std::fs::write(&bad, text).unwrap();
+    std::fs::copy(
+        fixture("four_bar.urdf"),
+        std::env::temp_dir().join("four_bar.urdf"),
+    )
+    .unwrap();
+    let e = urdyn::scene::Scene::from_file(&bad, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("constraints[0].link2") && !e.contains('\n'),
+        "{e}"
+    );
+}
