@@ -31,6 +31,7 @@ mod kinematics_energy;
 mod layering;
 mod mjcf_cli;
 mod mjcf_oracle;
+mod mjcf_sim;
 mod output_files;
 mod pinocchio_derivatives;
 mod pinocchio_fixtures;

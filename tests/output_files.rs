@@ -55,7 +55,10 @@ fn check_lamp_csv(text: &str) {
     let mut lines = text.lines();
     let header = lines.next().unwrap_or_default();
     assert!(header.starts_with("t,"), "header: {header}");
-    assert!(header.ends_with(",energy,contacts,penetration,awake"), "{header}");
+    assert!(
+        header.ends_with(",energy,contacts,penetration,awake"),
+        "{header}"
+    );
     let width = header.split(',').count();
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), 51, "rows at 0, 1, ..., 50 ms");

@@ -77,9 +77,15 @@ fn a_settled_64_box_pile_sleeps_and_ends_within_a_millimetre_of_the_awake_run() 
         dp = dp.max((pa - pb).amax());
         dr = dr.max(ra.angle_to(rb));
     }
-    assert!(dp < 1e-3 && dr < 1e-2, "{dp} m, {dr} rad from the run awake");
+    assert!(
+        dp < 1e-3 && dr < 1e-2,
+        "{dp} m, {dr} rad from the run awake"
+    );
     // asleep: velocities exactly zero, and it reads so per model
-    assert!(on.v().iter().all(|&x| x == 0.0), "a sleeping velocity is not 0");
+    assert!(
+        on.v().iter().all(|&x| x == 0.0),
+        "a sleeping velocity is not 0"
+    );
     assert_eq!(on.sleeping("o0"), Some(true));
     assert_eq!(on.sleeping("nothing"), None);
     // the awake run is at rest but not exactly
@@ -111,7 +117,12 @@ fn a_ball_dropped_on_a_sleeping_pile_wakes_it_moves_it_and_rests_on_it_energy_ne
     let s = pile_and_ball();
     let mut sim = simulation(&s, true);
     let e0 = sim.energy().abs();
-    let ball = sim.model.trees.iter().position(|t| t.name == "ball").unwrap();
+    let ball = sim
+        .model
+        .trees
+        .iter()
+        .position(|t| t.name == "ball")
+        .unwrap();
     let fb = &sim.model.free_joints[sim.model.trees[ball].free.unwrap()];
     let bz = fb.iq + 2;
     let mut before: Option<Vec<(Vector3<f64>, UnitQuaternion<f64>)>> = None;
@@ -153,7 +164,10 @@ fn a_ball_dropped_on_a_sleeping_pile_wakes_it_moves_it_and_rests_on_it_energy_ne
     // never inside a box, never through the pile: it rests on top (the boxes
     // are 0.1 m, two layers in a 0.6 m bin)
     assert!(deepest_after < 5e-3, "{deepest_after} m deep");
-    assert!(lowest_ball > 0.08 - 5e-3, "the ball went to {lowest_ball} m");
+    assert!(
+        lowest_ball > 0.08 - 5e-3,
+        "the ball went to {lowest_ball} m"
+    );
     // it rests on boxes: a contact between the ball and a box carries force
     let bodies = sim.model.trees[ball].bodies.clone();
     let on_box = sim.contact_forces().iter().any(|f| {

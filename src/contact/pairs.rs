@@ -279,10 +279,13 @@ impl PairContact {
     /// Bounding spheres of the moving members: (body, centre in the body
     /// frame, radius).
     pub fn member_spheres(&self) -> impl Iterator<Item = (usize, Vector3<f64>, f64)> + '_ {
-        self.members
-            .iter()
-            .filter(|m| m.body != 0)
-            .map(|m| (m.body, m.placement.act_point(&m.shape.mid), m.shape.half.norm()))
+        self.members.iter().filter(|m| m.body != 0).map(|m| {
+            (
+                m.body,
+                m.placement.act_point(&m.shape.mid),
+                m.shape.half.norm(),
+            )
+        })
     }
 
     /// Pairs whose two bodies are flagged in `asleep` (or static) keep what

@@ -195,7 +195,11 @@ impl Simulation {
     /// Deepest penetration into the ground at the current state (m, 0 if none).
     pub fn penetration(&self) -> f64 {
         let frozen = &self.sleep.frozen_points;
-        self.points.iter().chain(frozen).map(|p| -p.gap).fold(0.0, f64::max)
+        self.points
+            .iter()
+            .chain(frozen)
+            .map(|p| -p.gap)
+            .fold(0.0, f64::max)
     }
     /// The contact points that carried force in the last step, with their forces.
     pub fn contact_forces(&self) -> &[ContactForce] {

@@ -105,9 +105,7 @@ impl Sleep {
                 }
             }
             has_dof[t] = !tree.v.is_empty();
-            never[t] = tree.free.is_none()
-                || tree.v.is_empty()
-                || never_names.contains(&tree.name);
+            never[t] = tree.free.is_none() || tree.v.is_empty() || never_names.contains(&tree.name);
         }
         let mut has_sphere = vec![false; model.nbodies];
         for s in &spheres {
@@ -404,7 +402,11 @@ impl Sleep {
         self.all_forces.extend_from_slice(&self.frozen_forces);
         for (b, out) in self.all_body.iter_mut().enumerate() {
             let f = body.get(b).copied().unwrap_or(Force::zero());
-            *out = if self.body_asleep[b] { self.frozen_body[b] } else { f };
+            *out = if self.body_asleep[b] {
+                self.frozen_body[b]
+            } else {
+                f
+            };
         }
     }
     /// The contact forces to report: `awake` (the last solve's) joined with

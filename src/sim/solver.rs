@@ -311,7 +311,10 @@ impl Rows {
             return 0.0;
         };
         let jr = &self.j[r * self.stride..r * self.stride + pl.min(self.stride)];
-        jr.iter().zip(path).map(|(a, &k)| a * x.get(k).copied().unwrap_or(0.0)).sum()
+        jr.iter()
+            .zip(path)
+            .map(|(a, &k)| a * x.get(k).copied().unwrap_or(0.0))
+            .sum()
     }
     /// Row `r` of J as (dof, entry) pairs over its path.
     pub fn jrow(&self, r: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
@@ -874,7 +877,11 @@ impl Rows {
     ) -> usize {
         let (nv, n) = (self.nv, self.n);
         let _ = f;
-        if dw.len() < nv || self.y.len() < n * self.stride || self.mu.len() < n || self.bpos.len() < n {
+        if dw.len() < nv
+            || self.y.len() < n * self.stride
+            || self.mu.len() < n
+            || self.bpos.len() < n
+        {
             return 0;
         }
         let table_v = std::mem::take(&mut self.table);
