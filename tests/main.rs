@@ -32,6 +32,7 @@ mod layering;
 mod loops_sim;
 mod mjcf_cli;
 mod mjcf_oracle;
+mod mjcf_sim;
 mod output_files;
 mod pinocchio_derivatives;
 mod pinocchio_fixtures;

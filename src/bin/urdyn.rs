@@ -107,14 +107,12 @@ struct SimulateCmd {
         allow_hyphen_values = true
     )]
     duration: f64,
-    /// Step in seconds (the first step of an adaptive integrator).
-    #[arg(
-        long,
-        value_name = "S",
-        default_value_t = 1e-3,
-        allow_hyphen_values = true
-    )]
-    dt: f64,
+    /// Step in seconds (the first step of an adaptive integrator) [default: 0.001; an MJCF file's <option timestep>].
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    dt: Option<f64>,
+    /// Start an MJCF model from its keyframe <key name="NAME">.
+    #[arg(long, value_name = "NAME")]
+    key: Option<String>,
     /// Integrator (see --list-integrators); default: euler with ground contact, dop853 without.
     #[arg(long, value_name = "NAME")]
     integrator: Option<String>,
@@ -470,6 +468,7 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
         floating_base: c.floating_base,
         duration: c.duration,
         dt: c.dt,
+        key: c.key,
         integrator: c.integrator,
         tol: c.tol,
         initial: c.initial,

@@ -12,5 +12,6 @@ pub mod eval_constrained;
 pub mod inspect;
 pub mod output;
 pub mod simulate;
+mod simulate_mjcf;
 pub mod state;
 pub mod view;

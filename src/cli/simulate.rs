@@ -22,8 +22,11 @@ pub struct SimulateArgs {
     pub floating_base: bool,
     /// Simulated seconds.
     pub duration: f64,
-    /// Step (the first step of an adaptive integrator), s.
-    pub dt: f64,
+    /// Step (the first step of an adaptive integrator), s (`None`: an MJCF
+    /// file's `<option timestep>`, else [`DEFAULT_DT`]).
+    pub dt: Option<f64>,
+    /// `--key NAME`: start an MJCF model from its `<keyframe><key name>`.
+    pub key: Option<String>,
     /// Integrator name (`None`: the project's best general choice).
     pub integrator: Option<String>,
     /// Error tolerance of adaptive integrators.
@@ -59,6 +62,9 @@ pub struct SimulateArgs {
     /// `--threads N` (0: every core; `None`: the scene's, else 1).
     pub threads: Option<usize>,
 }
+
+/// The step when neither `--dt` nor an MJCF file's `<option timestep>` gives one (s).
+pub const DEFAULT_DT: f64 = 1e-3;
 
 /// What a run did (the summary line).
 #[derive(Clone, Debug, PartialEq)]
@@ -108,6 +114,9 @@ pub enum SimulateError {
     /// The URDF could not be imported.
     #[error(transparent)]
     Urdf(#[from] crate::UrdfError),
+    /// The MJCF file could not be imported.
+    #[error(transparent)]
+    Mjcf(#[from] crate::mjcf::MjcfError),
     /// The scene file is malformed or names what does not exist.
     #[error(transparent)]
     Scene(#[from] crate::scene::SceneError),
@@ -144,10 +153,11 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             args.duration
         )));
     }
-    if !(args.dt.is_finite() && args.dt > 0.0) {
+    if let Some(dt) = args.dt
+        && !(dt.is_finite() && dt > 0.0)
+    {
         return Err(SimulateError::Option(format!(
-            "--dt must be a positive number (got {})",
-            args.dt
+            "--dt must be a positive number (got {dt})"
         )));
     }
     if !(args.tol.is_finite() && args.tol > 0.0) {
@@ -207,6 +217,12 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             ));
         }
     }
+    if let (Some(scene), Some(k)) = (&args.scene, &args.key) {
+        return Err(SimulateError::Option(format!(
+            "--key {k}: keyframes belong to MJCF files, not to the scene {}",
+            scene.display()
+        )));
+    }
     if let Some(scene) = &args.scene {
         let given = [
             (args.floating_base, "--floating-base"),
@@ -224,6 +240,9 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
     }
     let (mut model, init, opts, geometry, urdf_name) = match &args.scene {
         Some(path) => scene_setup(args, path, integrator)?,
+        None if crate::load::file_format(&args.urdf) == crate::load::Format::Mjcf => {
+            super::simulate_mjcf::setup(args, integrator)?
+        }
         None => urdf_setup(args, integrator)?,
     };
     if let Some(g) = args.gravity {
@@ -474,7 +493,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
 
 /// What a run starts from: the model, its starting state, the options, the
 /// page's geometry (with `--html`) and the name in messages.
-type Setup = (
+pub(crate) type Setup = (
     Model,
     Option<state::StateVectors>,
     SimOptions,
@@ -484,9 +503,9 @@ type Setup = (
 
 /// A lone URDF's run: `--floating-base`, `--initial`, the ground and friction options.
 fn urdf_setup(args: &SimulateArgs, integrator: Option<Integrator>) -> Result<Setup, SimulateError> {
-    if crate::load::file_format(&args.urdf) == crate::load::Format::Mjcf {
+    if let Some(k) = &args.key {
         return Err(SimulateError::Option(format!(
-            "{}: simulating an MJCF world (its contacts, actuators, tendons and equalities) is not supported yet; inspect, eval and bench read it",
+            "--key {k}: keyframes belong to MJCF files ({} is not one)",
             args.urdf.display()
         )));
     }
@@ -527,7 +546,7 @@ fn urdf_setup(args: &SimulateArgs, integrator: Option<Integrator>) -> Result<Set
     let mut contact = crate::contact::ContactParams::default();
     contact.friction = args.friction;
     let opts = SimOptions {
-        dt: args.dt,
+        dt: args.dt.unwrap_or(DEFAULT_DT),
         integrator,
         tol: args.tol,
         ground: if args.no_ground {
@@ -581,7 +600,7 @@ fn scene_setup(
         contact.friction = g.friction;
     }
     let opts = SimOptions {
-        dt: args.dt,
+        dt: args.dt.unwrap_or(DEFAULT_DT),
         integrator,
         tol: args.tol,
         ground: scene.ground.map(|g| g.height),
@@ -616,7 +635,7 @@ fn scene_setup(
 const BLOCKS_IN_FLIGHT: usize = 6;
 
 /// One warning line on standard error (the run goes on).
-fn warn(line: &str) {
+pub(crate) fn warn(line: &str) {
     let _ = writeln!(std::io::stderr().lock(), "{line}");
 }
 

@@ -202,11 +202,13 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
     }
     let nbodies = parent.len();
 
-    // collision shapes that urdyn's contact has today; the others wait for the
-    // simulation phase (they stay in the compiled World)
+    // collision shapes (MuJoCo's geoms that may collide); planes are the
+    // ground (`collide::ground`), ellipsoids, meshes and height fields are not
+    // collision shapes yet
     let mut collisions = Vec::new();
+    let mut colliding = vec![false; world.geoms.len()];
     let mut later = 0usize;
-    for g in &world.geoms {
+    for (k, g) in world.geoms.iter().enumerate() {
         if g.contype == 0 && g.conaffinity == 0 {
             continue;
         }
@@ -224,11 +226,13 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
             MjGeomType::Box => Shape::Box {
                 size: [2.0 * s[0], 2.0 * s[1], 2.0 * s[2]],
             },
+            MjGeomType::Plane => continue,
             _ => {
                 later += 1;
                 continue;
             }
         };
+        colliding[k] = true;
         let at = ub[g.body];
         collisions.push(CollisionGeom {
             link: world.bodies[g.body].name.clone(),
@@ -237,14 +241,20 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
             shape,
             trimesh: false,
             friction: g.friction[0],
-            model: if g.body == 0 { OBSTACLE } else { 0 },
+            // welded to the world: a static obstacle (touches every moving body)
+            model: if at == 0 { OBSTACLE } else { 0 },
         });
     }
     if later > 0 {
         report.warnings.push(format!(
-            "{later} plane, ellipsoid, height-field or mesh geom(s): not yet collision shapes (MJCF simulation is the next phase)"
+            "{later} ellipsoid, height-field or mesh geom(s): not collision shapes (not modelled in contact)"
         ));
     }
+    let (ground, ground_warnings) = super::collide::ground(world);
+    report.warnings.extend(ground_warnings);
+    let (excluded, filter_warnings) =
+        super::collide::excluded_pairs(world, &ub, &colliding, ground.as_ref());
+    report.warnings.extend(filter_warnings);
     report.warnings.extend(world.warnings.iter().cloned());
 
     // λ: the previous velocity coordinate on the path to the root
@@ -293,8 +303,8 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
         frames,
         collisions,
         collision_filter: CollisionFilter {
-            excluded: Vec::new(),
-            self_collision: vec![false],
+            excluded,
+            self_collision: vec![true],
         },
         dof_parent,
         has_mimic: false,

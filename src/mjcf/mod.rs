@@ -17,16 +17,20 @@
 //! composition) is urdyn's in either case: mjcf-rs stops at the AST.
 
 mod attrs;
+mod collide;
 mod compile;
 mod convert;
 mod inertia;
 mod lower;
 mod orient;
+mod sections;
 mod world;
 mod xml;
 
+pub use collide::Ground;
 pub use compile::{MjBody, MjGeom, MjGeomType, MjJoint, MjJointType, World};
 pub use convert::{from_mujoco_qpos, from_mujoco_qvel, to_mujoco_qpos, to_mujoco_qvel};
+pub use sections::MjKey;
 pub use xml::is_mjcf_text;
 
 use crate::model::Model;
@@ -95,6 +99,22 @@ pub fn load_file(path: impl AsRef<Path>) -> Result<Model, MjcfError> {
     let mut model = lower::lower(&world)?;
     model.source = Some(path.to_path_buf());
     Ok(model)
+}
+
+/// Reads an MJCF file into both its [`Model`] and MuJoCo's compiled [`World`]
+/// (what a simulation reads besides the model: planes, keyframes).
+pub fn load_file_with_world(path: impl AsRef<Path>) -> Result<(Model, World), MjcfError> {
+    let path = path.as_ref();
+    let world = load_world(path)?;
+    let mut model = lower::lower(&world)?;
+    model.source = Some(path.to_path_buf());
+    Ok((model, world))
+}
+
+/// The ground an MJCF world's planes give (the highest upward-facing plane
+/// welded to the world), if any.
+pub fn ground_of(world: &World) -> Option<Ground> {
+    collide::ground(world).0
 }
 
 /// Imports MJCF text; `file` names it in errors, includes are read under `base_dir`.
@@ -171,6 +191,8 @@ fn compile(
             geoms: Vec::new(),
             gravity: Vector3::new(0.0, 0.0, -9.81),
             timestep: 0.002,
+            excludes: Vec::new(),
+            keys: Vec::new(),
             warnings: Vec::new(),
         },
         names: Default::default(),
@@ -183,6 +205,12 @@ fn compile(
     }
     let mut world = cx.world;
     inertia::bodies(&mut world, &cx.set);
+    sections::keyframes(&mut world, &of("keyframe").collect::<Vec<_>>())?;
+    sections::contacts(
+        &mut world,
+        &of("contact").collect::<Vec<_>>(),
+        &mut cx.not_modelled,
+    )?;
     for (tag, what) in [
         ("tendon", "tendons: not modelled yet (MJCF simulation)"),
         ("actuator", "actuators: not modelled yet (MJCF simulation)"),
@@ -191,10 +219,6 @@ fn compile(
             "equality constraints: not modelled yet (MJCF simulation)",
         ),
         ("sensor", "sensors: not modelled (urdyn has its own)"),
-        (
-            "contact",
-            "explicit contact pairs and exclusions: not modelled yet (MJCF simulation)",
-        ),
     ] {
         if of(tag).any(|s| !s.children.is_empty()) {
             cx.not_modelled.push(what.to_string());

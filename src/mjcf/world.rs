@@ -145,6 +145,10 @@ pub struct World {
     pub gravity: Vector3<f64>,
     /// `<option timestep>`.
     pub timestep: f64,
+    /// `<contact><exclude>`: body pairs (MuJoCo ids) that never touch.
+    pub excludes: Vec<(usize, usize)>,
+    /// `<keyframe><key>`s in file order.
+    pub keys: Vec<super::sections::MjKey>,
     /// What urdyn does not model, one line a kind.
     pub warnings: Vec<String>,
 }

@@ -181,6 +181,29 @@ impl Default for SimOptions {
     }
 }
 
+/// The joint springs of `model` (an MJCF joint's `stiffness` about its
+/// `springref`, on hinge and slide joints) as servo gains and targets, `None`
+/// when there is none (or joint dynamics are off).
+fn joint_springs(model: &Model, on: bool) -> Option<(DVector<f64>, DVector<f64>)> {
+    if !on
+        || !model
+            .dofs
+            .iter()
+            .any(|d| d.stiffness > 0.0 && d.kind.nv() == 1)
+    {
+        return None;
+    }
+    let mut kp = DVector::zeros(model.nv);
+    let mut q_ref = model.neutral();
+    for d in &model.dofs {
+        if d.kind.nv() == 1 && d.stiffness.is_finite() && d.stiffness > 0.0 {
+            kp[d.iv] = d.stiffness;
+            q_ref[d.iq] = d.springref;
+        }
+    }
+    Some((kp, q_ref))
+}
+
 /// The velocity-level constraint solver.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Solver {
@@ -413,7 +436,9 @@ impl Simulation {
         let mut effort = vec![f64::INFINITY; nv];
         for (d, _, iv) in model.dof_indices() {
             let info = &model.dofs[d];
-            armature[iv] = a;
+            // --armature on every joint, plus the model's own (an MJCF joint's
+            // `armature`: MuJoCo's qM diagonal)
+            armature[iv] = a + info.armature.max(0.0);
             if opts.joint_dynamics {
                 damping[iv] = if info.damping.is_finite() {
                     info.damping.max(0.0)
@@ -447,7 +472,8 @@ impl Simulation {
         let total_mass: f64 = model.inertias.iter().skip(1).map(|i| i.mass).sum();
         let scale = total_mass * model.gravity.norm();
         let has_damping = damping.iter().any(|&d| d > 0.0);
-        let has_armature = a > 0.0 && !model.dofs.is_empty();
+        let has_armature = armature.iter().any(|&x| x > 0.0);
+        let springs = joint_springs(&model, opts.joint_dynamics);
         let spheres = contact.as_ref().map_or(Vec::new(), |c| c.body_spheres());
         let sleep = sleep::Sleep::new(
             &model,
@@ -523,6 +549,12 @@ impl Simulation {
             model: Arc::new(model),
             deriv: Default::default(),
         };
+        if let Some((kp, q_ref)) = springs {
+            // joint springs (MJCF `stiffness`/`springref`) are servos without
+            // damping gain: τ = k (springref − q), integrated implicitly
+            sim.set_targets(&q_ref, None)?;
+            sim.set_gains(&kp, &DVector::zeros(nv))?;
+        }
         sim.state_changed();
         Ok(sim)
     }
@@ -649,7 +681,20 @@ impl Simulation {
         }
         let (ke, pe) = crate::dynamics::energies(&self.model, &self.q, &self.v)
             .unwrap_or((f64::NAN, f64::NAN));
-        ke + pe + self.armature_energy()
+        ke + pe + self.armature_energy() + self.spring_energy()
+    }
+
+    /// The joint springs' potential `½ Σ k (q − springref)²` (MJCF `stiffness`;
+    /// 0 without springs).
+    fn spring_energy(&self) -> f64 {
+        let mut e = 0.0;
+        for d in &self.model.dofs {
+            if d.stiffness > 0.0 && d.stiffness.is_finite() && d.kind.nv() == 1 {
+                let x = self.q[d.iq] - d.springref;
+                e += 0.5 * d.stiffness * x * x;
+            }
+        }
+        e
     }
 
     /// The rotors' kinetic energy `½ Σ A v²` (0 without an armature).
@@ -680,7 +725,8 @@ impl Simulation {
         let e = kinetic_energy_from_placements(&self.model, &mut self.data, &self.v)
             .unwrap_or(f64::NAN)
             + potential_energy(&self.model, &self.data)
-            + self.armature_energy();
+            + self.armature_energy()
+            + self.spring_energy();
         self.energy_now = Some(e);
         e
     }

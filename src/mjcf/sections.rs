@@ -1,0 +1,122 @@
+//! The sections a simulation reads besides the bodies: `<contact><exclude>`
+//! (body pairs that never touch) and `<keyframe><key>` (named starting states in
+//! MuJoCo's qpos/qvel order), checked against the compiled bodies and joints.
+
+use super::compile::{MjJointType, World};
+use super::xml::El;
+use super::MjcfError;
+
+/// A `<key>`: MuJoCo's qpos and qvel (MuJoCo's order and conventions; `None`:
+/// qpos0, zero velocity).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MjKey {
+    /// Its name (`key_K` when unnamed, K its MuJoCo id).
+    pub name: String,
+    /// MuJoCo's qpos (nq), if given.
+    pub qpos: Option<Vec<f64>>,
+    /// MuJoCo's qvel (nv), if given.
+    pub qvel: Option<Vec<f64>>,
+}
+
+const KEY_ATTRS: &[&str] = &[
+    "name", "time", "qpos", "qvel", "act", "ctrl", "mpos", "mquat",
+];
+const EXCLUDE_ATTRS: &[&str] = &["name", "body1", "body2"];
+
+/// MuJoCo's nq and nv of the compiled joints.
+fn sizes(world: &World) -> (usize, usize) {
+    world.joints.iter().fold((0, 0), |(q, v), j| match j.kind {
+        MjJointType::Free => (q + 7, v + 6),
+        MjJointType::Ball => (q + 4, v + 3),
+        MjJointType::Hinge | MjJointType::Slide => (q + 1, v + 1),
+    })
+}
+
+fn check_known(el: &El, known: &[&str]) -> Result<(), MjcfError> {
+    match el.attrs.iter().find(|(k, _)| !known.contains(&k.as_str())) {
+        Some((k, _)) => Err(el.err(format!("unknown attribute \"{k}\""))),
+        None => Ok(()),
+    }
+}
+
+fn numbers(el: &El, k: &str) -> Result<Option<Vec<f64>>, MjcfError> {
+    let Some(s) = el.attr(k) else {
+        return Ok(None);
+    };
+    s.split_whitespace()
+        .map(|p| match p.parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(x),
+            Ok(_) => Err(el.err(format!("{k}: \"{p}\" is not a finite number"))),
+            Err(_) => Err(el.err(format!("{k}: \"{p}\" is not numeric"))),
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Some)
+}
+
+/// Reads the `<keyframe>` sections' keys into `world.keys`.
+pub(super) fn keyframes(world: &mut World, sections: &[&El]) -> Result<(), MjcfError> {
+    let (nq, nv) = sizes(world);
+    for el in sections.iter().flat_map(|s| s.children.iter()) {
+        if el.tag != "key" {
+            return Err(el.err(format!("unknown element <{}> in <keyframe>", el.tag)));
+        }
+        check_known(el, KEY_ATTRS)?;
+        let qpos = numbers(el, "qpos")?;
+        let qvel = numbers(el, "qvel")?;
+        for (k, v, n) in [("qpos", &qpos, nq), ("qvel", &qvel, nv)] {
+            if let Some(v) = v
+                && v.len() != n
+            {
+                return Err(el.err(format!(
+                    "{k} has {} numbers, the model's {k} has {n}",
+                    v.len()
+                )));
+            }
+        }
+        let name = match el.attr("name") {
+            Some(n) if !n.is_empty() => n.to_string(),
+            _ => format!("key_{}", world.keys.len()),
+        };
+        if world.keys.iter().any(|k| k.name == name) {
+            return Err(el.err("duplicate keyframe name"));
+        }
+        world.keys.push(MjKey { name, qpos, qvel });
+    }
+    Ok(())
+}
+
+/// Reads the `<contact>` sections' `<exclude>`s into `world.excludes`; a
+/// `<pair>` is reported as not modelled.
+pub(super) fn contacts(
+    world: &mut World,
+    sections: &[&El],
+    not_modelled: &mut Vec<String>,
+) -> Result<(), MjcfError> {
+    for el in sections.iter().flat_map(|s| s.children.iter()) {
+        match el.tag.as_str() {
+            "exclude" => {
+                check_known(el, EXCLUDE_ATTRS)?;
+                let body = |k: &str| -> Result<usize, MjcfError> {
+                    let n = el
+                        .attr(k)
+                        .ok_or_else(|| el.err(format!("{k}: missing (a body name)")))?;
+                    world
+                        .bodies
+                        .iter()
+                        .position(|b| b.name == n)
+                        .ok_or_else(|| el.err(format!("{k}=\"{n}\": no such body")))
+                };
+                let pair = (body("body1")?, body("body2")?);
+                world.excludes.push(pair);
+            }
+            "pair" => {
+                let line = "<contact><pair>: explicit contact pairs are not modelled (the geoms' contype/conaffinity decide)".to_string();
+                if !not_modelled.contains(&line) {
+                    not_modelled.push(line);
+                }
+            }
+            t => return Err(el.err(format!("unknown element <{t}> in <contact>"))),
+        }
+    }
+    Ok(())
+}
