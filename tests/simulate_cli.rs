@@ -174,7 +174,12 @@ fn list_integrators_and_help() {
     assert_eq!(String::from_utf8_lossy(&o.stdout), "euler\nrk4\ndop853\n");
     let o = urdyn().args(["simulate", "--help"]).output().unwrap();
     let help = String::from_utf8_lossy(&o.stdout);
-    assert!(help.contains("no self-collision"), "{help}");
+    // the help says what a run does: self-collision, and with --scene the models
+    // and obstacles (tests/contact_pairs.rs and scene_physics.rs run them), not the
+    // stale "ground plane only (no self-collision)"
+    assert!(!help.contains("no self-collision"), "{help}");
+    assert!(help.contains("self-collision"), "{help}");
+    assert!(help.contains("between the models and with the scene's obstacles"), "{help}");
 }
 
 #[test]

@@ -26,6 +26,12 @@ pub const QUATERNION_TOLERANCE: f64 = 1e-3;
 /// ("not a unit quaternion (norm N)") unless its norm is within
 /// [`QUATERNION_TOLERANCE`] of 1.
 pub fn normalize_base_quaternion(quat: &mut [f64], name: &str) -> PyResult<()> {
+    normalize_quaternion_at(quat, name, 3)
+}
+
+/// As [`normalize_base_quaternion`] for the quaternion at `name[at:at + 4]` (a
+/// scene's later floating model: its own entries named, not the first model's).
+pub fn normalize_quaternion_at(quat: &mut [f64], name: &str, at: usize) -> PyResult<()> {
     // |q| = sqrt(qx² + qy² + qz² + qw²)
     let n = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
     if (n - 1.0).abs() <= QUATERNION_TOLERANCE {
@@ -33,8 +39,83 @@ pub fn normalize_base_quaternion(quat: &mut [f64], name: &str) -> PyResult<()> {
         Ok(())
     } else {
         Err(value_error(format!(
-            "{name}[3:7] (the base orientation qx, qy, qz, qw): not a unit quaternion (norm {n})"
+            "{name}[{at}:{}] (the base orientation qx, qy, qz, qw): not a unit quaternion (norm {n})",
+            at + 4
         )))
+    }
+}
+
+/// A count (`n`, `nstep`, `threads`): a whole number ≥ `min`; a negative number,
+/// a float (`2.5`, even `2.0`), a bool or anything else is a `ValueError` naming
+/// `name`.
+pub fn read_count(x: &Bound<'_, PyAny>, name: &str, min: i64) -> PyResult<usize> {
+    let bad = |what: String| {
+        value_error(format!(
+            "{name} must be a whole number ≥ {min} (got {what})"
+        ))
+    };
+    let shown = || {
+        x.repr()
+            .map(|r| r.to_string())
+            .unwrap_or_else(|_| "?".into())
+    };
+    if x.is_instance_of::<pyo3::types::PyBool>() || x.is_instance_of::<pyo3::types::PyFloat>() {
+        return Err(bad(shown()));
+    }
+    let k: i64 = x.extract().map_err(|_| bad(shown()))?;
+    if k < min {
+        return Err(bad(k.to_string()));
+    }
+    usize::try_from(k).map_err(|_| bad(k.to_string()))
+}
+
+/// `threads=None` or a count ≥ 1.
+pub fn read_threads(x: Option<&Bound<'_, PyAny>>) -> PyResult<Option<usize>> {
+    match x {
+        Some(t) if !t.is_none() => read_count(t, "threads", 1).map(Some),
+        _ => Ok(None),
+    }
+}
+
+/// A keyword whose omission is told apart from every value it may be given,
+/// `None` included (`ground=` beside a scene is an error even at its default).
+pub enum Given {
+    /// Not passed.
+    Omitted,
+    /// Passed, with this value.
+    Value(Py<PyAny>),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Given {
+    type Error = PyErr;
+    fn extract(obj: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        Ok(Given::Value(obj.to_owned().unbind()))
+    }
+}
+
+impl Given {
+    /// Whether the keyword was passed.
+    pub fn given(&self) -> bool {
+        matches!(self, Given::Value(_))
+    }
+    /// `ground=`: omitted → 0.0, `None` → no ground, else a number.
+    pub fn ground(&self, py: Python<'_>) -> PyResult<Option<f64>> {
+        match self {
+            Given::Omitted => Ok(Some(0.0)),
+            Given::Value(v) if v.is_none(py) => Ok(None),
+            Given::Value(v) => v.extract::<f64>(py).map(Some).map_err(|_| {
+                value_error("ground must be a number (the plane's height, m) or None (no ground)")
+            }),
+        }
+    }
+    /// `friction=`: omitted → 1.0, else a number.
+    pub fn friction(&self, py: Python<'_>) -> PyResult<f64> {
+        match self {
+            Given::Omitted => Ok(1.0),
+            Given::Value(v) => v
+                .extract::<f64>(py)
+                .map_err(|_| value_error("friction must be a number (the Coulomb coefficient)")),
+        }
     }
 }
 
@@ -49,7 +130,7 @@ pub fn read_q(
 ) -> PyResult<()> {
     read_vec(x, name, "nq", out)?;
     for &at in quats {
-        normalize_base_quaternion(&mut out.as_mut_slice()[at..at + 4], name)?;
+        normalize_quaternion_at(&mut out.as_mut_slice()[at..at + 4], name, at)?;
     }
     Ok(())
 }

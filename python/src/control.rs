@@ -87,6 +87,7 @@ pub fn mat_out<'py>(py: Python<'py>, m: &DMatrix<f64>) -> Bound<'py, PyArray2<f6
 }
 
 /// `sim.transition_jacobians(tau=None, method="analytic", eps=1e-6)`.
+#[allow(clippy::type_complexity)]
 pub fn transition_jacobians<'py>(
     py: Python<'py>,
     sim: &Simulation,
@@ -111,6 +112,7 @@ pub fn transition_jacobians<'py>(
 }
 
 /// A pair of 3-vectors as numpy arrays.
+#[allow(clippy::type_complexity)]
 pub fn pair<'py>(
     py: Python<'py>,
     r: Result<(Vector3<f64>, Vector3<f64>), urdyn::sim::SimError>,
@@ -124,7 +126,7 @@ pub fn pair<'py>(
 
 /// `urdyn.linearize(sim, q, v, tau, threads=None)`: A, B at each of T states,
 /// in parallel (one workspace per rayon task), the GIL released.
-#[allow(clippy::type_complexity)]
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
 pub fn linearize<'py>(
     py: Python<'py>,
     sim: &Simulation,

@@ -193,7 +193,7 @@ fn forward<'py>(
     fext: Option<&Bound<'py, PyDict>>,
     algo: Fd,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    read_qvx(&model, d, q, v, tau, "tau")?;
+    read_qvx(model, d, q, v, tau, "tau")?;
     let has = read_fext(model, d, fext)?;
     let f = has.then_some(&d.fext[..]);
     let m = &model.model;

@@ -6,12 +6,16 @@
 //! names are fixed by `shared/spec/python.md` (Pinocchio's where it has one).
 
 mod args;
+mod contacts;
 mod control;
 mod derivatives;
 mod dynamics;
+mod introspect;
 mod model;
+mod rollout;
 mod scene;
 mod sim;
+mod view;
 
 use pyo3::prelude::*;
 
@@ -31,14 +35,15 @@ fn _urdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<sim::PySimulation>()?;
     m.add_class::<scene::PyScene>()?;
     m.add_function(wrap_pyfunction!(scene::_scene_from_state, m)?)?;
-    m.add_function(wrap_pyfunction!(model::_scene_model_from_state, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::_scene_model_from_state, m)?)?;
     m.add("SimulationError", m.py().get_type::<SimulationError>())?;
     m.add_function(wrap_pyfunction!(model::_model_from_state, m)?)?;
     m.add_function(wrap_pyfunction!(model::to_pinocchio_q, m)?)?;
     m.add_function(wrap_pyfunction!(model::from_pinocchio_q, m)?)?;
     dynamics::register(m)?;
     derivatives::register(m)?;
-    m.add_function(wrap_pyfunction!(sim::rollout, m)?)?;
+    m.add_function(wrap_pyfunction!(rollout::rollout, m)?)?;
+    m.add_function(wrap_pyfunction!(view::write_html, m)?)?;
     m.add_function(wrap_pyfunction!(sim::integrators, m)?)?;
     m.add_function(wrap_pyfunction!(sim::linearize, m)?)?;
     Ok(())

@@ -4,7 +4,8 @@
 use crate::args::{
     normalize_base_quaternion, not_found_error, quat_offsets, read3, read_q, read_vec, value_error,
 };
-use numpy::PyArray1;
+use crate::introspect::{self, link_inertials, py_slice, LinkInertial};
+use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use std::collections::HashMap;
@@ -29,6 +30,8 @@ pub struct PyModel {
     /// A scene's model: the scene's JSON text, file name and folder (a pickled
     /// scene model is rebuilt from them).
     pub scene_state: Option<(String, String, PathBuf)>,
+    /// Every URDF link's own `<inertial>` (`link_mass`, `link_inertia`).
+    pub inertials: HashMap<String, LinkInertial>,
 }
 
 impl PyModel {
@@ -48,6 +51,7 @@ impl PyModel {
             .enumerate()
             .map(|(i, f)| (f.name.clone(), i))
             .collect();
+        let inertials = link_inertials(&text, "");
         Ok(Self {
             model,
             text,
@@ -55,12 +59,19 @@ impl PyModel {
             package_dirs,
             links,
             scene_state: None,
+            inertials,
         })
     }
 
-    /// The `Model` of a scene (names `MODEL/NAME`).
-    pub fn from_scene(s: &crate::scene::PyScene) -> Self {
-        let model = s.scene.model.clone();
+    /// A model made elsewhere (a scene's: `scene_state` its JSON text, file and
+    /// folder), its links indexed.
+    pub fn from_parts(
+        model: Model,
+        file: String,
+        package_dirs: Vec<PathBuf>,
+        scene_state: Option<(String, String, PathBuf)>,
+        inertials: HashMap<String, LinkInertial>,
+    ) -> Self {
         let links = model
             .frames
             .iter()
@@ -70,14 +81,11 @@ impl PyModel {
         Self {
             model,
             text: String::new(),
-            file: s.scene.file.clone(),
-            package_dirs: s.package_dirs.clone(),
+            file,
+            package_dirs,
             links,
-            scene_state: Some((
-                s.text.clone(),
-                s.scene.file.clone(),
-                s.scene.base_dir.clone(),
-            )),
+            scene_state,
+            inertials,
         }
     }
 
@@ -178,6 +186,17 @@ impl PyModel {
     fn nv(&self) -> usize {
         self.model.nv
     }
+    /// The name of every entry of q, as eval's (a floating base's `base_x` …
+    /// `base_qw` first; mechanisms.md).
+    #[getter]
+    fn q_names(&self) -> Vec<String> {
+        self.model.q_names()
+    }
+    /// The name of every entry of v (and a, tau), as eval's (`base_vx` … first).
+    #[getter]
+    fn v_names(&self) -> Vec<String> {
+        self.model.v_names()
+    }
     /// The joint degrees of freedom in engine order (the base's 6 not included).
     #[getter]
     fn dof_names(&self) -> Vec<String> {
@@ -228,6 +247,112 @@ impl PyModel {
         }
         PyArray1::from_slice(py, q.as_slice())
     }
+    // --- Introspection (python.md §"Introspection, contacts, ..."; introspect.rs) ---
+
+    /// `slice` of joint `name`'s entries in q (Pinocchio's idx_q/nq; a continuous
+    /// joint one entry, a floating base "base" / "MODEL/base" seven).
+    fn joint_q_slice<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        py_slice(py, &introspect::joint_ranges(&self.model, name)?.0)
+    }
+    /// `slice` of joint `name`'s entries in v (Pinocchio's idx_v/nv).
+    fn joint_v_slice<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        py_slice(py, &introspect::joint_ranges(&self.model, name)?.1)
+    }
+    /// `slice` of a scene model's entries in q (a lone URDF: "robot", all of q).
+    fn model_q_slice<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        py_slice(py, &introspect::model_ranges(&self.model, name)?.0)
+    }
+    /// `slice` of a scene model's entries in v.
+    fn model_v_slice<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        py_slice(py, &introspect::model_ranges(&self.model, name)?.1)
+    }
+    /// The models in q order: a scene's names, ["robot"] for a lone URDF.
+    #[getter]
+    fn models(&self) -> Vec<String> {
+        introspect::models(&self.model)
+            .into_iter()
+            .map(|m| m.0)
+            .collect()
+    }
+    /// (nq,) lower position limits: -inf where none, on continuous joints and the base.
+    #[getter]
+    fn lower_limits<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, introspect::position_limits(&self.model).0)
+    }
+    /// (nq,) upper position limits: +inf where none, on continuous joints and the base.
+    #[getter]
+    fn upper_limits<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, introspect::position_limits(&self.model).1)
+    }
+    /// (nv,) `<limit effort>` (N·m or N; inf where none and on the base): what
+    /// `step` clamps each joint torque to.
+    #[getter]
+    fn effort_limits<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let e = introspect::per_dof(&self.model, f64::INFINITY, |d| {
+            d.limits
+                .effort
+                .filter(|&e| e > 0.0)
+                .unwrap_or(f64::INFINITY)
+        });
+        PyArray1::from_vec(py, e)
+    }
+    /// (nv,) `<limit velocity>` (rad/s or m/s; inf where none and on the base).
+    #[getter]
+    fn velocity_limits<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let e = introspect::per_dof(&self.model, f64::INFINITY, |d| {
+            d.limits.velocity.unwrap_or(f64::INFINITY)
+        });
+        PyArray1::from_vec(py, e)
+    }
+    /// (nv,) viscous damping the simulation uses (`<dynamics damping>`; base 0).
+    #[getter]
+    fn damping<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let e = introspect::per_dof(&self.model, 0.0, |d| {
+            if d.damping.is_finite() {
+                d.damping.max(0.0)
+            } else {
+                0.0
+            }
+        });
+        PyArray1::from_vec(py, e)
+    }
+    /// (nv,) Coulomb joint friction the simulation uses (`<dynamics friction>`; base 0).
+    #[getter]
+    fn friction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, introspect::per_dof(&self.model, 0.0, |d| d.friction))
+    }
+    /// (nv,) rotor inertia on each joint's diagonal (URDF has none: zeros).
+    #[getter]
+    fn armature<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, vec![0.0; self.model.nv])
+    }
+    /// A link's own `<inertial>` mass (kg; 0 without one).
+    fn link_mass(&self, link: &str) -> PyResult<f64> {
+        self.link(link, "link")?;
+        Ok(self.inertials.get(link).map_or(0.0, |i| i.mass))
+    }
+    /// A link's own (centre of mass (3), inertia about it (3, 3)), link frame
+    /// (zeros without an `<inertial>`).
+    #[allow(clippy::type_complexity)]
+    fn link_inertia<'py>(
+        &self,
+        py: Python<'py>,
+        link: &str,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
+        self.link(link, "link")?;
+        let (c, i) = self
+            .inertials
+            .get(link)
+            .map_or((Vector3::zeros(), urdyn::nalgebra::Matrix3::zeros()), |l| {
+                (l.com, l.inertia)
+            });
+        let rows: Vec<Vec<f64>> = (0..3)
+            .map(|r| (0..3).map(|k| i[(r, k)]).collect())
+            .collect();
+        let m = PyArray2::from_vec2(py, &rows).map_err(|e| value_error(e.to_string()))?;
+        Ok((PyArray1::from_slice(py, c.as_slice()), m))
+    }
+
     /// A new preallocated workspace for this model.
     fn create_data(&self) -> PyData {
         PyData::new(&self.model)
@@ -302,21 +427,6 @@ pub fn _model_from_state(
     source: Option<PathBuf>,
 ) -> PyResult<PyModel> {
     let mut m = PyModel::build(text, file, floating_base, source, package_dirs)?;
-    m.model.gravity = Vector3::new(gravity[0], gravity[1], gravity[2]);
-    Ok(m)
-}
-
-/// Rebuilds a pickled scene's `Model`.
-#[pyfunction]
-pub fn _scene_model_from_state(
-    text: String,
-    file: String,
-    base_dir: PathBuf,
-    package_dirs: Vec<PathBuf>,
-    gravity: [f64; 3],
-) -> PyResult<PyModel> {
-    let s = crate::scene::_scene_from_state(text, file, base_dir, package_dirs)?;
-    let mut m = PyModel::from_scene(&s);
     m.model.gravity = Vector3::new(gravity[0], gravity[1], gravity[2]);
     Ok(m)
 }

@@ -4,12 +4,14 @@
 //! pickles as its JSON text and the folder its paths are resolved against.
 
 use crate::args::value_error;
+use crate::introspect::link_inertials;
 use crate::model::PyModel;
 use numpy::PyArray1;
 use pyo3::exceptions::PyFileNotFoundError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use std::path::PathBuf;
+use urdyn::nalgebra::Vector3;
 use urdyn::scene::{Scene, SceneError};
 
 /// A scene (`Scene.from_file(path)`, `Scene.from_json(text, base_dir=None)`).
@@ -33,6 +35,24 @@ fn scene_error(e: SceneError) -> PyErr {
 }
 
 impl PyScene {
+    /// The `Model` of this scene (names `MODEL/NAME`; pickles as the scene).
+    pub fn py_model(&self) -> PyModel {
+        let s = &self.scene;
+        let mut inertials = std::collections::HashMap::new();
+        for m in &s.models {
+            if let Ok(text) = std::fs::read_to_string(&m.urdf) {
+                inertials.extend(link_inertials(&text, &format!("{}/", m.name)));
+            }
+        }
+        PyModel::from_parts(
+            s.model.clone(),
+            s.file.clone(),
+            self.package_dirs.clone(),
+            Some((self.text.clone(), s.file.clone(), s.base_dir.clone())),
+            inertials,
+        )
+    }
+
     fn build(
         text: String,
         file: &str,
@@ -84,7 +104,7 @@ impl PyScene {
     /// The whole scene as one `Model` (`dof_names`, `link_names` as `MODEL/NAME`).
     #[getter]
     fn model(&self) -> PyModel {
-        PyModel::from_scene(self)
+        self.py_model()
     }
 
     /// The models' names, in file (and q) order.
@@ -170,4 +190,19 @@ pub fn _scene_from_state(
     package_dirs: Vec<PathBuf>,
 ) -> PyResult<PyScene> {
     PyScene::build(text, &file, base_dir, package_dirs)
+}
+
+/// Rebuilds a pickled scene's `Model`.
+#[pyfunction]
+pub fn _scene_model_from_state(
+    text: String,
+    file: String,
+    base_dir: PathBuf,
+    package_dirs: Vec<PathBuf>,
+    gravity: [f64; 3],
+) -> PyResult<PyModel> {
+    let s = _scene_from_state(text, file, base_dir, package_dirs)?;
+    let mut m = s.py_model();
+    m.model.gravity = Vector3::new(gravity[0], gravity[1], gravity[2]);
+    Ok(m)
 }

@@ -1,20 +1,20 @@
-//! `urdyn.Simulation` and `urdyn.rollout`: one simulation stepped from Python,
-//! and B of them in parallel on rayon with the GIL released. Both go through
-//! [`prototype`] and [`advance`], so that a rollout's states equal, bit for bit,
-//! a `Simulation` stepped alone.
+//! `urdyn.Simulation`: one simulation stepped from Python. It and `rollout`
+//! (rollout.rs) go through [`prototype_any`] and [`advance`], so that a
+//! rollout's states equal, bit for bit, a `Simulation` stepped alone.
 
 use crate::args::{
-    normalize_base_quaternion, not_found_error, quat_offsets, read_array, read_q, read_vec,
-    value_error,
+    not_found_error, quat_offsets, read_count, read_q, read_threads, read_vec, value_error, Given,
 };
 use crate::model::PyModel;
 use crate::scene::PyScene;
+use crate::view::Frame;
 use crate::SimulationError;
-use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use rayon::prelude::*;
+use std::collections::HashMap;
 use std::path::PathBuf;
+use urdyn::cli::view::ContactArrow;
 use urdyn::contact::ContactError;
 use urdyn::nalgebra::DVector;
 use urdyn::sim::{Integrator, SimError, SimOptions, Simulation};
@@ -88,7 +88,7 @@ fn prototype_scene(
     package_dirs: Option<Vec<PathBuf>>,
 ) -> PyResult<Simulation> {
     let s = &scene.scene;
-    let model = PyModel::from_scene(scene);
+    let model = scene.py_model();
     let ground = s.ground.map(|g| g.height);
     let friction = s.ground.map_or(1.0, |g| g.friction);
     let mut sim = prototype(&model, dt, integrator, ground, friction, package_dirs)?;
@@ -100,27 +100,44 @@ fn prototype_scene(
 
 /// The simulation `Simulation(...)` / `rollout(...)` start from: of a `Model`
 /// (neutral, at rest) or of a `Scene` (its ground, friction and start; the
-/// `ground` and `friction` arguments are the file's then).
-fn prototype_any(
+/// `ground` and `friction` the file decides: given beside a scene, even at
+/// their defaults, they are a `ValueError`).
+pub(crate) fn prototype_any(
     source: &Bound<'_, PyAny>,
     dt: f64,
     integrator: Option<&str>,
-    ground: Option<f64>,
-    friction: f64,
+    ground: &Given,
+    friction: &Given,
     package_dirs: Option<Vec<PathBuf>>,
 ) -> PyResult<Simulation> {
     if let Ok(scene) = source.extract::<PyRef<'_, PyScene>>() {
+        for (name, g) in [("ground", ground), ("friction", friction)] {
+            if g.given() {
+                return Err(value_error(format!(
+                    "{name}= does not apply beside a scene: the scene file decides its ground and friction ({})",
+                    scene.scene.file
+                )));
+            }
+        }
         return prototype_scene(&scene, dt, integrator, package_dirs);
     }
     let model = source
         .extract::<PyRef<'_, PyModel>>()
         .map_err(|_| value_error("model: expected a urdyn.Model or a urdyn.Scene".to_string()))?;
-    prototype(&model, dt, integrator, ground, friction, package_dirs)
+    let py = source.py();
+    prototype(
+        &model,
+        dt,
+        integrator,
+        ground.ground(py)?,
+        friction.friction(py)?,
+        package_dirs,
+    )
 }
 
 /// One step of `dt` of simulated time (an adaptive integrator may take several
 /// steps of its own to get there; the last lands exactly).
-fn advance(sim: &mut Simulation, dt: f64) -> Result<(), SimError> {
+pub(crate) fn advance(sim: &mut Simulation, dt: f64) -> Result<(), SimError> {
     let target = sim.time() + dt;
     while sim.time() < target {
         sim.step_until(target)?;
@@ -129,7 +146,7 @@ fn advance(sim: &mut Simulation, dt: f64) -> Result<(), SimError> {
 }
 
 /// Constant joint torques (every free joint's part of `tau` ignored).
-fn set_torques(sim: &mut Simulation, tau: &[f64]) {
+pub(crate) fn set_torques(sim: &mut Simulation, tau: &[f64]) {
     let free: Vec<usize> = sim.model.free_joints.iter().map(|f| f.iv).collect();
     let t = sim.torques_mut();
     for k in 0..t.len() {
@@ -142,7 +159,7 @@ fn set_torques(sim: &mut Simulation, tau: &[f64]) {
 }
 
 /// A `SimulationError` with `.q`, `.v` (and `.index`) attached.
-fn sim_error(
+pub(crate) fn sim_error(
     py: Python<'_>,
     msg: String,
     q: Py<PyAny>,
@@ -161,53 +178,154 @@ fn sim_error(
 #[pyclass(name = "Simulation", module = "urdyn")]
 pub struct PySimulation {
     sim: Simulation,
+    /// The simulation as constructed (`reset()` returns to it).
+    start: Simulation,
     dt: f64,
     tau: DVector<f64>,
     /// `step(tau=None)`'s torques: zero, or a scene's `initial.tau`.
     tau0: DVector<f64>,
-    links: Vec<String>,
+    /// The URDF links and their order (`contacts()` orders a pair's sides by it).
+    frames: HashMap<String, usize>,
+    /// What a page of this simulation is drawn from (`write_html`), made at
+    /// the first `record(True)`.
+    stage: Option<crate::view::Stage>,
+    /// The model or scene given (a page's geometry is read from it).
+    source: Py<PyAny>,
+    /// The recording: `Some` while recording or after it stopped.
+    frames_rec: Vec<Frame>,
+    recording: bool,
+}
+
+impl PySimulation {
+    /// Adds the current state to the recording.
+    fn record_frame(&mut self) {
+        let arrows = self
+            .sim
+            .contact_forces()
+            .iter()
+            .map(|c| ContactArrow {
+                point: c.point.point.into(),
+                force: c.force.into(),
+            })
+            .collect();
+        self.frames_rec.push(Frame {
+            t: self.sim.time(),
+            q: self.sim.q().clone(),
+            plot: [
+                self.sim.energy(),
+                self.sim.active_contacts() as f64,
+                self.sim.penetration(),
+            ],
+            arrows,
+        });
+    }
 }
 
 #[pymethods]
 impl PySimulation {
     /// `ground=None`: no ground; `integrator=None`: the default for the scene
-    /// (`urdyn.integrators()` lists the names).
+    /// (`urdyn.integrators()` lists the names). Of a `Scene`: its ground,
+    /// friction, obstacles and start (`ground=`/`friction=` beside it are a
+    /// ValueError: the file decides).
     #[new]
-    #[pyo3(signature = (model, dt=1e-3, integrator=None, ground=Some(0.0), friction=1.0, package_dirs=None))]
+    #[pyo3(signature = (model, dt=1e-3, integrator=None, ground=Given::Omitted, friction=Given::Omitted, package_dirs=None))]
+    #[pyo3(
+        text_signature = "(model, dt=1e-3, integrator=None, ground=0.0, friction=1.0, package_dirs=None)"
+    )]
     fn new(
         model: &Bound<'_, PyAny>,
         dt: f64,
         integrator: Option<&str>,
-        ground: Option<f64>,
-        friction: f64,
+        ground: Given,
+        friction: Given,
         package_dirs: Option<Vec<PathBuf>>,
     ) -> PyResult<Self> {
-        let sim = prototype_any(model, dt, integrator, ground, friction, package_dirs)?;
+        let sim = prototype_any(model, dt, integrator, &ground, &friction, package_dirs)?;
+        let frames = sim
+            .model
+            .frames
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.name.clone(), i))
+            .collect();
         Ok(Self {
             dt,
             tau: sim.torques().clone(),
             tau0: sim.torques().clone(),
-            links: sim.model.body_link_names.clone(),
+            frames,
+            start: sim.clone(),
             sim,
+            stage: None,
+            source: model.clone().unbind(),
+            frames_rec: Vec::new(),
+            recording: false,
         })
     }
 
-    /// Sets the state (q: nq, v: nv) and time 0's warm starts.
-    fn set_state(&mut self, q: &Bound<'_, PyAny>, v: &Bound<'_, PyAny>) -> PyResult<()> {
+    /// Sets the state (q: nq, v: nv; warm starts forgotten); the time stays
+    /// unless `time` is given. The start `reset()` returns to does not move.
+    #[pyo3(signature = (q, v, time=None))]
+    fn set_state(
+        &mut self,
+        q: &Bound<'_, PyAny>,
+        v: &Bound<'_, PyAny>,
+        time: Option<f64>,
+    ) -> PyResult<()> {
         let m = &self.sim.model;
         let (mut qv, mut vv) = (DVector::zeros(m.nq), DVector::zeros(m.nv));
         read_q(q, "q", &quat_offsets(m), &mut qv)?;
         read_vec(v, "v", "nv", &mut vv)?;
+        if let Some(t) = time {
+            if !t.is_finite() {
+                return Err(value_error(format!(
+                    "time must be a finite number (got {t})"
+                )));
+            }
+        }
         self.sim
             .set_state(&qv, &vv)
-            .map_err(|e| value_error(e.to_string()))
+            .map_err(|e| value_error(e.to_string()))?;
+        if let Some(t) = time {
+            self.sim.set_time(t);
+        }
+        Ok(())
+    }
+
+    /// Back to the state and time the Simulation started from (a scene's
+    /// start), warm starts cleared; gains, targets and the recording stay. The
+    /// same inputs then replay the first run bit for bit.
+    fn reset(&mut self) -> PyResult<()> {
+        let (kp, kd) = self.sim.gains();
+        let (kp, kd) = (kp.clone(), kd.clone());
+        let (q_ref, v_ref) = self.sim.targets();
+        let (q_ref, v_ref) = (q_ref.clone(), v_ref.clone());
+        let mut sim = self.start.clone();
+        sim.set_gains(&kp, &kd)
+            .and_then(|_| sim.set_targets(&q_ref, Some(&v_ref)))
+            .map_err(|e| value_error(e.to_string()))?;
+        self.sim = sim;
+        Ok(())
     }
 
     /// `n` steps of `dt` with constant joint torques `tau` (nv entries, the
-    /// base's part ignored; None: zero).
-    #[pyo3(signature = (tau=None, n=1))]
-    fn step(&mut self, py: Python<'_>, tau: Option<&Bound<'_, PyAny>>, n: usize) -> PyResult<()> {
-        match tau {
+    /// base's part ignored; None: zero, or a scene's `initial` torques). With
+    /// servos (`set_gains`) tau is the feed-forward part. Each joint's torque,
+    /// servo included, is clamped to its URDF `<limit effort>` (as the CLI
+    /// does; `model.effort_limits`): a torque beyond it moves the joint as the
+    /// limit would, and `applied_torques` shows what was applied.
+    #[pyo3(signature = (tau=None, n=None))]
+    #[pyo3(text_signature = "(self, tau=None, n=1)")]
+    fn step(
+        &mut self,
+        py: Python<'_>,
+        tau: Option<&Bound<'_, PyAny>>,
+        n: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let n = match n {
+            Some(n) => read_count(n, "n", 0)?,
+            None => 1,
+        };
+        match tau.filter(|t| !t.is_none()) {
             Some(t) => {
                 read_vec(t, "tau", "nv", &mut self.tau)?;
                 set_torques(&mut self.sim, self.tau.as_slice());
@@ -215,13 +333,27 @@ impl PySimulation {
             // zero, or a scene's constant forces (its bases' included), as rollout
             None => self.sim.torques_mut().copy_from(&self.tau0),
         }
-        let (sim, dt) = (&mut self.sim, self.dt);
-        let r = py.detach(|| {
-            for _ in 0..n {
-                advance(sim, dt)?;
+        let (dt, recording) = (self.dt, self.recording);
+        let mut r = Ok(());
+        for _ in 0..n {
+            let sim = &mut self.sim;
+            // one call a step while recording, else all n without the GIL
+            let k = if recording { 1 } else { n };
+            r = py.detach(|| {
+                for _ in 0..k {
+                    advance(sim, dt)?;
+                }
+                Ok::<(), SimError>(())
+            });
+            if r.is_err() {
+                break;
             }
-            Ok::<(), SimError>(())
-        });
+            if recording {
+                self.record_frame();
+            } else {
+                break;
+            }
+        }
         r.map_err(|e| {
             let q = PyArray1::from_slice(py, self.sim.q().as_slice())
                 .into_any()
@@ -252,22 +384,67 @@ impl PySimulation {
     fn energy(&mut self) -> f64 {
         self.sim.energy()
     }
-    /// The last step's contact points: dicts with `link`, `point`, `normal` and
-    /// `force` (world frame, N).
-    fn contact_forces<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        self.sim
-            .contact_forces()
+    /// The deepest penetration now (m, 0 if none), as the CSV's column.
+    #[getter]
+    fn penetration(&self) -> f64 {
+        self.sim.penetration()
+    }
+    /// (nv,) the torques the last step applied: feed-forward plus servo, each
+    /// clamped to its effort limit (implicit servos: their end-of-step value;
+    /// an RK or adaptive step: its last stage's); base entries 0.
+    #[getter]
+    fn applied_torques<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let mut t = self.sim.applied_torques().clone();
+        for f in &self.sim.model.free_joints {
+            t.rows_mut(f.iv, 6).fill(0.0);
+        }
+        PyArray1::from_slice(py, t.as_slice())
+    }
+    /// Every contact point of the last step (within the contact margin, force
+    /// possibly zero): dicts with "link", "other" (a link, an obstacle's name
+    /// or "ground"), "point", "normal" (unit, from `other` into `link`),
+    /// "force" (on `link`, N) and "depth" (m, > 0 penetrating, < 0 a gap, at
+    /// the step's end as `penetration`), world frame.
+    fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        crate::contacts::contacts(&self.sim, &self.frames)
             .iter()
-            .map(|c| {
-                let d = PyDict::new(py);
-                let link = self.links.get(c.point.body).cloned().unwrap_or_default();
-                d.set_item("link", link)?;
-                d.set_item("point", PyArray1::from_slice(py, c.point.point.as_slice()))?;
-                d.set_item("normal", PyArray1::from_slice(py, &[0.0, 0.0, 1.0]))?;
-                d.set_item("force", PyArray1::from_slice(py, c.force.as_slice()))?;
-                Ok(d)
-            })
+            .map(|c| crate::contacts::to_dict(py, c))
             .collect()
+    }
+    /// The entries of `contacts()` that carry a force (link, other, point,
+    /// normal, force, depth).
+    fn contact_forces<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        crate::contacts::contacts(&self.sim, &self.frames)
+            .iter()
+            .filter(|c| c.force != urdyn::nalgebra::Vector3::zeros())
+            .map(|c| crate::contacts::to_dict(py, c))
+            .collect()
+    }
+
+    /// `record(True)` starts a recording, the current state its first frame
+    /// (starting again clears it); `record(False)` stops it (kept for
+    /// `write_html`).
+    fn record(&mut self, py: Python<'_>, on: bool) -> PyResult<()> {
+        if on {
+            if self.stage.is_none() {
+                let ground = self.sim.options().ground;
+                self.stage = Some(crate::view::stage(self.source.bind(py), ground)?);
+            }
+            self.frames_rec.clear();
+            self.record_frame();
+        }
+        self.recording = on;
+        Ok(())
+    }
+    /// Writes the recording's replay page to `path` (the recording is kept);
+    /// returns the number of frames the page holds (thinned for size).
+    fn write_html(&self, path: PathBuf) -> PyResult<usize> {
+        let Some(stage) = &self.stage else {
+            return Err(value_error(
+                "write_html: nothing recorded (call sim.record(True) before stepping)",
+            ));
+        };
+        crate::view::write(&path, stage, &self.frames_rec)
     }
 
     // --- Control and sensors (python.md §"Control", §"Sensors"; control.rs) ---
@@ -286,7 +463,13 @@ impl PySimulation {
         crate::control::set_targets(&mut self.sim, q_ref, v_ref)
     }
     /// A = ∂x'/∂x (2nv × 2nv), B = ∂x'/∂τ_ff (2nv × nv) of one step from the
-    /// current state (as a new Simulation would step it); `sim` is not changed.
+    /// current state, as a new Simulation with the same settings, gains and
+    /// targets would step it; `sim` is not changed. x = (q, v) in the tangent
+    /// space. `method="analytic"` differentiates the step with its contact set
+    /// held: where contacts touch, A is the contact-held derivative (a resting
+    /// foot stays on the ground), while "forward"/"central" (finite differences
+    /// of the step, step `eps`, as MuJoCo's mjd_transitionFD) see a perturbation
+    /// that lifts the foot leave the ground: one-sided, so they differ there.
     #[pyo3(signature = (tau=None, method="analytic", eps=1e-6))]
     #[allow(clippy::type_complexity)]
     fn transition_jacobians<'py>(
@@ -338,151 +521,10 @@ pub fn linearize<'py>(
     q: &Bound<'py, PyAny>,
     v: &Bound<'py, PyAny>,
     tau: &Bound<'py, PyAny>,
-    threads: Option<usize>,
+    threads: Option<&Bound<'py, PyAny>>,
     method: &str,
     eps: f64,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
+    let threads = read_threads(threads)?;
     crate::control::linearize(py, &sim.sim, q, v, tau, threads, method, eps)
-}
-
-/// The torques of a rollout: none, constant per run (B, nv), or per step
-/// (B, nstep, nv).
-enum Torques {
-    Zero,
-    Constant(Vec<f64>),
-    PerStep(Vec<f64>),
-}
-
-/// B simulations of `nstep` steps of `dt` from (q0[b], v0[b]), in parallel.
-/// Returns q (B, nstep + 1, nq) and v (B, nstep + 1, nv), initial states included.
-#[pyfunction]
-#[pyo3(signature = (model, q0, v0, tau=None, nstep=1000, dt=1e-3, threads=None, integrator=None, ground=Some(0.0), friction=1.0))]
-#[allow(clippy::too_many_arguments, clippy::type_complexity)]
-pub fn rollout<'py>(
-    py: Python<'py>,
-    model: &Bound<'py, PyAny>,
-    q0: &Bound<'py, PyAny>,
-    v0: &Bound<'py, PyAny>,
-    tau: Option<&Bound<'py, PyAny>>,
-    nstep: usize,
-    dt: f64,
-    threads: Option<usize>,
-    integrator: Option<&str>,
-    ground: Option<f64>,
-    friction: f64,
-) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
-    let proto = prototype_any(model, dt, integrator, ground, friction, None)?;
-    let (nq, nv) = (proto.model.nq, proto.model.nv);
-    let (qs, q0) = read_array(q0, "q0")?;
-    let (vs, v0) = read_array(v0, "v0")?;
-    if qs.len() != 2 || qs[1] != nq {
-        return Err(value_error(format!(
-            "q0 has shape {qs:?}, expected (B, {nq}) (nq = {nq})"
-        )));
-    }
-    let b = qs[0];
-    let mut q0 = q0;
-    for f in &proto.model.free_joints {
-        let at = f.iq + 3;
-        for i in 0..b {
-            normalize_base_quaternion(&mut q0[i * nq + at..i * nq + at + 4], &format!("q0[{i}]"))?;
-        }
-    }
-    if vs != [b, nv] {
-        return Err(value_error(format!(
-            "v0 has shape {vs:?}, expected ({b}, {nv}) (B, nv)"
-        )));
-    }
-    let torques = match tau {
-        None => Torques::Zero,
-        Some(t) if t.is_none() => Torques::Zero,
-        Some(t) => {
-            let (ts, tv) = read_array(t, "tau")?;
-            if ts == [b, nv] {
-                Torques::Constant(tv)
-            } else if ts == [b, nstep, nv] {
-                Torques::PerStep(tv)
-            } else {
-                return Err(value_error(format!(
-                    "tau has shape {ts:?}, expected ({b}, {nv}) or ({b}, {nstep}, {nv})"
-                )));
-            }
-        }
-    };
-    if threads == Some(0) {
-        return Err(value_error("threads must be at least 1 (None: all cores)"));
-    }
-    let qa = PyArray3::<f64>::zeros(py, [b, nstep + 1, nq], false);
-    let va = PyArray3::<f64>::zeros(py, [b, nstep + 1, nv], false);
-    let failures = {
-        // SAFETY: fresh C-contiguous arrays that no Python code has seen yet; the
-        // GIL is released below but nothing else holds them.
-        let qo = unsafe { qa.as_slice_mut() }.map_err(|e| value_error(e.to_string()))?;
-        let vo = unsafe { va.as_slice_mut() }.map_err(|e| value_error(e.to_string()))?;
-        // a failure: (batch index, whether the input was bad, message)
-        let run =
-            |(i, (qo, vo)): (usize, (&mut [f64], &mut [f64]))| -> Option<(usize, bool, String)> {
-                let mut sim = proto.clone();
-                let q = DVector::from_column_slice(&q0[i * nq..(i + 1) * nq]);
-                let v = DVector::from_column_slice(&v0[i * nv..(i + 1) * nv]);
-                let fail =
-                    |qo: &mut [f64], vo: &mut [f64], from: usize, input: bool, msg: String| {
-                        qo[from * nq..].fill(f64::NAN);
-                        vo[from * nv..].fill(f64::NAN);
-                        Some((i, input, msg))
-                    };
-                if let Err(e) = sim.set_state(&q, &v) {
-                    return fail(qo, vo, 0, true, format!("q0[{i}], v0[{i}]: {e}"));
-                }
-                if let Torques::Constant(t) = &torques {
-                    set_torques(&mut sim, &t[i * nv..(i + 1) * nv]);
-                }
-                qo[..nq].copy_from_slice(sim.q().as_slice());
-                vo[..nv].copy_from_slice(sim.v().as_slice());
-                for k in 0..nstep {
-                    if let Torques::PerStep(t) = &torques {
-                        let at = (i * nstep + k) * nv;
-                        set_torques(&mut sim, &t[at..at + nv]);
-                    }
-                    if let Err(e) = advance(&mut sim, dt) {
-                        return fail(qo, vo, k + 1, false, format!("batch index {i}: {e}"));
-                    }
-                    qo[(k + 1) * nq..(k + 2) * nq].copy_from_slice(sim.q().as_slice());
-                    vo[(k + 1) * nv..(k + 2) * nv].copy_from_slice(sim.v().as_slice());
-                }
-                None
-            };
-        let (sq, sv) = ((nstep + 1) * nq, (nstep + 1) * nv);
-        py.detach(|| {
-            let mut work = move || -> Vec<(usize, bool, String)> {
-                qo.par_chunks_mut(sq.max(1))
-                    .zip(vo.par_chunks_mut(sv.max(1)))
-                    .enumerate()
-                    .filter_map(run)
-                    .collect()
-            };
-            match threads {
-                None => Ok(work()),
-                Some(n) => rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build()
-                    .map(|pool| pool.install(work))
-                    .map_err(|e| e.to_string()),
-            }
-        })
-        .map_err(|e| value_error(format!("threads: cannot start a thread pool: {e}")))?
-    };
-    if let Some((_, _, msg)) = failures.iter().find(|f| f.1) {
-        return Err(value_error(msg.clone()));
-    }
-    if let Some((i, _, msg)) = failures.into_iter().min_by_key(|f| f.0) {
-        return Err(sim_error(
-            py,
-            msg,
-            qa.clone().into_any().unbind(),
-            va.clone().into_any().unbind(),
-            Some(i),
-        ));
-    }
-    Ok((qa, va))
 }

@@ -43,6 +43,7 @@ from ._urdyn import (  # noqa: F401
     rnea,
     rollout,
     to_pinocchio_q,
+    write_html,
 )
 from ._urdyn import (  # noqa: F401
     aba_derivatives,
@@ -78,6 +79,7 @@ __all__ = [
     "rnea",
     "rollout",
     "to_pinocchio_q",
+    "write_html",
     "aba_derivatives",
     "difference",
     "frame_jacobian_time_variation",

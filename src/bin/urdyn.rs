@@ -55,9 +55,9 @@ enum Command {
         #[arg(long, value_name = "OUT.json")]
         output: Option<PathBuf>,
     },
-    /// Simulate the robot (joint damping, friction, limits from the URDF; contact
-    /// between links and a ground plane only — no self-collision) and write its
-    /// trajectory as CSV.
+    /// Simulate the robot or a scene (joint damping, friction, limits from the
+    /// URDF; contact with the ground, between the robot's own links and, with
+    /// --scene, between models and with obstacles) and write its trajectory as CSV.
     Simulate(Box<SimulateCmd>),
     /// Time each dynamics algorithm on random states of this robot (median ns per call).
     Bench(BenchArgs),
@@ -86,7 +86,7 @@ enum Command {
 /// `urdyn simulate` options (cli.md).
 #[derive(clap::Args)]
 #[command(
-    after_help = "Contact is between the links' collision geometry and the ground plane only (no self-collision); links welded to the world take no part. Contact model: velocity-level impulses with exact Coulomb friction (stick and slip), solved each step."
+    after_help = "Contact is between the links' collision geometry and the ground plane, and between two links of one robot (self-collision) that are not a body and its parent, not on one body, not both welded to the world and not a <disable_collisions> pair of an SRDF; pairs that overlap at the start are dropped with a warning. With --scene, also between the models and with the scene's obstacles (scene.md \"Who touches whom\"). Contact model: velocity-level impulses with exact Coulomb friction (stick and slip), solved each step."
 )]
 struct SimulateCmd {
     /// The URDF file.

@@ -210,6 +210,13 @@ impl Simulation {
     pub fn has_servos(&self) -> bool {
         self.servo.active
     }
+    /// The generalized forces the last step applied (nv): τ_ff plus the servo
+    /// torque, each joint's clamped to its effort limit; with implicit servos
+    /// their end-of-step value, for a smooth (RK, adaptive) step the last
+    /// stage's; a floating base's entries as set. Zero before the first step.
+    pub fn applied_torques(&self) -> &DVector<f64> {
+        &self.servo.applied
+    }
 
     /// The free velocity with servos (the servo form of
     /// [`Simulation::free_velocity`]'s dense branch):

@@ -21,6 +21,12 @@ the Python standard library only.
     view_check.py shot PAGE.html OUT.png [--time T] [--size WxH]
         a screenshot of a page at time T (default: its end).
 
+    view_check.py page PAGE.html [--min-frames N]
+        any replay page (e.g. one urdyn.write_html or sim.write_html wrote from
+        Python): it becomes ready without a console error, holds at least N frames,
+        draws (screenshots at the start and the end not blank), moves (they differ)
+        and plays (the play button moves the slider on).
+
 Exit status 0 when every check passes; 77 with a loud message when no Chromium is
 installed (the caller decides whether that is a failure); 1 otherwise.
 """
@@ -387,6 +393,46 @@ def shot(args):
     return 1 if errors else 0
 
 
+def check_page(args):
+    chromium = find_chromium()
+    if not chromium:
+        print("no Chromium installed", file=sys.stderr)
+        return SKIP
+    failures = []
+    b = Browser(chromium)
+    try:
+        ready_ms, wall = b.open(args.page)
+        print(f"{args.page}: ready {ready_ms:.0f} ms (page clock), {wall:.2f} s wall")
+        times = b.evaluate("Array.from(urdynViewer.times)")
+        if len(times) < args.min_frames:
+            failures.append(f"{len(times)} frames, expected at least {args.min_frames}")
+        b.evaluate(f"urdynViewer.seek({json.dumps(times[0])})")
+        first = b.screenshot()
+        b.evaluate(f"urdynViewer.seek({json.dumps(times[-1])})")
+        last = b.screenshot()
+        _, _, pa = png_pixels(first)
+        _, _, pb = png_pixels(last)
+        fa, fb, diff = drawn_fraction(pa), drawn_fraction(pb), pixel_difference(pa, pb)
+        print(f"screenshots: {fa:.1%} and {fb:.1%} of the scene drawn, {diff:.2%} of pixels differ")
+        if fa < 0.005 or fb < 0.005:
+            failures.append("a screenshot shows nothing drawn (blank page?)")
+        if diff < 0.002:
+            failures.append("the start and end screenshots do not differ")
+        b.evaluate(f"urdynViewer.seek({json.dumps(times[0])}); document.getElementById('play').click()")
+        time.sleep(0.6)
+        moved = b.evaluate("+document.getElementById('slider').value")
+        print(f"playback: slider at frame {moved} after 0.6 s")
+        if not moved > 0:
+            failures.append("the play button did not move the slider")
+        failures.extend(b.errors())
+    finally:
+        b.close()
+    for f in failures:
+        print("FAIL:", f, file=sys.stderr)
+    print(f"browser test of {args.page}: " + ("FAILED" if failures else "passed"))
+    return 1 if failures else 0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -400,8 +446,11 @@ def main():
     s.add_argument("out")
     s.add_argument("--time", type=float)
     s.add_argument("--size", default="800x600")
+    p = sub.add_parser("page")
+    p.add_argument("page")
+    p.add_argument("--min-frames", type=int, default=2)
     args = ap.parse_args()
-    return check_lamp(args) if args.cmd == "lamp" else shot(args)
+    return {"lamp": check_lamp, "shot": shot, "page": check_page}[args.cmd](args)
 
 
 if __name__ == "__main__":

@@ -77,6 +77,7 @@ impl Simulation {
         let nv = self.model.nv;
         let mut tau = std::mem::replace(&mut self.mass.tau, DVector::zeros(0));
         self.clamped_tau(&mut tau);
+        self.servo.applied.copy_from(&tau);
         for k in 0..nv {
             tau[k] -= self.damping[k] * self.v[k];
         }

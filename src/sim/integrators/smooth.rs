@@ -34,7 +34,10 @@ impl Simulation {
         normalize_quats(model, &mut w.qn);
         for k in 0..nv {
             let (t, e) = (self.tau_applied[k], self.effort[k]);
-            w.tau[k] = self.servo.rhs_torque(t, e, &w.qn, &w.vv, k) + w.tau_c[k];
+            let applied = self.servo.rhs_torque(t, e, &w.qn, &w.vv, k);
+            // the last stage's applied torque ([`Simulation::applied_torques`])
+            self.servo.applied[k] = applied;
+            w.tau[k] = applied + w.tau_c[k];
         }
         if self.has_damping {
             for k in 0..nv {

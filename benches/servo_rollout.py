@@ -1,0 +1,139 @@
+"""Batched PD-target rollouts: urdyn.rollout with servos (kp, kd, q_ref per environment)
+against mujoco.rollout with position actuators, on solo12, in one run.
+
+64 environments of solo12 (floating base, ground plane, dt = 1 ms, semi-implicit Euler on
+both sides) starting in a standing stance with the feet 3 cm up, each with its own joint
+targets (the stance plus a per-environment offset of up to ±0.2 rad), kp = 5 N·m/rad and kd = 0.1 N·m·s/rad on every joint, 1000 steps,
+2 threads. MuJoCo's model is the same URDF through its importer (benches/sim_compare.py's
+build_mujoco: floor, friction 1, no self-collision) with one position actuator per joint
+(gain kp, bias -kp q - kd v, the targets as controls); urdyn's is the URDF with its
+default contact (self-collision included). Prints steps/s of each (best of --repeats
+calls; wall time and the process's CPU time, the fairer measure on a shared machine) and
+the ratios, and checks that one urdyn environment equals a Simulation with
+the same gains and targets stepped alone, bit for bit.
+
+    /work/venv/bin/python benches/servo_rollout.py    # needs mujoco and urdyn installed
+"""
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mujoco  # noqa: E402
+from mujoco import rollout as mj_rollout  # noqa: E402
+from sim_compare import mujoco_xml  # noqa: E402
+
+import urdyn  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+URDF = os.path.join(ROOT, "assets", "robots", "solo12.urdf")
+KP, KD = 5.0, 0.1
+
+
+def best(f, repeats):
+    """(best wall seconds, best CPU seconds of this process) over `repeats` calls: on a
+    shared machine the CPU time is the fairer measure (both sides run 2 threads)."""
+    wall, cpu = [], []
+    for _ in range(repeats):
+        c0, t0 = time.process_time(), time.perf_counter()
+        f()
+        wall.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
+    return min(wall), min(cpu)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--batch", type=int, default=64)
+    ap.add_argument("--nstep", type=int, default=1000)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--repeats", type=int, default=3)
+    args = ap.parse_args()
+    B, N = args.batch, args.nstep
+    rng = np.random.default_rng(0)
+
+    um = urdyn.Model.from_urdf(URDF, floating_base=True)
+    nq, nv, nj = um.nq, um.nv, um.nv - 6
+    # the stance (hips 0, thighs ±0.8, knees ∓1.6; front legs first), the feet 1 cm up
+    stance = um.neutral()
+    for k, name in enumerate(um.dof_names):
+        front = name.startswith("F")
+        stance[7 + k] = 0.0 if name.endswith("HAA") else (
+            (0.8 if front else -0.8) if name.endswith("HFE") else (-1.6 if front else 1.6))
+    data = um.create_data()
+    feet = [n for n in um.link_names if n.endswith("FOOT")]
+    stance[2] = -min(urdyn.frame_placement(um, data, stance, f)[2, 3] for f in feet) + 0.03
+    q0 = np.tile(stance, (B, 1))
+    v0 = np.zeros((B, nv))
+    q_ref = np.tile(stance, (B, 1))
+    q_ref[:, 7:] += rng.uniform(-0.2, 0.2, (B, nj))
+    kp = np.zeros(nv)
+    kp[6:] = KP
+    kd = np.zeros(nv)
+    kd[6:] = KD
+
+    def run_urdyn():
+        return urdyn.rollout(um, q0, v0, nstep=N, threads=args.threads, integrator="euler",
+                             kp=kp, kd=kd, q_ref=q_ref)
+
+    urdyn.rollout(um, q0[:2], v0[:2], nstep=10, threads=args.threads, integrator="euler",
+                  kp=kp, kd=kd, q_ref=q_ref[:2])
+    t_ur = best(run_urdyn, args.repeats)
+    Q, V = run_urdyn()
+    sim = urdyn.Simulation(um, integrator="euler")
+    sim.set_state(q0[5], v0[5])
+    sim.set_gains(kp, kd)
+    sim.set_targets(q_ref[5])
+    sim.step(n=N)
+    same = bool(np.array_equal(sim.q, Q[5, -1]) and np.array_equal(sim.v, V[5, -1]))
+
+    ma = mujoco_model()
+    nu = ma.nu
+    assert nu == nj, (nu, nj)
+    qpos0 = np.tile(ma.qpos0, (B, 1))
+    qpos0[:, :7] = q0[:, :7][:, [0, 1, 2, 6, 3, 4, 5]]  # MuJoCo's quaternion is w, x, y, z
+    init = np.concatenate([np.zeros((B, 1)), qpos0, np.zeros((B, ma.nv))], axis=1)
+    ctrl = np.repeat(q_ref[:, None, 7:], N, axis=1)
+    datas = [mujoco.MjData(ma) for _ in range(args.threads)]
+    mj_rollout.rollout(ma, datas, init[:2], ctrl[:2, :10], nstep=10)
+    t_mj = best(lambda: mj_rollout.rollout(ma, datas, init, ctrl, nstep=N), args.repeats)
+    (w_ur, c_ur), (w_mj, c_mj) = t_ur, t_mj
+    print(f"solo12, {B} environments x {N} steps, per-environment targets, {args.threads} threads:\n"
+          f"  wall: mujoco.rollout {B * N / w_mj:,.0f} steps/s, urdyn.rollout {B * N / w_ur:,.0f} "
+          f"steps/s, ratio {w_mj / w_ur:.2f}\n"
+          f"  CPU:  mujoco.rollout {B * N / c_mj:,.0f} steps/CPU-s, urdyn.rollout "
+          f"{B * N / c_ur:,.0f} steps/CPU-s, ratio {c_mj / c_ur:.2f}\n"
+          f"  urdyn environment 5 == a Simulation with the same gains and targets, bit for bit: {same}")
+
+
+def mujoco_model():
+    """solo12 as benches/sim_compare.py's build_mujoco makes it (the URDF through MuJoCo's
+    importer, a free joint, a floor, friction 1, no self-collision, dt = 1 ms), with a
+    position actuator (kp, kd) on every hinge joint, semi-implicit Euler."""
+    spec = mujoco.MjSpec.from_string(mujoco_xml(URDF, [os.path.dirname(URDF)]))
+    base = list(spec.worldbody.bodies)[0]
+    base.add_freejoint()
+    for g in spec.geoms:
+        g.contype, g.conaffinity = 1, 0
+        g.friction = [1.0, 0.005, 0.0001]
+    spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1],
+                            contype=0, conaffinity=1, friction=[1.0, 0.005, 0.0001])
+    for j in spec.joints:
+        if j.type == mujoco.mjtJoint.mjJNT_HINGE:
+            spec.add_actuator(name=f"pos_{j.name}", target=j.name,
+                              trntype=mujoco.mjtTrn.mjTRN_JOINT,
+                              gaintype=mujoco.mjtGain.mjGAIN_FIXED,
+                              biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+                              gainprm=[KP] + [0] * 9, biasprm=[0, -KP, -KD] + [0] * 7)
+    spec.option.timestep = 1e-3
+    spec.option.gravity = [0, 0, -9.81]
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    return spec.compile()
+
+
+if __name__ == "__main__":
+    main()
