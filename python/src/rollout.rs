@@ -143,8 +143,7 @@ pub fn rollout<'py>(
     }
     let b = qs[0];
     let mut q0 = q0;
-    for f in &proto.model.free_joints {
-        let at = f.iq + 3;
+    for at in crate::args::quat_offsets(&proto.model) {
         for i in 0..b {
             normalize_quaternion_at(
                 &mut q0[i * nq + at..i * nq + at + 4],
