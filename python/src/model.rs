@@ -32,6 +32,9 @@ pub struct PyModel {
     pub scene_state: Option<(String, String, PathBuf)>,
     /// Every URDF link's own `<inertial>` (`link_mass`, `link_inertia`).
     pub inertials: HashMap<String, LinkInertial>,
+    /// An MJCF model: the folder its includes and meshes are read from (`text`
+    /// is then the MJCF text; a pickled model is rebuilt from both).
+    pub mjcf_dir: Option<PathBuf>,
 }
 
 impl PyModel {
@@ -60,6 +63,7 @@ impl PyModel {
             links,
             scene_state: None,
             inertials,
+            mjcf_dir: None,
         })
     }
 
@@ -86,6 +90,7 @@ impl PyModel {
             links,
             scene_state,
             inertials,
+            mjcf_dir: None,
         }
     }
 
@@ -167,6 +172,47 @@ impl PyModel {
             Some(path),
             package_dirs.unwrap_or_default(),
         )
+    }
+
+    /// Imports an MJCF file (mjcf.md): its whole world (every body with its
+    /// joints, in MuJoCo's qpos order; each ball or free joint's quaternion
+    /// `[qx, qy, qz, qw]`, a free joint's linear velocity in its body frame:
+    /// `from_mujoco_qpos`/`from_mujoco_qvel` convert). Joint `armature` is in
+    /// `crba` and `forward_dynamics` as in MuJoCo's qM (`model.armature`).
+    #[staticmethod]
+    fn from_mjcf(path: PathBuf) -> PyResult<Self> {
+        crate::mjcf::from_mjcf(path)
+    }
+
+    /// Imports MJCF text; `<include>`s and meshes are read under `base_dir`.
+    #[staticmethod]
+    #[pyo3(signature = (xml, base_dir=PathBuf::from(".")))]
+    fn from_mjcf_string(xml: String, base_dir: PathBuf) -> PyResult<Self> {
+        crate::mjcf::from_mjcf_string(xml, "<string>".into(), base_dir)
+    }
+
+    /// Imports a URDF or an MJCF file, the format from its content (a root
+    /// `<mujoco>` is MJCF whatever the extension); `floating_base=True` beside
+    /// an MJCF file is a `ValueError` (the file says which joints are free).
+    #[staticmethod]
+    #[pyo3(signature = (path, floating_base=false, package_dirs=None))]
+    fn from_file(
+        path: PathBuf,
+        floating_base: bool,
+        package_dirs: Option<Vec<PathBuf>>,
+    ) -> PyResult<Self> {
+        match urdyn::load::file_format(&path) {
+            urdyn::load::Format::Mjcf => {
+                if floating_base {
+                    let e = urdyn::load_model(&path, LoadOptions { floating_base });
+                    return Err(value_error(
+                        e.err().map(|e| e.to_string()).unwrap_or_default(),
+                    ));
+                }
+                crate::mjcf::from_mjcf(path)
+            }
+            _ => Self::from_urdf(path, floating_base, package_dirs),
+        }
     }
 
     /// Imports URDF text.
@@ -321,10 +367,16 @@ impl PyModel {
     fn friction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_vec(py, introspect::per_dof(&self.model, 0.0, |d| d.friction))
     }
-    /// (nv,) rotor inertia on each joint's diagonal (URDF has none: zeros).
+    /// (nv,) rotor inertia on each joint's diagonal: an MJCF joint's
+    /// `armature` (in H as MuJoCo's qM: `crba`, `rnea`, `forward_dynamics`
+    /// include it); a URDF has none (zeros).
     #[getter]
     fn armature<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_vec(py, vec![0.0; self.model.nv])
+        let a = self
+            .model
+            .armature()
+            .unwrap_or_else(|| DVector::zeros(self.model.nv));
+        PyArray1::from_slice(py, a.as_slice())
     }
     /// A link's own `<inertial>` mass (kg; 0 without one).
     fn link_mass(&self, link: &str) -> PyResult<f64> {
@@ -397,6 +449,21 @@ impl PyModel {
                 file.clone(),
                 dir.display().to_string(),
                 dirs,
+                g,
+            )
+                .into_pyobject(py)?;
+            return Ok((f, args));
+        }
+        if let Some(dir) = &self.mjcf_dir {
+            let f = py
+                .import("urdyn._urdyn")?
+                .getattr("_mjcf_model_from_state")?
+                .unbind();
+            let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.clone());
+            let args = (
+                self.text.clone(),
+                self.file.clone(),
+                dir.display().to_string(),
                 g,
             )
                 .into_pyobject(py)?;
