@@ -665,11 +665,11 @@ pub fn from_pinocchio_q<'py>(
     read_vec(q_pin, "q_pin", "Pinocchio's nq", &mut qp)?;
     let mut out = Vec::with_capacity(m.nq);
     let mut k = 0;
-    let angle = |qp: &DVector<f64>, k: usize, name: &str| -> PyResult<f64> {
+    let angle = |qp: &DVector<f64>, k: usize, kind: &str, name: &str| -> PyResult<f64> {
         let (c, s) = (qp[k], qp[k + 1]);
         if c == 0.0 && s == 0.0 {
             return Err(value_error(format!(
-                "q_pin[{k}:{}]: the (cos, sin) pair of joint \"{name}\" is (0, 0)",
+                "q_pin[{k}:{}]: the (cos, sin) pair of {kind} joint \"{name}\" is (0, 0)",
                 k + 2
             )));
         }
@@ -686,11 +686,11 @@ pub fn from_pinocchio_q<'py>(
                 k += n;
             }
             PinBlock::Angle => {
-                out.push(angle(&qp, k, name)?);
+                out.push(angle(&qp, k, "continuous", name)?);
                 k += 2;
             }
             PinBlock::Planar => {
-                out.extend_from_slice(&[qp[k], qp[k + 1], angle(&qp, k + 2, name)?]);
+                out.extend_from_slice(&[qp[k], qp[k + 1], angle(&qp, k + 2, "planar", name)?]);
                 k += 4;
             }
         }
