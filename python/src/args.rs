@@ -21,16 +21,11 @@ pub fn not_found_error(msg: impl Into<String>) -> PyErr {
 /// tolerance for `base.orientation_xyzw` (src/cli/state.rs).
 pub const QUATERNION_TOLERANCE: f64 = 1e-3;
 
-/// Normalises `quat` (a floating base's `[qx, qy, qz, qw]`, entries 3..7 of
-/// `name`) in place, as the CLI does; a `ValueError` with the CLI's message
+/// Normalises the quaternion `quat` (`[qx, qy, qz, qw]`, entries `name[at:at + 4]`:
+/// a floating base's orientation, a scene's later floating model's, a spherical
+/// joint's) in place, as the CLI does; a `ValueError` with the CLI's message
 /// ("not a unit quaternion (norm N)") unless its norm is within
 /// [`QUATERNION_TOLERANCE`] of 1.
-pub fn normalize_base_quaternion(quat: &mut [f64], name: &str) -> PyResult<()> {
-    normalize_quaternion_at(quat, name, 3)
-}
-
-/// As [`normalize_base_quaternion`] for the quaternion at `name[at:at + 4]` (a
-/// scene's later floating model: its own entries named, not the first model's).
 pub fn normalize_quaternion_at(quat: &mut [f64], name: &str, at: usize) -> PyResult<()> {
     // |q| = sqrt(qx² + qy² + qz² + qw²)
     let n = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -39,7 +34,7 @@ pub fn normalize_quaternion_at(quat: &mut [f64], name: &str, at: usize) -> PyRes
         Ok(())
     } else {
         Err(value_error(format!(
-            "{name}[{at}:{}] (the base orientation qx, qy, qz, qw): not a unit quaternion (norm {n})",
+            "{name}[{at}:{}] (a quaternion qx, qy, qz, qw: a floating base's orientation or a spherical joint's): not a unit quaternion (norm {n})",
             at + 4
         )))
     }
@@ -135,9 +130,26 @@ pub fn read_q(
     Ok(())
 }
 
-/// The offsets in q of every free joint's quaternion (`iq + 3`).
+/// The offsets in q of every quaternion: each free joint's (`iq + 3`, the
+/// floating base's and an MJCF body's inner free joint alike) and each
+/// spherical joint's (`iq`), in q order.
 pub fn quat_offsets(model: &urdyn::Model) -> Vec<usize> {
-    model.free_joints.iter().map(|f| f.iq + 3).collect()
+    use urdyn::model::JointKind;
+    let mut out: Vec<usize> = model.free_joints.iter().map(|f| f.iq + 3).collect();
+    out.extend(
+        model
+            .joints
+            .iter()
+            .skip(1)
+            .filter_map(|j| match j.kind {
+                JointKind::Free => Some(j.iq + 3),
+                JointKind::Spherical => Some(j.iq),
+                _ => None,
+            }),
+    );
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 /// Copies the 1-D array-like `x` into `out` (length `n`, the model's `what`):

@@ -133,8 +133,13 @@ pub fn rnea<'py>(
     read_qvx(&model, d, q, v, a, "a")?;
     let has = read_fext(&model, d, fext)?;
     let f = has.then_some(&d.fext[..]);
-    let tau = dynamics::rnea(&model.model, &mut d.data, &d.q, &d.v, &d.a, f)
-        .map_err(|e| dyn_error(&model, e))?;
+    let mut tau = dynamics::rnea(&model.model, &mut d.data, &d.q, &d.v, &d.a, f)
+        .map_err(|e| dyn_error(&model, e))?
+        .clone();
+    // an MJCF joint's armature is in H (MuJoCo's qM), as eval: τ + A a
+    if let Some(arm) = model.model.armature() {
+        tau += arm.component_mul(&d.a);
+    }
     Ok(vec_out(py, tau.as_slice()))
 }
 
@@ -170,8 +175,16 @@ pub fn crba<'py>(
     let d = &mut *data;
     d.check(&model.model)?;
     read_q(d, q)?;
-    let h = dynamics::crba(&model.model, &mut d.data, &d.q).map_err(|e| dyn_error(&model, e))?;
-    Ok(mat_out(py, h))
+    let mut h = dynamics::crba(&model.model, &mut d.data, &d.q)
+        .map_err(|e| dyn_error(&model, e))?
+        .clone();
+    // an MJCF joint's armature is in H (MuJoCo's qM), as eval: H + A
+    if let Some(arm) = model.model.armature() {
+        for k in 0..arm.len() {
+            h[(k, k)] += arm[k];
+        }
+    }
+    Ok(mat_out(py, &h))
 }
 
 /// The three forward-dynamics entry points differ only in the algorithm.
@@ -197,6 +210,25 @@ fn forward<'py>(
     let has = read_fext(model, d, fext)?;
     let f = has.then_some(&d.fext[..]);
     let m = &model.model;
+    if let Some(arm) = m.armature() {
+        // an MJCF joint's armature is in H (MuJoCo's qM), as eval: whichever
+        // algorithm, q̈ = (H + A)⁻¹ (τ − C) by H + A's Cholesky factor
+        let mut h = dynamics::crba(m, &mut d.data, &d.q)
+            .map_err(|e| dyn_error(model, e))?
+            .clone();
+        for k in 0..arm.len() {
+            h[(k, k)] += arm[k];
+        }
+        let bias = dynamics::bias(m, &mut d.data, &d.q, &d.v, f)
+            .map_err(|e| dyn_error(model, e))?
+            .clone();
+        if let Err(k) = dynamics::linalg::cholesky(&h, &mut d.data.chol) {
+            return Err(dyn_error(model, DynamicsError::Singular(k)));
+        }
+        let mut x = &d.a - &bias;
+        dynamics::linalg::cholesky_solve(&d.data.chol, &mut x);
+        return Ok(vec_out(py, x.as_slice()));
+    }
     let r = match algo {
         Fd::Aba => dynamics::aba(m, &mut d.data, &d.q, &d.v, &d.a, f),
         Fd::Fastest => dynamics::forward_dynamics(m, &mut d.data, &d.q, &d.v, &d.a, f),

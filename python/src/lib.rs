@@ -6,11 +6,13 @@
 //! names are fixed by `shared/spec/python.md` (Pinocchio's where it has one).
 
 mod args;
+mod constraints;
 mod contacts;
 mod control;
 mod derivatives;
 mod dynamics;
 mod introspect;
+mod mjcf;
 mod model;
 mod rollout;
 mod scene;
@@ -42,6 +44,8 @@ fn _urdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(model::from_pinocchio_q, m)?)?;
     dynamics::register(m)?;
     derivatives::register(m)?;
+    constraints::register(m)?;
+    mjcf::register(m)?;
     m.add_function(wrap_pyfunction!(rollout::rollout, m)?)?;
     m.add_function(wrap_pyfunction!(view::write_html, m)?)?;
     m.add_function(wrap_pyfunction!(sim::integrators, m)?)?;

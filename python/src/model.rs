@@ -2,7 +2,7 @@
 //! (the preallocated workspace).
 
 use crate::args::{
-    normalize_base_quaternion, not_found_error, quat_offsets, read3, read_q, read_vec, value_error,
+    normalize_quaternion_at, not_found_error, quat_offsets, read3, read_q, read_vec, value_error,
 };
 use crate::introspect::{self, link_inertials, py_slice, LinkInertial};
 use numpy::{PyArray1, PyArray2};
@@ -32,6 +32,9 @@ pub struct PyModel {
     pub scene_state: Option<(String, String, PathBuf)>,
     /// Every URDF link's own `<inertial>` (`link_mass`, `link_inertia`).
     pub inertials: HashMap<String, LinkInertial>,
+    /// An MJCF model: the folder its includes and meshes are read from (`text`
+    /// is then the MJCF text; a pickled model is rebuilt from both).
+    pub mjcf_dir: Option<PathBuf>,
 }
 
 impl PyModel {
@@ -60,6 +63,7 @@ impl PyModel {
             links,
             scene_state: None,
             inertials,
+            mjcf_dir: None,
         })
     }
 
@@ -86,6 +90,7 @@ impl PyModel {
             links,
             scene_state,
             inertials,
+            mjcf_dir: None,
         }
     }
 
@@ -167,6 +172,47 @@ impl PyModel {
             Some(path),
             package_dirs.unwrap_or_default(),
         )
+    }
+
+    /// Imports an MJCF file (mjcf.md): its whole world (every body with its
+    /// joints, in MuJoCo's qpos order; each ball or free joint's quaternion
+    /// `[qx, qy, qz, qw]`, a free joint's linear velocity in its body frame:
+    /// `from_mujoco_qpos`/`from_mujoco_qvel` convert). Joint `armature` is in
+    /// `crba` and `forward_dynamics` as in MuJoCo's qM (`model.armature`).
+    #[staticmethod]
+    fn from_mjcf(path: PathBuf) -> PyResult<Self> {
+        crate::mjcf::from_mjcf(path)
+    }
+
+    /// Imports MJCF text; `<include>`s and meshes are read under `base_dir`.
+    #[staticmethod]
+    #[pyo3(signature = (xml, base_dir=PathBuf::from(".")))]
+    fn from_mjcf_string(xml: String, base_dir: PathBuf) -> PyResult<Self> {
+        crate::mjcf::from_mjcf_string(xml, "<string>".into(), base_dir)
+    }
+
+    /// Imports a URDF or an MJCF file, the format from its content (a root
+    /// `<mujoco>` is MJCF whatever the extension); `floating_base=True` beside
+    /// an MJCF file is a `ValueError` (the file says which joints are free).
+    #[staticmethod]
+    #[pyo3(signature = (path, floating_base=false, package_dirs=None))]
+    fn from_file(
+        path: PathBuf,
+        floating_base: bool,
+        package_dirs: Option<Vec<PathBuf>>,
+    ) -> PyResult<Self> {
+        match urdyn::load::file_format(&path) {
+            urdyn::load::Format::Mjcf => {
+                if floating_base {
+                    let e = urdyn::load_model(&path, LoadOptions { floating_base });
+                    return Err(value_error(
+                        e.err().map(|e| e.to_string()).unwrap_or_default(),
+                    ));
+                }
+                crate::mjcf::from_mjcf(path)
+            }
+            _ => Self::from_urdf(path, floating_base, package_dirs),
+        }
     }
 
     /// Imports URDF text.
@@ -321,10 +367,16 @@ impl PyModel {
     fn friction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_vec(py, introspect::per_dof(&self.model, 0.0, |d| d.friction))
     }
-    /// (nv,) rotor inertia on each joint's diagonal (URDF has none: zeros).
+    /// (nv,) rotor inertia on each joint's diagonal: an MJCF joint's
+    /// `armature` (in H as MuJoCo's qM: `crba`, `rnea`, `forward_dynamics`
+    /// include it); a URDF has none (zeros).
     #[getter]
     fn armature<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_vec(py, vec![0.0; self.model.nv])
+        let a = self
+            .model
+            .armature()
+            .unwrap_or_else(|| DVector::zeros(self.model.nv));
+        PyArray1::from_slice(py, a.as_slice())
     }
     /// A link's own `<inertial>` mass (kg; 0 without one).
     fn link_mass(&self, link: &str) -> PyResult<f64> {
@@ -397,6 +449,21 @@ impl PyModel {
                 file.clone(),
                 dir.display().to_string(),
                 dirs,
+                g,
+            )
+                .into_pyobject(py)?;
+            return Ok((f, args));
+        }
+        if let Some(dir) = &self.mjcf_dir {
+            let f = py
+                .import("urdyn._urdyn")?
+                .getattr("_mjcf_model_from_state")?
+                .unbind();
+            let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.clone());
+            let args = (
+                self.text.clone(),
+                self.file.clone(),
+                dir.display().to_string(),
                 g,
             )
                 .into_pyobject(py)?;
@@ -477,25 +544,73 @@ impl PyData {
     }
 }
 
-/// Where each degree of freedom's coordinate sits in Pinocchio's q: the base's 7
-/// coordinates (the same `[x, y, z, qx, qy, qz, qw]` in both), then per degree of
-/// freedom one coordinate, or two (cos θ, sin θ) for a continuous joint. Returns
-/// (the base's length, Pinocchio's nq).
-fn pinocchio_layout(model: &Model) -> (usize, usize) {
-    let base = model.nq - model.dofs.len();
-    let nq_pin = base
-        + model
-            .dofs
-            .iter()
-            .map(|d| if d.continuous { 2 } else { 1 })
-            .sum::<usize>();
-    (base, nq_pin)
+/// How a joint's coordinates map to Pinocchio's: a continuous revolute joint's
+/// θ is (cos θ, sin θ) (`JointModelRUB`), a planar joint's (x, y, θ) is
+/// (x, y, cos θ, sin θ) (`JointModelPlanar`); every other coordinate is copied.
+enum PinBlock {
+    /// `n` coordinates copied (the base, prismatic, revolute, spherical, free).
+    Copy(usize),
+    /// A continuous joint: θ ↔ (cos θ, sin θ).
+    Angle,
+    /// A planar joint: (x, y, θ) ↔ (x, y, cos θ, sin θ).
+    Planar,
+}
+
+/// The blocks of q in order with their joint names (the base's first when the
+/// model floats), each with its quaternion's offset inside the block (a free
+/// joint's at 3, a spherical joint's at 0), and Pinocchio's nq.
+fn pinocchio_layout(model: &Model) -> (Vec<(PinBlock, String, Option<usize>)>, usize) {
+    use urdyn::model::JointKind;
+    // (iq, nq, block, name, quaternion offset): the free joints (bases), then
+    // every joint that owns coordinates, in q order
+    let mut joints: Vec<(usize, usize, PinBlock, String, Option<usize>)> = model
+        .free_joints
+        .iter()
+        .map(|f| (f.iq, 7, PinBlock::Copy(7), f.name.clone(), Some(3)))
+        .collect();
+    for d in &model.dofs {
+        if joints.iter().any(|j| j.0 == d.iq) {
+            continue;
+        }
+        let (b, quat) = match d.kind {
+            JointKind::Planar => (PinBlock::Planar, None),
+            JointKind::Spherical => (PinBlock::Copy(4), Some(0)),
+            JointKind::Free => (PinBlock::Copy(7), Some(3)),
+            JointKind::Revolute(_) if d.continuous => (PinBlock::Angle, None),
+            ref k => (PinBlock::Copy(k.nq()), None),
+        };
+        joints.push((d.iq, d.kind.nq(), b, d.name.clone(), quat));
+    }
+    joints.sort_by_key(|j| j.0);
+    let mut blocks = Vec::new();
+    let mut at = 0;
+    for (iq, n, b, name, quat) in joints {
+        if iq > at {
+            // coordinates no joint claims (none expected): copied
+            blocks.push((PinBlock::Copy(iq - at), String::new(), None));
+        }
+        blocks.push((b, name, quat));
+        at = iq + n;
+    }
+    if model.nq > at {
+        blocks.push((PinBlock::Copy(model.nq - at), String::new(), None));
+    }
+    let nq_pin = blocks
+        .iter()
+        .map(|(b, _, _)| match b {
+            PinBlock::Copy(n) => *n,
+            PinBlock::Angle => 2,
+            PinBlock::Planar => 4,
+        })
+        .sum();
+    (blocks, nq_pin)
 }
 
 /// Pinocchio's q of urdyn's `q`: each continuous joint's angle θ becomes the pair
-/// (cos θ, sin θ) (Pinocchio's `JointModelRUB`); every other coordinate, the
-/// floating base's included, is copied. The degrees of freedom are in the same
-/// order in both (`model.dof_names`).
+/// (cos θ, sin θ) (Pinocchio's `JointModelRUB`), each planar joint's (x, y, θ)
+/// becomes (x, y, cos θ, sin θ) (`JointModelPlanar`); every other coordinate,
+/// the floating base's and the spherical joints' quaternions included, is
+/// copied. The joints are in the same order in both (`model.dof_names`).
 #[pyfunction]
 pub fn to_pinocchio_q<'py>(
     py: Python<'py>,
@@ -505,15 +620,27 @@ pub fn to_pinocchio_q<'py>(
     let m = &model.model;
     let mut qv = DVector::zeros(m.nq);
     read_q(q, "q", &quat_offsets(m), &mut qv)?;
-    let (base, nq_pin) = pinocchio_layout(m);
+    let (blocks, nq_pin) = pinocchio_layout(m);
     let mut out = Vec::with_capacity(nq_pin);
-    out.extend_from_slice(&qv.as_slice()[..base]);
-    for (d, &x) in m.dofs.iter().zip(&qv.as_slice()[base..]) {
-        if d.continuous {
-            // (cos θ, sin θ)
-            out.extend_from_slice(&[x.cos(), x.sin()]);
-        } else {
-            out.push(x);
+    let qs = qv.as_slice();
+    let mut k = 0;
+    for (b, _, _) in &blocks {
+        match b {
+            PinBlock::Copy(n) => {
+                out.extend_from_slice(&qs[k..k + n]);
+                k += n;
+            }
+            PinBlock::Angle => {
+                // (cos θ, sin θ)
+                out.extend_from_slice(&[qs[k].cos(), qs[k].sin()]);
+                k += 1;
+            }
+            PinBlock::Planar => {
+                // (x, y, cos θ, sin θ)
+                let t = qs[k + 2];
+                out.extend_from_slice(&[qs[k], qs[k + 1], t.cos(), t.sin()]);
+                k += 3;
+            }
         }
     }
     Ok(PyArray1::from_vec(py, out))
@@ -522,9 +649,10 @@ pub fn to_pinocchio_q<'py>(
 /// urdyn's q of Pinocchio's `q_pin` (of length `nq` of the Pinocchio model of the
 /// same URDF, `pin.buildModelFromUrdf(path, mimic=True)`, where a mimic joint has
 /// no coordinate of its own, as here): each continuous joint's pair (cos θ,
-/// sin θ) becomes θ = atan2(sin θ, cos θ) in (−π, π]; every other coordinate is
-/// copied. A pair (0, 0), a wrong length, a non-finite entry or a base
-/// quaternion off unit norm is a `ValueError`.
+/// sin θ) becomes θ = atan2(sin θ, cos θ) in (−π, π], each planar joint's
+/// (x, y, cos θ, sin θ) becomes (x, y, θ) likewise; every other coordinate is
+/// copied. A pair (0, 0), a wrong length, a non-finite entry or a quaternion
+/// (a floating base's or a spherical joint's) off unit norm is a `ValueError`.
 #[pyfunction]
 pub fn from_pinocchio_q<'py>(
     py: Python<'py>,
@@ -532,31 +660,39 @@ pub fn from_pinocchio_q<'py>(
     q_pin: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let m = &model.model;
-    let (base, nq_pin) = pinocchio_layout(m);
+    let (blocks, nq_pin) = pinocchio_layout(m);
     let mut qp = DVector::zeros(nq_pin);
     read_vec(q_pin, "q_pin", "Pinocchio's nq", &mut qp)?;
-    if m.floating_base {
-        normalize_base_quaternion(&mut qp.as_mut_slice()[3..7], "q_pin")?;
-    }
     let mut out = Vec::with_capacity(m.nq);
-    out.extend_from_slice(&qp.as_slice()[..base]);
-    let mut k = base;
-    for d in &m.dofs {
-        if d.continuous {
-            let (c, s) = (qp[k], qp[k + 1]);
-            if c == 0.0 && s == 0.0 {
-                return Err(value_error(format!(
-                    "q_pin[{k}:{}]: the (cos, sin) pair of continuous joint \"{}\" is (0, 0)",
-                    k + 2,
-                    d.name
-                )));
+    let mut k = 0;
+    let angle = |qp: &DVector<f64>, k: usize, kind: &str, name: &str| -> PyResult<f64> {
+        let (c, s) = (qp[k], qp[k + 1]);
+        if c == 0.0 && s == 0.0 {
+            return Err(value_error(format!(
+                "q_pin[{k}:{}]: the (cos, sin) pair of {kind} joint \"{name}\" is (0, 0)",
+                k + 2
+            )));
+        }
+        // θ = atan2(sin θ, cos θ)
+        Ok(s.atan2(c))
+    };
+    for (b, name, quat) in &blocks {
+        match b {
+            PinBlock::Copy(n) => {
+                if let Some(o) = quat.filter(|o| o + 4 <= *n) {
+                    normalize_quaternion_at(&mut qp.as_mut_slice()[k + o..k + o + 4], "q_pin", k + o)?;
+                }
+                out.extend_from_slice(&qp.as_slice()[k..k + n]);
+                k += n;
             }
-            // θ = atan2(sin θ, cos θ)
-            out.push(s.atan2(c));
-            k += 2;
-        } else {
-            out.push(qp[k]);
-            k += 1;
+            PinBlock::Angle => {
+                out.push(angle(&qp, k, "continuous", name)?);
+                k += 2;
+            }
+            PinBlock::Planar => {
+                out.extend_from_slice(&[qp[k], qp[k + 1], angle(&qp, k + 2, "planar", name)?]);
+                k += 4;
+            }
         }
     }
     Ok(PyArray1::from_vec(py, out))

@@ -107,8 +107,13 @@ fn read_gains(
 
 /// B simulations of `nstep` steps of `dt` from (q0[b], v0[b]), in parallel.
 /// Returns q (B, nstep + 1, nq) and v (B, nstep + 1, nv), initial states included.
+/// `threads`: the batch's workers, and each simulation's island threads
+/// (scene.md §"Large scenes"); `sleep`: whether still islands sleep. `None`
+/// takes the scene's settings (a model alone sleeps, one island thread); each
+/// batch entry equals a `Simulation` with the same `sleep`/`threads` stepped
+/// alone, bit for bit.
 #[pyfunction]
-#[pyo3(signature = (model, q0, v0, tau=None, nstep=None, dt=1e-3, threads=None, integrator=None, ground=Given::Omitted, friction=Given::Omitted, kp=None, kd=None, q_ref=None, v_ref=None))]
+#[pyo3(signature = (model, q0, v0, tau=None, nstep=None, dt=1e-3, threads=None, integrator=None, ground=Given::Omitted, friction=Given::Omitted, kp=None, kd=None, q_ref=None, v_ref=None, sleep=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn rollout<'py>(
     py: Python<'py>,
@@ -126,13 +131,16 @@ pub fn rollout<'py>(
     kd: Option<&Bound<'py, PyAny>>,
     q_ref: Option<&Bound<'py, PyAny>>,
     v_ref: Option<&Bound<'py, PyAny>>,
+    sleep: Option<bool>,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
     let nstep = match nstep {
         Some(n) if !n.is_none() => read_count(n, "nstep", 0)?,
         _ => 1000,
     };
     let threads = read_threads(threads)?;
-    let proto = prototype_any(model, dt, integrator, &ground, &friction, None)?;
+    let proto = prototype_any(
+        model, dt, integrator, &ground, &friction, None, sleep, threads,
+    )?;
     let (nq, nv) = (proto.model.nq, proto.model.nv);
     let (qs, q0) = read_array(q0, "q0")?;
     let (vs, v0) = read_array(v0, "v0")?;
@@ -143,8 +151,7 @@ pub fn rollout<'py>(
     }
     let b = qs[0];
     let mut q0 = q0;
-    for f in &proto.model.free_joints {
-        let at = f.iq + 3;
+    for at in crate::args::quat_offsets(&proto.model) {
         for i in 0..b {
             normalize_quaternion_at(
                 &mut q0[i * nq + at..i * nq + at + 4],

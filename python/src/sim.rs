@@ -34,6 +34,7 @@ fn prototype(
     ground: Option<f64>,
     friction: f64,
     package_dirs: Option<Vec<PathBuf>>,
+    islands: Islands,
 ) -> PyResult<Simulation> {
     if !(dt > 0.0 && dt.is_finite()) {
         return Err(value_error(format!(
@@ -66,6 +67,11 @@ fn prototype(
         integrator,
         ground,
         package_paths: package_dirs.unwrap_or_else(|| model.package_dirs.clone()),
+        sleep: islands.sleep,
+        sleep_velocity: islands.sleep_velocity,
+        sleep_time: islands.sleep_time,
+        threads: islands.threads,
+        never_sleep: islands.never_sleep,
         ..SimOptions::default()
     };
     opts.contact.friction = friction;
@@ -79,6 +85,17 @@ fn prototype(
     })
 }
 
+/// Sleep and threads (scene.md §"Large scenes"): a scene's from its file, a
+/// model alone's the defaults (it sleeps, one thread), `sleep=`/`threads=` of
+/// the call over either.
+pub(crate) struct Islands {
+    sleep: bool,
+    sleep_velocity: f64,
+    sleep_time: f64,
+    threads: usize,
+    never_sleep: Vec<String>,
+}
+
 /// A simulation of a scene at its starting state (poses, `pose`, `initial`),
 /// with its ground, friction and obstacles; the scene's constant torques.
 fn prototype_scene(
@@ -86,12 +103,29 @@ fn prototype_scene(
     dt: f64,
     integrator: Option<&str>,
     package_dirs: Option<Vec<PathBuf>>,
+    sleep: Option<bool>,
+    threads: Option<usize>,
 ) -> PyResult<Simulation> {
     let s = &scene.scene;
     let model = scene.py_model();
     let ground = s.ground.map(|g| g.height);
     let friction = s.ground.map_or(1.0, |g| g.friction);
-    let mut sim = prototype(&model, dt, integrator, ground, friction, package_dirs)?;
+    // as `urdyn simulate SCENE.json` (src/cli/simulate.rs): the file's settings
+    // where the call gives none
+    let spec = &s.spec;
+    let islands = Islands {
+        sleep: sleep.unwrap_or(spec.sleep.unwrap_or(true)),
+        sleep_velocity: spec.sleep_velocity.unwrap_or(1e-3),
+        sleep_time: spec.sleep_time.unwrap_or(0.5),
+        threads: threads.or(spec.threads).unwrap_or(1),
+        never_sleep: spec
+            .models
+            .iter()
+            .filter(|m| m.sleep == Some(false))
+            .map(|m| m.name.clone())
+            .collect(),
+    };
+    let mut sim = prototype(&model, dt, integrator, ground, friction, package_dirs, islands)?;
     sim.set_state(&s.q0, &s.v0)
         .map_err(|e| value_error(format!("{}: {e}", s.file)))?;
     sim.torques_mut().copy_from(&s.tau0);
@@ -109,6 +143,8 @@ pub(crate) fn prototype_any(
     ground: &Given,
     friction: &Given,
     package_dirs: Option<Vec<PathBuf>>,
+    sleep: Option<bool>,
+    threads: Option<usize>,
 ) -> PyResult<Simulation> {
     if let Ok(scene) = source.extract::<PyRef<'_, PyScene>>() {
         for (name, g) in [("ground", ground), ("friction", friction)] {
@@ -119,7 +155,7 @@ pub(crate) fn prototype_any(
                 )));
             }
         }
-        return prototype_scene(&scene, dt, integrator, package_dirs);
+        return prototype_scene(&scene, dt, integrator, package_dirs, sleep, threads);
     }
     let model = source
         .extract::<PyRef<'_, PyModel>>()
@@ -132,6 +168,13 @@ pub(crate) fn prototype_any(
         ground.ground(py)?,
         friction.friction(py)?,
         package_dirs,
+        Islands {
+            sleep: sleep.unwrap_or(true),
+            sleep_velocity: 1e-3,
+            sleep_time: 0.5,
+            threads: threads.unwrap_or(1),
+            never_sleep: Vec::new(),
+        },
     )
 }
 
@@ -226,12 +269,17 @@ impl PySimulation {
     /// `ground=None`: no ground; `integrator=None`: the default for the scene
     /// (`urdyn.integrators()` lists the names). Of a `Scene`: its ground,
     /// friction, obstacles and start (`ground=`/`friction=` beside it are a
-    /// ValueError: the file decides).
+    /// ValueError: the file decides). `sleep`, `threads` (scene.md §"Large
+    /// scenes"): `None` takes the scene's settings (its `"sleep"`,
+    /// `"threads"`, a model's own `"sleep": false`); a model alone is a
+    /// one-model scene, so it sleeps by default on one thread, as `urdyn
+    /// simulate ROBOT.urdf` does.
     #[new]
-    #[pyo3(signature = (model, dt=1e-3, integrator=None, ground=Given::Omitted, friction=Given::Omitted, package_dirs=None))]
+    #[pyo3(signature = (model, dt=1e-3, integrator=None, ground=Given::Omitted, friction=Given::Omitted, package_dirs=None, sleep=None, threads=None))]
     #[pyo3(
-        text_signature = "(model, dt=1e-3, integrator=None, ground=0.0, friction=1.0, package_dirs=None)"
+        text_signature = "(model, dt=1e-3, integrator=None, ground=0.0, friction=1.0, package_dirs=None, sleep=None, threads=None)"
     )]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         model: &Bound<'_, PyAny>,
         dt: f64,
@@ -239,8 +287,20 @@ impl PySimulation {
         ground: Given,
         friction: Given,
         package_dirs: Option<Vec<PathBuf>>,
+        sleep: Option<bool>,
+        threads: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let sim = prototype_any(model, dt, integrator, &ground, &friction, package_dirs)?;
+        let threads = read_threads(threads)?;
+        let sim = prototype_any(
+            model,
+            dt,
+            integrator,
+            &ground,
+            &friction,
+            package_dirs,
+            sleep,
+            threads,
+        )?;
         let frames = sim
             .model
             .frames
@@ -383,6 +443,40 @@ impl PySimulation {
     /// Kinetic plus gravitational potential energy (J), as the CSV's column.
     fn energy(&mut self) -> f64 {
         self.sim.energy()
+    }
+    /// The number of awake models (with degrees of freedom) now (cli.md's
+    /// `awake`).
+    #[getter]
+    fn awake(&self) -> usize {
+        self.sim.awake()
+    }
+    /// Whether the model `name` sleeps now (a scene's model name; a lone
+    /// model's is its `models[0]`). An unknown name is a `ValueError`.
+    fn sleeping(&self, name: &str) -> PyResult<bool> {
+        let trees = &self.sim.model.trees;
+        let key = if trees.len() == 1 && trees[0].name.is_empty() {
+            // a lone model's one tree is named "" in the library
+            ""
+        } else {
+            name
+        };
+        let lone = trees.len() == 1 && trees[0].name.is_empty();
+        if lone && !(name.is_empty() || name == "robot" || name == self.sim.model.name) {
+            return Err(value_error(format!(
+                "sleeping: unknown model \"{name}\" (one model: \"robot\")"
+            )));
+        }
+        self.sim.sleeping(key).ok_or_else(|| {
+            let names: Vec<&str> = trees.iter().map(|t| t.name.as_str()).collect();
+            value_error(format!(
+                "sleeping: unknown model \"{name}\" (models: {})",
+                names.join(", ")
+            ))
+        })
+    }
+    /// Wakes every sleeping island now.
+    fn wake(&mut self) {
+        self.sim.wake();
     }
     /// The deepest penetration now (m, 0 if none), as the CSV's column.
     #[getter]

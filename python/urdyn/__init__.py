@@ -11,9 +11,12 @@ Pinocchio's names where it has one::
 Every vector is a 1-D float64 array in the engine's order, which is Pinocchio's (a
 floating base first: position, quaternion xyzw; velocities in the body frame; then
 the joints as pin.buildModelFromUrdf orders them). A continuous joint is one angle
-here and (cos, sin) in Pinocchio's q: from_pinocchio_q / to_pinocchio_q convert. A
-wrong length, a non-finite number, a base quaternion off unit norm (by more than
-1e-3) or an unknown name raises ValueError with the CLI's one-line message; a file
+here and (cos, sin) in Pinocchio's q, a planar joint's (x, y, θ) is (x, y, cos θ,
+sin θ) there: from_pinocchio_q / to_pinocchio_q convert. An MJCF model
+(Model.from_mjcf, Model.from_file) keeps MuJoCo's order with xyzw quaternions:
+from_mujoco_qpos / to_mujoco_qpos / from_mujoco_qvel / to_mujoco_qvel convert. A
+wrong length, a non-finite number, a quaternion (a floating base's, a spherical or
+inner free joint's) off unit norm (by more than 1e-3) or an unknown name raises ValueError with the CLI's one-line message; a file
 that does not exist raises FileNotFoundError; a diverging simulation raises
 urdyn.SimulationError.
 """
@@ -53,6 +56,17 @@ from ._urdyn import (  # noqa: F401
     random_configuration,
     rnea_derivatives,
 )
+from ._urdyn import (  # noqa: F401
+    Constraints,
+    constraint_dynamics,
+    constraint_dynamics_derivatives,
+    constraint_jacobian,
+    constraint_violation,
+    from_mujoco_qpos,
+    from_mujoco_qvel,
+    to_mujoco_qpos,
+    to_mujoco_qvel,
+)
 
 __all__ = [
     "Data",
@@ -86,4 +100,13 @@ __all__ = [
     "integrate",
     "random_configuration",
     "rnea_derivatives",
+    "Constraints",
+    "constraint_dynamics",
+    "constraint_dynamics_derivatives",
+    "constraint_jacobian",
+    "constraint_violation",
+    "from_mujoco_qpos",
+    "from_mujoco_qvel",
+    "to_mujoco_qpos",
+    "to_mujoco_qvel",
 ]
