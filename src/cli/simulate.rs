@@ -89,13 +89,16 @@ pub struct Summary {
     pub contact_queries: u64,
     /// The mean number of awake models with degrees of freedom over the steps.
     pub mean_awake: f64,
+    /// The largest loop-constraint violation over the run (m or rad; `None`
+    /// without loop constraints).
+    pub max_constraint_violation: Option<f64>,
 }
 
 impl std::fmt::Display for Summary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "simulate: {} steps ({}) in {:.4} s wall, real-time factor {:.1}, energy {:.9e} J -> {:.9e} J, deepest penetration {:.3e} m, mean awake {:.2}",
+            "simulate: {} steps ({}) in {:.4} s wall, real-time factor {:.1}, energy {:.9e} J -> {:.9e} J, deepest penetration {:.3e} m",
             self.steps,
             self.integrator,
             self.wall_seconds,
@@ -103,8 +106,11 @@ impl std::fmt::Display for Summary {
             self.energy_start,
             self.energy_end,
             self.max_penetration,
-            self.mean_awake
-        )
+        )?;
+        if let Some(c) = self.max_constraint_violation {
+            write!(f, ", largest constraint violation {c:.3e}")?;
+        }
+        write!(f, ", mean awake {:.2}", self.mean_awake)
     }
 }
 
@@ -238,7 +244,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             )));
         }
     }
-    let (mut model, init, opts, geometry, urdf_name) = match &args.scene {
+    let (mut model, init, opts, geometry, urdf_name, loops) = match &args.scene {
         Some(path) => scene_setup(args, path, integrator)?,
         None if crate::load::file_format(&args.urdf) == crate::load::Format::Mjcf => {
             super::simulate_mjcf::setup(args, integrator)?
@@ -261,6 +267,14 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         sim.set_state(&sv.q, &sv.v).map_err(sim_err)?;
         sim.torques_mut().copy_from(&sv.tau);
     }
+    // loop constraints: world anchors left out are placed at the start state; a
+    // start violating one by more than 1 mm is one warning line (mechanisms.md)
+    if let Some(set) = loops {
+        for line in sim.set_constraints(set).map_err(sim_err)? {
+            warn(&format!("warning: {urdf_name}: {line}"));
+        }
+    }
+    let has_loops = sim.has_constraints();
     if let Some(h) = args.above_ground {
         if !sim.lift_above_ground(h).map_err(sim_err)? {
             warn(&format!(
@@ -321,7 +335,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
     // flight), the channel is bounded (the writer cannot fall behind by more
     // than a few blocks).
     let (nq, nv) = (sim.model.nq, sim.model.nv);
-    let width = row_width(nq, nv);
+    let width = row_width(nq, nv) + usize::from(has_loops);
     let header = {
         let (qn, vn) = column_names(&sim.model);
         let mut h = String::from("t");
@@ -329,7 +343,11 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             h.push(',');
             h.push_str(n);
         }
-        h.push_str(",energy,contacts,penetration,awake\n");
+        h.push_str(",energy,contacts,penetration,awake");
+        if has_loops {
+            h.push_str(",constraint_violation");
+        }
+        h.push('\n');
         h
     };
     let block_rows = 256usize;
@@ -340,6 +358,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         .map(|_| crate::cli::view::Recorder::new(&sim.model, duration, true));
     let mut loop_body = |w: Option<&mut (dyn Write + Send)>| -> Result<Summary, SimulateError> {
         let mut max_pen = sim.penetration();
+        let mut max_viol = if has_loops { sim.constraint_violation() } else { 0.0 };
         // the clock starts inside the scope, once the writer is set up
         let start = std::thread::scope(|scope| {
             let (to_writer, from_sim) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
@@ -356,7 +375,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                 for _ in 0..BLOCKS_IN_FLIGHT {
                     let _ = recycle.send(touched());
                 }
-                scope.spawn(|| write_rows(w, &header, (nq, nv), from_sim, recycle))
+                scope.spawn(|| write_rows(w, &header, (nq, nv, has_loops), from_sim, recycle))
             });
             let mut block: Vec<f64> = touched();
             let start = Instant::now();
@@ -373,6 +392,10 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                 block.push(sim.active_contacts() as f64);
                 block.push(sim.penetration());
                 block.push(sim.awake() as f64);
+                if has_loops {
+                    let c = sim.constraint_violation();
+                    block.push(c);
+                }
                 if let Some(r) = recorder {
                     let plot = [e, sim.active_contacts() as f64, sim.penetration()];
                     r.offer_with(sim.time(), sim.q(), plot, last, |out| {
@@ -411,6 +434,9 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
                 }
                 k += 1;
                 max_pen = max_pen.max(sim.penetration());
+                if has_loops {
+                    max_viol = max_viol.max(sim.constraint_violation());
+                }
                 let last = sim.time() >= duration;
                 if last || k % every as u64 == 0 {
                     if let Err(e) = push_row(&mut sim, &mut block, &mut recorder, last) {
@@ -463,6 +489,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             integrator: sim.integrator().name(),
             contact_queries: sim.contact_queries(),
             mean_awake: sim.mean_awake(),
+            max_constraint_violation: has_loops.then_some(max_viol),
         })
     };
     let summary = match &args.out {
@@ -499,6 +526,7 @@ pub(crate) type Setup = (
     SimOptions,
     Option<crate::cli::view::Geometry>,
     String,
+    Option<crate::model::Constraints>,
 );
 
 /// A lone URDF's run: `--floating-base`, `--initial`, the ground and friction options.
@@ -571,7 +599,7 @@ fn urdf_setup(args: &SimulateArgs, integrator: Option<Integrator>) -> Result<Set
         )?),
         None => None,
     };
-    Ok((model, init, opts, geometry, urdf_name))
+    Ok((model, init, opts, geometry, urdf_name, None))
 }
 
 /// A scene's run: models, obstacles, ground, friction and the starting state
@@ -627,7 +655,9 @@ fn scene_setup(
         )?),
         None => None,
     };
-    Ok((model, Some(init), opts, geometry, scene.file.clone()))
+    // the scene's loop constraints (mechanisms.md §"Simulation")
+    let loops = (!scene.constraints.items.is_empty()).then(|| scene.constraints.clone());
+    Ok((model, Some(init), opts, geometry, scene.file.clone(), loops))
 }
 
 /// Blocks of rows allocated for the writer before the stepping starts (the
@@ -649,13 +679,13 @@ fn row_width(nq: usize, nv: usize) -> usize {
 fn write_rows(
     w: &mut (dyn Write + Send),
     header: &str,
-    (nq, nv): (usize, usize),
+    (nq, nv, has_loops): (usize, usize, bool),
     rows: std::sync::mpsc::Receiver<Vec<f64>>,
     recycle: std::sync::mpsc::Sender<Vec<f64>>,
 ) -> Result<(), SimulateError> {
     use std::fmt::Write as _;
     let io = |e: std::io::Error| SimulateError::Output(format!("cannot write trajectory: {e}"));
-    let width = row_width(nq, nv);
+    let width = row_width(nq, nv) + usize::from(has_loops);
     let mut line = String::with_capacity(32 * width + 64);
     w.write_all(header.as_bytes()).map_err(io)?;
     let mut rb = zmij::Buffer::new();
@@ -686,6 +716,10 @@ fn write_rows(
             line.push_str(rb.format(pen));
             line.push(',');
             let _ = write!(line, "{}", awake as u64);
+            if has_loops {
+                line.push(',');
+                line.push_str(rb.format(rest.get(4).copied().unwrap_or(0.0)));
+            }
             line.push('\n');
             w.write_all(line.as_bytes()).map_err(io)?;
         }

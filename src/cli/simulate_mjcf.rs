@@ -88,7 +88,7 @@ pub(crate) fn setup(
         threads: args.threads.unwrap_or(1),
         ..SimOptions::default()
     };
-    Ok((model, init, opts, None, name))
+    Ok((model, init, opts, None, name, None))
 }
 
 /// The starting state of keyframe `key` (MuJoCo's qpos/qvel converted).
