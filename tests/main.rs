@@ -30,6 +30,7 @@ mod joint_kinds;
 mod kinematics_energy;
 mod layering;
 mod loops_sim;
+mod mechanism_examples;
 mod mjcf_cli;
 mod mjcf_oracle;
 mod mjcf_sim;
@@ -50,7 +51,6 @@ mod simulate_trust;
 mod sleep;
 mod step_jacobians;
 mod view;
-mod mechanism_examples;
 
 /// Every `tests/*.rs` file is a module of this binary (with `autotests = false` a file
 /// without its `mod` line would silently never be compiled or run).

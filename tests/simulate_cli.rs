@@ -179,7 +179,10 @@ fn list_integrators_and_help() {
     // stale "ground plane only (no self-collision)"
     assert!(!help.contains("no self-collision"), "{help}");
     assert!(help.contains("self-collision"), "{help}");
-    assert!(help.contains("between the models and with the scene's obstacles"), "{help}");
+    assert!(
+        help.contains("between the models and with the scene's obstacles"),
+        "{help}"
+    );
 }
 
 #[test]

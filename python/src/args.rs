@@ -136,17 +136,11 @@ pub fn read_q(
 pub fn quat_offsets(model: &urdyn::Model) -> Vec<usize> {
     use urdyn::model::JointKind;
     let mut out: Vec<usize> = model.free_joints.iter().map(|f| f.iq + 3).collect();
-    out.extend(
-        model
-            .joints
-            .iter()
-            .skip(1)
-            .filter_map(|j| match j.kind {
-                JointKind::Free => Some(j.iq + 3),
-                JointKind::Spherical => Some(j.iq),
-                _ => None,
-            }),
-    );
+    out.extend(model.joints.iter().skip(1).filter_map(|j| match j.kind {
+        JointKind::Free => Some(j.iq + 3),
+        JointKind::Spherical => Some(j.iq),
+        _ => None,
+    }));
     out.sort_unstable();
     out.dedup();
     out

@@ -63,7 +63,11 @@ impl PyConstraints {
     /// The constraints' names, in order.
     #[getter]
     fn names(&self) -> Vec<String> {
-        self.constraints.items.iter().map(|c| c.name.clone()).collect()
+        self.constraints
+            .items
+            .iter()
+            .map(|c| c.name.clone())
+            .collect()
     }
     /// The number of rows of J_c (point 3, frame 6, joint 1 each).
     #[getter]
@@ -182,7 +186,9 @@ pub fn constraint_dynamics<'py>(
         None
     } else {
         dynamics::forward_kinematics(m, &mut d.data, &d.q).map_err(|e| dyn_error(&model, e))?;
-        d.fext.iter_mut().for_each(|f| *f = urdyn::spatial::Force::zero());
+        d.fext
+            .iter_mut()
+            .for_each(|f| *f = urdyn::spatial::Force::zero());
         for w in &ws {
             dynamics::add_link_wrench(m, &d.data, w.frame, &w.force, &w.torque, &mut d.fext)
                 .map_err(|e| dyn_error(&model, e))?;
@@ -226,17 +232,8 @@ pub fn constraint_dynamics_derivatives<'py>(
     let m = &model.model;
     let w = (!ws.is_empty()).then_some(ws.as_slice());
     let mut cd = ConstraintData::new(m, &cons);
-    dynamics::constraint_dynamics_derivatives(
-        m,
-        &mut d.data,
-        &mut cd,
-        &cons,
-        &d.q,
-        &d.v,
-        &d.a,
-        w,
-    )
-    .map_err(|e| cd_error(&model, e))?;
+    dynamics::constraint_dynamics_derivatives(m, &mut d.data, &mut cd, &cons, &d.q, &d.v, &d.a, w)
+        .map_err(|e| cd_error(&model, e))?;
     Ok((
         mat_out(py, &cd.dqdd_dq),
         mat_out(py, &cd.dqdd_dv),

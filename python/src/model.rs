@@ -680,7 +680,11 @@ pub fn from_pinocchio_q<'py>(
         match b {
             PinBlock::Copy(n) => {
                 if let Some(o) = quat.filter(|o| o + 4 <= *n) {
-                    normalize_quaternion_at(&mut qp.as_mut_slice()[k + o..k + o + 4], "q_pin", k + o)?;
+                    normalize_quaternion_at(
+                        &mut qp.as_mut_slice()[k + o..k + o + 4],
+                        "q_pin",
+                        k + o,
+                    )?;
                 }
                 out.extend_from_slice(&qp.as_slice()[k..k + n]);
                 k += n;

@@ -125,7 +125,15 @@ fn prototype_scene(
             .map(|m| m.name.clone())
             .collect(),
     };
-    let mut sim = prototype(&model, dt, integrator, ground, friction, package_dirs, islands)?;
+    let mut sim = prototype(
+        &model,
+        dt,
+        integrator,
+        ground,
+        friction,
+        package_dirs,
+        islands,
+    )?;
     sim.set_state(&s.q0, &s.v0)
         .map_err(|e| value_error(format!("{}: {e}", s.file)))?;
     sim.torques_mut().copy_from(&s.tau0);

@@ -358,7 +358,11 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         .map(|_| crate::cli::view::Recorder::new(&sim.model, duration, true));
     let mut loop_body = |w: Option<&mut (dyn Write + Send)>| -> Result<Summary, SimulateError> {
         let mut max_pen = sim.penetration();
-        let mut max_viol = if has_loops { sim.constraint_violation() } else { 0.0 };
+        let mut max_viol = if has_loops {
+            sim.constraint_violation()
+        } else {
+            0.0
+        };
         // the clock starts inside the scope, once the writer is set up
         let start = std::thread::scope(|scope| {
             let (to_writer, from_sim) = std::sync::mpsc::sync_channel::<Vec<f64>>(4);
