@@ -16,7 +16,10 @@
 //!   kinetic energy); restitution e > 0 raises b to −e·u⁻ on fast impacts;
 //! - position pass: b_pos = min(β(−φ − slop)/Δt, cap) where φ < −slop.
 
+mod solve;
+
 use super::factor::MassFactor;
+use super::islands::Islands;
 use super::loops::Loops;
 use super::newton::Newton;
 use super::solver::{RowKind, Rows};
@@ -117,6 +120,11 @@ pub(crate) struct Constraints {
     jd: Vec<f64>,
     /// The loop constraints (none: a run without loops, untouched).
     pub loops: Option<Loops>,
+    /// This step's islands of rows (the PGS solve's units).
+    islands: Islands,
+    /// Rows times sweeps of every solve so far (velocity, energy-safe exit and
+    /// position pass): the solve's work, independent of the machine.
+    pub work: u64,
 }
 
 impl Constraints {
@@ -170,6 +178,8 @@ impl Constraints {
             jd: vec![0.0; 3 * nv],
             newton: Newton::new(if newton { nv } else { 0 }, if newton { cap } else { 0 }),
             loops,
+            islands: Islands::new(model, cap),
+            work: 0,
         }
     }
 
@@ -440,174 +450,4 @@ impl Constraints {
         }
         self.counts
     }
-
-    /// Solves the assembled rows given the factor `l` of H̃ (column-major, lower
-    /// triangle) and the free velocity `vfree`, for a step `h`: the velocity
-    /// impulses λ (warm-started), then, where a row is violated, the position
-    /// pass. Writes the warm starts, the joint rows' generalized force and the
-    /// contact forces.
-    #[allow(clippy::too_many_arguments)]
-    pub fn solve(
-        &mut self,
-        model: &Model,
-        points: &[ContactPoint],
-        f: &MassFactor,
-        vfree: &DVector<f64>,
-        h: f64,
-        iterations: usize,
-        tol: f64,
-        relaxation: f64,
-        solver: Solver,
-    ) -> Impulses<'_> {
-        self.clear_forces();
-        self.dv.fill(0.0);
-        let rows = &mut self.rows;
-        // Y rows = R⁻ᵀ jᵣ (H̃ = RᵀR, each over its path): W = J H̃⁻¹ Jᵀ = Y Yᵀ,
-        // the solver works on Δv' = R Δv with uᵣ = cᵣ + yᵣ·Δv'
-        rows.form(f, vfree.as_slice());
-        let mut sweeps = match solver {
-            Solver::Pgs => rows.solve(f, self.dv.as_mut_slice(), iterations, tol, relaxation),
-            Solver::Newton => self
-                .newton
-                .solve(rows, f, self.dv.as_mut_slice(), iterations, tol),
-        };
-        // a solve stopped by the cap, or one that took a subspace step (whose
-        // projection of a large step is not checked by the sweeps' test
-        // alone), is held to the exact solution's energy bound
-        if sweeps >= iterations || (solver == Solver::Pgs && rows.polished) {
-            // (a Newton solve stopped by the cap is scaled, never swept)
-            let more = if solver == Solver::Pgs { iterations } else { 0 };
-            f.apply_r(vfree.as_slice(), &mut self.a);
-            sweeps += energy_safe_exit(rows, f, &self.a, self.dv.as_mut_slice(), more, tol);
-        }
-        // Δv = R⁻¹ Δv'
-        f.half_solve(self.dv.as_mut_slice());
-        // the position pass, only where something is violated
-        let pushing = self.counts.violated > 0;
-        if pushing {
-            rows.solve_position(f, self.push.as_mut_slice(), iterations, tol);
-            f.half_solve(self.push.as_mut_slice());
-        }
-        if let Some(l) = self.loops.as_mut() {
-            l.read(rows);
-        }
-        // joint rows: warm starts and generalized force
-        for w in self.warm_joint.iter_mut() {
-            *w = [0.0; 3];
-        }
-        for (k, &(d, which)) in self.joint_rows.iter().enumerate() {
-            let r = self.first_joint_row + k;
-            let lam = rows.lambda[r];
-            self.warm_joint[d][which as usize] = lam;
-            let iv = model.dof_v(d);
-            let jv = rows.entry(r, iv);
-            self.tau_joint[iv] += jv * lam / h;
-        }
-        // contact rows: warm starts by slot, forces
-        for &k in &self.warm_slots {
-            if let Some(w) = self.warm_contact.get_mut(k) {
-                *w = [0.0; 3];
-            }
-        }
-        self.warm_slots.clear();
-        for (c, &pi) in self.row_point.iter().enumerate() {
-            let rn = 3 * c;
-            let (ln, l1, l2) = (rows.lambda[rn], rows.lambda[rn + 1], rows.lambda[rn + 2]);
-            let Some(pt) = points.get(pi) else {
-                continue;
-            };
-            if let Some(w) = self.warm_contact.get_mut(pt.slot) {
-                *w = [ln, l1, l2];
-                self.warm_slots.push(pt.slot);
-            }
-            if ln > 0.0 {
-                // F = (λₙ n + λₜ₁ t₁ + λₜ₂ t₂)/Δt on `body`, −F on `other`
-                let f = if pt.normal == Vector3::z() {
-                    Vector3::new(l1, l2, ln) / h
-                } else {
-                    let (t1, t2) = tangents(&pt.normal);
-                    (pt.normal * ln + t1 * l1 + t2 * l2) / h
-                };
-                if let Some(fb) = self.fext.get_mut(pt.body) {
-                    *fb += Force::at_point(f, &pt.point);
-                }
-                if pt.other != 0 {
-                    if let Some(fb) = self.fext.get_mut(pt.other) {
-                        *fb += Force::at_point(-f, &pt.point);
-                    }
-                }
-                self.contact_forces.push(ContactForce {
-                    point: *pt,
-                    force: f,
-                });
-            }
-        }
-        Impulses {
-            dv: &self.dv,
-            push: if pushing { Some(&self.push) } else { None },
-            tau_joint: &self.tau_joint,
-            sweeps,
-        }
-    }
-}
-
-/// (ΔKE of the impulse, the exact solution's bound Σ λᵣ max(bᵣ, 0), a·d, ‖d‖²)
-/// for the factored Δv' = `d` (a = R v*: the kinetic energy after the impulse
-/// is ½‖a + d‖² in the H̃-norm).
-fn impulse_work(rows: &Rows, a: &[f64], d: &[f64]) -> (f64, f64, f64, f64) {
-    let (mut ad, mut dd) = (0.0, 0.0);
-    for (ak, dk) in a.iter().zip(d) {
-        ad += ak * dk;
-        dd += dk * dk;
-    }
-    let mut allow = 0.0;
-    for r in 0..rows.n {
-        if matches!(rows.kind[r], RowKind::Normal | RowKind::Unilateral) {
-            allow += rows.lambda[r] * rows.b[r].max(0.0);
-        }
-    }
-    (ad + 0.5 * dd, allow, ad, dd)
-}
-
-/// A solve stopped by the sweep cap may leave an iterate that adds kinetic
-/// energy, which the exact solution never does: its impulses change the kinetic
-/// energy by λᵀu − ½λᵀWλ ≤ Σ λᵣ max(bᵣ, 0) (complementarity on the unilateral
-/// rows, maximal dissipation on the friction rows). While the iterate exceeds
-/// that bound, more plain sweeps run (up to 4× the cap); if it still does, the
-/// impulses are scaled by the largest s ≤ 1 that meets it (a scaled impulse
-/// stays inside every cone and box). `a` = R v*. Returns the extra sweeps.
-fn energy_safe_exit(
-    rows: &mut Rows,
-    f: &MassFactor,
-    a: &[f64],
-    d: &mut [f64],
-    iterations: usize,
-    tol: f64,
-) -> usize {
-    let nv = rows.nv;
-    if a.len() < nv || d.len() < nv {
-        return 0;
-    }
-    let budget = 4 * iterations;
-    let mut extra = 0;
-    loop {
-        let (work, allow, _, _) = impulse_work(rows, a, d);
-        if work <= allow || extra >= budget {
-            break;
-        }
-        let it = rows.solve(f, d, 10, tol, 1.0);
-        extra += it;
-        if it < 10 {
-            break;
-        }
-    }
-    let (work, allow, ad, dd) = impulse_work(rows, a, d);
-    if work <= allow || dd <= 0.0 {
-        return extra;
-    }
-    // ΔKE(s) = s a·d + ½ s² ‖d‖² ≤ s·allow ⇐ s ≤ 2(allow − a·d)/‖d‖²
-    let s = (2.0 * (allow - ad) / dd).clamp(0.0, 1.0);
-    d[..nv].iter_mut().for_each(|x| *x *= s);
-    rows.lambda[..rows.n].iter_mut().for_each(|x| *x *= s);
-    extra
 }

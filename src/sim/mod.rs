@@ -66,6 +66,7 @@ pub mod factor;
 mod loops;
 pub use loops::LoopForce;
 pub(crate) mod integrators;
+mod islands;
 pub mod newton;
 pub use contact_view::Violation;
 mod build;

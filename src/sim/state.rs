@@ -8,6 +8,13 @@ impl Simulation {
     pub fn integrator(&self) -> Integrator {
         self.integrator
     }
+    /// The constraint solve's work so far: rows times sweeps, summed over the
+    /// islands and the steps (velocity solve, its energy-safe exit and the
+    /// position pass). A measure of cost that does not depend on the machine:
+    /// two piles far apart cost twice one pile.
+    pub fn solve_work(&self) -> u64 {
+        self.cons.work
+    }
     /// Simulated time (s), 0 at construction.
     pub fn time(&self) -> f64 {
         self.t

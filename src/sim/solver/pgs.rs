@@ -26,18 +26,37 @@ impl Rows {
         tol: f64,
         relax: f64,
     ) -> usize {
-        self.polished = false;
         let _ = f;
+        let all = [(0, 0, self.n)];
+        self.solve_runs(&all, None, dv, max_iter, tol, relax)
+    }
+
+    /// [`Rows::solve`] on the rows of `runs` only ((key, start, end): an
+    /// island's rows, [`super::super::islands`]), whose Δv' lives on `dofs`
+    /// (`None`: every dof): only those entries of `dv` are zeroed and written.
+    pub(crate) fn solve_runs(
+        &mut self,
+        runs: &[(usize, usize, usize)],
+        dofs: Option<&[usize]>,
+        dv: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+        relax: f64,
+    ) -> usize {
+        self.polished = false;
         let table_v = std::mem::take(&mut self.table);
-        let it = self.sweeps(&table_v, dv, max_iter, tol, relax);
+        let it = self.sweeps(&table_v, runs, dofs, dv, max_iter, tol, relax);
         self.table = table_v;
         it
     }
 
     /// [`Rows::solve`] on the path table `table` (taken out of the rows).
+    #[allow(clippy::too_many_arguments)]
     fn sweeps(
         &mut self,
         table: &[usize],
+        runs: &[(usize, usize, usize)],
+        dofs: Option<&[usize]>,
         dv: &mut [f64],
         max_iter: usize,
         tol: f64,
@@ -47,11 +66,13 @@ impl Rows {
         if dv.len() < nv
             || self.y.len() < n * st
             || self.kind.len() < n
-            || self
-                .path
-                .iter()
-                .take(n)
-                .any(|&(s, l)| s + l > table.len() || l > st)
+            || runs.iter().any(|&(_, s, e)| {
+                e > n
+                    || self.path[s..e]
+                        .iter()
+                        .any(|&(s, l)| s + l > table.len() || l > st)
+            })
+            || dofs.is_some_and(|d| d.iter().any(|&k| k >= nv))
         {
             return 0;
         }
@@ -101,11 +122,16 @@ impl Rows {
             &table[s..s + l]
         };
         // Δv' from the warm start
-        dv.iter_mut().for_each(|x| *x = 0.0);
-        for r in 0..n {
-            let l = lambda[r];
-            if l != 0.0 {
-                raxpy(l, y, r, st, path(r), dv);
+        match dofs {
+            Some(d) => d.iter().for_each(|&k| dv[k] = 0.0),
+            None => dv.iter_mut().for_each(|x| *x = 0.0),
+        }
+        for &(_, s, e) in runs {
+            for r in s..e {
+                let l = lambda[r];
+                if l != 0.0 {
+                    raxpy(l, y, r, st, path(r), dv);
+                }
             }
         }
         let mut it = 0;
@@ -123,125 +149,127 @@ impl Rows {
             let relax = if plain { 1.0 } else { relax };
             let first = it == 1;
             let mut change: f64 = 0.0;
-            let mut r = 0;
-            while r < n {
-                let kind = kinds[r];
-                if contact[r] {
-                    // a contact's three rows in one pass over its path: the
-                    // normal, then the tangent pair from the velocity the
-                    // normal's change left (through the block's entries)
-                    let p = path(r);
-                    let (mut dn, mut d1, mut d2) = (0.0, 0.0, 0.0);
-                    for (t, &k) in p.iter().enumerate() {
-                        let x = unsafe { *dv.get_unchecked(k) };
-                        unsafe {
-                            dn += y.get_unchecked(r * st + t) * x;
-                            d1 += y.get_unchecked((r + 1) * st + t) * x;
-                            d2 += y.get_unchecked((r + 2) * st + t) * x;
-                        }
-                    }
-                    let [wn1, wn2, w12] = w_block[r];
-                    let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
-                    let on = lambda[r];
-                    let un = c[r] + dn;
-                    let nn = (on - relax * (un - b[r]) * winv[r]).max(0.0) * live(r);
-                    let dln = nn - on;
-                    lambda[r] = nn;
-                    let mu = match kinds[r + 1] {
-                        RowKind::Tangent { mu, .. } => mu,
-                        _ => 0.0,
-                    };
-                    let (o1, o2) = (lambda[r + 1], lambda[r + 2]);
-                    let u1 = c[r + 1] + d1 + dln * wn1;
-                    let u2 = c[r + 2] + d2 + dln * wn2;
-                    let mut t1 = (o1 - u1 * winv[r + 1]) * live(r + 1);
-                    let mut t2 = (o2 - u2 * winv[r + 2]) * live(r + 2);
-                    let lim = mu * nn;
-                    if t1 * t1 + t2 * t2 > lim * lim {
-                        // w̄ = (W₁₁ + W₂₂)/2 + √(((W₁₁ − W₂₂)/2)² + W₁₂²)
-                        let half = 0.5 * (w11 - w22);
-                        let wbar = 0.5 * (w11 + w22) + (half * half + w12 * w12).sqrt();
-                        (t1, t2) = slide_onto_cone(o1, o2, u1, u2, wbar, lim);
-                        t1 *= live(r + 1);
-                        t2 *= live(r + 2);
-                    }
-                    lambda[r + 1] = t1;
-                    lambda[r + 2] = t2;
-                    let (dl1, dl2) = (t1 - o1, t2 - o2);
-                    if dln != 0.0 || dl1 != 0.0 || dl2 != 0.0 {
+            for &(_, s, e) in runs {
+                let mut r = s;
+                while r < e {
+                    let kind = kinds[r];
+                    if contact[r] {
+                        // a contact's three rows in one pass over its path: the
+                        // normal, then the tangent pair from the velocity the
+                        // normal's change left (through the block's entries)
+                        let p = path(r);
+                        let (mut dn, mut d1, mut d2) = (0.0, 0.0, 0.0);
                         for (t, &k) in p.iter().enumerate() {
+                            let x = unsafe { *dv.get_unchecked(k) };
                             unsafe {
-                                *dv.get_unchecked_mut(k) += dln * y.get_unchecked(r * st + t)
-                                    + dl1 * y.get_unchecked((r + 1) * st + t)
-                                    + dl2 * y.get_unchecked((r + 2) * st + t);
+                                dn += y.get_unchecked(r * st + t) * x;
+                                d1 += y.get_unchecked((r + 1) * st + t) * x;
+                                d2 += y.get_unchecked((r + 2) * st + t) * x;
                             }
                         }
-                    }
-                    change = change
-                        .max(measure(first, (dln * wnn).abs(), un, &mut u_prev[r]))
-                        .max(measure(first, (dl1 * w11).abs(), u1, &mut u_prev[r + 1]))
-                        .max(measure(first, (dl2 * w22).abs(), u2, &mut u_prev[r + 2]));
-                    r += 3;
-                    continue;
-                }
-                match kind {
-                    RowKind::Tangent { normal, mu } if r + 1 < n => {
-                        let (p1, p2) = (path(r), path(r + 1));
-                        let (w11, w22) = (w[r], w[r + 1]);
-                        let u1 = c[r] + rdot(y, r, st, p1, dv);
-                        let u2 = c[r + 1] + rdot(y, r + 1, st, p2, dv);
-                        let (o1, o2) = (lambda[r], lambda[r + 1]);
-                        let mut t1 = if w11 > 1e-14 { o1 - u1 / w11 } else { 0.0 };
-                        let mut t2 = if w22 > 1e-14 { o2 - u2 / w22 } else { 0.0 };
-                        let ln = lambda.get(normal).copied().unwrap_or(0.0);
-                        let lim = mu * if ln > 0.0 { ln } else { 0.0 };
+                        let [wn1, wn2, w12] = w_block[r];
+                        let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
+                        let on = lambda[r];
+                        let un = c[r] + dn;
+                        let nn = (on - relax * (un - b[r]) * winv[r]).max(0.0) * live(r);
+                        let dln = nn - on;
+                        lambda[r] = nn;
+                        let mu = match kinds[r + 1] {
+                            RowKind::Tangent { mu, .. } => mu,
+                            _ => 0.0,
+                        };
+                        let (o1, o2) = (lambda[r + 1], lambda[r + 2]);
+                        let u1 = c[r + 1] + d1 + dln * wn1;
+                        let u2 = c[r + 2] + d2 + dln * wn2;
+                        let mut t1 = (o1 - u1 * winv[r + 1]) * live(r + 1);
+                        let mut t2 = (o2 - u2 * winv[r + 2]) * live(r + 2);
+                        let lim = mu * nn;
                         if t1 * t1 + t2 * t2 > lim * lim {
-                            // the block's largest eigenvalue ≤ its trace
-                            (t1, t2) = slide_onto_cone(o1, o2, u1, u2, w11 + w22, lim);
+                            // w̄ = (W₁₁ + W₂₂)/2 + √(((W₁₁ − W₂₂)/2)² + W₁₂²)
+                            let half = 0.5 * (w11 - w22);
+                            let wbar = 0.5 * (w11 + w22) + (half * half + w12 * w12).sqrt();
+                            (t1, t2) = slide_onto_cone(o1, o2, u1, u2, wbar, lim);
+                            t1 *= live(r + 1);
+                            t2 *= live(r + 2);
                         }
-                        lambda[r] = t1;
-                        lambda[r + 1] = t2;
-                        let (d1, d2) = (t1 - o1, t2 - o2);
-                        if d1 != 0.0 {
-                            raxpy(d1, y, r, st, p1, dv);
-                        }
-                        if d2 != 0.0 {
-                            raxpy(d2, y, r + 1, st, p2, dv);
+                        lambda[r + 1] = t1;
+                        lambda[r + 2] = t2;
+                        let (dl1, dl2) = (t1 - o1, t2 - o2);
+                        if dln != 0.0 || dl1 != 0.0 || dl2 != 0.0 {
+                            for (t, &k) in p.iter().enumerate() {
+                                unsafe {
+                                    *dv.get_unchecked_mut(k) += dln * y.get_unchecked(r * st + t)
+                                        + dl1 * y.get_unchecked((r + 1) * st + t)
+                                        + dl2 * y.get_unchecked((r + 2) * st + t);
+                                }
+                            }
                         }
                         change = change
-                            .max(measure(first, (d1 * w11).abs(), u1, &mut u_prev[r]))
-                            .max(measure(first, (d2 * w22).abs(), u2, &mut u_prev[r + 1]));
-                        r += 2;
+                            .max(measure(first, (dln * wnn).abs(), un, &mut u_prev[r]))
+                            .max(measure(first, (dl1 * w11).abs(), u1, &mut u_prev[r + 1]))
+                            .max(measure(first, (dl2 * w22).abs(), u2, &mut u_prev[r + 2]));
+                        r += 3;
                         continue;
                     }
-                    RowKind::Tangent2 | RowKind::Tangent { .. } => {
-                        r += 1;
-                        continue;
-                    }
-                    _ => {}
-                }
-                let wrr = w[r];
-                let old = lambda[r];
-                let p = path(r);
-                let mut u = 0.0;
-                let new = if winv[r] != 0.0 {
-                    u = c[r] + rdot(y, r, st, p, dv);
-                    let x = old - relax * (u - b[r]) * winv[r];
                     match kind {
-                        RowKind::Box { limit } => x.clamp(-limit, limit),
-                        RowKind::Bilateral => x,
-                        _ => x.max(0.0),
+                        RowKind::Tangent { normal, mu } if r + 1 < e => {
+                            let (p1, p2) = (path(r), path(r + 1));
+                            let (w11, w22) = (w[r], w[r + 1]);
+                            let u1 = c[r] + rdot(y, r, st, p1, dv);
+                            let u2 = c[r + 1] + rdot(y, r + 1, st, p2, dv);
+                            let (o1, o2) = (lambda[r], lambda[r + 1]);
+                            let mut t1 = if w11 > 1e-14 { o1 - u1 / w11 } else { 0.0 };
+                            let mut t2 = if w22 > 1e-14 { o2 - u2 / w22 } else { 0.0 };
+                            let ln = lambda.get(normal).copied().unwrap_or(0.0);
+                            let lim = mu * if ln > 0.0 { ln } else { 0.0 };
+                            if t1 * t1 + t2 * t2 > lim * lim {
+                                // the block's largest eigenvalue ≤ its trace
+                                (t1, t2) = slide_onto_cone(o1, o2, u1, u2, w11 + w22, lim);
+                            }
+                            lambda[r] = t1;
+                            lambda[r + 1] = t2;
+                            let (d1, d2) = (t1 - o1, t2 - o2);
+                            if d1 != 0.0 {
+                                raxpy(d1, y, r, st, p1, dv);
+                            }
+                            if d2 != 0.0 {
+                                raxpy(d2, y, r + 1, st, p2, dv);
+                            }
+                            change = change
+                                .max(measure(first, (d1 * w11).abs(), u1, &mut u_prev[r]))
+                                .max(measure(first, (d2 * w22).abs(), u2, &mut u_prev[r + 1]));
+                            r += 2;
+                            continue;
+                        }
+                        RowKind::Tangent2 | RowKind::Tangent { .. } => {
+                            r += 1;
+                            continue;
+                        }
+                        _ => {}
                     }
-                } else {
-                    0.0
-                };
-                lambda[r] = new;
-                let d = new - old;
-                if d != 0.0 {
-                    raxpy(d, y, r, st, p, dv);
+                    let wrr = w[r];
+                    let old = lambda[r];
+                    let p = path(r);
+                    let mut u = 0.0;
+                    let new = if winv[r] != 0.0 {
+                        u = c[r] + rdot(y, r, st, p, dv);
+                        let x = old - relax * (u - b[r]) * winv[r];
+                        match kind {
+                            RowKind::Box { limit } => x.clamp(-limit, limit),
+                            RowKind::Bilateral => x,
+                            _ => x.max(0.0),
+                        }
+                    } else {
+                        0.0
+                    };
+                    lambda[r] = new;
+                    let d = new - old;
+                    if d != 0.0 {
+                        raxpy(d, y, r, st, p, dv);
+                    }
+                    change = change.max(measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
+                    r += 1;
                 }
-                change = change.max(measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
-                r += 1;
             }
             if finishing || (change <= tol && plain) {
                 break;
@@ -254,6 +282,7 @@ impl Rows {
                 attempts += 1;
                 let rows = Solved {
                     n,
+                    runs,
                     nv,
                     st,
                     y,

@@ -25,29 +25,60 @@ impl Rows {
         {
             return 0;
         }
+        let all = [(0, 0, n)];
+        self.solve_position_runs(&all, None, dw, max_iter, tol)
+    }
+
+    /// [`Rows::solve_position`] on the rows of `runs` only (an island's,
+    /// [`Rows::solve_runs`]), whose w' lives on `dofs` (`None`: every dof):
+    /// only those entries of `dw` are zeroed and written.
+    pub(crate) fn solve_position_runs(
+        &mut self,
+        runs: &[(usize, usize, usize)],
+        dofs: Option<&[usize]>,
+        dw: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+    ) -> usize {
+        let (nv, n) = (self.nv, self.n);
+        if dw.len() < nv
+            || self.mu.len() < n
+            || runs.iter().any(|&(_, _, e)| e > n)
+            || dofs.is_some_and(|d| d.iter().any(|&k| k >= nv))
+        {
+            return 0;
+        }
         let table_v = std::mem::take(&mut self.table);
-        let it = self.position_sweeps(&table_v, dw, max_iter, tol);
+        let it = self.position_sweeps(&table_v, runs, dofs, dw, max_iter, tol);
         self.table = table_v;
         it
     }
 
     /// [`Rows::solve_position`] on the path table `table` (taken out of the rows).
+    #[allow(clippy::too_many_arguments)]
     fn position_sweeps(
         &mut self,
         table: &[usize],
+        runs: &[(usize, usize, usize)],
+        dofs: Option<&[usize]>,
         dw: &mut [f64],
         max_iter: usize,
         tol: f64,
     ) -> usize {
-        let (nv, n, st) = (self.nv, self.n, self.stride);
+        let (nv, st) = (self.nv, self.stride);
         let dw = &mut dw[..nv];
-        dw.iter_mut().for_each(|x| *x = 0.0);
-        self.mu[..n].iter_mut().for_each(|x| *x = 0.0);
+        match dofs {
+            Some(d) => d.iter().for_each(|&k| dw[k] = 0.0),
+            None => dw.iter_mut().for_each(|x| *x = 0.0),
+        }
+        for &(_, s, e) in runs {
+            self.mu[s..e].iter_mut().for_each(|x| *x = 0.0);
+        }
         let mut it = 0;
         while it < max_iter {
             it += 1;
             let mut change: f64 = 0.0;
-            for r in 0..n {
+            for r in runs.iter().flat_map(|&(_, s, e)| s..e) {
                 let bilateral = self.kind[r] == RowKind::Bilateral;
                 if !bilateral && !matches!(self.kind[r], RowKind::Normal | RowKind::Unilateral) {
                     continue;

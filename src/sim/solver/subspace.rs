@@ -11,20 +11,18 @@ pub(super) struct Subspace {
     pub(super) rows: Vec<usize>,
     pub(super) w: Vec<f64>,
     pub(super) rhs: Vec<f64>,
-    pub(super) dense: Vec<f64>,
     pub(super) lam: Vec<f64>,
     /// At a tangent pair's first row: it lay on its cone's boundary (sliding).
     pub(super) sliding: Vec<bool>,
 }
 
 impl Subspace {
-    pub(super) fn new(nv: usize, cap: usize) -> Self {
+    pub(super) fn new(_nv: usize, cap: usize) -> Self {
         let m = cap.min(SUBSPACE_MAX);
         Self {
             rows: Vec::with_capacity(m),
             w: vec![0.0; m * m],
             rhs: vec![0.0; m],
-            dense: vec![0.0; m * nv],
             lam: vec![0.0; m],
             sliding: vec![false; cap],
         }
@@ -34,6 +32,8 @@ impl Subspace {
 /// The read-only view of the rows a subspace step needs.
 pub(super) struct Solved<'a> {
     pub(super) n: usize,
+    /// The island's row runs (key, start, end).
+    pub(super) runs: &'a [(usize, usize, usize)],
     pub(super) nv: usize,
     /// Room of a row in `y`.
     pub(super) st: usize,
@@ -69,6 +69,7 @@ pub(super) fn subspace_step(
 ) -> bool {
     let Solved {
         n,
+        runs,
         nv,
         st,
         y,
@@ -88,72 +89,73 @@ pub(super) fn subspace_step(
         |t1: f64, t2: f64, ln: f64, mu: f64| (t1 * t1 + t2 * t2).sqrt() < mu * ln * (1.0 - 1e-9);
     // F: the free rows
     sm.rows.clear();
-    let mut r = 0;
-    while r < n {
-        let live = |q: usize| winv[q] != 0.0;
-        if contact[r] {
-            let mu = match kinds[r + 1] {
-                RowKind::Tangent { mu, .. } => mu,
-                _ => 0.0,
-            };
-            sm.sliding[r + 1] = !inside(lambda[r + 1], lambda[r + 2], lambda[r], mu);
-            if lambda[r] > 0.0 && live(r) {
-                sm.rows.push(r);
-                if !sm.sliding[r + 1] && live(r + 1) && live(r + 2) {
-                    sm.rows.push(r + 1);
-                    sm.rows.push(r + 2);
-                }
-            }
-            r += 3;
-            continue;
-        }
-        match kinds[r] {
-            RowKind::Tangent { normal, mu } if r + 1 < n => {
-                let ln = lambda.get(normal).copied().unwrap_or(0.0);
-                sm.sliding[r] = !inside(lambda[r], lambda[r + 1], ln, mu);
-                if ln > 0.0 && !sm.sliding[r] && live(r) && live(r + 1) {
-                    sm.rows.push(r);
-                    sm.rows.push(r + 1);
-                }
-                r += 2;
-                continue;
-            }
-            RowKind::Tangent2 | RowKind::Tangent { .. } => {}
-            RowKind::Normal | RowKind::Unilateral => {
+    for &(_, s, e) in runs {
+        let mut r = s;
+        while r < e {
+            let live = |q: usize| winv[q] != 0.0;
+            if contact[r] {
+                let mu = match kinds[r + 1] {
+                    RowKind::Tangent { mu, .. } => mu,
+                    _ => 0.0,
+                };
+                sm.sliding[r + 1] = !inside(lambda[r + 1], lambda[r + 2], lambda[r], mu);
                 if lambda[r] > 0.0 && live(r) {
                     sm.rows.push(r);
+                    if !sm.sliding[r + 1] && live(r + 1) && live(r + 2) {
+                        sm.rows.push(r + 1);
+                        sm.rows.push(r + 2);
+                    }
+                }
+                r += 3;
+                continue;
+            }
+            match kinds[r] {
+                RowKind::Tangent { normal, mu } if r + 1 < e => {
+                    let ln = lambda.get(normal).copied().unwrap_or(0.0);
+                    sm.sliding[r] = !inside(lambda[r], lambda[r + 1], ln, mu);
+                    if ln > 0.0 && !sm.sliding[r] && live(r) && live(r + 1) {
+                        sm.rows.push(r);
+                        sm.rows.push(r + 1);
+                    }
+                    r += 2;
+                    continue;
+                }
+                RowKind::Tangent2 | RowKind::Tangent { .. } => {}
+                RowKind::Normal | RowKind::Unilateral => {
+                    if lambda[r] > 0.0 && live(r) {
+                        sm.rows.push(r);
+                    }
+                }
+                RowKind::Box { limit } => {
+                    if lambda[r].abs() < limit * (1.0 - 1e-9) && live(r) {
+                        sm.rows.push(r);
+                    }
+                }
+                RowKind::Bilateral => {
+                    if live(r) {
+                        sm.rows.push(r);
+                    }
                 }
             }
-            RowKind::Box { limit } => {
-                if lambda[r].abs() < limit * (1.0 - 1e-9) && live(r) {
-                    sm.rows.push(r);
-                }
+            r += 1;
+            if sm.rows.len() > SUBSPACE_MAX {
+                return false;
             }
-            RowKind::Bilateral => {
-                if live(r) {
-                    sm.rows.push(r);
-                }
-            }
-        }
-        r += 1;
-        if sm.rows.len() > SUBSPACE_MAX {
-            return false;
         }
     }
     let m = sm.rows.len();
-    if m == 0 || m > SUBSPACE_MAX || sm.dense.len() < m * nv {
+    if m == 0 || m > SUBSPACE_MAX {
         return false;
     }
-    // the free rows of Y at full width, the residuals b − u, and the lower
-    // triangle of W_FF = Y_F Y_Fᵀ
+    let _ = nv;
+    // the residuals b − u and the lower triangle of W_FF = Y_F Y_Fᵀ, each
+    // entry a merge of two ascending paths (no row scattered to full width:
+    // the cost follows the rows' paths, never nv)
     for (a, &r) in sm.rows.iter().enumerate() {
-        let d = &mut sm.dense[a * nv..(a + 1) * nv];
-        d.fill(0.0);
+        let pa = path(r);
         let mut u = c[r];
-        for (t, &k) in path(r).iter().enumerate() {
-            let yt = y[r * st + t];
-            d[k] = yt;
-            u += yt * dv[k];
+        for (t, &k) in pa.iter().enumerate() {
+            u += y[r * st + t] * dv[k];
         }
         let target = match kinds[r] {
             RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
@@ -161,9 +163,15 @@ pub(super) fn subspace_step(
         };
         sm.rhs[a] = target - u;
         for (bb, &q) in sm.rows.iter().enumerate().take(a + 1) {
-            let mut s = 0.0;
-            for (t, &k) in path(q).iter().enumerate() {
-                s += y[q * st + t] * d[k];
+            let pq = path(q);
+            let (mut s, mut i) = (0.0, 0);
+            for (t, &k) in pq.iter().enumerate() {
+                while i < pa.len() && pa[i] < k {
+                    i += 1;
+                }
+                if i < pa.len() && pa[i] == k {
+                    s += y[q * st + t] * y[r * st + i];
+                }
             }
             sm.w[a * m + bb] = s;
         }
@@ -202,10 +210,11 @@ pub(super) fn subspace_step(
         lambda[r] = x;
         add(r, d, dv);
     }
-    let mut r = 0;
-    while r + 1 < n {
+    for r in runs.iter().flat_map(|&(_, s, e)| s..e) {
+        if r + 1 >= n {
+            break;
+        }
         let RowKind::Tangent { normal, mu } = kinds[r] else {
-            r += 1;
             continue;
         };
         let lim = mu * lambda.get(normal).copied().unwrap_or(0.0).max(0.0);
@@ -230,7 +239,6 @@ pub(super) fn subspace_step(
         lambda[r + 1] = n2;
         add(r, d1, dv);
         add(r + 1, d2, dv);
-        r += 2;
     }
     true
 }

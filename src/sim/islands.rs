@@ -1,0 +1,184 @@
+//! Islands of the constraint solve (scene.md §"Large scenes: islands and
+//! sleep"; docs/theory.md §"Islands").
+//!
+//! Two trees of the model are in one island when a row of this step acts on
+//! both: a contact point between their bodies (the rows of the points within
+//! the contact margin), or a loop constraint; a tree's own joint rows (friction,
+//! limits) are in its island. The world, obstacles and trees without degrees
+//! of freedom join nothing (a row acts on dofs only). Rows are found from
+//! their dof paths: a row's path runs over the dofs of at most two trees, the
+//! first and the last of its ascending path, so the trees of its first and
+//! last dof are all it joins.
+//!
+//! The rows of an island are runs of consecutive rows (a contact's three rows
+//! are one run: they share a path); the islands list their runs in row order,
+//! so that an island's Gauss–Seidel sweep visits its rows in the order the
+//! global sweep did, and a scene of one island is solved exactly as before.
+//! Everything here is sized at construction: nothing is allocated in a step.
+
+use super::solver::Rows;
+use crate::model::Model;
+
+/// This step's islands: their row runs and their dofs.
+#[derive(Clone, Debug)]
+pub(crate) struct Islands {
+    /// Each velocity coordinate's tree (`usize::MAX`: none).
+    tree_of_dof: Vec<usize>,
+    /// Union-find parents over the trees (scratch).
+    parent: Vec<usize>,
+    /// Each row's island root tree (`usize::MAX`: a row on no dof).
+    key: Vec<usize>,
+    /// Runs of consecutive rows of one island: (island key, first row, end).
+    runs: Vec<(usize, usize, usize)>,
+    /// Per island: its runs, a range of `runs`, and its dofs, a range of `dofs`.
+    islands: Vec<((usize, usize), (usize, usize))>,
+    /// The islands' dofs, island after island (ascending within one).
+    dofs: Vec<usize>,
+    /// Scratch: a dof already listed.
+    mark: Vec<bool>,
+}
+
+/// One island of this step: its row runs and its dofs.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Island<'a> {
+    /// Runs of rows, `start..end`, in row order.
+    pub runs: &'a [(usize, usize, usize)],
+    /// The dofs its rows act on.
+    pub dofs: &'a [usize],
+}
+
+impl Island<'_> {
+    /// The rows of the island.
+    pub fn rows(&self) -> usize {
+        self.runs.iter().map(|&(_, s, e)| e - s).sum()
+    }
+    /// Each row of the island, in order.
+    pub fn each_row(&self) -> impl Iterator<Item = usize> + '_ {
+        self.runs.iter().flat_map(|&(_, s, e)| s..e)
+    }
+}
+
+impl Islands {
+    /// Room for the islands of `model` with at most `rows` rows.
+    pub fn new(model: &Model, rows: usize) -> Self {
+        let nt = model.trees.len();
+        let mut tree_of_dof = vec![usize::MAX; model.nv];
+        for (t, tree) in model.trees.iter().enumerate() {
+            for k in tree.v.clone() {
+                if let Some(x) = tree_of_dof.get_mut(k) {
+                    *x = t;
+                }
+            }
+        }
+        Self {
+            tree_of_dof,
+            parent: (0..nt).collect(),
+            key: vec![0; rows],
+            runs: Vec::with_capacity(rows),
+            islands: Vec::with_capacity(rows.min(nt + 1)),
+            dofs: Vec::with_capacity(model.nv),
+            mark: vec![false; model.nv],
+        }
+    }
+
+    fn find(&mut self, mut t: usize) -> usize {
+        while self.parent[t] != t {
+            self.parent[t] = self.parent[self.parent[t]];
+            t = self.parent[t];
+        }
+        t
+    }
+
+    /// The tree of a row's first and last dof (`None`: a row on no dof).
+    fn ends(&self, rows: &Rows, r: usize) -> Option<(usize, usize)> {
+        let (s, l) = rows.path[r];
+        let p = rows.table().get(s..s + l)?;
+        let (first, last) = (*p.first()?, *p.last()?);
+        let t = |k: usize| {
+            self.tree_of_dof
+                .get(k)
+                .copied()
+                .filter(|&t| t != usize::MAX)
+        };
+        Some((t(first)?, t(last)?))
+    }
+
+    /// Groups the assembled rows into islands.
+    pub fn group(&mut self, rows: &Rows) {
+        let n = rows.n.min(self.key.len());
+        for p in self.parent.iter_mut().enumerate() {
+            *p.1 = p.0;
+        }
+        for r in 0..n {
+            if let Some((a, b)) = self.ends(rows, r) {
+                let (ra, rb) = (self.find(a), self.find(b));
+                if ra != rb {
+                    self.parent[ra.max(rb)] = ra.min(rb);
+                }
+            }
+        }
+        for r in 0..n {
+            self.key[r] = match self.ends(rows, r) {
+                Some((a, _)) => self.find(a),
+                None => usize::MAX,
+            };
+        }
+        // runs of consecutive rows with one key, then grouped by key (stable:
+        // row order within an island)
+        self.runs.clear();
+        let mut r = 0;
+        while r < n {
+            let k = self.key[r];
+            let s = r;
+            while r < n && self.key[r] == k {
+                r += 1;
+            }
+            self.runs.push((k, s, r));
+        }
+        self.runs.sort_unstable_by_key(|&(k, s, _)| (k, s));
+        // each island's runs and dofs
+        self.islands.clear();
+        self.dofs.clear();
+        let table = rows.table();
+        let mut i = 0;
+        while i < self.runs.len() {
+            let k = self.runs[i].0;
+            let (r0, d0) = (i, self.dofs.len());
+            while i < self.runs.len() && self.runs[i].0 == k {
+                let (_, s, e) = self.runs[i];
+                for q in s..e {
+                    let (ps, pl) = rows.path[q];
+                    for &d in table.get(ps..ps + pl).unwrap_or(&[]) {
+                        if let Some(m) = self.mark.get_mut(d) {
+                            if !*m {
+                                *m = true;
+                                self.dofs.push(d);
+                            }
+                        }
+                    }
+                }
+                i += 1;
+            }
+            let dofs = &mut self.dofs[d0..];
+            dofs.sort_unstable();
+            for &d in dofs.iter() {
+                self.mark[d] = false;
+            }
+            self.islands.push(((r0, i), (d0, self.dofs.len())));
+        }
+    }
+
+    /// The islands of the last grouping.
+    pub fn len(&self) -> usize {
+        self.islands.len()
+    }
+
+    /// Island `i` of the last grouping.
+    pub fn get(&self, i: usize) -> Island<'_> {
+        let ((r0, r1), (d0, d1)) = self.islands[i];
+        Island {
+            runs: &self.runs[r0..r1],
+            dofs: &self.dofs[d0..d1],
+        }
+    }
+}
