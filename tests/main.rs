@@ -26,6 +26,7 @@ mod eval_constrained;
 mod eval_singular;
 mod example_scenes;
 mod fast_dynamics;
+mod islands;
 mod joint_kinds;
 mod kinematics_energy;
 mod layering;

@@ -1,0 +1,79 @@
+//! Islands (scene.md §"Large scenes: islands and sleep", issue 30 "Must
+//! show"): the constraint solve is island by island, so two piles far apart
+//! cost what each costs alone, never more (no cross term: a global solve
+//! sweeps every row until the slowest pile has converged). Cost is counted as
+//! the solve's work (rows × sweeps, `Simulation::solve_work`), not wall time.
+
+use serde_json::Value;
+use urdyn::scene::Scene;
+use urdyn::sim::{SimOptions, Simulation};
+
+fn dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/scenes")
+}
+
+fn spec(name: &str) -> Value {
+    let p = dir().join(name);
+    serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap()
+}
+
+/// `spec` with its models and obstacles moved `dx` along x and renamed.
+fn shifted(mut s: Value, dx: f64, prefix: &str) -> Value {
+    for key in ["models", "obstacles"] {
+        for m in s[key].as_array_mut().unwrap() {
+            let x = m["position"][0].as_f64().unwrap();
+            m["position"][0] = (x + dx).into();
+            let n = m["name"].as_str().unwrap().to_string();
+            m["name"] = format!("{prefix}{n}").into();
+        }
+    }
+    s
+}
+
+fn joined(a: Value, b: Value) -> Value {
+    let mut s = a;
+    for key in ["models", "obstacles"] {
+        let extra = b[key].as_array().unwrap().clone();
+        s[key].as_array_mut().unwrap().extend(extra);
+    }
+    s
+}
+
+/// The solve's work over 1 s (sleep off: every step solves every pile).
+fn work(s: &Value) -> u64 {
+    let scene = Scene::from_json(&s.to_string(), "piles.json", &dir(), &[])
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut opts = SimOptions {
+        ground: scene.ground.map(|g| g.height),
+        sleep: false,
+        ..SimOptions::default()
+    };
+    if let Some(g) = scene.ground {
+        opts.contact.friction = g.friction;
+    }
+    let mut sim = Simulation::new(scene.model.clone(), opts).unwrap();
+    sim.set_state(&scene.q0, &scene.v0).unwrap();
+    while sim.time() < 1.0 {
+        sim.step().unwrap();
+    }
+    sim.solve_work()
+}
+
+#[test]
+fn two_piles_ten_metres_apart_cost_what_each_costs_alone() {
+    let a = spec("pile_boxes_16.json");
+    let b = shifted(spec("pile_mixed_16.json"), 10.0, "b_");
+    let (wa, wb) = (work(&a), work(&b));
+    let both = work(&joined(a.clone(), b));
+    assert!(wa > 0 && wb > 0);
+    // each pile's island converges on its own: the sum, give or take the
+    // order of the contact points (a different warm start)
+    let sum = (wa + wb) as f64;
+    assert!(
+        (both as f64) <= 1.05 * sum,
+        "two piles {both}, alone {wa} + {wb}"
+    );
+    // the issue's form: two piles of one kind cost at most 2.2× one
+    let two = work(&joined(a.clone(), shifted(a, 10.0, "c_")));
+    assert!(two as f64 <= 2.2 * wa as f64, "two piles {two}, one {wa}");
+}
