@@ -149,11 +149,11 @@ impl Islands {
                 for q in s..e {
                     let (ps, pl) = rows.path[q];
                     for &d in table.get(ps..ps + pl).unwrap_or(&[]) {
-                        if let Some(m) = self.mark.get_mut(d) {
-                            if !*m {
-                                *m = true;
-                                self.dofs.push(d);
-                            }
+                        if let Some(m) = self.mark.get_mut(d)
+                            && !*m
+                        {
+                            *m = true;
+                            self.dofs.push(d);
                         }
                     }
                 }

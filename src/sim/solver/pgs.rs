@@ -127,8 +127,7 @@ impl Rows {
             None => dv.iter_mut().for_each(|x| *x = 0.0),
         }
         for &(_, s, e) in runs {
-            for r in s..e {
-                let l = lambda[r];
+            for (r, &l) in lambda.iter().enumerate().take(e).skip(s) {
                 if l != 0.0 {
                     raxpy(l, y, r, st, path(r), dv);
                 }
