@@ -14,6 +14,7 @@ mod dynamics;
 mod introspect;
 mod mjcf;
 mod model;
+mod prototype;
 mod rollout;
 mod scene;
 mod sim;
