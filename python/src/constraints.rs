@@ -170,7 +170,7 @@ fn read_state(
 /// does. Inconsistent rows are a `ValueError` naming the constraints.
 #[pyfunction]
 #[pyo3(signature = (model, data, q, v, tau, c, fext=None))]
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn constraint_dynamics<'py>(
     py: Python<'py>,
     model: PyRef<'py, PyModel>,

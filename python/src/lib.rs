@@ -14,6 +14,7 @@ mod dynamics;
 mod introspect;
 mod mjcf;
 mod model;
+mod pinocchio;
 mod prototype;
 mod rollout;
 mod scene;
@@ -41,8 +42,8 @@ fn _urdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::_scene_model_from_state, m)?)?;
     m.add("SimulationError", m.py().get_type::<SimulationError>())?;
     m.add_function(wrap_pyfunction!(model::_model_from_state, m)?)?;
-    m.add_function(wrap_pyfunction!(model::to_pinocchio_q, m)?)?;
-    m.add_function(wrap_pyfunction!(model::from_pinocchio_q, m)?)?;
+    m.add_function(wrap_pyfunction!(pinocchio::to_pinocchio_q, m)?)?;
+    m.add_function(wrap_pyfunction!(pinocchio::from_pinocchio_q, m)?)?;
     dynamics::register(m)?;
     derivatives::register(m)?;
     constraints::register(m)?;
