@@ -40,25 +40,7 @@ pub struct PyConstraints {
 impl PyConstraints {
     #[new]
     fn new(model: PyRef<'_, PyModel>, items: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let py = items.py();
-        let text: String = py
-            .import("json")?
-            .call_method1("dumps", (items,))
-            .and_then(|t| t.extract())
-            .map_err(|e| {
-                value_error(format!(
-                    "constraints: expected a list of dicts of numbers and strings ({e})"
-                ))
-            })?;
-        let v: serde_json::Value = serde_json::from_str(&text)
-            .map_err(|e| value_error(format!("constraints: not JSON-like ({e})")))?;
-        let m = &model.model;
-        let constraints = Constraints::from_value(m, &v)
-            .map_err(|e| value_error(format!("{}: {e}", model.file)))?;
-        Ok(Self {
-            constraints,
-            shape: (m.nq, m.nv, m.nbodies),
-        })
+        Self::build(&model, items)
     }
     /// The constraints' names, in order.
     #[getter]
@@ -87,12 +69,34 @@ impl PyConstraints {
 }
 
 impl PyConstraints {
-    /// A `ValueError` unless made for a model of `model`'s shape.
-    fn check(&self, model: &PyModel) -> PyResult<()> {
+    /// The set of the JSON objects `items` (a list of dicts) for `model`.
+    pub(crate) fn build(model: &PyModel, items: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let py = items.py();
+        let text: String = py
+            .import("json")?
+            .call_method1("dumps", (items,))
+            .and_then(|t| t.extract())
+            .map_err(|e| {
+                value_error(format!(
+                    "constraints: expected a list of dicts of numbers and strings ({e})"
+                ))
+            })?;
+        let v: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| value_error(format!("constraints: not JSON-like ({e})")))?;
+        let m = &model.model;
+        let constraints = Constraints::from_value(m, &v)
+            .map_err(|e| value_error(format!("{}: {e}", model.file)))?;
+        Ok(Self {
+            constraints,
+            shape: (m.nq, m.nv, m.nbodies),
+        })
+    }
+    /// A `ValueError` naming `arg` unless made for a model of `model`'s shape.
+    pub(crate) fn check(&self, model: &PyModel, arg: &str) -> PyResult<()> {
         let m = &model.model;
         if self.shape != (m.nq, m.nv, m.nbodies) {
             return Err(value_error(format!(
-                "c: made for another model (nq = {}, nv = {}), this one has nq = {}, nv = {}",
+                "{arg}: made for another model (nq = {}, nv = {}), this one has nq = {}, nv = {}",
                 self.shape.0, self.shape.1, m.nq, m.nv
             )));
         }
@@ -152,7 +156,7 @@ fn read_state(
     v: &Bound<'_, PyAny>,
     tau: &Bound<'_, PyAny>,
 ) -> PyResult<()> {
-    c.check(model)?;
+    c.check(model, "c")?;
     read_qv(model, d, q, v)?;
     read_vec(tau, "tau", "nv", &mut d.a)
 }
@@ -166,7 +170,7 @@ fn read_state(
 /// does. Inconsistent rows are a `ValueError` naming the constraints.
 #[pyfunction]
 #[pyo3(signature = (model, data, q, v, tau, c, fext=None))]
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn constraint_dynamics<'py>(
     py: Python<'py>,
     model: PyRef<'py, PyModel>,
@@ -251,7 +255,7 @@ pub fn constraint_jacobian<'py>(
     c: PyRef<'py, PyConstraints>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let d = &mut *data;
-    c.check(&model)?;
+    c.check(&model, "c")?;
     d.check(&model.model)?;
     read_q(d, q)?;
     let cons = c.placed(&model, d)?;
@@ -274,7 +278,7 @@ pub fn constraint_violation<'py>(
     c: PyRef<'py, PyConstraints>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let d = &mut *data;
-    c.check(&model)?;
+    c.check(&model, "c")?;
     d.check(&model.model)?;
     read_q(d, q)?;
     let cons = c.placed(&model, d)?;
@@ -282,4 +286,77 @@ pub fn constraint_violation<'py>(
     dynamics::constraint_violation(&model.model, &mut d.data, &cons, &d.q, &mut out)
         .map_err(|e| dyn_error(&model, e))?;
     Ok(PyArray1::from_vec(py, out))
+}
+
+/// `sim.constraint_forces()`: each constraint's force in the last step (λ/Δt,
+/// world), `{name: {"force": (3,), "torque": (3,)}}` for `point` (torque 0) and
+/// `frame` (on link1 at its point or frame origin; on link2 the opposite), a
+/// `joint` constraint's generalized force on joint1 as `{"torque": x}`
+/// (revolute, continuous) or `{"force": x}` (prismatic). An inactive
+/// constraint's is zero.
+pub(crate) fn forces_dict<'py>(
+    py: Python<'py>,
+    sim: &urdyn::sim::Simulation,
+) -> PyResult<Bound<'py, PyDict>> {
+    use urdyn::model::ConstraintKind;
+    let out = PyDict::new(py);
+    let Some(set) = sim.constraints() else {
+        return Ok(out);
+    };
+    for (c, f) in set.items.iter().zip(sim.constraint_forces()) {
+        let d = PyDict::new(py);
+        match c.kind {
+            ConstraintKind::Joint { prismatic, .. } => {
+                d.set_item(if prismatic { "force" } else { "torque" }, f.generalized)?;
+            }
+            _ => {
+                d.set_item("force", PyArray1::from_slice(py, f.force.as_slice()))?;
+                d.set_item("torque", PyArray1::from_slice(py, f.torque.as_slice()))?;
+            }
+        }
+        out.set_item(&c.name, d)?;
+    }
+    Ok(out)
+}
+
+/// `sim.set_constraint_active(name, on)`'s arguments: a constraint of the run
+/// (`name`, a `ValueError` naming the nearest otherwise) and a bool (`on`).
+pub(crate) fn read_switch(
+    sim: &urdyn::sim::Simulation,
+    name: &Bound<'_, PyAny>,
+    on: &Bound<'_, PyAny>,
+) -> PyResult<(String, bool)> {
+    let name: String = name.extract().map_err(|_| {
+        value_error(format!(
+            "name: expected a constraint's name (str), got {}",
+            name.repr().map(|r| r.to_string()).unwrap_or_default()
+        ))
+    })?;
+    let names: Vec<&str> = sim
+        .constraints()
+        .map(|s| s.items.iter().map(|c| c.name.as_str()).collect())
+        .unwrap_or_default();
+    if !names.contains(&name.as_str()) {
+        let near = urdyn::model::nearest(&name, names.iter().copied())
+            .map(|k| format!(" (nearest: \"{k}\")"))
+            .unwrap_or_else(|| " (the simulation has no loop constraints)".into());
+        return Err(value_error(format!(
+            "name: no constraint named \"{name}\"{near}"
+        )));
+    }
+    // True/False (numpy's bool_ too), not a number or a string
+    let is_bool = on.is_instance_of::<pyo3::types::PyBool>()
+        || on
+            .get_type()
+            .name()
+            .map(|n| n == "bool" || n == "bool_")
+            .unwrap_or(false);
+    let value = if is_bool { on.is_truthy().ok() } else { None };
+    let on = value.ok_or_else(|| {
+        value_error(format!(
+            "on: expected True or False, got {}",
+            on.repr().map(|r| r.to_string()).unwrap_or_default()
+        ))
+    })?;
+    Ok((name, on))
 }

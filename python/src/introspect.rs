@@ -52,6 +52,36 @@ pub fn link_inertials(text: &str, prefix: &str) -> HashMap<String, LinkInertial>
         .collect()
 }
 
+/// Every body's own inertial of the MJCF `text` (includes and meshes read
+/// under `dir`), as MuJoCo compiles it (`body_mass`, `body_ipos`, and the
+/// inertia about the centre of mass, `body_iquat`·diag(`body_inertia`), in the
+/// body frame): from `<inertial>`, or from the geoms where there is none. A
+/// text that does not compile gives none (the model's import read it already).
+pub fn mjcf_inertials(
+    text: &str,
+    file: &str,
+    dir: &std::path::Path,
+) -> HashMap<String, LinkInertial> {
+    let Ok(world) = urdyn::mjcf::compile_str(text, file, dir) else {
+        return HashMap::new();
+    };
+    world
+        .bodies
+        .iter()
+        .skip(1)
+        .map(|b| {
+            (
+                b.name.clone(),
+                LinkInertial {
+                    mass: b.mass,
+                    com: b.com,
+                    inertia: b.inertia,
+                },
+            )
+        })
+        .collect()
+}
+
 /// The name a lone URDF's one model goes by in `model.models` and
 /// `model_q_slice` (a scene's models by their own names).
 pub const LONE_MODEL: &str = "robot";

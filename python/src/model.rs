@@ -1,19 +1,24 @@
 //! `urdyn.Model` (the immutable model, its names, pickling) and `urdyn.Data`
 //! (the preallocated workspace).
 
-use crate::args::{
-    normalize_quaternion_at, not_found_error, quat_offsets, read3, read_q, read_vec, value_error,
-};
+use crate::args::{not_found_error, quat_offsets, read3, read_q, value_error};
 use crate::introspect::{self, link_inertials, py_slice, LinkInertial};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use std::collections::HashMap;
 use std::path::PathBuf;
+use std::sync::{Arc, OnceLock};
 use urdyn::model::FrameId;
 use urdyn::nalgebra::{DVector, Vector3};
 use urdyn::spatial::Force;
 use urdyn::{LoadOptions, Model};
+
+/// How a pickled model made elsewhere is rebuilt: given the model's gravity,
+/// the function (of `urdyn._urdyn`) and its arguments. The maker of the model
+/// (a scene) sets it, so that this file knows nothing of scenes.
+pub type Rebuild =
+    Arc<dyn Fn(Python<'_>, [f64; 3]) -> PyResult<(Py<PyAny>, Py<PyTuple>)> + Send + Sync>;
 
 /// A multibody model imported from a URDF (`Model.from_urdf`).
 #[pyclass(name = "Model", module = "urdyn")]
@@ -27,11 +32,16 @@ pub struct PyModel {
     pub package_dirs: Vec<PathBuf>,
     /// Index into `model.frames` of every URDF link.
     pub links: HashMap<String, usize>,
-    /// A scene's model: the scene's JSON text, file name and folder (a pickled
-    /// scene model is rebuilt from them).
+    /// A scene's model: the scene's JSON text, file name and folder (its
+    /// replay page draws the scene's obstacles).
     pub scene_state: Option<(String, String, PathBuf)>,
+    /// How a model made elsewhere (a scene's) is rebuilt when unpickled.
+    pub rebuild: Option<Rebuild>,
     /// Every URDF link's own `<inertial>` (`link_mass`, `link_inertia`).
     pub inertials: HashMap<String, LinkInertial>,
+    /// An MJCF model's bodies' own inertials, compiled at the first
+    /// `link_mass`/`link_inertia`.
+    mjcf_inertials: OnceLock<HashMap<String, LinkInertial>>,
     /// An MJCF model: the folder its includes and meshes are read from (`text`
     /// is then the MJCF text; a pickled model is rebuilt from both).
     pub mjcf_dir: Option<PathBuf>,
@@ -62,13 +72,15 @@ impl PyModel {
             package_dirs,
             links,
             scene_state: None,
+            rebuild: None,
             inertials,
+            mjcf_inertials: OnceLock::new(),
             mjcf_dir: None,
         })
     }
 
-    /// A model made elsewhere (a scene's: `scene_state` its JSON text, file and
-    /// folder), its links indexed.
+    /// A model made elsewhere (a scene's: `scene_state` its JSON text, file
+    /// and folder; its maker sets `rebuild`), its links indexed.
     pub fn from_parts(
         model: Model,
         file: String,
@@ -89,9 +101,24 @@ impl PyModel {
             package_dirs,
             links,
             scene_state,
+            rebuild: None,
             inertials,
+            mjcf_inertials: OnceLock::new(),
             mjcf_dir: None,
         }
+    }
+
+    /// Link `name`'s own inertial (a URDF's `<inertial>`, an MJCF body's as
+    /// MuJoCo compiles it; `None` without one), `link` in the message.
+    fn own_inertial(&self, name: &str) -> PyResult<Option<&LinkInertial>> {
+        self.link(name, "link")?;
+        let table = match &self.mjcf_dir {
+            Some(dir) => self
+                .mjcf_inertials
+                .get_or_init(|| introspect::mjcf_inertials(&self.text, &self.file, dir)),
+            None => &self.inertials,
+        };
+        Ok(table.get(name))
     }
 
     /// The frame index of URDF link `name` (`arg` in the message).
@@ -378,10 +405,11 @@ impl PyModel {
             .unwrap_or_else(|| DVector::zeros(self.model.nv));
         PyArray1::from_slice(py, a.as_slice())
     }
-    /// A link's own `<inertial>` mass (kg; 0 without one).
+    /// A link's own `<inertial>` mass (kg; 0 without one); an MJCF body's
+    /// own mass as MuJoCo's `body_mass` (from its geoms where it has no
+    /// `<inertial>`).
     fn link_mass(&self, link: &str) -> PyResult<f64> {
-        self.link(link, "link")?;
-        Ok(self.inertials.get(link).map_or(0.0, |i| i.mass))
+        Ok(self.own_inertial(link)?.map_or(0.0, |i| i.mass))
     }
     /// A link's own (centre of mass (3), inertia about it (3, 3)), link frame
     /// (zeros without an `<inertial>`).
@@ -391,10 +419,8 @@ impl PyModel {
         py: Python<'py>,
         link: &str,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
-        self.link(link, "link")?;
         let (c, i) = self
-            .inertials
-            .get(link)
+            .own_inertial(link)?
             .map_or((Vector3::zeros(), urdyn::nalgebra::Matrix3::zeros()), |l| {
                 (l.com, l.inertia)
             });
@@ -438,21 +464,9 @@ impl PyModel {
             self.model.gravity.y,
             self.model.gravity.z,
         ];
-        if let Some((text, file, dir)) = &self.scene_state {
-            let f = py
-                .import("urdyn._urdyn")?
-                .getattr("_scene_model_from_state")?
-                .unbind();
-            let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.clone());
-            let args = (
-                text.clone(),
-                file.clone(),
-                dir.display().to_string(),
-                dirs,
-                g,
-            )
-                .into_pyobject(py)?;
-            return Ok((f, args));
+        if let Some(rebuild) = &self.rebuild {
+            let (f, args) = rebuild(py, g)?;
+            return Ok((f, args.into_bound(py)));
         }
         if let Some(dir) = &self.mjcf_dir {
             let f = py
@@ -542,162 +556,4 @@ impl PyData {
         }
         Ok(())
     }
-}
-
-/// How a joint's coordinates map to Pinocchio's: a continuous revolute joint's
-/// θ is (cos θ, sin θ) (`JointModelRUB`), a planar joint's (x, y, θ) is
-/// (x, y, cos θ, sin θ) (`JointModelPlanar`); every other coordinate is copied.
-enum PinBlock {
-    /// `n` coordinates copied (the base, prismatic, revolute, spherical, free).
-    Copy(usize),
-    /// A continuous joint: θ ↔ (cos θ, sin θ).
-    Angle,
-    /// A planar joint: (x, y, θ) ↔ (x, y, cos θ, sin θ).
-    Planar,
-}
-
-/// The blocks of q in order with their joint names (the base's first when the
-/// model floats), each with its quaternion's offset inside the block (a free
-/// joint's at 3, a spherical joint's at 0), and Pinocchio's nq.
-fn pinocchio_layout(model: &Model) -> (Vec<(PinBlock, String, Option<usize>)>, usize) {
-    use urdyn::model::JointKind;
-    // (iq, nq, block, name, quaternion offset): the free joints (bases), then
-    // every joint that owns coordinates, in q order
-    let mut joints: Vec<(usize, usize, PinBlock, String, Option<usize>)> = model
-        .free_joints
-        .iter()
-        .map(|f| (f.iq, 7, PinBlock::Copy(7), f.name.clone(), Some(3)))
-        .collect();
-    for d in &model.dofs {
-        if joints.iter().any(|j| j.0 == d.iq) {
-            continue;
-        }
-        let (b, quat) = match d.kind {
-            JointKind::Planar => (PinBlock::Planar, None),
-            JointKind::Spherical => (PinBlock::Copy(4), Some(0)),
-            JointKind::Free => (PinBlock::Copy(7), Some(3)),
-            JointKind::Revolute(_) if d.continuous => (PinBlock::Angle, None),
-            ref k => (PinBlock::Copy(k.nq()), None),
-        };
-        joints.push((d.iq, d.kind.nq(), b, d.name.clone(), quat));
-    }
-    joints.sort_by_key(|j| j.0);
-    let mut blocks = Vec::new();
-    let mut at = 0;
-    for (iq, n, b, name, quat) in joints {
-        if iq > at {
-            // coordinates no joint claims (none expected): copied
-            blocks.push((PinBlock::Copy(iq - at), String::new(), None));
-        }
-        blocks.push((b, name, quat));
-        at = iq + n;
-    }
-    if model.nq > at {
-        blocks.push((PinBlock::Copy(model.nq - at), String::new(), None));
-    }
-    let nq_pin = blocks
-        .iter()
-        .map(|(b, _, _)| match b {
-            PinBlock::Copy(n) => *n,
-            PinBlock::Angle => 2,
-            PinBlock::Planar => 4,
-        })
-        .sum();
-    (blocks, nq_pin)
-}
-
-/// Pinocchio's q of urdyn's `q`: each continuous joint's angle θ becomes the pair
-/// (cos θ, sin θ) (Pinocchio's `JointModelRUB`), each planar joint's (x, y, θ)
-/// becomes (x, y, cos θ, sin θ) (`JointModelPlanar`); every other coordinate,
-/// the floating base's and the spherical joints' quaternions included, is
-/// copied. The joints are in the same order in both (`model.dof_names`).
-#[pyfunction]
-pub fn to_pinocchio_q<'py>(
-    py: Python<'py>,
-    model: PyRef<'py, PyModel>,
-    q: &Bound<'py, PyAny>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let m = &model.model;
-    let mut qv = DVector::zeros(m.nq);
-    read_q(q, "q", &quat_offsets(m), &mut qv)?;
-    let (blocks, nq_pin) = pinocchio_layout(m);
-    let mut out = Vec::with_capacity(nq_pin);
-    let qs = qv.as_slice();
-    let mut k = 0;
-    for (b, _, _) in &blocks {
-        match b {
-            PinBlock::Copy(n) => {
-                out.extend_from_slice(&qs[k..k + n]);
-                k += n;
-            }
-            PinBlock::Angle => {
-                // (cos θ, sin θ)
-                out.extend_from_slice(&[qs[k].cos(), qs[k].sin()]);
-                k += 1;
-            }
-            PinBlock::Planar => {
-                // (x, y, cos θ, sin θ)
-                let t = qs[k + 2];
-                out.extend_from_slice(&[qs[k], qs[k + 1], t.cos(), t.sin()]);
-                k += 3;
-            }
-        }
-    }
-    Ok(PyArray1::from_vec(py, out))
-}
-
-/// urdyn's q of Pinocchio's `q_pin` (of length `nq` of the Pinocchio model of the
-/// same URDF, `pin.buildModelFromUrdf(path, mimic=True)`, where a mimic joint has
-/// no coordinate of its own, as here): each continuous joint's pair (cos θ,
-/// sin θ) becomes θ = atan2(sin θ, cos θ) in (−π, π], each planar joint's
-/// (x, y, cos θ, sin θ) becomes (x, y, θ) likewise; every other coordinate is
-/// copied. A pair (0, 0), a wrong length, a non-finite entry or a quaternion
-/// (a floating base's or a spherical joint's) off unit norm is a `ValueError`.
-#[pyfunction]
-pub fn from_pinocchio_q<'py>(
-    py: Python<'py>,
-    model: PyRef<'py, PyModel>,
-    q_pin: &Bound<'py, PyAny>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let m = &model.model;
-    let (blocks, nq_pin) = pinocchio_layout(m);
-    let mut qp = DVector::zeros(nq_pin);
-    read_vec(q_pin, "q_pin", "Pinocchio's nq", &mut qp)?;
-    let mut out = Vec::with_capacity(m.nq);
-    let mut k = 0;
-    let angle = |qp: &DVector<f64>, k: usize, kind: &str, name: &str| -> PyResult<f64> {
-        let (c, s) = (qp[k], qp[k + 1]);
-        if c == 0.0 && s == 0.0 {
-            return Err(value_error(format!(
-                "q_pin[{k}:{}]: the (cos, sin) pair of {kind} joint \"{name}\" is (0, 0)",
-                k + 2
-            )));
-        }
-        // θ = atan2(sin θ, cos θ)
-        Ok(s.atan2(c))
-    };
-    for (b, name, quat) in &blocks {
-        match b {
-            PinBlock::Copy(n) => {
-                if let Some(o) = quat.filter(|o| o + 4 <= *n) {
-                    normalize_quaternion_at(
-                        &mut qp.as_mut_slice()[k + o..k + o + 4],
-                        "q_pin",
-                        k + o,
-                    )?;
-                }
-                out.extend_from_slice(&qp.as_slice()[k..k + n]);
-                k += n;
-            }
-            PinBlock::Angle => {
-                out.push(angle(&qp, k, "continuous", name)?);
-                k += 2;
-            }
-            PinBlock::Planar => {
-                out.extend_from_slice(&[qp[k], qp[k + 1], angle(&qp, k + 2, "planar", name)?]);
-                k += 4;
-            }
-        }
-    }
-    Ok(PyArray1::from_vec(py, out))
 }

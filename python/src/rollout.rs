@@ -2,13 +2,14 @@
 //! each with its own torques, servo gains and targets (python.md §"Batches on
 //! every core", §"Introspection, contacts, batched control, pictures"); each
 //! equals, bit for bit, a `Simulation` given the same calls and stepped alone
-//! (the same [`prototype_any`], [`set_torques`], `set_gains`, `set_targets`
-//! and [`advance`]).
+//! (the same [`prototype_any`], [`start_state`], [`set_torques`], `set_gains`,
+//! `set_targets` and [`advance`]).
 
 use crate::args::{
     normalize_quaternion_at, read_array, read_count, read_threads, value_error, Given,
 };
-use crate::sim::{advance, prototype_any, set_torques, sim_error};
+use crate::prototype::prototype_any;
+use crate::sim::{advance, set_torques, sim_error, start_state};
 use numpy::{PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use rayon::prelude::*;
@@ -111,9 +112,11 @@ fn read_gains(
 /// (scene.md §"Large scenes"); `sleep`: whether still islands sleep. `None`
 /// takes the scene's settings (a model alone sleeps, one island thread); each
 /// batch entry equals a `Simulation` with the same `sleep`/`threads` stepped
-/// alone, bit for bit.
+/// alone, bit for bit. `constraints`: a model's loops, as
+/// `Simulation(model, constraints=...)` (a scene's come from its file); each
+/// run starts them at its (q0[b], v0[b]) as `set_state` does.
 #[pyfunction]
-#[pyo3(signature = (model, q0, v0, tau=None, nstep=None, dt=1e-3, threads=None, integrator=None, ground=Given::Omitted, friction=Given::Omitted, kp=None, kd=None, q_ref=None, v_ref=None, sleep=None))]
+#[pyo3(signature = (model, q0, v0, tau=None, nstep=None, dt=1e-3, threads=None, integrator=None, ground=Given::Omitted, friction=Given::Omitted, kp=None, kd=None, q_ref=None, v_ref=None, sleep=None, constraints=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn rollout<'py>(
     py: Python<'py>,
@@ -132,15 +135,25 @@ pub fn rollout<'py>(
     q_ref: Option<&Bound<'py, PyAny>>,
     v_ref: Option<&Bound<'py, PyAny>>,
     sleep: Option<bool>,
+    constraints: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
     let nstep = match nstep {
         Some(n) if !n.is_none() => read_count(n, "nstep", 0)?,
         _ => 1000,
     };
     let threads = read_threads(threads)?;
-    let proto = prototype_any(
-        model, dt, integrator, &ground, &friction, None, sleep, threads,
+    let start = prototype_any(
+        model,
+        dt,
+        integrator,
+        &ground,
+        &friction,
+        None,
+        sleep,
+        threads,
+        constraints,
     )?;
+    let (proto, loops) = (start.sim, start.loops);
     let (nq, nv) = (proto.model.nq, proto.model.nv);
     let (qs, q0) = read_array(q0, "q0")?;
     let (vs, v0) = read_array(v0, "v0")?;
@@ -215,7 +228,7 @@ pub fn rollout<'py>(
                         vo[from * nv..].fill(f64::NAN);
                         Some((i, input, msg))
                     };
-                if let Err(e) = sim.set_state(&q, &v) {
+                if let Err(e) = start_state(&mut sim, &q, &v, loops.as_ref(), &[]) {
                     return fail(qo, vo, 0, true, format!("q0[{i}], v0[{i}]: {e}"));
                 }
                 if let (PerRun::Constant(_), Some(t)) = (&torques, torques.row(i, 0, nstep, nv)) {

@@ -5,12 +5,13 @@
 
 use crate::args::value_error;
 use crate::introspect::link_inertials;
-use crate::model::PyModel;
+use crate::model::{PyModel, Rebuild};
 use numpy::PyArray1;
 use pyo3::exceptions::PyFileNotFoundError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use std::path::PathBuf;
+use std::sync::Arc;
 use urdyn::nalgebra::Vector3;
 use urdyn::scene::{Scene, SceneError};
 
@@ -44,13 +45,40 @@ impl PyScene {
                 inertials.extend(link_inertials(&text, &format!("{}/", m.name)));
             }
         }
-        PyModel::from_parts(
+        // unpickled: `_scene_model_from_state` of the scene's text, file,
+        // folder and package roots, and the model's gravity
+        let (text, file) = (self.text.clone(), s.file.clone());
+        let dir = std::fs::canonicalize(&s.base_dir).unwrap_or_else(|_| s.base_dir.clone());
+        let dirs: Vec<String> = self
+            .package_dirs
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        let rebuild: Rebuild = Arc::new(move |py, g| {
+            let f = py
+                .import("urdyn._urdyn")?
+                .getattr("_scene_model_from_state")?
+                .unbind();
+            let args = (
+                text.clone(),
+                file.clone(),
+                dir.display().to_string(),
+                dirs.clone(),
+                g,
+            )
+                .into_pyobject(py)?
+                .unbind();
+            Ok((f, args))
+        });
+        let mut m = PyModel::from_parts(
             s.model.clone(),
             s.file.clone(),
             self.package_dirs.clone(),
             Some((self.text.clone(), s.file.clone(), s.base_dir.clone())),
             inertials,
-        )
+        );
+        m.rebuild = Some(rebuild);
+        m
     }
 
     fn build(

@@ -1,12 +1,9 @@
 //! `urdyn.Simulation`: one simulation stepped from Python. It and `rollout`
-//! (rollout.rs) go through [`prototype_any`] and [`advance`], so that a
-//! rollout's states equal, bit for bit, a `Simulation` stepped alone.
+//! (rollout.rs) go through [`prototype_any`], [`start_state`] and [`advance`],
+//! so that a rollout's states equal, bit for bit, a `Simulation` stepped alone.
 
-use crate::args::{
-    not_found_error, quat_offsets, read_count, read_q, read_threads, read_vec, value_error, Given,
-};
-use crate::model::PyModel;
-use crate::scene::PyScene;
+use crate::args::{quat_offsets, read_count, read_q, read_threads, read_vec, value_error, Given};
+use crate::prototype::{prototype_any, start_loops};
 use crate::view::Frame;
 use crate::SimulationError;
 use numpy::{PyArray1, PyArray2, PyArray3};
@@ -15,9 +12,9 @@ use pyo3::types::PyDict;
 use std::collections::HashMap;
 use std::path::PathBuf;
 use urdyn::cli::view::ContactArrow;
-use urdyn::contact::ContactError;
+use urdyn::model::Constraints;
 use urdyn::nalgebra::DVector;
-use urdyn::sim::{Integrator, SimError, SimOptions, Simulation};
+use urdyn::sim::{Integrator, SimError, Simulation};
 
 /// The names `integrator=` accepts.
 #[pyfunction]
@@ -25,165 +22,22 @@ pub fn integrators() -> Vec<&'static str> {
     Integrator::ALL.iter().map(|i| i.name()).collect()
 }
 
-/// A simulation of `model` at its neutral configuration, at rest, with the
-/// options of `Simulation(...)` / `rollout(...)`.
-fn prototype(
-    model: &PyModel,
-    dt: f64,
-    integrator: Option<&str>,
-    ground: Option<f64>,
-    friction: f64,
-    package_dirs: Option<Vec<PathBuf>>,
-    islands: Islands,
-) -> PyResult<Simulation> {
-    if !(dt > 0.0 && dt.is_finite()) {
-        return Err(value_error(format!(
-            "dt must be a positive number (got {dt})"
-        )));
+/// A new start at (q, v), as `Simulation.set_state` and each rollout entry
+/// make it: the library's `set_state`, then the loops `loops` (if any) started
+/// again there (world anchors left out placed where side 1 is in this state;
+/// the constraints in `off` switched off). Returns the start's warning lines.
+pub(crate) fn start_state(
+    sim: &mut Simulation,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+    loops: Option<&Constraints>,
+    off: &[String],
+) -> Result<Vec<String>, SimError> {
+    sim.set_state(q, v)?;
+    match loops {
+        Some(set) => start_loops(sim, set, off),
+        None => Ok(Vec::new()),
     }
-    if !(friction >= 0.0 && friction.is_finite()) {
-        return Err(value_error(format!(
-            "friction must be a finite number ≥ 0 (got {friction})"
-        )));
-    }
-    if let Some(g) = ground {
-        if !g.is_finite() {
-            return Err(value_error(format!(
-                "ground must be a finite number (got {g})"
-            )));
-        }
-    }
-    let integrator = match integrator {
-        None => None,
-        Some(name) => Some(Integrator::from_name(name).ok_or_else(|| {
-            value_error(format!(
-                "integrator: unknown \"{name}\" (one of: {})",
-                integrators().join(", ")
-            ))
-        })?),
-    };
-    let mut opts = SimOptions {
-        dt,
-        integrator,
-        ground,
-        package_paths: package_dirs.unwrap_or_else(|| model.package_dirs.clone()),
-        sleep: islands.sleep,
-        sleep_velocity: islands.sleep_velocity,
-        sleep_time: islands.sleep_time,
-        threads: islands.threads,
-        never_sleep: islands.never_sleep,
-        ..SimOptions::default()
-    };
-    opts.contact.friction = friction;
-    Simulation::new(model.model.clone(), opts).map_err(|e| match e {
-        // the library's message is neutral; the hint is Python's (the CLI names its flags)
-        SimError::Contact(ContactError::MissingMesh { .. }) => not_found_error(format!(
-            "{}: {e} (give its package root with package_dirs=[...] or ROS_PACKAGE_PATH, or pass ground=None for no contact)",
-            model.file
-        )),
-        e => value_error(format!("{}: {e}", model.file)),
-    })
-}
-
-/// Sleep and threads (scene.md §"Large scenes"): a scene's from its file, a
-/// model alone's the defaults (it sleeps, one thread), `sleep=`/`threads=` of
-/// the call over either.
-pub(crate) struct Islands {
-    sleep: bool,
-    sleep_velocity: f64,
-    sleep_time: f64,
-    threads: usize,
-    never_sleep: Vec<String>,
-}
-
-/// A simulation of a scene at its starting state (poses, `pose`, `initial`),
-/// with its ground, friction and obstacles; the scene's constant torques.
-fn prototype_scene(
-    scene: &PyScene,
-    dt: f64,
-    integrator: Option<&str>,
-    package_dirs: Option<Vec<PathBuf>>,
-    sleep: Option<bool>,
-    threads: Option<usize>,
-) -> PyResult<Simulation> {
-    let s = &scene.scene;
-    let model = scene.py_model();
-    let ground = s.ground.map(|g| g.height);
-    let friction = s.ground.map_or(1.0, |g| g.friction);
-    // as `urdyn simulate SCENE.json` (src/cli/simulate.rs): the file's settings
-    // where the call gives none
-    let spec = &s.spec;
-    let islands = Islands {
-        sleep: sleep.unwrap_or(spec.sleep.unwrap_or(true)),
-        sleep_velocity: spec.sleep_velocity.unwrap_or(1e-3),
-        sleep_time: spec.sleep_time.unwrap_or(0.5),
-        threads: threads.or(spec.threads).unwrap_or(1),
-        never_sleep: spec
-            .models
-            .iter()
-            .filter(|m| m.sleep == Some(false))
-            .map(|m| m.name.clone())
-            .collect(),
-    };
-    let mut sim = prototype(
-        &model,
-        dt,
-        integrator,
-        ground,
-        friction,
-        package_dirs,
-        islands,
-    )?;
-    sim.set_state(&s.q0, &s.v0)
-        .map_err(|e| value_error(format!("{}: {e}", s.file)))?;
-    sim.torques_mut().copy_from(&s.tau0);
-    Ok(sim)
-}
-
-/// The simulation `Simulation(...)` / `rollout(...)` start from: of a `Model`
-/// (neutral, at rest) or of a `Scene` (its ground, friction and start; the
-/// `ground` and `friction` the file decides: given beside a scene, even at
-/// their defaults, they are a `ValueError`).
-pub(crate) fn prototype_any(
-    source: &Bound<'_, PyAny>,
-    dt: f64,
-    integrator: Option<&str>,
-    ground: &Given,
-    friction: &Given,
-    package_dirs: Option<Vec<PathBuf>>,
-    sleep: Option<bool>,
-    threads: Option<usize>,
-) -> PyResult<Simulation> {
-    if let Ok(scene) = source.extract::<PyRef<'_, PyScene>>() {
-        for (name, g) in [("ground", ground), ("friction", friction)] {
-            if g.given() {
-                return Err(value_error(format!(
-                    "{name}= does not apply beside a scene: the scene file decides its ground and friction ({})",
-                    scene.scene.file
-                )));
-            }
-        }
-        return prototype_scene(&scene, dt, integrator, package_dirs, sleep, threads);
-    }
-    let model = source
-        .extract::<PyRef<'_, PyModel>>()
-        .map_err(|_| value_error("model: expected a urdyn.Model or a urdyn.Scene".to_string()))?;
-    let py = source.py();
-    prototype(
-        &model,
-        dt,
-        integrator,
-        ground.ground(py)?,
-        friction.friction(py)?,
-        package_dirs,
-        Islands {
-            sleep: sleep.unwrap_or(true),
-            sleep_velocity: 1e-3,
-            sleep_time: 0.5,
-            threads: threads.unwrap_or(1),
-            never_sleep: Vec::new(),
-        },
-    )
 }
 
 /// One step of `dt` of simulated time (an adaptive integrator may take several
@@ -245,6 +99,15 @@ pub struct PySimulation {
     /// The recording: `Some` while recording or after it stopped.
     frames_rec: Vec<Frame>,
     recording: bool,
+    /// The loop constraints as given (world anchors not placed): `set_state`
+    /// starts them again.
+    loops: Option<Constraints>,
+    /// The constraints switched off (`set_constraint_active`), kept across
+    /// `set_state` and `reset`.
+    off: Vec<String>,
+    /// The start's warning lines (a constraint violated by more than 1 mm),
+    /// given as `RuntimeWarning`s at the next `step`.
+    pending: Vec<String>,
 }
 
 impl PySimulation {
@@ -281,11 +144,15 @@ impl PySimulation {
     /// scenes"): `None` takes the scene's settings (its `"sleep"`,
     /// `"threads"`, a model's own `"sleep": false`); a model alone is a
     /// one-model scene, so it sleeps by default on one thread, as `urdyn
-    /// simulate ROBOT.urdf` does.
+    /// simulate ROBOT.urdf` does. `constraints` (a `urdyn.Constraints` made
+    /// for `model`, or a list of mechanisms.md's constraint dicts): loops of a
+    /// one-model simulation, no scene file needed (a scene's come from its
+    /// file). A world anchor left out is placed where its link is at the start
+    /// — construction, and each `set_state`, which starts a run anew.
     #[new]
-    #[pyo3(signature = (model, dt=1e-3, integrator=None, ground=Given::Omitted, friction=Given::Omitted, package_dirs=None, sleep=None, threads=None))]
+    #[pyo3(signature = (model, dt=1e-3, integrator=None, ground=Given::Omitted, friction=Given::Omitted, package_dirs=None, sleep=None, threads=None, constraints=None))]
     #[pyo3(
-        text_signature = "(model, dt=1e-3, integrator=None, ground=0.0, friction=1.0, package_dirs=None, sleep=None, threads=None)"
+        text_signature = "(model, dt=1e-3, integrator=None, ground=0.0, friction=1.0, package_dirs=None, sleep=None, threads=None, constraints=None)"
     )]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -297,9 +164,10 @@ impl PySimulation {
         package_dirs: Option<Vec<PathBuf>>,
         sleep: Option<bool>,
         threads: Option<&Bound<'_, PyAny>>,
+        constraints: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let threads = read_threads(threads)?;
-        let sim = prototype_any(
+        let proto = prototype_any(
             model,
             dt,
             integrator,
@@ -308,7 +176,9 @@ impl PySimulation {
             package_dirs,
             sleep,
             threads,
+            constraints,
         )?;
+        let sim = proto.sim;
         let frames = sim
             .model
             .frames
@@ -327,11 +197,16 @@ impl PySimulation {
             source: model.clone().unbind(),
             frames_rec: Vec::new(),
             recording: false,
+            loops: proto.loops,
+            off: Vec::new(),
+            pending: proto.warnings,
         })
     }
 
     /// Sets the state (q: nq, v: nv; warm starts forgotten); the time stays
     /// unless `time` is given. The start `reset()` returns to does not move.
+    /// With loop constraints a new start: world anchors left out are placed
+    /// where their link is in this state.
     #[pyo3(signature = (q, v, time=None))]
     fn set_state(
         &mut self,
@@ -350,8 +225,7 @@ impl PySimulation {
                 )));
             }
         }
-        self.sim
-            .set_state(&qv, &vv)
+        self.pending = start_state(&mut self.sim, &qv, &vv, self.loops.as_ref(), &self.off)
             .map_err(|e| value_error(e.to_string()))?;
         if let Some(t) = time {
             self.sim.set_time(t);
@@ -360,8 +234,9 @@ impl PySimulation {
     }
 
     /// Back to the state and time the Simulation started from (a scene's
-    /// start), warm starts cleared; gains, targets and the recording stay. The
-    /// same inputs then replay the first run bit for bit.
+    /// start), warm starts cleared; gains, targets, the constraints switched
+    /// off and the recording stay. The same inputs then replay the first run
+    /// bit for bit.
     fn reset(&mut self) -> PyResult<()> {
         let (kp, kd) = self.sim.gains();
         let (kp, kd) = (kp.clone(), kd.clone());
@@ -371,6 +246,10 @@ impl PySimulation {
         sim.set_gains(&kp, &kd)
             .and_then(|_| sim.set_targets(&q_ref, Some(&v_ref)))
             .map_err(|e| value_error(e.to_string()))?;
+        for name in &self.off {
+            sim.set_constraint_active(name, false)
+                .map_err(|e| value_error(e.to_string()))?;
+        }
         self.sim = sim;
         Ok(())
     }
@@ -393,6 +272,12 @@ impl PySimulation {
             Some(n) => read_count(n, "n", 0)?,
             None => 1,
         };
+        // a start that violates a loop by more than 1 mm: one warning a constraint
+        for line in std::mem::take(&mut self.pending) {
+            let w = py.get_type::<pyo3::exceptions::PyRuntimeWarning>();
+            let msg = std::ffi::CString::new(format!("warning: {line}")).unwrap_or_default();
+            PyErr::warn(py, &w, &msg, 1)?;
+        }
         match tau.filter(|t| !t.is_none()) {
             Some(t) => {
                 read_vec(t, "tau", "nv", &mut self.tau)?;
@@ -547,6 +432,42 @@ impl PySimulation {
             ));
         };
         crate::view::write(&path, stage, &self.frames_rec)
+    }
+
+    // --- Loop constraints (mechanisms.md §"Python"; constraints.rs) ---
+
+    /// The largest violation over the active loop constraints now (m for
+    /// `point`, the larger of m and rad for `frame`, |residual| for `joint`; 0
+    /// without loops). An attribute; calling it (`sim.constraint_violation()`)
+    /// gives the same number.
+    #[getter]
+    fn constraint_violation<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let x = self.sim.constraint_violation();
+        py.import("urdyn")?.getattr("_Reading")?.call1((x,))
+    }
+    /// Each loop constraint's force in the last step (world): `{name:
+    /// {"force": (3,), "torque": (3,)}}` on link1 at its point or frame origin
+    /// (`point`: torque 0; on link2 the opposite), a `joint` constraint's
+    /// generalized force on joint1 `{"torque": x}` (`{"force": x}` prismatic).
+    fn constraint_forces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::constraints::forces_dict(py, &self.sim)
+    }
+    /// Switches the loop constraint `name` on or off (`on`: True or False);
+    /// kept across `set_state` and `reset`. Switching one on wakes the run.
+    fn set_constraint_active(
+        &mut self,
+        name: &Bound<'_, PyAny>,
+        on: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let (name, on) = crate::constraints::read_switch(&self.sim, name, on)?;
+        self.sim
+            .set_constraint_active(&name, on)
+            .map_err(|e| value_error(format!("name: {e}")))?;
+        self.off.retain(|n| *n != name);
+        if !on {
+            self.off.push(name);
+        }
+        Ok(())
     }
 
     // --- Control and sensors (python.md §"Control", §"Sensors"; control.rs) ---

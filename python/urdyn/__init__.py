@@ -68,6 +68,21 @@ from ._urdyn import (  # noqa: F401
     to_mujoco_qvel,
 )
 
+
+
+class _Reading(float):
+    """A number read from a simulation now (`sim.constraint_violation`): a float;
+    calling it, `sim.constraint_violation()`, gives the same number."""
+
+    __slots__ = ()
+
+    def __call__(self):
+        return float(self)
+
+    def __repr__(self):
+        return float.__repr__(self)
+
+
 __all__ = [
     "Data",
     "Model",

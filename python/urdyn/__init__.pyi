@@ -163,8 +163,10 @@ class Simulation:
         package_dirs: Optional[Sequence[Union[str, "PathLike[str]"]]] = None,
         sleep: Optional[bool] = None,
         threads: Optional[int] = None,
+        constraints: Optional[Union["Constraints", Sequence[Dict[str, Any]]]] = None,
     ) -> None:
-        """sleep/threads None: the scene's settings (a model alone sleeps, one thread)."""
+        """sleep/threads None: the scene's settings (a model alone sleeps, one thread).
+        constraints: a one-model simulation's loops (a scene's come from its file)."""
         ...
     @property
     def awake(self) -> int: ...
@@ -203,6 +205,16 @@ class Simulation:
     def imu(self, link: str) -> Tuple[Vec, Vec]: ...
     def joint_wrench(self, joint: str) -> Tuple[Vec, Vec]: ...
     def contact_wrench(self, link: str) -> Tuple[Vec, Vec]: ...
+    # loop constraints (mechanisms.md "Python")
+    @property
+    def constraint_violation(self) -> float:
+        """The largest violation over the active loops now (calling it gives the same)."""
+        ...
+    def constraint_forces(self) -> Dict[str, Dict[str, Any]]:
+        """{name: {"force": (3,), "torque": (3,)}} on link1, world; a joint
+        constraint's {"torque": x} ({"force": x} prismatic); last step."""
+        ...
+    def set_constraint_active(self, name: str, on: bool) -> None: ...
 
 def linearize(
     sim: Simulation,
@@ -240,6 +252,7 @@ def rollout(
     q_ref: Optional[ArrayLike] = None,
     v_ref: Optional[ArrayLike] = None,
     sleep: Optional[bool] = None,
+    constraints: Optional[Union["Constraints", Sequence[Dict[str, Any]]]] = None,
 ) -> Tuple[Vec, Vec]: ...
 
 class Constraints:

@@ -1,0 +1,263 @@
+//! The simulation `Simulation(...)` and `rollout(...)` start from: a `Model`'s
+//! (neutral, at rest; loop constraints from `constraints=`) or a `Scene`'s (its
+//! ground, friction, obstacles, start and `"constraints"`), and the start of a
+//! run with loops ([`start_loops`]): both go through here, so that a rollout's
+//! states equal, bit for bit, a `Simulation` stepped alone.
+
+use crate::args::{not_found_error, value_error, Given};
+use crate::constraints::PyConstraints;
+use crate::model::PyModel;
+use crate::scene::PyScene;
+use crate::sim::integrators;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+use urdyn::contact::ContactError;
+use urdyn::model::Constraints;
+use urdyn::sim::{Integrator, SimError, SimOptions, Simulation};
+
+/// A starting simulation with what a run with loops needs to start again.
+pub(crate) struct Proto {
+    /// The simulation at its start (loops set, holds placed there).
+    pub sim: Simulation,
+    /// The loop constraints as given (world holds not yet placed): a new
+    /// start (`set_state`) places them again.
+    pub loops: Option<Constraints>,
+    /// The start's warning lines (a constraint violated by more than 1 mm).
+    pub warnings: Vec<String>,
+}
+
+/// Starts the loops `set` at the simulation's current state (world anchors
+/// left out placed where side 1 is now; the passive energy reference taken
+/// afresh), the constraints named in `off` switched off. Returns the warning
+/// lines of the constraints this state violates by more than 1 mm.
+pub(crate) fn start_loops(
+    sim: &mut Simulation,
+    set: &Constraints,
+    off: &[String],
+) -> Result<Vec<String>, SimError> {
+    let lines = sim.set_constraints(set.clone())?;
+    for name in off {
+        sim.set_constraint_active(name, false)?;
+    }
+    Ok(lines)
+}
+
+/// The loop constraints of `constraints=` for `model`: a `urdyn.Constraints`
+/// made for it, or a list of the JSON objects as dicts.
+fn read_constraints(model: &PyModel, c: &Bound<'_, PyAny>) -> PyResult<Constraints> {
+    if let Ok(c) = c.extract::<PyRef<'_, PyConstraints>>() {
+        c.check(model, "constraints")?;
+        return Ok(c.constraints.clone());
+    }
+    if c.is_instance_of::<pyo3::types::PyList>() || c.is_instance_of::<pyo3::types::PyTuple>() {
+        return Ok(PyConstraints::build(model, c)?.constraints);
+    }
+    Err(value_error(format!(
+        "constraints: expected a urdyn.Constraints or a list of constraint dicts (got {})",
+        c.get_type()
+            .name()
+            .map(|n| n.to_string())
+            .unwrap_or_default()
+    )))
+}
+
+/// A simulation of `model` at its neutral configuration, at rest, with the
+/// options of `Simulation(...)` / `rollout(...)`.
+fn prototype(
+    model: &PyModel,
+    dt: f64,
+    integrator: Option<&str>,
+    ground: Option<f64>,
+    friction: f64,
+    package_dirs: Option<Vec<PathBuf>>,
+    islands: Islands,
+) -> PyResult<Simulation> {
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(value_error(format!(
+            "dt must be a positive number (got {dt})"
+        )));
+    }
+    if !(friction >= 0.0 && friction.is_finite()) {
+        return Err(value_error(format!(
+            "friction must be a finite number ≥ 0 (got {friction})"
+        )));
+    }
+    if let Some(g) = ground {
+        if !g.is_finite() {
+            return Err(value_error(format!(
+                "ground must be a finite number (got {g})"
+            )));
+        }
+    }
+    let integrator = match integrator {
+        None => None,
+        Some(name) => Some(Integrator::from_name(name).ok_or_else(|| {
+            value_error(format!(
+                "integrator: unknown \"{name}\" (one of: {})",
+                integrators().join(", ")
+            ))
+        })?),
+    };
+    let mut opts = SimOptions {
+        dt,
+        integrator,
+        ground,
+        package_paths: package_dirs.unwrap_or_else(|| model.package_dirs.clone()),
+        sleep: islands.sleep,
+        sleep_velocity: islands.sleep_velocity,
+        sleep_time: islands.sleep_time,
+        threads: islands.threads,
+        never_sleep: islands.never_sleep,
+        ..SimOptions::default()
+    };
+    opts.contact.friction = friction;
+    Simulation::new(model.model.clone(), opts).map_err(|e| match e {
+        // the library's message is neutral; the hint is Python's (the CLI names its flags)
+        SimError::Contact(ContactError::MissingMesh { .. }) => not_found_error(format!(
+            "{}: {e} (give its package root with package_dirs=[...] or ROS_PACKAGE_PATH, or pass ground=None for no contact)",
+            model.file
+        )),
+        e => value_error(format!("{}: {e}", model.file)),
+    })
+}
+
+/// Sleep and threads (scene.md §"Large scenes"): a scene's from its file, a
+/// model alone's the defaults (it sleeps, one thread), `sleep=`/`threads=` of
+/// the call over either.
+pub(crate) struct Islands {
+    sleep: bool,
+    sleep_velocity: f64,
+    sleep_time: f64,
+    threads: usize,
+    never_sleep: Vec<String>,
+}
+
+/// A simulation of a scene at its starting state (poses, `pose`, `initial`),
+/// with its ground, friction and obstacles; the scene's constant torques.
+fn prototype_scene(
+    scene: &PyScene,
+    dt: f64,
+    integrator: Option<&str>,
+    package_dirs: Option<Vec<PathBuf>>,
+    sleep: Option<bool>,
+    threads: Option<usize>,
+) -> PyResult<Simulation> {
+    let s = &scene.scene;
+    let model = scene.py_model();
+    let ground = s.ground.map(|g| g.height);
+    let friction = s.ground.map_or(1.0, |g| g.friction);
+    // as `urdyn simulate SCENE.json` (src/cli/simulate.rs): the file's settings
+    // where the call gives none
+    let spec = &s.spec;
+    let islands = Islands {
+        sleep: sleep.unwrap_or(spec.sleep.unwrap_or(true)),
+        sleep_velocity: spec.sleep_velocity.unwrap_or(1e-3),
+        sleep_time: spec.sleep_time.unwrap_or(0.5),
+        threads: threads.or(spec.threads).unwrap_or(1),
+        never_sleep: spec
+            .models
+            .iter()
+            .filter(|m| m.sleep == Some(false))
+            .map(|m| m.name.clone())
+            .collect(),
+    };
+    let mut sim = prototype(
+        &model,
+        dt,
+        integrator,
+        ground,
+        friction,
+        package_dirs,
+        islands,
+    )?;
+    sim.set_state(&s.q0, &s.v0)
+        .map_err(|e| value_error(format!("{}: {e}", s.file)))?;
+    sim.torques_mut().copy_from(&s.tau0);
+    Ok(sim)
+}
+
+/// The simulation `Simulation(...)` / `rollout(...)` start from: of a `Model`
+/// (neutral, at rest; the loops of `constraints`) or of a `Scene` (its ground,
+/// friction, start and `"constraints"`; the `ground`, `friction` and
+/// `constraints` the file decides: given beside a scene, even at their
+/// defaults, they are a `ValueError`).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn prototype_any(
+    source: &Bound<'_, PyAny>,
+    dt: f64,
+    integrator: Option<&str>,
+    ground: &Given,
+    friction: &Given,
+    package_dirs: Option<Vec<PathBuf>>,
+    sleep: Option<bool>,
+    threads: Option<usize>,
+    constraints: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Proto> {
+    let constraints = constraints.filter(|c| !c.is_none());
+    if let Ok(scene) = source.extract::<PyRef<'_, PyScene>>() {
+        for (name, g) in [("ground", ground), ("friction", friction)] {
+            if g.given() {
+                return Err(value_error(format!(
+                    "{name}= does not apply beside a scene: the scene file decides its ground and friction ({})",
+                    scene.scene.file
+                )));
+            }
+        }
+        if constraints.is_some() {
+            return Err(value_error(format!(
+                "constraints= does not apply beside a scene: the scene file's \"constraints\" decide ({})",
+                scene.scene.file
+            )));
+        }
+        let mut sim = prototype_scene(&scene, dt, integrator, package_dirs, sleep, threads)?;
+        let set = &scene.scene.constraints;
+        if set.items.is_empty() {
+            return Ok(Proto {
+                sim,
+                loops: None,
+                warnings: Vec::new(),
+            });
+        }
+        let warnings = start_loops(&mut sim, set, &[])
+            .map_err(|e| value_error(format!("{}: {e}", scene.scene.file)))?;
+        return Ok(Proto {
+            sim,
+            loops: Some(set.clone()),
+            warnings,
+        });
+    }
+    let model = source
+        .extract::<PyRef<'_, PyModel>>()
+        .map_err(|_| value_error("model: expected a urdyn.Model or a urdyn.Scene".to_string()))?;
+    let loops = constraints
+        .map(|c| read_constraints(&model, c))
+        .transpose()?
+        .filter(|c| !c.items.is_empty());
+    let py = source.py();
+    let mut sim = prototype(
+        &model,
+        dt,
+        integrator,
+        ground.ground(py)?,
+        friction.friction(py)?,
+        package_dirs,
+        Islands {
+            sleep: sleep.unwrap_or(true),
+            sleep_velocity: 1e-3,
+            sleep_time: 0.5,
+            threads: threads.unwrap_or(1),
+            never_sleep: Vec::new(),
+        },
+    )?;
+    let warnings = match &loops {
+        Some(set) => {
+            start_loops(&mut sim, set, &[]).map_err(|e| value_error(format!("constraints: {e}")))?
+        }
+        None => Vec::new(),
+    };
+    Ok(Proto {
+        sim,
+        loops,
+        warnings,
+    })
+}
