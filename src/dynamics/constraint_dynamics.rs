@@ -13,7 +13,7 @@
 //! q̈ = q̈₀ + Y λ.
 
 use super::kkt::{mul_add, KktFactor};
-use super::{check_massless, check_sizes, forward_dynamics_crba, linalg, ltdl, DynamicsError};
+use super::{check_massless, check_sizes, forward_dynamics_crba, linalg, DynamicsError};
 use crate::model::{Attachment, ConstraintKind, Constraints, Data, DimensionError, Model};
 use crate::spatial::ops::madd;
 use crate::spatial::{Force, Motion};
@@ -232,16 +232,6 @@ pub(crate) fn bias_rows(
     }
 }
 
-/// `x ← H⁻¹ x` with the factor in `data.chol` (LTDL, or dense Cholesky with
-/// mimic joints).
-fn h_solve(model: &Model, data: &Data, x: &mut DVector<f64>) {
-    if model.has_mimic {
-        linalg::cholesky_solve(&data.chol, x);
-    } else {
-        ltdl::ltdl_solve(&data.chol, &model.dof_parent, x);
-    }
-}
-
 /// Sizes and the workspace's rows.
 pub(crate) fn check_workspace(
     model: &Model,
@@ -291,13 +281,17 @@ pub fn constraint_dynamics<'c>(
     );
     cd.qdd.copy_from(&data.qdd);
     if model.has_mimic {
-        // Y = H⁻¹ J_cᵀ, one column a row (dense Cholesky)
-        for r in 0..cd.rows {
-            for c in 0..model.nv {
-                cd.tmp[c] = cd.jc[(r, c)];
+        // Y = H⁻¹ J_cᵀ (dense Cholesky), every row at once: J_c's columns are
+        // the rows of J_cᵀ, m contiguous entries each
+        let (n, m) = (model.nv, cd.rows);
+        let x = cd.p.as_mut_slice();
+        x.copy_from_slice(cd.jc.as_slice());
+        linalg::cholesky_solve_rows(&data.chol, m, x);
+        let y = cd.y.as_mut_slice();
+        for i in 0..n {
+            for r in 0..m {
+                y[i + r * n] = x[i * m + r];
             }
-            h_solve(model, data, &mut cd.tmp);
-            cd.y.set_column(r, &cd.tmp);
         }
         return solve_rows(cd, constraints).map(|_| &cd.qdd);
     }

@@ -23,7 +23,9 @@ use super::constraint_dynamics::{
     ConstraintDynamicsError,
 };
 use super::kkt::{mul_add, mul_add_bt};
-use super::rnea_derivatives::{check_wrenches, rnea_derivatives_pass, LinkWrench};
+use super::rnea_derivatives::{
+    check_wrenches, rnea_derivatives_pass, rnea_derivatives_pass_after_minv, LinkWrench,
+};
 use super::{check_massless, check_sizes, minv};
 use crate::model::{Attachment, ConstraintKind, Constraints, Data, Model};
 use crate::spatial::{Force, Motion};
@@ -72,13 +74,13 @@ pub fn constraint_dynamics_derivatives(
             super::constraint_dynamics(model, data, cd, constraints, q, v, tau, fbody).map(|_| ());
         data.deriv_fext = fb;
         r?;
+        // H⁻¹ = solve(H, 1), all columns at once (symmetric: rows are columns)
         let nv = model.nv;
+        data.minv.fill(0.0);
         for c in 0..nv {
-            cd.tmp.fill(0.0);
-            cd.tmp[c] = 1.0;
-            super::linalg::cholesky_solve(&data.chol, &mut cd.tmp);
-            data.minv.set_column(c, &cd.tmp);
+            data.minv[(c, c)] = 1.0;
         }
+        super::linalg::cholesky_solve_rows(&data.chol, nv, data.minv.as_mut_slice());
     } else {
         // q̈₀ and H⁻¹ by the world-frame ABA, world velocities in data.minv_ov
         let r = minv::minv_pass(model, data, q, v, tau, fbody);
@@ -101,7 +103,12 @@ pub fn constraint_dynamics_derivatives(
     // ∂ID/∂q, ∂ID/∂v at a = q̈ (world velocities and accelerations kept)
     let mut a = std::mem::replace(&mut data.deriv_tmp, DVector::zeros(0));
     a.copy_from(&cd.qdd);
-    rnea_derivatives_pass(model, data, q, v, &a, fext);
+    if model.has_mimic {
+        rnea_derivatives_pass(model, data, q, v, &a, fext);
+    } else {
+        // the poses and world columns of minv_pass
+        rnea_derivatives_pass_after_minv(model, data, q, v, &a, fext);
+    }
     data.deriv_tmp = a;
     // G_q −= ∂(J_cᵀ λ)/∂q; ∂A/∂q, ∂A/∂v
     cd.aq.fill(0.0);

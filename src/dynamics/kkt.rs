@@ -265,7 +265,14 @@ pub(crate) fn mul_add_bt(
 }
 
 /// `c ← β c + α a b` with `b[k, j]` at `b[k s₀ + j s₁]`, `(s₀, s₁) = bs`.
-fn gemm(c: &mut DMatrix<f64>, alpha: f64, a: &DMatrix<f64>, b: &[f64], bs: (usize, usize), beta: f64) {
+fn gemm(
+    c: &mut DMatrix<f64>,
+    alpha: f64,
+    a: &DMatrix<f64>,
+    b: &[f64],
+    bs: (usize, usize),
+    beta: f64,
+) {
     let (m, n, kk) = (a.nrows(), c.ncols(), a.ncols());
     debug_assert!(c.nrows() == m);
     let (a, c) = (a.as_slice(), c.as_mut_slice());
@@ -332,10 +339,10 @@ impl Gemm<'_> {
         let mut acc = [[0.0; R]; C];
         for k in 0..kk {
             let ak = &self.a[k * m + i0..][..R];
-            for q in 0..C {
+            for (q, aq) in acc.iter_mut().enumerate() {
                 let bk = self.b[k * s0 + (j0 + q) * s1];
                 for r in 0..R {
-                    acc[q][r] = madd(ak[r], bk, acc[q][r]);
+                    aq[r] = madd(ak[r], bk, aq[r]);
                 }
             }
         }
