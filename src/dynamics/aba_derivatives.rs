@@ -4,7 +4,9 @@
 //! ∂q̈/∂x = −H⁻¹ ∂ID/∂x; H⁻¹ from the world-frame ABA of `minv.rs`, "Inverse of
 //! H"; the products over ∂ID/∂x's tree pattern, "The products").
 
-use super::rnea_derivatives::{check_wrenches, rnea_derivatives_pass, LinkWrench};
+use super::rnea_derivatives::{
+    check_wrenches, rnea_derivatives_pass, rnea_derivatives_pass_after_minv, LinkWrench,
+};
 use super::{check_massless, check_sizes, linalg, minv, DynamicsError};
 use crate::model::{Data, Model};
 use crate::spatial::ops::madd;
@@ -54,7 +56,7 @@ pub fn aba_derivatives<T: Scalar>(
         // ∂τ/∂q, ∂τ/∂v at a = q̈
         let mut a = std::mem::replace(&mut data.deriv_tmp, DVector::zeros(0));
         a.copy_from(&data.qdd);
-        rnea_derivatives_pass(model, data, q, v, &a, fext);
+        rnea_derivatives_pass_after_minv(model, data, q, v, &a, fext);
         data.deriv_tmp = a;
         if data.deriv_low_rank {
             // ∂q̈/∂x = −H⁻¹ ∂τ/∂x from ∂τ/∂x's low-rank parts (long chains)

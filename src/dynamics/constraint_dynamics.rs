@@ -13,8 +13,9 @@
 //! q̈ = q̈₀ + Y λ.
 
 use super::kkt::{mul_add, KktFactor};
-use super::{check_massless, check_sizes, forward_dynamics_crba, linalg, ltdl, DynamicsError};
+use super::{check_massless, check_sizes, forward_dynamics_crba, linalg, DynamicsError};
 use crate::model::{Attachment, ConstraintKind, Constraints, Data, DimensionError, Model};
+use crate::spatial::ops::madd;
 use crate::spatial::{Force, Motion};
 use nalgebra::{DMatrix, DVector, Vector3};
 
@@ -57,14 +58,15 @@ pub struct ConstraintData {
     pub dqdd_dq: DMatrix<f64>,
     /// ∂q̈/∂v.
     pub dqdd_dv: DMatrix<f64>,
-    /// ∂q̈/∂τ = H⁻¹ − Y K⁺ Yᵀ.
+    /// ∂q̈/∂τ = H⁻¹ − Y K⁺ Yᵀ (= M_c).
     pub dqdd_dtau: DMatrix<f64>,
     /// Y = H⁻¹ J_cᵀ (nv × m; after [`constraint_dynamics`] on a model without
-    /// mimic joints, W = L⁻ᵀ J_cᵀ by rows of m: its columns' storage).
+    /// mimic joints, W = L⁻ᵀ J_cᵀ by rows of m: its columns' storage; Ȳ = Y S
+    /// after the derivatives, `KktFactor::right_half`).
     pub(crate) y: DMatrix<f64>,
-    /// K = J_c Y (m × m; K⁺ after the derivatives).
+    /// K = J_c Y (m × m).
     pub(crate) k: DMatrix<f64>,
-    /// Derivatives: P = Y K⁺ (nv × m; J_cᵀ before it).
+    /// Scratch (nv × m): D⁻¹ W in [`constraint_dynamics`], the derivatives' `right_half`.
     pub(crate) p: DMatrix<f64>,
     pub(crate) kkt: KktFactor,
     /// Scratch: m entries.
@@ -73,12 +75,10 @@ pub struct ConstraintData {
     pub(crate) r2: DVector<f64>,
     /// Scratch: nv entries.
     pub(crate) tmp: DVector<f64>,
-    /// Derivatives: ∂(J_c a + γ_c)/∂q at a = q̈ (m × nv).
+    /// Derivatives: ∂(J_c a + γ_c)/∂q at a = q̈, transposed (nv × m).
     pub(crate) aq: DMatrix<f64>,
-    /// Derivatives: ∂(J_c a + γ_c)/∂v (m × nv).
+    /// Derivatives: ∂(J_c a + γ_c)/∂v, transposed (nv × m).
     pub(crate) av: DMatrix<f64>,
-    /// Derivatives: m × nv scratch.
-    pub(crate) z: DMatrix<f64>,
     /// Derivatives: the world columns of one side's path (scratch).
     pub(crate) path: Vec<(usize, usize, Motion<f64>)>,
     /// Derivatives: per body, the world velocity-product acceleration.
@@ -106,9 +106,8 @@ impl ConstraintData {
             r: DVector::zeros(m),
             r2: DVector::zeros(m),
             tmp: DVector::zeros(nv),
-            aq: DMatrix::zeros(m, nv),
-            av: DMatrix::zeros(m, nv),
-            z: DMatrix::zeros(m, nv),
+            aq: DMatrix::zeros(nv, m),
+            av: DMatrix::zeros(nv, m),
             path: Vec::with_capacity(model.nv),
             oa0: vec![Motion::zero(); model.nbodies],
         }
@@ -233,16 +232,6 @@ pub(crate) fn bias_rows(
     }
 }
 
-/// `x ← H⁻¹ x` with the factor in `data.chol` (LTDL, or dense Cholesky with
-/// mimic joints).
-fn h_solve(model: &Model, data: &Data, x: &mut DVector<f64>) {
-    if model.has_mimic {
-        linalg::cholesky_solve(&data.chol, x);
-    } else {
-        ltdl::ltdl_solve(&data.chol, &model.dof_parent, x);
-    }
-}
-
 /// Sizes and the workspace's rows.
 pub(crate) fn check_workspace(
     model: &Model,
@@ -292,13 +281,17 @@ pub fn constraint_dynamics<'c>(
     );
     cd.qdd.copy_from(&data.qdd);
     if model.has_mimic {
-        // Y = H⁻¹ J_cᵀ, one column a row (dense Cholesky)
-        for r in 0..cd.rows {
-            for c in 0..model.nv {
-                cd.tmp[c] = cd.jc[(r, c)];
+        // Y = H⁻¹ J_cᵀ (dense Cholesky), every row at once: J_c's columns are
+        // the rows of J_cᵀ, m contiguous entries each
+        let (n, m) = (model.nv, cd.rows);
+        let x = cd.p.as_mut_slice();
+        x.copy_from_slice(cd.jc.as_slice());
+        linalg::cholesky_solve_rows(&data.chol, m, x);
+        let y = cd.y.as_mut_slice();
+        for i in 0..n {
+            for r in 0..m {
+                y[i + r * n] = x[i * m + r];
             }
-            h_solve(model, data, &mut cd.tmp);
-            cd.y.set_column(r, &cd.tmp);
         }
         return solve_rows(cd, constraints).map(|_| &cd.qdd);
     }
@@ -307,37 +300,52 @@ pub fn constraint_dynamics<'c>(
     // (docs/theory.md §"Constrained dynamics", "Solving")
     let (n, m) = (model.nv, cd.rows);
     let lam = &model.dof_parent;
+    // the ancestors of each coordinate as runs of consecutive coordinates (models
+    // without mimic joints): every elimination step is a contiguous axpy
+    let direct = data.deriv_direct;
+    let (runs, run0) = (&data.deriv_anc_runs, &data.deriv_anc_run0);
     let u = data.chol.as_slice();
     let w = cd.y.as_mut_slice();
+    let jcs = cd.jc.as_slice();
     for r in 0..m {
         let wr = &mut w[r * n..(r + 1) * n];
         for (c, x) in wr.iter_mut().enumerate() {
-            *x = cd.jc[(r, c)];
+            *x = jcs[r + c * m];
         }
         for i in (0..n).rev() {
             let xi = wr[i];
             if xi == 0.0 {
                 continue;
             }
-            let mut j = lam[i];
-            while j != usize::MAX {
-                wr[j] -= u[j + i * n] * xi;
-                j = lam[j];
+            if direct {
+                let (above, _) = wr.split_at_mut(i);
+                let ui = &u[i * n..i * n + i];
+                for &(lo, hi) in &runs[run0[i]..run0[i + 1]] {
+                    for (x, &l) in above[lo..hi].iter_mut().zip(&ui[lo..hi]) {
+                        *x = madd(-l, xi, *x);
+                    }
+                }
+            } else {
+                let mut j = lam[i];
+                while j != usize::MAX {
+                    wr[j] -= u[j + i * n] * xi;
+                    j = lam[j];
+                }
             }
         }
     }
-    for k in 0..n {
-        cd.tmp[k] = 1.0 / u[k + k * n];
+    // K = Wᵀ D⁻¹ W: with D⁻¹ W in `dw` (cd.p's storage), dot products of
+    // contiguous rows, eight partial sums each
+    let dw = cd.p.as_mut_slice();
+    for r in 0..m {
+        for k in 0..n {
+            dw[r * n + k] = w[r * n + k] / u[k + k * n];
+        }
     }
-    let dinv = cd.tmp.as_slice();
     for r in 0..m {
         let wr = &w[r * n..(r + 1) * n];
         for s2 in 0..=r {
-            let ws = &w[s2 * n..(s2 + 1) * n];
-            let mut acc = 0.0;
-            for k in 0..n {
-                acc += wr[k] * ws[k] * dinv[k];
-            }
+            let acc = dot8(wr, &dw[s2 * n..(s2 + 1) * n]);
             cd.k[(r, s2)] = acc;
             cd.k[(s2, r)] = acc;
         }
@@ -355,16 +363,43 @@ pub fn constraint_dynamics<'c>(
     }
     for i in 0..n {
         let mut s1 = t[i];
-        let mut j = lam[i];
-        while j != usize::MAX {
-            s1 -= u[j + i * n] * t[j];
-            j = lam[j];
+        if direct {
+            let ui = &u[i * n..i * n + i];
+            for &(lo, hi) in &runs[run0[i]..run0[i + 1]] {
+                for (&l, &x) in ui[lo..hi].iter().zip(&t[lo..hi]) {
+                    s1 = madd(-l, x, s1);
+                }
+            }
+        } else {
+            let mut j = lam[i];
+            while j != usize::MAX {
+                s1 -= u[j + i * n] * t[j];
+                j = lam[j];
+            }
         }
         t[i] = s1;
     }
     cd.qdd += &cd.tmp;
     cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
     Ok(&cd.qdd)
+}
+
+/// `Σₖ a[k] b[k]` in eight interleaved partial sums (vectorised).
+#[inline(always)]
+fn dot8(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 8];
+    let (ac, bc) = (a.chunks_exact(8), b.chunks_exact(8));
+    let (ar, br) = (ac.remainder(), bc.remainder());
+    for (x, y) in ac.zip(bc) {
+        for l in 0..8 {
+            acc[l] = madd(x[l], y[l], acc[l]);
+        }
+    }
+    let mut s = 0.0;
+    for (&x, &y) in ar.iter().zip(br) {
+        s = madd(x, y, s);
+    }
+    ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + s
 }
 
 /// With `cd.qdd` = q̈₀, `cd.jc`, `cd.gamma`, `cd.y` set: K, its factor, λ, the

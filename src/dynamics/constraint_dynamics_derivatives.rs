@@ -7,6 +7,7 @@
 //! ```text
 //! H ∂q̈ − J_cᵀ ∂λ = −G,   J_c ∂q̈ = −∂A,    G = ∂ID/∂x − ∂(J_cᵀ λ)/∂x
 //! ∂q̈ = X − P (J_c X + ∂A),   X = −H⁻¹ G,   Y = H⁻¹ J_cᵀ,   K = J_c Y,   P = Y K⁺
+//! (computed as ∂q̈ = −M_c G − Ȳ Sᵀ ∂A with M_c = ∂q̈/∂τ, Ȳ = Y S, K⁺ = S Sᵀ)
 //! ∂q̈/∂τ = H⁻¹ − P Yᵀ
 //! ```
 //!
@@ -21,8 +22,10 @@ use super::constraint_dynamics::{
     bias_rows, check_workspace, jacobian_rows, side_point, solve_rows, ConstraintData,
     ConstraintDynamicsError,
 };
-use super::kkt::mul_add;
-use super::rnea_derivatives::{check_wrenches, rnea_derivatives_pass, LinkWrench};
+use super::kkt::{mul_add, mul_add_bt};
+use super::rnea_derivatives::{
+    check_wrenches, rnea_derivatives_pass, rnea_derivatives_pass_after_minv, LinkWrench,
+};
 use super::{check_massless, check_sizes, minv};
 use crate::model::{Attachment, ConstraintKind, Constraints, Data, Model};
 use crate::spatial::{Force, Motion};
@@ -71,13 +74,13 @@ pub fn constraint_dynamics_derivatives(
             super::constraint_dynamics(model, data, cd, constraints, q, v, tau, fbody).map(|_| ());
         data.deriv_fext = fb;
         r?;
+        // H⁻¹ = solve(H, 1), all columns at once (symmetric: rows are columns)
         let nv = model.nv;
+        data.minv.fill(0.0);
         for c in 0..nv {
-            cd.tmp.fill(0.0);
-            cd.tmp[c] = 1.0;
-            super::linalg::cholesky_solve(&data.chol, &mut cd.tmp);
-            data.minv.set_column(c, &cd.tmp);
+            data.minv[(c, c)] = 1.0;
         }
+        super::linalg::cholesky_solve_rows(&data.chol, nv, data.minv.as_mut_slice());
     } else {
         // q̈₀ and H⁻¹ by the world-frame ABA, world velocities in data.minv_ov
         let r = minv::minv_pass(model, data, q, v, tau, fbody);
@@ -93,15 +96,19 @@ pub fn constraint_dynamics_derivatives(
         let (ov, oa0) = (&data.minv_ov, &cd.oa0);
         bias_rows(data, constraints, |b| ov[b], |b| oa0[b], &mut cd.gamma);
         // Y = H⁻¹ J_cᵀ (J_cᵀ's zeros skipped)
-        cd.jc.transpose_to(&mut cd.p);
-        mul_add(&mut cd.y, 1.0, &data.minv, &cd.p, 0.0);
+        mul_add_bt(&mut cd.y, 1.0, &data.minv, &cd.jc, 0.0);
         cd.qdd.copy_from(&data.qdd);
         solve_rows(cd, constraints)?;
     }
     // ∂ID/∂q, ∂ID/∂v at a = q̈ (world velocities and accelerations kept)
     let mut a = std::mem::replace(&mut data.deriv_tmp, DVector::zeros(0));
     a.copy_from(&cd.qdd);
-    rnea_derivatives_pass(model, data, q, v, &a, fext);
+    if model.has_mimic {
+        rnea_derivatives_pass(model, data, q, v, &a, fext);
+    } else {
+        // the poses and world columns of minv_pass
+        rnea_derivatives_pass_after_minv(model, data, q, v, &a, fext);
+    }
     data.deriv_tmp = a;
     // G_q −= ∂(J_cᵀ λ)/∂q; ∂A/∂q, ∂A/∂v
     cd.aq.fill(0.0);
@@ -117,17 +124,23 @@ pub fn constraint_dynamics_derivatives(
         }
         row += n;
     }
-    // X = −H⁻¹ G
+    // ∂q̈/∂τ = M_c = H⁻¹ − Y K⁺ Yᵀ = H⁻¹ − Ȳ Ȳᵀ with Ȳ = Y S, K⁺ = S Sᵀ
+    // (docs/theory.md §"Constrained dynamics", "Derivatives")
+    cd.dqdd_dtau.copy_from(&data.minv);
+    if cd.rows > 0 {
+        cd.kkt.right_half(&mut cd.y, &mut cd.p);
+        mul_add_bt(&mut cd.dqdd_dtau, -1.0, &cd.y, &cd.y, 1.0);
+    }
+    // ∂q̈ = −M_c G − Ȳ (Sᵀ ∂A): first −M_c G
     if model.has_mimic || !data.deriv_direct {
         for (x, g) in [
             (&mut cd.dqdd_dq, &data.dtau_dq),
             (&mut cd.dqdd_dv, &data.dtau_dv),
         ] {
-            mul_add(x, -1.0, &data.minv, g, 0.0);
+            mul_add(x, -1.0, &cd.dqdd_dtau, g, 0.0);
         }
     } else {
         let Data {
-            minv,
             dtau_dq,
             dtau_dv,
             deriv_dof_end: dof_end,
@@ -141,36 +154,20 @@ pub fn constraint_dynamics_derivatives(
             run0,
         };
         neg_mul_tree(
-            minv,
+            &cd.dqdd_dtau,
             [dtau_dq, dtau_dv],
             [&mut cd.dqdd_dq, &mut cd.dqdd_dv],
             &pat,
         );
     }
-    let m = cd.rows;
-    if m == 0 {
-        cd.dqdd_dtau.copy_from(&data.minv);
+    if cd.rows == 0 {
         return Ok(());
     }
-    // P = Y K⁺ (K⁺ once, by columns of the identity)
-    cd.k.fill(0.0);
-    for i in 0..m {
-        cd.k[(i, i)] = 1.0;
+    // ∂Aᵀ S = (Sᵀ ∂A)ᵀ (aq, av hold ∂Aᵀ)
+    for (x, da) in [(&mut cd.dqdd_dq, &mut cd.aq), (&mut cd.dqdd_dv, &mut cd.av)] {
+        cd.kkt.right_half(da, &mut cd.p);
+        mul_add_bt(x, -1.0, &cd.y, da, 1.0);
     }
-    for col in cd.k.as_mut_slice().chunks_exact_mut(m) {
-        cd.kkt.solve(col);
-    }
-    mul_add(&mut cd.p, 1.0, &cd.y, &cd.k, 0.0);
-    // ∂q̈ = X − P (J_c X + ∂A)
-    for (x, da) in [(&mut cd.dqdd_dq, &cd.aq), (&mut cd.dqdd_dv, &cd.av)] {
-        cd.z.copy_from(da);
-        mul_add(&mut cd.z, 1.0, &cd.jc, x, 1.0);
-        mul_add(x, -1.0, &cd.p, &cd.z, 1.0);
-    }
-    // ∂q̈/∂τ = H⁻¹ − P Yᵀ
-    cd.y.transpose_to(&mut cd.z);
-    cd.dqdd_dtau.copy_from(&data.minv);
-    mul_add(&mut cd.dqdd_dtau, -1.0, &cd.p, &cd.z, 1.0);
     Ok(())
 }
 
@@ -222,15 +219,22 @@ fn side_terms(
     let alpha = oab.ang;
     let pdot = ovb.lin + omega.cross(&p);
     let dtau = &mut data.dtau_dq;
+    let n = model.nv;
+    let dtau = dtau.as_mut_slice();
     for &(cj, mj, sj) in &cd.path {
         let dp = sj.lin + sj.ang.cross(&p);
         let dpf = dp.cross(&f);
+        // (sⱼ × sₖ)·W = −sₖ·(sⱼ ×* W)
+        let fj = sj.cross_force(&w);
+        let (e1a, e1l) = (dpf - fj.ang, -fj.lin);
+        let col = &mut dtau[cj * n..(cj + 1) * n];
         for &(ck, mk, sk) in &cd.path {
-            let mut x = sk.ang.dot(&dpf);
-            if mj <= mk {
-                x += sj.cross(&sk).dot(&w);
-            }
-            dtau[(ck, cj)] -= x;
+            let x = if mj <= mk {
+                sk.ang.dot(&e1a) + sk.lin.dot(&e1l)
+            } else {
+                sk.ang.dot(&dpf)
+            };
+            col[ck] -= x;
         }
         let pm = model.parent[mj];
         let (ovp, oap) = (ov[pm], oa[pm]);
@@ -262,10 +266,11 @@ fn add_rows(
     lin: &Vector3<f64>,
     ang: Option<&Vector3<f64>>,
 ) {
+    // a holds ∂Aᵀ (nv × m)
     for r in 0..3 {
-        a[(row + r, col)] += sign * lin[r];
+        a[(col, row + r)] += sign * lin[r];
         if let Some(w) = ang {
-            a[(row + 3 + r, col)] += sign * w[r];
+            a[(col, row + 3 + r)] += sign * w[r];
         }
     }
 }

@@ -5,6 +5,7 @@
 //! pseudo-inverse `K⁺ = V Λ⁺ Vᵀ`, which gives the least-norm λ of a consistent
 //! system. No allocation: every buffer is sized once.
 
+use crate::spatial::ops::madd;
 use nalgebra::{DMatrix, DVector};
 
 /// An eigenvalue (or Cholesky pivot) at most this fraction of the largest
@@ -118,6 +119,41 @@ impl KktFactor {
     }
 }
 
+impl KktFactor {
+    /// `y ← y S` for an n × m `y`, with `K⁺ = S Sᵀ` (docs/theory.md
+    /// §"Constrained dynamics", "Derivatives"): `S = L⁻ᵀ` at full rank (the
+    /// columns by forward substitution, in place), else `S = V Λ^{+½}` (the
+    /// dropped eigenvalues' columns zero; `scratch` n × m).
+    pub fn right_half(&self, y: &mut DMatrix<f64>, scratch: &mut DMatrix<f64>) {
+        let (n, m) = (y.nrows(), self.t.len());
+        if self.full_rank {
+            let l = self.f.as_slice();
+            let ys = y.as_mut_slice();
+            for j in 0..m {
+                let (done, rest) = ys.split_at_mut(j * n);
+                let yj = &mut rest[..n];
+                for k in 0..j {
+                    let ljk = l[j + k * m];
+                    for (x, &z) in yj.iter_mut().zip(&done[k * n..(k + 1) * n]) {
+                        *x = madd(-ljk, z, *x);
+                    }
+                }
+                let d = 1.0 / l[j + j * m];
+                yj.iter_mut().for_each(|x| *x *= d);
+            }
+            return;
+        }
+        mul_add(scratch, 1.0, y, &self.f, 0.0);
+        for j in 0..m {
+            let e = self.ev[j];
+            let d = if e > 0.0 { 1.0 / e.sqrt() } else { 0.0 };
+            for i in 0..n {
+                y[(i, j)] = scratch[(i, j)] * d;
+            }
+        }
+    }
+}
+
 /// `k = L Lᵀ` into `l` (lower triangle); false when a pivot is at most
 /// [`RANK_TOL`] of its diagonal entry (or not finite).
 fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>) -> bool {
@@ -200,8 +236,9 @@ fn jacobi_eigen(v: &mut DMatrix<f64>, q: &mut DMatrix<f64>, ev: &mut DVector<f64
 }
 
 /// `c ← β c + α a b` for column-major matrices, allocation-free (nalgebra's
-/// `gemm` packs through the heap for larger sizes); a zero entry of `b` skips
-/// its column of `a` (J_c's rows and columns are mostly zero).
+/// `gemm` packs through the heap for larger sizes): register tiles of R × 4
+/// accumulators (R = 16, 8, 4, 2, 1 down the rows), each column of `a` read once
+/// per tile, the sums added to c at the end.
 pub(crate) fn mul_add(
     c: &mut DMatrix<f64>,
     alpha: f64,
@@ -209,23 +246,110 @@ pub(crate) fn mul_add(
     b: &DMatrix<f64>,
     beta: f64,
 ) {
-    let (m, n, kk) = (a.nrows(), b.ncols(), a.ncols());
-    debug_assert!(c.nrows() == m && c.ncols() == n && b.nrows() == kk);
-    let (a, b, c) = (a.as_slice(), b.as_slice(), c.as_mut_slice());
-    for j in 0..n {
-        let cj = &mut c[j * m..(j + 1) * m];
-        if beta == 0.0 {
-            cj.fill(0.0);
-        } else if beta != 1.0 {
-            cj.iter_mut().for_each(|x| *x *= beta);
-        }
-        for k in 0..kk {
-            let s = alpha * b[k + j * kk];
-            if s == 0.0 {
-                continue;
+    debug_assert!(c.ncols() == b.ncols() && b.nrows() == a.ncols());
+    let kk = a.ncols();
+    gemm(c, alpha, a, b.as_slice(), (1, kk), beta);
+}
+
+/// `c ← β c + α a bᵀ` (b is c's columns × a's columns), as [`mul_add`].
+pub(crate) fn mul_add_bt(
+    c: &mut DMatrix<f64>,
+    alpha: f64,
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    beta: f64,
+) {
+    debug_assert!(c.ncols() == b.nrows() && b.ncols() == a.ncols());
+    let n = b.nrows();
+    gemm(c, alpha, a, b.as_slice(), (n, 1), beta);
+}
+
+/// `c ← β c + α a b` with `b[k, j]` at `b[k s₀ + j s₁]`, `(s₀, s₁) = bs`.
+fn gemm(
+    c: &mut DMatrix<f64>,
+    alpha: f64,
+    a: &DMatrix<f64>,
+    b: &[f64],
+    bs: (usize, usize),
+    beta: f64,
+) {
+    let (m, n, kk) = (a.nrows(), c.ncols(), a.ncols());
+    debug_assert!(c.nrows() == m);
+    let (a, c) = (a.as_slice(), c.as_mut_slice());
+    if beta == 0.0 {
+        c.fill(0.0);
+    } else if beta != 1.0 {
+        c.iter_mut().for_each(|x| *x *= beta);
+    }
+    let g = Gemm {
+        m,
+        kk,
+        alpha,
+        a,
+        b,
+        bs,
+    };
+    let mut i0 = 0;
+    while i0 + 16 <= m {
+        g.panel::<16>(n, c, i0);
+        i0 += 16;
+    }
+    for r in [8, 4, 2, 1] {
+        if i0 + r <= m {
+            match r {
+                8 => g.panel::<8>(n, c, i0),
+                4 => g.panel::<4>(n, c, i0),
+                2 => g.panel::<2>(n, c, i0),
+                _ => g.panel::<1>(n, c, i0),
             }
-            for (x, &y) in cj.iter_mut().zip(&a[k * m..(k + 1) * m]) {
-                *x += s * y;
+            i0 += r;
+        }
+    }
+}
+
+/// The operands of one [`mul_add`].
+struct Gemm<'a> {
+    m: usize,
+    kk: usize,
+    alpha: f64,
+    a: &'a [f64],
+    b: &'a [f64],
+    bs: (usize, usize),
+}
+
+impl Gemm<'_> {
+    /// Rows `i0..i0 + R` of every column: blocks of 4, then single columns.
+    #[inline(always)]
+    fn panel<const R: usize>(&self, n: usize, c: &mut [f64], i0: usize) {
+        let mut j0 = 0;
+        while j0 + 4 <= n {
+            self.tile::<R, 4>(c, i0, j0);
+            j0 += 4;
+        }
+        while j0 < n {
+            self.tile::<R, 1>(c, i0, j0);
+            j0 += 1;
+        }
+    }
+
+    /// `c[i0.., j0..] += α Σₖ a[i0.., k] b[k, j0..]`, an R × C tile.
+    #[inline(always)]
+    fn tile<const R: usize, const C: usize>(&self, c: &mut [f64], i0: usize, j0: usize) {
+        let (m, kk, (s0, s1)) = (self.m, self.kk, self.bs);
+        let mut acc = [[0.0; R]; C];
+        for k in 0..kk {
+            let ak = &self.a[k * m + i0..][..R];
+            for (q, aq) in acc.iter_mut().enumerate() {
+                let bk = self.b[k * s0 + (j0 + q) * s1];
+                for r in 0..R {
+                    aq[r] = madd(ak[r], bk, aq[r]);
+                }
+            }
+        }
+        for q in 0..C {
+            let col = &mut c[(j0 + q) * m + i0..(j0 + q) * m + i0 + R];
+            for r in 0..R {
+                col[r] = madd(self.alpha, acc[q][r], col[r]);
             }
         }
     }

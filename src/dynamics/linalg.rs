@@ -1,5 +1,6 @@
 //! Dense symmetric positive-definite factorisation in place (no allocation).
 
+use crate::spatial::ops::madd;
 use crate::spatial::{lit, Scalar};
 use nalgebra::{DMatrix, DVector};
 
@@ -47,6 +48,40 @@ pub fn cholesky_solve<T: Scalar>(l: &DMatrix<T>, x: &mut DVector<T>) {
             s -= l[(k, i)] * x[k];
         }
         x[i] = s / l[(i, i)];
+    }
+}
+
+/// [`cholesky_solve`] for `w` right-hand sides at once, stored as the rows of
+/// the n × w row-contiguous `x` (`x[i w + j]`: entry i of right-hand side j):
+/// every elimination step is one contiguous axpy over all of them.
+pub fn cholesky_solve_rows<T: Scalar>(l: &DMatrix<T>, w: usize, x: &mut [T]) {
+    let n = l.nrows();
+    let l = l.as_slice();
+    let x = &mut x[..n * w];
+    for i in 0..n {
+        let (done, rest) = x.split_at_mut(i * w);
+        let xi = &mut rest[..w];
+        for k in 0..i {
+            let s = l[i + k * n];
+            for (p, &q) in xi.iter_mut().zip(&done[k * w..(k + 1) * w]) {
+                *p = madd(-s, q, *p);
+            }
+        }
+        let d = T::one() / l[i + i * n];
+        xi.iter_mut().for_each(|p| *p *= d);
+    }
+    for i in (0..n).rev() {
+        let (head, tail) = x.split_at_mut((i + 1) * w);
+        let xi = &mut head[i * w..];
+        for k in (i + 1)..n {
+            let s = l[k + i * n];
+            let o = (k - i - 1) * w;
+            for (p, &q) in xi.iter_mut().zip(&tail[o..o + w]) {
+                *p = madd(-s, q, *p);
+            }
+        }
+        let d = T::one() / l[i + i * n];
+        xi.iter_mut().for_each(|p| *p *= d);
     }
 }
 

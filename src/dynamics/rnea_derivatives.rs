@@ -71,8 +71,26 @@ pub(crate) fn rnea_derivatives_pass<T: Scalar>(
     fext: Option<&[LinkWrench<T>]>,
 ) {
     match fext {
-        Some(w) if !w.is_empty() => pass::<T, true>(model, data, q, v, a, w),
-        _ => pass::<T, false>(model, data, q, v, a, &[]),
+        Some(w) if !w.is_empty() => pass::<T, true, false>(model, data, q, v, a, w),
+        _ => pass::<T, false, false>(model, data, q, v, a, &[]),
+    }
+}
+
+/// [`rnea_derivatives_pass`] right after [`super::minv::minv_pass`] at the same q
+/// on a model without mimic joints: the poses `data.li_m_i`, `data.o_m_i` and the
+/// world columns `data.minv_j` it left are reused (no joint placement, no sin/cos).
+pub(crate) fn rnea_derivatives_pass_after_minv<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+    a: &DVector<T>,
+    fext: Option<&[LinkWrench<T>]>,
+) {
+    debug_assert!(data.deriv_direct);
+    match fext {
+        Some(w) if !w.is_empty() => pass::<T, true, true>(model, data, q, v, a, w),
+        _ => pass::<T, false, true>(model, data, q, v, a, &[]),
     }
 }
 
@@ -116,8 +134,9 @@ fn variation_tr_mul<T: Scalar>(s: &Matrix3<T>, hm: &Force<T>, x: &Motion<T>) -> 
     )
 }
 
-/// The two sweeps; `F`: external wrenches present.
-fn pass<T: Scalar, const F: bool>(
+/// The two sweeps; `F`: external wrenches present; `K`: the poses and world
+/// columns are those `minv_pass` left (direct columns only).
+fn pass<T: Scalar, const F: bool, const K: bool>(
     model: &Model<T>,
     data: &mut Data<T>,
     q: &DVector<T>,
@@ -163,6 +182,7 @@ fn pass<T: Scalar, const F: bool>(
         deriv_ytj: ytj,
         deriv_ext_e: ext_e,
         deriv_full: full,
+        minv_j,
         ..
     } = data;
     let direct = *direct;
@@ -174,19 +194,28 @@ fn pass<T: Scalar, const F: bool>(
     oa[0] = Motion::new(Vector3::zeros(), -model.gravity);
     for i in 1..nb {
         let p = parent[i];
-        let (op, ovp, oap) = (o_m_i[p], ov[p], oa[p]);
+        let (ovp, oap) = (ov[p], oa[p]);
         let c0 = col0[i];
         let (ovi, oai) = dispatch_joint!(&joints[i], ident[i], jm => {
-            let li = jm.placement(&placements[i], q);
-            let om = jm.world_pose(&op, &li);
-            li_m_i[i] = li;
-            o_m_i[i] = om;
             let iv = jm.joint().iv;
+            let om = if K {
+                o_m_i[i]
+            } else {
+                let li = jm.placement(&placements[i], q);
+                let om = jm.world_pose(&o_m_i[p], &li);
+                li_m_i[i] = li;
+                o_m_i[i] = om;
+                om
+            };
             // ⁰v̂ᵢ = ⁰v̂ₚ + J q̇, ⁰âᵢ = ⁰âₚ + J q̈ + ⁰v̂ᵢ × J q̇
             let mut vj = Motion::zero();
             let mut aj = Motion::zero();
             for c in 0..jm.nv() {
-                let s = jm.subspace_in(c, &om);
+                let s = if K {
+                    minv_j[iv + c]
+                } else {
+                    jm.subspace_in(c, &om)
+                };
                 jcol[c0 + c] = s;
                 vj += s * v[iv + c];
                 aj += s * a[iv + c];
