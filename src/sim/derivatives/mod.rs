@@ -16,6 +16,9 @@
 //! gains and targets; a new model makes a new copy).
 
 mod analytic;
+mod output;
+mod position;
+mod second_order;
 mod fd;
 mod smooth;
 
