@@ -60,6 +60,7 @@
 pub mod broad;
 mod face;
 pub mod filter;
+pub mod frame;
 pub mod ground;
 mod hull;
 pub mod mesh;

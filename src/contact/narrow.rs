@@ -4,7 +4,7 @@
 //! `max_points_per_shape`.
 
 use super::face::{hull_on_face, FaceContact, FacePoint, FaceShape, HullRef};
-use super::pairs::tangents;
+use super::frame::tangents;
 use super::shapes::{from_pvec, to_pose, PairShape};
 use super::ContactPoint;
 use crate::spatial::Se3;

@@ -115,24 +115,8 @@ fn world(m: &Member, o_m_i: &[Se3<f64>]) -> Se3<f64> {
         .map_or(m.placement, |o| o.compose(&m.placement))
 }
 
-/// Two unit tangents completing the unit normal n to a right-handed frame
-/// (t₁, t₂, n); x and y for n = +z.
-#[inline]
-pub fn tangents(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    if n.x == 0.0 && n.y == 0.0 && n.z > 0.0 {
-        return (Vector3::x(), Vector3::y());
-    }
-    // the axis least aligned with n
-    let e = if n.x.abs() <= n.y.abs() && n.x.abs() <= n.z.abs() {
-        Vector3::x()
-    } else if n.y.abs() <= n.z.abs() {
-        Vector3::y()
-    } else {
-        Vector3::z()
-    };
-    let t1 = n.cross(&e).normalize();
-    (t1, n.cross(&t1))
-}
+/// The contact frame's tangents ([`super::frame::tangents`]), here too.
+pub use super::frame::tangents;
 
 impl PairContact {
     /// The pairs of `model`'s geometries that may touch (none: `None`, and no

@@ -1,0 +1,206 @@
+//! Setting up a [`Simulation`]: options checked, contact shapes built, every
+//! buffer of a step sized here (none allocated in a step).
+
+use super::*;
+
+/// The joint springs of `model` (an MJCF joint's `stiffness` about its
+/// `springref`, on hinge and slide joints) as servo gains and targets, `None`
+/// when there is none (or joint dynamics are off).
+fn joint_springs(model: &Model, on: bool) -> Option<(DVector<f64>, DVector<f64>)> {
+    if !on
+        || !model
+            .dofs
+            .iter()
+            .any(|d| d.stiffness > 0.0 && d.kind.nv() == 1)
+    {
+        return None;
+    }
+    let mut kp = DVector::zeros(model.nv);
+    let mut q_ref = model.neutral();
+    for d in &model.dofs {
+        if d.kind.nv() == 1 && d.stiffness.is_finite() && d.stiffness > 0.0 {
+            kp[d.iv] = d.stiffness;
+            q_ref[d.iq] = d.springref;
+        }
+    }
+    Some((kp, q_ref))
+}
+
+impl Simulation {
+    /// Sets up a simulation of `model` at its neutral configuration, at rest.
+    /// Contact shapes (and meshes) are built here when `opts.ground` is set and a
+    /// moving link has collision geometry.
+    pub fn new(model: Model, opts: SimOptions) -> Result<Self, SimError> {
+        let positive = |x: f64, name: &str| {
+            if x.is_finite() && x > 0.0 {
+                Ok(())
+            } else {
+                Err(SimError::Invalid(format!(
+                    "{name} must be a positive number (got {x})"
+                )))
+            }
+        };
+        positive(opts.dt, "--dt")?;
+        positive(opts.tol, "--tol")?;
+        positive(opts.limit_push_speed, "limit_push_speed")?;
+        positive(opts.contact.max_push_speed, "contact.max_push_speed")?;
+        positive(opts.sleep_velocity, "sleep_velocity")?;
+        if !(opts.sleep_time.is_finite() && opts.sleep_time >= 0.0) {
+            return Err(SimError::Invalid(format!(
+                "sleep_time must be a non-negative number (got {})",
+                opts.sleep_time
+            )));
+        }
+        let w = opts.solver_relaxation;
+        if !(w > 0.0 && w < 2.0) {
+            return Err(SimError::Invalid(format!(
+                "solver_relaxation must lie in (0, 2) (got {w})"
+            )));
+        }
+        let f = opts.contact.friction;
+        if !(f.is_finite() && f >= 0.0) {
+            return Err(SimError::Invalid(format!(
+                "--friction must be a non-negative number (got {f})"
+            )));
+        }
+        let a = opts.armature;
+        if !(a.is_finite() && a >= 0.0) {
+            return Err(SimError::Invalid(format!(
+                "--armature must be a non-negative number (got {a})"
+            )));
+        }
+        crate::dynamics::check_massless(&model)?;
+        // the ground, obstacles and pairs of bodies (none of them: no contact work)
+        let contact = Collision::build(&model, opts.ground, opts.contact, &opts.package_paths)?;
+        let integrator = opts
+            .integrator
+            .unwrap_or(Integrator::default_for(contact.is_some()));
+        let (nq, nv) = (model.nq, model.nv);
+        let mut damping = DVector::zeros(nv);
+        let mut armature = DVector::zeros(nv);
+        let mut effort = vec![f64::INFINITY; nv];
+        for (d, _, iv) in model.dof_indices() {
+            let info = &model.dofs[d];
+            // --armature on every joint, plus the model's own (an MJCF joint's
+            // `armature`: MuJoCo's qM diagonal)
+            armature[iv] = a + info.armature.max(0.0);
+            if opts.joint_dynamics {
+                damping[iv] = if info.damping.is_finite() {
+                    info.damping.max(0.0)
+                } else {
+                    0.0
+                };
+                if let Some(e) = info.limits.effort {
+                    if e > 0.0 {
+                        effort[iv] = e;
+                    }
+                }
+            }
+        }
+        let max_points = contact.as_ref().map_or(0, |c| c.max_points());
+        let pair_points = contact
+            .as_ref()
+            .and_then(|c| c.pairs.as_ref())
+            .map_or(0, |p| p.max_points());
+        let mass_factor = factor::MassFactor::new(&model);
+        let nslots = contact.as_ref().map_or(0, |c| c.nslots);
+        let row_params = RowParams {
+            joint_dynamics: opts.joint_dynamics,
+            restitution: opts.contact.restitution,
+            gravity: model.gravity.norm(),
+            beta: opts.contact.baumgarte,
+            contact_push_cap: opts.contact.max_push_speed,
+            limit_push_cap: opts.limit_push_speed,
+            contact_slop: opts.contact.slop,
+            limit_slop: 1e-4,
+        };
+        let total_mass: f64 = model.inertias.iter().skip(1).map(|i| i.mass).sum();
+        let scale = total_mass * model.gravity.norm();
+        let has_damping = damping.iter().any(|&d| d > 0.0);
+        let has_armature = armature.iter().any(|&x| x > 0.0);
+        let springs = joint_springs(&model, opts.joint_dynamics);
+        let spheres = contact.as_ref().map_or(Vec::new(), |c| c.body_spheres());
+        let sleep = sleep::Sleep::new(
+            &model,
+            opts.sleep,
+            opts.sleep_velocity,
+            opts.sleep_time,
+            spheres,
+            &opts.never_sleep,
+        );
+        let mut sim = Self {
+            sleep,
+            sleep_forced: vec![false; model.trees.len()],
+            integrator,
+            dt: opts.dt,
+            tol: opts.tol,
+            t: 0.0,
+            q: model.neutral(),
+            v: DVector::zeros(nv),
+            tau_applied: DVector::zeros(nv),
+            damping,
+            armature,
+            effort,
+            has_damping,
+            has_armature,
+            data: Data::new(&model),
+            cons: Constraints::new(
+                &model,
+                &mass_factor,
+                max_points,
+                pair_points,
+                nslots,
+                opts.solver == Solver::Newton,
+            ),
+            contact,
+            points: Vec::with_capacity(max_points),
+            fk_valid: false,
+            row_params,
+            mass: MassWork {
+                f: mass_factor,
+                vfree: DVector::zeros(nv),
+                tau: DVector::zeros(nv),
+                vtot: DVector::zeros(nv),
+            },
+            smooth: SmoothWork {
+                data: Data::new(&model),
+                qn: model.neutral(),
+                vv: DVector::zeros(nv),
+                tau: DVector::zeros(nv),
+                tau_c: DVector::zeros(nv),
+                y: DVector::zeros(nq + nv),
+                y_new: DVector::zeros(nq + nv),
+                y_stage: DVector::zeros(nq + nv),
+                k: (0..13).map(|_| DVector::zeros(nq + nv)).collect(),
+                h_next: opts.dt,
+                fsal_ok: false,
+            },
+            servo: servo::Servo::new(&model, &model.neutral()),
+            sensors: sensors::Sensors::new(nq, nv),
+            forcing_changed: true,
+            energy_now: None,
+            guard: EnergyGuard {
+                reference: None,
+                v_ref: DVector::zeros(nv),
+                recovering_until: None,
+                scale,
+            },
+            steps: 0,
+            rejected: 0,
+            rhs_evals: 0,
+            pgs_sweeps: 0,
+            rows_total: 0,
+            opts,
+            model: Arc::new(model),
+            deriv: Default::default(),
+        };
+        if let Some((kp, q_ref)) = springs {
+            // joint springs (MJCF `stiffness`/`springref`) are servos without
+            // damping gain: τ = k (springref − q), integrated implicitly
+            sim.set_targets(&q_ref, None)?;
+            sim.set_gains(&kp, &DVector::zeros(nv))?;
+        }
+        sim.state_changed();
+        Ok(sim)
+    }
+}

@@ -1,0 +1,312 @@
+//! Velocity-level constraint solve of one step: ground contact (normal +
+//! Coulomb cone), joint Coulomb friction (stiction) and joint position limits, by
+//! projected Gauss–Seidel on the Delassus matrix W = J H⁻¹ Jᵀ.
+//!
+//! With the free velocity v* = v + Δt H⁻¹(τ − C(q, v)) the impulses λ make the
+//! end-of-step velocity v⁺ = v* + H⁻¹ Jᵀ λ satisfy, row by row (u = J v⁺):
+//! - contact normal: 0 ≤ λₙ ⊥ uₙ − bₙ ≥ 0;
+//! - contact tangents (pair): ‖λₜ‖ ≤ μ λₙ, uₜ = 0 inside the cone (stick), λₜ
+//!   anti-parallel to uₜ on its boundary (slip);
+//! - joint friction: |λ| ≤ F Δt, u = 0 inside (a joint loaded below its
+//!   friction F stays at rest);
+//! - joint limit (one-sided): 0 ≤ λ ⊥ u − b ≥ 0, with b = −φ/Δt for a gap φ > 0
+//!   (the joint may reach its limit, not pass it) and b = 0 when past it.
+//!
+//! The velocity solve never pushes a violated constraint back (b ≤ 0 for every
+//! unilateral row): that would turn a position error into kinetic energy.
+//! Violations are removed by a separate *position pass* ([`Rows::solve_position`],
+//! split impulse / post-stabilisation): a pseudo-velocity w = H̃⁻¹Jᵀμ with
+//! 0 ≤ μ ⊥ J w − b_pos ≥ 0 on the unilateral rows, b_pos = min(βφ⁻/Δt, cap),
+//! moves q but never enters v.
+
+mod form;
+mod pgs;
+mod position;
+mod subspace;
+
+use super::factor::MassFactor;
+use subspace::Subspace;
+
+/// What a row is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RowKind {
+    /// Contact normal (λ ≥ 0).
+    Normal,
+    /// First of a contact's two tangent rows; the next row is its partner.
+    /// `normal` is the row index of the contact's normal, `mu` the friction.
+    Tangent {
+        /// Row index of the contact's normal row.
+        normal: usize,
+        /// Coulomb friction coefficient μ of the contact's cone.
+        mu: f64,
+    },
+    /// The second tangent row (handled with the first).
+    Tangent2,
+    /// Joint friction: |λ| ≤ limit.
+    Box {
+        /// Largest impulse magnitude, F·Δt (N·m·s or N·s).
+        limit: f64,
+    },
+    /// Joint limit: λ ≥ 0.
+    Unilateral,
+    /// Loop constraint (mechanisms.md §"Simulation"): bilateral, λ free.
+    Bilateral,
+}
+
+/// Preallocated rows: Jacobians and Y = J R⁻ᵀ (each row compact over its dof
+/// path, `stride` apart), diag W, targets. Every per-row vector holds `capacity()` entries, the first `n` in use.
+#[derive(Clone, Debug)]
+pub struct Rows {
+    /// The model's nv (the length of velocity vectors).
+    pub nv: usize,
+    /// Room of a row in `j` and `y`: the longest path a row can have (two
+    /// bodies' paths to the root; nv for a dense factor), so that storage
+    /// grows with rows × path length, never rows × nv.
+    pub stride: usize,
+    /// Rows in use.
+    pub n: usize,
+    /// Each row's kind (the first `n` entries in use).
+    pub kind: Vec<RowKind>,
+    /// Jacobians J, `stride` apart, each row compact over its path (entry t of
+    /// row r, `j[r·stride + t]`, belongs to dof `path[t]`; J is zero elsewhere).
+    pub j: Vec<f64>,
+    /// Rows of Y = J R⁻ᵀ (H̃ = RᵀR), `stride` apart, each held compactly over its
+    /// path (entry t belongs to dof `path[t]`); filled by [`Rows::form`].
+    pub y: Vec<f64>,
+    /// Delassus diagonal Wᵣᵣ = ‖yᵣ‖² (the row's velocity per unit impulse).
+    pub w: Vec<f64>,
+    /// 1 / Wᵣᵣ, and 0 where Wᵣᵣ ≤ 1e-14 (a row no impulse can move: its
+    /// impulse stays 0).
+    winv: Vec<f64>,
+    /// J v* (free velocity).
+    pub c: Vec<f64>,
+    /// Target (b) of each row.
+    pub b: Vec<f64>,
+    /// Impulse of each row (N·s for contact rows, N·m·s or N·s for joint rows);
+    /// the warm start on entry to [`Rows::solve`], the solution after.
+    pub lambda: Vec<f64>,
+    /// Position-pass target of each unilateral row (0: not violated).
+    pub bpos: Vec<f64>,
+    /// Position-pass multipliers.
+    pub mu: Vec<f64>,
+    /// Each row's dof path (start, length) in the factor's table: its Jacobian
+    /// and y live there only (compact y: entry t is dof `path[t]`).
+    pub path: Vec<(usize, usize)>,
+    /// At a contact's normal row: the off-diagonal entries of its 3×3 block of
+    /// W (n·t₁, n·t₂, t₁·t₂), so that a sweep reads the contact's path once.
+    pub w_block: Vec<[f64; 3]>,
+    is_block: Vec<bool>,
+    /// Each row's velocity at its update in the last sweep.
+    u_prev: Vec<f64>,
+    /// Scratch of the subspace step ([`subspace_step`]).
+    sm: Subspace,
+    /// The last solve took a subspace step.
+    pub polished: bool,
+    cap: usize,
+    /// The dof paths rows live on: the factor's table ([`MassFactor::table`],
+    /// every dof's path to the root, the first `static_len` entries), then the
+    /// step's unions of two paths (a contact between two bodies acts on both
+    /// bodies' paths: their union, ascending, is where its row and y live).
+    table: Vec<usize>,
+    static_len: usize,
+    /// The last union made: its two paths and where it is.
+    last_union: ((usize, usize), (usize, usize), (usize, usize)),
+}
+
+/// Most rows a subspace step solves directly (its dense W_FF is this square).
+pub const SUBSPACE_MAX: usize = 16;
+
+impl Rows {
+    /// Room for `cap` rows of width `nv`, all allocated here (none in a step).
+    pub fn new(nv: usize, cap: usize, stride: usize) -> Self {
+        let stride = stride.clamp(1, nv.max(1));
+        Self {
+            nv,
+            stride,
+            n: 0,
+            kind: vec![RowKind::Unilateral; cap],
+            j: vec![0.0; cap * stride],
+            y: vec![0.0; cap * stride],
+            w: vec![0.0; cap],
+            winv: vec![0.0; cap],
+            c: vec![0.0; cap],
+            b: vec![0.0; cap],
+            lambda: vec![0.0; cap],
+            bpos: vec![0.0; cap],
+            mu: vec![0.0; cap],
+            path: vec![(0, 0); cap],
+            w_block: vec![[0.0; 3]; cap],
+            is_block: vec![false; cap],
+            u_prev: vec![0.0; cap],
+            sm: Subspace::new(nv, cap),
+            polished: false,
+            cap,
+            table: Vec::new(),
+            static_len: 0,
+            last_union: ((0, 0), (0, 0), (0, 0)),
+        }
+    }
+    /// Takes the factor's path table (`base`, [`MassFactor::table`]) with room
+    /// for `unions` two-body paths of at most nv entries each, allocated here.
+    pub fn set_table(&mut self, base: &[usize], unions: usize) {
+        self.table = Vec::with_capacity(base.len() + unions * self.stride);
+        self.table.extend_from_slice(base);
+        self.static_len = base.len();
+    }
+    /// The dof paths rows index ([`Rows::path`]).
+    pub fn table(&self) -> &[usize] {
+        &self.table
+    }
+    /// Takes the path table out (no entry moved), for a solver that mutates
+    /// the rows while reading it; [`Rows::put_table`] puts it back.
+    pub(crate) fn take_table(&mut self) -> Vec<usize> {
+        std::mem::take(&mut self.table)
+    }
+    /// Puts back the table [`Rows::take_table`] took.
+    pub(crate) fn put_table(&mut self, table: Vec<usize>) {
+        self.table = table;
+    }
+    /// The path of a row acting on the dofs of two paths `a` and `b` (entries
+    /// of the table): their union, ascending (appended to the table for this
+    /// step; the last union is reused when asked again).
+    pub fn union_path(&mut self, a: (usize, usize), b: (usize, usize)) -> (usize, usize) {
+        if a == b || b.1 == 0 {
+            return a;
+        }
+        if a.1 == 0 {
+            return b;
+        }
+        let (la, lb, at) = self.last_union;
+        if la == a && lb == b && at.0 + at.1 <= self.table.len() && at.0 >= self.static_len {
+            return at;
+        }
+        let start = self.table.len();
+        let (mut i, mut j) = (a.0, b.0);
+        let (ea, eb) = (a.0 + a.1, b.0 + b.1);
+        while i < ea || j < eb {
+            let x = if i < ea { self.table[i] } else { usize::MAX };
+            let y = if j < eb { self.table[j] } else { usize::MAX };
+            let k = if x <= y {
+                i += 1;
+                if x == y {
+                    j += 1;
+                }
+                x
+            } else {
+                j += 1;
+                y
+            };
+            self.table.push(k);
+        }
+        let at = (start, self.table.len() - start);
+        self.last_union = (a, b, at);
+        at
+    }
+    /// The most rows that fit.
+    pub fn capacity(&self) -> usize {
+        self.cap
+    }
+    /// Empties the rows; their Jacobian entries are zeroed here, once, so that
+    /// every row pushed after starts from zeros (a row holds its path's
+    /// entries only: the cost follows the rows' path lengths, never rows × nv).
+    pub fn clear(&mut self) {
+        self.zero_rows(0, self.n);
+        self.n = 0;
+        self.table.truncate(self.static_len);
+        self.last_union = ((0, 0), (0, 0), (0, 0));
+    }
+    /// Drops the last `k` rows (pushed, their Jacobian entries not yet written).
+    pub fn pop(&mut self, k: usize) {
+        let k = k.min(self.n);
+        self.n -= k;
+        self.zero_rows(self.n, self.n + k);
+    }
+    /// Zeroes the Jacobian entries of rows `from..to`.
+    fn zero_rows(&mut self, from: usize, to: usize) {
+        let st = self.stride;
+        for r in from..to.min(self.cap) {
+            let pl = self.path[r].1.min(st);
+            self.j[r * st..r * st + pl].fill(0.0);
+        }
+    }
+    /// Adds a row (zeroed Jacobian: rows are zeroed by [`Rows::clear`]) and returns
+    /// its index, or `None` when full.
+    #[inline]
+    pub fn push(
+        &mut self,
+        kind: RowKind,
+        b: f64,
+        warm: f64,
+        path: (usize, usize),
+    ) -> Option<usize> {
+        if self.n >= self.cap {
+            return None;
+        }
+        let r = self.n;
+        self.n += 1;
+        self.kind[r] = kind;
+        self.b[r] = b;
+        self.lambda[r] = warm;
+        self.bpos[r] = 0.0;
+        self.path[r] = path;
+        Some(r)
+    }
+    /// Where dof `d` lies on row `r`'s path (`None`: off it, J is 0 there).
+    fn slot_of(&self, r: usize, d: usize) -> Option<usize> {
+        let (ps, pl) = self.path[r];
+        self.table.get(ps..ps + pl)?.iter().position(|&k| k == d)
+    }
+    /// Adds `x` to J's entry of row `r` at dof `d` (on the row's path; a dof
+    /// off the path is ignored: the row cannot act there).
+    pub fn add_entry(&mut self, r: usize, d: usize, x: f64) {
+        if let Some(t) = self.slot_of(r, d) {
+            self.j[r * self.stride + t] += x;
+        }
+    }
+    /// J's entry of row `r` at dof `d` (0 off its path).
+    pub fn entry(&self, r: usize, d: usize) -> f64 {
+        self.slot_of(r, d)
+            .map_or(0.0, |t| self.j[r * self.stride + t])
+    }
+    /// Row `r` of J written from a dense row `dense` (nv entries, J's
+    /// entries on the row's path; zero elsewhere), whose path entries are
+    /// zeroed after (the caller's scratch is left all zeros).
+    pub fn gather(&mut self, r: usize, dense: &mut [f64]) {
+        let (ps, pl) = self.path[r];
+        let st = self.stride;
+        let Some(path) = self.table.get(ps..ps + pl) else {
+            return;
+        };
+        for (t, &d) in path.iter().enumerate().take(st) {
+            if let Some(x) = dense.get_mut(d) {
+                self.j[r * st + t] = *x;
+                *x = 0.0;
+            }
+        }
+    }
+    /// J's row `r` times `x` (nv entries).
+    pub fn jdot(&self, r: usize, x: &[f64]) -> f64 {
+        let (ps, pl) = self.path[r];
+        let Some(path) = self.table.get(ps..ps + pl) else {
+            return 0.0;
+        };
+        let jr = &self.j[r * self.stride..r * self.stride + pl.min(self.stride)];
+        jr.iter()
+            .zip(path)
+            .map(|(a, &k)| a * x.get(k).copied().unwrap_or(0.0))
+            .sum()
+    }
+    /// Row `r` of J as (dof, entry) pairs over its path.
+    pub fn jrow(&self, r: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let (ps, pl) = self.path[r];
+        let path = self.table.get(ps..ps + pl).unwrap_or(&[]);
+        let jr = &self.j[r * self.stride..r * self.stride + path.len().min(self.stride)];
+        path.iter().copied().zip(jr.iter().copied())
+    }
+}
+
+/// `Σ aₖ bₖ` over the shorter of the two slices.
+#[inline(always)]
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}

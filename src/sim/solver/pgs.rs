@@ -1,0 +1,303 @@
+//! Projected Gauss–Seidel on W = Y Yᵀ (the velocity solve), with a
+//! contact's three rows taken in one pass and the exact Coulomb slide onto
+//! the friction disc.
+
+use super::subspace::{subspace_step, Solved};
+use super::{MassFactor, RowKind, Rows};
+
+impl Rows {
+    /// Projected Gauss–Seidel on W = Y Yᵀ, kept implicit: Δv' = Yᵀλ is carried
+    /// along (in `dv`, length nv) so that a row's velocity is uᵣ = cᵣ + yᵣ·Δv',
+    /// O(path length) a row; the caller recovers Δv = R⁻¹ Δv'. Stops when no
+    /// row's velocity changes by more than `tol` (m/s or rad/s) in a sweep, or
+    /// after `max_iter` sweeps; returns the sweeps. Rows with a (numerically)
+    /// zero diagonal stay at 0. After three plain sweeps, the scalar rows
+    /// (contact normals, joint friction and limits) are over-relaxed by `relax`
+    /// ∈ (0, 2) (projected SOR, convergent for the positive semi-definite W in
+    /// that range; 1 is plain Gauss–Seidel) until converged, then one plain
+    /// sweep ends the solve; the tangent pairs, projected onto the friction
+    /// disc, are never over-relaxed. A solve still unconverged after half of
+    /// `max_iter` sweeps goes on with plain sweeps.
+    pub fn solve(
+        &mut self,
+        f: &MassFactor,
+        dv: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+        relax: f64,
+    ) -> usize {
+        self.polished = false;
+        let _ = f;
+        let table_v = std::mem::take(&mut self.table);
+        let it = self.sweeps(&table_v, dv, max_iter, tol, relax);
+        self.table = table_v;
+        it
+    }
+
+    /// [`Rows::solve`] on the path table `table` (taken out of the rows).
+    fn sweeps(
+        &mut self,
+        table: &[usize],
+        dv: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+        relax: f64,
+    ) -> usize {
+        let (nv, n, st) = (self.nv, self.n, self.stride);
+        if dv.len() < nv
+            || self.y.len() < n * st
+            || self.kind.len() < n
+            || self
+                .path
+                .iter()
+                .take(n)
+                .any(|&(s, l)| s + l > table.len() || l > st)
+        {
+            return 0;
+        }
+        let dv = &mut dv[..nv];
+        let (y, paths) = (&self.y[..], &self.path[..n]);
+        let (kinds, w, c, b) = (&self.kind[..n], &self.w[..n], &self.c[..n], &self.b[..n]);
+        let contact = &self.is_block[..n];
+        let w_block = &self.w_block[..n];
+        let winv = &self.winv[..n];
+        // a row no impulse can move keeps 0
+        let live = |r: usize| if winv[r] != 0.0 { 1.0 } else { 0.0 };
+        let u_prev = &mut self.u_prev[..n];
+        // a row's convergence measure: its own residual |Δλ|·Wᵣᵣ, or, when
+        // smaller, how much its velocity moved since the last sweep (redundant
+        // contacts can trade impulse among themselves for many sweeps while no
+        // velocity changes: that is converged)
+        #[inline(always)]
+        fn measure(first: bool, residual: f64, u: f64, prev: &mut f64) -> f64 {
+            let moved = (u - *prev).abs();
+            *prev = u;
+            if first {
+                residual
+            } else {
+                residual.min(moved)
+            }
+        }
+        let lambda = &mut self.lambda[..n];
+        // SAFETY (unchecked reads in rdot/raxpy): every path lies in `table`
+        // (checked above) and holds dof indices < nv; y holds n·stride entries and
+        // a path is at most stride long.
+        #[inline(always)]
+        fn rdot(y: &[f64], r: usize, st: usize, p: &[usize], x: &[f64]) -> f64 {
+            let mut s = 0.0;
+            for (t, &k) in p.iter().enumerate() {
+                s += unsafe { y.get_unchecked(r * st + t) * x.get_unchecked(k) };
+            }
+            s
+        }
+        #[inline(always)]
+        fn raxpy(a: f64, y: &[f64], r: usize, st: usize, p: &[usize], x: &mut [f64]) {
+            for (t, &k) in p.iter().enumerate() {
+                unsafe { *x.get_unchecked_mut(k) += a * y.get_unchecked(r * st + t) };
+            }
+        }
+        let path = |r: usize| {
+            let (s, l) = paths[r];
+            &table[s..s + l]
+        };
+        // Δv' from the warm start
+        dv.iter_mut().for_each(|x| *x = 0.0);
+        for r in 0..n {
+            let l = lambda[r];
+            if l != 0.0 {
+                raxpy(l, y, r, st, path(r), dv);
+            }
+        }
+        let mut it = 0;
+        // plain sweeps first; a problem not solved in `PLAIN` sweeps is
+        // over-relaxed, and once that has converged one plain sweep finishes it
+        // (every row then leaves its own residual exactly 0 or projected, as
+        // Gauss–Seidel does)
+        const PLAIN: usize = 3;
+        let mut finishing = false;
+        let mut attempts = 0;
+        let mut polished = false;
+        while it < max_iter {
+            it += 1;
+            let plain = it <= PLAIN || finishing || polished || 2 * it > max_iter || relax == 1.0;
+            let relax = if plain { 1.0 } else { relax };
+            let first = it == 1;
+            let mut change: f64 = 0.0;
+            let mut r = 0;
+            while r < n {
+                let kind = kinds[r];
+                if contact[r] {
+                    // a contact's three rows in one pass over its path: the
+                    // normal, then the tangent pair from the velocity the
+                    // normal's change left (through the block's entries)
+                    let p = path(r);
+                    let (mut dn, mut d1, mut d2) = (0.0, 0.0, 0.0);
+                    for (t, &k) in p.iter().enumerate() {
+                        let x = unsafe { *dv.get_unchecked(k) };
+                        unsafe {
+                            dn += y.get_unchecked(r * st + t) * x;
+                            d1 += y.get_unchecked((r + 1) * st + t) * x;
+                            d2 += y.get_unchecked((r + 2) * st + t) * x;
+                        }
+                    }
+                    let [wn1, wn2, w12] = w_block[r];
+                    let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
+                    let on = lambda[r];
+                    let un = c[r] + dn;
+                    let nn = (on - relax * (un - b[r]) * winv[r]).max(0.0) * live(r);
+                    let dln = nn - on;
+                    lambda[r] = nn;
+                    let mu = match kinds[r + 1] {
+                        RowKind::Tangent { mu, .. } => mu,
+                        _ => 0.0,
+                    };
+                    let (o1, o2) = (lambda[r + 1], lambda[r + 2]);
+                    let u1 = c[r + 1] + d1 + dln * wn1;
+                    let u2 = c[r + 2] + d2 + dln * wn2;
+                    let mut t1 = (o1 - u1 * winv[r + 1]) * live(r + 1);
+                    let mut t2 = (o2 - u2 * winv[r + 2]) * live(r + 2);
+                    let lim = mu * nn;
+                    if t1 * t1 + t2 * t2 > lim * lim {
+                        // w̄ = (W₁₁ + W₂₂)/2 + √(((W₁₁ − W₂₂)/2)² + W₁₂²)
+                        let half = 0.5 * (w11 - w22);
+                        let wbar = 0.5 * (w11 + w22) + (half * half + w12 * w12).sqrt();
+                        (t1, t2) = slide_onto_cone(o1, o2, u1, u2, wbar, lim);
+                        t1 *= live(r + 1);
+                        t2 *= live(r + 2);
+                    }
+                    lambda[r + 1] = t1;
+                    lambda[r + 2] = t2;
+                    let (dl1, dl2) = (t1 - o1, t2 - o2);
+                    if dln != 0.0 || dl1 != 0.0 || dl2 != 0.0 {
+                        for (t, &k) in p.iter().enumerate() {
+                            unsafe {
+                                *dv.get_unchecked_mut(k) += dln * y.get_unchecked(r * st + t)
+                                    + dl1 * y.get_unchecked((r + 1) * st + t)
+                                    + dl2 * y.get_unchecked((r + 2) * st + t);
+                            }
+                        }
+                    }
+                    change = change
+                        .max(measure(first, (dln * wnn).abs(), un, &mut u_prev[r]))
+                        .max(measure(first, (dl1 * w11).abs(), u1, &mut u_prev[r + 1]))
+                        .max(measure(first, (dl2 * w22).abs(), u2, &mut u_prev[r + 2]));
+                    r += 3;
+                    continue;
+                }
+                match kind {
+                    RowKind::Tangent { normal, mu } if r + 1 < n => {
+                        let (p1, p2) = (path(r), path(r + 1));
+                        let (w11, w22) = (w[r], w[r + 1]);
+                        let u1 = c[r] + rdot(y, r, st, p1, dv);
+                        let u2 = c[r + 1] + rdot(y, r + 1, st, p2, dv);
+                        let (o1, o2) = (lambda[r], lambda[r + 1]);
+                        let mut t1 = if w11 > 1e-14 { o1 - u1 / w11 } else { 0.0 };
+                        let mut t2 = if w22 > 1e-14 { o2 - u2 / w22 } else { 0.0 };
+                        let ln = lambda.get(normal).copied().unwrap_or(0.0);
+                        let lim = mu * if ln > 0.0 { ln } else { 0.0 };
+                        if t1 * t1 + t2 * t2 > lim * lim {
+                            // the block's largest eigenvalue ≤ its trace
+                            (t1, t2) = slide_onto_cone(o1, o2, u1, u2, w11 + w22, lim);
+                        }
+                        lambda[r] = t1;
+                        lambda[r + 1] = t2;
+                        let (d1, d2) = (t1 - o1, t2 - o2);
+                        if d1 != 0.0 {
+                            raxpy(d1, y, r, st, p1, dv);
+                        }
+                        if d2 != 0.0 {
+                            raxpy(d2, y, r + 1, st, p2, dv);
+                        }
+                        change = change
+                            .max(measure(first, (d1 * w11).abs(), u1, &mut u_prev[r]))
+                            .max(measure(first, (d2 * w22).abs(), u2, &mut u_prev[r + 1]));
+                        r += 2;
+                        continue;
+                    }
+                    RowKind::Tangent2 | RowKind::Tangent { .. } => {
+                        r += 1;
+                        continue;
+                    }
+                    _ => {}
+                }
+                let wrr = w[r];
+                let old = lambda[r];
+                let p = path(r);
+                let mut u = 0.0;
+                let new = if winv[r] != 0.0 {
+                    u = c[r] + rdot(y, r, st, p, dv);
+                    let x = old - relax * (u - b[r]) * winv[r];
+                    match kind {
+                        RowKind::Box { limit } => x.clamp(-limit, limit),
+                        RowKind::Bilateral => x,
+                        _ => x.max(0.0),
+                    }
+                } else {
+                    0.0
+                };
+                lambda[r] = new;
+                let d = new - old;
+                if d != 0.0 {
+                    raxpy(d, y, r, st, p, dv);
+                }
+                change = change.max(measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
+                r += 1;
+            }
+            if finishing || (change <= tol && plain) {
+                break;
+            }
+            if change <= tol {
+                finishing = true;
+            } else if it >= SUBSPACE_AFTER && attempts < SUBSPACE_TRIES && it + 1 < max_iter {
+                // slow linear convergence (coupled rows): solve the rows
+                // the sweeps left free exactly, then let plain sweeps check
+                attempts += 1;
+                let rows = Solved {
+                    n,
+                    nv,
+                    st,
+                    y,
+                    paths,
+                    table,
+                    kinds,
+                    contact,
+                    winv,
+                    c,
+                    b,
+                };
+                if subspace_step(&mut self.sm, &rows, lambda, dv) {
+                    polished = true;
+                }
+            }
+        }
+        self.polished = polished;
+        it
+    }
+}
+
+/// Sweeps before the first subspace step, and the most a solve takes.
+const SUBSPACE_AFTER: usize = 2;
+const SUBSPACE_TRIES: usize = 3;
+
+/// A tangent pair's update when its Gauss–Seidel step leaves the cone (the
+/// point slides): one isotropic step, λₜ − uₜ/w̄ with `wbar` = w̄ at least the
+/// largest eigenvalue of the pair's 2 × 2 Delassus block, projected onto the disc
+/// of radius `lim`. A fixed point of it is the exact Coulomb law: λₜ = s (λₜ − uₜ/w̄)
+/// with s < 1 makes λₜ anti-parallel to the slip uₜ, ‖λₜ‖ = μλₙ (maximal
+/// dissipation; the per-row diagonal step would leave λₜ anti-parallel to
+/// D⁻¹uₜ instead, off by the block's anisotropy: docs/theory.md §"Constraint
+/// solve"). Inside the cone (sticking) the diagonal step is kept.
+#[inline]
+fn slide_onto_cone(o1: f64, o2: f64, u1: f64, u2: f64, wbar: f64, lim: f64) -> (f64, f64) {
+    if !(wbar > 1e-14) {
+        return (0.0, 0.0);
+    }
+    let (t1, t2) = (o1 - u1 / wbar, o2 - u2 / wbar);
+    let m = (t1 * t1 + t2 * t2).sqrt();
+    if m > lim {
+        let s = if m > 0.0 { lim / m } else { 0.0 };
+        (t1 * s, t2 * s)
+    } else {
+        (t1, t2)
+    }
+}

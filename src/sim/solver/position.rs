@@ -1,0 +1,83 @@
+//! The position pass (split impulse) on the solve's rows.
+
+use super::{MassFactor, RowKind, Rows};
+
+impl Rows {
+    /// The position pass (split impulse): projected Gauss–Seidel on the same
+    /// W = Y Yᵀ over the unilateral rows (contact normals, joint limits) only,
+    /// from μ = 0, for 0 ≤ μᵣ ⊥ yᵣ·w' − b_posᵣ ≥ 0; the pseudo-velocity is
+    /// w = L⁻ᵀ w' (`dw` receives w' = Yᵀμ; the caller back-substitutes). Rows
+    /// that are not violated (b_pos = 0) take part so that pushing one point out
+    /// never pushes another in. Returns the sweeps.
+    pub fn solve_position(
+        &mut self,
+        f: &MassFactor,
+        dw: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+    ) -> usize {
+        let (nv, n) = (self.nv, self.n);
+        let _ = f;
+        if dw.len() < nv
+            || self.y.len() < n * self.stride
+            || self.mu.len() < n
+            || self.bpos.len() < n
+        {
+            return 0;
+        }
+        let table_v = std::mem::take(&mut self.table);
+        let it = self.position_sweeps(&table_v, dw, max_iter, tol);
+        self.table = table_v;
+        it
+    }
+
+    /// [`Rows::solve_position`] on the path table `table` (taken out of the rows).
+    fn position_sweeps(
+        &mut self,
+        table: &[usize],
+        dw: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+    ) -> usize {
+        let (nv, n, st) = (self.nv, self.n, self.stride);
+        let dw = &mut dw[..nv];
+        dw.iter_mut().for_each(|x| *x = 0.0);
+        self.mu[..n].iter_mut().for_each(|x| *x = 0.0);
+        let mut it = 0;
+        while it < max_iter {
+            it += 1;
+            let mut change: f64 = 0.0;
+            for r in 0..n {
+                let bilateral = self.kind[r] == RowKind::Bilateral;
+                if !bilateral && !matches!(self.kind[r], RowKind::Normal | RowKind::Unilateral) {
+                    continue;
+                }
+                let wrr = self.w[r];
+                if !(wrr > 1e-14) {
+                    continue;
+                }
+                let (ps, pl) = self.path[r];
+                let (Some(p), Some(yr)) = (table.get(ps..ps + pl), self.y.get(r * st..r * st + pl))
+                else {
+                    continue;
+                };
+                let u: f64 = yr.iter().zip(p).map(|(a, &k)| a * dw[k]).sum();
+                let old = self.mu[r];
+                let x = old - (u - self.bpos[r]) / wrr;
+                let new = if bilateral { x } else { x.max(0.0) };
+                let d = new - old;
+                if d != 0.0 {
+                    self.mu[r] = new;
+                    for (a, &k) in yr.iter().zip(p) {
+                        dw[k] += d * a;
+                    }
+                    change = change.max((d * wrr).abs());
+                }
+            }
+            if change <= tol {
+                break;
+            }
+        }
+        it
+    }
+}

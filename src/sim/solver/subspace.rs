@@ -1,0 +1,236 @@
+//! The subspace-minimisation step of projected Gauss–Seidel (PGS-SM): the
+//! free rows solved exactly by a dense LDLᵀ.
+
+use super::{RowKind, SUBSPACE_MAX};
+use crate::dynamics::linalg::{ldlt_dropping, ldlt_dropping_solve};
+
+/// Preallocated scratch of [`subspace_step`]: the free rows, their dense
+/// Delassus block and right-hand side, their Y rows scattered to full width.
+#[derive(Clone, Debug)]
+pub(super) struct Subspace {
+    pub(super) rows: Vec<usize>,
+    pub(super) w: Vec<f64>,
+    pub(super) rhs: Vec<f64>,
+    pub(super) dense: Vec<f64>,
+    pub(super) lam: Vec<f64>,
+    /// At a tangent pair's first row: it lay on its cone's boundary (sliding).
+    pub(super) sliding: Vec<bool>,
+}
+
+impl Subspace {
+    pub(super) fn new(nv: usize, cap: usize) -> Self {
+        let m = cap.min(SUBSPACE_MAX);
+        Self {
+            rows: Vec::with_capacity(m),
+            w: vec![0.0; m * m],
+            rhs: vec![0.0; m],
+            dense: vec![0.0; m * nv],
+            lam: vec![0.0; m],
+            sliding: vec![false; cap],
+        }
+    }
+}
+
+/// The read-only view of the rows a subspace step needs.
+pub(super) struct Solved<'a> {
+    pub(super) n: usize,
+    pub(super) nv: usize,
+    /// Room of a row in `y`.
+    pub(super) st: usize,
+    pub(super) y: &'a [f64],
+    pub(super) paths: &'a [(usize, usize)],
+    pub(super) table: &'a [usize],
+    pub(super) kinds: &'a [RowKind],
+    pub(super) contact: &'a [bool],
+    /// 1 / Wᵣᵣ (0: a row no impulse can move).
+    pub(super) winv: &'a [f64],
+    pub(super) c: &'a [f64],
+    pub(super) b: &'a [f64],
+}
+
+/// One subspace-minimisation step of projected Gauss–Seidel (PGS-SM,
+/// docs/theory.md §"Constraint solve"): the rows the sweeps left strictly
+/// inside their sets — positive normals and limits, sticking tangent pairs,
+/// joint friction below its bound — are solved exactly as equalities
+/// (W_FF δ = b_F − u_F, the other rows held), by a dense LDLᵀ of W_FF that
+/// drops rows dependent on earlier ones (redundant contacts). The result is
+/// projected onto the sets (normals and limits ≥ 0, friction in its box, a
+/// sticking pair into its cone) and a sliding pair, held in the solve, is put
+/// back on its cone's boundary at the new normal impulse; the sweeps that
+/// follow check it (exact when the sweeps had found the active set). Gauss–
+/// Seidel converges linearly, at a rate that coupled rows (a light arm on a
+/// base resting on several points) make slow. Returns whether a step was taken
+/// (λ and Δv' = Yᵀλ updated).
+pub(super) fn subspace_step(
+    sm: &mut Subspace,
+    rows: &Solved,
+    lambda: &mut [f64],
+    dv: &mut [f64],
+) -> bool {
+    let Solved {
+        n,
+        nv,
+        st,
+        y,
+        paths,
+        table,
+        kinds,
+        contact,
+        winv,
+        c,
+        b,
+    } = *rows;
+    let path = |r: usize| {
+        let (s, l) = paths[r];
+        &table[s..s + l]
+    };
+    let inside =
+        |t1: f64, t2: f64, ln: f64, mu: f64| (t1 * t1 + t2 * t2).sqrt() < mu * ln * (1.0 - 1e-9);
+    // F: the free rows
+    sm.rows.clear();
+    let mut r = 0;
+    while r < n {
+        let live = |q: usize| winv[q] != 0.0;
+        if contact[r] {
+            let mu = match kinds[r + 1] {
+                RowKind::Tangent { mu, .. } => mu,
+                _ => 0.0,
+            };
+            sm.sliding[r + 1] = !inside(lambda[r + 1], lambda[r + 2], lambda[r], mu);
+            if lambda[r] > 0.0 && live(r) {
+                sm.rows.push(r);
+                if !sm.sliding[r + 1] && live(r + 1) && live(r + 2) {
+                    sm.rows.push(r + 1);
+                    sm.rows.push(r + 2);
+                }
+            }
+            r += 3;
+            continue;
+        }
+        match kinds[r] {
+            RowKind::Tangent { normal, mu } if r + 1 < n => {
+                let ln = lambda.get(normal).copied().unwrap_or(0.0);
+                sm.sliding[r] = !inside(lambda[r], lambda[r + 1], ln, mu);
+                if ln > 0.0 && !sm.sliding[r] && live(r) && live(r + 1) {
+                    sm.rows.push(r);
+                    sm.rows.push(r + 1);
+                }
+                r += 2;
+                continue;
+            }
+            RowKind::Tangent2 | RowKind::Tangent { .. } => {}
+            RowKind::Normal | RowKind::Unilateral => {
+                if lambda[r] > 0.0 && live(r) {
+                    sm.rows.push(r);
+                }
+            }
+            RowKind::Box { limit } => {
+                if lambda[r].abs() < limit * (1.0 - 1e-9) && live(r) {
+                    sm.rows.push(r);
+                }
+            }
+            RowKind::Bilateral => {
+                if live(r) {
+                    sm.rows.push(r);
+                }
+            }
+        }
+        r += 1;
+        if sm.rows.len() > SUBSPACE_MAX {
+            return false;
+        }
+    }
+    let m = sm.rows.len();
+    if m == 0 || m > SUBSPACE_MAX || sm.dense.len() < m * nv {
+        return false;
+    }
+    // the free rows of Y at full width, the residuals b − u, and the lower
+    // triangle of W_FF = Y_F Y_Fᵀ
+    for (a, &r) in sm.rows.iter().enumerate() {
+        let d = &mut sm.dense[a * nv..(a + 1) * nv];
+        d.fill(0.0);
+        let mut u = c[r];
+        for (t, &k) in path(r).iter().enumerate() {
+            let yt = y[r * st + t];
+            d[k] = yt;
+            u += yt * dv[k];
+        }
+        let target = match kinds[r] {
+            RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
+            _ => b[r],
+        };
+        sm.rhs[a] = target - u;
+        for (bb, &q) in sm.rows.iter().enumerate().take(a + 1) {
+            let mut s = 0.0;
+            for (t, &k) in path(q).iter().enumerate() {
+                s += y[q * st + t] * d[k];
+            }
+            sm.w[a * m + bb] = s;
+        }
+    }
+    // W_FF = L D Lᵀ; a pivot that lost all but 1e-10 of its diagonal is a
+    // row dependent on earlier ones (redundant contacts): dropped (δ = 0)
+    ldlt_dropping(&mut sm.w[..m * m], m, 1e-10);
+    ldlt_dropping_solve(&sm.w[..m * m], m, &mut sm.rhs[..m]);
+    // the new impulses (none taken if one is not finite)
+    for (a, &r) in sm.rows.iter().enumerate() {
+        let x = lambda[r] + sm.rhs[a];
+        if !x.is_finite() {
+            return false;
+        }
+        sm.lam[a] = x;
+    }
+    // projected onto the sets (the step is exact when nothing moves here):
+    // normals and limits ≥ 0, friction in its box; then the tangent pairs, a
+    // sticking pair into the cone of its new normal, a sliding one (held in
+    // the solve) along its direction onto that cone's boundary, μλₙ
+    let add = |r: usize, d: f64, dv: &mut [f64]| {
+        if d != 0.0 {
+            for (t, &k) in path(r).iter().enumerate() {
+                dv[k] += d * y[r * st + t];
+            }
+        }
+    };
+    for (a, &r) in sm.rows.iter().enumerate() {
+        let x = match kinds[r] {
+            RowKind::Normal | RowKind::Unilateral => sm.lam[a].max(0.0),
+            RowKind::Box { limit } => sm.lam[a].clamp(-limit, limit),
+            RowKind::Bilateral => sm.lam[a],
+            _ => continue,
+        };
+        let d = x - lambda[r];
+        lambda[r] = x;
+        add(r, d, dv);
+    }
+    let mut r = 0;
+    while r + 1 < n {
+        let RowKind::Tangent { normal, mu } = kinds[r] else {
+            r += 1;
+            continue;
+        };
+        let lim = mu * lambda.get(normal).copied().unwrap_or(0.0).max(0.0);
+        let free = sm.rows.iter().position(|&q| q == r).filter(|&a| a + 1 < m);
+        let (t1, t2) = match free {
+            Some(a) => (sm.lam[a], sm.lam[a + 1]),
+            None => (lambda[r], lambda[r + 1]),
+        };
+        let norm = (t1 * t1 + t2 * t2).sqrt();
+        let s = if norm > lim || (free.is_none() && sm.sliding[r]) {
+            if norm > 0.0 {
+                lim / norm
+            } else {
+                0.0
+            }
+        } else {
+            1.0
+        };
+        let (n1, n2) = (t1 * s, t2 * s);
+        let (d1, d2) = (n1 - lambda[r], n2 - lambda[r + 1]);
+        lambda[r] = n1;
+        lambda[r + 1] = n2;
+        add(r, d1, dv);
+        add(r + 1, d2, dv);
+        r += 2;
+    }
+    true
+}
