@@ -156,7 +156,11 @@ impl Simulation {
         } else {
             Vec::new()
         };
-        let m = if rows_used { self.cons.rows_view().n } else { 0 };
+        let m = if rows_used {
+            self.cons.rows_view().n
+        } else {
+            0
+        };
         // back at the start: poses and H̃ (the step's saturation set); the
         // step's end state is put back at the end
         let (q1, v1) = (self.q.clone(), self.v.clone());
@@ -181,7 +185,14 @@ impl Simulation {
         // the loop rows' ∂γ/∂q, ∂γ/∂v from a pass at (q, v, 0)
         let (mut gq, mut gv) = (DMatrix::zeros(m, n), DMatrix::zeros(m, n));
         if !loops.is_empty() && push.is_some() {
-            rnea_derivatives(&self.model, &mut self.data, q0, v0, &DVector::zeros(n), None)?;
+            rnea_derivatives(
+                &self.model,
+                &mut self.data,
+                q0,
+                v0,
+                &DVector::zeros(n),
+                None,
+            )?;
             loop_gamma_derivatives(self, &loops, &mut gq, &mut gv);
         }
         // ∂ID/∂q, ∂ID/∂v at (q, v, a) in data.dtau_dq, dtau_dv, ∂ID/∂a = H in
@@ -459,7 +470,6 @@ impl Simulation {
             .and_then(|g| g.shapes.get(pt.shape))
             .map_or(0.0, |s| s.rolling_radius())
     }
-
 }
 
 /// M X = R by Gaussian elimination with complete pivoting (M square), stopped
@@ -563,7 +573,6 @@ fn omega(v: &DVector<f64>) -> Vector3<f64> {
 fn lin(v: &DVector<f64>) -> Vector3<f64> {
     Vector3::new(v[0], v[1], v[2])
 }
-
 
 /// Whether every null vector ν of the active set's matrix M (its SVD, singular
 /// values at most `tol` counted as zero) leaves the velocity alone: `Y ν = 0`

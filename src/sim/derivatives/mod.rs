@@ -16,10 +16,10 @@
 //! gains and targets; a new model makes a new copy).
 
 mod analytic;
+mod fd;
 mod output;
 mod position;
 mod second_order;
-mod fd;
 mod smooth;
 
 use crate::model::configuration::{difference, integrate};

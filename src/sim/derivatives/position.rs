@@ -67,7 +67,7 @@ impl Simulation {
             .contact_push_cap
             .max(self.row_params.limit_push_cap);
         for r in 0..m {
-            if !(rows.w[r] > 1e-14) {
+            if rows.w[r] <= 1e-14 || rows.w[r].is_nan() {
                 continue;
             }
             match rows.kind[r] {
@@ -90,10 +90,14 @@ impl Simulation {
         }
         for &(k, r0) in p.loops {
             let phi = loop_residual(self, k);
-            let nrows = self.cons.loops.as_ref().map_or(0, |l| l.set.items[k].rows());
-            for t in 0..nrows {
+            let nrows = self
+                .cons
+                .loops
+                .as_ref()
+                .map_or(0, |l| l.set.items[k].rows());
+            for (t, phi_t) in phi.iter().enumerate().take(nrows) {
                 let r = r0 + t;
-                let open = (phi[t] / h).abs() < loop_cap;
+                let open = (phi_t / h).abs() < loop_cap;
                 for c in 0..n {
                     let mut x = -0.5 * h * p.gq[(r, c)];
                     if open {
