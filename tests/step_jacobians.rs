@@ -490,3 +490,147 @@ fn smooth_integrators_by_the_runge_kutta_chain_rule() {
         );
     }
 }
+
+/// Richardson-extrapolated central differences of the step: (4 D(ε/2) − D(ε))/3.
+fn richardson(sim: &Simulation, tau: &DVector<f64>, eps: f64) -> TransitionJacobians {
+    let d1 = sim
+        .transition_jacobians(tau, JacobianMethod::Central, eps)
+        .unwrap();
+    let d2 = sim
+        .transition_jacobians(tau, JacobianMethod::Central, eps / 2.0)
+        .unwrap();
+    TransitionJacobians {
+        a: (&d2.a * 4.0 - &d1.a) / 3.0,
+        b: (&d2.b * 4.0 - &d1.b) / 3.0,
+    }
+}
+
+fn maxabs(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    (a - b).amax()
+}
+
+/// The sliding box of `box_sliding_on_the_ground` at friction 0.5, moving at
+/// (vx, 0, 0) and spinning at wz, pressed into its slop.
+fn sliding_box(vx: f64, wz: f64) -> Simulation {
+    let model = load_str(box_urdf(), "box.urdf", FLOAT).unwrap();
+    let opts = SimOptions {
+        contact: ContactParams {
+            friction: 0.5,
+            ..Default::default()
+        },
+        ..tight()
+    };
+    let mut sim = Simulation::new(model, opts).unwrap();
+    let mut q = sim.q().clone();
+    q[2] = 0.05;
+    sim.set_state(&q, &DVector::zeros(6)).unwrap();
+    for _ in 0..200 {
+        sim.step().unwrap();
+    }
+    let (q, mut v) = (sim.q().clone(), sim.v().clone());
+    v[0] = vx;
+    v[5] = wz;
+    sim.set_state(&q, &v).unwrap();
+    pressed(&mut sim);
+    assert_eq!(sim.active_contacts(), 4, "four corners");
+    sim
+}
+
+/// The analytic A, B against Richardson-extrapolated central differences of
+/// the step (ε = `eps`, ε/2): the largest entry's error, asserted ≤ 1e-6.
+fn against_richardson(sim: &Simulation, tau: &DVector<f64>, eps: f64, what: &str) -> (f64, f64) {
+    let an = jac(sim, tau, JacobianMethod::Analytic);
+    let r = richardson(sim, tau, eps);
+    let (ea, eb) = (maxabs(&an.a, &r.a), maxabs(&an.b, &r.b));
+    eprintln!(
+        "{what}: analytic vs Richardson FD: A {ea:.2e} (relative {:.2e}), B {eb:.2e} (relative {:.2e}); |A| {:.2e}, |B| {:.2e}",
+        rel(&an.a, &r.a),
+        rel(&an.b, &r.b),
+        r.a.amax(),
+        r.b.amax()
+    );
+    assert!(ea < 1e-6 && eb < 1e-6, "{what}: A {ea:.3e}, B {eb:.3e}");
+    (ea, eb)
+}
+
+#[test]
+fn box_sliding_on_four_corners_against_richardson() {
+    // every corner slipping the same way: the four corners are redundant (three
+    // fix the normal motion) but the velocity the solve produces is the same
+    // for every split of their normal impulses, and so is its derivative
+    let sim = sliding_box(1.0, 0.0);
+    let tau = DVector::zeros(6);
+    against_richardson(&sim, &tau, 1e-5, "box sliding on four corners, mu 0.5");
+    // by the analytic route (not its finite-difference fallback)
+    let an = jac(&sim, &tau, JacobianMethod::Analytic);
+    assert_ne!(an, jac(&sim, &tau, JacobianMethod::Central));
+}
+
+#[test]
+fn box_sliding_and_spinning_on_four_corners_against_richardson() {
+    // corners slipping different ways: the split of the normal impulses moves
+    // the friction and so v⁺ (the four-legged table's indeterminacy); the
+    // step's v⁺ is the solve's own pick among a family of solutions, which no
+    // linearisation of its conditions gives (docs/theory.md §"Step Jacobians
+    // with redundant rows"). The analytic method detects it and takes central
+    // differences of the step
+    let sim = sliding_box(1.0, 3.0);
+    let tau = DVector::zeros(6);
+    against_richardson(&sim, &tau, 1e-5, "box sliding and spinning, mu 0.5");
+    let an = jac(&sim, &tau, JacobianMethod::Analytic);
+    assert_eq!(an, jac(&sim, &tau, JacobianMethod::Central));
+}
+
+/// The four-bar's crank, coupler and rocker angles closing the loop at crank
+/// angle θ (examples/common/four_bar_setup.rs).
+fn four_bar_closed_q(theta: f64) -> [f64; 3] {
+    let (l1, l2, l3, d) = (0.10, 0.30, 0.25, 0.30);
+    let a = [l1 * theta.cos(), l1 * theta.sin()];
+    let dv = [d - a[0], -a[1]];
+    let dist = dv[0].hypot(dv[1]);
+    let x = (l2 * l2 - l3 * l3 + dist * dist) / (2.0 * dist);
+    let h = (l2 * l2 - x * x).sqrt();
+    let u = [dv[0] / dist, dv[1] / dist];
+    let n = [-u[1], u[0]];
+    let b1 = [a[0] + x * u[0] + h * n[0], a[1] + x * u[1] + h * n[1]];
+    let b2 = [a[0] + x * u[0] - h * n[0], a[1] + x * u[1] - h * n[1]];
+    let b = if b1[1] < b2[1] { b1 } else { b2 };
+    let phi2 = (b[1] - a[1]).atan2(b[0] - a[0]);
+    let phi3 = b[1].atan2(b[0] - d);
+    [theta, phi2 - theta, phi3]
+}
+
+#[test]
+fn four_bar_driven_by_a_servo_against_richardson() {
+    // assets/four_bar.urdf closed by assets/four_bar_constraints.json (a 3-D
+    // point on a planar mechanism: three bilateral rows of rank two), the crank
+    // driven by a servo toward a target 1 rad ahead; moving when differentiated,
+    // so the position pass's drift target −½hγ acts in the step
+    let model = load_file("assets/four_bar.urdf", LoadOptions::default()).unwrap();
+    let text = std::fs::read_to_string("assets/four_bar_constraints.json").unwrap();
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let c = urdyn::model::Constraints::from_value(&model, &json).unwrap();
+    let opts = SimOptions {
+        ground: None,
+        ..tight()
+    };
+    let mut sim = Simulation::new(model, opts).unwrap();
+    let q = DVector::from_row_slice(&four_bar_closed_q(-1.0));
+    sim.set_state(&q, &DVector::zeros(3)).unwrap();
+    assert!(sim.set_constraints(c).unwrap().is_empty());
+    let kp = DVector::from_vec(vec![20.0, 0.0, 0.0]);
+    let kd = DVector::from_vec(vec![0.5, 0.0, 0.0]);
+    sim.set_gains(&kp, &kd).unwrap();
+    let mut target = q.clone();
+    target[0] += 1.0;
+    sim.set_targets(&target, None).unwrap();
+    for _ in 0..150 {
+        sim.step().unwrap();
+    }
+    assert!(sim.v()[0].abs() > 0.1, "the crank turns: {}", sim.v());
+    assert!(sim.constraint_violation() < 1e-6);
+    let tau = DVector::from_vec(vec![0.05, -0.02, 0.01]);
+    against_richardson(&sim, &tau, 1e-5, "four-bar driven by a servo");
+    let an = jac(&sim, &tau, JacobianMethod::Analytic);
+    assert_ne!(an, jac(&sim, &tau, JacobianMethod::Central));
+}

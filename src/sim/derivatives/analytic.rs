@@ -17,22 +17,28 @@
 //!   q⁺ = q ⊕ h v⁺ and the free base's velocity rotation, differentiated in
 //!   the tangent space (right Jacobian of SO(3)).
 //!
-//! The position pass's pseudo-velocity w is held fixed (its rows are at rest
-//! when nothing penetrates deeper than the slop). Contact points are material
-//! points of their link (hull and box vertices), a sphere's and a capsule's
+//! Redundant rows (more than the contact or loop can fix) leave λ non-unique
+//! but v⁺ unique, and v⁺ is what is differentiated (docs/theory.md §"Step
+//! Jacobians with redundant rows"); where sliding rows leave even v⁺ to the
+//! solve's pick, `None` (central differences). Loop rows are equality rows;
+//! the position pass's w is differentiated in `position.rs` (§"Loops and the
+//! position pass in the step Jacobians"). Contact points are material points
+//! of their link (hull and box vertices), a sphere's and a capsule's
 //! lowest point the point below its centre.
 
+use super::position::PositionPass;
+use super::second_order::{add_second_order, loop_gamma_derivatives, loop_rows};
 use super::smooth::Tableau;
 use super::TransitionJacobians;
-use crate::contact::{tangents, ContactPoint, NO_GEOM};
+use crate::contact::{ContactPoint, NO_GEOM};
 use crate::dynamics::{rnea_derivatives, DynamicsError};
 use crate::model::Shape;
 use crate::sim::integrators::dop853_tableau::{A, B, N_STAGES};
 use crate::sim::integrators::explicit_limit;
 use crate::sim::solver::RowKind;
 use crate::sim::{Integrator, SimError, Simulation};
-use crate::spatial::{axis_angle, skew, Motion};
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use crate::spatial::skew;
+use nalgebra::{DMatrix, DVector, Vector3};
 use std::ops::AddAssign;
 
 impl Simulation {
@@ -114,7 +120,6 @@ impl Simulation {
             }));
         }
         self.implicit_step_jacobian(&q0, &v0, &points, counts, h, tau)
-            .map(Some)
     }
 
     /// The Jacobian of the time-stepping step just taken from (q0, v0) with
@@ -127,19 +132,35 @@ impl Simulation {
         counts: crate::sim::constraints::RowCounts,
         h: f64,
         tau: &DVector<f64>,
-    ) -> Result<TransitionJacobians, SimError> {
+    ) -> Result<Option<TransitionJacobians>, SimError> {
         let n = self.model.nv;
         let rows_used = self.cons.rows_len() > 0 && counts.total() > 0;
         // v⁺ in the start frame (before the base velocity's rotation), w
         let mut vplus = self.mass.vfree.clone();
         let mut vtot = vplus.clone();
+        let mut push: Option<DVector<f64>> = None;
         if rows_used {
             vplus += self.cons.impulse_velocity();
             vtot.copy_from(&vplus);
             if let Some(w) = self.cons.push_velocity() {
                 vtot += w;
+                push = Some(w.clone());
             }
         }
+        // the loop constraints' rows (after every other row)
+        let loops = if rows_used {
+            match loop_rows(self, self.cons.rows_view()) {
+                Some(l) => l,
+                None => return Ok(None),
+            }
+        } else {
+            Vec::new()
+        };
+        let m = if rows_used {
+            self.cons.rows_view().n
+        } else {
+            0
+        };
         // back at the start: poses and H̃ (the step's saturation set); the
         // step's end state is put back at the end
         let (q1, v1) = (self.q.clone(), self.v.clone());
@@ -155,9 +176,31 @@ impl Simulation {
                 acc[i] -= fr[i];
             }
         }
+        // ∂(H w)/∂q = ∂ID/∂q (q, v, a + w) − ∂ID/∂q (q, v, a) (ID is affine in a)
+        let mut hw_q = None;
+        if let Some(w) = push.as_ref() {
+            rnea_derivatives(&self.model, &mut self.data, q0, v0, &(&acc + w), None)?;
+            hw_q = Some(self.data.dtau_dq.clone());
+        }
+        // the loop rows' ∂γ/∂q, ∂γ/∂v from a pass at (q, v, 0)
+        let (mut gq, mut gv) = (DMatrix::zeros(m, n), DMatrix::zeros(m, n));
+        if !loops.is_empty() && push.is_some() {
+            rnea_derivatives(
+                &self.model,
+                &mut self.data,
+                q0,
+                v0,
+                &DVector::zeros(n),
+                None,
+            )?;
+            loop_gamma_derivatives(self, &loops, &mut gq, &mut gv);
+        }
         // ∂ID/∂q, ∂ID/∂v at (q, v, a) in data.dtau_dq, dtau_dv, ∂ID/∂a = H in
         // data.h, the poses at q
         rnea_derivatives(&self.model, &mut self.data, q0, v0, &acc, None)?;
+        if let Some(x) = hw_q.as_mut() {
+            *x -= &self.data.dtau_dq;
+        }
         self.fk_valid = true;
         if self.model.has_mimic {
             self.factor_mass(h)?;
@@ -195,9 +238,8 @@ impl Simulation {
                 }
             }
         }
-        // the rows: Jacobian, kinds, impulses; the contact points' second-order terms
+        // the rows: Jacobian, kinds, impulses; their second-order terms
         let rows = self.cons.rows_view();
-        let m = rows.n;
         let mut jac = DMatrix::<f64>::zeros(m, n);
         for r in 0..m {
             for (c, x) in rows.jrow(r) {
@@ -206,27 +248,8 @@ impl Simulation {
         }
         let mut jq = DMatrix::<f64>::zeros(m, n);
         let mut gc = DMatrix::<f64>::zeros(n, n);
-        for (ci, &pi) in self.cons.row_points().iter().enumerate() {
-            let Some(pt) = points.get(pi) else { continue };
-            let rn = 3 * ci;
-            // the rows (n, t₁, t₂): the ground's (z, x, y), an obstacle's own
-            let (t1, t2) = tangents(&pt.normal);
-            let f =
-                pt.normal * rows.lambda[rn] + t1 * rows.lambda[rn + 1] + t2 * rows.lambda[rn + 2];
-            let anchor = pt.point + pt.normal * self.rolling_radius(pt);
-            let t = point_second_derivatives(self, pt.body, &pt.point, &anchor);
-            for (a, &(ca, _)) in t.cols.iter().enumerate() {
-                for (b, &(cb, _)) in t.cols.iter().enumerate() {
-                    let d = t.d[a * t.cols.len() + b];
-                    // ∂(Jᵀλ)_ca / ∂q_cb
-                    gc[(ca, cb)] += d.dot(&f);
-                    // (∂J/∂q_cb v⁺) for the rows z (normal), x, y
-                    let wd = d * vplus[ca];
-                    jq[(rn, cb)] += wd.dot(&pt.normal);
-                    jq[(rn + 1, cb)] += wd.dot(&t1);
-                    jq[(rn + 2, cb)] += wd.dot(&t2);
-                }
-            }
+        if m > 0 {
+            add_second_order(self, points, &loops, &rows.lambda, &vplus, &mut gc, &mut jq);
         }
         // H̃⁻¹ (n solves), Y = H̃⁻¹Jᵀ, W = J Y
         let mut minv = DMatrix::zeros(n, n);
@@ -352,6 +375,11 @@ impl Simulation {
                         }
                         r += 1;
                     }
+                    RowKind::Bilateral => {
+                        // a loop row: δu = 0 (velocity target 0, λ free)
+                        equality_row(&mut mm, &mut rr, &w, &cq, &jac, 0.0, r, n, h);
+                        r += 1;
+                    }
                     RowKind::Unilateral => {
                         if rows.lambda[r] <= 0.0 {
                             mm[(r, r)] = 1.0;
@@ -371,6 +399,13 @@ impl Simulation {
             let dl = if any_sliding {
                 let svd = mm.svd(true, true);
                 let tol = 1e-12 * svd.singular_values.max().max(1e-300);
+                // the velocity must not depend on the solution chosen: every
+                // null vector ν of M has H̃⁻¹Jᵀν = 0 (docs/theory.md §"Step
+                // Jacobians with redundant rows"); else the step's v⁺ is the
+                // solve's own pick among many, and no linearisation gives it
+                if !velocity_determined(&svd, tol, &y) {
+                    return Ok(None);
+                }
                 svd.solve(&rr, tol)
                     .map_err(|e| SimError::Invalid(format!("transition_jacobians: {e}")))?
             } else {
@@ -378,10 +413,32 @@ impl Simulation {
             };
             z0 + &y * dl
         };
+        // the position pass's δw (docs/theory.md §"Loops and the position pass
+        // in the step Jacobians"): added to the configuration's velocity only
+        let mut dvtot = dvplus.clone();
+        if let (Some(wv), Some(hwq)) = (push.as_ref(), hw_q.as_ref()) {
+            let mut gcm = DMatrix::<f64>::zeros(n, n);
+            let mut jqw = DMatrix::<f64>::zeros(m, n);
+            add_second_order(self, points, &loops, &rows.mu, wv, &mut gcm, &mut jqw);
+            let pass = PositionPass {
+                jac: &jac,
+                y: &y,
+                w: &w,
+                minv: &minv,
+                h_w_q: hwq,
+                gc_mu: &gcm,
+                jq_w: &jqw,
+                gq: &gq,
+                gv: &gv,
+                loops: &loops,
+                h,
+            };
+            dvtot += self.position_pass_jacobian(&pass);
+        }
         self.q.copy_from(&q1);
         self.v.copy_from(&v1);
         self.fk_valid = false;
-        Ok(self.output_map(&vtot, &dvplus, h))
+        Ok(Some(self.output_map(&vtot, &vplus, &dvtot, &dvplus, h)))
     }
 
     /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces): the
@@ -399,7 +456,7 @@ impl Simulation {
 
     /// The radius of a contact shape that rolls (sphere, capsule): its contact
     /// point is that far below the centre it moves with; 0 for vertices.
-    fn rolling_radius(&self, pt: &ContactPoint) -> f64 {
+    pub(super) fn rolling_radius(&self, pt: &ContactPoint) -> f64 {
         if pt.other_geom != NO_GEOM {
             // an obstacle's point: a sphere or capsule rolls on it too
             return match self.model.collisions.get(pt.geom).map(|g| &g.shape) {
@@ -413,78 +470,12 @@ impl Simulation {
             .and_then(|g| g.shapes.get(pt.shape))
             .map_or(0.0, |s| s.rolling_radius())
     }
-
-    /// [δq'; δv'] from δv⁺ (start frame) and the unperturbed total velocity
-    /// `vtot`, for the columns (δq, δv) (A) and δτ (B).
-    fn output_map(
-        &self,
-        vtot: &DVector<f64>,
-        dvplus: &DMatrix<f64>,
-        h: f64,
-    ) -> TransitionJacobians {
-        let n = self.model.nv;
-        let mut out = TransitionJacobians {
-            a: DMatrix::zeros(2 * n, 2 * n),
-            b: DMatrix::zeros(2 * n, n),
-        };
-        // column c of [A B]
-        let put = |out: &mut TransitionJacobians, r: usize, c: usize, x: f64| {
-            if c < 2 * n {
-                out.a[(r, c)] = x;
-            } else {
-                out.b[(r, c - 2 * n)] = x;
-            }
-        };
-        // joints: δq' = δq + h δv⁺, δv' = δv⁺
-        for c in 0..3 * n {
-            for k in 0..n {
-                let dq = if c < n && c == k { 1.0 } else { 0.0 };
-                put(&mut out, k, c, dq + h * dvplus[(k, c)]);
-                put(&mut out, n + k, c, dvplus[(k, c)]);
-            }
-        }
-        if self.model.floating_base {
-            // p' = p + h R l, R' = R Exp(h ω), v'_lin = Exp(h ω)ᵀ l⁺
-            let (w, l) = (omega(vtot), lin(vtot));
-            let th = (w * h).norm();
-            let e = if th > 0.0 {
-                axis_angle(&(w * h / th), th)
-            } else {
-                Matrix3::identity()
-            };
-            let et = e.transpose();
-            let jr = right_jacobian(&(w * h));
-            let vlin_new = et * l;
-            for c in 0..3 * n {
-                let (dl_in, dth_in) = if c < 3 {
-                    (unit(c), Vector3::zeros())
-                } else if c < 6 {
-                    (Vector3::zeros(), unit(c - 3))
-                } else {
-                    (Vector3::zeros(), Vector3::zeros())
-                };
-                let dlv = Vector3::new(dvplus[(0, c)], dvplus[(1, c)], dvplus[(2, c)]);
-                let dwv = Vector3::new(dvplus[(3, c)], dvplus[(4, c)], dvplus[(5, c)]);
-                // δl' = Eᵀ(δl + h δθ × l + h δl⁺), δθ' = Eᵀ δθ + J_r h δω
-                let dl_out = et * (dl_in + dth_in.cross(&l) * h + dlv * h);
-                let dth_out = et * dth_in + jr * dwv * h;
-                // δv'_lin = Eᵀ δl⁺ + [v'_lin]× J_r h δω
-                let dv_out = et * dlv + vlin_new.cross(&(jr * dwv * h));
-                for i in 0..3 {
-                    put(&mut out, i, c, dl_out[i]);
-                    put(&mut out, 3 + i, c, dth_out[i]);
-                    put(&mut out, n + i, c, dv_out[i]);
-                }
-            }
-        }
-        out
-    }
 }
 
 /// M X = R by Gaussian elimination with complete pivoting (M square), stopped
 /// at the first pivot below `tol` times the first (the largest entry): the
 /// unknowns of the pivots left are 0, a basic solution where R lies in M's range.
-fn solve_basic(mut a: DMatrix<f64>, mut b: DMatrix<f64>, tol: f64) -> DMatrix<f64> {
+pub(super) fn solve_basic(mut a: DMatrix<f64>, mut b: DMatrix<f64>, tol: f64) -> DMatrix<f64> {
     let (m, nc) = (a.nrows(), b.ncols());
     // unknown perm[k] sits in column k
     let mut perm: Vec<usize> = (0..m).collect();
@@ -582,76 +573,28 @@ fn omega(v: &DVector<f64>) -> Vector3<f64> {
 fn lin(v: &DVector<f64>) -> Vector3<f64> {
     Vector3::new(v[0], v[1], v[2])
 }
-fn unit(i: usize) -> Vector3<f64> {
-    let mut e = Vector3::zeros();
-    e[i] = 1.0;
-    e
-}
 
-/// SO(3)'s right Jacobian: Exp(x + δ) ≈ Exp(x) Exp(J_r(x) δ).
-fn right_jacobian(x: &Vector3<f64>) -> Matrix3<f64> {
-    let th = x.norm();
-    let k = skew(x);
-    if th < 1e-8 {
-        return Matrix3::identity() - k * 0.5 + k * k / 6.0;
-    }
-    Matrix3::identity() - k * ((1.0 - th.cos()) / (th * th))
-        + k * k * ((th - th.sin()) / (th * th * th))
-}
-
-/// ∂(S_c at p)/∂q_k for the columns c, k of a contact point's path (root
-/// first): `d[a·len + b]` is d/dq_{cols[b]} of column cols[a]'s point velocity.
-struct PointTerms {
-    /// (v index, depth of its joint on the path).
-    cols: Vec<(usize, usize)>,
-    d: Vec<Vector3<f64>>,
-}
-
-/// The second-order terms of a material point `p` of `body` (moving with its
-/// `anchor`: p itself for a vertex, the centre above a sphere's lowest point):
-/// the world column S_c of each ancestor dof varies as S_k × S_c for k on the
-/// same joint or an ancestor's, and the point moves by S_k at the anchor.
-fn point_second_derivatives(
-    sim: &Simulation,
-    body: usize,
-    p: &Vector3<f64>,
-    anchor: &Vector3<f64>,
-) -> PointTerms {
-    let model = &sim.model;
-    let mut chain = Vec::new();
-    let mut b = body;
-    while b != 0 {
-        chain.push(b);
-        b = model.parent[b];
-    }
-    chain.reverse();
-    let mut cols = Vec::new();
-    let mut s: Vec<Motion> = Vec::new();
-    for (depth, &b) in chain.iter().enumerate() {
-        let j = &model.joints[b];
-        let o = sim.data.o_m_i[b];
-        for c in 0..j.nv().min(6) {
-            cols.push((j.iv + c, depth));
-            s.push(o.act_motion(&j.subspace_column(c)));
+/// Whether every null vector ν of the active set's matrix M (its SVD, singular
+/// values at most `tol` counted as zero) leaves the velocity alone: `Y ν = 0`
+/// with Y = H̃⁻¹Jᵀ, to 1e-9 of Y's size. Then every solution δλ of M δλ = R
+/// gives the same δv⁺ = Z₀ + Y δλ.
+fn velocity_determined(
+    svd: &nalgebra::SVD<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    tol: f64,
+    y: &DMatrix<f64>,
+) -> bool {
+    let Some(vt) = svd.v_t.as_ref() else {
+        return false;
+    };
+    let scale = y.amax().max(1e-300);
+    for (k, &s) in svd.singular_values.iter().enumerate() {
+        if s > tol {
+            continue;
+        }
+        let nu = vt.row(k).transpose();
+        if (y * nu).amax() > 1e-9 * scale {
+            return false;
         }
     }
-    let len = cols.len();
-    let mut d = vec![Vector3::zeros(); len * len];
-    for a in 0..len {
-        let sc = &s[a];
-        for bb in 0..len {
-            let sk = &s[bb];
-            let mut t = Vector3::zeros();
-            if cols[bb].1 <= cols[a].1 {
-                // S_k × S_c at p: (ω_k × v_c + v_k × ω_c) + (ω_k × ω_c) × p
-                let ang = sk.ang.cross(&sc.ang);
-                t += sk.ang.cross(&sc.lin) + sk.lin.cross(&sc.ang) + ang.cross(p);
-            }
-            // the point's own motion: ω_c × δp, δp = v_k + ω_k × anchor
-            let dp = sk.lin + sk.ang.cross(anchor);
-            t += sc.ang.cross(&dp);
-            d[a * len + bb] = t;
-        }
-    }
-    PointTerms { cols, d }
+    true
 }

@@ -17,6 +17,9 @@
 
 mod analytic;
 mod fd;
+mod output;
+mod position;
+mod second_order;
 mod smooth;
 
 use crate::model::configuration::{difference, integrate};
