@@ -138,8 +138,10 @@ fn luxo_dropped_on_the_table_comes_to_rest_with_its_loops_closed() {
     use urdyn::sim::{SimOptions, Simulation};
     let scene =
         urdyn::scene::Scene::from_file(root().join("assets/luxo_on_table.json"), &[]).unwrap();
-    let mut contact = urdyn::contact::ContactParams::default();
-    contact.friction = scene.ground.unwrap().friction;
+    let contact = urdyn::contact::ContactParams {
+        friction: scene.ground.unwrap().friction,
+        ..Default::default()
+    };
     let opts = SimOptions {
         ground: scene.ground.map(|g| g.height),
         contact,
