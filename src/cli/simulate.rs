@@ -244,7 +244,7 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             )));
         }
     }
-    let (mut model, init, opts, geometry, urdf_name, loops) = match &args.scene {
+    let (mut model, init, opts, mut geometry, urdf_name, loops) = match &args.scene {
         Some(path) => scene_setup(args, path, integrator)?,
         None if crate::load::file_format(&args.urdf) == crate::load::Format::Mjcf => {
             super::simulate_mjcf::setup(args, integrator)?
@@ -511,7 +511,10 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         }
         None => loop_body(None),
     }?;
-    if let (Some(path), Some(geometry), Some(recorder)) = (&args.html, &geometry, &recorder) {
+    if let (Some(path), Some(geometry), Some(recorder)) = (&args.html, &mut geometry, &recorder) {
+        if let Some(set) = sim.constraints() {
+            geometry.set_loops(set);
+        }
         let page = crate::cli::view::write_page(path, &sim.model, geometry, recorder, ground)?;
         warn(&format!(
             "urdyn simulate: wrote the replay page {} ({})",

@@ -19,6 +19,11 @@ use crate::model::{ConstraintKind, Constraints as LoopSet, Data, Model};
 use crate::spatial::Motion;
 use nalgebra::{DMatrix, DVector, Vector3};
 
+/// A loop row direction whose singular value is below this fraction of its
+/// constraint's largest is dependent on the others and left out of the step
+/// ([`Loops::directions`]).
+const DEPENDENT: f64 = 1e-3;
+
 /// The force a loop constraint exerted in the last step (world frame): on
 /// `link1` at its point (the reaction on `link2`), or the generalized force on
 /// `joint1` of a `joint` constraint.
@@ -47,8 +52,14 @@ pub(crate) struct Loops {
     row_of: Vec<Option<usize>>,
     /// Each constraint's first row in `jc`.
     first: Vec<usize>,
-    /// Warm start and last impulse of each of the set's rows.
+    /// Warm start and last impulse of each of the set's rows (world axes).
     lambda: Vec<f64>,
+    /// Per constraint: the directions its rows took in the last step (the
+    /// principal directions of its rows kept, each of `c.rows()` entries, in
+    /// order), as a column-major `rows × kept` block.
+    basis: Vec<Vec<f64>>,
+    /// Per constraint: the directions kept in the last step.
+    kept: Vec<usize>,
     /// The last step's length (for forces λ/h).
     h: f64,
     ov: Vec<Motion<f64>>,
@@ -78,6 +89,12 @@ impl Loops {
             jc: DMatrix::zeros(m, model.nv),
             gamma: DVector::zeros(m),
             lambda: vec![0.0; m],
+            basis: set
+                .items
+                .iter()
+                .map(|c| vec![0.0; c.rows() * c.rows()])
+                .collect(),
+            kept: vec![0; set.items.len()],
             h: 0.0,
             ov: vec![Motion::zero(); model.nbodies],
             oa0: vec![Motion::zero(); model.nbodies],
@@ -192,20 +209,26 @@ impl Loops {
                 }
             }
             let first = self.first[k];
+            let m = c.rows();
+            let kept = directions(&self.jc, first, m, &mut self.basis[k]);
+            self.kept[k] = kept;
             let start = rows.n;
             let mut full = true;
-            for t in 0..c.rows() {
-                let row = first + t;
-                let Some(r) = rows.push(RowKind::Bilateral, 0.0, self.lambda[row], path) else {
+            for t in 0..kept {
+                let e = &self.basis[k][t * m..(t + 1) * m];
+                let along = |x: &[f64]| e.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+                let warm = along(&self.lambda[first..first + m]);
+                let Some(r) = rows.push(RowKind::Bilateral, 0.0, warm, path) else {
                     full = false;
                     break;
                 };
                 for (d, x) in self.dense.iter_mut().enumerate() {
-                    *x = self.jc[(row, d)];
+                    *x = (0..m).map(|i| e[i] * self.jc[(first + i, d)]).sum();
                 }
                 rows.gather(r, &mut self.dense);
-                let close = (-phi[t] / h).clamp(-cap, cap);
-                rows.bpos[r] = close - 0.5 * h * self.gamma[row];
+                let close = (-along(&phi[..m]) / h).clamp(-cap, cap);
+                let gamma = along(&self.gamma.as_slice()[first..first + m]);
+                rows.bpos[r] = close - 0.5 * h * gamma;
                 violated |= rows.bpos[r] != 0.0;
             }
             if !full {
@@ -213,20 +236,25 @@ impl Loops {
                 break;
             }
             self.row_of[k] = Some(start);
-            added += c.rows();
+            added += kept;
         }
         (added, violated)
     }
 
-    /// Reads the step's impulses back (warm starts, forces).
+    /// Reads the step's impulses back (warm starts, forces), in world axes.
     pub fn read(&mut self, rows: &Rows) {
         for (k, c) in self.set.items.iter().enumerate() {
-            let first = self.first[k];
-            for t in 0..c.rows() {
-                self.lambda[first + t] = match self.row_of[k] {
-                    Some(r) => rows.lambda[r + t],
-                    None => 0.0,
-                };
+            let (first, m) = (self.first[k], c.rows());
+            let out = &mut self.lambda[first..first + m];
+            out.iter_mut().for_each(|x| *x = 0.0);
+            let Some(r) = self.row_of[k] else {
+                continue;
+            };
+            for t in 0..self.kept[k] {
+                let l = rows.lambda[r + t];
+                for (i, x) in out.iter_mut().enumerate() {
+                    *x += self.basis[k][t * m + i] * l;
+                }
             }
         }
     }
@@ -268,6 +296,45 @@ impl Loops {
             .filter(|(_, a)| **a)
             .fold(0.0, |m, (x, _)| m.max(x.abs()))
     }
+}
+
+/// The directions of a constraint's rows this step (its `m` rows from
+/// `first` in `jc`) into `e` (column-major, m × kept); returns how many are kept. A `joint`
+/// constraint keeps its row. A `point` or `frame` constraint's rows are
+/// turned onto the principal directions of its Jacobian block J_k
+/// (eigenvectors of J_k J_kᵀ, largest first), and a direction whose
+/// singular value is below [`DEPENDENT`] times the largest is dropped: a
+/// planar loop closed by a 3-D point has a row that is identically zero on
+/// the closed mechanism and, off it, a tiny row nearly dependent on the
+/// others, whose exact enforcement asks for unbounded impulses
+/// (docs/theory.md §"Loops in the simulation").
+fn directions(jc: &DMatrix<f64>, first: usize, m: usize, e: &mut [f64]) -> usize {
+    if m == 1 {
+        e[0] = 1.0;
+        return 1;
+    }
+    let nv = jc.ncols();
+    let g = DMatrix::from_fn(m, m, |i, j| {
+        (0..nv)
+            .map(|d| jc[(first + i, d)] * jc[(first + j, d)])
+            .sum::<f64>()
+    });
+    let eig = nalgebra::SymmetricEigen::new(g);
+    let mut order: Vec<usize> = (0..m).collect();
+    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
+    let top = eig.eigenvalues[order[0]];
+    let mut kept = 0;
+    for &o in &order {
+        let ev = eig.eigenvalues[o];
+        if !(top > 0.0 && ev > DEPENDENT * DEPENDENT * top) {
+            break;
+        }
+        for i in 0..m {
+            e[kept * m + i] = eig.eigenvectors[(i, o)];
+        }
+        kept += 1;
+    }
+    kept
 }
 
 impl super::Simulation {

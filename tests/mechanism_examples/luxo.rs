@@ -124,3 +124,47 @@ fn luxo_loops_close_and_constrained_dynamics_holds_fixed() {
 fn luxo_loops_close_and_constrained_dynamics_holds_floating() {
     check(true);
 }
+
+/// The Luxo with its parallelograms dropped from 0.3 m onto the table
+/// (assets/luxo_on_table.json, examples/luxo_on_table.rs): it lands, falls
+/// asleep under the default sleep rule within 4 s, and at rest both loops are
+/// closed below 1e-6 m. (Measured: asleep at 2.73 s, violation 3.3e-9 m at rest.
+/// Not yet met, docs/mechanisms_examples.md: on the ground the same lamp keeps
+/// rocking, and the impacts open the loops by up to 2e-5 m and raise the energy
+/// by 0.1 J: the projected Gauss–Seidel solve does not converge on the closed
+/// chain's stiff rows at an impact.)
+#[test]
+fn luxo_dropped_on_the_table_comes_to_rest_with_its_loops_closed() {
+    use urdyn::sim::{SimOptions, Simulation};
+    let scene =
+        urdyn::scene::Scene::from_file(root().join("assets/luxo_on_table.json"), &[]).unwrap();
+    let contact = urdyn::contact::ContactParams {
+        friction: scene.ground.unwrap().friction,
+        ..Default::default()
+    };
+    let opts = SimOptions {
+        ground: scene.ground.map(|g| g.height),
+        contact,
+        ..Default::default()
+    };
+    let mut sim = Simulation::new(scene.model.clone(), opts).unwrap();
+    sim.set_state(&scene.q0, &scene.v0).unwrap();
+    assert!(sim
+        .set_constraints(scene.constraints.clone())
+        .unwrap()
+        .is_empty());
+    let e0 = sim.energy();
+    let mut asleep_at = None;
+    while sim.time() < 4.0 - 1e-9 {
+        sim.step().unwrap();
+        if asleep_at.is_none() && sim.awake() == 0 {
+            asleep_at = Some(sim.time());
+        }
+    }
+    let viol = sim.constraint_violation();
+    let e = sim.energy();
+    eprintln!("luxo on the table: asleep at {asleep_at:?} s, violation at rest {viol:.2e}, energy {e0:.4} J -> {e:.4} J");
+    assert!(asleep_at.is_some_and(|t| t < 4.0), "{asleep_at:?}");
+    assert!(viol < 1e-6, "{viol}");
+    assert!(e < e0, "{e} >= {e0}");
+}

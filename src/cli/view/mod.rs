@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 mod scene;
 mod visuals;
 
-pub use scene::{run_scene, SceneViewArgs};
+pub use scene::{run_scene, LoopMark, SceneViewArgs};
 
 const PAGE_HTML: &str = include_str!("page.html");
 const VIEWER_JS: &str = include_str!("viewer.js");
@@ -517,6 +517,9 @@ pub struct Geometry {
     pub visuals: Vec<Visual>,
     /// Visual elements left out (malformed), one line each, naming the URDF and link.
     pub warnings: Vec<String>,
+    /// The loop constraints drawn (mechanisms.md): a line between each
+    /// `point`/`frame` constraint's two anchor points.
+    pub loops: Vec<LoopMark>,
 }
 
 /// The colour of a visual without a material, and of collision geometry.
@@ -963,6 +966,8 @@ fn page_data(model: &Model, geometry: &Geometry, rec: &Recorder, ground: Option<
         "contacts": series(1),
         "penetration": series(2),
         "contactForces": contacts,
+        "loops": geometry.loops.iter().map(|l| json!({"name": l.name, "body1": l.body1,
+            "p1": l.point1, "body2": l.body2, "p2": l.point2})).collect::<Vec<_>>(),
     })
 }
 

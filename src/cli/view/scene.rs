@@ -33,7 +33,13 @@ pub struct SceneViewArgs {
 pub fn run_scene(args: &SceneViewArgs) -> Result<PageSummary, ViewError> {
     let scene = Scene::from_file(&args.scene, &args.package_path)
         .map_err(|e| ViewError::Geometry(e.to_string()))?;
-    let geometry = Geometry::load_scene(&scene, &args.package_path)?;
+    let mut geometry = Geometry::load_scene(&scene, &args.package_path)?;
+    // the loop constraints, their held world anchors where the start puts them
+    let mut loops = scene.constraints.clone();
+    let mut data = crate::model::Data::new(&scene.model);
+    crate::dynamics::forward_kinematics_pass(&scene.model, &mut data, &scene.q0);
+    loops.place_holds(&data);
+    geometry.set_loops(&loops);
     let csv_name = args.traj.display().to_string();
     let text = std::fs::read(&args.traj)
         .map_err(|e| ViewError::Csv(format!("{csv_name}: cannot read: {e}")))?;
@@ -166,5 +172,44 @@ mod tests {
             let [a, b, c] = t.map(|i| m.vertices[i as usize]);
             assert!((b - a).cross(&(c - a)).z > 0.0);
         }
+    }
+}
+
+/// A loop constraint as the page draws it: its two anchor points, each fixed
+/// in a body (body 0: the world, the point in world coordinates).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopMark {
+    /// The constraint's name.
+    pub name: String,
+    /// Side 1's body and its anchor point in that body's frame.
+    pub body1: usize,
+    /// Side 1's anchor point (m, body frame).
+    pub point1: [f64; 3],
+    /// Side 2's body (0: the world).
+    pub body2: usize,
+    /// Side 2's anchor point (m, body frame, or world for the world).
+    pub point2: [f64; 3],
+}
+
+impl Geometry {
+    /// Draws the `point` and `frame` constraints of `set` (its held world
+    /// anchors placed: a simulation's set, or one placed at the start state);
+    /// `joint` constraints have no anchor points and are not drawn.
+    pub fn set_loops(&mut self, set: &crate::model::Constraints) {
+        self.loops = set
+            .items
+            .iter()
+            .filter(|c| !matches!(c.kind, crate::model::ConstraintKind::Joint { .. }))
+            .map(|c| {
+                let p = |t: &nalgebra::Vector3<f64>| [t.x, t.y, t.z];
+                LoopMark {
+                    name: c.name.clone(),
+                    body1: c.a.body,
+                    point1: p(&c.a.local.trans),
+                    body2: c.b.body,
+                    point2: p(&c.b.local.trans),
+                }
+            })
+            .collect();
     }
 }

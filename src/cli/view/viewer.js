@@ -439,8 +439,11 @@
     follow: document.getElementById("follow"),
     frames: document.getElementById("frames"),
     forces: document.getElementById("forces"),
+    loops: document.getElementById("loops"),
   };
   if (!arrows) document.getElementById("forces-label").style.display = "none";
+  const loops = D.loops || [];
+  if (!loops.length) document.getElementById("loops-label").style.display = "none";
   const legend = document.getElementById("legend");
   function showLegend() {
     legend.textContent = arrows && ui.forces.checked ? forceLegend : "";
@@ -555,6 +558,22 @@
         }
         seg([p[0] - mk, p[1], p[2]], [p[0] + mk, p[1], p[2]], col);
         seg([p[0], p[1] - mk, p[2]], [p[0], p[1] + mk, p[2]], col);
+      }
+    }
+    // loop constraints: a line between the two anchor points (closed: a
+    // point), a cross at each (side 1 magenta, side 2 cyan)
+    if (ui.loops && ui.loops.checked) {
+      const mk = R0 * 0.015;
+      for (const l of loops) {
+        const a = act(bodyPose(f, l.body1, blend), l.p1), b = act(bodyPose(f, l.body2, blend), l.p2);
+        seg(a, b, [0.95, 0.85, 0.1]);
+        for (const [p, col] of [[a, [0.9, 0.1, 0.8]], [b, [0.1, 0.8, 0.9]]]) {
+          for (let k = 0; k < 3; k++) {
+            const lo = p.slice(), hi = p.slice();
+            lo[k] -= mk; hi[k] += mk;
+            seg(lo, hi, col);
+          }
+        }
       }
     }
     if (lines.length) {
@@ -695,6 +714,7 @@
     dirty = true;
   });
   ui.forces.addEventListener("change", () => { showLegend(); dirty = true; });
+  ui.loops.addEventListener("change", () => { dirty = true; });
   window.addEventListener("keydown", (e) => {
     if (e.code === "Space" && e.target.tagName !== "BUTTON") { e.preventDefault(); playBtn.click(); }
   });
@@ -773,6 +793,11 @@
       drawPlot();
       dirty = false;
       return times[k];
+    },
+    // the drawn loop constraints' two anchor points (world) at the frame shown
+    loopAnchors() {
+      return loops.map((l) => ({ name: l.name, point1: act(bodyPose(frame, l.body1, 0), l.p1),
+        point2: act(bodyPose(frame, l.body2, 0), l.p2) }));
     },
     linkPose(name) {
       const P = linkPoseAt(frame, name);
