@@ -378,9 +378,12 @@ impl super::Simulation {
         let mut lines = Vec::new();
         self.energy_now = None;
         let e0 = self.energy();
+        let mut open = false;
         if let Some(l) = self.cons.loops.as_mut() {
             if l.violation(&self.data, &self.q, &mut out) <= 1e-6 {
                 l.e_ref = Some(e0);
+            } else {
+                open = true;
             }
             for (c, x) in l.set.items.iter().zip(&out) {
                 if x.abs() > 1e-3 {
@@ -393,7 +396,35 @@ impl super::Simulation {
                 }
             }
         }
+        if open {
+            // Closing a violated start moves energy in and out (the position
+            // pass): the divergence test waits as for any violated start.
+            self.guard.reference = None;
+            self.guard.recovering_until = Some(self.t + 2.0);
+        }
         Ok(lines)
+    }
+
+    /// After `set_state`: the passive energy reference taken from the new
+    /// state when its loops are closed, else dropped until they close; returns
+    /// whether a loop is open (above 1e-6).
+    pub(super) fn restart_loops(&mut self) -> bool {
+        if self.loop_count() == 0 {
+            return false;
+        }
+        let open = self.constraint_violation() > 1e-6;
+        self.energy_now = None;
+        let e = self.energy();
+        if let Some(l) = self.cons.loops.as_mut() {
+            l.e_ref = if open { None } else { Some(e) };
+        }
+        open
+    }
+
+    /// The loop constraint set's largest violation above 1e-3 while closing
+    /// a violated start (the divergence test's recovery).
+    pub(super) fn loops_recovering(&mut self) -> bool {
+        self.loop_count() > 0 && self.constraint_violation() > 1e-3
     }
 
     /// The loop constraints of the run, if any.

@@ -76,8 +76,9 @@ impl Simulation {
             self.decide_start_overlaps();
         }
         self.refresh_contacts();
+        let loops_open = self.restart_loops();
         self.guard.reference = None;
-        self.guard.recovering_until = if !self.violates() {
+        self.guard.recovering_until = if !self.violates() && !loops_open {
             let e = self.update_energy();
             if e.is_finite() {
                 self.guard.reference = Some(e);

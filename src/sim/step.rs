@@ -181,7 +181,8 @@ impl Simulation {
         }
         if let Some(until) = self.guard.recovering_until {
             let (depth, excess) = self.worst_violation();
-            let recovered = self.t >= until || (depth <= 1e-3 && excess <= 1e-3);
+            let recovered =
+                self.t >= until || (depth <= 1e-3 && excess <= 1e-3 && !self.loops_recovering());
             if !recovered {
                 return Ok(());
             }
