@@ -31,6 +31,7 @@ mod kinematics_energy;
 mod layering;
 mod loops_sim;
 mod mechanism_examples;
+mod mjcf_actuators;
 mod mjcf_cli;
 mod mjcf_oracle;
 mod mjcf_sim;

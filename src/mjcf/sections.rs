@@ -16,6 +16,8 @@ pub struct MjKey {
     pub qpos: Option<Vec<f64>>,
     /// MuJoCo's qvel (nv), if given.
     pub qvel: Option<Vec<f64>>,
+    /// MuJoCo's ctrl (nu), if given.
+    pub ctrl: Option<Vec<f64>>,
 }
 
 const KEY_ATTRS: &[&str] = &[
@@ -63,7 +65,13 @@ pub(super) fn keyframes(world: &mut World, sections: &[&El]) -> Result<(), MjcfE
         check_known(el, KEY_ATTRS)?;
         let qpos = numbers(el, "qpos")?;
         let qvel = numbers(el, "qvel")?;
-        for (k, v, n) in [("qpos", &qpos, nq), ("qvel", &qvel, nv)] {
+        let ctrl = numbers(el, "ctrl")?;
+        let nu = world.actuators.len();
+        for (k, v, n) in [
+            ("qpos", &qpos, nq),
+            ("qvel", &qvel, nv),
+            ("ctrl", &ctrl, nu),
+        ] {
             if let Some(v) = v
                 && v.len() != n
             {
@@ -80,7 +88,12 @@ pub(super) fn keyframes(world: &mut World, sections: &[&El]) -> Result<(), MjcfE
         if world.keys.iter().any(|k| k.name == name) {
             return Err(el.err("duplicate keyframe name"));
         }
-        world.keys.push(MjKey { name, qpos, qvel });
+        world.keys.push(MjKey {
+            name,
+            qpos,
+            qvel,
+            ctrl,
+        });
     }
     Ok(())
 }
