@@ -228,7 +228,7 @@ fn controls_are_checked_clamped_and_reported() {
     for needle in ["muscle", "ball or free", "tendons", "dyntype", "forcerange"] {
         assert!(w.contains(needle), "no warning about {needle}: {w}");
     }
-    assert!(m.actuators[0].dof.is_some() == false && m.actuators[4].dof.is_some());
+    assert!(m.actuators[0].dof.is_none() && m.actuators[4].dof.is_some());
 }
 
 #[test]

@@ -187,7 +187,7 @@ pub(crate) fn schedule(
         .as_ref()
         .and_then(|k| model.keyframes.iter().find(|f| &f.name == k))
         .and_then(|k| k.ctrl.clone())
-        .map(|c| DVector::from_vec(c));
+        .map(DVector::from_vec);
     let mut rows = Vec::new();
     if let Some(u) = &start {
         rows.push((f64::NEG_INFINITY, u.clone()));

@@ -172,6 +172,11 @@ fn compile(
     let of = |tag: &'static str| root.children.iter().filter(move |c| c.tag == tag);
     let defaults = attrs::Defaults::read(&of("default").collect::<Vec<_>>())?;
     let set = settings(&of("compiler").collect::<Vec<_>>(), &defaults)?;
+    sections::asset_files(
+        &of("asset").collect::<Vec<_>>(),
+        &of("compiler").collect::<Vec<_>>(),
+        base_dir,
+    )?;
     let mut cx = Ctx {
         set,
         defaults: &defaults,

@@ -133,3 +133,35 @@ pub(super) fn contacts(
     }
     Ok(())
 }
+
+/// Checks that every `<asset>` `<mesh>` and `<hfield>` file exists (relative to
+/// `meshdir`, else `assetdir`, else the model's directory, as MuJoCo resolves
+/// them): a missing one is an error naming the asset and its `file`.
+pub(super) fn asset_files(
+    sections: &[&El],
+    compilers: &[&El],
+    base_dir: &std::path::Path,
+) -> Result<(), MjcfError> {
+    let dir_of = |k: &str| compilers.iter().rev().find_map(|c| c.attr(k));
+    for el in sections.iter().flat_map(|s| s.children.iter()) {
+        let dir = match el.tag.as_str() {
+            "mesh" | "skin" => dir_of("meshdir").or_else(|| dir_of("assetdir")),
+            "hfield" => dir_of("assetdir"),
+            _ => continue,
+        };
+        let Some(file) = el.attr("file") else {
+            continue;
+        };
+        let path = match dir {
+            Some(d) => base_dir.join(d).join(file),
+            None => base_dir.join(file),
+        };
+        if !path.is_file() {
+            return Err(el.err(format!(
+                "file=\"{file}\": cannot read {} (no such file)",
+                path.display()
+            )));
+        }
+    }
+    Ok(())
+}
