@@ -28,6 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         duration: 3.0,
         dt: Some(1e-3),
         key: None,
+        controls: None,
         integrator: None,
         tol: 1e-6,
         initial: Some(root.join("assets/lamp_initial.json")),

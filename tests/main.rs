@@ -32,6 +32,8 @@ mod kinematics_energy;
 mod layering;
 mod loops_sim;
 mod mechanism_examples;
+mod mjcf_actuators;
+mod mjcf_bad;
 mod mjcf_cli;
 mod mjcf_oracle;
 mod mjcf_sim;

@@ -1,7 +1,7 @@
 //! MJCF through the command line: `eval` on Gymnasium's ant (free joint, armature)
 //! against MuJoCo's numbers (the committed oracle fixture), `inspect --json`'s mass
-//! properties, `--floating-base` refused, and malformed MJCF files refused with one
-//! line naming the file, the element and the attribute.
+//! properties and `--floating-base` refused (malformed MJCF files: the corpus in
+//! tests/bad/mjcf, tests/mjcf_bad.rs).
 
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -170,118 +170,5 @@ fn mjcf_commands_refuse_floating_base() {
             "{err}"
         );
         assert_eq!(err.trim().lines().count(), 1, "{err}");
-    }
-}
-
-/// Malformed MJCF: one line naming the file, the element and what is wrong.
-#[test]
-fn malformed_mjcf_is_one_line_naming_the_element() {
-    let tmp = tempfile::tempdir().unwrap();
-    let body = |inner: &str| {
-        format!("<mujoco><worldbody><body name=\"b\">{inner}</body></worldbody></mujoco>")
-    };
-    let cases: Vec<(&str, String, &str)> = vec![
-        (
-            "unknown_element",
-            "<mujoco><worldbody><bogus/></worldbody></mujoco>".into(),
-            "bogus",
-        ),
-        (
-            "unknown_attribute",
-            body("<geom size=\"1\" colour=\"red\"/>"),
-            "colour",
-        ),
-        (
-            "unknown_class",
-            body("<geom class=\"nope\" size=\"1\"/>"),
-            "nope",
-        ),
-        (
-            "missing_include",
-            "<mujoco><include file=\"missing.xml\"/></mujoco>".into(),
-            "missing.xml",
-        ),
-        (
-            "cyclic_include",
-            "<mujoco><include file=\"cyclic_include.xml\"/></mujoco>".into(),
-            "cyclic",
-        ),
-        (
-            "entity",
-            "<!DOCTYPE m [<!ENTITY a \"b\">]><mujoco/>".into(),
-            "DOCTYPE",
-        ),
-        ("nan", body("<geom size=\"nan\"/>"), "size"),
-        ("inf_mass", body("<geom size=\"1\" mass=\"inf\"/>"), "mass"),
-        (
-            "zero_quat",
-            body("<geom size=\"1\" quat=\"0 0 0 0\"/>"),
-            "quat",
-        ),
-        (
-            "two_free",
-            body("<freejoint/><freejoint/><geom size=\"1\"/>"),
-            "free joint",
-        ),
-        (
-            "free_below_top",
-            body("<geom size=\"1\"/><body><freejoint/><geom size=\"1\"/></body>"),
-            "top-level",
-        ),
-        (
-            "zero_axis",
-            body("<joint axis=\"0 0 0\"/><geom size=\"1\"/>"),
-            "axis",
-        ),
-        (
-            "bad_range",
-            body("<joint range=\"1 -1\"/><geom size=\"1\"/>"),
-            "range",
-        ),
-        (
-            "negative_mass",
-            body("<geom size=\"1\" mass=\"-1\"/>"),
-            "mass",
-        ),
-        (
-            "dup_body",
-            "<mujoco><worldbody><body name=\"a\"/><body name=\"a\"/></worldbody></mujoco>".into(),
-            "duplicate",
-        ),
-        ("not_xml", "this is not xml <".into(), "XML"),
-        ("empty", String::new(), "empty"),
-        ("bad_number", body("<geom size=\"1x\"/>"), "size"),
-        (
-            "ball_range",
-            body("<joint type=\"ball\" range=\"-1 1\"/><geom size=\"1\"/>"),
-            "range",
-        ),
-        (
-            "bad_joint_type",
-            body("<joint type=\"universal\"/><geom size=\"1\"/>"),
-            "universal",
-        ),
-        (
-            "two_orientations",
-            body("<geom size=\"1\" quat=\"1 0 0 0\" euler=\"0 0 0\"/>"),
-            "orientation",
-        ),
-    ];
-    for (name, text, needle) in &cases {
-        let path = tmp.path().join(format!("{name}.xml"));
-        std::fs::write(&path, text).unwrap();
-        // "not_xml" and "empty" are not <mujoco> files: read as MJCF by the library
-        let err = urdyn::mjcf::load_file(&path).expect_err(name).to_string();
-        assert!(
-            err.contains(&format!("{name}.xml")) && err.contains(needle),
-            "{name}: {err}"
-        );
-        assert_eq!(err.lines().count(), 1, "{name}: {err}");
-        if text.contains("<mujoco") && !text.contains("DOCTYPE") {
-            let (ok, _, stderr) = run(&["inspect", path.to_str().unwrap()]);
-            assert!(!ok, "{name}");
-            assert!(stderr.contains(needle), "{name}: {stderr}");
-            assert_eq!(stderr.trim().lines().count(), 1, "{name}: {stderr}");
-        }
     }
 }

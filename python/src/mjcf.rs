@@ -1,7 +1,8 @@
 //! MJCF models (mjcf.md §"Entry points"): `Model.from_mjcf`,
 //! `Model.from_mjcf_string` (model.rs calls these), and the MuJoCo state
 //! converters `from_mujoco_qpos`, `from_mujoco_qvel`, `to_mujoco_qpos`,
-//! `to_mujoco_qvel` (the library's `urdyn::mjcf::*`).
+//! `to_mujoco_qvel` (the library's `urdyn::mjcf::*`), and a Simulation's
+//! `set_controls`, `set_key`, `controls` (sim.rs's marked block).
 
 use crate::args::{not_found_error, read_vec, value_error};
 use crate::model::PyModel;
@@ -10,6 +11,7 @@ use pyo3::prelude::*;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use urdyn::nalgebra::{DVector, Vector3};
+use urdyn::sim::Simulation;
 
 /// Registers this file's functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -136,4 +138,43 @@ pub fn to_mujoco_qvel<'py>(
     let q = read(q, "q", "nq", m.nq)?;
     let v = read(v, "v", "nv", m.nv)?;
     out(py, urdyn::mjcf::to_mujoco_qvel(m, &q, &v))
+}
+
+// --- A simulation's MJCF actuators and keyframes (sim.rs's marked block calls these) ---
+
+/// `sim.set_controls(u)`: the model's actuators' controls (nu, in the file's
+/// order, each clamped into its ctrlrange), held until set again.
+pub(crate) fn set_controls(sim: &mut Simulation, u: &Bound<'_, PyAny>) -> PyResult<()> {
+    let u = read(u, "u", "nu", sim.model.actuators.len())?;
+    sim.set_controls(&u).map_err(|e| value_error(e.to_string()))
+}
+
+/// `sim.set_key(name)`: the state and controls of the model's keyframe `name`.
+pub(crate) fn set_key(sim: &mut Simulation, name: &str) -> PyResult<()> {
+    sim.set_key(name).map_err(|e| value_error(e.to_string()))
+}
+
+/// The controls as last set (nu).
+pub(crate) fn controls<'py>(py: Python<'py>, sim: &Simulation) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_slice(py, sim.controls().as_slice())
+}
+
+/// After `step(tau)` replaced the applied torques: the actuators' constant
+/// forces added back (the controls hold across steps).
+pub(crate) fn add_actuator_torques(sim: &mut Simulation) {
+    if sim.model.actuators.is_empty() {
+        return;
+    }
+    let ff = sim.actuator_torques().clone();
+    *sim.torques_mut() += ff;
+}
+
+/// `reset()`: the controls stay (their servo gains came back with the others;
+/// their constant forces are added to the start's torques).
+pub(crate) fn keep_controls(from: &Simulation, to: &mut Simulation) -> PyResult<()> {
+    if from.model.actuators.is_empty() {
+        return Ok(());
+    }
+    to.set_controls(from.controls())
+        .map_err(|e| value_error(e.to_string()))
 }

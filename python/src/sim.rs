@@ -250,6 +250,7 @@ impl PySimulation {
             sim.set_constraint_active(name, false)
                 .map_err(|e| value_error(e.to_string()))?;
         }
+        crate::mjcf::keep_controls(&self.sim, &mut sim)?; // MJCF actuators (mjcf.rs)
         self.sim = sim;
         Ok(())
     }
@@ -286,6 +287,7 @@ impl PySimulation {
             // zero, or a scene's constant forces (its bases' included), as rollout
             None => self.sim.torques_mut().copy_from(&self.tau0),
         }
+        crate::mjcf::add_actuator_torques(&mut self.sim); // MJCF actuators (mjcf.rs)
         let (dt, recording) = (self.dt, self.recording);
         let mut r = Ok(());
         for _ in 0..n {
@@ -468,6 +470,25 @@ impl PySimulation {
             self.off.push(name);
         }
         Ok(())
+    }
+
+    // --- MJCF actuators and keyframes (mjcf.md; python/src/mjcf.rs, the mjcfact block) ---
+
+    /// The MJCF model's actuator controls (nu, in the file's order; each
+    /// clamped into its ctrlrange), held until set again: position and
+    /// velocity actuators are servos (integrated implicitly), a motor's force
+    /// is added to `step`'s tau.
+    fn set_controls(&mut self, u: &Bound<'_, PyAny>) -> PyResult<()> {
+        crate::mjcf::set_controls(&mut self.sim, u)
+    }
+    /// Starts from the MJCF model's keyframe `name`: its q, v and controls.
+    fn set_key(&mut self, name: &str) -> PyResult<()> {
+        crate::mjcf::set_key(&mut self.sim, name)
+    }
+    /// The actuator controls as last set (nu).
+    #[getter]
+    fn controls<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        crate::mjcf::controls(py, &self.sim)
     }
 
     // --- Control and sensors (python.md §"Control", §"Sensors"; control.rs) ---

@@ -113,6 +113,9 @@ struct SimulateCmd {
     /// Start an MJCF model from its keyframe <key name="NAME">.
     #[arg(long, value_name = "NAME")]
     key: Option<String>,
+    /// An MJCF model's actuator controls: a CSV with a t column and one column per actuator name, held piecewise constant.
+    #[arg(long, value_name = "FILE.csv")]
+    controls: Option<PathBuf>,
     /// Integrator (see --list-integrators); default: euler with ground contact, dop853 without.
     #[arg(long, value_name = "NAME")]
     integrator: Option<String>,
@@ -469,6 +472,7 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
         duration: c.duration,
         dt: c.dt,
         key: c.key,
+        controls: c.controls,
         integrator: c.integrator,
         tol: c.tol,
         initial: c.initial,

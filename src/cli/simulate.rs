@@ -27,6 +27,9 @@ pub struct SimulateArgs {
     pub dt: Option<f64>,
     /// `--key NAME`: start an MJCF model from its `<keyframe><key name>`.
     pub key: Option<String>,
+    /// `--controls FILE.csv`: an MJCF model's actuator controls over time
+    /// (a `t` column and one column per actuator, held piecewise constant).
+    pub controls: Option<PathBuf>,
     /// Integrator name (`None`: the project's best general choice).
     pub integrator: Option<String>,
     /// Error tolerance of adaptive integrators.
@@ -275,6 +278,11 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         }
     }
     let has_loops = sim.has_constraints();
+    // MJCF actuators: --key's ctrl, then --controls' rows as time reaches them
+    let mut schedule = super::simulate_mjcf::schedule(args, &sim.model)?;
+    if let Some(s) = &mut schedule {
+        s.apply_due(&mut sim).map_err(sim_err)?;
+    }
     if let Some(h) = args.above_ground {
         if !sim.lift_above_ground(h).map_err(sim_err)? {
             warn(&format!(
@@ -429,7 +437,18 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
             let mut k = 0u64;
             let mut last_tick = 0u64;
             while sim_result.is_ok() && sim.time() < duration {
-                if let Err(error) = sim.step_until(duration) {
+                let t_stop = match schedule.as_mut().map(|s| s.apply_due(&mut sim)) {
+                    None => duration,
+                    Some(Ok(t)) => t.min(duration),
+                    Some(Err(error)) => {
+                        sim_result = Err(SimulateError::Sim {
+                            urdf: urdf_name.clone(),
+                            error,
+                        });
+                        break;
+                    }
+                };
+                if let Err(error) = sim.step_until(t_stop) {
                     sim_result = Err(SimulateError::Sim {
                         urdf: urdf_name.clone(),
                         error,

@@ -415,6 +415,9 @@ fn joint(
         }
         (frame.0 + frame.1 * p, frame.1 * (ax / n))
     };
+    if a.get("actuatorfrcrange").is_some() || a.get("actuatorgravcomp") == Some("true") {
+        cx.note("joints' actuatorfrcrange and actuatorgravcomp".into());
+    }
     let angular = matches!(kind, MjJointType::Hinge | MjJointType::Ball);
     let conv = |x: f64| if angular { cx.angle(x) } else { x };
     let range = a.arr::<2>("range")?;

@@ -276,7 +276,7 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
         ));
     }
     let topology = Topology::new(&dof_parent, nbodies, false);
-    Ok(Model {
+    let mut model = Model {
         name: world.name.clone(),
         nq,
         nv,
@@ -313,7 +313,11 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
         source: None,
         report,
         qpos0: Some(qpos0),
-    })
+        actuators: Vec::new(),
+        keyframes: Vec::new(),
+    };
+    super::actuators::lower(world, &mut model)?;
+    Ok(model)
 }
 
 fn close_tree(t: &mut Tree, nb: usize, nf: usize, nd: usize, nq: usize, nv: usize) {

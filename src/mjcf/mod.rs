@@ -16,6 +16,7 @@
 //! numbers (MuJoCo's compiler: mass properties, frames, `fromto`, joint
 //! composition) is urdyn's in either case: mjcf-rs stops at the AST.
 
+mod actuators;
 mod attrs;
 mod collide;
 mod compile;
@@ -27,6 +28,7 @@ mod sections;
 mod world;
 mod xml;
 
+pub use actuators::MjActuator;
 pub use collide::Ground;
 pub use compile::{MjBody, MjGeom, MjGeomType, MjJoint, MjJointType, World};
 pub use convert::{from_mujoco_qpos, from_mujoco_qvel, to_mujoco_qpos, to_mujoco_qvel};
@@ -170,6 +172,11 @@ fn compile(
     let of = |tag: &'static str| root.children.iter().filter(move |c| c.tag == tag);
     let defaults = attrs::Defaults::read(&of("default").collect::<Vec<_>>())?;
     let set = settings(&of("compiler").collect::<Vec<_>>(), &defaults)?;
+    sections::asset_files(
+        &of("asset").collect::<Vec<_>>(),
+        &of("compiler").collect::<Vec<_>>(),
+        base_dir,
+    )?;
     let mut cx = Ctx {
         set,
         defaults: &defaults,
@@ -193,6 +200,7 @@ fn compile(
             timestep: 0.002,
             excludes: Vec::new(),
             keys: Vec::new(),
+            actuators: Vec::new(),
             warnings: Vec::new(),
         },
         names: Default::default(),
@@ -205,6 +213,13 @@ fn compile(
     }
     let mut world = cx.world;
     inertia::bodies(&mut world, &cx.set);
+    actuators::read(
+        &mut world,
+        &of("actuator").collect::<Vec<_>>(),
+        &defaults,
+        cx.set.autolimits,
+        &mut cx.not_modelled,
+    )?;
     sections::keyframes(&mut world, &of("keyframe").collect::<Vec<_>>())?;
     sections::contacts(
         &mut world,
@@ -213,7 +228,6 @@ fn compile(
     )?;
     for (tag, what) in [
         ("tendon", "tendons: not modelled yet (MJCF simulation)"),
-        ("actuator", "actuators: not modelled yet (MJCF simulation)"),
         (
             "equality",
             "equality constraints: not modelled yet (MJCF simulation)",

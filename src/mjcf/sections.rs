@@ -16,6 +16,8 @@ pub struct MjKey {
     pub qpos: Option<Vec<f64>>,
     /// MuJoCo's qvel (nv), if given.
     pub qvel: Option<Vec<f64>>,
+    /// MuJoCo's ctrl (nu), if given.
+    pub ctrl: Option<Vec<f64>>,
 }
 
 const KEY_ATTRS: &[&str] = &[
@@ -63,7 +65,13 @@ pub(super) fn keyframes(world: &mut World, sections: &[&El]) -> Result<(), MjcfE
         check_known(el, KEY_ATTRS)?;
         let qpos = numbers(el, "qpos")?;
         let qvel = numbers(el, "qvel")?;
-        for (k, v, n) in [("qpos", &qpos, nq), ("qvel", &qvel, nv)] {
+        let ctrl = numbers(el, "ctrl")?;
+        let nu = world.actuators.len();
+        for (k, v, n) in [
+            ("qpos", &qpos, nq),
+            ("qvel", &qvel, nv),
+            ("ctrl", &ctrl, nu),
+        ] {
             if let Some(v) = v
                 && v.len() != n
             {
@@ -80,7 +88,12 @@ pub(super) fn keyframes(world: &mut World, sections: &[&El]) -> Result<(), MjcfE
         if world.keys.iter().any(|k| k.name == name) {
             return Err(el.err("duplicate keyframe name"));
         }
-        world.keys.push(MjKey { name, qpos, qvel });
+        world.keys.push(MjKey {
+            name,
+            qpos,
+            qvel,
+            ctrl,
+        });
     }
     Ok(())
 }
@@ -116,6 +129,38 @@ pub(super) fn contacts(
                 }
             }
             t => return Err(el.err(format!("unknown element <{t}> in <contact>"))),
+        }
+    }
+    Ok(())
+}
+
+/// Checks that every `<asset>` `<mesh>` and `<hfield>` file exists (relative to
+/// `meshdir`, else `assetdir`, else the model's directory, as MuJoCo resolves
+/// them): a missing one is an error naming the asset and its `file`.
+pub(super) fn asset_files(
+    sections: &[&El],
+    compilers: &[&El],
+    base_dir: &std::path::Path,
+) -> Result<(), MjcfError> {
+    let dir_of = |k: &str| compilers.iter().rev().find_map(|c| c.attr(k));
+    for el in sections.iter().flat_map(|s| s.children.iter()) {
+        let dir = match el.tag.as_str() {
+            "mesh" | "skin" => dir_of("meshdir").or_else(|| dir_of("assetdir")),
+            "hfield" => dir_of("assetdir"),
+            _ => continue,
+        };
+        let Some(file) = el.attr("file") else {
+            continue;
+        };
+        let path = match dir {
+            Some(d) => base_dir.join(d).join(file),
+            None => base_dir.join(file),
+        };
+        if !path.is_file() {
+            return Err(el.err(format!(
+                "file=\"{file}\": cannot read {} (no such file)",
+                path.display()
+            )));
         }
     }
     Ok(())

@@ -149,6 +149,8 @@ pub struct World {
     pub excludes: Vec<(usize, usize)>,
     /// `<keyframe><key>`s in file order.
     pub keys: Vec<super::sections::MjKey>,
+    /// `<actuator>`s in MuJoCo's order.
+    pub actuators: Vec<super::actuators::MjActuator>,
     /// What urdyn does not model, one line a kind.
     pub warnings: Vec<String>,
 }

@@ -5,6 +5,7 @@
 //! world. A body is a movable joint plus every link welded to its child link
 //! through fixed joints; each URDF link stays addressable as a [`Frame`].
 
+mod actuators;
 mod armature;
 pub mod configuration;
 mod constraints;
@@ -17,6 +18,7 @@ mod trees;
 
 pub use names::{edit_distance, nearest, BodyId, FrameId, JointId, NameError};
 
+pub use actuators::{Actuator, Keyframe};
 pub use constraints::{Attachment, Constraint, ConstraintError, ConstraintKind, Constraints};
 pub use data::Data;
 pub(crate) use joint::{dispatch_joint, JointModel};
@@ -324,6 +326,10 @@ pub struct Model<T: Scalar = f64> {
     /// its `ref`, each free joint at its body's defined pose), returned by
     /// [`Model::neutral`]; `None` (a URDF, a scene): zeros and identity rotations.
     pub qpos0: Option<Vec<f64>>,
+    /// The file's actuators (MJCF `<actuator>`; none for a URDF), in its order.
+    pub actuators: Vec<Actuator>,
+    /// The file's named starting states (MJCF `<keyframe>`; none for a URDF).
+    pub keyframes: Vec<Keyframe>,
 }
 
 impl<T: Scalar> Model<T> {
@@ -500,6 +506,8 @@ impl Model<f64> {
             source: self.source.clone(),
             report: self.report.clone(),
             qpos0: self.qpos0.clone(),
+            actuators: self.actuators.clone(),
+            keyframes: self.keyframes.clone(),
         }
     }
 }

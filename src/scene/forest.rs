@@ -65,6 +65,8 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
         source: None,
         report: Default::default(),
         qpos0: None,
+        actuators: Vec::new(),
+        keyframes: Vec::new(),
     };
     for (i, part) in parts.into_iter().enumerate() {
         let p = &part.model;

@@ -59,6 +59,7 @@
 //!
 //! Nothing is allocated in [`Simulation::step`]: every buffer is sized at construction.
 
+mod actuators;
 pub mod constraints;
 mod contact_view;
 pub mod derivatives;

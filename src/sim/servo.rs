@@ -42,6 +42,11 @@ pub(crate) struct Servo {
     /// The q index of each v coordinate's joint ([`FREE`] on a free joint's
     /// six: no servo there).
     pub iq: Vec<usize>,
+    /// The model's actuators' controls as last set (nu; `actuators.rs`).
+    pub controls: DVector<f64>,
+    /// The actuators' constant force per v coordinate, part of the applied
+    /// torques (`actuators.rs`).
+    pub ctrl_tau: DVector<f64>,
 }
 
 /// [`Servo::iq`] of a free joint's coordinate.
@@ -64,6 +69,8 @@ impl Servo {
             active: false,
             saturated: vec![0; nv],
             applied: DVector::zeros(nv),
+            controls: DVector::zeros(model.actuators.len()),
+            ctrl_tau: DVector::zeros(nv),
         }
     }
 

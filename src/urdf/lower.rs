@@ -457,6 +457,8 @@ pub(crate) fn lower(
         source: None,
         report,
         qpos0: None,
+        actuators: Vec::new(),
+        keyframes: Vec::new(),
     })
 }
 
