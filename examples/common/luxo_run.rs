@@ -32,6 +32,7 @@ pub fn run(
         duration: DURATION,
         dt: Some(1e-3),
         key: None,
+        controls: None,
         integrator: None,
         tol: 1e-6,
         initial: None,
