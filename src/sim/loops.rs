@@ -73,6 +73,13 @@ pub(crate) struct Loops {
 }
 
 impl Loops {
+    /// Constraint `k`'s row directions in the last step: its world rows'
+    /// principal directions kept (column-major, `c.rows() × kept`) and how
+    /// many (the step Jacobians map world-row terms onto the step's rows).
+    pub(in crate::sim) fn row_basis(&self, k: usize) -> (&[f64], usize) {
+        (&self.basis[k], self.kept[k])
+    }
+
     /// The loops of `set` on `model`.
     pub fn new(model: &Model, set: LoopSet) -> Self {
         let m = set.rows();

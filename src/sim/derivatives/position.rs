@@ -90,12 +90,16 @@ impl Simulation {
         }
         for &(k, r0) in p.loops {
             let phi = loop_residual(self, k);
-            let nrows = self
-                .cons
-                .loops
-                .as_ref()
-                .map_or(0, |l| l.set.items[k].rows());
-            for (t, phi_t) in phi.iter().enumerate().take(nrows) {
+            // the step's rows: the world rows along the kept directions E
+            let Some(l) = self.cons.loops.as_ref() else {
+                continue;
+            };
+            let m = l.set.items[k].rows();
+            let (e, kept) = l.row_basis(k);
+            let phi_rows: Vec<f64> = (0..kept)
+                .map(|t| (0..m).map(|i| e[t * m + i] * phi[i]).sum())
+                .collect();
+            for (t, phi_t) in phi_rows.iter().enumerate() {
                 let r = r0 + t;
                 let open = (phi_t / h).abs() < loop_cap;
                 for c in 0..n {

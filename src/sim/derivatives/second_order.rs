@@ -85,10 +85,10 @@ pub(super) fn loop_rows(sim: &Simulation, rows: &Rows) -> Option<Vec<(usize, usi
     let first = (0..rows.n).find(|&r| rows.kind[r] == RowKind::Bilateral)?;
     let mut out = Vec::new();
     let mut r = first;
-    for (k, c) in l.set.items.iter().enumerate() {
+    for k in 0..l.set.items.len() {
         if l.active[k] {
             out.push((k, r));
-            r += c.rows();
+            r += l.row_basis(k).1;
         }
     }
     let all_bilateral = (first..rows.n).all(|r| rows.kind[r] == RowKind::Bilateral);
@@ -138,15 +138,24 @@ pub(super) fn add_second_order(
             ConstraintKind::Frame => true,
             ConstraintKind::Point => false,
         };
+        // the step's rows are the constraint's world rows along its kept
+        // directions E (sim/loops.rs): λ_world = E λ, their J_q rows Eᵀ(world)
+        let m = c.rows();
+        let (e, kept) = l.row_basis(k);
+        let mut lw = [0.0; 6];
+        for (i, x) in lw.iter_mut().enumerate().take(m) {
+            *x = (0..kept).map(|t| e[t * m + i] * lam[r0 + t]).sum();
+        }
+        let mut jw = DMatrix::<f64>::zeros(m, jq.ncols());
         for (side, sign) in [(&c.a, 1.0), (&c.b, -1.0)] {
             if side.body == 0 {
                 continue;
             }
             let p = side_point(&sim.data, side);
             let t = point_second_derivatives(sim, side.body, &p, &p);
-            let f = Vector3::new(lam[r0], lam[r0 + 1], lam[r0 + 2]) * sign;
+            let f = Vector3::new(lw[0], lw[1], lw[2]) * sign;
             let tq = if frame {
-                Vector3::new(lam[r0 + 3], lam[r0 + 4], lam[r0 + 5]) * sign
+                Vector3::new(lw[3], lw[4], lw[5]) * sign
             } else {
                 Vector3::zeros()
             };
@@ -156,13 +165,31 @@ pub(super) fn add_second_order(
                     let (d, da) = (t.d[a * len + b], t.dang[a * len + b]);
                     gc[(ca, cb)] += d.dot(&f) + da.dot(&tq);
                     for i in 0..3 {
-                        jq[(r0 + i, cb)] += sign * d[i] * x[ca];
+                        jw[(i, cb)] += sign * d[i] * x[ca];
                         if frame {
-                            jq[(r0 + 3 + i, cb)] += sign * da[i] * x[ca];
+                            jw[(3 + i, cb)] += sign * da[i] * x[ca];
                         }
                     }
                 }
             }
+        }
+        project_rows(e, kept, &jw, r0, jq);
+    }
+}
+
+/// Adds world rows `w` (a constraint's `m` rows) along its kept directions
+/// `e` (column-major m × kept) into rows `r0..r0 + kept` of `out`.
+pub(super) fn project_rows(
+    e: &[f64],
+    kept: usize,
+    w: &DMatrix<f64>,
+    r0: usize,
+    out: &mut DMatrix<f64>,
+) {
+    let m = w.nrows();
+    for t in 0..kept {
+        for c in 0..w.ncols() {
+            out[(r0 + t, c)] += (0..m).map(|i| e[t * m + i] * w[(i, c)]).sum::<f64>();
         }
     }
 }
@@ -190,9 +217,17 @@ pub(super) fn loop_gamma_derivatives(
             ConstraintKind::Frame => true,
             ConstraintKind::Point => false,
         };
+        let m = c.rows();
+        let (e, kept) = l.row_basis(k);
+        let (mut gqw, mut gvw) = (
+            DMatrix::<f64>::zeros(m, gq.ncols()),
+            DMatrix::<f64>::zeros(m, gv.ncols()),
+        );
         for (side, sign) in [(&c.a, 1.0), (&c.b, -1.0)] {
-            side_gamma_terms(sim, side, sign, frame, r0, gq, gv);
+            side_gamma_terms(sim, side, sign, frame, 0, &mut gqw, &mut gvw);
         }
+        project_rows(e, kept, &gqw, r0, gq);
+        project_rows(e, kept, &gvw, r0, gv);
     }
 }
 
