@@ -383,15 +383,8 @@ impl super::Simulation {
         self.sleep.joins = self.loop_body_pairs();
         let mut out = vec![0.0; self.loop_count()];
         let mut lines = Vec::new();
-        self.energy_now = None;
-        let e0 = self.energy();
-        let mut open = false;
-        if let Some(l) = self.cons.loops.as_mut() {
-            if l.violation(&self.data, &self.q, &mut out) <= 1e-6 {
-                l.e_ref = Some(e0);
-            } else {
-                open = true;
-            }
+        if let Some(l) = self.cons.loops.as_ref() {
+            l.violation(&self.data, &self.q, &mut out);
             for (c, x) in l.set.items.iter().zip(&out) {
                 if x.abs() > 1e-3 {
                     lines.push(format!(
@@ -403,7 +396,7 @@ impl super::Simulation {
                 }
             }
         }
-        if open {
+        if self.restart_loops() {
             // Closing a violated start moves energy in and out (the position
             // pass): the divergence test waits as for any violated start.
             self.guard.reference = None;
@@ -412,16 +405,16 @@ impl super::Simulation {
         Ok(lines)
     }
 
-    /// After `set_state`: the passive energy reference taken from the new
-    /// state when its loops are closed, else dropped until they close; returns
-    /// whether a loop is open (above 1e-6).
+    /// At the start of a run (`set_constraints`, `set_state`): the passive
+    /// energy reference taken from the state when its loops are closed, else
+    /// dropped until they close; returns whether a loop is open (above 1e-6).
     pub(super) fn restart_loops(&mut self) -> bool {
         if self.loop_count() == 0 {
             return false;
         }
         let open = self.constraint_violation() > 1e-6;
-        self.energy_now = None;
-        let e = self.energy();
+        // cached: state_changed's divergence reference reads the same value
+        let e = self.update_energy();
         if let Some(l) = self.cons.loops.as_mut() {
             l.e_ref = if open { None } else { Some(e) };
         }
