@@ -23,29 +23,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(&out_dir)?;
     let csv = out_dir.join("lamp_on_table.csv");
     let args = urdyn::cli::simulate::SimulateArgs {
-        urdf: PathBuf::new(),
-        scene: Some(root.join("assets/lamp_on_table.json")),
-        floating_base: false,
         duration: 3.0,
         dt: Some(1e-3),
-        key: None,
-        controls: None,
-        integrator: None,
-        tol: 1e-6,
-        initial: None,
-        armature: 0.0,
-        above_ground: None,
-        ground: None,
-        no_ground: false,
-        no_sleep: false,
-        threads: None,
-        gravity: None,
-        friction: 1.0,
-        package_path: vec![],
         out: Some(csv.clone()),
         html: Some(out_dir.join("lamp_on_table.html")),
-        every: 1,
-        progress: false,
+        ..urdyn::cli::simulate::SimulateArgs::scene(root.join("assets/lamp_on_table.json"))
     };
     let summary = urdyn::cli::simulate::run(&args)?;
     eprintln!("{summary}");
