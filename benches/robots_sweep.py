@@ -71,7 +71,12 @@ Per run (the CSV, written every step, is stream-parsed and deleted):
   max base linear speed; max |joint speed|.
 - pass: exit 0, finite, energy rise <= 1e-3*|E0| + 1e-3 J and, for floating robots that
   touch the ground, first contact within 0.03 s of sqrt(2H/|g|) (0.247 s for a 0.3 m
-  fall) and at rest by the end (rest is not "never").
+  fall) and at rest by the end (rest is not "never"), and, when every velocity
+  coordinate (base and joints) has stayed below 0.05 from at least SLEEP_MARGIN (1 s)
+  before the end, asleep by the end (scene.md: an island at rest for
+  sleep_time, 0.5 s, sleeps; its velocities then read exactly 0).
+- asleep: the first t after which the CSV's `awake` column stays 0 to the end; "never"
+  when the last row has an awake model.
 
 Output: `--out` (docs/robots.md): header (command line, date, urdyn commit, cores; `--title`,
 `--note` add a title and a paragraph), the table (floating first, then by name; the note
@@ -99,6 +104,7 @@ import xml.etree.ElementTree as ET
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 G = 9.81
 REST_SPEED = 0.05  # m/s (base) or rad/s, m/s (joints)
+SLEEP_MARGIN = 1.0  # s: at rest this long before the end => must be asleep
 CONTACT_TOL = 0.03  # s
 
 # free_flyer of example-robot-data's loaders (robots_loader.py, devel 8d470d2), keyed by
@@ -281,7 +287,8 @@ def parse_csv(path, floating):
     if not os.path.exists(path):
         return None
     m = {"rows": 0, "finite_csv": True, "E0": None, "rise": -math.inf, "first_contact": None,
-         "rest": None, "max_pen": 0.0, "max_base_speed": None, "max_joint_speed": 0.0}
+         "rest": None, "max_pen": 0.0, "max_base_speed": None, "max_joint_speed": 0.0,
+         "asleep": None}
     with open(path, newline="") as fh:
         rd = csv.reader(fh)
         head = next(rd, None)
@@ -294,6 +301,9 @@ def parse_csv(path, floating):
         base = [col[k] for k in ("v:base_vx", "v:base_vy", "v:base_vz")] if floating else None
         joints = [i for h, i in col.items() if h.startswith("v:") and not h.startswith("v:base_")]
         moving_since = None  # t of the first row of the current at-rest stretch
+        ia = col.get("awake")
+        asleep_since = None  # t of the first row of the current all-asleep stretch
+        all_still_since = None  # ... of every velocity coordinate below REST_SPEED
         for row in rd:
             vals = [fnum(x) for x in row]
             if not all(math.isfinite(x) for x in vals):
@@ -319,7 +329,19 @@ def parse_csv(path, floating):
                     moving_since = t
             else:
                 moving_since = None
+            if still and js < REST_SPEED:
+                if all_still_since is None:
+                    all_still_since = t
+            else:
+                all_still_since = None
+            if ia is not None and vals[ia] == 0:
+                if asleep_since is None:
+                    asleep_since = t
+            else:
+                asleep_since = None
         m["rest"] = moving_since
+        m["asleep"] = asleep_since
+        m["all_still"] = all_still_since
         m["t_end"] = t if m["rows"] else None
     return m
 
@@ -497,6 +519,10 @@ def sweep_one(job, args, have_above_ground):
         if r.get("rest") is None:
             ok = False
             why.append("not at rest")
+        elif (r.get("t_end") is not None and r.get("all_still") is not None
+              and r["all_still"] <= r["t_end"] - SLEEP_MARGIN and r.get("asleep") is None):
+            ok = False
+            why.append("at rest but awake")
     r["pass"] = ok
     r["fail_reasons"] = why
     return r
@@ -516,9 +542,9 @@ def write_md(path, results, header):
     ran.sort(key=lambda r: (not r["floating"], r["robot"]))
     L = list(header)
     L += ["", "| robot | base | DoF | exit | finite | E0 (J) | energy rise (J) | rise rel. "
-          "| first contact (s) | rest (s) | max pen. (mm) | steps/s, integrator | max base v (m/s) "
+          "| first contact (s) | rest (s) | asleep (s) | max pen. (mm) | steps/s, integrator | max base v (m/s) "
           "| max joint v | pass | note |",
-          "|" + "---|" * 16]
+          "|" + "---|" * 17]
     for r in ran:
         note = r["note"] or r.get("error") or ""
         if r["floating"] and r.get("collision_elements") == 0:
@@ -538,12 +564,13 @@ def write_md(path, results, header):
             rest_s = "never"
         else:
             rest_s = fmt(rest, "%.3f")
-        L.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+        asleep_s = "never" if r.get("E0") is not None and r.get("asleep") is None else fmt(r.get("asleep"), "%.3f")
+        L.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
             r["robot"], "float" if r["floating"] else "fixed", r.get("dofs", "–"),
             r["exit"] if r["exit"] is not None else "–",
             {True: "yes", False: "**no**", None: "–"}[r["finite"]],
             fmt(r.get("E0"), "%.4g"), fmt(r.get("rise"), "%.2e"), fmt(r.get("rise_rel"), "%.1e"),
-            fmt(r.get("first_contact"), "%.3f"), rest_s,
+            fmt(r.get("first_contact"), "%.3f"), rest_s, asleep_s,
             fmt(None if r.get("E0") is None else 1e3 * r["max_pen"], "%.2f"),
             fmt(r.get("steps_per_s"), "%.0f") + (" " + r["integrator"] if r.get("integrator") else ""),
             fmt(r.get("max_base_speed"), "%.2f"),
@@ -716,14 +743,17 @@ def main():
         "pass = exit 0, finite, energy rise <= 1e-3·|E0| + 1e-3 J%s." % (
             len(results), n_load, len(ran), sum(1 for r in ran if r.get("pass")), REST_SPEED,
             ", and for floating robots that touch the ground: first contact within %g s of %.3f s "
-            "and at rest by the end" % (CONTACT_TOL, math.sqrt(2 * args.above_ground / G))
+            "and at rest by the end, and asleep by the end when every velocity is below the rest "
+            "threshold %g s before it" % (
+                CONTACT_TOL, math.sqrt(2 * args.above_ground / G), SLEEP_MARGIN)
             if have_above_ground else
             ", and for floating robots that touch the ground: at rest by the end (no contact-time "
             "check without `--above-ground`)"),
         "",
         "Columns: energy rise = max over rows of E(t) − E(0); rise rel. = rise / max(|E0|, 1 J); "
         "first contact = first row with contacts > 0; rest = first t after which the base speed "
-        "(floating) or every joint speed (fixed) stays below %g; max pen. = deepest penetration; "
+        "(floating) or every joint speed (fixed) stays below %g; asleep = first t after which the "
+        "`awake` column stays 0 (every model asleep); max pen. = deepest penetration; "
         "steps/s = steps / wall seconds of urdyn's summary line (an adaptive integrator takes fewer, "
         "longer steps: compare within one integrator); max joint v in rad/s or m/s. A failed run leaves no "
         "CSV (urdyn writes it atomically), hence the dashes." % REST_SPEED,
