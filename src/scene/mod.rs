@@ -683,9 +683,14 @@ impl Loader<'_> {
                 filename: path.display().to_string(),
                 scale,
             }
-        } else {
-            let h = o.heightfield.as_ref().expect("one shape key");
+        } else if let Some(h) = &o.heightfield {
             self.height_field(&key, h)?
+        } else {
+            // (the count of shape keys above is exactly one)
+            return Err(self.err(
+                key.clone(),
+                "no shape key (one of box, sphere, cylinder, capsule, mesh, heightfield)",
+            ));
         };
         Ok(Obstacle {
             name: o.name.clone(),
