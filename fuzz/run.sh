@@ -6,7 +6,7 @@
 # become a file in tests/bad with a test.
 #
 # Usage: fuzz/run.sh [SECONDS_PER_TARGET (default 180)] [TARGET...]
-# (targets: urdf_eval states_eval scene_load; default the first two)
+# (targets: urdf_eval states_eval scene_load mjcf_load; default the first two)
 set -euo pipefail
 cd "$(dirname "$0")"
 SECS=${1:-180}
@@ -21,7 +21,7 @@ export RUSTFLAGS="-Cpasses=sancov-module -Cllvm-args=-sanitizer-coverage-level=4
 TRIPLE=$(rustc +nightly -vV | sed -n "s/^host: //p")
 cargo +nightly build --release --target-dir target --target "$TRIPLE" --bins
 
-mkdir -p seeds/urdf_eval seeds/states_eval seeds/scene_load logs
+mkdir -p seeds/urdf_eval seeds/states_eval seeds/scene_load seeds/mjcf_load logs
 for f in ../tests/bad/*.urdf ../tests/urdf/*.urdf ../assets/*.urdf ../assets/robots/*.urdf; do
     [ -f "$f" ] || continue
     # 8 bytes of state seed (bit 1: floating base), then the URDF.
@@ -33,6 +33,11 @@ for f in ../tests/bad/states_* ; do cp "$f" seeds/states_eval/; done
 # target loads them there, so "lamp.urdf" resolves)
 for f in ../tests/bad/scene/*.json ../assets/*.json; do
     [ -f "$f" ] && sed 's#\.\./\.\./\.\./assets/##g' "$f" > "seeds/scene_load/$(basename "$f")"
+done
+# MJCF: the bad corpus, the committed Gymnasium and dm_control models and the
+# synthetic ones (the target reads includes under tests/fixtures/mjcf/dm_control)
+for f in ../tests/bad/mjcf/*.xml ../tests/fixtures/mjcf/*/*.xml ../tests/fixtures/mjcf/dm_control/common/*.xml; do
+    [ -f "$f" ] && cp "$f" "seeds/mjcf_load/$(basename "$(dirname "$f")")_$(basename "$f")"
 done
 for d in ../tests/fixtures/*/; do
     [ -f "$d/states.json" ] && cp "$d/states.json" "seeds/states_eval/$(basename "$d").json"
