@@ -77,3 +77,48 @@ fn two_piles_ten_metres_apart_cost_what_each_costs_alone() {
     let two = work(&joined(a.clone(), shifted(a, 10.0, "c_")));
     assert!(two as f64 <= 2.2 * wa as f64, "two piles {two}, one {wa}");
 }
+
+/// `urdyn simulate --scene` of `scene` for `t` s with `args`: its CSV.
+fn csv(scene: &std::path::Path, t: f64, args: &[&str]) -> String {
+    let out = std::env::temp_dir().join(format!(
+        "urdyn_islands_{}_{}.csv",
+        std::process::id(),
+        args.join("_").replace('-', "")
+    ));
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_urdyn"))
+        .arg("simulate")
+        .arg("--scene")
+        .arg(scene)
+        .args(["--duration", &t.to_string(), "--dt", "0.001", "--out"])
+        .arg(&out)
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let s = std::fs::read_to_string(&out).unwrap();
+    let _ = std::fs::remove_file(&out);
+    s
+}
+
+#[test]
+fn threads_one_and_two_give_identical_csvs_on_a_pile_with_sleep_on_and_off() {
+    // the 64-box pile: dozens of islands while it falls, one heap at the end,
+    // boxes falling asleep from about 0.8 s
+    let scene = dir().join("pile_boxes_64.json");
+    for sleep in [&[][..], &["--no-sleep"][..]] {
+        let one = csv(&scene, 1.2, &[sleep, &["--threads", "1"]].concat());
+        let two = csv(&scene, 1.2, &[sleep, &["--threads", "2"]].concat());
+        assert_eq!(one.lines().count(), 1201 + 1, "{sleep:?}");
+        // the same file, byte for byte (every figure printed to round-trip)
+        let first_diff = one.lines().zip(two.lines()).position(|(a, b)| a != b);
+        assert_eq!(
+            first_diff, None,
+            "{sleep:?}: rows differ from line {first_diff:?}"
+        );
+        assert_eq!(one, two, "{sleep:?}");
+    }
+}

@@ -200,6 +200,7 @@ impl Simulation {
             sim.set_targets(&q_ref, None)?;
             sim.set_gains(&kp, &DVector::zeros(nv))?;
         }
+        sim.cons.set_threads(sim.opts.threads);
         sim.state_changed();
         Ok(sim)
     }

@@ -22,7 +22,7 @@ use super::factor::MassFactor;
 use super::islands::Islands;
 use super::loops::Loops;
 use super::newton::Newton;
-use super::solver::{RowKind, Rows};
+use super::solver::{RowKind, Rows, Scratch};
 use super::{ContactForce, Solver};
 use crate::contact::{tangents, ContactPoint};
 use crate::model::Model;
@@ -122,6 +122,12 @@ pub(crate) struct Constraints {
     pub loops: Option<Loops>,
     /// This step's islands of rows (the PGS solve's units).
     islands: Islands,
+    /// The threads islands are solved on (`None`: this one).
+    pool: Option<std::sync::Arc<rayon::ThreadPool>>,
+    /// A subspace step's scratch for each thread (at least one).
+    scratch: Vec<Scratch>,
+    /// Each island's sweeps in the last solve.
+    isl_sweeps: Vec<usize>,
     /// Rows times sweeps of every solve so far (velocity, energy-safe exit and
     /// position pass): the solve's work, independent of the machine.
     pub work: u64,
@@ -159,6 +165,7 @@ impl Constraints {
         let longest = (0..nv).map(|d| f.path_of(d).1).max().unwrap_or(0);
         let mut rows = Rows::new(nv, cap, 2 * longest);
         rows.set_table(f.table(), pair_points);
+        let rows_scratch = rows.scratch();
         Self {
             rows,
             joint_rows: Vec::with_capacity(3 * ndof),
@@ -179,8 +186,34 @@ impl Constraints {
             newton: Newton::new(if newton { nv } else { 0 }, if newton { cap } else { 0 }),
             loops,
             islands: Islands::new(model, cap),
+            pool: None,
+            scratch: vec![rows_scratch],
+            isl_sweeps: vec![0; model.trees.len() + 1],
             work: 0,
         }
+    }
+
+    /// Solves the islands on `threads` threads (0: every core; 1: this
+    /// thread, the default): the same results bit for bit whatever the count
+    /// (scene.md §"Large scenes: islands and sleep"). A pool that cannot be
+    /// started leaves the solve on this thread.
+    pub fn set_threads(&mut self, threads: usize) {
+        self.pool = None;
+        self.scratch.truncate(1);
+        if threads == 1 {
+            return;
+        }
+        let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(threads).build() else {
+            return;
+        };
+        let n = pool.current_num_threads();
+        if n <= 1 {
+            return;
+        }
+        while self.scratch.len() < n {
+            self.scratch.push(self.rows.scratch());
+        }
+        self.pool = Some(std::sync::Arc::new(pool));
     }
 
     /// Forgets the warm starts (a new state was set).

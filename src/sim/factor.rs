@@ -34,6 +34,12 @@ pub struct MassFactor {
     /// a division costs a dozen multiplies, and a step does hundreds).
     inv_sqrt_d: Vec<f64>,
     lambda: Vec<usize>,
+    /// Tree: L's entries of each dof's column at its ancestors, packed along
+    /// [`Self::table`] (`anc[start[k] + s]` = L[path_k[s], k] for the dof's
+    /// path root … k; the last, the diagonal, unused): a row's transform reads
+    /// its bodies' few entries from one place, not from the columns of an
+    /// nv × nv matrix (a page each in a large scene).
+    anc: Vec<f64>,
     /// Every dof's path (root … dof, ascending) back to back, then `0..n`.
     table: Vec<usize>,
     start: Vec<usize>,
@@ -78,6 +84,11 @@ impl MassFactor {
             sqrt_d: vec![1.0; n],
             inv_sqrt_d: vec![1.0; n],
             lambda: model.dof_parent.clone(),
+            anc: if tree {
+                vec![0.0; table.len()]
+            } else {
+                Vec::new()
+            },
             table,
             start,
             len,
@@ -114,6 +125,11 @@ impl MassFactor {
                 let d = self.m[(k, k)];
                 self.sqrt_d[k] = d.sqrt();
                 self.inv_sqrt_d[k] = 1.0 / self.sqrt_d[k];
+                let (s, l) = (self.start[k], self.len[k]);
+                let col = self.m.column(k);
+                for (a, &i) in self.anc[s..s + l].iter_mut().zip(&self.table[s..s + l]) {
+                    *a = col[i];
+                }
             }
             Ok(())
         } else {
@@ -123,6 +139,22 @@ impl MassFactor {
             }
             Ok(())
         }
+    }
+
+    /// Tree: where the ancestors of `path[t]` lie on `path` when they are
+    /// exactly `path[s0..t]` (a row on one body's path, or on two bodies'
+    /// paths in two trees: each a run of the path), with L's entries at them
+    /// ([`Self::anc`]); `None` otherwise (two branches of one tree
+    /// interleaved). L is zero between a dof and a non-ancestor, so the
+    /// entries skipped (the other tree's) are zeros.
+    #[inline(always)]
+    fn ancestors(&self, path: &[usize], t: usize) -> Option<(usize, &[f64])> {
+        let d = *path.get(t)?;
+        let (s, l) = (*self.start.get(d)?, *self.len.get(d)?);
+        // the union is ascending and holds every ancestor of d (its root
+        // the least): the l entries ending at t are them iff they start at d's root
+        let s0 = (t + 1).checked_sub(l)?;
+        (path.get(s0)? == self.table.get(s)?).then(|| (s0, &self.anc[s..s + l - 1]))
     }
 
     /// x ← H̃⁻¹ x.
@@ -155,9 +187,18 @@ impl MassFactor {
         for t in (0..len).rev() {
             let yt = y[t];
             if yt != 0.0 {
-                let col = path[t] * n;
-                for s in 0..t {
-                    y[s] -= m[col + path[s]] * yt;
+                match self.ancestors(path, t) {
+                    Some((s0, anc)) => {
+                        for (ys, l) in y[s0..t].iter_mut().zip(anc) {
+                            *ys -= l * yt;
+                        }
+                    }
+                    None => {
+                        let col = path[t] * n;
+                        for s in 0..t {
+                            y[s] -= m[col + path[s]] * yt;
+                        }
+                    }
                 }
             }
         }
@@ -179,12 +220,23 @@ impl MassFactor {
         let len = path.len().min(y0.len()).min(y1.len()).min(y2.len());
         for t in (0..len).rev() {
             let (a0, a1, a2) = (y0[t], y1[t], y2[t]);
-            let col = path[t] * n;
-            for s in 0..t {
-                let l = m[col + path[s]];
-                y0[s] -= l * a0;
-                y1[s] -= l * a1;
-                y2[s] -= l * a2;
+            match self.ancestors(path, t) {
+                Some((s0, anc)) => {
+                    for (s, &l) in (s0..t).zip(anc) {
+                        y0[s] -= l * a0;
+                        y1[s] -= l * a1;
+                        y2[s] -= l * a2;
+                    }
+                }
+                None => {
+                    let col = path[t] * n;
+                    for s in 0..t {
+                        let l = m[col + path[s]];
+                        y0[s] -= l * a0;
+                        y1[s] -= l * a1;
+                        y2[s] -= l * a2;
+                    }
+                }
             }
         }
         for t in 0..len {

@@ -380,6 +380,7 @@ impl super::Simulation {
             self.opts.solver == super::Solver::Newton,
             Some(loops),
         );
+        self.cons.set_threads(self.opts.threads);
         self.sleep.joins = self.loop_body_pairs();
         let mut out = vec![0.0; self.loop_count()];
         let mut lines = Vec::new();

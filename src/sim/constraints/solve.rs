@@ -4,7 +4,8 @@
 //! each on one island's rows and dofs, so that no cost grows with the square
 //! of the scene; then what the impulses do (forces, warm starts).
 
-use super::super::islands::Island;
+use super::super::islands::{Island, Islands};
+use super::super::solver::{IslandOut, Scratch};
 use super::*;
 
 impl Constraints {
@@ -37,40 +38,70 @@ impl Constraints {
             runs: &all,
             dofs: &[],
         };
-        // PGS: each island on its own; Newton: the whole scene at once
-        let pgs = solver == Solver::Pgs;
-        if pgs {
+        let mut sweeps = 0;
+        if solver == Solver::Pgs {
+            // each island on its own (on several threads: docs/theory.md
+            // §"Islands"), every island's result independent of the others'
             self.islands.group(rows);
+            f.apply_r(vfree.as_slice(), &mut self.a);
+            let count = self.islands.len();
+            if self.isl_sweeps.len() < count {
+                self.isl_sweeps.resize(count, 0);
+            }
+            let written = rows.take_written();
+            let (mut lam, mut up) = written;
+            let dv = self.dv.as_mut_slice();
+            let args = (f, &self.a[..], iterations, tol, relaxation);
+            match self.pool.as_ref().filter(|_| count > 1) {
+                Some(pool) => par_islands(
+                    pool,
+                    rows,
+                    &self.islands,
+                    &mut self.scratch,
+                    &mut self.isl_sweeps[..count],
+                    (&mut lam, &mut up, dv),
+                    args,
+                ),
+                None => {
+                    let mut out = IslandOut {
+                        lambda: &mut lam,
+                        u_prev: &mut up,
+                        sm: &mut self.scratch[0],
+                    };
+                    for (i, s) in self.isl_sweeps[..count].iter_mut().enumerate() {
+                        *s = solve_island(rows, &mut out, &self.islands.get(i), dv, args);
+                    }
+                }
+            }
+            rows.put_written((lam, up));
+            for (i, &s) in self.isl_sweeps[..count].iter().enumerate() {
+                self.work += (self.islands.get(i).rows() * s) as u64;
+                sweeps = sweeps.max(s);
+            }
+        } else {
+            // Newton: the whole scene at once; a solve stopped by the cap is
+            // scaled onto the exact solution's energy bound, never swept
+            let dv = self.dv.as_mut_slice();
+            let mut s = self.newton.solve(rows, f, dv, iterations, tol);
+            if s >= iterations {
+                f.apply_r(vfree.as_slice(), &mut self.a);
+                let (mut lam, mut up) = rows.take_written();
+                let mut out = IslandOut {
+                    lambda: &mut lam,
+                    u_prev: &mut up,
+                    sm: &mut self.scratch[0],
+                };
+                let d = self.dv.as_mut_slice();
+                s += energy_safe_exit(rows, &mut out, &whole, None, &self.a, d, 0, tol);
+                rows.put_written((lam, up));
+            }
+            self.work += (whole.rows() * s) as u64;
+            sweeps = s;
         }
+        let pgs = solver == Solver::Pgs;
         let count = if pgs { self.islands.len() } else { 1 };
         fn dofs<'a>(pgs: bool, isl: &Island<'a>) -> Option<&'a [usize]> {
             pgs.then_some(isl.dofs)
-        }
-        let mut sweeps = 0;
-        let mut a_ready = false;
-        for i in 0..count {
-            let isl = if pgs { self.islands.get(i) } else { whole };
-            let dv = self.dv.as_mut_slice();
-            let mut s = if pgs {
-                rows.solve_runs(isl.runs, dofs(pgs, &isl), dv, iterations, tol, relaxation)
-            } else {
-                self.newton.solve(rows, f, dv, iterations, tol)
-            };
-            // a solve stopped by the cap, or one that took a subspace step
-            // (whose projection of a large step is not checked by the sweeps'
-            // test alone), is held to the exact solution's energy bound
-            if s >= iterations || (pgs && rows.polished) {
-                if !a_ready {
-                    f.apply_r(vfree.as_slice(), &mut self.a);
-                    a_ready = true;
-                }
-                // (a Newton solve stopped by the cap is scaled, never swept)
-                let more = if pgs { iterations } else { 0 };
-                let d = self.dv.as_mut_slice();
-                s += energy_safe_exit(rows, &isl, dofs(pgs, &isl), f, &self.a, d, more, tol);
-            }
-            self.work += (isl.rows() * s) as u64;
-            sweeps = sweeps.max(s);
         }
         // Δv = R⁻¹ Δv'
         f.half_solve(self.dv.as_mut_slice());
@@ -155,10 +186,11 @@ impl Constraints {
 
 /// (ΔKE of the impulse, the exact solution's bound Σ λᵣ max(bᵣ, 0), a·d, ‖d‖²)
 /// for the factored Δv' = `d` (a = R v*: the kinetic energy after the impulse
-/// is ½‖a + d‖² in the H̃-norm).
+/// is ½‖a + d‖² in the H̃-norm), the impulses `lambda`.
 /// Over the island's rows and `dofs` (`None`: every dof).
 fn impulse_work(
     rows: &Rows,
+    lambda: &[f64],
     isl: &Island<'_>,
     dofs: Option<&[usize]>,
     a: &[f64],
@@ -183,10 +215,107 @@ fn impulse_work(
     let mut allow = 0.0;
     for r in isl.each_row() {
         if matches!(rows.kind[r], RowKind::Normal | RowKind::Unilateral) {
-            allow += rows.lambda[r] * rows.b[r].max(0.0);
+            allow += lambda[r] * rows.b[r].max(0.0);
         }
     }
     (ad + 0.5 * dd, allow, ad, dd)
+}
+
+/// What every island's solve reads besides the rows: the factor, a = R v*,
+/// the sweep cap, tolerance and over-relaxation.
+type IslandArgs<'a> = (&'a MassFactor, &'a [f64], usize, f64, f64);
+
+/// One island's velocity solve: warm-started PGS on its rows, written into
+/// `out` and `dv` (on its dofs only); a solve stopped by its cap, or one that
+/// took a subspace step (whose projection of a large step is not checked by
+/// the sweeps' test alone), is held to the exact solution's energy bound.
+/// Returns its sweeps.
+fn solve_island(
+    rows: &Rows,
+    out: &mut IslandOut<'_>,
+    isl: &Island<'_>,
+    dv: &mut [f64],
+    (_f, a, iterations, tol, relax): IslandArgs<'_>,
+) -> usize {
+    let dofs = Some(isl.dofs);
+    let (mut s, polished) = rows.sweeps(out, isl.runs, dofs, dv, iterations, tol, relax);
+    if s >= iterations || polished {
+        s += energy_safe_exit(rows, out, isl, dofs, a, dv, iterations, tol);
+    }
+    s
+}
+
+/// Every row's impulse and last velocity and Δv', shared by the threads
+/// solving islands at once ([`par_islands`]).
+#[derive(Clone, Copy)]
+struct Shared {
+    lambda: (*mut f64, usize),
+    u_prev: (*mut f64, usize),
+    dv: (*mut f64, usize),
+}
+// SAFETY: the threads given a `Shared` read and write only their own
+// islands' rows (of `lambda`, `u_prev`) and dofs (of `dv`): islands share no
+// row and no dof (src/sim/islands.rs), so no element is touched by two threads.
+unsafe impl Send for Shared {}
+unsafe impl Sync for Shared {}
+
+/// The islands solved on the threads of `pool`: cut into one run of
+/// consecutive islands a thread, of about equal rows; each island's result
+/// (its impulses, its Δv', its sweeps in `sweeps`) is the one a single
+/// thread computes, whatever the cut (bit for bit: nothing an island reads
+/// is written by another).
+fn par_islands(
+    pool: &rayon::ThreadPool,
+    rows: &Rows,
+    islands: &Islands,
+    scratch: &mut [Scratch],
+    sweeps: &mut [usize],
+    (lambda, u_prev, dv): (&mut [f64], &mut [f64], &mut [f64]),
+    args: IslandArgs<'_>,
+) {
+    let count = sweeps.len();
+    let total: usize = (0..count).map(|i| islands.get(i).rows()).sum();
+    let parts = scratch.len().max(1);
+    let sh = Shared {
+        lambda: (lambda.as_mut_ptr(), lambda.len()),
+        u_prev: (u_prev.as_mut_ptr(), u_prev.len()),
+        dv: (dv.as_mut_ptr(), dv.len()),
+    };
+    pool.scope(|sc| {
+        let (mut rest, mut first, mut acc) = (sweeps, 0, 0);
+        for (k, sm) in scratch.iter_mut().enumerate() {
+            // the islands up to about (k + 1)/parts of the rows
+            let goal = total * (k + 1) / parts;
+            let mut end = first;
+            while end < count && (acc < goal || k + 1 == parts) {
+                acc += islands.get(end).rows();
+                end += 1;
+            }
+            let (mine, more) = rest.split_at_mut(end - first);
+            rest = more;
+            let start = first;
+            first = end;
+            if mine.is_empty() {
+                continue;
+            }
+            sc.spawn(move |_| {
+                let sh = sh;
+                // SAFETY: see `Shared`; the pointers and lengths are those of
+                // live slices borrowed for the whole scope
+                let (lambda, u_prev, dv) = unsafe {
+                    (
+                        std::slice::from_raw_parts_mut(sh.lambda.0, sh.lambda.1),
+                        std::slice::from_raw_parts_mut(sh.u_prev.0, sh.u_prev.1),
+                        std::slice::from_raw_parts_mut(sh.dv.0, sh.dv.1),
+                    )
+                };
+                let mut out = IslandOut { lambda, u_prev, sm };
+                for (j, s) in mine.iter_mut().enumerate() {
+                    *s = solve_island(rows, &mut out, &islands.get(start + j), dv, args);
+                }
+            });
+        }
+    });
 }
 
 /// A solve stopped by the sweep cap may leave an iterate that adds kinetic
@@ -198,10 +327,10 @@ fn impulse_work(
 /// stays inside every cone and box). `a` = R v*. Returns the extra sweeps.
 #[allow(clippy::too_many_arguments)]
 fn energy_safe_exit(
-    rows: &mut Rows,
+    rows: &Rows,
+    out: &mut IslandOut<'_>,
     isl: &Island<'_>,
     dofs: Option<&[usize]>,
-    f: &MassFactor,
     a: &[f64],
     d: &mut [f64],
     iterations: usize,
@@ -214,18 +343,17 @@ fn energy_safe_exit(
     let budget = 4 * iterations;
     let mut extra = 0;
     loop {
-        let (work, allow, _, _) = impulse_work(rows, isl, dofs, a, d);
+        let (work, allow, _, _) = impulse_work(rows, out.lambda, isl, dofs, a, d);
         if work <= allow || extra >= budget {
             break;
         }
-        let _ = f;
-        let it = rows.solve_runs(isl.runs, dofs, d, 10, tol, 1.0);
+        let (it, _) = rows.sweeps(out, isl.runs, dofs, d, 10, tol, 1.0);
         extra += it;
         if it < 10 {
             break;
         }
     }
-    let (work, allow, ad, dd) = impulse_work(rows, isl, dofs, a, d);
+    let (work, allow, ad, dd) = impulse_work(rows, out.lambda, isl, dofs, a, d);
     if work <= allow || dd <= 0.0 {
         return extra;
     }
@@ -236,7 +364,7 @@ fn energy_safe_exit(
         None => d[..nv].iter_mut().for_each(|x| *x *= s),
     }
     for r in isl.each_row() {
-        rows.lambda[r] *= s;
+        out.lambda[r] *= s;
     }
     extra
 }

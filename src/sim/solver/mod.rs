@@ -24,6 +24,8 @@ mod pgs;
 mod position;
 mod subspace;
 
+pub(crate) use pgs::{IslandOut, Scratch};
+
 use super::factor::MassFactor;
 use subspace::Subspace;
 

@@ -2,7 +2,7 @@
 //! contact's three rows taken in one pass and the exact Coulomb slide onto
 //! the friction disc.
 
-use super::subspace::{subspace_step, Solved};
+use super::subspace::{subspace_step, Solved, Subspace};
 use super::{MassFactor, RowKind, Rows};
 
 impl Rows {
@@ -43,25 +43,56 @@ impl Rows {
         tol: f64,
         relax: f64,
     ) -> usize {
-        self.polished = false;
-        let table_v = std::mem::take(&mut self.table);
-        let it = self.sweeps(&table_v, runs, dofs, dv, max_iter, tol, relax);
-        self.table = table_v;
+        let mut lambda = std::mem::take(&mut self.lambda);
+        let mut u_prev = std::mem::take(&mut self.u_prev);
+        let mut sm = Scratch(std::mem::replace(&mut self.sm, Subspace::new(0, 0)));
+        let mut out = IslandOut {
+            lambda: &mut lambda,
+            u_prev: &mut u_prev,
+            sm: &mut sm,
+        };
+        let (it, polished) = self.sweeps(&mut out, runs, dofs, dv, max_iter, tol, relax);
+        self.lambda = lambda;
+        self.u_prev = u_prev;
+        self.sm = sm.0;
+        self.polished = polished;
         it
     }
 
-    /// [`Rows::solve`] on the path table `table` (taken out of the rows).
+    /// Takes out what the sweeps write (impulses, each row's last velocity),
+    /// so that several islands can be solved at once on the rows left
+    /// read-only ([`Rows::sweeps`]); [`Rows::put_written`] puts them back.
+    pub(crate) fn take_written(&mut self) -> (Vec<f64>, Vec<f64>) {
+        (
+            std::mem::take(&mut self.lambda),
+            std::mem::take(&mut self.u_prev),
+        )
+    }
+    /// Puts back what [`Rows::take_written`] took.
+    pub(crate) fn put_written(&mut self, w: (Vec<f64>, Vec<f64>)) {
+        (self.lambda, self.u_prev) = w;
+    }
+    /// A subspace step's scratch, one for each thread solving islands.
+    pub(crate) fn scratch(&self) -> Scratch {
+        Scratch(Subspace::new(self.nv, self.cap))
+    }
+
+    /// Projected Gauss–Seidel ([`Rows::solve`]) on the rows of `runs`, the
+    /// rows read-only: it writes the impulses and row velocities in `out`
+    /// (taken out of the rows, [`Rows::take_written`]) and `dv` on `dofs`
+    /// only. Returns the sweeps and whether a subspace step was taken.
     #[allow(clippy::too_many_arguments)]
-    fn sweeps(
-        &mut self,
-        table: &[usize],
+    pub(crate) fn sweeps(
+        &self,
+        out: &mut IslandOut<'_>,
         runs: &[(usize, usize, usize)],
         dofs: Option<&[usize]>,
         dv: &mut [f64],
         max_iter: usize,
         tol: f64,
         relax: f64,
-    ) -> usize {
+    ) -> (usize, bool) {
+        let table = &self.table[..];
         let (nv, n, st) = (self.nv, self.n, self.stride);
         if dv.len() < nv
             || self.y.len() < n * st
@@ -73,8 +104,10 @@ impl Rows {
                         .any(|&(s, l)| s + l > table.len() || l > st)
             })
             || dofs.is_some_and(|d| d.iter().any(|&k| k >= nv))
+            || out.lambda.len() < n
+            || out.u_prev.len() < n
         {
-            return 0;
+            return (0, false);
         }
         let dv = &mut dv[..nv];
         let (y, paths) = (&self.y[..], &self.path[..n]);
@@ -84,7 +117,7 @@ impl Rows {
         let winv = &self.winv[..n];
         // a row no impulse can move keeps 0
         let live = |r: usize| if winv[r] != 0.0 { 1.0 } else { 0.0 };
-        let u_prev = &mut self.u_prev[..n];
+        let u_prev = &mut out.u_prev[..n];
         // a row's convergence measure: its own residual |Δλ|·Wᵣᵣ, or, when
         // smaller, how much its velocity moved since the last sweep (redundant
         // contacts can trade impulse among themselves for many sweeps while no
@@ -99,7 +132,7 @@ impl Rows {
                 residual.min(moved)
             }
         }
-        let lambda = &mut self.lambda[..n];
+        let lambda = &mut out.lambda[..n];
         // SAFETY (unchecked reads in rdot/raxpy): every path lies in `table`
         // (checked above) and holds dof indices < nv; y holds n·stride entries and
         // a path is at most stride long.
@@ -293,15 +326,30 @@ impl Rows {
                     c,
                     b,
                 };
-                if subspace_step(&mut self.sm, &rows, lambda, dv) {
+                if subspace_step(&mut out.sm.0, &rows, lambda, dv) {
                     polished = true;
                 }
             }
         }
-        self.polished = polished;
-        it
+        (it, polished)
     }
 }
+
+/// What one island's sweeps write besides Δv': the rows' impulses and last
+/// velocities (whole-length, taken out of the rows; an island writes its own
+/// rows only) and the subspace step's scratch.
+pub(crate) struct IslandOut<'a> {
+    /// Every row's impulse.
+    pub lambda: &'a mut [f64],
+    /// Every row's velocity at its last update.
+    pub u_prev: &'a mut [f64],
+    /// The subspace step's scratch.
+    pub sm: &'a mut Scratch,
+}
+
+/// A subspace step's scratch ([`Rows::scratch`]).
+#[derive(Clone, Debug)]
+pub(crate) struct Scratch(Subspace);
 
 /// Sweeps before the first subspace step, and the most a solve takes.
 const SUBSPACE_AFTER: usize = 2;
