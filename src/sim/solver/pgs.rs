@@ -2,6 +2,7 @@
 //! contact's three rows taken in one pass and the exact Coulomb slide onto
 //! the friction disc.
 
+use super::loop_block::BlockRows;
 use super::subspace::{subspace_step, Solved};
 use super::{MassFactor, RowKind, Rows};
 
@@ -133,6 +134,14 @@ impl Rows {
                 }
             }
         }
+        // the loop rows as one exact block after each sweep (loop_block.rs)
+        let view = BlockRows {
+            st,
+            y,
+            paths,
+            table,
+        };
+        let block = self.sm.loops.prepare(&view, runs, kinds, w);
         let mut it = 0;
         // plain sweeps first; a problem not solved in `PLAIN` sweeps is
         // over-relaxed, and once that has converged one plain sweep finishes it
@@ -211,6 +220,10 @@ impl Rows {
                         continue;
                     }
                     match kind {
+                        RowKind::Bilateral if block => {
+                            r += 1;
+                            continue;
+                        }
                         RowKind::Tangent { normal, mu } if r + 1 < e => {
                             let (p1, p2) = (path(r), path(r + 1));
                             let (w11, w22) = (w[r], w[r + 1]);
@@ -269,6 +282,9 @@ impl Rows {
                     change = change.max(measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
                     r += 1;
                 }
+            }
+            if block {
+                change = change.max(self.sm.loops.solve(&view, Some(c), b, lambda, dv));
             }
             if finishing || (change <= tol && plain) {
                 break;
