@@ -79,10 +79,28 @@ impl Rows {
         }
         let dv = &mut dv[..nv];
         let (y, paths) = (&self.y[..], &self.path[..n]);
-        let (kinds, w, c, b) = (&self.kind[..n], &self.w[..n], &self.c[..n], &self.b[..n]);
+        let (kinds, c, b) = (&self.kind[..n], &self.c[..n], &self.b[..n]);
         let contact = &self.is_block[..n];
-        let w_block = &self.w_block[..n];
-        let winv = &self.winv[..n];
+        // the loop rows as one exact block, every other row seen through them
+        // (the reduced W', loop_block.rs): taken out for the solve
+        let mut lb = std::mem::take(&mut self.sm.loops);
+        let view = BlockRows {
+            st,
+            y,
+            paths,
+            table,
+        };
+        let block = lb.prepare(&view, runs, kinds, &self.w[..n]);
+        if block {
+            let (w, wb, wi) = (&self.w[..n], &self.w_block[..n], &self.winv[..n]);
+            lb.reduce(&view, runs, kinds, contact, w, wb, wi);
+        }
+        let lb = lb;
+        let (w, w_block, winv) = if block {
+            (&lb.wr[..n], &lb.wblockr[..n], &lb.winvr[..n])
+        } else {
+            (&self.w[..n], &self.w_block[..n], &self.winv[..n])
+        };
         // a row no impulse can move keeps 0
         let live = |r: usize| if winv[r] != 0.0 { 1.0 } else { 0.0 };
         let u_prev = &mut self.u_prev[..n];
@@ -134,14 +152,9 @@ impl Rows {
                 }
             }
         }
-        // the loop rows as one exact block after each sweep (loop_block.rs)
-        let view = BlockRows {
-            st,
-            y,
-            paths,
-            table,
-        };
-        let block = self.sm.loops.prepare(&view, runs, kinds, w);
+        if block {
+            lb.solve(&view, Some(c), b, lambda, dv);
+        }
         let mut it = 0;
         // plain sweeps first; a problem not solved in `PLAIN` sweeps is
         // over-relaxed, and once that has converged one plain sweep finishes it
@@ -211,6 +224,9 @@ impl Rows {
                                         + dl2 * y.get_unchecked((r + 2) * st + t);
                                 }
                             }
+                            if block {
+                                lb.follow(&view, r, &[dln, dl1, dl2], lambda, dv);
+                            }
                         }
                         change = change
                             .max(measure(first, (dln * wnn).abs(), un, &mut u_prev[r]))
@@ -247,6 +263,9 @@ impl Rows {
                             if d2 != 0.0 {
                                 raxpy(d2, y, r + 1, st, p2, dv);
                             }
+                            if block {
+                                lb.follow(&view, r, &[d1, d2], lambda, dv);
+                            }
                             change = change
                                 .max(measure(first, (d1 * w11).abs(), u1, &mut u_prev[r]))
                                 .max(measure(first, (d2 * w22).abs(), u2, &mut u_prev[r + 1]));
@@ -278,13 +297,17 @@ impl Rows {
                     let d = new - old;
                     if d != 0.0 {
                         raxpy(d, y, r, st, p, dv);
+                        if block && lb.couples(r) {
+                            lb.follow(&view, r, &[d], lambda, dv);
+                        }
                     }
                     change = change.max(measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
                     r += 1;
                 }
             }
             if block {
-                change = change.max(self.sm.loops.solve(&view, Some(c), b, lambda, dv));
+                // (rounding only: every update above kept the loop rows on target)
+                change = change.max(lb.solve(&view, Some(c), b, lambda, dv));
             }
             if finishing || (change <= tol && plain) {
                 break;
@@ -311,10 +334,14 @@ impl Rows {
                 };
                 if subspace_step(&mut self.sm, &rows, lambda, dv) {
                     polished = true;
+                    if block {
+                        lb.solve(&view, Some(c), b, lambda, dv);
+                    }
                 }
             }
         }
         self.polished = polished;
+        self.sm.loops = lb;
         it
     }
 }
