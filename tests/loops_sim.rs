@@ -385,8 +385,9 @@ fn set_state_takes_a_fresh_energy_reference() {
 /// block (src/sim/solver/loop_block.rs) keeps both loops closed through the
 /// impacts — the violation, the distance between the two points each
 /// constraint holds together (outside truth: the geometry), stays below 1e-6 m
-/// at every step after landing — and the lamp comes to rest (asleep) within
-/// 4 s with contacts holding it on the table top (z ≥ 0.75 m − 3 mm).
+/// at every step after landing —, the energy never rises above its lowest
+/// value so far by more than 1e-6·(|E₀| + M·g·1 m), and the lamp comes to rest
+/// (asleep) within 4 s with contacts holding it on the table top (z ≥ 0.75 m − 3 mm).
 #[test]
 fn luxo_on_the_table_keeps_its_loops_closed_and_rests() {
     let root = env!("CARGO_MANIFEST_DIR");
@@ -410,9 +411,17 @@ fn luxo_on_the_table_keeps_its_loops_closed_and_rests() {
         .set_constraints(scene.constraints.clone())
         .unwrap()
         .is_empty());
+    // the energy never rises above its lowest value so far by more than
+    // 1e-6·(|E₀| + M·g·1 m), M = 4.17 kg (the URDF's masses summed)
+    let e0 = sim.energy();
+    let allowed = 1e-6 * (e0.abs() + 4.17 * 9.81);
+    let (mut lowest, mut rise) = (e0, 0.0f64);
     let (mut landed, mut worst, mut asleep_at) = (None, 0.0f64, None);
     while sim.time() < 4.0 - 1e-9 {
         sim.step().unwrap();
+        let e = sim.energy();
+        rise = rise.max(e - lowest);
+        lowest = lowest.min(e);
         if landed.is_none() && !sim.contact_forces().is_empty() {
             landed = Some(sim.time());
         }
@@ -426,6 +435,10 @@ fn luxo_on_the_table_keeps_its_loops_closed_and_rests() {
     let landed = landed.expect("the lamp lands");
     assert!((0.2..0.3).contains(&landed), "landed at {landed}");
     assert!(worst < 1e-6, "loops opened by {worst:.3e} m after landing");
+    assert!(
+        rise <= allowed,
+        "energy rose {rise:.3e} J (allowed {allowed:.3e})"
+    );
     let asleep = asleep_at.expect("the lamp comes to rest within 4 s");
     assert!(asleep < 4.0, "asleep at {asleep}");
     // resting on the table top (0.75 m), not fallen to the ground
