@@ -378,3 +378,70 @@ fn set_state_takes_a_fresh_energy_reference() {
         "{e_set} -> {e1} (first state {e0})"
     );
 }
+
+/// The Luxo lamp (assets/luxo.urdf, two parallelograms closed by `point`
+/// constraints) dropped onto the table exactly as `examples/luxo_on_table.rs`
+/// runs it (dt 1 ms, the scene's ground friction, sleep on): the loops' exact
+/// block (src/sim/solver/loop_block.rs) keeps both loops closed through the
+/// impacts — the violation, the distance between the two points each
+/// constraint holds together (outside truth: the geometry), stays below 1e-6 m
+/// at every step after landing —, the energy never rises above its lowest
+/// value so far by more than 1e-6·(|E₀| + M·g·1 m), and the lamp comes to rest
+/// (asleep) within 4 s with contacts holding it on the table top (z ≥ 0.75 m − 3 mm).
+#[test]
+fn luxo_on_the_table_keeps_its_loops_closed_and_rests() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let scene =
+        urdyn::scene::Scene::from_file(format!("{root}/assets/luxo_on_table.json"), &[]).unwrap();
+    let ground = scene.ground.unwrap();
+    let mut contact = urdyn::contact::ContactParams::default();
+    contact.friction = ground.friction;
+    let opts = SimOptions {
+        dt: 1e-3,
+        ground: Some(ground.height),
+        contact,
+        sleep: true,
+        sleep_velocity: 1e-3,
+        sleep_time: 0.5,
+        ..Default::default()
+    };
+    let mut sim = Simulation::new(scene.model.clone(), opts).unwrap();
+    sim.set_state(&scene.q0, &scene.v0).unwrap();
+    assert!(sim
+        .set_constraints(scene.constraints.clone())
+        .unwrap()
+        .is_empty());
+    // the energy never rises above its lowest value so far by more than
+    // 1e-6·(|E₀| + M·g·1 m), M = 4.17 kg (the URDF's masses summed)
+    let e0 = sim.energy();
+    let allowed = 1e-6 * (e0.abs() + 4.17 * 9.81);
+    let (mut lowest, mut rise) = (e0, 0.0f64);
+    let (mut landed, mut worst, mut asleep_at) = (None, 0.0f64, None);
+    while sim.time() < 4.0 - 1e-9 {
+        sim.step().unwrap();
+        let e = sim.energy();
+        rise = rise.max(e - lowest);
+        lowest = lowest.min(e);
+        if landed.is_none() && !sim.contact_forces().is_empty() {
+            landed = Some(sim.time());
+        }
+        if landed.is_some() {
+            worst = worst.max(sim.constraint_violation());
+        }
+        if asleep_at.is_none() && sim.awake() == 0 {
+            asleep_at = Some(sim.time());
+        }
+    }
+    let landed = landed.expect("the lamp lands");
+    assert!((0.2..0.3).contains(&landed), "landed at {landed}");
+    assert!(worst < 1e-6, "loops opened by {worst:.3e} m after landing");
+    assert!(
+        rise <= allowed,
+        "energy rose {rise:.3e} J (allowed {allowed:.3e})"
+    );
+    let asleep = asleep_at.expect("the lamp comes to rest within 4 s");
+    assert!(asleep < 4.0, "asleep at {asleep}");
+    // resting on the table top (0.75 m), not fallen to the ground
+    let z = sim.q()[2];
+    assert!(z > 0.75 - 3e-3, "base at z = {z}");
+}

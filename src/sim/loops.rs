@@ -486,7 +486,8 @@ impl super::Simulation {
     /// (docs/theory.md §"Loops in the simulation"): the time-stepping scheme's
     /// O(h) energy oscillation, which a closed chain's coupled rows do not damp,
     /// is clipped by scaling v (J v = 0 kept: the rows are linear in v) so that
-    /// T + V never exceeds the energy of the first closed state. The
+    /// T + V never exceeds the energy of the first closed state, lowered to the
+    /// lowest energy of the steps in contact since. The
     /// reference is dropped while driven (servo, torques) or while a violated
     /// start closes (violation above 1e-6), and taken afresh after.
     pub(super) fn clip_loop_energy(&mut self) {
@@ -496,6 +497,7 @@ impl super::Simulation {
             self.fk_valid = true;
         }
         let armature = self.armature_energy();
+        let touching = !self.cons.contact_forces().is_empty();
         let Some(l) = self.cons.loops.as_mut() else {
             return;
         };
@@ -519,6 +521,13 @@ impl super::Simulation {
             let s = ((e_ref - pe).max(0.0) / ke).sqrt();
             self.v *= s;
             self.energy_now = None;
+        } else if touching {
+            // while something touches, the reference follows the lowest energy
+            // so far (contact and friction only take energy out of a passive
+            // run); without contact it stays (a conservative mechanism keeps
+            // its energy, and lowering the reference at each dip of the
+            // scheme's oscillation would damp it)
+            l.e_ref = Some(e_ref.min(ke + pe));
         }
     }
 

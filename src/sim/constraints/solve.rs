@@ -366,5 +366,9 @@ fn energy_safe_exit(
     for r in isl.each_row() {
         out.lambda[r] *= s;
     }
+    // the scaling opened the loops: their rows put back exactly, an
+    // H̃-orthogonal projection that only lowers the kinetic energy
+    // (src/sim/solver/loop_block.rs)
+    rows.close_loops(out, isl.runs, d);
     extra
 }

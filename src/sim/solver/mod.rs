@@ -20,6 +20,7 @@
 //! moves q but never enters v.
 
 mod form;
+mod loop_block;
 mod pgs;
 mod position;
 mod subspace;

@@ -2,6 +2,7 @@
 //! contact's three rows taken in one pass and the exact Coulomb slide onto
 //! the friction disc.
 
+use super::loop_block::BlockRows;
 use super::subspace::{subspace_step, Solved, Subspace};
 use super::{MassFactor, RowKind, Rows};
 
@@ -111,10 +112,28 @@ impl Rows {
         }
         let dv = &mut dv[..nv];
         let (y, paths) = (&self.y[..], &self.path[..n]);
-        let (kinds, w, c, b) = (&self.kind[..n], &self.w[..n], &self.c[..n], &self.b[..n]);
+        let (kinds, c, b) = (&self.kind[..n], &self.c[..n], &self.b[..n]);
         let contact = &self.is_block[..n];
-        let w_block = &self.w_block[..n];
-        let winv = &self.winv[..n];
+        // the loop rows as one exact block, every other row seen through them
+        // (the reduced W', loop_block.rs): taken out for the solve
+        let mut lb = std::mem::take(&mut out.sm.0.loops);
+        let view = BlockRows {
+            st,
+            y,
+            paths,
+            table,
+        };
+        let block = lb.prepare(&view, runs, kinds, &self.w[..n]);
+        if block {
+            let (w, wb, wi) = (&self.w[..n], &self.w_block[..n], &self.winv[..n]);
+            lb.reduce(&view, runs, kinds, contact, w, wb, wi);
+        }
+        let lb = lb;
+        let (w, w_block, winv) = if block {
+            (&lb.wr[..n], &lb.wblockr[..n], &lb.winvr[..n])
+        } else {
+            (&self.w[..n], &self.w_block[..n], &self.winv[..n])
+        };
         // a row no impulse can move keeps 0
         let live = |r: usize| if winv[r] != 0.0 { 1.0 } else { 0.0 };
         let u_prev = &mut out.u_prev[..n];
@@ -165,6 +184,9 @@ impl Rows {
                     raxpy(l, y, r, st, path(r), dv);
                 }
             }
+        }
+        if block {
+            lb.solve(&view, Some(c), b, lambda, dv);
         }
         let mut it = 0;
         // plain sweeps first; a problem not solved in `PLAIN` sweeps is
@@ -235,6 +257,9 @@ impl Rows {
                                         + dl2 * y.get_unchecked((r + 2) * st + t);
                                 }
                             }
+                            if block {
+                                lb.follow(&view, r, &[dln, dl1, dl2], lambda, dv);
+                            }
                         }
                         change = change
                             .max(measure(first, (dln * wnn).abs(), un, &mut u_prev[r]))
@@ -244,6 +269,10 @@ impl Rows {
                         continue;
                     }
                     match kind {
+                        RowKind::Bilateral if block => {
+                            r += 1;
+                            continue;
+                        }
                         RowKind::Tangent { normal, mu } if r + 1 < e => {
                             let (p1, p2) = (path(r), path(r + 1));
                             let (w11, w22) = (w[r], w[r + 1]);
@@ -266,6 +295,9 @@ impl Rows {
                             }
                             if d2 != 0.0 {
                                 raxpy(d2, y, r + 1, st, p2, dv);
+                            }
+                            if block {
+                                lb.follow(&view, r, &[d1, d2], lambda, dv);
                             }
                             change = change
                                 .max(measure(first, (d1 * w11).abs(), u1, &mut u_prev[r]))
@@ -298,10 +330,17 @@ impl Rows {
                     let d = new - old;
                     if d != 0.0 {
                         raxpy(d, y, r, st, p, dv);
+                        if block && lb.couples(r) {
+                            lb.follow(&view, r, &[d], lambda, dv);
+                        }
                     }
                     change = change.max(measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
                     r += 1;
                 }
+            }
+            if block {
+                // (rounding only: every update above kept the loop rows on target)
+                change = change.max(lb.solve(&view, Some(c), b, lambda, dv));
             }
             if finishing || (change <= tol && plain) {
                 break;
@@ -328,9 +367,13 @@ impl Rows {
                 };
                 if subspace_step(&mut out.sm.0, &rows, lambda, dv) {
                     polished = true;
+                    if block {
+                        lb.solve(&view, Some(c), b, lambda, dv);
+                    }
                 }
             }
         }
+        out.sm.0.loops = lb;
         (it, polished)
     }
 }
@@ -349,7 +392,7 @@ pub(crate) struct IslandOut<'a> {
 
 /// A subspace step's scratch ([`Rows::scratch`]).
 #[derive(Clone, Debug)]
-pub(crate) struct Scratch(Subspace);
+pub(crate) struct Scratch(pub(super) Subspace);
 
 /// Sweeps before the first subspace step, and the most a solve takes.
 const SUBSPACE_AFTER: usize = 2;

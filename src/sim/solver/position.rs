@@ -1,5 +1,6 @@
 //! The position pass (split impulse) on the solve's rows.
 
+use super::loop_block::BlockRows;
 use super::{MassFactor, RowKind, Rows};
 
 impl Rows {
@@ -74,12 +75,27 @@ impl Rows {
         for &(_, s, e) in runs {
             self.mu[s..e].iter_mut().for_each(|x| *x = 0.0);
         }
+        // the loop rows as one exact block after each sweep (loop_block.rs):
+        // J_b w = b_pos,b to rounding at the pass's end
+        let view = BlockRows {
+            st,
+            y: &self.y,
+            paths: &self.path[..self.n],
+            table,
+        };
+        let block = self
+            .sm
+            .loops
+            .prepare(&view, runs, &self.kind[..self.n], &self.w[..self.n]);
         let mut it = 0;
         while it < max_iter {
             it += 1;
             let mut change: f64 = 0.0;
             for r in runs.iter().flat_map(|&(_, s, e)| s..e) {
                 let bilateral = self.kind[r] == RowKind::Bilateral;
+                if bilateral && block {
+                    continue;
+                }
                 if !bilateral && !matches!(self.kind[r], RowKind::Normal | RowKind::Unilateral) {
                     continue;
                 }
@@ -104,6 +120,20 @@ impl Rows {
                     }
                     change = change.max((d * wrr).abs());
                 }
+            }
+            if block {
+                let view = BlockRows {
+                    st,
+                    y: &self.y,
+                    paths: &self.path[..self.n],
+                    table,
+                };
+                let n = self.n;
+                let moved =
+                    self.sm
+                        .loops
+                        .solve(&view, None, &self.bpos[..n], &mut self.mu[..n], dw);
+                change = change.max(moved);
             }
             if change <= tol {
                 break;

@@ -1,6 +1,7 @@
 //! The subspace-minimisation step of projected Gauss–Seidel (PGS-SM): the
 //! free rows solved exactly by a dense LDLᵀ.
 
+use super::loop_block::LoopBlock;
 use super::{RowKind, SUBSPACE_MAX};
 use crate::dynamics::linalg::{ldlt_dropping, ldlt_dropping_solve};
 
@@ -14,6 +15,8 @@ pub(super) struct Subspace {
     pub(super) lam: Vec<f64>,
     /// At a tangent pair's first row: it lay on its cone's boundary (sliding).
     pub(super) sliding: Vec<bool>,
+    /// The loop rows' exact block ([`LoopBlock`]).
+    pub(super) loops: LoopBlock,
 }
 
 impl Subspace {
@@ -25,6 +28,7 @@ impl Subspace {
             rhs: vec![0.0; m],
             lam: vec![0.0; m],
             sliding: vec![false; cap],
+            loops: LoopBlock::new(cap),
         }
     }
 }
