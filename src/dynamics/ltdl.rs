@@ -108,3 +108,90 @@ pub fn ltdl_solve<T: Scalar>(u: &DMatrix<T>, lambda: &[usize], x: &mut DVector<T
         x[i] = s;
     }
 }
+
+/// [`ltdl`] with each coordinate's ancestors given as runs of consecutive
+/// coordinates (`runs[run0[k]..run0[k + 1]]`, nearest first, each `[lo, hi)`:
+/// `Data::deriv_anc_runs`, models without mimic joints): the same operations in
+/// the same order on the same entries (the same factor to the last bit), every
+/// inner loop a contiguous, unchecked slice of one column of `u`.
+pub(crate) fn ltdl_runs<T: Scalar>(
+    h: &DMatrix<T>,
+    runs: &[(usize, usize)],
+    run0: &[usize],
+    u: &mut DMatrix<T>,
+) -> Result<(), usize> {
+    let n = h.nrows();
+    let tiny = lit::<T>(64.0 * f64::EPSILON);
+    let hs = h.as_slice();
+    let us = u.as_mut_slice();
+    // Copy the pattern of H (column k: k and its ancestors).
+    for k in 0..n {
+        us[k + k * n] = hs[k + k * n];
+        for &(lo, hi) in &runs[run0[k]..run0[k + 1]] {
+            us[k * n + lo..k * n + hi].copy_from_slice(&hs[k * n + lo..k * n + hi]);
+        }
+    }
+    for k in (0..n).rev() {
+        let d = us[k + k * n];
+        if !(d > tiny * hs[k + k * n].abs()) || !d.is_finite() {
+            return Err(k);
+        }
+        let (left, right) = us.split_at_mut(k * n);
+        let colk = &mut right[..k];
+        let rk = &runs[run0[k]..run0[k + 1]];
+        // the ancestors i of k, nearest first; for each, its ancestors-or-self j
+        // (those of k up to i): H[j, i] −= H[k, i] H[k, j] / D[k]
+        for (ri, &(lo, hi)) in rk.iter().enumerate() {
+            for i in (lo..hi).rev() {
+                let a = colk[i] / d;
+                let coli = &mut left[i * n..i * n + i + 1];
+                for (x, &y) in coli[lo..=i].iter_mut().zip(&colk[lo..=i]) {
+                    *x = madd(-a, y, *x);
+                }
+                for &(l2, h2) in &rk[ri + 1..] {
+                    for (x, &y) in coli[l2..h2].iter_mut().zip(&colk[l2..h2]) {
+                        *x = madd(-a, y, *x);
+                    }
+                }
+                colk[i] = a;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// [`ltdl_solve`] with the ancestor runs of [`ltdl_runs`]: the same operations in
+/// the same order.
+pub(crate) fn ltdl_solve_runs<T: Scalar>(
+    u: &DMatrix<T>,
+    runs: &[(usize, usize)],
+    run0: &[usize],
+    x: &mut DVector<T>,
+) {
+    let n = u.nrows();
+    let us = u.as_slice();
+    let x = x.as_mut_slice();
+    for i in (0..n).rev() {
+        let xi = x[i];
+        let (lower, _) = x.split_at_mut(i);
+        let col = &us[i * n..i * n + i];
+        for &(lo, hi) in &runs[run0[i]..run0[i + 1]] {
+            for (y, &l) in lower[lo..hi].iter_mut().zip(&col[lo..hi]) {
+                *y = madd(-l, xi, *y);
+            }
+        }
+    }
+    for i in 0..n {
+        x[i] /= us[i + i * n];
+    }
+    for i in 0..n {
+        let mut s = x[i];
+        let col = &us[i * n..i * n + i];
+        for &(lo, hi) in &runs[run0[i]..run0[i + 1]] {
+            for j in (lo..hi).rev() {
+                s = madd(-col[j], x[j], s);
+            }
+        }
+        x[i] = s;
+    }
+}
