@@ -168,11 +168,6 @@ pub fn forward_dynamics_crba<'d, T: Scalar>(
     if model.has_mimic {
         linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)?;
         linalg::cholesky_solve(&data.chol, &mut data.qdd);
-    } else if data.deriv_direct {
-        // the ancestors as runs of consecutive coordinates: contiguous sweeps
-        let (runs, run0) = (&data.deriv_anc_runs, &data.deriv_anc_run0);
-        ltdl::ltdl_runs(&data.h, runs, run0, &mut data.chol).map_err(DynamicsError::Singular)?;
-        ltdl::ltdl_solve_runs(&data.chol, runs, run0, &mut data.qdd);
     } else {
         ltdl::ltdl(&data.h, &model.dof_parent, &mut data.chol).map_err(DynamicsError::Singular)?;
         ltdl::ltdl_solve(&data.chol, &model.dof_parent, &mut data.qdd);
