@@ -25,7 +25,7 @@ use nalgebra::{DMatrix, DVector, Vector3};
 /// from ∂τ/∂x's low-rank parts in O(nv²) ("The products", `data.deriv_low_rank`).
 /// With mimic joints: q̈ by the engine's forward dynamics, H by the derivative
 /// sweep, dense Cholesky solves against the identity and both Jacobians. Also
-/// leaves `data.dtau_dq`, `data.dtau_dv` (at a = q̈) and `data.h`. No allocation.
+/// leaves `data.dtau_dq`, `data.dtau_dv` (at a = q̈); `data.h` only with mimic joints. No allocation.
 pub fn aba_derivatives<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,

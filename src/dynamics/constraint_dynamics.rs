@@ -61,12 +61,12 @@ pub struct ConstraintData {
     /// ∂q̈/∂τ = H⁻¹ − Y K⁺ Yᵀ (= M_c).
     pub dqdd_dtau: DMatrix<f64>,
     /// Y = H⁻¹ J_cᵀ (nv × m; after [`constraint_dynamics`] on a model without
-    /// mimic joints, W = L⁻ᵀ J_cᵀ by rows of m: its columns' storage; Ȳ = Y S
-    /// after the derivatives, `KktFactor::right_half`).
+    /// mimic joints, W = L⁻ᵀ J_cᵀ coordinate-major, W[k, r] at k m + r, in its
+    /// storage; Ȳ = Y S after the derivatives, `KktFactor::right_half`).
     pub(crate) y: DMatrix<f64>,
     /// K = J_c Y (m × m).
     pub(crate) k: DMatrix<f64>,
-    /// Scratch (nv × m): D⁻¹ W in [`constraint_dynamics`], the derivatives' `right_half`.
+    /// Scratch (nv × m): the derivatives' `right_half`.
     pub(crate) p: DMatrix<f64>,
     pub(crate) kkt: KktFactor,
     /// Scratch: m entries.
@@ -297,69 +297,73 @@ pub fn constraint_dynamics<'c>(
     }
     // H = Lᵀ D L (tree-sparse): W = L⁻ᵀ J_cᵀ keeps each row's support on its
     // path to the root; K = Wᵀ D⁻¹ W; q̈ = q̈₀ + L⁻¹ D⁻¹ W λ
-    // (docs/theory.md §"Constrained dynamics", "Solving")
+    // (docs/theory.md §"Constrained dynamics", "Solving"). W is kept
+    // coordinate-major (W[k, r] at k m + r, J_c's own column-major storage):
+    // every elimination step is one m-wide axpy over all the rows at once.
     let (n, m) = (model.nv, cd.rows);
     let lam = &model.dof_parent;
-    // the ancestors of each coordinate as runs of consecutive coordinates (models
-    // without mimic joints): every elimination step is a contiguous axpy
     let direct = data.deriv_direct;
     let (runs, run0) = (&data.deriv_anc_runs, &data.deriv_anc_run0);
     let u = data.chol.as_slice();
-    let w = cd.y.as_mut_slice();
-    let jcs = cd.jc.as_slice();
-    for r in 0..m {
-        let wr = &mut w[r * n..(r + 1) * n];
-        for (c, x) in wr.iter_mut().enumerate() {
-            *x = jcs[r + c * m];
+    let w = &mut cd.y.as_mut_slice()[..n * m];
+    w.copy_from_slice(&cd.jc.as_slice()[..n * m]);
+    for i in (0..n).rev() {
+        let (above, rest) = w.split_at_mut(i * m);
+        let xi = &rest[..m];
+        if xi.iter().all(|&x| x == 0.0) {
+            continue;
         }
-        for i in (0..n).rev() {
-            let xi = wr[i];
-            if xi == 0.0 {
+        let mut step = |j: usize| {
+            let l = u[j + i * n];
+            for (y, &x) in above[j * m..(j + 1) * m].iter_mut().zip(xi) {
+                *y = madd(-l, x, *y);
+            }
+        };
+        if direct {
+            for &(lo, hi) in &runs[run0[i]..run0[i + 1]] {
+                (lo..hi).for_each(&mut step);
+            }
+        } else {
+            let mut j = lam[i];
+            while j != usize::MAX {
+                step(j);
+                j = lam[j];
+            }
+        }
+    }
+    // K = Wᵀ D⁻¹ W = Σₖ D⁻¹ₖ W[k, :]ᵀ W[k, :]: the upper triangle by rank-1
+    // updates of contiguous columns (K[s, r] at s + r m), then mirrored
+    let k = &mut cd.k.as_mut_slice()[..m * m];
+    k.fill(0.0);
+    for c in 0..n {
+        let xk = &w[c * m..(c + 1) * m];
+        let dinv = 1.0 / u[c + c * n];
+        for (r, &xr) in xk.iter().enumerate() {
+            if xr == 0.0 {
                 continue;
             }
-            if direct {
-                let (above, _) = wr.split_at_mut(i);
-                let ui = &u[i * n..i * n + i];
-                for &(lo, hi) in &runs[run0[i]..run0[i + 1]] {
-                    for (x, &l) in above[lo..hi].iter_mut().zip(&ui[lo..hi]) {
-                        *x = madd(-l, xi, *x);
-                    }
-                }
-            } else {
-                let mut j = lam[i];
-                while j != usize::MAX {
-                    wr[j] -= u[j + i * n] * xi;
-                    j = lam[j];
-                }
+            let a = xr * dinv;
+            for (y, &x) in k[r * m..r * m + r + 1].iter_mut().zip(xk) {
+                *y = madd(a, x, *y);
             }
         }
     }
-    // K = Wᵀ D⁻¹ W: with D⁻¹ W in `dw` (cd.p's storage), dot products of
-    // contiguous rows, eight partial sums each
-    let dw = cd.p.as_mut_slice();
     for r in 0..m {
-        for k in 0..n {
-            dw[r * n + k] = w[r * n + k] / u[k + k * n];
-        }
-    }
-    for r in 0..m {
-        let wr = &w[r * n..(r + 1) * n];
-        for s2 in 0..=r {
-            let acc = dot8(wr, &dw[s2 * n..(s2 + 1) * n]);
-            cd.k[(r, s2)] = acc;
-            cd.k[(s2, r)] = acc;
+        for s2 in 0..r {
+            k[r + s2 * m] = k[s2 + r * m];
         }
     }
     solve_lambda(cd, constraints)?;
     // t = D⁻¹ W λ, then L⁻¹ t (root outwards)
-    let w = cd.y.as_slice();
+    let w = &cd.y.as_slice()[..n * m];
+    let lambda = cd.lambda.as_slice();
     let t = cd.tmp.as_mut_slice();
-    for k in 0..n {
+    for c in 0..n {
         let mut acc = 0.0;
-        for r in 0..m {
-            acc += w[r * n + k] * cd.lambda[r];
+        for (&x, &l) in w[c * m..(c + 1) * m].iter().zip(lambda) {
+            acc = madd(x, l, acc);
         }
-        t[k] = acc / u[k + k * n];
+        t[c] = acc / u[c + c * n];
     }
     for i in 0..n {
         let mut s1 = t[i];
@@ -382,24 +386,6 @@ pub fn constraint_dynamics<'c>(
     cd.qdd += &cd.tmp;
     cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
     Ok(&cd.qdd)
-}
-
-/// `Σₖ a[k] b[k]` in eight interleaved partial sums (vectorised).
-#[inline(always)]
-fn dot8(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0; 8];
-    let (ac, bc) = (a.chunks_exact(8), b.chunks_exact(8));
-    let (ar, br) = (ac.remainder(), bc.remainder());
-    for (x, y) in ac.zip(bc) {
-        for l in 0..8 {
-            acc[l] = madd(x[l], y[l], acc[l]);
-        }
-    }
-    let mut s = 0.0;
-    for (&x, &y) in ar.iter().zip(br) {
-        s = madd(x, y, s);
-    }
-    ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + s
 }
 
 /// With `cd.qdd` = q̈₀, `cd.jc`, `cd.gamma`, `cd.y` set: K, its factor, λ, the

@@ -62,6 +62,14 @@ fn rows6_mut<T>(x: &mut [T], w: usize, lo: usize, hi: usize) -> [&mut [T]; 6] {
     [r0, r1, r2, r3, r4, r5].map(|r| &mut r[lo..hi])
 }
 
+/// `a += b` on 6x6 matrices (inlined: nalgebra's `+=` was an out-of-line call).
+#[inline(always)]
+fn add6<T: Scalar>(a: &mut Matrix6<T>, b: &Matrix6<T>) {
+    for (x, &y) in a.as_mut_slice().iter_mut().zip(b.as_slice()) {
+        *x += y;
+    }
+}
+
 /// `m += a · s` on spatial motions.
 #[inline(always)]
 fn motion_axpy<T: Scalar>(m: &mut Motion<T>, s: T, a: &Motion<T>) {
@@ -109,6 +117,8 @@ pub(crate) fn minv_pass<T: Scalar>(
         minv_fcol: fcol,
         minv_acol: acol,
         minv_acol_off: acol_off,
+        deriv_oy: oy,
+        deriv_hm: hmom,
         ..
     } = data;
     let qdd = qdd.as_mut_slice();
@@ -143,7 +153,12 @@ pub(crate) fn minv_pass<T: Scalar>(
         // Iᴬᵢ = Yᵢ = ⁰X̂*ᵢ Îᵢ ⁱX̂₀, pᴬᵢ = ⁰v̂ᵢ ×* Yᵢ ⁰v̂ᵢ − f̂ᵢˣ
         let y = inertias[i].act(&o_m_i[i]);
         ia[i] = matrix6(&y);
-        let mut pi = ovi.cross_force(&y.mul_motion(&ovi));
+        let hm = y.mul_motion(&ovi);
+        // Yᵢ and ⁰v̂ᵢ's momentum left for the derivative sweep that follows
+        // (`rnea_derivatives_pass_after_minv`)
+        oy[i] = y;
+        hmom[i] = hm;
+        let mut pi = ovi.cross_force(&hm);
         if let Some(fx) = fext {
             pi -= fx[i];
         }
@@ -234,7 +249,7 @@ pub(crate) fn minv_pass<T: Scalar>(
                     }
                 }
                 let pa = fi + fv(&(iai * mv(&agf[i]) + udvec * ui));
-                ia[p] += iai;
+                add6(&mut ia[p], &iai);
                 of[p] += pa;
             }
         } else {
@@ -299,7 +314,7 @@ pub(crate) fn minv_pass<T: Scalar>(
                 let uvec = Vector6::from_fn(|r, _| if r < ni { uq[c0 + r] } else { T::zero() });
                 iai -= ud * u.transpose();
                 let pa = fi + fv(&(iai * mv(&agf[i]) + ud * uvec));
-                ia[p] += iai;
+                add6(&mut ia[p], &iai);
                 of[p] += pa;
             }
         }

@@ -76,9 +76,12 @@ pub(crate) fn rnea_derivatives_pass<T: Scalar>(
     }
 }
 
-/// [`rnea_derivatives_pass`] right after [`super::minv::minv_pass`] at the same q
-/// on a model without mimic joints: the poses `data.li_m_i`, `data.o_m_i` and the
-/// world columns `data.minv_j` it left are reused (no joint placement, no sin/cos).
+/// [`rnea_derivatives_pass`] right after [`super::minv::minv_pass`] at the same
+/// (q, v) on a model without mimic joints: the poses `data.li_m_i`, `data.o_m_i`,
+/// the world columns `data.minv_j`, the world inertias `data.deriv_oy` and
+/// momenta `data.deriv_hm` it left are reused (no joint placement, no sin/cos, no
+/// inertia turned to the world). Its callers have H⁻¹ and read only ∂τ/∂q,
+/// ∂τ/∂v: `data.h` is not written.
 pub(crate) fn rnea_derivatives_pass_after_minv<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,
@@ -134,8 +137,9 @@ fn variation_tr_mul<T: Scalar>(s: &Matrix3<T>, hm: &Force<T>, x: &Motion<T>) -> 
     )
 }
 
-/// The two sweeps; `F`: external wrenches present; `K`: the poses and world
-/// columns are those `minv_pass` left (direct columns only).
+/// The two sweeps; `F`: external wrenches present; `K`: the poses, world
+/// columns, world inertias and momenta are those `minv_pass` left (direct columns
+/// only), and H is not written.
 fn pass<T: Scalar, const F: bool, const K: bool>(
     model: &Model<T>,
     data: &mut Data<T>,
@@ -236,12 +240,17 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
         ov[i] = ovi;
         oa[i] = oai;
         // ⁰Yᵢ, the world force f = Y a + v ×* Y v and its variation Ẏ
-        let y = inertias[i].act(&o_m_i[i]);
-        let hm = y.mul_motion(&ovi);
+        let (y, hm) = if K {
+            (oy[i], hmom[i])
+        } else {
+            let y = inertias[i].act(&o_m_i[i]);
+            let hm = y.mul_motion(&ovi);
+            hmom[i] = hm;
+            oy[i] = y;
+            (y, hm)
+        };
         of[i] = y.mul_motion(&oai) + ovi.cross_force(&hm);
         doy[i] = variation_s(&y, &ovi);
-        hmom[i] = hm;
-        oy[i] = y;
         if F {
             fbody[i] = Force::zero();
             ext_t[i] = Vector3::zeros();
@@ -273,7 +282,9 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
     let n = if direct { model.nv } else { col_iv.len() };
     let [fq, fv, fa] = full;
     let (mq, mv, ma) = if direct {
-        h.fill(T::zero());
+        if !K {
+            h.fill(T::zero());
+        }
         (
             dtau_dq.as_mut_slice(),
             dtau_dv.as_mut_slice(),
@@ -320,7 +331,9 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
             // rows of this joint, columns of its subtree: Jᵀ ∂F
             for c in c0..end {
                 let at = r + c * n;
-                ma[at] = s.dot(&dfda[c]);
+                if !K {
+                    ma[at] = s.dot(&dfda[c]);
+                }
                 mq[at] = s.dot(&dfdq[c]);
                 mv[at] = s.dot(&dfdv[c]);
             }
@@ -335,7 +348,9 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
                 }
                 mq[at] = x;
                 mv[at] = av.dot(&dfda[c]) + jr.dot(&ytj[c]);
-                ma[at] = ma[r + c * n];
+                if !K {
+                    ma[at] = ma[r + c * n];
+                }
             }
         }
         // the subtree moves rigidly with the joint: ∂F/∂q += J ×* F
