@@ -25,6 +25,7 @@ mod inertia;
 mod lower;
 mod orient;
 mod sections;
+mod tendons;
 mod world;
 mod xml;
 
@@ -201,6 +202,7 @@ fn compile(
             excludes: Vec::new(),
             keys: Vec::new(),
             actuators: Vec::new(),
+            tendons: Vec::new(),
             warnings: Vec::new(),
         },
         names: Default::default(),
@@ -213,6 +215,13 @@ fn compile(
     }
     let mut world = cx.world;
     inertia::bodies(&mut world, &cx.set);
+    tendons::read(
+        &mut world,
+        &of("tendon").collect::<Vec<_>>(),
+        &defaults,
+        cx.set.autolimits,
+        &mut cx.not_modelled,
+    )?;
     actuators::read(
         &mut world,
         &of("actuator").collect::<Vec<_>>(),
@@ -227,7 +236,6 @@ fn compile(
         &mut cx.not_modelled,
     )?;
     for (tag, what) in [
-        ("tendon", "tendons: not modelled yet (MJCF simulation)"),
         (
             "equality",
             "equality constraints: not modelled yet (MJCF simulation)",
@@ -348,6 +356,23 @@ fn options(cx: &mut Ctx, els: &[&xml::El]) -> Result<(), MjcfError> {
             cx.not_modelled.push(format!(
                 "<option integrator=\"{i}\">: urdyn integrates with its own"
             ));
+        }
+        // MuJoCo's fluid forces (density and viscosity of the medium, wind): urdyn's
+        // bodies move in vacuum, so a non-zero medium is reported, not silently dropped.
+        for key in ["density", "viscosity"] {
+            if let Some(v) = a.num(key)? {
+                if v != 0.0 {
+                    cx.not_modelled.push(format!(
+                        "<option {key}=\"{v}\">: fluid forces (urdyn's bodies move in vacuum)"
+                    ));
+                }
+            }
+        }
+        if let Some(w) = a.arr::<3>("wind")? {
+            if w != [0.0; 3] {
+                cx.not_modelled
+                    .push("<option wind>: fluid forces (urdyn's bodies move in vacuum)".into());
+            }
         }
         for f in el.children.iter().filter(|c| c.tag == "flag") {
             if f.attr("gravity") == Some("disable") {

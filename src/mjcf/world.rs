@@ -151,6 +151,8 @@ pub struct World {
     pub keys: Vec<super::sections::MjKey>,
     /// `<actuator>`s in MuJoCo's order.
     pub actuators: Vec<super::actuators::MjActuator>,
+    /// `<tendon>`s in MuJoCo's order.
+    pub tendons: Vec<super::tendons::MjTendon>,
     /// What urdyn does not model, one line a kind.
     pub warnings: Vec<String>,
 }
