@@ -199,6 +199,7 @@ fn compile(
             geoms: Vec::new(),
             gravity: Vector3::new(0.0, 0.0, -9.81),
             timestep: 0.002,
+            contact_disabled: false,
             excludes: Vec::new(),
             keys: Vec::new(),
             actuators: Vec::new(),
@@ -377,6 +378,9 @@ fn options(cx: &mut Ctx, els: &[&xml::El]) -> Result<(), MjcfError> {
         for f in el.children.iter().filter(|c| c.tag == "flag") {
             if f.attr("gravity") == Some("disable") {
                 cx.world.gravity = Vector3::zeros();
+            }
+            if f.attr("contact") == Some("disable") {
+                cx.world.contact_disabled = true;
             }
         }
     }

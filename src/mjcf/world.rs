@@ -143,6 +143,9 @@ pub struct World {
     pub geoms: Vec<MjGeom>,
     /// `<option gravity>` (zero under `<flag gravity="disable">`).
     pub gravity: Vector3<f64>,
+    /// `<option><flag contact="disable">`: no contact at all (no collision
+    /// shapes, no ground).
+    pub contact_disabled: bool,
     /// `<option timestep>`.
     pub timestep: f64,
     /// `<contact><exclude>`: body pairs (MuJoCo ids) that never touch.
