@@ -2,7 +2,9 @@
 //! cartpole, reacher and pendulum, Gymnasium's reacher and pusher, and
 //! actuator_kinds.xml (position with kp and kv, velocity, motor, affine
 //! general, gears, a clamped ctrlrange, a forcerange, two actuators on one
-//! joint, an actuator beside a spring), contact off, driven 2 s by
+//! joint, an actuator beside a spring), dm_control's point_mass (motors on
+//! fixed tendons) and tendon_kinds.xml (fixed tendons' springs, dampers, a
+//! range, actuators pulling one- and two-joint tendons), contact off, driven 2 s by
 //! piecewise-constant random controls that keep every joint off its limits:
 //! urdyn's adaptive integrator (dop853, tol 1e-10) against MuJoCo's RK4 at
 //! dt = 1e-5 (tests/oracle/make_mjcf_actuator_fixtures.py), every joint within
@@ -77,7 +79,18 @@ fn actuated_models_follow_mujoco_within_1e_5() {
             .map(|n| n.as_str().unwrap())
             .collect();
         assert_eq!(names, want, "{file}: actuator names and order");
-        assert!(model.actuators.iter().all(|a| a.dof.is_some()), "{file}");
+        assert!(
+            model
+                .actuators
+                .iter()
+                .all(|a| a.dof.is_some() || !a.moment.is_empty()),
+            "{file}: every actuator modelled"
+        );
+        assert!(
+            !model.report.warnings.iter().any(|w| w.contains("tendon")),
+            "{file}: {:?}",
+            model.report.warnings
+        );
         let mut sim = Simulation::new(model, adaptive()).unwrap();
         let samples = entry["samples"].as_array().unwrap();
         let (q0, v0) = start(&sim, &samples[0]);
@@ -118,7 +131,7 @@ fn actuated_models_follow_mujoco_within_1e_5() {
             "{file}: urdyn and MuJoCo differ by {worst:e}"
         );
     }
-    assert_eq!(report.len(), 7);
+    assert_eq!(report.len(), 9);
 }
 
 #[test]
@@ -218,14 +231,20 @@ fn controls_are_checked_clamped_and_reported() {
     // what urdyn does not model is one line each in the import report
     let xml = r#"<mujoco><worldbody><body><joint name="j"/><geom size="0.1"/>
         <body pos="0 0 -1"><joint name="b" type="ball"/><geom size="0.1"/></body></body></worldbody>
-        <tendon><fixed name="t"><joint joint="j" coef="1"/></fixed></tendon>
+        <tendon><spatial name="t"><site site="s1"/><site site="s2"/></spatial></tendon>
         <actuator><muscle name="m" joint="j"/><motor name="onball" joint="b"/>
         <motor name="ontendon" tendon="t"/><general name="g" joint="j" dyntype="filter"/>
         <position name="p" joint="j" kp="2" forcerange="-1 2"/></actuator></mujoco>"#;
     let m = mjcf::load_str(xml, "inline.xml", Path::new(".")).unwrap();
     assert_eq!(m.actuators.len(), 5);
     let w = m.report.warnings.join("\n");
-    for needle in ["muscle", "ball or free", "tendons", "dyntype", "forcerange"] {
+    for needle in [
+        "muscle",
+        "ball or free",
+        "spatial tendons",
+        "dyntype",
+        "forcerange",
+    ] {
         assert!(w.contains(needle), "no warning about {needle}: {w}");
     }
     assert!(m.actuators[0].dof.is_none() && m.actuators[4].dof.is_some());
@@ -255,4 +274,43 @@ fn a_keyframe_sets_state_and_controls() {
         e.contains("key.xml") && e.contains("push") && e.contains("ctrl"),
         "{e}"
     );
+}
+
+/// A one-joint tendon's range, spring and damper are its joint's, in the
+/// joint's units (closed form: L = c q); a coupling tendon is reported.
+#[test]
+fn one_joint_tendons_become_joint_limits_springs_and_dampers() {
+    let model = mjcf::load_file(dir().join("actuators/tendon_kinds.xml")).unwrap();
+    let elbow = model.dofs.iter().find(|d| d.name == "elbow").unwrap();
+    // range ±2.5 on L = 2 q; spring 3 about L₀ = 0.2 beside the joint's 1 about 0.1;
+    // damper 0.5 beside the joint's 0.05
+    assert_eq!(
+        (elbow.limits.lower, elbow.limits.upper),
+        (Some(-1.25), Some(1.25))
+    );
+    assert!((elbow.stiffness - (1.0 + 3.0 * 4.0)).abs() < 1e-15);
+    let rest = (1.0 * 0.1 + 12.0 * 0.1) / 13.0; // (k_j r_j + k c² (L₀/c)) / (k_j + k c²)
+    assert!(
+        (elbow.springref - rest).abs() < 1e-15,
+        "{}",
+        elbow.springref
+    );
+    assert!((elbow.damping - (0.05 + 0.5 * 4.0)).abs() < 1e-15);
+    // the wrist cable (coef −1.5): the default tendon damper 0.02 · 2.25
+    let wrist = model.dofs.iter().find(|d| d.name == "wrist").unwrap();
+    assert!((wrist.damping - (0.05 + 0.02 * 2.25)).abs() < 1e-15);
+    let xml = r#"<mujoco><worldbody><body><joint name="a"/><geom size="0.1"/>
+        <body pos="0 0 -1"><joint name="b"/><geom size="0.1"/></body></body></worldbody>
+        <tendon><fixed name="t" stiffness="2"><joint joint="a" coef="1"/>
+        <joint joint="b" coef="1"/></fixed></tendon></mujoco>"#;
+    let m = mjcf::load_str(xml, "inline.xml", Path::new(".")).unwrap();
+    assert!(
+        m.report
+            .warnings
+            .iter()
+            .any(|w| w.contains("coupled joints")),
+        "{:?}",
+        m.report.warnings
+    );
+    assert!(m.dofs.iter().all(|d| d.stiffness == 0.0));
 }

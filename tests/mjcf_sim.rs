@@ -249,3 +249,24 @@ fn simulate_reads_the_mjcf_world_and_its_keyframe() {
         "{err}"
     );
 }
+
+/// `<option><flag contact="disable">` (dm_control's point_mass): nothing
+/// collides, as in MuJoCo (which finds no contact there, while the point mass
+/// starts inside the world's `target` sphere); the same file without the flag
+/// has collision shapes.
+#[test]
+fn a_disabled_contact_flag_leaves_no_collision_shape() {
+    let dir =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mjcf/dm_control");
+    let text = std::fs::read_to_string(dir.join("point_mass.xml")).unwrap();
+    assert!(text.contains(r#"<flag contact="disable"/>"#));
+    let off = urdyn::mjcf::load_str(&text, "point_mass.xml", &dir).unwrap();
+    assert!(off.collisions.is_empty(), "{:?}", off.collisions.len());
+    let on = urdyn::mjcf::load_str(
+        &text.replace(r#"<flag contact="disable"/>"#, ""),
+        "point_mass.xml",
+        &dir,
+    )
+    .unwrap();
+    assert!(!on.collisions.is_empty());
+}

@@ -20,6 +20,8 @@ pub struct MjActuator {
     pub name: String,
     /// The MuJoCo joint it drives; `None`: not modelled (it keeps its control slot).
     pub joint: Option<usize>,
+    /// The fixed tendon it pulls (MuJoCo tendon id), when that is its transmission.
+    pub tendon: Option<usize>,
     /// `gear[0]`: L = gear·q, the joint's generalized force gear·f.
     pub gear: f64,
     /// Affine gain g₀ + g₁L + g₂L̇ (MuJoCo's `gainprm[0..3]`; fixed: g₁ = g₂ = 0).
@@ -91,7 +93,7 @@ fn own_attrs(tag: &str) -> Option<&'static [&'static str]> {
 }
 
 /// `limited="true|false|auto"` with MuJoCo's `autolimits`: limited when a range is given.
-fn limited(
+pub(super) fn limited(
     a: &Attrs,
     flag: &str,
     range: &str,
@@ -167,6 +169,7 @@ pub(super) fn read(
         let target = targets[0];
         let tname = el.attr(target).unwrap_or_default();
         let mut joint = None;
+        let mut tendon = None;
         match target {
             "joint" | "jointinparent" => {
                 let j = world
@@ -179,7 +182,17 @@ pub(super) fn read(
                     _ => note("actuators on ball or free joints".into()),
                 }
             }
-            "tendon" => note("actuators on tendons".into()),
+            "tendon" => {
+                let t = world
+                    .tendons
+                    .iter()
+                    .position(|t| t.name == tname)
+                    .ok_or_else(|| a.err(target, "no such tendon"))?;
+                match world.tendons[t].fixed {
+                    true => tendon = Some(t),
+                    false => note("actuators on spatial tendons".into()),
+                }
+            }
             "cranksite" => note("slider-crank actuators".into()),
             "site" => note("actuators on sites".into()),
             _ => note("actuators on bodies (adhesion)".into()),
@@ -221,6 +234,7 @@ pub(super) fn read(
             t => {
                 note(format!("<{t}> actuators (activation dynamics)"));
                 joint = None;
+                tendon = None;
                 ([0.0; 3], [0.0; 3])
             }
         };
@@ -230,6 +244,7 @@ pub(super) fn read(
         world.actuators.push(MjActuator {
             name,
             joint,
+            tendon,
             gear: gear[0],
             gain,
             bias,
@@ -287,28 +302,59 @@ fn general(a: &Attrs, note: &mut impl FnMut(String)) -> Result<([f64; 3], [f64; 
 /// effort limit where that is exact — one actuator on a joint without a
 /// spring, a range symmetric about 0 — else a warning).
 pub(super) fn lower(world: &World, model: &mut crate::model::Model) -> Result<(), MjcfError> {
-    let dof_of = |j: usize| {
-        let name = &world.joints[j].name;
-        model
-            .dofs
-            .iter()
-            .position(|d| &d.name == name && d.kind.nv() == 1)
-    };
+    let joint_dof: Vec<Option<usize>> = world
+        .joints
+        .iter()
+        .map(|j| {
+            model
+                .dofs
+                .iter()
+                .position(|d| d.name == j.name && d.kind.nv() == 1)
+        })
+        .collect();
+    let dof_of = |j: usize| joint_dof[j];
+    let single = super::tendons::lower(world, model, &dof_of);
     let mut acts = Vec::with_capacity(world.actuators.len());
     let mut per_dof = vec![0usize; model.dofs.len()];
+    let mut coupled = 0usize;
     for a in &world.actuators {
-        let d = a.joint.and_then(dof_of);
+        // (dof, the tendon's coefficient on it) or a constant force over several
+        let (mut d, mut gear, mut moment) = (a.joint.and_then(dof_of), a.gear, Vec::new());
+        if let Some(t) = a.tendon {
+            if let Some((dt, c)) = single[t] {
+                d = Some(dt);
+                gear = a.gear * c;
+            } else if a.gain[1..] == [0.0, 0.0] && a.bias[1..] == [0.0, 0.0] {
+                moment = world.tendons[t]
+                    .active()
+                    .filter_map(|(j, c)| dof_of(j).map(|k| (model.dofs[k].iv, a.gear * c)))
+                    .collect();
+            } else {
+                coupled += 1;
+            }
+        }
         if let Some(d) = d {
             per_dof[d] += 1;
         }
-        acts.push((a, d));
+        acts.push((a, d, gear, moment));
+    }
+    if coupled > 0 {
+        model.report.warnings.push(format!(
+            "{coupled} actuator(s) with a length or velocity term on a fixed tendon over several joints: not modelled (coupled joints)"
+        ));
     }
     let mut out = Vec::with_capacity(acts.len());
-    for (a, d) in acts {
+    for (a, d, gear, moment) in acts {
+        if a.forcerange.is_some() && !moment.is_empty() {
+            model.report.warnings.push(format!(
+                "actuator \"{}\": its forcerange is not modelled (on a tendon over several joints)",
+                a.name
+            ));
+        }
         if let (Some(d), Some((lo, hi))) = (d, a.forcerange) {
             let dof = &mut model.dofs[d];
             if per_dof[d] == 1 && dof.stiffness == 0.0 && lo == -hi {
-                dof.limits.effort = Some(a.gear.abs() * hi);
+                dof.limits.effort = Some(gear.abs() * hi);
             } else {
                 model.report.warnings.push(format!(
                     "actuator \"{}\": its forcerange is not modelled (only a range symmetric about 0 of the joint's only actuator, on a joint without a spring, is)",
@@ -319,7 +365,8 @@ pub(super) fn lower(world: &World, model: &mut crate::model::Model) -> Result<()
         out.push(crate::model::Actuator {
             name: a.name.clone(),
             dof: d.map(|d| (model.dofs[d].iv, model.dofs[d].iq)),
-            gear: a.gear,
+            moment,
+            gear,
             gain: a.gain,
             bias: a.bias,
             ctrlrange: a.ctrlrange,

@@ -72,6 +72,28 @@ impl Defaults {
         };
         Ok(Attrs { el, base })
     }
+
+    /// As [`Defaults::resolve`], with the defaults of element kind `kind` (a
+    /// `<fixed>` tendon takes `<default><tendon>`); `kind` empty: no defaults
+    /// (a tendon's `<joint>` entries).
+    pub fn resolve_as<'a>(
+        &'a self,
+        el: &'a El,
+        childclass: &str,
+        kind: &str,
+    ) -> Result<Attrs<'a>, MjcfError> {
+        let class = el.attr("class").unwrap_or(childclass);
+        let defaults = self
+            .classes
+            .get(class)
+            .ok_or_else(|| el.err(format!("class=\"{class}\": unknown default class")))?;
+        let base = if kind.is_empty() {
+            None
+        } else {
+            defaults.get(kind)
+        };
+        Ok(Attrs { el, base })
+    }
 }
 
 /// An element's attributes with its class's defaults behind them.

@@ -31,6 +31,9 @@ fn bits_touch(a: &MjGeom, b: &MjGeom) -> bool {
 pub fn ground(world: &World) -> (Option<Ground>, Vec<String>) {
     let mut warnings = Vec::new();
     let mut best: Option<Ground> = None;
+    if world.contact_disabled {
+        return (None, warnings);
+    }
     for g in world.geoms.iter().filter(|g| g.kind == MjGeomType::Plane) {
         if g.contype == 0 && g.conaffinity == 0 {
             continue;

@@ -208,7 +208,13 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
     let mut collisions = Vec::new();
     let mut colliding = vec![false; world.geoms.len()];
     let mut later = 0usize;
-    for (k, g) in world.geoms.iter().enumerate() {
+    // `<flag contact="disable">`: no geom collides
+    let geoms = if world.contact_disabled {
+        &world.geoms[..0]
+    } else {
+        &world.geoms[..]
+    };
+    for (k, g) in geoms.iter().enumerate() {
         if g.contype == 0 && g.conaffinity == 0 {
             continue;
         }

@@ -25,6 +25,7 @@ mod inertia;
 mod lower;
 mod orient;
 mod sections;
+mod tendons;
 mod world;
 mod xml;
 
@@ -198,9 +199,11 @@ fn compile(
             geoms: Vec::new(),
             gravity: Vector3::new(0.0, 0.0, -9.81),
             timestep: 0.002,
+            contact_disabled: false,
             excludes: Vec::new(),
             keys: Vec::new(),
             actuators: Vec::new(),
+            tendons: Vec::new(),
             warnings: Vec::new(),
         },
         names: Default::default(),
@@ -213,6 +216,13 @@ fn compile(
     }
     let mut world = cx.world;
     inertia::bodies(&mut world, &cx.set);
+    tendons::read(
+        &mut world,
+        &of("tendon").collect::<Vec<_>>(),
+        &defaults,
+        cx.set.autolimits,
+        &mut cx.not_modelled,
+    )?;
     actuators::read(
         &mut world,
         &of("actuator").collect::<Vec<_>>(),
@@ -227,7 +237,6 @@ fn compile(
         &mut cx.not_modelled,
     )?;
     for (tag, what) in [
-        ("tendon", "tendons: not modelled yet (MJCF simulation)"),
         (
             "equality",
             "equality constraints: not modelled yet (MJCF simulation)",
@@ -349,9 +358,29 @@ fn options(cx: &mut Ctx, els: &[&xml::El]) -> Result<(), MjcfError> {
                 "<option integrator=\"{i}\">: urdyn integrates with its own"
             ));
         }
+        // MuJoCo's fluid forces (density and viscosity of the medium, wind): urdyn's
+        // bodies move in vacuum, so a non-zero medium is reported, not silently dropped.
+        for key in ["density", "viscosity"] {
+            if let Some(v) = a.num(key)? {
+                if v != 0.0 {
+                    cx.not_modelled.push(format!(
+                        "<option {key}=\"{v}\">: fluid forces (urdyn's bodies move in vacuum)"
+                    ));
+                }
+            }
+        }
+        if let Some(w) = a.arr::<3>("wind")? {
+            if w != [0.0; 3] {
+                cx.not_modelled
+                    .push("<option wind>: fluid forces (urdyn's bodies move in vacuum)".into());
+            }
+        }
         for f in el.children.iter().filter(|c| c.tag == "flag") {
             if f.attr("gravity") == Some("disable") {
                 cx.world.gravity = Vector3::zeros();
+            }
+            if f.attr("contact") == Some("disable") {
+                cx.world.contact_disabled = true;
             }
         }
     }

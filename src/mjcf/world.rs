@@ -143,6 +143,9 @@ pub struct World {
     pub geoms: Vec<MjGeom>,
     /// `<option gravity>` (zero under `<flag gravity="disable">`).
     pub gravity: Vector3<f64>,
+    /// `<option><flag contact="disable">`: no contact at all (no collision
+    /// shapes, no ground).
+    pub contact_disabled: bool,
     /// `<option timestep>`.
     pub timestep: f64,
     /// `<contact><exclude>`: body pairs (MuJoCo ids) that never touch.
@@ -151,6 +154,8 @@ pub struct World {
     pub keys: Vec<super::sections::MjKey>,
     /// `<actuator>`s in MuJoCo's order.
     pub actuators: Vec<super::actuators::MjActuator>,
+    /// `<tendon>`s in MuJoCo's order.
+    pub tendons: Vec<super::tendons::MjTendon>,
     /// What urdyn does not model, one line a kind.
     pub warnings: Vec<String>,
 }

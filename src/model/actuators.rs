@@ -13,6 +13,10 @@ pub struct Actuator {
     /// `None`: not modelled (its control is read and has no effect; the import
     /// report says why).
     pub dof: Option<(usize, usize)>,
+    /// Without `dof`: a constant-force actuator on a fixed tendon over several
+    /// joints, its generalized force per unit force (v coordinate, gear·coef);
+    /// empty otherwise (MJCF `<tendon><fixed>`, src/mjcf/tendons.rs).
+    pub moment: Vec<(usize, f64)>,
     /// L = gear·q; the joint's force gear·f.
     pub gear: f64,
     /// The affine gain (g₀, g₁, g₂).

@@ -54,11 +54,13 @@ impl Simulation {
             }
         }
         for (a, &x) in model.actuators.iter().zip(u.iter()) {
-            let Some((iv, _)) = a.dof else { continue };
             let x = match a.ctrlrange {
                 Some((lo, hi)) => x.clamp(lo, hi),
                 None => x,
             };
+            // a constant force along a fixed tendon over several joints
+            crate::sim::tendons::add_tendon_force(&mut ff, a, x);
+            let Some((iv, _)) = a.dof else { continue };
             let g = a.gear;
             ff[iv] += g * (a.gain[0] * x + a.bias[0]);
             kp[iv] -= g * g * (a.gain[1] * x + a.bias[1]);

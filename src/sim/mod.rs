@@ -65,6 +65,7 @@ mod contact_view;
 pub mod derivatives;
 pub mod factor;
 mod loops;
+mod tendons;
 pub use loops::LoopForce;
 pub(crate) mod integrators;
 mod islands;

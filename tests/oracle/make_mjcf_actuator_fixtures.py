@@ -2,6 +2,8 @@
 (issue 29, "Actuators right"): dm_control's acrobot, cartpole, reacher and
 pendulum, Gymnasium's reacher and pusher, and urdyn's actuator_kinds.xml
 (position, velocity, motor, affine general, gears, ctrl and force ranges),
+dm_control's point_mass (motors on fixed tendons) and urdyn's tendon_kinds.xml
+(fixed tendons: springs, dampers, a range, actuators pulling them),
 contact off, from qpos0 at rest (a limited hinge or slide within 0.1 of
 a limit at qpos0 starts at its range's middle instead: Gymnasium's pusher's elbow
 and wrist), driven 2 s by piecewise-constant random
@@ -26,6 +28,8 @@ MODELS = [
     "gymnasium/reacher.xml",
     "gymnasium/pusher.xml",
     "actuators/actuator_kinds.xml",
+    "dm_control/point_mass.xml",
+    "actuators/tendon_kinds.xml",
 ]
 DT, T, HOLD, EVERY = 1e-5, 2.0, 0.1, 0.5
 MARGIN = 0.05
