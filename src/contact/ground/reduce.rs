@@ -123,3 +123,75 @@ pub(super) fn reduce(
         }
     }
 }
+
+/// The slope (height along the normal over the distance across it) above
+/// which a point of a pair's patch is hidden by a deeper point of the same
+/// patch (see [`cull_hidden`]): 0.05, a tilt of 2.9° about the deeper point,
+/// which a body turning at 10 rad/s takes 5 steps of 1 ms to go through.
+pub(crate) const HIDDEN_SLOPE: f64 = 0.05;
+
+/// The slope above which a ground point is hidden by a deeper point of the
+/// same body less than [`TINY_PATCH`] of its shape's radius away (a
+/// rounded foot's ring of hull vertices: 0.1–0.5 mm up, 2–7 mm across).
+pub(crate) const HIDDEN_SLOPE_TINY: f64 = 0.02;
+
+/// A ground patch is tiny when its points are less than this fraction of
+/// their shape's bounding radius apart.
+pub(crate) const TINY_PATCH: f64 = 0.5;
+
+/// `Some((h, d))`: `p` lies `h` > 0 above `q` along `q`'s normal, `d` across it.
+#[inline]
+pub(crate) fn above(p: &ContactPoint, q: &ContactPoint) -> Option<(f64, f64)> {
+    let h = p.gap - q.gap;
+    if !(h > 0.0) {
+        return None;
+    }
+    let d = p.point - q.point;
+    let across = d - q.normal * d.dot(&q.normal);
+    Some((h, across.norm()))
+}
+
+/// Drops from `out[start..]` every point `p` that `hidden(p, q)` says a
+/// deeper point `q` of the same body in the same run of `out` hides (a
+/// body's shapes' points are contiguous). The callers' rule: `p` lies above
+/// `q` more steeply than a slope, so it cannot reach the other side before
+/// `q` unless the body turns about `q` through that slope within the step
+/// (a translation keeps it above `q`), and when it does, the next detection
+/// finds it; meanwhile it would carry no force, only rows. A rounded foot's
+/// ring of vertices a fraction of a millimetre above its lowest one, and a
+/// lower leg's copy of the foot millimetres up, are hidden; the corners of a
+/// face lying flat (equal heights) are not (docs/theory.md §"Contact points
+/// hidden by deeper ones").
+pub(crate) fn cull_hidden(
+    out: &mut Vec<ContactPoint>,
+    start: usize,
+    hidden: impl Fn(&ContactPoint, &ContactPoint) -> bool,
+) {
+    let n = out.len();
+    let mut w = start;
+    let mut a = start;
+    while a < n {
+        let body = out[a].body;
+        let mut b = a + 1;
+        while b < n && out[b].body == body {
+            b += 1;
+        }
+        // a run's verdicts first (a bit a point), then the kept ones moved down
+        let mut hide = 0u64;
+        if b - a > 1 && b - a <= 64 {
+            for i in a..b {
+                if (a..b).any(|j| j != i && hidden(&out[i], &out[j])) {
+                    hide |= 1 << (i - a);
+                }
+            }
+        }
+        for i in a..b {
+            if hide & (1 << (i - a)) == 0 {
+                out[w] = out[i];
+                w += 1;
+            }
+        }
+        a = b;
+    }
+    out.truncate(w);
+}
