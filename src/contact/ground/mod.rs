@@ -12,9 +12,9 @@ use crate::spatial::Se3;
 use nalgebra::Vector3;
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, SupportMap};
+pub(crate) use reduce::{above, cull_hidden, HIDDEN_SLOPE};
 use reduce::{
-    above, band_best, cull_hidden, reduce, HIDDEN_SLOPE_TINY, HOLD_DEEPEST, HOLD_EXTREME, MAX_DIRS,
-    TINY_PATCH, TINY_PATCH_MAX,
+    band_best, reduce, HIDDEN_SLOPE_TINY, HOLD_DEEPEST, HOLD_EXTREME, MAX_DIRS, TINY_PATCH,
 };
 
 #[derive(Clone, Debug)]
@@ -464,17 +464,13 @@ impl GroundContact {
             reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
         }
         // a tiny patch is one point: a point less than TINY_PATCH of its
-        // shape's radius (and TINY_PATCH_MAX) from a deeper one of its body,
-        // and above it more steeply than HIDDEN_SLOPE_TINY, is dropped when
-        // that deeper one touches (a body still in the air may be turning
-        // fast: talos falling limp sank 1.2 mm at its impact otherwise)
+        // shape's radius from a deeper one of its body, and above it more
+        // steeply than HIDDEN_SLOPE_TINY, is dropped
         let shapes = &self.shapes;
         cull_hidden(out, 0, |p, q| {
-            q.gap <= 0.0
-                && above(p, q).is_some_and(|(h, d)| {
-                    d < (TINY_PATCH * shapes[p.shape].bound).min(TINY_PATCH_MAX)
-                        && h > HIDDEN_SLOPE_TINY * d
-                })
+            above(p, q).is_some_and(|(h, d)| {
+                d < TINY_PATCH * shapes[p.shape].bound && h > HIDDEN_SLOPE_TINY * d
+            })
         });
         for &k in &self.prev_list {
             self.prev_flag[k] = false;

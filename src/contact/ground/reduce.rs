@@ -125,26 +125,23 @@ pub(super) fn reduce(
 }
 
 /// The slope (height along the normal over the distance across it) above
-/// which a ground point is hidden by a deeper point of the same body in a
-/// tiny patch (see [`cull_hidden`]): 0.02, a tilt of 1.15° about the deeper
-/// point, which a body turning at 10 rad/s takes 2 steps of 1 ms to go
-/// through (a rounded foot's ring of hull vertices: 0.1–0.5 mm up, 2–7 mm
-/// across).
-pub(super) const HIDDEN_SLOPE_TINY: f64 = 0.02;
+/// which a point of a pair's patch is hidden by a deeper point of the same
+/// patch (see [`cull_hidden`]): 0.05, a tilt of 2.9° about the deeper point,
+/// which a body turning at 10 rad/s takes 5 steps of 1 ms to go through.
+pub(crate) const HIDDEN_SLOPE: f64 = 0.05;
+
+/// The slope above which a ground point is hidden by a deeper point of the
+/// same body less than [`TINY_PATCH`] of its shape's radius away (a
+/// rounded foot's ring of hull vertices: 0.1–0.5 mm up, 2–7 mm across).
+pub(crate) const HIDDEN_SLOPE_TINY: f64 = 0.02;
 
 /// A ground patch is tiny when its points are less than this fraction of
-/// their shape's bounding radius apart, and less than [`TINY_PATCH_MAX`].
-pub(super) const TINY_PATCH: f64 = 0.5;
-
-/// The largest distance (m) between two points of a tiny patch: a foot's
-/// size (solo12's lower leg's copy of the foot lies 12 mm across from the
-/// foot's lowest point; a humanoid's sole's corners, farther apart, are kept
-/// whatever their shape's radius).
-pub(super) const TINY_PATCH_MAX: f64 = 0.02;
+/// their shape's bounding radius apart.
+pub(crate) const TINY_PATCH: f64 = 0.5;
 
 /// `Some((h, d))`: `p` lies `h` > 0 above `q` along `q`'s normal, `d` across it.
 #[inline]
-pub(super) fn above(p: &ContactPoint, q: &ContactPoint) -> Option<(f64, f64)> {
+pub(crate) fn above(p: &ContactPoint, q: &ContactPoint) -> Option<(f64, f64)> {
     let h = p.gap - q.gap;
     if !(h > 0.0) {
         return None;
@@ -165,7 +162,7 @@ pub(super) fn above(p: &ContactPoint, q: &ContactPoint) -> Option<(f64, f64)> {
 /// lower leg's copy of the foot millimetres up, are hidden; the corners of a
 /// face lying flat (equal heights) are not (docs/theory.md §"Contact points
 /// hidden by deeper ones").
-pub(super) fn cull_hidden(
+pub(crate) fn cull_hidden(
     out: &mut Vec<ContactPoint>,
     start: usize,
     hidden: impl Fn(&ContactPoint, &ContactPoint) -> bool,
