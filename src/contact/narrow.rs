@@ -5,7 +5,6 @@
 
 use super::face::{hull_on_face, FaceContact, FacePoint, FaceShape, HullRef};
 use super::frame::tangents;
-use super::ground::{above, cull_hidden, HIDDEN_SLOPE};
 use super::shapes::{from_pvec, to_pose, PairShape};
 use super::ContactPoint;
 use crate::spatial::Se3;
@@ -294,12 +293,8 @@ pub(super) fn reduce_pair(
     out: &mut Vec<ContactPoint>,
     make: impl Fn(&Raw) -> ContactPoint,
 ) {
-    let start = out.len();
     if raw.len() <= maxp {
         out.extend(raw.iter().map(&make));
-        cull_hidden(out, start, |p, q| {
-            above(p, q).is_some_and(|(h, d)| h > HIDDEN_SLOPE * d)
-        });
         return;
     }
     let deepest = (0..raw.len())
@@ -311,6 +306,7 @@ pub(super) fn reduce_pair(
         })
         .unwrap_or(0);
     let band = raw[deepest].gap + EXTREME_BAND;
+    let start = out.len();
     out.push(make(&raw[deepest]));
     let (t1, t2) = tangents(&raw[deepest].normal);
     let dirs = maxp - 1;
@@ -329,9 +325,6 @@ pub(super) fn reduce_pair(
             out.push(make(&raw[best]));
         }
     }
-    cull_hidden(out, start, |p, q| {
-        above(p, q).is_some_and(|(h, d)| h > HIDDEN_SLOPE * d)
-    });
 }
 
 #[cfg(test)]

@@ -12,10 +12,7 @@ use crate::spatial::Se3;
 use nalgebra::Vector3;
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, SupportMap};
-pub(crate) use reduce::{above, cull_hidden, HIDDEN_SLOPE};
-use reduce::{
-    band_best, reduce, HIDDEN_SLOPE_TINY, HOLD_DEEPEST, HOLD_EXTREME, MAX_DIRS, TINY_PATCH,
-};
+use reduce::{band_best, reduce, HOLD_DEEPEST, HOLD_EXTREME, MAX_DIRS};
 
 #[derive(Clone, Debug)]
 pub(super) enum ParryShape {
@@ -463,15 +460,6 @@ impl GroundContact {
             }
             reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
         }
-        // a tiny patch is one point: a point less than TINY_PATCH of its
-        // shape's radius from a deeper one of its body, and above it more
-        // steeply than HIDDEN_SLOPE_TINY, is dropped
-        let shapes = &self.shapes;
-        cull_hidden(out, 0, |p, q| {
-            above(p, q).is_some_and(|(h, d)| {
-                d < TINY_PATCH * shapes[p.shape].bound && h > HIDDEN_SLOPE_TINY * d
-            })
-        });
         for &k in &self.prev_list {
             self.prev_flag[k] = false;
         }
