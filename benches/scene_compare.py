@@ -32,7 +32,7 @@ MuJoCo's scene is built from the same file with mujoco.MjSpec:
 Euler and implicitfast are both timed (perf_counter around a Python loop of mj_step on a
 fresh MjData); the faster is reported.
 
-urdyn: `urdyn simulate --scene FILE --duration T --dt DT --package-path ... --out CSV`;
+urdyn: `urdyn simulate --scene FILE --duration T --dt DT --package-path ... --no-sleep --out CSV` (awake against awake);
 steps/s = steps / wall seconds of its stderr summary line (the stepping loop only).
 
 Per repeat: urdyn, then MuJoCo euler, then implicitfast; the table gives medians.
@@ -339,7 +339,7 @@ def bench(name, args, tmp):
                          "nexclude": model.nexclude}
     csvp = os.path.join(tmp, name + ".csv")
     cmd = [args.urdyn, "simulate", "--scene", path, "--duration", repr(args.duration),
-           "--dt", repr(args.dt)]
+           "--dt", repr(args.dt), "--no-sleep"]
     for p in args.roots:
         cmd += ["--package-path", p]
     cmd += ["--out", csvp]
@@ -427,7 +427,7 @@ def profile(name, args, tmp):
         csvp = os.path.join(tmp, name + "_profile.csv")
         # --integrator euler: without ground and obstacles urdyn's default would be dop853
         cmd = [args.urdyn, "simulate", "--scene", path, "--duration", repr(dur),
-               "--dt", repr(args.dt), "--integrator", "euler"]
+               "--dt", repr(args.dt), "--integrator", "euler", "--no-sleep"]
         for p in args.roots:
             cmd += ["--package-path", p]
         cmd += ["--out", csvp]

@@ -114,9 +114,13 @@ fn read_gains(
 /// batch entry equals a `Simulation` with the same `sleep`/`threads` stepped
 /// alone, bit for bit. `constraints`: a model's loops, as
 /// `Simulation(model, constraints=...)` (a scene's come from its file); each
-/// run starts them at its (q0[b], v0[b]) as `set_state` does.
+/// run starts them at its (q0[b], v0[b]) as `set_state` does. `controls`:
+/// an MJCF model's actuator controls, (B, nu) or (B, nstep, nu); each run
+/// equals a `Simulation` given `set_gains`, `set_targets` and then
+/// `set_controls` before its steps (the controls replace the servos' gains and
+/// targets, as `set_controls` does).
 #[pyfunction]
-#[pyo3(signature = (model, q0, v0, tau=None, nstep=None, dt=1e-3, threads=None, integrator=None, ground=Given::Omitted, friction=Given::Omitted, kp=None, kd=None, q_ref=None, v_ref=None, sleep=None, constraints=None))]
+#[pyo3(signature = (model, q0, v0, tau=None, nstep=None, dt=1e-3, threads=None, integrator=None, ground=Given::Omitted, friction=Given::Omitted, kp=None, kd=None, q_ref=None, v_ref=None, sleep=None, constraints=None, controls=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn rollout<'py>(
     py: Python<'py>,
@@ -136,6 +140,7 @@ pub fn rollout<'py>(
     v_ref: Option<&Bound<'py, PyAny>>,
     sleep: Option<bool>,
     constraints: Option<&Bound<'py, PyAny>>,
+    controls: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
     let nstep = match nstep {
         Some(n) if !n.is_none() => read_count(n, "nstep", 0)?,
@@ -181,6 +186,16 @@ pub fn rollout<'py>(
     let torques = PerRun::read(tau, "tau", b, nstep, nv)?;
     let q_refs = PerRun::read(q_ref, "q_ref", b, nstep, nq)?;
     let v_refs = PerRun::read(v_ref, "v_ref", b, nstep, nv)?;
+    let nu = proto.model.actuators.len();
+    let controls = PerRun::read(controls, "controls", b, nstep, nu)?;
+    if nu == 0 && !matches!(controls, PerRun::None) {
+        return Err(value_error(
+            "controls: the model has no actuators (nu = 0; MJCF <actuator> elements give them)",
+        ));
+    }
+    // with controls, each step's applied torques are made as `Simulation.step`
+    // makes them: tau's row (or the start's torques) plus the actuators' forces
+    let tau0 = proto.torques().clone();
     let kp = read_gains(kp, "kp", b, &proto.model)?;
     let kd = read_gains(kd, "kd", b, &proto.model)?;
     // the servo of run i, as `Simulation.set_gains` / `set_targets` set it
@@ -240,7 +255,22 @@ pub fn rollout<'py>(
                     if let Err(msg) = servo(&mut sim, i, k) {
                         return fail(qo, vo, k, true, msg);
                     }
-                    if let (true, Some(t)) = (torques.per_step(), torques.row(i, k, nstep, nv)) {
+                    if let Some(u) = controls.row(i, k, nstep, nu) {
+                        if k == 0 || controls.per_step() {
+                            let u = DVector::from_column_slice(u);
+                            if let Err(e) = sim.set_controls(&u) {
+                                return fail(qo, vo, k, true, format!("controls[{i}]: {e}"));
+                            }
+                        }
+                        match torques.row(i, k, nstep, nv) {
+                            Some(t) => set_torques(&mut sim, t),
+                            None => sim.torques_mut().copy_from(&tau0),
+                        }
+                        let ff = sim.actuator_torques().clone();
+                        *sim.torques_mut() += ff;
+                    } else if let (true, Some(t)) =
+                        (torques.per_step(), torques.row(i, k, nstep, nv))
+                    {
                         set_torques(&mut sim, t);
                     }
                     if let Err(e) = advance(&mut sim, dt) {
