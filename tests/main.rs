@@ -47,6 +47,7 @@ mod seed_examples;
 mod sensors;
 mod servo;
 mod sim;
+mod sim_clone;
 mod sim_no_alloc;
 mod sim_trust;
 mod simulate_cli;

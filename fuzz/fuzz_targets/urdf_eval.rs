@@ -4,7 +4,7 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 use std::collections::BTreeMap;
-use urdyn::cli::state::{BaseState, State, StatesFile};
+use urdyn::cli::state::{BaseState, JointValue, State, StatesFile};
 
 fn next(s: &mut u64) -> f64 {
     *s ^= *s << 13;
@@ -34,10 +34,10 @@ fuzz_target!(|data: &[u8]| {
     if model.nv > 64 {
         return;
     }
-    let mut maps: Vec<BTreeMap<String, f64>> = vec![BTreeMap::new(); 4];
+    let mut maps: Vec<BTreeMap<String, JointValue>> = vec![BTreeMap::new(); 4];
     for name in model.dof_names() {
         for m in maps.iter_mut() {
-            m.insert(name.to_string(), next(&mut seed));
+            m.insert(name.to_string(), JointValue::Scalar(next(&mut seed)));
         }
     }
     let mut quat = [next(&mut seed), next(&mut seed), next(&mut seed), next(&mut seed)];
@@ -64,7 +64,9 @@ fuzz_target!(|data: &[u8]| {
             v: maps.pop(),
             q: maps.pop(),
             base: Some(base),
+            ..State::default()
         }],
+        constraints: None,
     };
     let _ = urdyn::cli::eval::evaluate_json(&model, &states, "fuzz.urdf", "fuzz.json");
 });

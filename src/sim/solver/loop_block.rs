@@ -26,6 +26,9 @@ const DROP: f64 = 1e-10;
 /// them (the reduced Delassus matrix, [`LoopBlock::reduce`]).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct LoopBlock {
+    /// Most rows this block takes (its `w` is this square): a field, not the
+    /// `rows` vector's capacity, which a clone does not keep.
+    max: usize,
     rows: Vec<usize>,
     w: Vec<f64>,
     /// Rows in the block now (0: no block; the sweeps update loop rows
@@ -93,6 +96,7 @@ impl LoopBlock {
     pub(super) fn new(cap: usize) -> Self {
         let m = cap.min(LOOP_BLOCK_MAX);
         Self {
+            max: m,
             rows: Vec::with_capacity(m),
             w: vec![0.0; m * m],
             m: 0,
@@ -255,7 +259,7 @@ impl LoopBlock {
         self.rows.clear();
         for r in runs.iter().flat_map(|&(_, s, e)| s..e) {
             if kinds[r] == RowKind::Bilateral && w[r] > 1e-14 {
-                if self.rows.len() == LOOP_BLOCK_MAX.min(self.rows.capacity()) {
+                if self.rows.len() == self.max {
                     self.rows.clear();
                     return false;
                 }
