@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Issue 13: urdyn's mesh reader (src/contact/mesh.rs) against the mesh-loader crate
+"""Issue 13: urdyn's mesh reader (src/mesh/) against the mesh-loader crate
 (openrr) on every mesh file of example-robot-data, with coal's assimp loader (the one
 Pinocchio uses) as referee; writes docs/meshes.md.
 
@@ -93,7 +93,7 @@ def main():
     lines = [
         "# Mesh readers on example-robot-data",
         "",
-        "Issue 13: urdyn's own reader (`src/contact/mesh.rs`: stl_io, tobj, a COLLADA reader",
+        "Issue 13: urdyn's own reader (`src/mesh/`: stl_io, tobj, a COLLADA reader",
         "that places geometry by the scene graph and the unit) against the `mesh-loader`",
         "crate (openrr; the version in `benches/meshes/Cargo.lock`, 0.1.13), on every STL,",
         "OBJ and DAE file under example-robot-data's",

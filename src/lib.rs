@@ -58,6 +58,7 @@ pub mod cli;
 pub mod contact;
 pub mod dynamics;
 pub mod load;
+pub mod mesh;
 pub mod mjcf;
 pub mod model;
 pub mod scene;

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the mesh files that the URDFs of this folder name, under
 `example-robot-data/robots/...` beside them, so that their `package://example-robot-data/...`
-paths resolve with no download (src/contact/paths.rs: the URDF's folder is a package root).
+paths resolve with no download (src/mesh/paths.rs: the URDF's folder is a package root).
 
     make_meshes.py SHARE   # SHARE holds example-robot-data/robots/... (cmeel.prefix/share)
 
@@ -100,7 +100,7 @@ def _transform(node):
 
 def read_dae(path):
     """[(positions, triangles, rgba or None)] of a COLLADA file as urdyn reads it
-    (src/contact/mesh.rs): the visual scene walked, node transforms multiplied in
+    (src/mesh/): the visual scene walked, node transforms multiplied in
     document order, <unit meter> applied, <triangles>/<polylist>/<polygons> fanned, each
     primitive's colour the diffuse <color> of the material its symbol is bound to."""
     root = ET.parse(path).getroot()

@@ -63,18 +63,16 @@ pub mod filter;
 pub mod frame;
 pub mod ground;
 mod hull;
-pub mod mesh;
 mod narrow;
 pub mod pairs;
-mod paths;
 mod pipeline;
 pub(crate) mod shapes;
 
+pub use crate::mesh::resolve_mesh_path;
 pub use filter::DroppedPair;
 pub use ground::{GroundContact, GroundShape};
 use nalgebra::Vector3;
 pub use pairs::{tangents, PairContact};
-pub use paths::resolve_mesh_path;
 pub use pipeline::Collision;
 
 /// Contact parameters (see the module doc).
@@ -137,7 +135,7 @@ pub enum ContactError {
         link: String,
         /// What went wrong with the file.
         #[source]
-        source: mesh::MeshError,
+        source: crate::mesh::MeshError,
     },
     /// A collision primitive with a non-finite or negative dimension.
     #[error("link \"{link}\": collision {kind} has a non-finite or negative size")]

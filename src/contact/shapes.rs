@@ -12,9 +12,9 @@
 //! reversed).
 
 use super::hull::ClimbHull;
-use super::mesh;
-use super::paths::resolve_mesh_path;
 use super::ContactError;
+use crate::mesh;
+use crate::mesh::resolve_mesh_path;
 use crate::model::{CollisionGeom, Model, Shape};
 use crate::spatial::Se3;
 use nalgebra::{Matrix3, Vector3};

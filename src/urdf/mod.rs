@@ -6,10 +6,9 @@
 
 mod lower;
 mod parse;
-mod paths;
 mod validate;
 
-pub use paths::resolve_mesh_path;
+pub use crate::mesh::resolve_mesh_path;
 
 use crate::model::Model;
 use std::path::Path;

@@ -1,7 +1,7 @@
 //! Reads mesh file paths (one a line) on standard input and prints, for each, one
 //! JSON line: `{"file", "urdyn": {"min", "max", "n"} | {"error"}, "mesh_loader": ...}`,
 //! the axis-aligned bounding box of the vertices each reader returns (urdyn's
-//! `contact::mesh::load_vertices`, mesh-loader's `Loader::load`, every mesh of the
+//! `mesh::load_vertices`, mesh-loader's `Loader::load`, every mesh of the
 //! scene) and their number.
 use serde_json::{json, Value};
 use std::io::BufRead;
@@ -29,7 +29,7 @@ fn main() {
     for line in std::io::stdin().lock().lines() {
         let Ok(file) = line else { break };
         let path = Path::new(file.trim());
-        let ours = match urdyn::contact::mesh::load_vertices(path, [1.0; 3]) {
+        let ours = match urdyn::mesh::load_vertices(path, [1.0; 3]) {
             Ok(v) => bbox(v.iter().map(|p| [p.x, p.y, p.z])),
             Err(e) => json!({"error": e.to_string()}),
         };

@@ -3,7 +3,7 @@
 //!
 //! The page carries everything it draws, so it opens from disk with no network:
 //! - the robot's geometry, from the URDF's `<visual>` elements (the `<collision>`
-//!   elements of a link without any): meshes read by [`crate::contact::mesh::load_mesh`],
+//!   elements of a link without any): meshes read by [`crate::mesh::load_mesh`],
 //!   simplified by vertex clustering past [`MAX_MESH_TRIANGLES`] triangles and
 //!   quantised to 16 bits a coordinate; boxes, cylinders, capsules and spheres as
 //!   their dimensions (the page builds them); the URDF's material colours;
@@ -19,8 +19,8 @@
 //! The page sets `window.urdynViewer` (cli.md) once it has drawn its first frame.
 
 use crate::cli::output::write_atomic;
-use crate::contact::mesh::{load_mesh_colored, Rgba, TriMesh};
 use crate::dynamics::forward_kinematics;
+use crate::mesh::{load_mesh_colored, Rgba, TriMesh};
 use crate::model::{Data, Shape};
 use crate::spatial::Se3;
 use crate::{LoadOptions, Model};

@@ -6,7 +6,7 @@ use super::{
     read_trajectory, write_page, Geometry, PageSummary, Recorder, ViewError, Visual, VisualShape,
     MAX_MESH_TRIANGLES, MAX_PAGE_TRIANGLES,
 };
-use crate::contact::mesh::{load_mesh, TriMesh};
+use crate::mesh::{load_mesh, TriMesh};
 use crate::model::Shape;
 use crate::scene::{HeightFieldSpec, Scene};
 use nalgebra::Vector3;

@@ -2,10 +2,11 @@
 
 use super::super::hull::compressed_graph;
 use super::super::shapes::rot_x90;
-use super::super::{mesh, ContactError, ContactParams, ContactPoint, NO_GEOM};
+use super::super::{ContactError, ContactParams, ContactPoint, NO_GEOM};
 use super::reduce::reduce_directions;
 use super::{GroundContact, GroundShape, Manifold, ParryShape};
 use crate::contact::resolve_mesh_path;
+use crate::mesh;
 use crate::model::{Model, Shape};
 use crate::spatial::Se3;
 use nalgebra::Vector3;

@@ -2,11 +2,9 @@
 //! the document walked with quick-xml, the scene graph placed, the primitives
 //! triangulated, the materials' diffuse colours bound.
 
-use super::dae_parts::{dae_local_ref, dae_snippet, dae_transform, keep_used};
+use super::dae_parts::{dae_local_ref, dae_snippet, dae_transform, keep_used, DaePrim, Mat4};
 use super::Rgba;
 use std::collections::HashMap;
-
-pub(super) type Mat4 = nalgebra::Matrix4<f64>;
 
 /// Most node visits the scene walk makes (`<instance_node>` can form cycles or
 /// blow up exponentially).
@@ -46,21 +44,6 @@ pub(super) enum DaeText {
     Indices(&'static str),
     /// The `<diffuse><color>` of an `<effect id>`.
     Color(String),
-}
-
-/// A `<triangles>`, `<polylist>` or `<polygons>` element of a geometry.
-#[derive(Default)]
-pub(super) struct DaePrim {
-    pub(super) kind: &'static str,
-    /// Indices per vertex (the largest input offset plus one).
-    pub(super) stride: usize,
-    /// The offset and `source` (a `<vertices>` id) of the VERTEX input.
-    pub(super) vertex: Option<(usize, String)>,
-    /// The `material` symbol.
-    pub(super) material: Option<String>,
-    pub(super) vcount: Vec<usize>,
-    /// Every `<p>`, in order (`<polygons>` has one per polygon).
-    pub(super) ps: Vec<Vec<u32>>,
 }
 
 /// Positions of a COLLADA document (see the module doc).

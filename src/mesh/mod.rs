@@ -1,5 +1,8 @@
-//! Mesh files as URDFs use them, read only for ground contact and reduced to
-//! their vertex positions (the contact shape is their convex hull).
+//! Mesh files, read in a room of their own below the importers (URDF, MJCF,
+//! scenes) and contact: their paths resolved without ROS ([`resolve_mesh_path`]),
+//! their vertices (a contact shape is their convex hull), their triangles (a
+//! mesh obstacle, mass properties) and, for drawing, their colours. This room
+//! names no other module of the crate (tests/layering.rs).
 //!
 //! - STL (ASCII or binary) through `stl_io`;
 //! - Wavefront OBJ through `tobj` (every object's `v` positions);
@@ -203,6 +206,8 @@ fn read_raw(path: &Path, with_triangles: bool) -> Result<RawMesh, MeshError> {
 
 /// A 4×4 affine transform acting on column vectors (COLLADA's convention).
 mod dae;
+mod paths;
+pub use paths::resolve_mesh_path;
 mod dae_parts;
 use dae::read_dae_colored;
 #[cfg(test)]

@@ -2,8 +2,25 @@
 //! triangulation, number lists, local references, node transforms, and the
 //! positions that the triangles use.
 
-use super::dae::{DaePrim, Mat4};
 use nalgebra::Vector3;
+
+/// A 4 × 4 homogeneous transform of the scene graph.
+pub(super) type Mat4 = nalgebra::Matrix4<f64>;
+
+/// A `<triangles>`, `<polylist>` or `<polygons>` element of a geometry.
+#[derive(Default)]
+pub(super) struct DaePrim {
+    pub(super) kind: &'static str,
+    /// Indices per vertex (the largest input offset plus one).
+    pub(super) stride: usize,
+    /// The offset and `source` (a `<vertices>` id) of the VERTEX input.
+    pub(super) vertex: Option<(usize, String)>,
+    /// The `material` symbol.
+    pub(super) material: Option<String>,
+    pub(super) vcount: Vec<usize>,
+    /// Every `<p>`, in order (`<polygons>` has one per polygon).
+    pub(super) ps: Vec<Vec<u32>>,
+}
 
 impl DaePrim {
     /// The primitive's triangles as indices into its position source of `n`
