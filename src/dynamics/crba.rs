@@ -295,7 +295,11 @@ pub(crate) fn crba_at_placements<T: Scalar>(model: &Model<T>, data: &mut Data<T>
 /// joint placements at `q` (forward kinematics ran at it). The same local-frame
 /// pass as [`crba`], so the entries are bit for bit those of `data.h`'s upper
 /// triangle. Returns false, computing nothing, where that pass does not run
-/// (mimic joints, long chains) or a size does not fit.
+/// (mimic joints, long chains) or a size does not fit. `bodies`: only the
+/// bodies of these ranges `[b0, b1)` (whole trees of a forest: a tree's
+/// entries depend on its bodies alone; `None`: every body); the other trees'
+/// entries are left as they were.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn crba_packed<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,
@@ -304,6 +308,7 @@ pub(crate) fn crba_packed<T: Scalar>(
     out: &mut [T],
     start: &[usize],
     len: &[usize],
+    bodies: Option<&[(usize, usize)]>,
 ) -> bool {
     let nv = model.nv;
     let fits = start.len() >= nv
@@ -321,10 +326,15 @@ pub(crate) fn crba_packed<T: Scalar>(
             }
         }
     };
+    let all = [(1, model.nbodies)];
+    let bodies = bodies.unwrap_or(&all);
+    if bodies.iter().any(|&(b0, b1)| b0 < 1 || b1 > model.nbodies) {
+        return false;
+    }
     if placed {
-        local_pass::<T, true, _>(model, data, &[], write);
+        local_pass::<T, true, _>(model, data, &[], bodies, write);
     } else {
-        local_pass::<T, false, _>(model, data, q, write);
+        local_pass::<T, false, _>(model, data, q, bodies, write);
     }
     true
 }
@@ -338,7 +348,8 @@ fn crba_local_pass<T: Scalar, const PLACED: bool>(model: &Model<T>, data: &mut D
     let hs = h.as_mut_slice();
     assert!(hs.len() >= nv * nv, "H is nv x nv");
     let hp = hs.as_mut_ptr();
-    local_pass::<T, PLACED, _>(model, data, q, |row, c, val| {
+    let all = [(1, model.nbodies)];
+    local_pass::<T, PLACED, _>(model, data, q, &all, |row, c, val| {
         // SAFETY: row < nv and c < nv (local_pass asserts it before every
         // write), so both row + c nv and c + row nv are < nv² ≤ the length
         // of `hs` (asserted above), which outlives the pass.
@@ -352,11 +363,14 @@ fn crba_local_pass<T: Scalar, const PLACED: bool>(model: &Model<T>, data: &mut D
 
 /// The local-frame pass: every entry `H[row, c]` on the tree pattern (row a
 /// coordinate of a joint, c one of its subtree's; row < nv, c < nv) given to
-/// `write` (the entries off the pattern are zero and never given).
+/// `write` (the entries off the pattern are zero and never given), over the
+/// bodies of `bodies` (ranges `[b0, b1)` in 1..nb, each whole subtrees of the
+/// world: every tree's bodies, or some trees' of a forest).
 fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
     model: &Model<T>,
     data: &mut Data<T>,
     q: &[T],
+    bodies: &[(usize, usize)],
     mut write: W,
 ) {
     let nb = model.nbodies;
@@ -372,7 +386,7 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
     ic.copy_from_slice(inertias);
     // Subtree forces F = I^c S per coordinate.
     let fc = &mut data.crba_fc[..nv];
-    for i in (1..nb).rev() {
+    for i in bodies.iter().flat_map(|&(b0, b1)| (b0..b1).rev()) {
         let p = parent[i];
         let (head, tail) = ic.split_at_mut(i);
         let ici = tail[0];

@@ -41,6 +41,15 @@ pub struct MassFactor {
     anc: Vec<f64>,
     /// Tree: H̃'s diagonal before the elimination (the pivot test's scale).
     hdiag: Vec<f64>,
+    /// Tree: the dof ranges `[k0, k1)` factored and solved (whole trees),
+    /// and their bodies: every tree's, or the awake ones' when some sleep
+    /// ([`Self::set_awake`]). A sleeping tree's entries keep their last
+    /// values and its dofs are left alone: no row reaches them, and the step
+    /// holds them.
+    dof_ranges: Vec<(usize, usize)>,
+    body_ranges: Vec<(usize, usize)>,
+    partial: bool,
+    all: (usize, usize),
     /// Every dof's path (root … dof, ascending) back to back, then `0..n`.
     table: Vec<usize>,
     start: Vec<usize>,
@@ -94,6 +103,10 @@ impl MassFactor {
                 Vec::new()
             },
             hdiag: vec![0.0; if tree { n } else { 0 }],
+            dof_ranges: Vec::with_capacity(model.trees.len()),
+            body_ranges: Vec::with_capacity(model.trees.len()),
+            partial: false,
+            all: (0, n),
             table,
             start,
             len,
@@ -125,6 +138,7 @@ impl MassFactor {
     /// its upper triangle is read). Fails with the index of a pivot that is
     /// not positive.
     pub fn factor(&mut self, h: &DMatrix<f64>) -> Result<(), usize> {
+        self.partial = false;
         if self.tree {
             for k in 0..self.n {
                 let (s, l) = (self.start[k], self.len[k]);
@@ -156,25 +170,55 @@ impl MassFactor {
         placed: bool,
         diag: impl Fn(usize) -> f64,
     ) -> Option<Result<(), usize>> {
-        if !self.tree
-            || !crba_packed(
-                model,
-                data,
-                q,
-                placed,
-                &mut self.anc,
-                &self.start,
-                &self.len,
-            )
-        {
+        let bodies = self.partial.then_some(&self.body_ranges[..]);
+        let (anc, start, len) = (&mut self.anc, &self.start, &self.len);
+        if !self.tree || !crba_packed(model, data, q, placed, anc, start, len, bodies) {
+            self.partial = false;
             return None;
         }
-        for k in 0..self.n {
-            if let Some(x) = self.anc.get_mut(self.start[k] + self.len[k] - 1) {
-                *x += diag(k);
+        for r in 0..self.ranges().len() {
+            let (k0, k1) = self.ranges()[r];
+            for k in k0..k1 {
+                if let Some(x) = self.anc.get_mut(self.start[k] + self.len[k] - 1) {
+                    *x += diag(k);
+                }
             }
         }
         Some(self.factor_packed())
+    }
+
+    /// The next [`Self::factor_at`] (and the solves until the next factor)
+    /// work on the trees of `model` not flagged in `asleep` (per tree;
+    /// `None`: every tree): a forest's trees are independent blocks of H̃.
+    pub fn set_awake(&mut self, model: &Model, asleep: Option<&[bool]>) {
+        self.partial = false;
+        let Some(asleep) = asleep.filter(|_| self.tree) else {
+            return;
+        };
+        self.dof_ranges.clear();
+        self.body_ranges.clear();
+        let (mut nv, mut nb) = (0, 0);
+        for (t, tree) in model.trees.iter().enumerate() {
+            nv += tree.v.len();
+            nb += tree.bodies.len();
+            if asleep.get(t) == Some(&true) || tree.bodies.start < 1 {
+                continue;
+            }
+            self.dof_ranges.push((tree.v.start, tree.v.end));
+            self.body_ranges.push((tree.bodies.start, tree.bodies.end));
+        }
+        // the trees must cover the model exactly, else everything is done
+        self.partial = nv == self.n && nb + 1 == model.nbodies && asleep.len() == model.trees.len();
+    }
+
+    /// The dof ranges worked on: every dof, or the awake trees'.
+    #[inline]
+    fn ranges(&self) -> &[(usize, usize)] {
+        if self.partial {
+            &self.dof_ranges
+        } else {
+            std::slice::from_ref(&self.all)
+        }
     }
 
     /// The tree-sparse LTDL elimination (docs/theory.md §"Tree-sparse LTDL")
@@ -184,11 +228,19 @@ impl MassFactor {
     /// H̃[j, i] for j ancestor-or-self of i sits at `start[i] + depth(j)`).
     fn factor_packed(&mut self) -> Result<(), usize> {
         let tiny = 64.0 * f64::EPSILON;
-        let n = self.n;
-        for k in 0..n {
+        for r in 0..self.ranges().len() {
+            let (k0, k1) = self.ranges()[r];
+            self.factor_range(k0, k1, tiny)?;
+        }
+        Ok(())
+    }
+
+    /// [`Self::factor_packed`] on the dofs `[k0, k1)` (whole trees).
+    fn factor_range(&mut self, k0: usize, k1: usize, tiny: f64) -> Result<(), usize> {
+        for k in k0..k1 {
             self.hdiag[k] = self.anc[self.start[k] + self.len[k] - 1];
         }
-        for k in (0..n).rev() {
+        for k in (k0..k1).rev() {
             let (sk, lk) = (self.start[k], self.len[k]);
             let d = self.anc[sk + lk - 1];
             if !(d > tiny * self.hdiag[k].abs()) || !d.is_finite() {
@@ -206,7 +258,7 @@ impl MassFactor {
                 self.anc[sk + t] = a;
             }
         }
-        for k in 0..n {
+        for k in k0..k1 {
             let d = self.anc[self.start[k] + self.len[k] - 1];
             self.sqrt_d[k] = d.sqrt();
             self.inv_sqrt_d[k] = 1.0 / self.sqrt_d[k];
@@ -247,26 +299,27 @@ impl MassFactor {
         if self.tree {
             // Lᵀ y = b (leaves inwards), z = D⁻¹ y, L x = z (root outwards):
             // [`crate::dynamics::ltdl::ltdl_solve`] on the packed factor
-            let n = self.n;
-            let x = &mut x.as_mut_slice()[..n];
-            for i in (0..n).rev() {
-                let xi = x[i];
-                let (s, l) = (self.start[i], self.len[i]);
-                for t in (0..l - 1).rev() {
-                    let j = self.table[s + t];
-                    x[j] = madd(-self.anc[s + t], xi, x[j]);
+            let x = &mut x.as_mut_slice()[..self.n];
+            for &(k0, k1) in self.ranges() {
+                for i in (k0..k1).rev() {
+                    let xi = x[i];
+                    let (s, l) = (self.start[i], self.len[i]);
+                    for t in (0..l - 1).rev() {
+                        let j = self.table[s + t];
+                        x[j] = madd(-self.anc[s + t], xi, x[j]);
+                    }
                 }
-            }
-            for i in 0..n {
-                x[i] /= self.anc[self.start[i] + self.len[i] - 1];
-            }
-            for i in 0..n {
-                let mut acc = x[i];
-                let (s, l) = (self.start[i], self.len[i]);
-                for t in (0..l - 1).rev() {
-                    acc = madd(-self.anc[s + t], x[self.table[s + t]], acc);
+                for i in k0..k1 {
+                    x[i] /= self.anc[self.start[i] + self.len[i] - 1];
                 }
-                x[i] = acc;
+                for i in k0..k1 {
+                    let mut acc = x[i];
+                    let (s, l) = (self.start[i], self.len[i]);
+                    for t in (0..l - 1).rev() {
+                        acc = madd(-self.anc[s + t], x[self.table[s + t]], acc);
+                    }
+                    x[i] = acc;
+                }
             }
         } else {
             let (l, inv, x) = (self.m.as_slice(), &self.inv_sqrt_d[..], x.as_mut_slice());
@@ -360,13 +413,18 @@ impl MassFactor {
             return;
         }
         // L x = D^-½ z, root outwards
-        for i in 0..n.min(z.len()) {
-            let mut acc = z[i] * self.inv_sqrt_d[i];
-            let (s, l) = (self.start[i], self.len[i]);
-            for t in (0..l - 1).rev() {
-                acc -= self.anc[s + t] * z[self.table[s + t]];
+        if z.len() < n {
+            return;
+        }
+        for &(k0, k1) in self.ranges() {
+            for i in k0..k1 {
+                let mut acc = z[i] * self.inv_sqrt_d[i];
+                let (s, l) = (self.start[i], self.len[i]);
+                for t in (0..l - 1).rev() {
+                    acc -= self.anc[s + t] * z[self.table[s + t]];
+                }
+                z[i] = acc;
             }
-            z[i] = acc;
         }
     }
 
@@ -385,13 +443,18 @@ impl MassFactor {
             }
             return;
         }
-        for i in 0..n.min(v.len()).min(out.len()) {
-            let mut acc = v[i];
-            let (s, l) = (self.start[i], self.len[i]);
-            for t in (0..l - 1).rev() {
-                acc += self.anc[s + t] * v[self.table[s + t]];
+        if v.len() < n || out.len() < n {
+            return;
+        }
+        for &(k0, k1) in self.ranges() {
+            for i in k0..k1 {
+                let mut acc = v[i];
+                let (s, l) = (self.start[i], self.len[i]);
+                for t in (0..l - 1).rev() {
+                    acc += self.anc[s + t] * v[self.table[s + t]];
+                }
+                out[i] = self.sqrt_d[i] * acc;
             }
-            out[i] = self.sqrt_d[i] * acc;
         }
     }
 

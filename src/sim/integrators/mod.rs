@@ -92,6 +92,11 @@ impl Simulation {
         // a tree: H̃ formed and factored in the factor's packed storage, no
         // nv × nv matrix touched (`data.h` is left as it was)
         let placed = self.fk_valid && self.q.len() == self.model.nq;
+        // only the awake trees (a sleeping tree's dofs are held, and no row
+        // reaches them)
+        self.mass
+            .f
+            .set_awake(&self.model, self.sleep.sleeping_trees());
         let (arm, damp, servo) = (&self.armature, &self.damping, &self.servo);
         let diag = |k: usize| arm[k] + c * damp[k] + servo.diag(k, c);
         if let Some(r) =
