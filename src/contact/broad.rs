@@ -10,6 +10,9 @@
 
 /// "No pair" in the pair table.
 pub(crate) const NO_PAIR: u32 = u32::MAX;
+/// A pair the filter allows whose state is not made yet (made when its boxes
+/// first overlap: a pile of n shapes allows n²/2 pairs and ever touches O(n)).
+pub(crate) const LAZY_PAIR: u32 = u32::MAX - 1;
 
 /// The sweep's state.
 #[derive(Clone, Debug, Default)]
@@ -40,8 +43,9 @@ impl SweepAndPrune {
     }
 
     /// The overlapping pairs the table allows (`table[i·n + j]` the pair index
-    /// of shapes i, j, or [`NO_PAIR`]), appended to `out`.
-    pub fn overlaps(&mut self, table: &[u32], out: &mut Vec<u32>) {
+    /// of shapes i, j, or [`NO_PAIR`]), appended to `out`; those marked
+    /// [`LAZY_PAIR`] (allowed, not made yet) as shapes (i, j) to `fresh`.
+    pub fn overlaps(&mut self, table: &[u32], out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
         let n = self.order.len();
         // insertion sort by lower x
         for k in 1..n {
@@ -66,10 +70,10 @@ impl SweepAndPrune {
                 if lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2] {
                     continue;
                 }
-                if let Some(&p) = table.get(i * n + j) {
-                    if p != NO_PAIR {
-                        out.push(p);
-                    }
+                match table.get(i * n + j) {
+                    Some(&LAZY_PAIR) => fresh.push((i as u32, j as u32)),
+                    Some(&p) if p != NO_PAIR => out.push(p),
+                    _ => {}
                 }
             }
         }
@@ -97,20 +101,29 @@ mod tests {
             }
         }
         let mut out = Vec::new();
-        s.overlaps(&table, &mut out);
+        s.overlaps(&table, &mut out, &mut Vec::new());
         out.sort();
         assert_eq!(out, vec![12, 23]);
         // moved apart in z: none
         s.set(2, [1.5, 0.0, 5.0], [1.0; 3]);
         out.clear();
-        s.overlaps(&table, &mut out);
+        s.overlaps(&table, &mut out, &mut Vec::new());
         assert!(out.is_empty(), "{out:?}");
         // a pair the filter forbids is not reported
         s.set(2, [1.5, 0.0, 0.0], [1.0; 3]);
         table[1 * 4 + 2] = NO_PAIR;
         table[2 * 4 + 1] = NO_PAIR;
         out.clear();
-        s.overlaps(&table, &mut out);
+        s.overlaps(&table, &mut out, &mut Vec::new());
         assert_eq!(out, vec![23]);
+        // a pair allowed but not made yet is reported by its shapes
+        table[1 * 4 + 2] = LAZY_PAIR;
+        table[2 * 4 + 1] = LAZY_PAIR;
+        out.clear();
+        let mut fresh = Vec::new();
+        s.overlaps(&table, &mut out, &mut fresh);
+        assert_eq!(out, vec![23]);
+        let fresh: Vec<_> = fresh.iter().map(|&(i, j)| (i.min(j), i.max(j))).collect();
+        assert_eq!(fresh, vec![(1, 2)]);
     }
 }

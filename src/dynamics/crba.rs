@@ -286,9 +286,93 @@ pub(crate) fn crba_at_placements<T: Scalar>(model: &Model<T>, data: &mut Data<T>
     true
 }
 
-/// The local-frame pass; `PLACED`: `data.li_m_i` holds the joint placements
-/// at q (then `q` is not read), else they are computed from `q` and stored.
+/// H's entries on the tree pattern, packed per coordinate (the storage of the
+/// step's tree-sparse factor, docs/theory.md §"Tree-sparse LTDL"): `H[i, k]`
+/// for i an ancestor-or-self of k at `out[start[k] + len[i] − 1]`, where
+/// `start[k]` is where k's path (root … k, `len[k]` coordinates) begins. No
+/// nv × nv matrix is read or written (a scene of many models has an nv of
+/// thousands, and H's columns a page each). `placed`: `data.li_m_i` holds the
+/// joint placements at `q` (forward kinematics ran at it). The same local-frame
+/// pass as [`crba`], so the entries are bit for bit those of `data.h`'s upper
+/// triangle. Returns false, computing nothing, where that pass does not run
+/// (mimic joints, long chains) or a size does not fit. `bodies`: only the
+/// bodies of these ranges `[b0, b1)` (whole trees of a forest: a tree's
+/// entries depend on its bodies alone; `None`: every body); the other trees'
+/// entries are left as they were.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn crba_packed<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &[T],
+    placed: bool,
+    out: &mut [T],
+    start: &[usize],
+    len: &[usize],
+    bodies: Option<&[(usize, usize)]>,
+) -> bool {
+    let nv = model.nv;
+    let fits = start.len() >= nv
+        && len.len() >= nv
+        && (0..nv).all(|k| len[k] >= 1 && start[k] + len[k] <= out.len());
+    if model.has_mimic || !model.topology.crba_local || !fits || (!placed && q.len() != model.nq) {
+        return false;
+    }
+    let write = |row: usize, c: usize, val: T| {
+        // the upper triangle (row an ancestor-or-self of c, so row ≤ c): the
+        // entry the factor reads; the lower one is its mirror
+        if row <= c {
+            if let Some(x) = out.get_mut(start[c] + len[row] - 1) {
+                *x = val;
+            }
+        }
+    };
+    let all = [(1, model.nbodies)];
+    let bodies = bodies.unwrap_or(&all);
+    if bodies.iter().any(|&(b0, b1)| b0 < 1 || b1 > model.nbodies) {
+        return false;
+    }
+    if placed {
+        local_pass::<T, true, _>(model, data, &[], bodies, write);
+    } else {
+        local_pass::<T, false, _>(model, data, q, bodies, write);
+    }
+    true
+}
+
+/// The local-frame pass into `data.h` (both triangles); `PLACED`:
+/// `data.li_m_i` holds the joint placements at q (then `q` is not read), else
+/// they are computed from `q` and stored.
 fn crba_local_pass<T: Scalar, const PLACED: bool>(model: &Model<T>, data: &mut Data<T>, q: &[T]) {
+    let nv = model.nv;
+    let mut h = std::mem::replace(&mut data.h, nalgebra::DMatrix::zeros(0, 0));
+    let hs = h.as_mut_slice();
+    assert!(hs.len() >= nv * nv, "H is nv x nv");
+    let hp = hs.as_mut_ptr();
+    let all = [(1, model.nbodies)];
+    local_pass::<T, PLACED, _>(model, data, q, &all, |row, c, val| {
+        // SAFETY: row < nv and c < nv (local_pass asserts it before every
+        // write), so both row + c nv and c + row nv are < nv² ≤ the length
+        // of `hs` (asserted above), which outlives the pass.
+        unsafe {
+            *hp.add(row + c * nv) = val;
+            *hp.add(c + row * nv) = val;
+        }
+    });
+    data.h = h;
+}
+
+/// The local-frame pass: every entry `H[row, c]` on the tree pattern (row a
+/// coordinate of a joint, c one of its subtree's; row < nv, c < nv) given to
+/// `write` (the entries off the pattern are zero and never given), over the
+/// bodies of `bodies` (ranges `[b0, b1)` in 1..nb, each whole subtrees of the
+/// world: every tree's bodies, or some trees' of a forest).
+fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &[T],
+    bodies: &[(usize, usize)],
+    mut write: W,
+) {
     let nb = model.nbodies;
     let nv = model.nv;
     let joints = &model.joints[..nb];
@@ -302,10 +386,7 @@ fn crba_local_pass<T: Scalar, const PLACED: bool>(model: &Model<T>, data: &mut D
     ic.copy_from_slice(inertias);
     // Subtree forces F = I^c S per coordinate.
     let fc = &mut data.crba_fc[..nv];
-    // Every entry on the tree pattern is written; the others keep Data::new's zeros.
-    let hs = data.h.as_mut_slice();
-    let hs = &mut hs[..nv * nv];
-    for i in (1..nb).rev() {
+    for i in bodies.iter().flat_map(|&(b0, b1)| (b0..b1).rev()) {
         let p = parent[i];
         let (head, tail) = ic.split_at_mut(i);
         let ici = tail[0];
@@ -321,18 +402,10 @@ fn crba_local_pass<T: Scalar, const PLACED: bool>(model: &Model<T>, data: &mut D
             // H[k0 + r, c] = S_rᵀ F_c for every coordinate c of the subtree
             // (docs/theory.md §"Joint-force projection") and its mirror H[c, k0 + r].
             assert!(k0 + jm.nv() <= end && end <= nv, "subtree coordinates out of range");
-            let hp = hs.as_mut_ptr();
             for (dc, f) in fsub.iter().enumerate() {
                 let c = k0 + dc;
                 for r in 0..jm.nv() {
-                    let row = k0 + r;
-                    let val = jm.project_column(r, f);
-                    // SAFETY: row < end <= nv and c < end <= nv (asserted above), so
-                    // both row + c nv and c + row nv are < nv², the length of `hs`.
-                    unsafe {
-                        *hp.add(row + c * nv) = val;
-                        *hp.add(c + row * nv) = val;
-                    }
+                    write(k0 + r, c, jm.project_column(r, f));
                 }
             }
             if p != 0 {

@@ -37,8 +37,8 @@ pub use constraint_dynamics::{
     ConstraintDynamicsError,
 };
 pub use constraint_dynamics_derivatives::constraint_dynamics_derivatives;
-pub(crate) use crba::crba_at_placements;
 pub use crba::{crba, crba_upper};
+pub(crate) use crba::{crba_at_placements, crba_packed};
 pub use external::add_link_wrench;
 pub use frames::{forward_kinematics_second_order, frame_classical_acceleration, frame_velocity};
 pub use jacobian_dot::frame_jacobian_time_variation;

@@ -271,8 +271,8 @@ impl<T: Scalar> Data<T> {
             tau: DVector::zeros(nv),
             bias: DVector::zeros(nv),
             qdd: DVector::zeros(nv),
-            h: DMatrix::zeros(nv, nv),
-            chol: DMatrix::zeros(nv, nv),
+            h: lazy_zeros(nv, nv),
+            chol: lazy_zeros(nv, nv),
             tmp_a: DVector::zeros(nv),
             crba_ic: vec![CompositeInertia::zero(); nb],
             crba_f: DMatrix::zeros(nv, 6),
@@ -283,11 +283,11 @@ impl<T: Scalar> Data<T> {
             aba_uq: vec![T::zero(); nb],
             aba_c: vec![Motion::zero(); nb],
             jacobians: DMatrix::zeros(6, nv),
-            dtau_dq: DMatrix::zeros(nv, nv),
-            dtau_dv: DMatrix::zeros(nv, nv),
-            dqdd_dq: DMatrix::zeros(nv, nv),
-            dqdd_dv: DMatrix::zeros(nv, nv),
-            minv: DMatrix::zeros(nv, nv),
+            dtau_dq: lazy_zeros(nv, nv),
+            dtau_dv: lazy_zeros(nv, nv),
+            dqdd_dq: lazy_zeros(nv, nv),
+            dqdd_dv: lazy_zeros(nv, nv),
+            minv: lazy_zeros(nv, nv),
             deriv_col0: col0,
             deriv_sub_end: sub_end,
             deriv_col_iv: col_iv,
@@ -311,8 +311,8 @@ impl<T: Scalar> Data<T> {
             deriv_dfda: vec![Force::zero(); ncol],
             deriv_ytj: vec![Force::zero(); ncol],
             deriv_ext_e: vec![Force::zero(); ncol],
-            deriv_full: std::array::from_fn(|_| DMatrix::zeros(nfull, nfull)),
-            deriv_scratch: DMatrix::zeros(nv, nv),
+            deriv_full: std::array::from_fn(|_| lazy_zeros(nfull, nfull)),
+            deriv_scratch: lazy_zeros(nv, nv),
             deriv_tmp: DVector::zeros(nv),
             deriv_dof_end: dof_end,
             deriv_anc_runs: anc_runs,
@@ -332,6 +332,16 @@ impl<T: Scalar> Data<T> {
             deriv_prod_s_off: s_off,
         }
     }
+}
+
+/// An r × c zero matrix whose memory the system zeroes page by page when first
+/// touched (`vec![0; n]` of a float asks the allocator for zeroed memory:
+/// `calloc`, fresh pages for a large block), where `DMatrix::zeros` writes every
+/// entry. A scene of a thousand models has an nv of thousands: an nv × nv
+/// matrix of 300 MB that most steps touch only on H's tree pattern, or never
+/// (the derivatives' results), then costs the pages used, not the whole.
+pub(crate) fn lazy_zeros<T: Scalar>(r: usize, c: usize) -> DMatrix<T> {
+    DMatrix::from_vec(r, c, vec![T::zero(); r * c])
 }
 
 /// Per velocity coordinate (a model without mimic joints): one past its subtree's

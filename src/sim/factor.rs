@@ -13,9 +13,10 @@
 //! tree-sparse `mj_factorI` / `mj_solveM` idea). With mimic joints H̃ is not
 //! tree-shaped: a dense Cholesky H̃ = L Lᵀ (R = Lᵀ) and full-length rows.
 
+use crate::dynamics::crba_packed;
 use crate::dynamics::linalg::{by_size, cholesky_fast};
-use crate::dynamics::ltdl::{ltdl, ltdl_solve};
-use crate::model::Model;
+use crate::model::{Data, Model};
+use crate::spatial::ops::madd;
 use nalgebra::{DMatrix, DVector};
 
 const NONE: usize = usize::MAX;
@@ -25,21 +26,30 @@ const NONE: usize = usize::MAX;
 pub struct MassFactor {
     tree: bool,
     n: usize,
-    /// Dense: L (lower, column-major). Tree: the LTDL storage (Lᵀ in the upper
-    /// triangle, D on the diagonal).
+    /// Dense: L (lower, column-major). Tree: empty (the factor is `anc`).
     m: DMatrix<f64>,
     /// Tree: D^½. Dense: unused.
     sqrt_d: Vec<f64>,
     /// Tree: D^-½. Dense: 1 / Lₖₖ (the substitutions multiply, never divide:
     /// a division costs a dozen multiplies, and a step does hundreds).
     inv_sqrt_d: Vec<f64>,
-    lambda: Vec<usize>,
-    /// Tree: L's entries of each dof's column at its ancestors, packed along
-    /// [`Self::table`] (`anc[start[k] + s]` = L[path_k[s], k] for the dof's
-    /// path root … k; the last, the diagonal, unused): a row's transform reads
-    /// its bodies' few entries from one place, not from the columns of an
-    /// nv × nv matrix (a page each in a large scene).
+    /// Tree: the whole LTDL factor packed along [`Self::table`]
+    /// (`anc[start[k] + s]` = L[k, path_k[s]] for the dof's path root … k,
+    /// the last entry D[k]); before the elimination, H̃'s entries there. No
+    /// nv × nv matrix: a large scene's nv is in the thousands (docs/theory.md
+    /// §"Tree-sparse LTDL", "Packed storage").
     anc: Vec<f64>,
+    /// Tree: H̃'s diagonal before the elimination (the pivot test's scale).
+    hdiag: Vec<f64>,
+    /// Tree: the dof ranges `[k0, k1)` factored and solved (whole trees),
+    /// and their bodies: every tree's, or the awake ones' when some sleep
+    /// ([`Self::set_awake`]). A sleeping tree's entries keep their last
+    /// values and its dofs are left alone: no row reaches them, and the step
+    /// holds them.
+    dof_ranges: Vec<(usize, usize)>,
+    body_ranges: Vec<(usize, usize)>,
+    partial: bool,
+    all: (usize, usize),
     /// Every dof's path (root … dof, ascending) back to back, then `0..n`.
     table: Vec<usize>,
     start: Vec<usize>,
@@ -80,15 +90,23 @@ impl MassFactor {
         Self {
             tree,
             n,
-            m: DMatrix::zeros(n, n),
+            m: if tree {
+                DMatrix::zeros(0, 0)
+            } else {
+                DMatrix::zeros(n, n)
+            },
             sqrt_d: vec![1.0; n],
             inv_sqrt_d: vec![1.0; n],
-            lambda: model.dof_parent.clone(),
             anc: if tree {
                 vec![0.0; table.len()]
             } else {
                 Vec::new()
             },
+            hdiag: vec![0.0; if tree { n } else { 0 }],
+            dof_ranges: Vec::with_capacity(model.trees.len()),
+            body_ranges: Vec::with_capacity(model.trees.len()),
+            partial: false,
+            all: (0, n),
             table,
             start,
             len,
@@ -116,28 +134,147 @@ impl MassFactor {
         &self.table
     }
 
-    /// Factors `h` (H̃, full symmetric storage; on a tree only the pattern is
-    /// read). Fails with the index of a pivot that is not positive.
+    /// Factors `h` (H̃, full symmetric storage; on a tree only the pattern of
+    /// its upper triangle is read). Fails with the index of a pivot that is
+    /// not positive.
     pub fn factor(&mut self, h: &DMatrix<f64>) -> Result<(), usize> {
+        self.partial = false;
         if self.tree {
-            ltdl(h, &self.lambda, &mut self.m)?;
             for k in 0..self.n {
-                let d = self.m[(k, k)];
-                self.sqrt_d[k] = d.sqrt();
-                self.inv_sqrt_d[k] = 1.0 / self.sqrt_d[k];
                 let (s, l) = (self.start[k], self.len[k]);
-                let col = self.m.column(k);
                 for (a, &i) in self.anc[s..s + l].iter_mut().zip(&self.table[s..s + l]) {
-                    *a = col[i];
+                    *a = h[(i, k)];
                 }
             }
-            Ok(())
+            self.factor_packed()
         } else {
             cholesky_fast(h, &mut self.m)?;
             for k in 0..self.n {
                 self.inv_sqrt_d[k] = 1.0 / self.m[(k, k)];
             }
             Ok(())
+        }
+    }
+
+    /// Factors H̃ = H(q) + diag(`diag`) formed straight into the packed tree
+    /// storage (the local-frame CRBA, [`crba_packed`]: no nv × nv matrix is
+    /// touched; `data.h` is left as it was). `placed`: `data.li_m_i` holds the
+    /// joint placements at `q`. `None` where that does not apply (a dense
+    /// factor, mimic joints, a long chain): the caller forms H in `data.h`
+    /// and calls [`Self::factor`].
+    pub fn factor_at(
+        &mut self,
+        model: &Model,
+        data: &mut Data,
+        q: &[f64],
+        placed: bool,
+        diag: impl Fn(usize) -> f64,
+    ) -> Option<Result<(), usize>> {
+        let bodies = self.partial.then_some(&self.body_ranges[..]);
+        let (anc, start, len) = (&mut self.anc, &self.start, &self.len);
+        if !self.tree || !crba_packed(model, data, q, placed, anc, start, len, bodies) {
+            self.partial = false;
+            return None;
+        }
+        for r in 0..self.ranges().len() {
+            let (k0, k1) = self.ranges()[r];
+            for k in k0..k1 {
+                if let Some(x) = self.anc.get_mut(self.start[k] + self.len[k] - 1) {
+                    *x += diag(k);
+                }
+            }
+        }
+        Some(self.factor_packed())
+    }
+
+    /// The next [`Self::factor_at`] (and the solves until the next factor)
+    /// work on the trees of `model` not flagged in `asleep` (per tree;
+    /// `None`: every tree): a forest's trees are independent blocks of H̃.
+    pub fn set_awake(&mut self, model: &Model, asleep: Option<&[bool]>) {
+        self.partial = false;
+        let Some(asleep) = asleep.filter(|_| self.tree) else {
+            return;
+        };
+        self.dof_ranges.clear();
+        self.body_ranges.clear();
+        let (mut nv, mut nb) = (0, 0);
+        for (t, tree) in model.trees.iter().enumerate() {
+            nv += tree.v.len();
+            nb += tree.bodies.len();
+            if asleep.get(t) == Some(&true) || tree.bodies.start < 1 {
+                continue;
+            }
+            self.dof_ranges.push((tree.v.start, tree.v.end));
+            self.body_ranges.push((tree.bodies.start, tree.bodies.end));
+        }
+        // the trees must cover the model exactly, else everything is done
+        self.partial = nv == self.n && nb + 1 == model.nbodies && asleep.len() == model.trees.len();
+    }
+
+    /// The dof ranges worked on: every dof, or the awake trees'.
+    #[inline]
+    fn ranges(&self) -> &[(usize, usize)] {
+        if self.partial {
+            &self.dof_ranges
+        } else {
+            std::slice::from_ref(&self.all)
+        }
+    }
+
+    /// The tree-sparse LTDL elimination (docs/theory.md §"Tree-sparse LTDL")
+    /// in place on `anc` (holding H̃'s pattern): the arithmetic of
+    /// [`crate::dynamics::ltdl::ltdl`], entry for entry, on each dof's packed
+    /// path (the path of an ancestor i of k is the start of k's path, so
+    /// H̃[j, i] for j ancestor-or-self of i sits at `start[i] + depth(j)`).
+    fn factor_packed(&mut self) -> Result<(), usize> {
+        let tiny = 64.0 * f64::EPSILON;
+        for r in 0..self.ranges().len() {
+            let (k0, k1) = self.ranges()[r];
+            self.factor_range(k0, k1, tiny)?;
+        }
+        Ok(())
+    }
+
+    /// [`Self::factor_packed`] on the dofs `[k0, k1)` (whole trees).
+    fn factor_range(&mut self, k0: usize, k1: usize, tiny: f64) -> Result<(), usize> {
+        for k in k0..k1 {
+            self.hdiag[k] = self.anc[self.start[k] + self.len[k] - 1];
+        }
+        for k in (k0..k1).rev() {
+            let (sk, lk) = (self.start[k], self.len[k]);
+            let d = self.anc[sk + lk - 1];
+            if !(d > tiny * self.hdiag[k].abs()) || !d.is_finite() {
+                return Err(k);
+            }
+            // eliminate k from its ancestors i = path_k[t], t = depth(i)
+            for t in (0..lk - 1).rev() {
+                let i = self.table[sk + t];
+                let si = self.start[i];
+                let a = self.anc[sk + t] / d;
+                for s in (0..=t).rev() {
+                    let hkj = self.anc[sk + s];
+                    self.anc[si + s] = madd(-a, hkj, self.anc[si + s]);
+                }
+                self.anc[sk + t] = a;
+            }
+        }
+        for k in k0..k1 {
+            let d = self.anc[self.start[k] + self.len[k] - 1];
+            self.sqrt_d[k] = d.sqrt();
+            self.inv_sqrt_d[k] = 1.0 / self.sqrt_d[k];
+        }
+        Ok(())
+    }
+
+    /// Tree: L[k, j] for j an ancestor of k (0 otherwise).
+    #[inline(always)]
+    fn l_entry(&self, k: usize, j: usize) -> f64 {
+        let (s, l) = (self.start[k], self.len[k]);
+        let dj = self.len[j] - 1;
+        if dj + 1 < l && self.table[s + dj] == j {
+            self.anc[s + dj]
+        } else {
+            0.0
         }
     }
 
@@ -160,7 +297,30 @@ impl MassFactor {
     /// x ← H̃⁻¹ x.
     pub fn solve(&self, x: &mut DVector<f64>) {
         if self.tree {
-            ltdl_solve(&self.m, &self.lambda, x);
+            // Lᵀ y = b (leaves inwards), z = D⁻¹ y, L x = z (root outwards):
+            // [`crate::dynamics::ltdl::ltdl_solve`] on the packed factor
+            let x = &mut x.as_mut_slice()[..self.n];
+            for &(k0, k1) in self.ranges() {
+                for i in (k0..k1).rev() {
+                    let xi = x[i];
+                    let (s, l) = (self.start[i], self.len[i]);
+                    for t in (0..l - 1).rev() {
+                        let j = self.table[s + t];
+                        x[j] = madd(-self.anc[s + t], xi, x[j]);
+                    }
+                }
+                for i in k0..k1 {
+                    x[i] /= self.anc[self.start[i] + self.len[i] - 1];
+                }
+                for i in k0..k1 {
+                    let mut acc = x[i];
+                    let (s, l) = (self.start[i], self.len[i]);
+                    for t in (0..l - 1).rev() {
+                        acc = madd(-self.anc[s + t], x[self.table[s + t]], acc);
+                    }
+                    x[i] = acc;
+                }
+            }
         } else {
             let (l, inv, x) = (self.m.as_slice(), &self.inv_sqrt_d[..], x.as_mut_slice());
             by_size!(self.n, N => {
@@ -183,7 +343,7 @@ impl MassFactor {
         }
         let len = path.len().min(y.len());
         // Lᵀ g = j from the leaf in: along a path the tree is a chain, the
-        // ancestors of path[t] are path[..t]; L[i, j] sits at m[i·n + j]
+        // ancestors of path[t] are path[..t]
         for t in (0..len).rev() {
             let yt = y[t];
             if yt != 0.0 {
@@ -194,9 +354,8 @@ impl MassFactor {
                         }
                     }
                     None => {
-                        let col = path[t] * n;
                         for s in 0..t {
-                            y[s] -= m[col + path[s]] * yt;
+                            y[s] -= self.l_entry(path[t], path[s]) * yt;
                         }
                     }
                 }
@@ -229,9 +388,8 @@ impl MassFactor {
                     }
                 }
                 None => {
-                    let col = path[t] * n;
                     for s in 0..t {
-                        let l = m[col + path[s]];
+                        let l = self.l_entry(path[t], path[s]);
                         y0[s] -= l * a0;
                         y1[s] -= l * a1;
                         y2[s] -= l * a2;
@@ -255,14 +413,18 @@ impl MassFactor {
             return;
         }
         // L x = D^-½ z, root outwards
-        for i in 0..n {
-            let mut s = z[i] * self.inv_sqrt_d[i];
-            let mut j = self.lambda[i];
-            while j != NONE {
-                s -= self.m[(j, i)] * z[j];
-                j = self.lambda[j];
+        if z.len() < n {
+            return;
+        }
+        for &(k0, k1) in self.ranges() {
+            for i in k0..k1 {
+                let mut acc = z[i] * self.inv_sqrt_d[i];
+                let (s, l) = (self.start[i], self.len[i]);
+                for t in (0..l - 1).rev() {
+                    acc -= self.anc[s + t] * z[self.table[s + t]];
+                }
+                z[i] = acc;
             }
-            z[i] = s;
         }
     }
 
@@ -281,14 +443,18 @@ impl MassFactor {
             }
             return;
         }
-        for i in 0..n {
-            let mut s = v[i];
-            let mut j = self.lambda[i];
-            while j != NONE {
-                s += self.m[(j, i)] * v[j];
-                j = self.lambda[j];
+        if v.len() < n || out.len() < n {
+            return;
+        }
+        for &(k0, k1) in self.ranges() {
+            for i in k0..k1 {
+                let mut acc = v[i];
+                let (s, l) = (self.start[i], self.len[i]);
+                for t in (0..l - 1).rev() {
+                    acc += self.anc[s + t] * v[self.table[s + t]];
+                }
+                out[i] = self.sqrt_d[i] * acc;
             }
-            out[i] = self.sqrt_d[i] * s;
         }
     }
 

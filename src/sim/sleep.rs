@@ -148,6 +148,11 @@ impl Sleep {
         }
     }
 
+    /// Per tree: asleep, when any tree sleeps (`None`: every tree is awake).
+    pub fn sleeping_trees(&self) -> Option<&[bool]> {
+        (self.on && self.any_asleep).then_some(&self.asleep[..])
+    }
+
     /// The awake trees with dofs now.
     fn count_awake(&self) -> usize {
         (0..self.asleep.len())

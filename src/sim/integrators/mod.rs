@@ -84,10 +84,28 @@ impl Integrator {
 }
 
 impl Simulation {
-    /// H̃ = H(q) + A + c·D at the current q, factored into `mass.f`
-    /// (`data.h` is left holding H̃; its upper triangle only on a tree, all the
-    /// tree-sparse factorisation reads).
+    /// H̃ = H(q) + A + c·D at the current q, factored into `mass.f` (on a
+    /// tree with the local-frame CRBA: formed in the factor's own packed
+    /// storage, `data.h` untouched; else `data.h` is left holding H̃, its upper
+    /// triangle only on a tree, all the tree-sparse factorisation reads).
     pub(in crate::sim) fn factor_mass(&mut self, c: f64) -> Result<(), SimError> {
+        // a tree: H̃ formed and factored in the factor's packed storage, no
+        // nv × nv matrix touched (`data.h` is left as it was)
+        let placed = self.fk_valid && self.q.len() == self.model.nq;
+        // only the awake trees (a sleeping tree's dofs are held, and no row
+        // reaches them)
+        self.mass
+            .f
+            .set_awake(&self.model, self.sleep.sleeping_trees());
+        let (arm, damp, servo) = (&self.armature, &self.damping, &self.servo);
+        let diag = |k: usize| arm[k] + c * damp[k] + servo.diag(k, c);
+        if let Some(r) =
+            self.mass
+                .f
+                .factor_at(&self.model, &mut self.data, self.q.as_slice(), placed, diag)
+        {
+            return r.map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)));
+        }
         // the joint placements of the last forward kinematics at this q are
         // reused where the local-frame CRBA runs (it fills all of H, what
         // either factor reads)

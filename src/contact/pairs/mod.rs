@@ -13,16 +13,19 @@
 //! pair's slots: the slot of the same features last step (its impulse warm
 //! starts the solve), else a free one marked fresh (no warm start).
 
-use super::broad::{SweepAndPrune, NO_PAIR};
+use super::broad::{SweepAndPrune, LAZY_PAIR, NO_PAIR};
 use super::filter::{is_self_pair, may_touch, DroppedPair, START_OVERLAP};
 use super::narrow::{face_kind, face_points, parry_points, reduce_pair, FaceScratch, Raw};
-use super::shapes::{from_pvec, pair_shape, to_pose, to_pvec, PairShape};
+use super::shapes::{from_pvec, pair_shape, to_pose, PairShape};
 use super::{ContactError, ContactParams, ContactPoint};
 use crate::model::Model;
 use crate::spatial::Se3;
 use nalgebra::Vector3;
 use parry3d_f64::query::{ContactManifold, ContactManifoldsWorkspace};
 use std::path::PathBuf;
+
+mod apart;
+use apart::{apart_along, still_apart};
 
 /// One shape of pair contact.
 #[derive(Clone, Debug)]
@@ -35,12 +38,17 @@ struct Member {
     shape: PairShape,
 }
 
-/// The persistent state of one allowed pair.
+/// The persistent state of one allowed pair, made when its boxes first
+/// overlap (self pairs: at the start, for rule 4).
 #[derive(Clone)]
 struct Pair {
     /// Member indices (a < b; a moves, or both do).
     a: usize,
     b: usize,
+    /// Its place in the visiting order: (lower geometry index)·G + higher (G
+    /// geometries), the order of the pairs of geometries i < j, whatever
+    /// order the pairs were made in.
+    ord: u64,
     /// The first of its slots (global).
     slot_base: usize,
     /// The features each of its slots held last step (`NO_KEY`: free).
@@ -70,17 +78,32 @@ const NO_KEY: u64 = u64::MAX;
 #[derive(Clone)]
 pub struct PairContact {
     members: Vec<Member>,
+    /// The pairs made so far (in the order they were made).
     pairs: Vec<Pair>,
-    /// `table[i·n + j]`: the pair of members i, j ([`NO_PAIR`]: none).
+    /// `table[i·n + j]`: the pair of members i, j ([`NO_PAIR`]: none allowed;
+    /// [`LAZY_PAIR`]: allowed, not made yet).
     table: Vec<u32>,
+    /// Pairs the filter allows (made or not).
+    allowed: usize,
+    /// The friction of each member's geometry, and whether two members are
+    /// of one model (a self pair), for the pairs made later.
+    friction: Vec<f64>,
+    model_of: Vec<Option<usize>>,
+    /// Geometries in the model (the `ord` base).
+    ngeoms: u64,
     sap: SweepAndPrune,
-    overlapping: Vec<u32>,
+    /// The overlapping pairs of this detection as (ord, pair).
+    overlapping: Vec<(u64, u32)>,
+    /// Scratch: the broad phase's pair indices.
+    sap_ids: Vec<u32>,
+    /// Member pairs allowed and overlapping whose pair is not made yet.
+    fresh: Vec<(u32, u32)>,
     /// The pairs holding anything after the last detection (points, manifolds,
-    /// a separating axis), ascending: with the overlapping ones, the only pairs
+    /// a separating axis), by `ord`: with the overlapping ones, the only pairs
     /// a detection visits (never all pairs: their count is the square of the scene's).
-    live: Vec<u32>,
-    /// The pairs a detection visits (overlapping ∪ live), ascending.
-    visit: Vec<u32>,
+    live: Vec<(u64, u32)>,
+    /// The pairs a detection visits (overlapping ∪ live), by `ord`.
+    visit: Vec<(u64, u32)>,
     /// Each member's world pose (parry's frame) at the last detection.
     poses: Vec<Se3<f64>>,
     scratch: FaceScratch,
@@ -162,75 +185,114 @@ impl PairContact {
         let n = members.len();
         let maxp = params.max_points_per_shape.max(1);
         let mut table = vec![NO_PAIR; n * n];
-        let mut pairs = Vec::new();
+        let mut allowed = 0;
+        let friction: Vec<f64> = members.iter().map(|m| g[m.geom].friction).collect();
+        let model_of: Vec<Option<usize>> = members
+            .iter()
+            .map(|m| {
+                let x = &g[m.geom];
+                is_self_pair(x, x).then_some(x.model)
+            })
+            .collect();
         for i in 0..g.len() {
             for j in i + 1..g.len() {
                 let (a, b) = (member_of[i], member_of[j]);
                 if a == usize::MAX || b == usize::MAX || !may_touch(model, &g[i], &g[j]) {
                     continue;
                 }
-                // a non-convex shape (a mesh obstacle, a height field) is
-                // never shape a: parry is given it second
-                let (a, b) = if members[a].shape.convex || !members[b].shape.convex {
-                    (a, b)
-                } else {
-                    (b, a)
-                };
-                if !members[a].shape.convex {
+                if !members[a].shape.convex && !members[b].shape.convex {
                     continue; // two non-convex shapes (both static): never
                 }
-                let p = pairs.len() as u32;
-                table[a * n + b] = p;
-                table[b * n + a] = p;
-                pairs.push(Pair {
-                    a,
-                    b,
-                    slot_base: slot_offset + pairs.len() * maxp,
-                    keys: vec![NO_KEY; maxp],
-                    manifolds: Vec::new(),
-                    workspace: None,
-                    dropped: false,
-                    self_pair: is_self_pair(&g[i], &g[j]),
-                    axis: Vector3::zeros(),
-                    apart: None,
-                    face: face_kind(&members[a].shape, &members[b].shape),
-                    friction: g[i].friction.max(g[j].friction),
-                });
+                allowed += 1;
+                table[a * n + b] = LAZY_PAIR;
+                table[b * n + a] = LAZY_PAIR;
             }
         }
-        if pairs.is_empty() {
-            return Ok(None);
-        }
-        let mut sap = SweepAndPrune::new(n);
-        let mut moving = Vec::new();
-        let mut poses = Vec::with_capacity(n);
-        for (k, m) in members.iter().enumerate() {
-            poses.push(m.placement);
-            if m.body == 0 {
-                set_box(&mut sap, k, m, &m.placement, params.margin);
-            } else {
-                moving.push(k);
-            }
-        }
-        Ok(Some(Self {
-            nslots: pairs.len() * maxp,
+        let mut made = Self {
+            nslots: allowed * maxp,
             members,
             table,
-            sap,
+            allowed,
+            friction,
+            model_of,
+            ngeoms: g.len() as u64,
+            sap: SweepAndPrune::new(n),
             overlapping: Vec::new(),
+            sap_ids: Vec::new(),
+            fresh: Vec::new(),
             live: Vec::new(),
             visit: Vec::new(),
-            poses,
+            poses: Vec::with_capacity(n),
             scratch: FaceScratch::default(),
             stamp: 0,
             raw: Vec::new(),
-            moving,
+            moving: Vec::new(),
             queries: 0,
             margin: params.margin,
             max_points: maxp,
             slot_offset,
-            pairs,
-        }))
+            pairs: Vec::new(),
+        };
+        // self pairs now (rule 4 looks at them before the first step)
+        for a in 0..n {
+            for b in a + 1..n {
+                let self_pair = made.model_of[a].is_some() && made.model_of[a] == made.model_of[b];
+                if self_pair && made.table[a * n + b] == LAZY_PAIR {
+                    made.make_pair(a, b);
+                }
+            }
+        }
+        if allowed == 0 {
+            return Ok(None);
+        }
+        for (k, m) in made.members.iter().enumerate() {
+            made.poses.push(m.placement);
+            if m.body == 0 {
+                set_box(&mut made.sap, k, m, &m.placement, params.margin);
+            } else {
+                made.moving.push(k);
+            }
+        }
+        Ok(Some(made))
+    }
+
+    /// Makes the pair of members `i` and `j` (allowed, not made yet): its
+    /// state, its slots (the next `max_points`), its place in the table.
+    fn make_pair(&mut self, i: usize, j: usize) -> u32 {
+        let n = self.members.len();
+        // members are in geometry order: the lower one first, as the filter
+        // enumerated them (the sweep meets them in either order)
+        let (i, j) = (i.min(j), i.max(j));
+        let (mi, mj) = (&self.members[i], &self.members[j]);
+        // a non-convex shape (a mesh obstacle, a height field) is never shape
+        // a: parry is given it second
+        let (a, b) = if mi.shape.convex || !mj.shape.convex {
+            (i, j)
+        } else {
+            (j, i)
+        };
+        let (ga, gb) = (self.members[a].geom as u64, self.members[b].geom as u64);
+        let p = self.pairs.len() as u32;
+        self.table[a * n + b] = p;
+        self.table[b * n + a] = p;
+        let maxp = self.max_points;
+        let self_pair = self.model_of[a].is_some() && self.model_of[a] == self.model_of[b];
+        self.pairs.push(Pair {
+            a,
+            b,
+            ord: ga.min(gb) * self.ngeoms + ga.max(gb),
+            slot_base: self.slot_offset + p as usize * maxp,
+            keys: vec![NO_KEY; maxp],
+            manifolds: Vec::new(),
+            workspace: None,
+            dropped: false,
+            self_pair,
+            axis: Vector3::zeros(),
+            apart: None,
+            face: face_kind(&self.members[a].shape, &self.members[b].shape),
+            friction: self.friction[a].max(self.friction[b]),
+        });
+        p
     }
 
     /// Forgets every pair's manifolds and the features its slots held: the
@@ -248,14 +310,15 @@ impl PairContact {
     /// pairs touching a moving shape at once (more are found, and cost an
     /// allocation, in crowded scenes).
     pub fn max_points(&self) -> usize {
-        self.pairs.len().min(8 * self.moving.len().max(1)) * self.max_points
+        self.allowed.min(8 * self.moving.len().max(1)) * self.max_points
     }
 
     /// The geometry (index into the model's collisions) of member `k`.
     pub fn geoms(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
-        self.pairs
-            .iter()
-            .map(|p| (self.members[p.a].geom, self.members[p.b].geom))
+        let n = self.members.len();
+        (0..n * n)
+            .filter(move |&k| k / n < k % n && self.table[k] != NO_PAIR)
+            .map(move |k| (self.members[k / n].geom, self.members[k % n].geom))
     }
 
     /// Appends the contact points of every pair to `out`, given every body's
@@ -283,17 +346,28 @@ impl PairContact {
             self.poses[k] = w;
         }
         self.overlapping.clear();
-        self.sap.overlaps(&self.table, &mut self.overlapping);
+        self.fresh.clear();
+        let mut ids = std::mem::take(&mut self.sap_ids);
+        ids.clear();
+        self.sap.overlaps(&self.table, &mut ids, &mut self.fresh);
+        for f in 0..self.fresh.len() {
+            let (i, j) = self.fresh[f];
+            ids.push(self.make_pair(i as usize, j as usize));
+        }
+        self.overlapping
+            .extend(ids.iter().map(|&p| (self.pairs[p as usize].ord, p)));
+        self.sap_ids = ids;
         // the pairs not overlapping forget their points
-        // (sorted: the same order every step, whatever the sweep's)
+        // (sorted: the same order every step, whatever the sweep's or the
+        // order the pairs were made in)
         self.overlapping.sort_unstable();
         // visited: the overlapping pairs and those that held anything
         self.visit.clear();
         let (mut i, mut j) = (0, 0);
         let (ov, live) = (&self.overlapping, &self.live);
         while i < ov.len() || j < live.len() {
-            let x = ov.get(i).copied().unwrap_or(u32::MAX);
-            let y = live.get(j).copied().unwrap_or(u32::MAX);
+            let x = ov.get(i).copied().unwrap_or((u64::MAX, u32::MAX));
+            let y = live.get(j).copied().unwrap_or((u64::MAX, u32::MAX));
             self.visit.push(x.min(y));
             i += usize::from(x <= y);
             j += usize::from(y <= x);
@@ -301,8 +375,9 @@ impl PairContact {
         self.live.clear();
         let mut next = 0;
         for vi in 0..self.visit.len() {
-            let pi = self.visit[vi] as usize;
-            let hit = next < self.overlapping.len() && self.overlapping[next] as usize == pi;
+            let (ord, pi) = self.visit[vi];
+            let pi = pi as usize;
+            let hit = next < self.overlapping.len() && self.overlapping[next].1 as usize == pi;
             if hit {
                 next += 1;
             }
@@ -317,7 +392,7 @@ impl PairContact {
                 }
                 continue;
             }
-            self.live.push(pi as u32);
+            self.live.push((ord, pi as u32));
             let still = |b: usize| b == 0 || asleep.get(b) == Some(&true);
             if still(self.members[pair.a].body) && still(self.members[pair.b].body) {
                 continue;
@@ -456,53 +531,6 @@ impl PairContact {
     }
 }
 
-/// The gap of convex members `a` at `wa` and `b` at `wb` along the unit
-/// axis `u` (a's frame, from a toward b; zero: not known, −∞): min over b
-/// of u·x − max over a of u·x (two support points), a lower bound of their
-/// distance when positive.
-#[inline]
-fn apart_along(u: &Vector3<f64>, a: &Member, b: &Member, wa: &Se3<f64>, wb: &Se3<f64>) -> f64 {
-    if u.x == 0.0 && u.y == 0.0 && u.z == 0.0 {
-        return f64::NEG_INFINITY;
-    }
-    let (Some(sa), Some(sb)) = (
-        a.shape.shape.as_support_map(),
-        b.shape.shape.as_support_map(),
-    ) else {
-        return f64::NEG_INFINITY;
-    };
-    // b in a's frame: x = R p + t
-    let a_m_b = wa.inverse().compose(wb);
-    let top_a = u.dot(&from_pvec(sa.local_support_point(to_pvec(u))));
-    let d = a_m_b.rot.transpose() * (-u);
-    let low_b = u.dot(&a_m_b.act_point(&from_pvec(sb.local_support_point(to_pvec(&d)))));
-    low_b - top_a
-}
-
-/// Whether two shapes separated by a plane with a gap g (> the margin) at
-/// the world poses `then` are still more than `margin` apart at `wa`, `wb`
-/// without a support query: no point of a shape moved farther than D =
-/// |w·c − w₀·c| + ‖R − R₀‖_F |h| (c, h its box's centre and half extents in
-/// its frame: every point lies within |h| of c), so across that plane the
-/// shapes are still g − D_a − D_b apart (conservative advancement).
-fn still_apart(
-    then: Option<&(f64, Se3<f64>, Se3<f64>)>,
-    a: &Member,
-    b: &Member,
-    wa: &Se3<f64>,
-    wb: &Se3<f64>,
-    margin: f64,
-) -> bool {
-    let Some((gap, wa0, wb0)) = then else {
-        return false;
-    };
-    let moved = |m: &Member, w0: &Se3<f64>, w: &Se3<f64>| {
-        (w.act_point(&m.shape.mid) - w0.act_point(&m.shape.mid)).norm()
-            + (w.rot - w0.rot).norm() * m.shape.half.norm()
-    };
-    gap - moved(a, wa0, wa) - moved(b, wb0, wb) > margin
-}
-
 /// Sets member `k`'s broad-phase box: its shape's box at the world pose `w`
 /// boxed along the world axes (centre R·c + t, half extents |R|·h), grown by
 /// `margin`.
@@ -547,75 +575,5 @@ fn assign_slots(pair: &mut Pair, pts: &mut [ContactPoint]) {
         if let Some(p) = pts.iter().find(|p| p.slot == pair.slot_base + s) {
             *key = p.key;
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use nalgebra::{Matrix3, Rotation3, Unit};
-    use parry3d_f64::shape::SharedShape;
-
-    fn member(half: [f64; 3]) -> Member {
-        let shape = SharedShape::cuboid(half[0], half[1], half[2]);
-        Member {
-            geom: 0,
-            body: 1,
-            placement: Se3::identity(),
-            shape: PairShape::new(shape, Se3::identity(), true),
-        }
-    }
-
-    fn distance(a: &Member, b: &Member, wa: &Se3<f64>, wb: &Se3<f64>) -> f64 {
-        let pose = |w: &Se3<f64>| super::super::shapes::to_pose(w);
-        parry3d_f64::query::distance(&pose(wa), &*a.shape.shape, &pose(wb), &*b.shape.shape)
-            .unwrap()
-            .distance
-    }
-
-    #[test]
-    fn still_apart_is_never_wrong_and_not_vacuous() {
-        // a long bar beside a cube, 3 cm apart along x: turning the bar about
-        // its centre swings its end into the cube with no translation at all
-        let (a, b) = (member([0.02, 0.1, 0.02]), member([0.02, 0.02, 0.02]));
-        let margin = 0.005;
-        let wa0 = Se3::identity();
-        let wb0 = Se3::new(Matrix3::identity(), Vector3::new(0.07, 0.08, 0.0));
-        let gap = apart_along(&Vector3::x(), &a, &b, &wa0, &wb0);
-        assert!((gap - 0.03).abs() < 1e-12, "{gap}");
-        let then = (gap, wa0, wb0);
-        let mut seed = 7u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
-        let (mut kept, mut asked, mut touching) = (0, 0, 0);
-        for k in 0..4000 {
-            // turns up to 0.6 rad about axes near z, moves up to 2 cm
-            let s = (k % 10) as f64 / 10.0;
-            let mut turn = |w: &Se3<f64>, by: f64| {
-                let axis = Unit::new_normalize(Vector3::new(0.2 * rnd(), 0.2 * rnd(), 1.0));
-                let r = Rotation3::from_axis_angle(&axis, by * s * rnd()).into_inner();
-                Se3::new(
-                    r * w.rot,
-                    w.trans + Vector3::new(rnd(), rnd(), rnd()) * 0.02 * s * s,
-                )
-            };
-            let (wa, wb) = (turn(&wa0, 0.6), turn(&wb0, 0.1));
-            let d = distance(&a, &b, &wa, &wb);
-            touching += usize::from(d <= margin);
-            if still_apart(Some(&then), &a, &b, &wa, &wb, margin) {
-                kept += 1;
-                assert!(d > margin, "move {k}: still apart, but {d} m apart");
-            } else {
-                asked += 1;
-            }
-        }
-        assert!(
-            kept > 500 && asked > 500 && touching > 100,
-            "{kept} {asked} {touching}"
-        );
     }
 }
