@@ -56,6 +56,11 @@ pub struct Ground {
     pub height: f64,
     /// Its side's friction coefficient.
     pub friction: f64,
+    /// Torsional friction coefficient (m), if the scene sets one
+    /// (docs/theory.md §"Torsional and rolling friction").
+    pub torsion: Option<f64>,
+    /// Rolling friction coefficient (m), if the scene sets one.
+    pub rolling: Option<f64>,
 }
 
 /// One model of a loaded scene.
@@ -310,9 +315,15 @@ impl Loader<'_> {
             Some(g) => {
                 let height = g.height.unwrap_or(0.0);
                 self.finite("ground.height", &[height])?;
+                let spin = |key: &str, x: Option<f64>| match x {
+                    Some(x) => self.friction(key, Some(x)).map(Some),
+                    None => Ok(None),
+                };
                 Some(Ground {
                     height,
                     friction: self.friction("ground.friction", g.friction)?,
+                    torsion: spin("ground.torsion", g.torsion)?,
+                    rolling: spin("ground.rolling", g.rolling)?,
                 })
             }
         };
