@@ -97,10 +97,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let vl = o.rot * data.v[p.body].lin;
             let vp = vl + w.cross(&(p.point - o.trans));
             println!(
-                "  contact {:>10} slot {:3} p [{:+.4} {:+.4} {:+.4}] gap {:+.2e} f [{:+.3} {:+.3} {:+.3}] vpt [{:+.2e} {:+.2e} {:+.2e}] |ft|/fn {:.3}",
+                "  contact {:>10} slot {:3} p [{:+.4} {:+.4} {:+.4}] gap {:+.2e} f [{:+.3} {:+.3} {:+.3}] vpt [{:+.2e} {:+.2e} {:+.2e}] |ft|/fn {:.3} fresh {}",
                 sim.contact_link(&p).unwrap_or("?"), p.slot, p.point.x, p.point.y, p.point.z, p.gap,
                 f.force.x, f.force.y, f.force.z, vp.x, vp.y, vp.z,
-                (f.force.x.hypot(f.force.y)) / f.force.z.max(1e-12)
+                (f.force.x.hypot(f.force.y)) / f.force.z.max(1e-12),
+                p.fresh
             );
         }
     }
