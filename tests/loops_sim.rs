@@ -379,23 +379,28 @@ fn set_state_takes_a_fresh_energy_reference() {
     );
 }
 
-/// The Luxo lamp (assets/luxo.urdf, two parallelograms closed by `point`
-/// constraints) dropped onto the table exactly as `examples/luxo_on_table.rs`
-/// runs it (dt 1 ms, the scene's ground friction, sleep on): the loops' exact
-/// block (src/sim/solver/loop_block.rs) keeps both loops closed through the
-/// impacts — the violation, the distance between the two points each
-/// constraint holds together (outside truth: the geometry), stays below 1e-6 m
-/// at every step after landing —, the energy never rises above its lowest
-/// value so far by more than 1e-6·(|E₀| + M·g·1 m), and the lamp comes to rest
-/// (asleep) within 4 s with contacts holding it on the table top (z ≥ 0.75 m − 3 mm).
-#[test]
-fn luxo_on_the_table_keeps_its_loops_closed_and_rests() {
+/// What a Luxo drop did: landing time, largest loop violation after landing,
+/// largest energy rise above the lowest so far and its bound, when it fell
+/// asleep, the base's final height.
+struct LuxoDrop {
+    landed: f64,
+    worst: f64,
+    rise: f64,
+    allowed: f64,
+    asleep: Option<f64>,
+    z: f64,
+}
+
+/// Runs a Luxo scene (assets/) as the examples do (dt 1 ms, the scene's
+/// ground friction, sleep on) for `duration` s.
+fn luxo_drop(scene: &str, duration: f64) -> LuxoDrop {
     let root = env!("CARGO_MANIFEST_DIR");
-    let scene =
-        urdyn::scene::Scene::from_file(format!("{root}/assets/luxo_on_table.json"), &[]).unwrap();
+    let scene = urdyn::scene::Scene::from_file(format!("{root}/assets/{scene}"), &[]).unwrap();
     let ground = scene.ground.unwrap();
     let mut contact = urdyn::contact::ContactParams::default();
     contact.friction = ground.friction;
+    contact.torsion = ground.torsion.unwrap_or(contact.torsion);
+    contact.rolling = ground.rolling.unwrap_or(contact.rolling);
     let opts = SimOptions {
         dt: 1e-3,
         ground: Some(ground.height),
@@ -416,8 +421,8 @@ fn luxo_on_the_table_keeps_its_loops_closed_and_rests() {
     let e0 = sim.energy();
     let allowed = 1e-6 * (e0.abs() + 4.17 * 9.81);
     let (mut lowest, mut rise) = (e0, 0.0f64);
-    let (mut landed, mut worst, mut asleep_at) = (None, 0.0f64, None);
-    while sim.time() < 4.0 - 1e-9 {
+    let (mut landed, mut worst, mut asleep) = (None, 0.0f64, None);
+    while sim.time() < duration - 1e-9 {
         sim.step().unwrap();
         let e = sim.energy();
         rise = rise.max(e - lowest);
@@ -428,20 +433,82 @@ fn luxo_on_the_table_keeps_its_loops_closed_and_rests() {
         if landed.is_some() {
             worst = worst.max(sim.constraint_violation());
         }
-        if asleep_at.is_none() && sim.awake() == 0 {
-            asleep_at = Some(sim.time());
+        if asleep.is_none() && sim.awake() == 0 {
+            asleep = Some(sim.time());
         }
     }
-    let landed = landed.expect("the lamp lands");
-    assert!((0.2..0.3).contains(&landed), "landed at {landed}");
-    assert!(worst < 1e-6, "loops opened by {worst:.3e} m after landing");
-    assert!(
-        rise <= allowed,
-        "energy rose {rise:.3e} J (allowed {allowed:.3e})"
+    LuxoDrop {
+        landed: landed.expect("the lamp lands"),
+        worst,
+        rise,
+        allowed,
+        asleep,
+        z: sim.q()[2],
+    }
+}
+
+/// The Luxo lamp (assets/luxo.urdf, two parallelograms closed by `point`
+/// constraints) dropped onto the table exactly as `examples/luxo_on_table.rs`
+/// runs it (dt 1 ms, the scene's ground friction, sleep on): the loops' exact
+/// block (src/sim/solver/loop_block.rs) keeps both loops closed through the
+/// impacts — the violation, the distance between the two points each
+/// constraint holds together (outside truth: the geometry), stays below 1e-6 m
+/// at every step after landing —, the energy never rises above its lowest
+/// value so far by more than 1e-6·(|E₀| + M·g·1 m), and the lamp comes to rest
+/// (asleep) within 4 s with contacts holding it on the table top (z ≥ 0.75 m − 3 mm).
+#[test]
+fn luxo_on_the_table_keeps_its_loops_closed_and_rests() {
+    let d = luxo_drop("luxo_on_table.json", 4.0);
+    eprintln!(
+        "luxo on the table: landed {:.3} s, violation {:.3e}, energy rise {:.3e} (allowed {:.3e}), asleep at {:?}",
+        d.landed, d.worst, d.rise, d.allowed, d.asleep
     );
-    let asleep = asleep_at.expect("the lamp comes to rest within 4 s");
+    assert!((0.2..0.3).contains(&d.landed), "landed at {}", d.landed);
+    assert!(
+        d.worst < 1e-6,
+        "loops opened by {:.3e} m after landing",
+        d.worst
+    );
+    assert!(
+        d.rise <= d.allowed,
+        "energy rose {:.3e} J (allowed {:.3e})",
+        d.rise,
+        d.allowed
+    );
+    let asleep = d.asleep.expect("the lamp comes to rest within 4 s");
     assert!(asleep < 4.0, "asleep at {asleep}");
     // resting on the table top (0.75 m), not fallen to the ground
-    let z = sim.q()[2];
-    assert!(z > 0.75 - 3e-3, "base at z = {z}");
+    assert!(d.z > 0.75 - 3e-3, "base at z = {}", d.z);
+}
+
+/// The Luxo lamp dropped onto the ground from 0.3 m, tilted 10°, exactly as
+/// `examples/luxo_drop.rs` runs it: it tips over and lands on its base's rim
+/// and its head, each touching at one point. Without torsional and rolling
+/// friction the base pivoted and rolled on that point forever (Coulomb
+/// friction at a point does no work against a spin about the normal, nor
+/// against rolling); with the contact model's default μ_τ = 5 mm, μ_r = 0.1 mm
+/// (src/sim/constraints/spin.rs) it comes to rest and sleeps within the
+/// example's 8 s, its loops closed and its energy never rising.
+#[test]
+fn luxo_dropped_on_the_ground_rests_with_its_loops_closed() {
+    let d = luxo_drop("luxo_drop.json", 8.0);
+    eprintln!(
+        "luxo on the ground: landed {:.3} s, violation {:.3e}, energy rise {:.3e} (allowed {:.3e}), asleep at {:?}",
+        d.landed, d.worst, d.rise, d.allowed, d.asleep
+    );
+    assert!(
+        d.worst < 1e-6,
+        "loops opened by {:.3e} m after landing",
+        d.worst
+    );
+    assert!(
+        d.rise <= d.allowed,
+        "energy rose {:.3e} J (allowed {:.3e})",
+        d.rise,
+        d.allowed
+    );
+    let asleep = d.asleep.expect("the lamp comes to rest within 8 s");
+    assert!(asleep < 8.0, "asleep at {asleep}");
+    // lying on the ground: the base's origin below its 0.11 m radius
+    assert!(d.z > -1e-3 && d.z < 0.11, "base at z = {}", d.z);
 }

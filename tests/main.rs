@@ -21,6 +21,7 @@ mod bad_inputs;
 mod cli_errors;
 mod constraint_dynamics;
 mod contact_pairs;
+mod contact_spin;
 mod derivatives;
 mod eval_constrained;
 mod eval_singular;

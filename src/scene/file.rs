@@ -52,6 +52,14 @@ pub struct GroundSpec {
     /// Coulomb friction coefficient on the ground's side (default 1.0).
     #[serde(default)]
     pub friction: Option<f64>,
+    /// Torsional friction coefficient of contacts with the ground (m; default
+    /// the contact model's, `ContactParams::torsion`).
+    #[serde(default)]
+    pub torsion: Option<f64>,
+    /// Rolling friction coefficient of contacts with the ground (m; default
+    /// the contact model's, `ContactParams::rolling`).
+    #[serde(default)]
+    pub rolling: Option<f64>,
 }
 
 /// How a model's root link is attached to the world.

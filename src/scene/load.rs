@@ -141,9 +141,15 @@ impl Loader<'_> {
             Some(g) => {
                 let height = g.height.unwrap_or(0.0);
                 self.finite("ground.height", &[height])?;
+                let spin = |key: &str, x: Option<f64>| match x {
+                    Some(x) => self.friction(key, Some(x)).map(Some),
+                    None => Ok(None),
+                };
                 Some(Ground {
                     height,
                     friction: self.friction("ground.friction", g.friction)?,
+                    torsion: spin("ground.torsion", g.torsion)?,
+                    rolling: spin("ground.rolling", g.rolling)?,
                 })
             }
         };

@@ -56,6 +56,11 @@ pub struct Ground {
     pub height: f64,
     /// Its side's friction coefficient.
     pub friction: f64,
+    /// Torsional friction coefficient (m), if the scene sets one
+    /// (docs/theory.md §"Torsional and rolling friction").
+    pub torsion: Option<f64>,
+    /// Rolling friction coefficient (m), if the scene sets one.
+    pub rolling: Option<f64>,
 }
 
 /// One model of a loaded scene.

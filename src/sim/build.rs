@@ -113,6 +113,18 @@ impl Simulation {
             limit_push_cap: opts.limit_push_speed,
             contact_slop: opts.contact.slop,
             limit_slop: 1e-4,
+            // torsional and rolling friction: rows of the PGS solve (the
+            // Newton solver keeps to the Coulomb cone)
+            torsion: if opts.solver == Solver::Pgs {
+                opts.contact.torsion
+            } else {
+                0.0
+            },
+            rolling: if opts.solver == Solver::Pgs {
+                opts.contact.rolling
+            } else {
+                0.0
+            },
         };
         let total_mass: f64 = model.inertias.iter().skip(1).map(|i| i.mass).sum();
         let scale = total_mass * model.gravity.norm();

@@ -17,6 +17,7 @@
 //! - position pass: b_pos = min(β(−φ − slop)/Δt, cap) where φ < −slop.
 
 mod solve;
+mod spin;
 
 use super::factor::MassFactor;
 use super::islands::Islands;
@@ -48,6 +49,10 @@ pub(crate) struct RowParams {
     pub contact_slop: f64,
     /// The joint-limit slop (rad or m).
     pub limit_slop: f64,
+    /// Torsional friction coefficient (m; 0: no torsion rows), [`spin`].
+    pub torsion: f64,
+    /// Rolling friction coefficient (m; 0: no rolling rows), [`spin`].
+    pub rolling: f64,
 }
 
 /// How many rows of each kind one assembly made.
@@ -63,12 +68,14 @@ pub(crate) struct RowCounts {
     pub violated: usize,
     /// Loop-constraint rows (bilateral).
     pub loops: usize,
+    /// Torsional and rolling friction rows ([`spin`]).
+    pub spin: usize,
 }
 
 impl RowCounts {
     /// All rows: friction + limits + 3 · contacts.
     pub fn total(&self) -> usize {
-        self.friction + self.limits + 3 * self.contacts + self.loops
+        self.friction + self.limits + 3 * self.contacts + self.loops + self.spin
     }
     /// Whether the step touches anything (a contact point or a joint limit):
     /// such a step is taken by the time-stepping scheme.
@@ -126,6 +133,8 @@ pub(crate) struct Constraints {
     pool: Option<std::sync::Arc<rayon::ThreadPool>>,
     /// A subspace step's scratch for each thread (at least one).
     scratch: Vec<Scratch>,
+    /// Torsional and rolling friction rows ([`spin`]).
+    spin: spin::Spin,
     /// Each island's sweeps in the last solve.
     isl_sweeps: Vec<usize>,
     /// Rows times sweeps of every solve so far (velocity, energy-safe exit and
@@ -159,7 +168,9 @@ impl Constraints {
         loops: Option<Loops>,
     ) -> Self {
         let ndof = model.dofs.len();
-        let cap = 3 * max_points + 3 * ndof + loops.as_ref().map_or(0, |l| l.rows());
+        let cap = (3 + spin::Spin::MAX_ROWS_PER_POINT) * max_points
+            + 3 * ndof
+            + loops.as_ref().map_or(0, |l| l.rows());
         let nv = model.nv;
         // a row's room: two bodies' paths to the root (a dense factor's are nv long)
         let longest = (0..nv).map(|d| f.path_of(d).1).max().unwrap_or(0);
@@ -188,6 +199,7 @@ impl Constraints {
             islands: Islands::new(model, cap),
             pool: None,
             scratch: vec![rows_scratch],
+            spin: spin::Spin::new(max_points, nslots),
             isl_sweeps: vec![0; model.trees.len() + 1],
             work: 0,
         }
@@ -219,6 +231,7 @@ impl Constraints {
     /// Forgets the warm starts (a new state was set).
     pub fn reset_warm_start(&mut self) {
         self.warm_contact.iter_mut().for_each(|w| *w = [0.0; 3]);
+        self.spin.reset();
         if let Some(l) = self.loops.as_mut() {
             l.reset_warm_start();
         }
@@ -280,6 +293,11 @@ impl Constraints {
         f: &MassFactor,
         h: f64,
     ) -> RowCounts {
+        // the last solve's torsion and rolling impulses: warm starts
+        self.spin.save(&self.rows);
+        self.spin.torsion = p.torsion;
+        self.spin.rolling = p.rolling;
+        self.spin.touch = p.contact_slop.max(1e-6);
         let rows = &mut self.rows;
         rows.clear();
         self.joint_rows.clear();
@@ -405,6 +423,9 @@ impl Constraints {
                     counts.violated += 1;
                 }
             }
+            // torsional and rolling friction where a pair has few points
+            let (sw, rp) = (&self.sw[..], &self.row_point[..]);
+            counts.spin = self.spin.push(rows, model, sw, points, rp, &mut self.jd);
         }
         self.first_joint_row = rows.n;
         // joint rows: friction (|λ| ≤ F h), limits (λ ≥ 0)

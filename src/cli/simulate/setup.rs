@@ -106,6 +106,8 @@ pub(super) fn scene(
     let mut contact = crate::contact::ContactParams::default();
     if let Some(g) = scene.ground {
         contact.friction = g.friction;
+        contact.torsion = g.torsion.unwrap_or(contact.torsion);
+        contact.rolling = g.rolling.unwrap_or(contact.rolling);
     }
     let opts = SimOptions {
         dt: args.dt.unwrap_or(DEFAULT_DT),

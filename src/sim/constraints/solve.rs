@@ -29,6 +29,9 @@ impl Constraints {
     ) -> Impulses<'_> {
         self.clear_forces();
         self.dv.fill(0.0);
+        // torsion and rolling rows (spin.rs) couple a point's rotation to its
+        // normal: a step with them may take twice the sweeps before the cap
+        let iterations = iterations * if self.counts.spin > 0 { 2 } else { 1 };
         let rows = &mut self.rows;
         // Y rows = R⁻ᵀ jᵣ (H̃ = RᵀR, each over its path): W = J H̃⁻¹ Jᵀ = Y Yᵀ,
         // the solver works on Δv' = R Δv with uᵣ = cᵣ + yᵣ·Δv'
@@ -175,6 +178,9 @@ impl Constraints {
                 });
             }
         }
+        // torsional and rolling friction torques
+        self.spin
+            .add_torques(rows, points, &self.row_point, &mut self.fext, h);
         Impulses {
             dv: &self.dv,
             push: if pushing { Some(&self.push) } else { None },

@@ -367,6 +367,39 @@ impl Simulation {
                         }
                         r += 3;
                     }
+                    RowKind::Tangent { normal, mu } if r + 1 < m => {
+                        // a torsional or rolling pair (sim/constraints/spin.rs)
+                        let ln = rows.lambda.get(normal).copied().unwrap_or(0.0);
+                        let ut = [cq_row_dot(&jac, r, &vplus), cq_row_dot(&jac, r + 1, &vplus)];
+                        let lt = rows.lambda[r].hypot(rows.lambda[r + 1]);
+                        let un = ut[0].hypot(ut[1]);
+                        if ln <= 0.0 {
+                            mm[(r, r)] = 1.0;
+                            mm[(r + 1, r + 1)] = 1.0;
+                        } else if lt >= mu * ln * (1.0 - 1e-9) && un > 1e-9 {
+                            any_sliding = true;
+                            let uh = [ut[0] / un, ut[1] / un];
+                            spin_sliding(
+                                &mut mm,
+                                &mut rr,
+                                &w,
+                                &cq,
+                                (r, normal),
+                                mu * ln / un,
+                                mu,
+                                uh,
+                            );
+                        } else {
+                            for k in r..r + 2 {
+                                if w[(k, k)] > 1e-14 {
+                                    equality_row(&mut mm, &mut rr, &w, &cq, &jac, 0.0, k, n, h);
+                                } else {
+                                    mm[(k, k)] = 1.0;
+                                }
+                            }
+                        }
+                        r += 2;
+                    }
                     RowKind::Box { limit } => {
                         if rows.lambda[r].abs() >= limit * (1.0 - 1e-9) {
                             mm[(r, r)] = 1.0;
@@ -554,6 +587,37 @@ fn equality_row(
     if b < 0.0 {
         for c in 0..n {
             rr[(r, c)] -= jac[(r, c)] / h;
+        }
+    }
+}
+
+/// A sliding torsional or rolling pair at rows `r`, `r + 1` (normal row
+/// `normal`): λ = −μ λₙ û, linearised as the Coulomb pair's
+/// δλ + μ û δλₙ + κ P δu = 0 (κ = μλₙ/‖u‖, P = I − ûûᵀ).
+#[allow(clippy::too_many_arguments)]
+fn spin_sliding(
+    mm: &mut DMatrix<f64>,
+    rr: &mut DMatrix<f64>,
+    w: &DMatrix<f64>,
+    cq: &DMatrix<f64>,
+    (r, normal): (usize, usize),
+    kappa: f64,
+    mu: f64,
+    uh: [f64; 2],
+) {
+    for a in 0..2 {
+        let ra = r + a;
+        mm[(ra, ra)] += 1.0;
+        mm[(ra, normal)] += mu * uh[a];
+        for b in 0..2 {
+            let p = if a == b { 1.0 } else { 0.0 } - uh[a] * uh[b];
+            let rb = r + b;
+            for k in 0..w.ncols() {
+                mm[(ra, k)] += kappa * p * w[(rb, k)];
+            }
+            for c in 0..cq.ncols() {
+                rr[(ra, c)] -= kappa * p * cq[(rb, c)];
+            }
         }
     }
 }

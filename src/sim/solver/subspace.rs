@@ -117,9 +117,13 @@ pub(super) fn subspace_step(
                 RowKind::Tangent { normal, mu } if r + 1 < e => {
                     let ln = lambda.get(normal).copied().unwrap_or(0.0);
                     sm.sliding[r] = !inside(lambda[r], lambda[r + 1], ln, mu);
-                    if ln > 0.0 && !sm.sliding[r] && live(r) && live(r + 1) {
+                    if ln > 0.0 && !sm.sliding[r] && live(r) {
                         sm.rows.push(r);
-                        sm.rows.push(r + 1);
+                        // a one-row cone (torsion: its partner row is empty,
+                        // sim/constraints/spin.rs) is free on its own row
+                        if live(r + 1) {
+                            sm.rows.push(r + 1);
+                        }
                     }
                     r += 2;
                     continue;
@@ -222,10 +226,11 @@ pub(super) fn subspace_step(
             continue;
         };
         let lim = mu * lambda.get(normal).copied().unwrap_or(0.0).max(0.0);
-        let free = sm.rows.iter().position(|&q| q == r).filter(|&a| a + 1 < m);
+        let free = sm.rows.iter().position(|&q| q == r);
         let (t1, t2) = match free {
-            Some(a) => (sm.lam[a], sm.lam[a + 1]),
-            None => (lambda[r], lambda[r + 1]),
+            Some(a) if winv[r + 1] == 0.0 => (sm.lam[a], 0.0),
+            Some(a) if a + 1 < m => (sm.lam[a], sm.lam[a + 1]),
+            _ => (lambda[r], lambda[r + 1]),
         };
         let norm = (t1 * t1 + t2 * t2).sqrt();
         let s = if norm > lim || (free.is_none() && sm.sliding[r]) {
