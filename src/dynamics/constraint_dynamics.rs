@@ -60,8 +60,8 @@ pub struct ConstraintData {
     pub dqdd_dv: DMatrix<f64>,
     /// ∂q̈/∂τ = H⁻¹ − Y K⁺ Yᵀ (= M_c).
     pub dqdd_dtau: DMatrix<f64>,
-    /// Y = H⁻¹ J_cᵀ (nv × m; after [`constraint_dynamics`] on a model without
-    /// mimic joints, W = L⁻ᵀ J_cᵀ coordinate-major, W[k, r] at k m + r, in its
+    /// Y = H⁻¹ J_cᵀ (nv × m; after [`constraint_dynamics`] on a model whose H
+    /// is factorised tree-sparse (`super::dense_factor`), W = L⁻ᵀ J_cᵀ coordinate-major, W[k, r] at k m + r, in its
     /// storage; Ȳ = Y S after the derivatives, `KktFactor::right_half`).
     pub(crate) y: DMatrix<f64>,
     /// K = J_c Y (m × m).
@@ -280,7 +280,7 @@ pub fn constraint_dynamics<'c>(
         &mut cd.gamma,
     );
     cd.qdd.copy_from(&data.qdd);
-    if model.has_mimic {
+    if super::dense_factor(model) {
         // Y = H⁻¹ J_cᵀ (dense Cholesky), every row at once: J_c's columns are
         // the rows of J_cᵀ, m contiguous entries each
         let (n, m) = (model.nv, cd.rows);

@@ -108,3 +108,43 @@ pub fn ltdl_solve<T: Scalar>(u: &DMatrix<T>, lambda: &[usize], x: &mut DVector<T
         x[i] = s;
     }
 }
+
+/// Solves `Lᵀ D L X = B` in place for `m` right-hand sides stored
+/// coordinate-major: row k of X (coordinate k of every right-hand side) at
+/// `x[k m..(k + 1) m]`, so that each elimination step of [`ltdl_solve`] is one
+/// m-wide axpy. O(m Σₖ depth(k)).
+pub fn ltdl_solve_rows<T: Scalar>(u: &DMatrix<T>, lambda: &[usize], m: usize, x: &mut [T]) {
+    let n = lambda.len();
+    let us = u.as_slice();
+    let x = &mut x[..n * m];
+    // Lᵀ y = b, leaves inwards: row j −= L[i, j] row i for each ancestor j of i
+    for i in (0..n).rev() {
+        let (above, rest) = x.split_at_mut(i * m);
+        let xi = &rest[..m];
+        let mut j = lambda[i];
+        while j != NONE {
+            let l = us[j + i * n];
+            for (y, &s) in above[j * m..(j + 1) * m].iter_mut().zip(xi) {
+                *y = madd(-l, s, *y);
+            }
+            j = lambda[j];
+        }
+    }
+    // z = D⁻¹ y, then L x = z root outwards: row i −= L[i, j] row j
+    for i in 0..n {
+        let (above, rest) = x.split_at_mut(i * m);
+        let xi = &mut rest[..m];
+        let dinv = T::one() / us[i + i * n];
+        for y in xi.iter_mut() {
+            *y *= dinv;
+        }
+        let mut j = lambda[i];
+        while j != NONE {
+            let l = us[j + i * n];
+            for (y, &s) in xi.iter_mut().zip(&above[j * m..(j + 1) * m]) {
+                *y = madd(-l, s, *y);
+            }
+            j = lambda[j];
+        }
+    }
+}

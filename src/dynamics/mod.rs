@@ -145,8 +145,8 @@ pub fn mass_matrix<'d, T: Scalar>(
 /// Forward dynamics through H: `C` by RNEA (docs/theory.md §"Bias forces"), H by
 /// [`crba`], then `H q̈ = τ − C` (docs/theory.md §"Equation of motion") by the
 /// tree-sparse LTDL factorisation (docs/theory.md §"Tree-sparse LTDL")
-/// ([`ltdl::ltdl`]), or, on a model with mimic joints (whose `Gᵀ H G` is not
-/// tree-shaped), the dense Cholesky. Result in `data.qdd`; `data.h` (its upper
+/// ([`ltdl::ltdl`]), or, on a model with mimic joints whose `Gᵀ H G` is not
+/// tree-shaped ([`dense_factor`]), the dense Cholesky. Result in `data.qdd`; `data.h` (its upper
 /// triangle, [`crba_upper`]; all of it with mimic joints), `data.bias` and the
 /// factor in `data.chol` are left for reuse.
 pub fn forward_dynamics_crba<'d, T: Scalar>(
@@ -165,7 +165,7 @@ pub fn forward_dynamics_crba<'d, T: Scalar>(
     crba::crba_dispatch(model, data, q, model.has_mimic);
     data.qdd.copy_from(tau);
     data.qdd -= &data.bias;
-    if model.has_mimic {
+    if dense_factor(model) {
         linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)?;
         linalg::cholesky_solve(&data.chol, &mut data.qdd);
     } else {
@@ -173,6 +173,30 @@ pub fn forward_dynamics_crba<'d, T: Scalar>(
         ltdl::ltdl_solve(&data.chol, &model.dof_parent, &mut data.qdd);
     }
     Ok(&data.qdd)
+}
+
+/// Whether [`forward_dynamics_crba`] factorises H densely (Cholesky) rather
+/// than by the tree-sparse LTDL: only with mimic joints whose reduced H leaves
+/// the tree pattern ([`crate::model::Topology::mimic_tree`]).
+#[inline]
+pub(crate) fn dense_factor<T: Scalar>(model: &Model<T>) -> bool {
+    model.has_mimic && !model.topology.mimic_tree
+}
+
+/// Solves `H X = B` for `m` right-hand sides stored coordinate-major (row k
+/// of X at `x[k m..(k + 1) m]`) with the factor [`forward_dynamics_crba`] left
+/// in `data.chol`: dense Cholesky or tree-sparse LTDL as [`dense_factor`] says.
+pub(crate) fn factor_solve_rows<T: Scalar>(
+    model: &Model<T>,
+    data: &Data<T>,
+    m: usize,
+    x: &mut [T],
+) {
+    if dense_factor(model) {
+        linalg::cholesky_solve_rows(&data.chol, m, x);
+    } else {
+        ltdl::ltdl_solve_rows(&data.chol, &model.dof_parent, m, x);
+    }
 }
 
 /// The engine's forward dynamics: `q̈` with `H q̈ = τ − C(q, q̇)`, written to `data.qdd`,
