@@ -60,8 +60,11 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
         }
         return Ok(());
     }
+    // Slices (column-major, u[(i, k)] at i + k n): the walks below index
+    // without nalgebra's per-access checks of both dimensions.
+    let us = u.as_mut_slice();
     for k in (0..n).rev() {
-        let d = u[(k, k)];
+        let d = us[k + k * n];
         if !(d > tiny * h[(k, k)].abs()) || !d.is_finite() {
             return Err(k);
         }
@@ -69,14 +72,14 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
         // j ancestor-or-self of i, H[i, j] −= H[k, i] H[k, j] / D[k].
         let mut i = lambda[k];
         while i != NONE {
-            let a = u[(i, k)] / d;
+            let a = us[i + k * n] / d;
             let mut j = i;
             while j != NONE {
-                let hkj = u[(j, k)];
-                u[(j, i)] = madd(-a, hkj, u[(j, i)]);
+                let hkj = us[j + k * n];
+                us[j + i * n] = madd(-a, hkj, us[j + i * n]);
                 j = lambda[j];
             }
-            u[(i, k)] = a;
+            us[i + k * n] = a;
             i = lambda[i];
         }
     }
@@ -87,22 +90,26 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
 /// (leaves inwards), `z = D⁻¹ y`, `L x = z` (root outwards). O(Σₖ depth(k)).
 pub fn ltdl_solve<T: Scalar>(u: &DMatrix<T>, lambda: &[usize], x: &mut DVector<T>) {
     let n = lambda.len();
+    let us = u.as_slice();
+    let x = &mut x.as_mut_slice()[..n];
     for i in (0..n).rev() {
         let xi = x[i];
+        let ui = &us[i * n..i * n + i];
         let mut j = lambda[i];
         while j != NONE {
-            x[j] = madd(-u[(j, i)], xi, x[j]);
+            x[j] = madd(-ui[j], xi, x[j]);
             j = lambda[j];
         }
     }
     for i in 0..n {
-        x[i] /= u[(i, i)];
+        x[i] /= us[i + i * n];
     }
     for i in 0..n {
         let mut s = x[i];
+        let ui = &us[i * n..i * n + i];
         let mut j = lambda[i];
         while j != NONE {
-            s = madd(-u[(j, i)], x[j], s);
+            s = madd(-ui[j], x[j], s);
             j = lambda[j];
         }
         x[i] = s;

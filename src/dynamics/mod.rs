@@ -160,19 +160,39 @@ pub fn forward_dynamics_crba<'d, T: Scalar>(
     check_sizes(model, q, &[("v", v), ("tau", tau)], fext)?;
     check_massless(model)?;
     // sizes checked above: the unchecked passes
-    rnea::bias_pass(model, data, q, v, fext);
-    // LTDL reads H's upper triangle only (mirrored for the dense Cholesky)
-    crba::crba_dispatch(model, data, q, model.has_mimic);
+    factor_crba(model, data, q, v, fext)?;
     data.qdd.copy_from(tau);
     data.qdd -= &data.bias;
     if dense_factor(model) {
-        linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)?;
         linalg::cholesky_solve(&data.chol, &mut data.qdd);
     } else {
-        ltdl::ltdl(&data.h, &model.dof_parent, &mut data.chol).map_err(DynamicsError::Singular)?;
         ltdl::ltdl_solve(&data.chol, &model.dof_parent, &mut data.qdd);
     }
     Ok(&data.qdd)
+}
+
+/// The first half of [`forward_dynamics_crba`] (sizes checked by the caller):
+/// `data.bias` = C (with the pass's body velocities and accelerations), H
+/// (`data.h`) and its factor in `data.chol`, no solve.
+pub(crate) fn factor_crba<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+    fext: Option<&[Force<T>]>,
+) -> Result<(), DynamicsError> {
+    rnea::bias_pass(model, data, q, v, fext);
+    // the bias pass left the joint placements at q: the local-frame CRBA reads
+    // them (no second sin/cos and transform per joint) where it runs; LTDL
+    // reads H's upper triangle only (mirrored for the dense Cholesky)
+    if !crba::crba_at_placements(model, data) {
+        crba::crba_dispatch(model, data, q, model.has_mimic);
+    }
+    if dense_factor(model) {
+        linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)
+    } else {
+        ltdl::ltdl(&data.h, &model.dof_parent, &mut data.chol).map_err(DynamicsError::Singular)
+    }
 }
 
 /// Whether [`forward_dynamics_crba`] factorises H densely (Cholesky) rather
