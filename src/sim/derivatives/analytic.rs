@@ -278,12 +278,18 @@ impl Simulation {
             kk.columns_mut(0, n).add_assign(&gc);
         }
         let mut z0 = DMatrix::zeros(n, 3 * n);
-        for c in 0..2 * n {
-            for k in 0..n {
-                let x = kk[(k, c)];
-                if x != 0.0 {
-                    for i in 0..n {
-                        z0[(i, c)] += minv[(i, k)] * x;
+        {
+            // column c of Z0 += K[k, c] · column k of H̃⁻¹ (contiguous columns,
+            // K's structural zeros skipped)
+            let (zs, ms, ks) = (z0.as_mut_slice(), minv.as_slice(), kk.as_slice());
+            for c in 0..2 * n {
+                let zc = &mut zs[c * n..(c + 1) * n];
+                for k in 0..n {
+                    let x = ks[k + c * n];
+                    if x != 0.0 {
+                        for (z, &mi) in zc.iter_mut().zip(&ms[k * n..(k + 1) * n]) {
+                            *z += mi * x;
+                        }
                     }
                 }
             }
