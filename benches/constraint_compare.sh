@@ -94,8 +94,8 @@ for c in cases.strip(";").split(";"):
         )
 lines += [
     "",
-    "urdyn's talos_reduced reduces its gripper mimic joints (nv 32 + 6); Pinocchio's URDF "
-    "parser makes them independent joints.",
+    "talos_reduced: nv 38 on both sides (its gripper followers carry <mimic> tags but are "
+    "fixed joints, which both parsers ignore).",
 ]
 open(out, "w").write("\n".join(lines) + "\n")
 print("\n".join(lines))

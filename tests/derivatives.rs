@@ -19,12 +19,14 @@ fn load(path: &str, floating_base: bool) -> Model {
     urdyn::load_file(root.join(path), LoadOptions { floating_base }).unwrap()
 }
 
-const ROBOTS: [(&str, bool); 8] = [
+const ROBOTS: [(&str, bool); 9] = [
     ("assets/robots/ur5.urdf", false),
     ("assets/robots/solo12.urdf", true),
     ("assets/robots/panda.urdf", false),
     ("tests/urdf/mimic.urdf", false),
     ("tests/urdf/mimic.urdf", true),
+    // a follower across branches: the dense factor (`Topology::mimic_tree`)
+    ("tests/urdf/mimic_cross.urdf", true),
     ("assets/synthetic/tree_5.urdf", false),
     ("assets/robots/anymal.urdf", true),
     ("assets/robots/ur5.urdf", true),

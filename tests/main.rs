@@ -33,6 +33,7 @@ mod kinematics_energy;
 mod layering;
 mod loops_sim;
 mod mechanism_examples;
+mod mimic_factor;
 mod mjcf_actuators;
 mod mjcf_bad;
 mod mjcf_cli;

@@ -7,7 +7,7 @@
 use super::rnea_derivatives::{
     check_wrenches, rnea_derivatives_pass, rnea_derivatives_pass_after_minv, LinkWrench,
 };
-use super::{check_massless, check_sizes, linalg, minv, DynamicsError};
+use super::{check_massless, check_sizes, minv, DynamicsError};
 use crate::model::{Data, Model};
 use crate::spatial::ops::madd;
 use crate::spatial::{Force, Scalar};
@@ -83,43 +83,49 @@ pub fn aba_derivatives<T: Scalar>(
         neg_mul_tree(minv, [dtau_dq, dtau_dv], [dqdd_dq, dqdd_dv], &pat);
         return Ok(());
     }
-    // mimic joints: the reduced H is not tree-shaped, the dense route
+    // mimic joints: q̈ through H's factor (dense, or tree-sparse where the
+    // followers keep the tree pattern, `super::dense_factor`), which stays in
+    // data.chol for the solves below
     let r =
         super::forward_dynamics(model, data, q, v, tau, fext.map(|_| fb.as_slice())).map(|_| ());
     data.deriv_fext = fb;
     r?;
-    // ∂τ/∂q, ∂τ/∂v and H at a = q̈
+    // ∂τ/∂q, ∂τ/∂v at a = q̈
     let mut a = std::mem::replace(&mut data.deriv_tmp, DVector::zeros(0));
     a.copy_from(&data.qdd);
     rnea_derivatives_pass(model, data, q, v, &a, fext);
     data.deriv_tmp = a;
-    // H = L Lᵀ
-    linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)?;
     let nv = model.nv;
-    let Data {
-        chol,
-        minv,
-        dqdd_dq,
-        dqdd_dv,
-        dtau_dq,
-        dtau_dv,
-        deriv_scratch: xt,
-        ..
-    } = data;
+    let empty = || DMatrix::zeros(0, 0);
+    let mut minv = std::mem::replace(&mut data.minv, empty());
+    let mut xt = std::mem::replace(&mut data.deriv_scratch, empty());
     // H⁻¹ = solve(H, 1) (symmetric: its rows are its columns)
     minv.fill(T::zero());
     for k in 0..nv {
         minv[(k, k)] = T::one();
     }
-    chol_solve_rows(chol.as_slice(), nv, minv.as_mut_slice());
+    super::factor_solve_rows(model, data, nv, minv.as_mut_slice());
     // ∂q̈/∂x = −solve(H, ∂τ/∂x), on the transpose (H X = B ⇔ Xᵀ H = Bᵀ: every
     // elimination step is one contiguous axpy over all right-hand sides)
-    for (out, b) in [(&mut *dqdd_dq, &*dtau_dq), (&mut *dqdd_dv, &*dtau_dv)] {
-        b.transpose_to(xt);
-        chol_solve_rows(chol.as_slice(), nv, xt.as_mut_slice());
-        xt.transpose_to(out);
-        out.neg_mut();
+    for which in 0..2 {
+        let (b, out) = if which == 0 {
+            (&data.dtau_dq, &mut data.dqdd_dq)
+        } else {
+            (&data.dtau_dv, &mut data.dqdd_dv)
+        };
+        b.transpose_to(&mut xt);
+        let mut o = std::mem::replace(out, empty());
+        super::factor_solve_rows(model, data, nv, xt.as_mut_slice());
+        xt.transpose_to(&mut o);
+        o.neg_mut();
+        if which == 0 {
+            data.dqdd_dq = o;
+        } else {
+            data.dqdd_dv = o;
+        }
     }
+    data.minv = minv;
+    data.deriv_scratch = xt;
     Ok(())
 }
 
@@ -431,43 +437,6 @@ fn tile<T: Scalar, const R: usize, const C: usize>(
         let col = &mut x[(j0 + c) * n + i0..(j0 + c) * n + i0 + R];
         for r in 0..R {
             col[r] = -acc[c][r];
-        }
-    }
-}
-
-/// `row_a −= s · row_b` of a row-contiguous n × n matrix (a ≠ b).
-#[inline(always)]
-fn row_axpy<T: Scalar>(x: &mut [T], n: usize, a: usize, b: usize, s: T) {
-    let (ra, rb) = if a < b {
-        let (lo, hi) = x.split_at_mut(b * n);
-        (&mut lo[a * n..a * n + n], &hi[..n])
-    } else {
-        let (lo, hi) = x.split_at_mut(a * n);
-        (&mut hi[..n], &lo[b * n..b * n + n])
-    };
-    for (p, &q) in ra.iter_mut().zip(rb) {
-        *p = madd(-s, q, *p);
-    }
-}
-
-/// [`linalg::cholesky_solve`] for every right-hand side at once (rows of `x`).
-fn chol_solve_rows<T: Scalar>(l: &[T], n: usize, x: &mut [T]) {
-    for i in 0..n {
-        for k in 0..i {
-            row_axpy(x, n, i, k, l[i + k * n]);
-        }
-        let d = T::one() / l[i + i * n];
-        for p in &mut x[i * n..i * n + n] {
-            *p *= d;
-        }
-    }
-    for i in (0..n).rev() {
-        for k in (i + 1)..n {
-            row_axpy(x, n, i, k, l[k + i * n]);
-        }
-        let d = T::one() / l[i + i * n];
-        for p in &mut x[i * n..i * n + n] {
-            *p *= d;
         }
     }
 }

@@ -60,8 +60,8 @@ pub struct ConstraintData {
     pub dqdd_dv: DMatrix<f64>,
     /// ∂q̈/∂τ = H⁻¹ − Y K⁺ Yᵀ (= M_c).
     pub dqdd_dtau: DMatrix<f64>,
-    /// Y = H⁻¹ J_cᵀ (nv × m; after [`constraint_dynamics`] on a model without
-    /// mimic joints, W = L⁻ᵀ J_cᵀ coordinate-major, W[k, r] at k m + r, in its
+    /// Y = H⁻¹ J_cᵀ (nv × m; after [`constraint_dynamics`] on a model whose H
+    /// is factorised tree-sparse (`super::dense_factor`), W = L⁻ᵀ J_cᵀ coordinate-major, W[k, r] at k m + r, in its
     /// storage; Ȳ = Y S after the derivatives, `KktFactor::right_half`).
     pub(crate) y: DMatrix<f64>,
     /// K = J_c Y (m × m).
@@ -73,8 +73,6 @@ pub struct ConstraintData {
     pub(crate) r: DVector<f64>,
     /// Scratch: m entries.
     pub(crate) r2: DVector<f64>,
-    /// Scratch: nv entries.
-    pub(crate) tmp: DVector<f64>,
     /// Derivatives: ∂(J_c a + γ_c)/∂q at a = q̈, transposed (nv × m).
     pub(crate) aq: DMatrix<f64>,
     /// Derivatives: ∂(J_c a + γ_c)/∂v, transposed (nv × m).
@@ -105,7 +103,6 @@ impl ConstraintData {
             kkt: KktFactor::new(m),
             r: DVector::zeros(m),
             r2: DVector::zeros(m),
-            tmp: DVector::zeros(nv),
             aq: DMatrix::zeros(nv, m),
             av: DMatrix::zeros(nv, m),
             path: Vec::with_capacity(model.nv),
@@ -261,8 +258,17 @@ pub fn constraint_dynamics<'c>(
     check_sizes(model, q, &[("v", v), ("tau", tau)], fext)?;
     check_massless(model)?;
     check_workspace(model, cd, constraints)?;
-    // q̈₀, C (with body velocities and velocity-product accelerations), H's factor
-    forward_dynamics_crba(model, data, q, v, tau, fext)?;
+    // C (with body velocities and velocity-product accelerations), H's factor;
+    // the dense route also q̈₀, the tree route leaves τ − C in data.qdd (its
+    // solve shares the elimination of J_cᵀ below)
+    let dense = super::dense_factor(model);
+    if dense {
+        forward_dynamics_crba(model, data, q, v, tau, fext)?;
+    } else {
+        super::factor_crba(model, data, q, v, fext)?;
+        data.qdd.copy_from(tau);
+        data.qdd -= &data.bias;
+    }
     world_poses(model, data);
     jacobian_rows(model, data, constraints, &mut cd.jc);
     let g = model.gravity;
@@ -279,8 +285,8 @@ pub fn constraint_dynamics<'c>(
         },
         &mut cd.gamma,
     );
-    cd.qdd.copy_from(&data.qdd);
-    if model.has_mimic {
+    if dense {
+        cd.qdd.copy_from(&data.qdd);
         // Y = H⁻¹ J_cᵀ (dense Cholesky), every row at once: J_c's columns are
         // the rows of J_cᵀ, m contiguous entries each
         let (n, m) = (model.nv, cd.rows);
@@ -296,7 +302,8 @@ pub fn constraint_dynamics<'c>(
         return solve_rows(cd, constraints).map(|_| &cd.qdd);
     }
     // H = Lᵀ D L (tree-sparse): W = L⁻ᵀ J_cᵀ keeps each row's support on its
-    // path to the root; K = Wᵀ D⁻¹ W; q̈ = q̈₀ + L⁻¹ D⁻¹ W λ
+    // path to the root; K = Wᵀ D⁻¹ W; q̈ = L⁻¹ D⁻¹ (w₀ + W λ) with
+    // w₀ = L⁻ᵀ (τ − C), eliminated with W, and J_c q̈₀ = Wᵀ D⁻¹ w₀ formed with K
     // (docs/theory.md §"Constrained dynamics", "Solving"). W is kept
     // coordinate-major (W[k, r] at k m + r, J_c's own column-major storage):
     // every elimination step is one m-wide axpy over all the rows at once.
@@ -305,19 +312,25 @@ pub fn constraint_dynamics<'c>(
     let direct = data.deriv_direct;
     let (runs, run0) = (&data.deriv_anc_runs, &data.deriv_anc_run0);
     let u = data.chol.as_slice();
+    let b = data.qdd.as_mut_slice();
     let w = &mut cd.y.as_mut_slice()[..n * m];
     w.copy_from_slice(&cd.jc.as_slice()[..n * m]);
     for i in (0..n).rev() {
         let (above, rest) = w.split_at_mut(i * m);
         let xi = &rest[..m];
-        if xi.iter().all(|&x| x == 0.0) {
+        let bi = b[i];
+        let rows = xi.iter().any(|&x| x != 0.0);
+        if !rows && bi == 0.0 {
             continue;
         }
         let mut step = |j: usize| {
             let l = u[j + i * n];
-            for (y, &x) in above[j * m..(j + 1) * m].iter_mut().zip(xi) {
-                *y = madd(-l, x, *y);
+            if rows {
+                for (y, &x) in above[j * m..(j + 1) * m].iter_mut().zip(xi) {
+                    *y = madd(-l, x, *y);
+                }
             }
+            b[j] = madd(-l, bi, b[j]);
         };
         if direct {
             for &(lo, hi) in &runs[run0[i]..run0[i + 1]] {
@@ -332,16 +345,21 @@ pub fn constraint_dynamics<'c>(
         }
     }
     // K = Wᵀ D⁻¹ W = Σₖ D⁻¹ₖ W[k, :]ᵀ W[k, :]: the upper triangle by rank-1
-    // updates of contiguous columns (K[s, r] at s + r m), then mirrored
+    // updates of contiguous columns (K[s, r] at s + r m), then mirrored; and
+    // −J_c q̈₀ = −Wᵀ D⁻¹ w₀ into cd.r
     let k = &mut cd.k.as_mut_slice()[..m * m];
     k.fill(0.0);
+    let jq0 = cd.r.as_mut_slice();
+    jq0.fill(0.0);
     for c in 0..n {
         let xk = &w[c * m..(c + 1) * m];
         let dinv = 1.0 / u[c + c * n];
+        let s0 = b[c] * dinv;
         for (r, &xr) in xk.iter().enumerate() {
             if xr == 0.0 {
                 continue;
             }
+            jq0[r] = madd(-xr, s0, jq0[r]);
             let a = xr * dinv;
             for (y, &x) in k[r * m..r * m + r + 1].iter_mut().zip(xk) {
                 *y = madd(a, x, *y);
@@ -353,13 +371,14 @@ pub fn constraint_dynamics<'c>(
             k[r + s2 * m] = k[s2 + r * m];
         }
     }
-    solve_lambda(cd, constraints)?;
-    // t = D⁻¹ W λ, then L⁻¹ t (root outwards)
+    solve_lambda_r(cd, constraints)?;
+    // t = D⁻¹ (w₀ + W λ), then q̈ = L⁻¹ t (root outwards)
     let w = &cd.y.as_slice()[..n * m];
     let lambda = cd.lambda.as_slice();
-    let t = cd.tmp.as_mut_slice();
+    let b = data.qdd.as_slice();
+    let t = cd.qdd.as_mut_slice();
     for c in 0..n {
-        let mut acc = 0.0;
+        let mut acc = b[c];
         for (&x, &l) in w[c * m..(c + 1) * m].iter().zip(lambda) {
             acc = madd(x, l, acc);
         }
@@ -383,7 +402,7 @@ pub fn constraint_dynamics<'c>(
         }
         t[i] = s1;
     }
-    cd.qdd += &cd.tmp;
+    data.qdd.copy_from(&cd.qdd);
     cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
     Ok(&cd.qdd)
 }
@@ -407,10 +426,18 @@ fn solve_lambda(
     cd: &mut ConstraintData,
     constraints: &Constraints,
 ) -> Result<(), ConstraintDynamicsError> {
+    cd.r.gemv(-1.0, &cd.jc, &cd.qdd, 0.0);
+    solve_lambda_r(cd, constraints)
+}
+
+/// [`solve_lambda`] with `cd.r` = −J_c q̈₀ given (`cd.qdd` not read).
+fn solve_lambda_r(
+    cd: &mut ConstraintData,
+    constraints: &Constraints,
+) -> Result<(), ConstraintDynamicsError> {
     let m = cd.rows;
     cd.kkt.factor(&cd.k);
     // r = −γ − J_c q̈₀
-    cd.r.gemv(-1.0, &cd.jc, &cd.qdd, 0.0);
     let scale = cd.r.amax() + cd.gamma.amax();
     cd.r -= &cd.gamma;
     cd.lambda.copy_from(&cd.r);

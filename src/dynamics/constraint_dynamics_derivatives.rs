@@ -69,18 +69,25 @@ pub fn constraint_dynamics_derivatives(
     }
     let fbody = fext.map(|_| fb.as_slice());
     if model.has_mimic {
-        // the reduced H is not tree-shaped: the dense route
+        // the reduced H through its factor (dense, or tree-sparse where the
+        // followers keep the tree pattern)
         let r =
             super::constraint_dynamics(model, data, cd, constraints, q, v, tau, fbody).map(|_| ());
         data.deriv_fext = fb;
         r?;
         // H⁻¹ = solve(H, 1), all columns at once (symmetric: rows are columns)
         let nv = model.nv;
-        data.minv.fill(0.0);
+        let mut minv = std::mem::replace(&mut data.minv, DMatrix::zeros(0, 0));
+        minv.fill(0.0);
         for c in 0..nv {
-            data.minv[(c, c)] = 1.0;
+            minv[(c, c)] = 1.0;
         }
-        super::linalg::cholesky_solve_rows(&data.chol, nv, data.minv.as_mut_slice());
+        super::factor_solve_rows(model, data, nv, minv.as_mut_slice());
+        data.minv = minv;
+        if !super::dense_factor(model) {
+            // the tree path left W in cd.y: Y = H⁻¹ J_cᵀ
+            mul_add_bt(&mut cd.y, 1.0, &data.minv, &cd.jc, 0.0);
+        }
     } else {
         // q̈₀ and H⁻¹ by the world-frame ABA, world velocities in data.minv_ov
         let r = minv::minv_pass(model, data, q, v, tau, fbody);

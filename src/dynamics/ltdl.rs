@@ -60,8 +60,11 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
         }
         return Ok(());
     }
+    // Slices (column-major, u[(i, k)] at i + k n): the walks below index
+    // without nalgebra's per-access checks of both dimensions.
+    let us = u.as_mut_slice();
     for k in (0..n).rev() {
-        let d = u[(k, k)];
+        let d = us[k + k * n];
         if !(d > tiny * h[(k, k)].abs()) || !d.is_finite() {
             return Err(k);
         }
@@ -69,14 +72,14 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
         // j ancestor-or-self of i, H[i, j] −= H[k, i] H[k, j] / D[k].
         let mut i = lambda[k];
         while i != NONE {
-            let a = u[(i, k)] / d;
+            let a = us[i + k * n] / d;
             let mut j = i;
             while j != NONE {
-                let hkj = u[(j, k)];
-                u[(j, i)] = madd(-a, hkj, u[(j, i)]);
+                let hkj = us[j + k * n];
+                us[j + i * n] = madd(-a, hkj, us[j + i * n]);
                 j = lambda[j];
             }
-            u[(i, k)] = a;
+            us[i + k * n] = a;
             i = lambda[i];
         }
     }
@@ -87,24 +90,68 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
 /// (leaves inwards), `z = D⁻¹ y`, `L x = z` (root outwards). O(Σₖ depth(k)).
 pub fn ltdl_solve<T: Scalar>(u: &DMatrix<T>, lambda: &[usize], x: &mut DVector<T>) {
     let n = lambda.len();
+    let us = u.as_slice();
+    let x = &mut x.as_mut_slice()[..n];
     for i in (0..n).rev() {
         let xi = x[i];
+        let ui = &us[i * n..i * n + i];
         let mut j = lambda[i];
         while j != NONE {
-            x[j] = madd(-u[(j, i)], xi, x[j]);
+            x[j] = madd(-ui[j], xi, x[j]);
             j = lambda[j];
         }
     }
     for i in 0..n {
-        x[i] /= u[(i, i)];
+        x[i] /= us[i + i * n];
     }
     for i in 0..n {
         let mut s = x[i];
+        let ui = &us[i * n..i * n + i];
         let mut j = lambda[i];
         while j != NONE {
-            s = madd(-u[(j, i)], x[j], s);
+            s = madd(-ui[j], x[j], s);
             j = lambda[j];
         }
         x[i] = s;
+    }
+}
+
+/// Solves `Lᵀ D L X = B` in place for `m` right-hand sides stored
+/// coordinate-major: row k of X (coordinate k of every right-hand side) at
+/// `x[k m..(k + 1) m]`, so that each elimination step of [`ltdl_solve`] is one
+/// m-wide axpy. O(m Σₖ depth(k)).
+pub fn ltdl_solve_rows<T: Scalar>(u: &DMatrix<T>, lambda: &[usize], m: usize, x: &mut [T]) {
+    let n = lambda.len();
+    let us = u.as_slice();
+    let x = &mut x[..n * m];
+    // Lᵀ y = b, leaves inwards: row j −= L[i, j] row i for each ancestor j of i
+    for i in (0..n).rev() {
+        let (above, rest) = x.split_at_mut(i * m);
+        let xi = &rest[..m];
+        let mut j = lambda[i];
+        while j != NONE {
+            let l = us[j + i * n];
+            for (y, &s) in above[j * m..(j + 1) * m].iter_mut().zip(xi) {
+                *y = madd(-l, s, *y);
+            }
+            j = lambda[j];
+        }
+    }
+    // z = D⁻¹ y, then L x = z root outwards: row i −= L[i, j] row j
+    for i in 0..n {
+        let (above, rest) = x.split_at_mut(i * m);
+        let xi = &mut rest[..m];
+        let dinv = T::one() / us[i + i * n];
+        for y in xi.iter_mut() {
+            *y *= dinv;
+        }
+        let mut j = lambda[i];
+        while j != NONE {
+            let l = us[j + i * n];
+            for (y, &s) in xi.iter_mut().zip(&above[j * m..(j + 1) * m]) {
+                *y = madd(-l, s, *y);
+            }
+            j = lambda[j];
+        }
     }
 }

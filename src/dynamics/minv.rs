@@ -266,10 +266,7 @@ pub(crate) fn minv_pass<T: Scalar>(
             for r in ni..6 {
                 d[(r, r)] = T::one();
             }
-            let dinv = d
-                .cholesky()
-                .map(|ch| ch.inverse())
-                .ok_or(DynamicsError::Singular(c0))?;
+            let dinv = super::linalg::spd6_inverse(&d).ok_or(DynamicsError::Singular(c0))?;
             let ud = u * dinv;
             for r in 0..ni {
                 udinv[c0 + r] = fv(&ud.column(r).into_owned());

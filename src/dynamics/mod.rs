@@ -145,8 +145,8 @@ pub fn mass_matrix<'d, T: Scalar>(
 /// Forward dynamics through H: `C` by RNEA (docs/theory.md §"Bias forces"), H by
 /// [`crba`], then `H q̈ = τ − C` (docs/theory.md §"Equation of motion") by the
 /// tree-sparse LTDL factorisation (docs/theory.md §"Tree-sparse LTDL")
-/// ([`ltdl::ltdl`]), or, on a model with mimic joints (whose `Gᵀ H G` is not
-/// tree-shaped), the dense Cholesky. Result in `data.qdd`; `data.h` (its upper
+/// ([`ltdl::ltdl`]), or, on a model with mimic joints whose `Gᵀ H G` is not
+/// tree-shaped ([`dense_factor`]), the dense Cholesky. Result in `data.qdd`; `data.h` (its upper
 /// triangle, [`crba_upper`]; all of it with mimic joints), `data.bias` and the
 /// factor in `data.chol` are left for reuse.
 pub fn forward_dynamics_crba<'d, T: Scalar>(
@@ -160,19 +160,63 @@ pub fn forward_dynamics_crba<'d, T: Scalar>(
     check_sizes(model, q, &[("v", v), ("tau", tau)], fext)?;
     check_massless(model)?;
     // sizes checked above: the unchecked passes
-    rnea::bias_pass(model, data, q, v, fext);
-    // LTDL reads H's upper triangle only (mirrored for the dense Cholesky)
-    crba::crba_dispatch(model, data, q, model.has_mimic);
+    factor_crba(model, data, q, v, fext)?;
     data.qdd.copy_from(tau);
     data.qdd -= &data.bias;
-    if model.has_mimic {
-        linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)?;
+    if dense_factor(model) {
         linalg::cholesky_solve(&data.chol, &mut data.qdd);
     } else {
-        ltdl::ltdl(&data.h, &model.dof_parent, &mut data.chol).map_err(DynamicsError::Singular)?;
         ltdl::ltdl_solve(&data.chol, &model.dof_parent, &mut data.qdd);
     }
     Ok(&data.qdd)
+}
+
+/// The first half of [`forward_dynamics_crba`] (sizes checked by the caller):
+/// `data.bias` = C (with the pass's body velocities and accelerations), H
+/// (`data.h`) and its factor in `data.chol`, no solve.
+pub(crate) fn factor_crba<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+    fext: Option<&[Force<T>]>,
+) -> Result<(), DynamicsError> {
+    rnea::bias_pass(model, data, q, v, fext);
+    // the bias pass left the joint placements at q: the local-frame CRBA reads
+    // them (no second sin/cos and transform per joint) where it runs; LTDL
+    // reads H's upper triangle only (mirrored for the dense Cholesky)
+    if !crba::crba_at_placements(model, data) {
+        crba::crba_dispatch(model, data, q, model.has_mimic);
+    }
+    if dense_factor(model) {
+        linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)
+    } else {
+        ltdl::ltdl(&data.h, &model.dof_parent, &mut data.chol).map_err(DynamicsError::Singular)
+    }
+}
+
+/// Whether [`forward_dynamics_crba`] factorises H densely (Cholesky) rather
+/// than by the tree-sparse LTDL: only with mimic joints whose reduced H leaves
+/// the tree pattern ([`crate::model::Topology::mimic_tree`]).
+#[inline]
+pub(crate) fn dense_factor<T: Scalar>(model: &Model<T>) -> bool {
+    model.has_mimic && !model.topology.mimic_tree
+}
+
+/// Solves `H X = B` for `m` right-hand sides stored coordinate-major (row k
+/// of X at `x[k m..(k + 1) m]`) with the factor [`forward_dynamics_crba`] left
+/// in `data.chol`: dense Cholesky or tree-sparse LTDL as [`dense_factor`] says.
+pub(crate) fn factor_solve_rows<T: Scalar>(
+    model: &Model<T>,
+    data: &Data<T>,
+    m: usize,
+    x: &mut [T],
+) {
+    if dense_factor(model) {
+        linalg::cholesky_solve_rows(&data.chol, m, x);
+    } else {
+        ltdl::ltdl_solve_rows(&data.chol, &model.dof_parent, m, x);
+    }
 }
 
 /// The engine's forward dynamics: `q̈` with `H q̈ = τ − C(q, q̇)`, written to `data.qdd`,

@@ -39,6 +39,12 @@ pub struct Topology {
     /// One past the last coordinate of k's subtree: without mimic joints the
     /// coordinates of a subtree are contiguous, `k..dof_subtree_end[k]`.
     pub dof_subtree_end: Vec<usize>,
+    /// With mimic joints: whether the reduced `Gᵀ H G` keeps the tree pattern of
+    /// `dof_parent` (every pair of bodies on one path to the root moves
+    /// coordinates on one path of `dof_parent`, [`Topology::mimic_tree_sparse`]),
+    /// so that the tree-sparse LTDL factorisation applies to it exactly (TALOS's
+    /// grippers: the followers hang beside their leader). Set by the importers.
+    pub mimic_tree: bool,
 }
 
 impl Default for Topology {
@@ -51,6 +57,7 @@ impl Default for Topology {
             fd_method: FdMethod::Aba,
             crba_local: false,
             dof_subtree_end: Vec::new(),
+            mimic_tree: false,
         }
     }
 }
@@ -84,9 +91,48 @@ impl Topology {
             fd_method: FdMethod::Aba,
             crba_local: !h_dense || nv < 16,
             dof_subtree_end,
+            mimic_tree: false,
         };
         t.fd_method = t.choose(nv, nbodies, has_mimic);
         t
+    }
+
+    /// Whether `Gᵀ H G` stays inside the tree pattern of `dof_parent`: H's
+    /// entry between two coordinates is a sum over pairs of bodies, one moving
+    /// each, one an ancestor of the other (docs/theory.md §"Tree-sparse LTDL"),
+    /// so it is enough that for every such pair of bodies (`parent`, each
+    /// body's coordinates `iv..iv + nv` from `dofs(b)`) the two coordinate
+    /// ranges are equal or one lies on the other's path to the root.
+    pub fn mimic_tree_sparse(
+        parent: &[usize],
+        dofs: impl Fn(usize) -> (usize, usize),
+        dof_parent: &[usize],
+    ) -> bool {
+        // x ancestor-or-self of y on dof_parent
+        let above = |x: usize, mut y: usize| {
+            while y != usize::MAX && y >= x {
+                if y == x {
+                    return true;
+                }
+                y = dof_parent[y];
+            }
+            false
+        };
+        for j in 1..parent.len() {
+            let (jv, jn) = dofs(j);
+            if jn == 0 {
+                continue;
+            }
+            let mut i = parent[j];
+            while i != 0 {
+                let (iv, inv) = dofs(i);
+                if inv > 0 && iv != jv && !above(iv + inv - 1, jv) && !above(jv + jn - 1, iv) {
+                    return false;
+                }
+                i = parent[i];
+            }
+        }
+        true
     }
 
     /// The measured cost rule: estimated instructions per call (callgrind on

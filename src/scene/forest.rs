@@ -184,5 +184,11 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
     }
     m.floating_base = m.free_joints.first().is_some_and(|f| f.body == 1);
     m.topology = Topology::new(&m.dof_parent, m.nbodies, m.has_mimic);
+    m.topology.mimic_tree = m.has_mimic
+        && Topology::mimic_tree_sparse(
+            &m.parent,
+            |b| (m.joints[b].iv, m.joints[b].nv()),
+            &m.dof_parent,
+        );
     m
 }

@@ -79,10 +79,15 @@ impl Simulation {
         let loops_open = self.restart_loops();
         self.guard.reference = None;
         self.guard.recovering_until = if !self.violates() && !loops_open {
-            let e = self.update_energy();
-            if e.is_finite() {
-                self.guard.reference = Some(e);
-                self.guard.v_ref.copy_from(&self.v);
+            // the reference is read only by the divergence test of a passive
+            // run (`check_energy`): a run without it (a derivative workspace)
+            // skips the energy
+            if self.opts.max_energy_rise.is_some() {
+                let e = self.update_energy();
+                if e.is_finite() {
+                    self.guard.reference = Some(e);
+                    self.guard.v_ref.copy_from(&self.v);
+                }
             }
             None
         } else {

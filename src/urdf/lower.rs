@@ -400,7 +400,13 @@ pub(crate) fn lower(
 
     let frames: Vec<Frame<f64>> = frames.into_iter().flatten().collect();
     fold_axis_placements(&mut joints, &mut placements);
-    let topology = crate::model::Topology::new(&dof_parent, nbodies, has_mimic);
+    let mut topology = crate::model::Topology::new(&dof_parent, nbodies, has_mimic);
+    topology.mimic_tree = has_mimic
+        && crate::model::Topology::mimic_tree_sparse(
+            &parent,
+            |b| (joints[b].iv, joints[b].nv()),
+            &dof_parent,
+        );
     Ok(Model {
         name: robot.name.clone(),
         nq,

@@ -247,7 +247,8 @@ impl Simulation {
             }
         }
         let mut jq = DMatrix::<f64>::zeros(m, n);
-        let mut gc = DMatrix::<f64>::zeros(n, n);
+        // (no rows: no second-order terms, nothing allocated)
+        let mut gc = DMatrix::<f64>::zeros(if m > 0 { n } else { 0 }, if m > 0 { n } else { 0 });
         if m > 0 {
             add_second_order(self, points, &loops, &rows.lambda, &vplus, &mut gc, &mut jq);
         }
@@ -273,14 +274,22 @@ impl Simulation {
             kk[(k, n + k)] += kv_diag[k];
         }
         kk *= -h;
-        kk.columns_mut(0, n).add_assign(&gc);
+        if m > 0 {
+            kk.columns_mut(0, n).add_assign(&gc);
+        }
         let mut z0 = DMatrix::zeros(n, 3 * n);
-        for c in 0..2 * n {
-            for k in 0..n {
-                let x = kk[(k, c)];
-                if x != 0.0 {
-                    for i in 0..n {
-                        z0[(i, c)] += minv[(i, k)] * x;
+        {
+            // column c of Z0 += K[k, c] · column k of H̃⁻¹ (contiguous columns,
+            // K's structural zeros skipped)
+            let (zs, ms, ks) = (z0.as_mut_slice(), minv.as_slice(), kk.as_slice());
+            for c in 0..2 * n {
+                let zc = &mut zs[c * n..(c + 1) * n];
+                for k in 0..n {
+                    let x = ks[k + c * n];
+                    if x != 0.0 {
+                        for (z, &mi) in zc.iter_mut().zip(&ms[k * n..(k + 1) * n]) {
+                            *z += mi * x;
+                        }
                     }
                 }
             }
@@ -448,7 +457,7 @@ impl Simulation {
         };
         // the position pass's δw (docs/theory.md §"Loops and the position pass
         // in the step Jacobians"): added to the configuration's velocity only
-        let mut dvtot = dvplus.clone();
+        let mut dvtot = None;
         if let (Some(wv), Some(hwq)) = (push.as_ref(), hw_q.as_ref()) {
             let mut gcm = DMatrix::<f64>::zeros(n, n);
             let mut jqw = DMatrix::<f64>::zeros(m, n);
@@ -466,12 +475,14 @@ impl Simulation {
                 loops: &loops,
                 h,
             };
-            dvtot += self.position_pass_jacobian(&pass);
+            dvtot = Some(&dvplus + self.position_pass_jacobian(&pass));
         }
         self.q.copy_from(&q1);
         self.v.copy_from(&v1);
         self.fk_valid = false;
-        Ok(Some(self.output_map(&vtot, &vplus, &dvtot, &dvplus, h)))
+        // without the position pass δv_tot = δv⁺ (no copy)
+        let dvtot = dvtot.as_ref().unwrap_or(&dvplus);
+        Ok(Some(self.output_map(&vtot, &vplus, dvtot, &dvplus, h)))
     }
 
     /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces): the
