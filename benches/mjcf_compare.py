@@ -15,13 +15,18 @@ The file as it is: dt = the file's <option timestep>, its gravity, its ground pl
 contact filter; zero controls; the start is the default pose qpos0 with zero velocity (the
 bodies are dropped from where the file puts them); --duration (3 s) of simulated time.
 
-urdyn: `urdyn simulate MODEL.xml --no-sleep --integrator euler --duration T --out CSV` (its
+urdyn: `urdyn simulate MODEL.xml --no-sleep --integrator euler --duration T --every 1000000000
+--out CSV` (its
 default integrator with contact, named so that a model without contact also steps at the
 file's dt instead of taking dop853's adaptive steps: velocity-level rigid contact with exact
 Coulomb friction). steps/s =
 steps / wall seconds of the stepping loop (no parsing, no process start), from the summary
 line urdyn prints on stderr: its real-time factor × steps / duration (4 significant digits,
-where the printed wall time has 0.1 ms steps).
+where the printed wall time has 0.1 ms steps). The timed runs write only the final state
+(--every larger than the run: no per-step energy, CSV formatting or writer thread), as
+MuJoCo's timed loop records nothing; the metrics below come from one extra untimed urdyn
+run with --every 1 (its steps/s, recording every step, is kept in the JSON as
+urdyn_record_sps).
 
 MuJoCo 4.0: mujoco.MjModel.from_xml_path on the same file, sleeping off (mjENBL_SLEEP
 cleared: every body awake), ctrl = 0, mj_resetData (qpos0); once with mjINT_EULER and once
@@ -143,9 +148,13 @@ def mujoco_metrics(m, integ, steps):
 
 # ---------------------------------------------------------------------------- urdyn
 
-def run_urdyn(urdyn, name, duration, out):
+def run_urdyn(urdyn, name, duration, out, record=False):
+    # timed rounds write the final state only (--every larger than the run), as
+    # MuJoCo's timed loop records nothing; the metrics come from one extra
+    # untimed run that writes every step (record=True), as MuJoCo's do
+    every = "1" if record else str(10**9)
     cmd = [urdyn, "simulate", path_of(name), "--no-sleep", "--integrator", "euler",
-           "--duration", str(duration), "--out", out]
+           "--duration", str(duration), "--every", every, "--out", out]
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     lines = [ln.strip() for ln in p.stderr.splitlines() if ln.strip()]
     summ = [ln for ln in lines if SUMMARY.search(ln)]
@@ -231,8 +240,9 @@ def write_md(path, rows, dyn, meta):
                                     meta["mujoco"], meta["machine"], meta["load"]), "",
          "Each model as its file defines it (dt = its timestep, its gravity, planes and contact "
          "filter), zero controls, dropped from the default pose qpos0, %g s. urdyn `simulate "
-         "--no-sleep` (euler, rigid contact); MuJoCo with every body awake, the faster of Euler "
-         "and implicitfast, timed in process. steps/s: best of %d rounds. Ratio = urdyn / "
+         "--no-sleep` (euler, rigid contact), timed without per-step recording (final state "
+         "only; the metrics from an extra untimed run writing every step); MuJoCo with every "
+         "body awake, the faster of Euler and implicitfast, timed in process. steps/s: best of %d rounds. Ratio = urdyn / "
          "MuJoCo (target: ≥ 2 on the four marked *, ≥ 1 elsewhere). lands: first contact; "
          "end: largest |v| component at the end (rest: < %g); pen.: deepest penetration over "
          "the run." % (meta["duration"], meta["repeats"], REST), "",
@@ -336,6 +346,8 @@ def main():
                      mujoco_sps=med[best], mujoco_integrator=best.lower(),
                      urdyn_command=u["command"], urdyn_warnings=u["warnings"])
             r["ratio"] = r["urdyn_sps"] / r["mujoco_sps"]
+            rec = run_urdyn(args.urdyn, name, args.duration, csvp, record=True)
+            r["urdyn_record_sps"] = rec.get("steps_per_s")
             r["urdyn_metrics"] = urdyn_metrics(csvp)
             r["mujoco_metrics"] = mujoco_metrics(m, getattr(mujoco.mjtIntegrator, "mjINT_" + best), steps)
             print("%s: urdyn %.0f, MuJoCo %.0f (%s), ratio %.2f; urdyn %s, MuJoCo %s" % (
