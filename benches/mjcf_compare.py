@@ -89,16 +89,21 @@ DYN_MODELS = ["gymnasium/ant", "gymnasium/humanoid", "gymnasium/half_cheetah",
 PINOCCHIO = "/work/shared/tools/pinocchio-bench/run"
 REST = 0.05
 NOTES = (
-    "`perf record` on `urdyn simulate MODEL.xml --no-sleep --integrator euler` (self time): "
-    "Gymnasium's humanoid: solver row forming 9 %, pair contact detection 8 %, PGS 8 %, "
-    "constraint assembly 6 %, CRBA 6 %, parry's convex-convex manifolds (capsule pairs) 6 %, "
-    "LTDL 5 %, bias 4 %, shape poses 4 %, island grouping 3 %; humanoid_CMU (nv 62): LTDL 19 %, "
-    "row forming 14 %, PGS 8 %, CRBA 8 %, assembly 7 %, LTDL solves 4 %; the ant at rest: PGS "
-    "18 %, the loop subspace step 11 %, assembly 8 %, CRBA 7 %, row forming 6 %, island "
-    "grouping 4 %. No MJCF-specific code (importer, actuators, tendons) appears: the cost is in "
-    "the contact pipeline and the solver (src/contact, src/sim/solver, src/sim/constraints) "
-    "and in the dynamics' factorisation (src/dynamics/ltdl.rs), outside this bench's room. "
-    "The timings move by up to 2x between runs on this shared machine (load 7-9 on 2 cores).")
+    "`perf record --call-graph dwarf` on 15 runs of `urdyn simulate MODEL.xml --no-sleep "
+    "--integrator euler --duration 3 --every 1000000000` (2026-12-03, share of the stepping "
+    "loop, children included): Gymnasium's humanoid: the constraint solve 45 % (PGS sweeps "
+    "32 %, 17 % self; the subspace step 10 %), the free velocity 22 % (CRBA 10 %, the mass "
+    "factor 5 %, bias 7 %), pair contact detection 15 % (parry's manifolds 9 %), solver row "
+    "forming 14 %, island grouping 4 %. humanoid_CMU (nv 62, self time): LTDL 18 %, PGS 11 %, "
+    "row forming 9 %, CRBA 7 %, assembly 5 %, LTDL solves 4 %, subspace step 3 %, bias 3 %, "
+    "pairs 3 %. No MJCF-specific code (importer, actuators as servos, tendons) appears in the "
+    "step: the cost is in the solver (src/sim/solver: PGS, subspace, forming), the contact "
+    "pipeline (src/contact) and the mass factor (src/dynamics/ltdl.rs, src/sim/factor.rs). "
+    "Recording every step (--every 1: energy per step, CSV formatting on a writer thread "
+    "sharing the 2 cores) cost humanoid and humanoid_CMU 18 %, ant 10 %, dm_control's "
+    "swimmer 63 % of the stepping loop's rate, which the timed runs now leave out (MuJoCo's "
+    "timed loop records nothing either). The timings move by up to 2x between runs on this "
+    "shared machine.")
 SUMMARY = re.compile(r"urdyn simulate: (\d+) steps \((\w+)\) in ([0-9.eE+-]+) s wall, "
                      r"real-time factor ([0-9.eE+-]+)")
 
