@@ -104,6 +104,19 @@ NOTES = (
     "swimmer 63 % of the stepping loop's rate, which the timed runs now leave out (MuJoCo's "
     "timed loop records nothing either). The timings move by up to 2x between runs on this "
     "shared machine.")
+ABA_NOTES = (
+    "urdyn gives each MJCF joint its own body (a body's several joints become a chain of "
+    "massless bodies, each about its own anchor, exactly MuJoCo's composition), so ABA does "
+    "one articulated-inertia step per joint; Pinocchio composes a body's joints into one "
+    "composite joint and does one step per MJCF body. Bodies in the two passes (urdyn / "
+    "Pinocchio): ant 9 / 9 (no body with several joints), half_cheetah 9 / 7, walker2d 9 / 7, "
+    "hopper 6 / 4, humanoid 18 / 11: the models with the largest share of their degrees of "
+    "freedom in multi-joint bodies (hopper: 3 of 6, its root slide-slide-hinge; humanoid: "
+    "12 of 23) have urdyn's worst aba ratios. Armature is not the cause: urdyn's `aba` "
+    "pass has no armature term (eval and the simulation factor H + A where a model has "
+    "armature), Pinocchio's adds it to each joint's scalar D at no extra cost. A composite "
+    "joint in urdyn's ABA (src/dynamics/aba*, another room) would remove the massless "
+    "bodies' steps.")
 SUMMARY = re.compile(r"urdyn simulate: (\d+) steps \((\w+)\) in ([0-9.eE+-]+) s wall, "
                      r"real-time factor ([0-9.eE+-]+)")
 
@@ -283,7 +296,9 @@ def write_md(path, rows, dyn, meta):
             L.append("| %s | %s | %.0f / %.0f | **%.2f** | %.0f / %.0f | **%.2f** |" % (
                 r["model"], r.get("nv", ""), u["rnea"], p["rnea"], u["rnea"] / p["rnea"],
                 u["aba"], p["aba"], u["aba"] / p["aba"]))
-    L += ["", "## Where urdyn's time goes (perf, 2026-12-02)", "", NOTES]
+    L += ["", "## Where urdyn's time goes (perf, 2026-12-03)", "", NOTES]
+    if dyn:
+        L += ["", "## Why aba is nearer 0.5 on some MJCF models", "", ABA_NOTES]
     with open(path, "w") as fh:
         fh.write("\n".join(L) + "\n")
 
