@@ -77,6 +77,8 @@ pub struct MjEquality {
     pub(crate) label: String,
 }
 
+type Orientation = UnitQuaternion<f64>;
+
 const ATTRS: &[&str] = &[
     "name",
     "class",
@@ -156,16 +158,15 @@ pub(super) fn read(
                     .ok_or_else(|| a.err(k, "no such body")),
             }
         };
-        let site =
-            |k: &str| -> Result<Option<(usize, Vector3<f64>, UnitQuaternion<f64>)>, MjcfError> {
-                let Some(n) = el.attr(k) else { return Ok(None) };
-                for (b, body) in world.bodies.iter().enumerate() {
-                    if let Some((_, p, q)) = body.sites.iter().find(|s| s.0 == n) {
-                        return Ok(Some((b, *p, *q)));
-                    }
+        let site = |k: &str| -> Result<Option<(usize, Vector3<f64>, Orientation)>, MjcfError> {
+            let Some(n) = el.attr(k) else { return Ok(None) };
+            for (b, body) in world.bodies.iter().enumerate() {
+                if let Some((_, p, q)) = body.sites.iter().find(|s| s.0 == n) {
+                    return Ok(Some((b, *p, *q)));
                 }
-                Err(a.err(k, "no such site"))
-            };
+            }
+            Err(a.err(k, "no such site"))
+        };
         let joint = |k: &str| -> Result<Option<usize>, MjcfError> {
             let Some(n) = el.attr(k) else { return Ok(None) };
             let j = world
