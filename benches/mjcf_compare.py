@@ -15,13 +15,18 @@ The file as it is: dt = the file's <option timestep>, its gravity, its ground pl
 contact filter; zero controls; the start is the default pose qpos0 with zero velocity (the
 bodies are dropped from where the file puts them); --duration (3 s) of simulated time.
 
-urdyn: `urdyn simulate MODEL.xml --no-sleep --integrator euler --duration T --out CSV` (its
+urdyn: `urdyn simulate MODEL.xml --no-sleep --integrator euler --duration T --every 1000000000
+--out CSV` (its
 default integrator with contact, named so that a model without contact also steps at the
 file's dt instead of taking dop853's adaptive steps: velocity-level rigid contact with exact
 Coulomb friction). steps/s =
 steps / wall seconds of the stepping loop (no parsing, no process start), from the summary
 line urdyn prints on stderr: its real-time factor × steps / duration (4 significant digits,
-where the printed wall time has 0.1 ms steps).
+where the printed wall time has 0.1 ms steps). The timed runs write only the final state
+(--every larger than the run: no per-step energy, CSV formatting or writer thread), as
+MuJoCo's timed loop records nothing; the metrics below come from one extra untimed urdyn
+run with --every 1 (its steps/s, recording every step, is kept in the JSON as
+urdyn_record_sps).
 
 MuJoCo 4.0: mujoco.MjModel.from_xml_path on the same file, sleeping off (mjENBL_SLEEP
 cleared: every body awake), ctrl = 0, mj_resetData (qpos0); once with mjINT_EULER and once
@@ -84,16 +89,34 @@ DYN_MODELS = ["gymnasium/ant", "gymnasium/humanoid", "gymnasium/half_cheetah",
 PINOCCHIO = "/work/shared/tools/pinocchio-bench/run"
 REST = 0.05
 NOTES = (
-    "`perf record` on `urdyn simulate MODEL.xml --no-sleep --integrator euler` (self time): "
-    "Gymnasium's humanoid: solver row forming 9 %, pair contact detection 8 %, PGS 8 %, "
-    "constraint assembly 6 %, CRBA 6 %, parry's convex-convex manifolds (capsule pairs) 6 %, "
-    "LTDL 5 %, bias 4 %, shape poses 4 %, island grouping 3 %; humanoid_CMU (nv 62): LTDL 19 %, "
-    "row forming 14 %, PGS 8 %, CRBA 8 %, assembly 7 %, LTDL solves 4 %; the ant at rest: PGS "
-    "18 %, the loop subspace step 11 %, assembly 8 %, CRBA 7 %, row forming 6 %, island "
-    "grouping 4 %. No MJCF-specific code (importer, actuators, tendons) appears: the cost is in "
-    "the contact pipeline and the solver (src/contact, src/sim/solver, src/sim/constraints) "
-    "and in the dynamics' factorisation (src/dynamics/ltdl.rs), outside this bench's room. "
-    "The timings move by up to 2x between runs on this shared machine (load 7-9 on 2 cores).")
+    "`perf record --call-graph dwarf` on 15 runs of `urdyn simulate MODEL.xml --no-sleep "
+    "--integrator euler --duration 3 --every 1000000000` (2026-12-03, share of the stepping "
+    "loop, children included): Gymnasium's humanoid: the constraint solve 45 % (PGS sweeps "
+    "32 %, 17 % self; the subspace step 10 %), the free velocity 22 % (CRBA 10 %, the mass "
+    "factor 5 %, bias 7 %), pair contact detection 15 % (parry's manifolds 9 %), solver row "
+    "forming 14 %, island grouping 4 %. humanoid_CMU (nv 62, self time): LTDL 18 %, PGS 11 %, "
+    "row forming 9 %, CRBA 7 %, assembly 5 %, LTDL solves 4 %, subspace step 3 %, bias 3 %, "
+    "pairs 3 %. No MJCF-specific code (importer, actuators as servos, tendons) appears in the "
+    "step: the cost is in the solver (src/sim/solver: PGS, subspace, forming), the contact "
+    "pipeline (src/contact) and the mass factor (src/dynamics/ltdl.rs, src/sim/factor.rs). "
+    "Recording every step (--every 1: energy per step, CSV formatting on a writer thread "
+    "sharing the 2 cores) cost humanoid and humanoid_CMU 18 %, ant 10 %, dm_control's "
+    "swimmer 63 % of the stepping loop's rate, which the timed runs now leave out (MuJoCo's "
+    "timed loop records nothing either). The timings move by up to 2x between runs on this "
+    "shared machine.")
+ABA_NOTES = (
+    "urdyn gives each MJCF joint its own body (a body's several joints become a chain of "
+    "massless bodies, each about its own anchor, exactly MuJoCo's composition), so ABA does "
+    "one articulated-inertia step per joint; Pinocchio composes a body's joints into one "
+    "composite joint and does one step per MJCF body. Bodies in the two passes (urdyn / "
+    "Pinocchio): ant 9 / 9 (no body with several joints), half_cheetah 9 / 7, walker2d 9 / 7, "
+    "hopper 6 / 4, humanoid 18 / 11: the models with the largest share of their degrees of "
+    "freedom in multi-joint bodies (hopper: 3 of 6, its root slide-slide-hinge; humanoid: "
+    "12 of 23) have urdyn's worst aba ratios. Armature is not the cause: urdyn's `aba` "
+    "pass has no armature term (eval and the simulation factor H + A where a model has "
+    "armature), Pinocchio's adds it to each joint's scalar D at no extra cost. A composite "
+    "joint in urdyn's ABA (src/dynamics/aba*, another room) would remove the massless "
+    "bodies' steps.")
 SUMMARY = re.compile(r"urdyn simulate: (\d+) steps \((\w+)\) in ([0-9.eE+-]+) s wall, "
                      r"real-time factor ([0-9.eE+-]+)")
 
@@ -143,9 +166,13 @@ def mujoco_metrics(m, integ, steps):
 
 # ---------------------------------------------------------------------------- urdyn
 
-def run_urdyn(urdyn, name, duration, out):
+def run_urdyn(urdyn, name, duration, out, record=False):
+    # timed rounds write the final state only (--every larger than the run), as
+    # MuJoCo's timed loop records nothing; the metrics come from one extra
+    # untimed run that writes every step (record=True), as MuJoCo's do
+    every = "1" if record else str(10**9)
     cmd = [urdyn, "simulate", path_of(name), "--no-sleep", "--integrator", "euler",
-           "--duration", str(duration), "--out", out]
+           "--duration", str(duration), "--every", every, "--out", out]
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     lines = [ln.strip() for ln in p.stderr.splitlines() if ln.strip()]
     summ = [ln for ln in lines if SUMMARY.search(ln)]
@@ -231,8 +258,9 @@ def write_md(path, rows, dyn, meta):
                                     meta["mujoco"], meta["machine"], meta["load"]), "",
          "Each model as its file defines it (dt = its timestep, its gravity, planes and contact "
          "filter), zero controls, dropped from the default pose qpos0, %g s. urdyn `simulate "
-         "--no-sleep` (euler, rigid contact); MuJoCo with every body awake, the faster of Euler "
-         "and implicitfast, timed in process. steps/s: best of %d rounds. Ratio = urdyn / "
+         "--no-sleep` (euler, rigid contact), timed without per-step recording (final state "
+         "only; the metrics from an extra untimed run writing every step); MuJoCo with every "
+         "body awake, the faster of Euler and implicitfast, timed in process. steps/s: best of %d rounds. Ratio = urdyn / "
          "MuJoCo (target: ≥ 2 on the four marked *, ≥ 1 elsewhere). lands: first contact; "
          "end: largest |v| component at the end (rest: < %g); pen.: deepest penetration over "
          "the run." % (meta["duration"], meta["repeats"], REST), "",
@@ -268,7 +296,9 @@ def write_md(path, rows, dyn, meta):
             L.append("| %s | %s | %.0f / %.0f | **%.2f** | %.0f / %.0f | **%.2f** |" % (
                 r["model"], r.get("nv", ""), u["rnea"], p["rnea"], u["rnea"] / p["rnea"],
                 u["aba"], p["aba"], u["aba"] / p["aba"]))
-    L += ["", "## Where urdyn's time goes (perf, 2026-12-02)", "", NOTES]
+    L += ["", "## Where urdyn's time goes (perf, 2026-12-03)", "", NOTES]
+    if dyn:
+        L += ["", "## Why aba is nearer 0.5 on some MJCF models", "", ABA_NOTES]
     with open(path, "w") as fh:
         fh.write("\n".join(L) + "\n")
 
@@ -336,6 +366,8 @@ def main():
                      mujoco_sps=med[best], mujoco_integrator=best.lower(),
                      urdyn_command=u["command"], urdyn_warnings=u["warnings"])
             r["ratio"] = r["urdyn_sps"] / r["mujoco_sps"]
+            rec = run_urdyn(args.urdyn, name, args.duration, csvp, record=True)
+            r["urdyn_record_sps"] = rec.get("steps_per_s")
             r["urdyn_metrics"] = urdyn_metrics(csvp)
             r["mujoco_metrics"] = mujoco_metrics(m, getattr(mujoco.mjtIntegrator, "mjINT_" + best), steps)
             print("%s: urdyn %.0f, MuJoCo %.0f (%s), ratio %.2f; urdyn %s, MuJoCo %s" % (

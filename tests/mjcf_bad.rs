@@ -28,6 +28,15 @@ const CASES: &[(&str, &[&str])] = &[
     ("empty.xml", &["empty"]),
     ("entity_bomb.xml", &["<!DOCTYPE>", "entity"]),
     (
+        "equality_ball_joint.xml",
+        &["<joint name=\"g\">", "joint2=\"s\"", "hinge or slide"],
+    ),
+    ("equality_nan_anchor.xml", &["<weld name=\"w\">", "anchor"]),
+    (
+        "equality_unknown_body.xml",
+        &["<connect name=\"c\">", "body2=\"ghost\""],
+    ),
+    (
         "exclude_unknown_body.xml",
         &["<exclude name=\"e\">", "body2=\"ghost\""],
     ),

@@ -8,26 +8,52 @@ use crate::spatial::Force;
 use nalgebra::{DMatrix, DVector};
 use serde_json::{json, Map, Value};
 
-/// The file's constraints, checked against the model (`None` when it has none).
+/// The model's own active constraints (MJCF `<equality>`, mjcf.md §"In
+/// `eval`") followed by the file's, checked against the model (`None` when
+/// there are none).
 pub fn parse(
     model: &Model,
     constraints: Option<&Value>,
     file: &str,
 ) -> Result<Option<Constraints>, StateError> {
+    let own: Vec<_> = model
+        .equalities
+        .items
+        .iter()
+        .zip(model.equality_active.iter().chain(std::iter::repeat(&true)))
+        .filter(|(_, on)| **on)
+        .map(|(c, _)| c.clone())
+        .collect();
     let Some(v) = constraints else {
-        return Ok(None);
+        return Ok((!own.is_empty()).then_some(Constraints { items: own }));
     };
-    Constraints::from_value(model, v)
-        .map(Some)
-        .map_err(|e| StateError {
+    let mut set = Constraints::from_value(model, v).map_err(|e| StateError {
+        file: file.to_string(),
+        key: if e.key.is_empty() {
+            "constraints".into()
+        } else {
+            format!("constraints[{}].{}", e.index, e.key)
+        },
+        message: e.message,
+    })?;
+    if let Some((k, c)) = set
+        .items
+        .iter()
+        .enumerate()
+        .find(|(_, c)| own.iter().any(|o| o.name == c.name))
+    {
+        return Err(StateError {
             file: file.to_string(),
-            key: if e.key.is_empty() {
-                "constraints".into()
-            } else {
-                format!("constraints[{}].{}", e.index, e.key)
-            },
-            message: e.message,
-        })
+            key: format!("constraints[{k}].name"),
+            message: format!(
+                "\"{}\" is the name of one of the model's equalities",
+                c.name
+            ),
+        });
+    }
+    let mut items = own;
+    items.append(&mut set.items);
+    Ok(Some(Constraints { items }))
 }
 
 fn rows(m: &DMatrix<f64>) -> Value {

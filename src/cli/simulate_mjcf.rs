@@ -35,11 +35,6 @@ pub(crate) fn setup(
             "{name}: {opt} does not apply to an MJCF file (the file says which joints are free and its planes are the ground)"
         )));
     }
-    if args.html.is_some() {
-        return Err(SimulateError::Option(format!(
-            "{name}: --html: the replay page of an MJCF world is not supported yet (simulate without --html)"
-        )));
-    }
     if let (Some(k), Some(_)) = (&args.key, &args.initial) {
         return Err(SimulateError::Option(format!(
             "{name}: --key {k} and --initial both give the starting state: give one"
@@ -89,7 +84,12 @@ pub(crate) fn setup(
         threads: args.threads.unwrap_or(1),
         ..SimOptions::default()
     };
-    Ok((model, init, opts, None, name, None))
+    // --html: every geom of the world in its colour (src/cli/view/mjcf.rs)
+    let geometry = args
+        .html
+        .as_ref()
+        .map(|_| crate::cli::view::mjcf::geometry(&model, &world, &name));
+    Ok((model, init, opts, geometry, name, None))
 }
 
 /// The starting state of keyframe `key` (MuJoCo's qpos/qvel converted).

@@ -36,6 +36,8 @@ pub(crate) struct Ctx<'a> {
     pub world: World,
     pub names: [HashSet<String>; 4],
     pub not_modelled: Vec<String>,
+    /// `<asset><material>` colours by name.
+    pub materials: std::collections::HashMap<String, [f64; 4]>,
 }
 
 impl Ctx<'_> {
@@ -565,7 +567,15 @@ fn geom(
         priority: a.int("priority")?.unwrap_or(0),
         group,
         friction,
-        rgba: a.partial::<4>("rgba", [0.5, 0.5, 0.5, 1.0])?,
+        rgba: {
+            // MuJoCo's renderer: the material's colour when the geom's is the default
+            const GREY: [f64; 4] = [0.5, 0.5, 0.5, 1.0];
+            let own = a.partial::<4>("rgba", GREY)?;
+            match a.get("material").and_then(|m| cx.materials.get(m)) {
+                Some(m) if own == GREY => *m,
+                _ => own,
+            }
+        },
         asset,
     });
     Ok(())

@@ -321,8 +321,11 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
         qpos0: Some(qpos0),
         actuators: Vec::new(),
         keyframes: Vec::new(),
+        equalities: Default::default(),
+        equality_active: Vec::new(),
     };
     super::actuators::lower(world, &mut model)?;
+    super::equality::lower(world, &ub, &ub_m, &mut model)?;
     Ok(model)
 }
 

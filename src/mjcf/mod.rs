@@ -21,6 +21,7 @@ mod attrs;
 mod collide;
 mod compile;
 mod convert;
+mod equality;
 mod inertia;
 mod lower;
 mod orient;
@@ -33,6 +34,7 @@ pub use actuators::MjActuator;
 pub use collide::Ground;
 pub use compile::{MjBody, MjGeom, MjGeomType, MjJoint, MjJointType, World};
 pub use convert::{from_mujoco_qpos, from_mujoco_qvel, to_mujoco_qpos, to_mujoco_qvel};
+pub use equality::{MjEqKind, MjEquality};
 pub use sections::MjKey;
 pub use xml::is_mjcf_text;
 
@@ -204,10 +206,12 @@ fn compile(
             keys: Vec::new(),
             actuators: Vec::new(),
             tendons: Vec::new(),
+            equalities: Vec::new(),
             warnings: Vec::new(),
         },
         names: Default::default(),
         not_modelled: Vec::new(),
+        materials: sections::materials(&of("asset").collect::<Vec<_>>(), &defaults)?,
     };
     options(&mut cx, &of("option").collect::<Vec<_>>())?;
     let origin = (Vector3::zeros(), nalgebra::UnitQuaternion::identity());
@@ -230,19 +234,19 @@ fn compile(
         cx.set.autolimits,
         &mut cx.not_modelled,
     )?;
+    equality::read(
+        &mut world,
+        &of("equality").collect::<Vec<_>>(),
+        &defaults,
+        &mut cx.not_modelled,
+    )?;
     sections::keyframes(&mut world, &of("keyframe").collect::<Vec<_>>())?;
     sections::contacts(
         &mut world,
         &of("contact").collect::<Vec<_>>(),
         &mut cx.not_modelled,
     )?;
-    for (tag, what) in [
-        (
-            "equality",
-            "equality constraints: not modelled yet (MJCF simulation)",
-        ),
-        ("sensor", "sensors: not modelled (urdyn has its own)"),
-    ] {
+    for (tag, what) in [("sensor", "sensors: not modelled (urdyn has its own)")] {
         if of(tag).any(|s| !s.children.is_empty()) {
             cx.not_modelled.push(what.to_string());
         }

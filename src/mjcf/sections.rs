@@ -165,3 +165,23 @@ pub(super) fn asset_files(
     }
     Ok(())
 }
+
+/// `<asset><material>` colours by name (`rgba`, MuJoCo's default white; class
+/// defaults applied), for the geoms that name them.
+pub(super) fn materials(
+    sections: &[&El],
+    defaults: &super::attrs::Defaults,
+) -> Result<std::collections::HashMap<String, [f64; 4]>, MjcfError> {
+    let mut out = std::collections::HashMap::new();
+    for el in sections.iter().flat_map(|s| s.children.iter()) {
+        if el.tag != "material" {
+            continue;
+        }
+        let Some(name) = el.attr("name") else {
+            continue;
+        };
+        let a = defaults.resolve(el, "main")?;
+        out.insert(name.to_string(), a.partial::<4>("rgba", [1.0; 4])?);
+    }
+    Ok(out)
+}

@@ -156,6 +156,8 @@ pub struct World {
     pub actuators: Vec<super::actuators::MjActuator>,
     /// `<tendon>`s in MuJoCo's order.
     pub tendons: Vec<super::tendons::MjTendon>,
+    /// `<equality>` constraints in MuJoCo's order.
+    pub equalities: Vec<super::equality::MjEquality>,
     /// What urdyn does not model, one line a kind.
     pub warnings: Vec<String>,
 }

@@ -330,6 +330,12 @@ pub struct Model<T: Scalar = f64> {
     pub actuators: Vec<Actuator>,
     /// The file's named starting states (MJCF `<keyframe>`; none for a URDF).
     pub keyframes: Vec<Keyframe>,
+    /// The file's own loop constraints (MJCF `<equality>` as mechanisms.md's
+    /// `point`, `frame`, `joint`; none for a URDF): `eval` applies the active
+    /// ones, a [`crate::sim::Simulation`] starts with them (inactive ones off).
+    pub equalities: Constraints,
+    /// Whether each of [`Model::equalities`] is on at the start (`active`).
+    pub equality_active: Vec<bool>,
 }
 
 impl<T: Scalar> Model<T> {
@@ -508,6 +514,8 @@ impl Model<f64> {
             qpos0: self.qpos0.clone(),
             actuators: self.actuators.clone(),
             keyframes: self.keyframes.clone(),
+            equalities: self.equalities.clone(),
+            equality_active: self.equality_active.clone(),
         }
     }
 }

@@ -67,6 +67,8 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
         qpos0: None,
         actuators: Vec::new(),
         keyframes: Vec::new(),
+        equalities: Default::default(),
+        equality_active: Vec::new(),
     };
     for (i, part) in parts.into_iter().enumerate() {
         let p = &part.model;

@@ -214,6 +214,8 @@ impl Simulation {
         }
         sim.cons.set_threads(sim.opts.threads);
         sim.state_changed();
+        // the model's own loop constraints (MJCF <equality>): src/sim/equalities.rs
+        sim.set_model_equalities()?;
         Ok(sim)
     }
 }

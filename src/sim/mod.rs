@@ -63,6 +63,7 @@ mod actuators;
 pub mod constraints;
 mod contact_view;
 pub mod derivatives;
+mod equalities;
 pub mod factor;
 mod loops;
 mod tendons;

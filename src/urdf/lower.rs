@@ -465,6 +465,8 @@ pub(crate) fn lower(
         qpos0: None,
         actuators: Vec::new(),
         keyframes: Vec::new(),
+        equalities: Default::default(),
+        equality_active: Vec::new(),
     })
 }
 

@@ -233,6 +233,11 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         for line in sim.set_constraints(set).map_err(sim_err)? {
             warn(&format!("warning: {urdf_name}: {line}"));
         }
+    } else if !sim.model.equalities.items.is_empty() {
+        // an MJCF file's equalities (Simulation::new set them) at its start state
+        for line in sim.constraint_start_lines() {
+            warn(&format!("warning: {urdf_name}: {line}"));
+        }
     }
     // MJCF actuators: --key's ctrl, then --controls' rows as time reaches them
     let mut schedule = super::simulate_mjcf::schedule(args, &sim.model)?;

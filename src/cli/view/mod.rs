@@ -29,6 +29,7 @@ use serde_json::{json, Value};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+pub mod mjcf;
 mod scene;
 mod visuals;
 
@@ -115,19 +116,30 @@ pub enum ViewError {
 /// Runs `urdyn view`: reads the URDF and the CSV, writes the page atomically (a
 /// bad input leaves no page).
 pub fn run(args: &ViewArgs) -> Result<PageSummary, ViewError> {
-    if crate::load::file_format(&args.urdf) == crate::load::Format::Mjcf {
+    let is_mjcf = crate::load::file_format(&args.urdf) == crate::load::Format::Mjcf;
+    if is_mjcf && args.floating_base {
         return Err(ViewError::Geometry(format!(
-            "{}: replaying an MJCF world is not supported yet (it comes with MJCF simulation)",
+            "{}: --floating-base does not apply to an MJCF file (the file says which joints are free)",
             args.urdf.display()
         )));
     }
-    let model = crate::load_file(
-        &args.urdf,
-        LoadOptions {
-            floating_base: args.floating_base,
-        },
-    )?;
-    let geometry = Geometry::load(&model, &args.urdf, &args.package_path)?;
+    let (model, geometry, ground) = if is_mjcf {
+        // the file's whole world, every geom in its colour (view/mjcf.rs)
+        let (model, world) = crate::mjcf::load_file_with_world(&args.urdf)
+            .map_err(|e| ViewError::Geometry(e.to_string()))?;
+        let g = mjcf::geometry(&model, &world, &args.urdf.display().to_string());
+        let ground = crate::mjcf::ground_of(&world).map(|g| g.height);
+        (model, g, ground)
+    } else {
+        let model = crate::load_file(
+            &args.urdf,
+            LoadOptions {
+                floating_base: args.floating_base,
+            },
+        )?;
+        let geometry = Geometry::load(&model, &args.urdf, &args.package_path)?;
+        (model, geometry, Some(0.0))
+    };
     let csv_name = args.traj.display().to_string();
     let text = std::fs::read(&args.traj)
         .map_err(|e| ViewError::Csv(format!("{csv_name}: cannot read: {e}")))?;
@@ -140,7 +152,7 @@ pub fn run(args: &ViewArgs) -> Result<PageSummary, ViewError> {
         let plot = [rows.energy[k], rows.contacts[k], rows.penetration[k]];
         recorder.offer(*t, &rows.q[k], plot, &[], k == last);
     }
-    write_page(&args.out, &model, &geometry, &recorder, Some(0.0))
+    write_page(&args.out, &model, &geometry, &recorder, ground)
 }
 
 /// Writes the page for `recorder`'s frames atomically to `out`.
@@ -484,6 +496,11 @@ pub enum VisualShape {
     Sphere {
         /// Radius (m).
         radius: f64,
+    },
+    /// Centred ellipsoid (an MJCF geom).
+    Ellipsoid {
+        /// Semi-axes along x, y, z (m).
+        radii: [f64; 3],
     },
 }
 
@@ -922,6 +939,7 @@ fn page_data(model: &Model, geometry: &Geometry, rec: &Recorder, ground: Option<
                     ("capsule", vec![*radius, *length], None)
                 }
                 VisualShape::Sphere { radius } => ("sphere", vec![*radius], None),
+                VisualShape::Ellipsoid { radii } => ("ellipsoid", radii.to_vec(), None),
             };
             json!({"link": v.link, "body": v.body, "p": v.placement.trans.as_slice(),
                    "R": rows9(&v.placement.rot), "kind": kind, "dims": dims,

@@ -287,7 +287,7 @@
     if (v.kind === "cylinder") {
       return (shapes.cyl = shapes.cyl || lathe([[0, -0.5], [1, -0.5], [1, 0.5], [0, 0.5]], 48));
     }
-    if (v.kind === "sphere") return (shapes.sph = shapes.sph || lathe(arc(24, 0, Math.PI, 0), 48));
+    if (v.kind === "sphere" || v.kind === "ellipsoid") return (shapes.sph = shapes.sph || lathe(arc(24, 0, Math.PI, 0), 48));
     // capsule: its own shape (radius 1 before scaling by r; half length l / 2r)
     const r = v.dims[0] || 1e-9, h = v.dims[1] / 2 / r;
     return lathe(arc(12, -h, Math.PI, Math.PI / 2).concat(arc(12, h, Math.PI / 2, 0)), 48);
@@ -298,6 +298,7 @@
       case "box": return d;
       case "cylinder": return [d[0], d[0], d[1]];
       case "sphere": case "capsule": return [d[0], d[0], d[0]];
+      case "ellipsoid": return d;
       default: return [1, 1, 1];
     }
   }
@@ -318,7 +319,8 @@
       const d = v.dims;
       radius = v.kind === "box" ? Math.hypot(d[0], d[1], d[2]) / 2
         : v.kind === "cylinder" ? Math.hypot(d[0], d[1] / 2)
-          : d[0] + (v.kind === "capsule" ? d[1] / 2 : 0);
+          : v.kind === "ellipsoid" ? Math.max(d[0], d[1], d[2])
+            : d[0] + (v.kind === "capsule" ? d[1] / 2 : 0);
     }
     // the parts drawn, each in its colour: a DAE mesh's colour groups (a group
     // without a colour takes the visual's), else the whole drawable
