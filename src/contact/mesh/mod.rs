@@ -202,6 +202,7 @@ fn read_raw(path: &Path, with_triangles: bool) -> Result<RawMesh, MeshError> {
 }
 
 /// A 4×4 affine transform acting on column vectors (COLLADA's convention).
+pub(crate) mod cache;
 mod dae;
 mod dae_parts;
 use dae::read_dae_colored;
