@@ -217,7 +217,8 @@ fn too_deep(man: &ContactManifold<(), ()>, bound: f64) -> bool {
 /// The contact points of a hull on a face shape (`hull_is_a`: the hull is
 /// the pair's a) by [`hull_on_face`], appended to `raw` with the normal from
 /// b toward a; false when the plane contact is not the exact one (the caller
-/// asks parry).
+/// asks parry). `maxp`: what [`reduce_pair`] will be given (of more points
+/// than that, only those it looks at are collected when they are enough).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn face_points(
     ma: &PairShape,
@@ -226,6 +227,7 @@ pub(super) fn face_points(
     wb: &Se3<f64>,
     hull_is_a: bool,
     margin: f64,
+    maxp: usize,
     scratch: &mut FaceScratch,
     raw: &mut Vec<Raw>,
     stamp: u32,
@@ -244,6 +246,9 @@ pub(super) fn face_points(
         &f_m_h,
         face,
         margin,
+        // more than `maxp` points: `reduce_pair` looks only at those within
+        // EXTREME_BAND of the deepest
+        Some((EXTREME_BAND, maxp + 1)),
         &mut scratch.points,
         &mut scratch.stack,
         &mut scratch.seen,
@@ -278,7 +283,32 @@ pub(super) fn face_points(
 /// vertices at a time, swapping every few steps, and crept down the slope
 /// at 0.05 rad/s; within 0.3 mm both are kept and it rests (v = 0 by 0.7 s).
 /// (2 mm, the ground's band, still left it creeping.)
-const EXTREME_BAND: f64 = 3e-4;
+pub(super) const EXTREME_BAND: f64 = 3e-4;
+
+/// (sin, cos) of direction `d` of `dirs` evenly spread ones.
+fn direction(d: usize, dirs: usize) -> (f64, f64) {
+    (std::f64::consts::TAU * d as f64 / dirs as f64).sin_cos()
+}
+
+/// The most directions [`directions`] keeps a table for.
+const TABLE_DIRS: usize = 8;
+
+/// The [`direction`]s of `dirs` (1 to [`TABLE_DIRS`]), computed once: the
+/// same numbers, without a sine and a cosine a direction a pair a step.
+fn directions(dirs: usize) -> Option<&'static [(f64, f64)]> {
+    static TABLE: std::sync::OnceLock<[[(f64, f64); TABLE_DIRS]; TABLE_DIRS + 1]> =
+        std::sync::OnceLock::new();
+    let t = TABLE.get_or_init(|| {
+        let mut t = [[(0.0, 0.0); TABLE_DIRS]; TABLE_DIRS + 1];
+        for (n, row) in t.iter_mut().enumerate().skip(1) {
+            for (d, x) in row.iter_mut().enumerate().take(n) {
+                *x = direction(d, n);
+            }
+        }
+        t
+    });
+    t.get(dirs).map(|row| &row[..dirs])
+}
 
 /// Appends at most `maxp` of `raw` to `out` as `make` makes them: all when
 /// they fit, else the deepest, then the extremes along `maxp − 1` tangent
@@ -310,8 +340,12 @@ pub(super) fn reduce_pair(
     out.push(make(&raw[deepest]));
     let (t1, t2) = tangents(&raw[deepest].normal);
     let dirs = maxp - 1;
+    let table = directions(dirs);
     for d in 0..dirs {
-        let (s, c) = (std::f64::consts::TAU * d as f64 / dirs as f64).sin_cos();
+        let (s, c) = match table {
+            Some(t) => t[d],
+            None => direction(d, dirs),
+        };
         let dir = t1 * c + t2 * s;
         let best = (0..raw.len())
             .filter(|&i| raw[i].gap <= band)

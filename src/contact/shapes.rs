@@ -126,6 +126,43 @@ pub(crate) fn mesh_vertices(
     }
 }
 
+/// The parry shape of `g`'s mesh file and whether it is convex: its
+/// triangles (an obstacle's `trimesh`) or the convex hull of its vertices;
+/// `None` for a flat or empty hull.
+fn mesh_shape(
+    g: &CollisionGeom,
+    filename: &str,
+    scale: [f64; 3],
+    model: &Model,
+    package_paths: &[PathBuf],
+) -> Result<Option<(SharedShape, bool)>, ContactError> {
+    let m = mesh_vertices(g, filename, scale, model, package_paths)?;
+    let pv: Vec<PVec> = m
+        .vertices
+        .iter()
+        .map(|p| PVec::new(p.x, p.y, p.z))
+        .collect();
+    if g.trimesh && !m.triangles.is_empty() {
+        match SharedShape::trimesh(pv, m.triangles) {
+            Ok(s) => Ok(Some((s, false))),
+            Err(e) => Err(ContactError::Mesh {
+                link: g.link.clone(),
+                source: mesh::MeshError {
+                    file: filename.to_string(),
+                    message: format!("not a usable triangle mesh: {e}"),
+                },
+            }),
+        }
+    } else {
+        // a large hull climbs its vertex graph for its support points
+        Ok(match ClimbHull::of_points(&pv) {
+            Some(Ok(h)) => Some((SharedShape::new(h), true)),
+            Some(Err(h)) => Some((SharedShape::new(h), true)),
+            None => None,
+        })
+    }
+}
+
 /// The parry shape of `g`; `None` for a shape that cannot collide (a flat or
 /// empty mesh: the ground path still handles its points).
 pub(crate) fn pair_shape(
@@ -173,32 +210,24 @@ pub(crate) fn pair_shape(
             )
         }
         Shape::Mesh { filename, scale } => {
-            let m = mesh_vertices(g, filename, *scale, model, package_paths)?;
-            let pv: Vec<PVec> = m
-                .vertices
-                .iter()
-                .map(|p| PVec::new(p.x, p.y, p.z))
-                .collect();
-            if g.trimesh && !m.triangles.is_empty() {
-                match SharedShape::trimesh(pv, m.triangles) {
-                    Ok(s) => (s, id, false),
-                    Err(e) => {
-                        return Err(ContactError::Mesh {
-                            link: g.link.clone(),
-                            source: mesh::MeshError {
-                                file: filename.clone(),
-                                message: format!("not a usable triangle mesh: {e}"),
-                            },
-                        })
-                    }
-                }
+            // made once a file (`mesh::cache`): a second simulation of the
+            // same model reads and hulls nothing
+            let path = resolve_mesh_path(filename, model.source.as_deref(), package_paths)
+                .ok_or_else(|| ContactError::MissingMesh {
+                    link: g.link.clone(),
+                    file: filename.to_string(),
+                })?;
+            let kind = if g.trimesh {
+                "pair-trimesh"
             } else {
-                // a large hull climbs its vertex graph for its support points
-                match ClimbHull::of_points(&pv) {
-                    Some(Ok(h)) => (SharedShape::new(h), id, true),
-                    Some(Err(h)) => (SharedShape::new(h), id, true),
-                    None => return Ok(None),
-                }
+                "pair-hull"
+            };
+            let made = mesh::cache::cached(kind, &path, *scale, || {
+                mesh_shape(g, filename, *scale, model, package_paths)
+            })?;
+            match &*made {
+                Some((s, convex)) => (s.clone(), id, *convex),
+                None => return Ok(None),
             }
         }
         Shape::HeightField { heights, size } => {

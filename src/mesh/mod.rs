@@ -204,7 +204,7 @@ fn read_raw(path: &Path, with_triangles: bool) -> Result<RawMesh, MeshError> {
     Ok((raw, triangles, colors))
 }
 
-/// A 4×4 affine transform acting on column vectors (COLLADA's convention).
+pub(crate) mod cache;
 mod dae;
 mod paths;
 pub use paths::resolve_mesh_path;

@@ -12,7 +12,7 @@ use crate::spatial::Se3;
 use nalgebra::Vector3;
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Hulls with more vertices than this are searched on their vertex graph
 /// instead of scanned whole.
@@ -26,6 +26,49 @@ fn hull_adjacency(h: &ConvexPolyhedron) -> (Vec<u32>, Vec<u32>) {
         h.points().len(),
         h.edges().iter().map(|e| (e.vertices[0], e.vertices[1])),
     )
+}
+
+/// What the ground path makes of a mesh file: the convex hull of its
+/// vertices (a flat mesh: the vertices themselves) and, for a large hull,
+/// its vertex graph.
+struct GroundMesh {
+    shape: ParryShape,
+    verts: Vec<Vector3<f64>>,
+    graph: (Vec<u32>, Vec<u32>),
+}
+
+/// Reads the mesh at `path` scaled by `scale` and makes its [`GroundMesh`].
+fn ground_mesh(path: &Path, scale: [f64; 3]) -> Result<GroundMesh, mesh::MeshError> {
+    let pts = mesh::load_vertices(path, scale)?;
+    let pv: Vec<PVec> = pts.iter().map(|p| PVec::new(p.x, p.y, p.z)).collect();
+    Ok(match ConvexPolyhedron::from_convex_hull(&pv) {
+        Some(h) => {
+            let verts: Vec<_> = h
+                .points()
+                .iter()
+                .map(|p| Vector3::new(p.x, p.y, p.z))
+                .collect();
+            let graph = if verts.len() > GRAPH_SEARCH_MIN {
+                hull_adjacency(&h)
+            } else {
+                (Vec::new(), Vec::new())
+            };
+            GroundMesh {
+                shape: ParryShape::Hull(h),
+                verts,
+                graph,
+            }
+        }
+        None => {
+            let mut verts = pts;
+            verts.dedup();
+            GroundMesh {
+                shape: ParryShape::Points,
+                verts,
+                graph: (Vec::new(), Vec::new()),
+            }
+        }
+    })
 }
 
 impl GroundContact {
@@ -122,31 +165,21 @@ impl GroundContact {
                             link: link.clone(),
                             file: filename.clone(),
                         })?;
-                    let pts = mesh::load_vertices(&path, *scale).map_err(|source| {
-                        ContactError::Mesh {
-                            link: link.clone(),
-                            source,
-                        }
+                    // the hull of the file's vertices, made once a file (`mesh::cache`)
+                    let made = mesh::cache::cached("ground-hull", &path, *scale, || {
+                        ground_mesh(&path, *scale)
+                    })
+                    .map_err(|source| ContactError::Mesh {
+                        link: link.clone(),
+                        source,
                     })?;
-                    let pv: Vec<PVec> = pts.iter().map(|p| PVec::new(p.x, p.y, p.z)).collect();
-                    match ConvexPolyhedron::from_convex_hull(&pv) {
-                        Some(h) => {
-                            let v: Vec<_> = h
-                                .points()
-                                .iter()
-                                .map(|p| Vector3::new(p.x, p.y, p.z))
-                                .collect();
-                            if v.len() > GRAPH_SEARCH_MIN {
-                                graph = hull_adjacency(&h);
-                            }
-                            (ParryShape::Hull(h), Manifold::Vertices, v, Se3::identity())
-                        }
-                        None => {
-                            let mut v = pts;
-                            v.dedup();
-                            (ParryShape::Points, Manifold::Vertices, v, Se3::identity())
-                        }
-                    }
+                    graph = made.graph.clone();
+                    (
+                        made.shape.clone(),
+                        Manifold::Vertices,
+                        made.verts.clone(),
+                        Se3::identity(),
+                    )
                 }
                 // (a scene's terrain is welded to the world: never a moving link's)
                 Shape::HeightField { .. } => continue,

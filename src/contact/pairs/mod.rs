@@ -413,6 +413,7 @@ impl PairContact {
                         &wb,
                         hull_is_a,
                         margin,
+                        self.max_points,
                         &mut self.scratch,
                         &mut self.raw,
                         self.stamp,

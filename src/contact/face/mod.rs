@@ -162,12 +162,28 @@ fn box_face(f: usize) -> (usize, Vector3<f64>) {
 /// The contact of `hull` placed at `b_m_a` (its frame in the face shape's)
 /// with `face`, within `margin`; the points go to `out` (cleared) with
 /// `stack`/`seen` as scratch (`seen` as long as the hull has vertices).
+///
+/// `dense = Some((inner, enough))`: the caller keeps, of more than `enough`
+/// − 1 points, only those within `inner` of the deepest (see
+/// [`crate::contact::narrow`]'s `reduce_pair`). The vertices within `inner`
+/// of the lowest are then collected first; when they are `enough` or more,
+/// they are the answer (a rounded foot's ring of a few vertices, not the
+/// hundred a 5 mm band holds); else the band's climb stops at `enough`
+/// points, and the answer is the near ones and the farther ones it found
+/// (the caller reduces them to the same points as the whole band), or the
+/// whole band when it holds fewer. The band's vertices not climbed are not
+/// checked: on a height field they could not fail the check (it bounds
+/// depth only, and they are shallower than the deepest), on a box's face
+/// one hanging over the face's edge (above its plane, beside the box) no
+/// longer sends the pair to parry, whose manifold would be the same face's
+/// points.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn hull_on_face(
     hull: HullRef<'_>,
     b_m_a: &Se3<f64>,
     face: FaceShape<'_>,
     margin: f64,
+    dense: Option<(f64, usize)>,
     out: &mut Vec<FacePoint>,
     stack: &mut Vec<u32>,
     seen: &mut Vec<u32>,
@@ -218,21 +234,22 @@ pub(crate) fn hull_on_face(
             let (i, n) = box_face(f);
             let (j1, j2) = ((i + 1) % 3, (i + 2) % 3);
             let band = margin.min(sep + BAND);
-            let ok = collect(
+            let valid = |q: &Vector3<f64>, gap: f64| {
+                let depth = (-gap).max(0.0);
+                depth <= e[i] && q[j1].abs() + depth <= e[j1] && q[j2].abs() + depth <= e[j2]
+            };
+            let mut scratch = (out, stack, seen, stamp);
+            let ok = collect_dense(
                 hull,
                 b_m_a,
                 &n,
                 e[i],
                 k0,
+                sep,
                 band,
-                out,
-                stack,
-                seen,
-                stamp,
-                |q, gap| {
-                    let depth = (-gap).max(0.0);
-                    depth <= e[i] && q[j1].abs() + depth <= e[j1] && q[j2].abs() + depth <= e[j2]
-                },
+                dense,
+                &mut scratch,
+                valid,
             );
             if ok {
                 FaceContact::Plane(n)
@@ -299,17 +316,17 @@ pub(crate) fn hull_on_face(
             // (every vertex within the margin: with the band's smaller
             // set, solo12 on the 10° slope kept rocking, 0.14 rad/s at 3 s)
             let band = margin;
-            let ok = collect(
+            let mut scratch = (out, stack, seen, stamp);
+            let ok = collect_dense(
                 hull,
                 b_m_a,
                 &n,
                 h,
                 k0,
+                low - h,
                 band,
-                out,
-                stack,
-                seen,
-                stamp,
+                dense,
+                &mut scratch,
                 |_, gap| gap >= -margin,
             );
             if ok {
@@ -321,10 +338,109 @@ pub(crate) fn hull_on_face(
     }
 }
 
+/// Slack (m) added to a dense first pass's band: the lowest vertex's height
+/// is computed two ways (support query, placed vertex) that may differ in
+/// the last bits; the pass keeps a little more, never less, than the
+/// caller's choice looks at.
+const DENSE_SLACK: f64 = 1e-9;
+
+/// The output and scratch of [`collect`]: points, stack, seen marks, stamp.
+type Scratch<'s> = (
+    &'s mut Vec<FacePoint>,
+    &'s mut Vec<u32>,
+    &'s mut Vec<u32>,
+    u32,
+);
+
+/// [`collect`] within `band` of the plane, or, with `dense` (see
+/// [`hull_on_face`]), first within its `inner` of the lowest height `low`
+/// (kept when that gives `enough` points or fails the check).
+#[allow(clippy::too_many_arguments)]
+fn collect_dense(
+    hull: HullRef<'_>,
+    b_m_a: &Se3<f64>,
+    n: &Vector3<f64>,
+    h: f64,
+    k0: usize,
+    low: f64,
+    band: f64,
+    dense: Option<(f64, usize)>,
+    scratch: &mut Scratch<'_>,
+    valid: impl Fn(&Vector3<f64>, f64) -> bool,
+) -> bool {
+    let (out, stack, seen, stamp) = scratch;
+    let all = usize::MAX;
+    let Some((inner, enough)) = dense else {
+        return collect(
+            hull, b_m_a, n, h, k0, band, all, out, stack, seen, *stamp, &valid,
+        );
+    };
+    let near = band.min(low + inner + DENSE_SLACK);
+    if near >= band {
+        return collect(
+            hull, b_m_a, n, h, k0, band, all, out, stack, seen, *stamp, &valid,
+        );
+    }
+    let ok = collect(
+        hull, b_m_a, n, h, k0, near, all, out, stack, seen, *stamp, &valid,
+    );
+    // a failure inside `near` fails the whole band too
+    if !ok || out.len() >= enough {
+        return ok;
+    }
+    // fewer than `enough` near the lowest: the band's climb, after them in
+    // `out`, stopped as soon as it has `enough` points (then the caller's
+    // reduction looks at the near ones only, and any farther ones make it
+    // reduce), its marks undone first (the points and the rim around them)
+    if let HullRef::Climb(c) = hull {
+        for p in out.iter() {
+            seen[p.vertex] = 0;
+            for &j in c.neighbours(p.vertex) {
+                seen[j as usize] = 0;
+            }
+        }
+    }
+    let m = out.len();
+    let ok = collect(
+        hull,
+        b_m_a,
+        n,
+        h,
+        k0,
+        band,
+        m + enough,
+        out,
+        stack,
+        seen,
+        *stamp,
+        &valid,
+    );
+    if !ok {
+        return false;
+    }
+    if out.len() < m + enough {
+        // the whole band, fewer than `enough` points: they are the answer,
+        // in the order of its climb
+        out.drain(..m);
+    } else {
+        // the near points, then the band's farther ones
+        let mut w = m;
+        for r in m..out.len() {
+            if out[r].gap > near {
+                out[w] = out[r];
+                w += 1;
+            }
+        }
+        out.truncate(w);
+    }
+    true
+}
+
 /// Appends the hull's vertices within `margin` (the band) of the plane n·q = h (q the
 /// vertex in the face shape's frame) to `out`, from the lowest `k0` (on the
 /// vertex graph of a large hull: the vertices below a plane are connected on
-/// it); false as soon as one fails `valid(q, gap)`.
+/// it); false as soon as one fails `valid(q, gap)`; stops (true) once `out`
+/// holds `limit` points.
 #[allow(clippy::too_many_arguments)]
 fn collect(
     hull: HullRef<'_>,
@@ -333,11 +449,12 @@ fn collect(
     h: f64,
     k0: usize,
     margin: f64,
+    limit: usize,
     out: &mut Vec<FacePoint>,
     stack: &mut Vec<u32>,
     seen: &mut Vec<u32>,
     stamp: u32,
-    valid: impl Fn(&Vector3<f64>, f64) -> bool,
+    valid: &impl Fn(&Vector3<f64>, f64) -> bool,
 ) -> bool {
     let pts = hull.points();
     // a vertex placed in the face shape's frame, and its height n·q − h
@@ -345,9 +462,22 @@ fn collect(
         let q = b_m_a.act_point(&to_v(pts[k]));
         (q, n.dot(&q) - h)
     };
+    // its height from the hull's frame, d·p + c (d = Rᵀn, c = n·t − h): the
+    // same number up to rounding, so a vertex it puts clearly above the band
+    // is skipped without being placed (most of a climb's rim)
+    let d = b_m_a.rot.transpose() * n;
+    let c = n.dot(&b_m_a.trans) - h;
+    let skip = margin + DENSE_SLACK;
+    let above = |k: usize| {
+        let p = &pts[k];
+        d.x * p.x + d.y * p.y + d.z * p.z + c > skip
+    };
     match hull {
         HullRef::Small(_) => {
             for k in 0..pts.len() {
+                if above(k) {
+                    continue;
+                }
                 let (q, gap) = at(k);
                 if gap <= margin {
                     if !valid(&q, gap) {
@@ -358,6 +488,9 @@ fn collect(
                         point: q,
                         gap,
                     });
+                    if out.len() >= limit {
+                        return true;
+                    }
                 }
             }
             true
@@ -371,6 +504,9 @@ fn collect(
             seen[k0] = stamp;
             while let Some(k) = stack.pop() {
                 let k = k as usize;
+                if above(k) {
+                    continue;
+                }
                 let (q, gap) = at(k);
                 if gap > margin {
                     continue;
@@ -383,6 +519,9 @@ fn collect(
                     point: q,
                     gap,
                 });
+                if out.len() >= limit {
+                    return true;
+                }
                 for &j in c.neighbours(k) {
                     if seen[j as usize] != stamp {
                         seen[j as usize] = stamp;
@@ -396,139 +535,4 @@ fn collect(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use parry3d_f64::math::Pose;
-    use parry3d_f64::shape::SharedShape;
-
-    /// A rounded box hull (many vertices: the climbing kind): points on a
-    /// superellipsoid of half extents 0.05 × 0.03 × 0.02.
-    fn rounded() -> ClimbHull {
-        crate::contact::hull::superellipsoid([0.05, 0.03, 0.02], 0.4)
-    }
-
-    fn at(x: f64, y: f64, z: f64, roll: f64) -> Se3<f64> {
-        let r = nalgebra::Rotation3::from_euler_angles(roll, 0.0, 0.0);
-        Se3 {
-            rot: *r.matrix(),
-            trans: Vector3::new(x, y, z),
-        }
-    }
-
-    fn run(h: &ClimbHull, pose: &Se3<f64>, face: FaceShape<'_>) -> (FaceContact, Vec<FacePoint>) {
-        let (mut out, mut stack, mut seen) = (Vec::new(), Vec::new(), Vec::new());
-        let c = hull_on_face(
-            HullRef::Climb(h),
-            pose,
-            face,
-            0.005,
-            &mut out,
-            &mut stack,
-            &mut seen,
-            1,
-        );
-        (c, out)
-    }
-
-    /// parry's signed distance between the hull at `pose` and `other`.
-    fn parry_dist(h: &ClimbHull, pose: &Se3<f64>, other: &dyn Shape) -> f64 {
-        let p = crate::contact::shapes::to_pose(pose);
-        parry3d_f64::query::contact(&p, h, &Pose::IDENTITY, other, 1.0)
-            .ok()
-            .flatten()
-            .map_or(f64::INFINITY, |c| c.dist)
-    }
-
-    #[test]
-    fn a_hull_on_a_box_top_is_the_plane_contact_parry_finds() {
-        let b = Cuboid::new(PVec::new(0.3, 0.2, 0.1));
-        let h = rounded();
-        // resting 1 mm into the top (z = 0.1), tilted 3°
-        for (z, roll) in [(0.1 + 0.02 - 0.001, 0.0), (0.12, 0.05)] {
-            let pose = at(0.05, -0.02, z, roll);
-            let (c, pts) = run(&h, &pose, FaceShape::Cuboid(&b));
-            assert_eq!(c, FaceContact::Plane(Vector3::z()));
-            // every vertex within the band (2 mm above the lowest, within
-            // the margin) of the top, each its height
-            let height = |p: &PVec| pose.act_point(&to_v(*p)).z - 0.1;
-            let low = h.points().iter().map(height).fold(f64::INFINITY, f64::min);
-            let want = h
-                .points()
-                .iter()
-                .filter(|p| height(p) <= 0.005f64.min(low + BAND))
-                .count();
-            assert!(want >= 3, "{want}");
-            assert_eq!(pts.len(), want);
-            for p in &pts {
-                assert!((p.gap - (p.point.z - 0.1)).abs() < 1e-15);
-            }
-            // the deepest is parry's distance
-            let deepest = pts.iter().map(|p| p.gap).fold(f64::INFINITY, f64::min);
-            let d = parry_dist(&h, &pose, &b);
-            assert!((deepest - d).abs() < 1e-9, "{deepest} vs parry {d}");
-        }
-    }
-
-    #[test]
-    fn over_the_box_edge_parry_decides_and_far_above_nothing_touches() {
-        let b = Cuboid::new(PVec::new(0.3, 0.2, 0.1));
-        let h = rounded();
-        // half over the edge x = 0.3
-        let (c, _) = run(&h, &at(0.3, 0.0, 0.119, 0.0), FaceShape::Cuboid(&b));
-        assert_eq!(c, FaceContact::Other);
-        // beside the box, against its side face x = 0.3: that face
-        let (c, pts) = run(&h, &at(0.35 - 0.001, 0.0, 0.0, 0.0), FaceShape::Cuboid(&b));
-        assert_eq!(c, FaceContact::Plane(Vector3::x()));
-        assert!(pts
-            .iter()
-            .all(|p| (p.gap - (p.point.x - 0.3)).abs() < 1e-15));
-        // 1 cm above: apart, as parry says
-        let pose = at(0.0, 0.0, 0.13, 0.0);
-        assert_eq!(run(&h, &pose, FaceShape::Cuboid(&b)).0, FaceContact::Apart);
-        assert!(parry_dist(&h, &pose, &b) > 0.005);
-    }
-
-    #[test]
-    fn a_hull_on_a_planar_height_field_is_its_plane_and_on_a_ridge_parry_decides() {
-        let h = rounded();
-        // parry's frame: the grid in x–z, heights along y; a 10° slope in x
-        let slope = 10f64.to_radians().tan();
-        let (rows, cols, size) = (9, 9, 2.0);
-        let grid = |f: &dyn Fn(f64) -> f64| {
-            let mut data = Vec::new();
-            for j in 0..cols {
-                for _ in 0..rows {
-                    let x = -size / 2.0 + size * j as f64 / (cols - 1) as f64;
-                    data.push(f(x));
-                }
-            }
-            parry3d_f64::utils::Array2::new(rows, cols, data)
-        };
-        let flat = SharedShape::heightfield(grid(&|x| slope * x), PVec::new(size, 1.0, size));
-        let hf = flat.as_heightfield().expect("a height field");
-        // the hull's z (thin axis) along the slope's normal, 0.5 mm in
-        let n = Vector3::new(-slope, 1.0, 0.0).normalize();
-        let r = nalgebra::Rotation3::rotation_between(&Vector3::z(), &n).expect("a rotation");
-        let c = Vector3::new(0.1, 0.1 * slope, 0.05) + n * (0.02 - 0.0005);
-        let pose = Se3 {
-            rot: *r.matrix(),
-            trans: c,
-        };
-        let (found, pts) = run(&h, &pose, FaceShape::HeightField(hf));
-        let FaceContact::Plane(m) = found else {
-            panic!("{found:?}");
-        };
-        assert!((m - n).norm() < 1e-12, "{m:?} vs {n:?}");
-        let deepest = pts.iter().map(|p| p.gap).fold(f64::INFINITY, f64::min);
-        assert!((deepest + 0.0005).abs() < 1e-9, "{deepest}");
-        assert!((deepest - parry_dist(&h, &pose, &*flat.0)).abs() < 1e-6);
-        // a ridge under the hull: not one plane
-        let ridge = SharedShape::heightfield(grid(&|x| -x.abs()), PVec::new(size, 1.0, size));
-        let hr = ridge.as_heightfield().expect("a height field");
-        let on_ridge = at(0.0, 0.019, 0.0, -std::f64::consts::FRAC_PI_2);
-        assert_eq!(
-            run(&h, &on_ridge, FaceShape::HeightField(hr)).0,
-            FaceContact::Other
-        );
-    }
-}
+mod tests;
