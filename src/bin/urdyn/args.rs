@@ -17,9 +17,9 @@ pub(crate) struct Cli {
 #[derive(Subcommand)]
 pub(crate) enum Command {
     /// Print the kinematic tree, degrees of freedom, masses, merged links, collision
-    /// geometry and warnings of a URDF.
+    /// geometry and warnings of a URDF or an MJCF file.
     Inspect {
-        /// The URDF file.
+        /// The URDF or MJCF file (root `<robot>` or `<mujoco>`).
         urdf: PathBuf,
         /// Give the root link a free 6-DoF joint (unit quaternion) instead of welding it.
         #[arg(long)]
@@ -38,7 +38,7 @@ pub(crate) enum Command {
     /// Evaluate inverse dynamics, forward dynamics, C(q, v), H(q) and link poses for a
     /// batch of states (JSON in, JSON out; see eval-contract.md).
     Eval {
-        /// The URDF file (mesh files are never read).
+        /// The URDF or MJCF file (a URDF's mesh files are never read).
         urdf: PathBuf,
         /// The states JSON file.
         #[arg(long, value_name = "STATES.json")]
@@ -50,8 +50,8 @@ pub(crate) enum Command {
         #[arg(long, value_name = "OUT.json")]
         output: Option<PathBuf>,
     },
-    /// Simulate the robot or a scene (joint damping, friction, limits from the
-    /// URDF; contact with the ground, between the robot's own links and, with
+    /// Simulate the robot, an MJCF world or a scene (joint damping, friction, limits from
+    /// the file; contact with the ground, between the robot's own links and, with
     /// --scene, between models and with obstacles) and write its trajectory as CSV.
     Simulate(Box<SimulateCmd>),
     /// Time each dynamics algorithm on random states of this robot (median ns per call).
@@ -59,7 +59,7 @@ pub(crate) enum Command {
     /// Write one self-contained HTML page that replays a trajectory CSV of `simulate`
     /// in 3D (no network, no other file; opens from disk in any current browser).
     View {
-        /// The URDF file (with --scene: the trajectory CSV).
+        /// The URDF or MJCF file (with --scene: the trajectory CSV).
         urdf: Option<PathBuf>,
         /// The trajectory CSV that `simulate --out` wrote.
         traj: Option<PathBuf>,
@@ -81,10 +81,10 @@ pub(crate) enum Command {
 /// `urdyn simulate` options (cli.md).
 #[derive(clap::Args)]
 #[command(
-    after_help = "Contact is between the links' collision geometry and the ground plane, and between two links of one robot (self-collision) that are not a body and its parent, not on one body, not both welded to the world and not a <disable_collisions> pair of an SRDF; pairs that overlap at the start are dropped with a warning. With --scene, also between the models and with the scene's obstacles (scene.md \"Who touches whom\"). Contact model: velocity-level impulses with exact Coulomb friction (stick and slip), solved each step."
+    after_help = "Contact is between the links' collision geometry and the ground plane, and between two links of one robot (self-collision) that are not a body and its parent, not on one body, not both welded to the world and not a <disable_collisions> pair of an SRDF; pairs that overlap at the start are dropped with a warning. With --scene, also between the models and with the scene's obstacles (scene.md \"Who touches whom\"). An MJCF world's contact follows its file (contype/conaffinity, the parent-child filter, <exclude>, <pair>; planes facing up are the ground). Contact model: velocity-level impulses with exact Coulomb friction (stick and slip), solved each step."
 )]
 pub(crate) struct SimulateCmd {
-    /// The URDF file.
+    /// The URDF or MJCF file.
     pub(crate) urdf: Option<PathBuf>,
     /// A scene file (scene.md: several models, obstacles, ground) in place of the URDF;
     /// the per-model options (--floating-base, --initial, --above-ground, --ground,
@@ -190,12 +190,14 @@ pub(crate) struct SimulateCmd {
 
 #[derive(clap::Args)]
 pub(crate) struct BenchArgs {
-    /// The URDF file.
+    /// The URDF or MJCF file.
     pub(crate) urdf: PathBuf,
     /// Give the root link a free 6-DoF joint (unit quaternion) instead of welding it.
     #[arg(long)]
     pub(crate) floating_base: bool,
-    /// Time only this algorithm (repeatable): rnea, bias, crba, aba, fd-rnea, fd-crba, fd, fk.
+    /// Time only this algorithm (repeatable): rnea, bias, crba, aba, fd-rnea, fd-crba, fd, fk,
+    /// rnea-derivatives, aba-derivatives, jacobians, constraint-dynamics,
+    /// constraint-dynamics-derivatives (the last two need --hold, --hold6 or --weld).
     #[arg(long = "algo", value_name = "NAME")]
     pub(crate) algos: Vec<String>,
     /// Timed samples per algorithm (each a batch of calls of about 50 µs).
