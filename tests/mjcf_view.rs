@@ -104,3 +104,94 @@ fn mjcf_simulate_html_and_view_write_the_page() {
     assert!(std::fs::metadata(&page2).unwrap().len() > 1000);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A unit cube centred at (0.5, 0.5, 0.5) as OBJ text (8 vertices, 12 triangles).
+const CUBE_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+
+#[test]
+fn mjcf_page_draws_mesh_geoms_from_their_files_scaled_in_their_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("m")).unwrap();
+    std::fs::write(dir.path().join("m/cube.obj"), CUBE_OBJ).unwrap();
+    let xml = r#"<mujoco>
+  <compiler meshdir="m"/>
+  <asset>
+    <mesh name="long" file="cube.obj" scale="2 1 1"/>
+    <mesh file="cube.obj"/>
+  </asset>
+  <worldbody>
+    <body name="b" pos="0 0 1">
+      <freejoint/>
+      <inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>
+      <geom type="mesh" mesh="long" rgba="1 0.5 0 1"/>
+      <geom type="mesh" mesh="cube" pos="0 0 2" rgba="0 0 1 1"/>
+      <geom type="mesh" mesh="cube" pos="0 0 4"/>
+    </body>
+  </worldbody>
+</mujoco>"#;
+    let world = urdyn::mjcf::compile_str(xml, "meshes.xml", dir.path()).unwrap();
+    let model = urdyn::mjcf::load_str(xml, "meshes.xml", dir.path()).unwrap();
+    let g = view::mjcf::geometry(&model, &world, "meshes.xml");
+    assert!(g.warnings.is_empty(), "{:?}", g.warnings);
+    // two distinct (file, scale) meshes, the cube's shared by two geoms
+    assert_eq!(g.meshes.len(), 2);
+    let shapes: Vec<_> = g.visuals.iter().map(|v| v.shape.clone()).collect();
+    assert_eq!(
+        shapes,
+        [
+            VisualShape::Mesh(0),
+            VisualShape::Mesh(1),
+            VisualShape::Mesh(1)
+        ]
+    );
+    // the file's 12 triangles, the scale along x only
+    assert_eq!(g.meshes[0].triangles.len(), 12);
+    let ext = |k: usize, a: usize| {
+        let xs = g.meshes[k].vertices.iter().map(|v| v[a]);
+        xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min)
+    };
+    assert_eq!([ext(0, 0), ext(0, 1), ext(0, 2)], [2.0, 1.0, 1.0]);
+    assert_eq!([ext(1, 0), ext(1, 1), ext(1, 2)], [1.0, 1.0, 1.0]);
+    // the geom's colour (MuJoCo's default grey where it gives none), its pose
+    let rgba: Vec<[f64; 4]> = g.visuals.iter().map(|v| v.rgba).collect();
+    assert_eq!(
+        rgba,
+        [
+            [1.0, 0.5, 0.0, 1.0],
+            [0.0, 0.0, 1.0, 1.0],
+            [0.5, 0.5, 0.5, 1.0]
+        ]
+    );
+    assert!((g.visuals[2].placement.trans.z - 4.0).abs() < 1e-12);
+    assert!(g.visuals.iter().all(|v| v.body == 1));
+}
+
+#[test]
+fn mjcf_page_of_a_menagerie_style_arm_draws_its_stl_meshes() {
+    // The Panda's collision STLs, one mesh geom a body (explicit inertials).
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mjcf/meshes/panda.xml");
+    let (model, world) = urdyn::mjcf::load_file_with_world(&file).unwrap();
+    let g = view::mjcf::geometry(&model, &world, "panda.xml");
+    assert!(g.warnings.is_empty(), "{:?}", g.warnings);
+    assert_eq!(g.meshes.len(), 9);
+    assert_eq!(g.visuals.len(), 9);
+    let stl = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets/robots/example-robot-data/robots/panda_description/meshes/collision");
+    for (k, name) in ["link0", "link1", "link2"].iter().enumerate() {
+        let m = urdyn::mesh::load_mesh(&stl.join(format!("{name}.stl")), [1.0; 3]).unwrap();
+        assert_eq!(g.visuals[k].shape, VisualShape::Mesh(k));
+        assert_eq!(g.meshes[k].triangles.len(), m.triangles.len(), "{name}");
+    }
+    assert_eq!(g.visuals[1].rgba, [0.95, 0.45, 0.1, 1.0]);
+}
+
+#[test]
+fn a_mesh_geom_in_a_body_without_inertial_still_says_what_is_missing() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("cube.obj"), CUBE_OBJ).unwrap();
+    let xml = r#"<mujoco><asset><mesh file="cube.obj"/></asset><worldbody>
+      <body><freejoint/><geom type="mesh" mesh="cube"/></body></worldbody></mujoco>"#;
+    let e = urdyn::mjcf::compile_str(xml, "m.xml", dir.path()).unwrap_err();
+    assert!(e.to_string().contains("mesh"), "{e}");
+}

@@ -11,7 +11,7 @@ use super::MjcfError;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use std::collections::HashSet;
 
-pub use super::world::{MjBody, MjGeom, MjGeomType, MjJoint, MjJointType, World};
+pub use super::world::{MjBody, MjGeom, MjGeomType, MjJoint, MjJointType, MjMesh, World};
 
 /// The `<compiler>` settings that decide numbers.
 #[derive(Clone, Debug)]
@@ -542,7 +542,13 @@ fn geom(
     }
     .map(str::to_string);
     let in_group = group >= cx.set.group_range.0 && group <= cx.set.group_range.1;
-    let (mass, inertia) = if b != 0 && in_group {
+    // a body with an <inertial> takes no mass from its geoms (unless
+    // inertiafromgeom="true"): a mesh there needs no mass properties
+    let from_geoms =
+        cx.world.bodies[b].explicit.is_none() || cx.set.inertia_from_geom == Some(true);
+    let (mass, inertia) = if kind == MjGeomType::Mesh && !from_geoms {
+        (0.0, [0.0; 3])
+    } else if b != 0 && in_group {
         let density = a.nonneg("density", 1000.0)?;
         let mass = a.num("mass")?;
         if mass.is_some_and(|m| m < 0.0) {

@@ -32,7 +32,7 @@ mod xml;
 
 pub use actuators::MjActuator;
 pub use collide::Ground;
-pub use compile::{MjBody, MjGeom, MjGeomType, MjJoint, MjJointType, World};
+pub use compile::{MjBody, MjGeom, MjGeomType, MjJoint, MjJointType, MjMesh, World};
 pub use convert::{from_mujoco_qpos, from_mujoco_qvel, to_mujoco_qpos, to_mujoco_qvel};
 pub use equality::{MjEqKind, MjEquality};
 pub use sections::MjKey;
@@ -207,6 +207,12 @@ fn compile(
             actuators: Vec::new(),
             tendons: Vec::new(),
             equalities: Vec::new(),
+            meshes: sections::meshes(
+                &of("asset").collect::<Vec<_>>(),
+                &of("compiler").collect::<Vec<_>>(),
+                base_dir,
+                &defaults,
+            )?,
             warnings: Vec::new(),
         },
         names: Default::default(),

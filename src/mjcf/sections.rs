@@ -166,6 +166,47 @@ pub(super) fn asset_files(
     Ok(())
 }
 
+/// `<asset><mesh>`es by name (`name`, else the file name without its
+/// extension, as MuJoCo names them), their files resolved as [`asset_files`]
+/// does and their `scale` with class defaults applied.
+pub(super) fn meshes(
+    sections: &[&El],
+    compilers: &[&El],
+    base_dir: &std::path::Path,
+    defaults: &super::attrs::Defaults,
+) -> Result<std::collections::HashMap<String, super::world::MjMesh>, MjcfError> {
+    let dir_of = |k: &str| compilers.iter().rev().find_map(|c| c.attr(k));
+    let dir = dir_of("meshdir").or_else(|| dir_of("assetdir"));
+    let mut out = std::collections::HashMap::new();
+    for el in sections.iter().flat_map(|s| s.children.iter()) {
+        if el.tag != "mesh" {
+            continue;
+        }
+        let a = defaults.resolve(el, "main")?;
+        let file = el.attr("file");
+        let name = match (el.attr("name"), file) {
+            (Some(n), _) => n.to_string(),
+            (None, Some(f)) => {
+                let f = std::path::Path::new(f);
+                f.file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default()
+            }
+            (None, None) => continue,
+        };
+        let file = file.map(|f| match dir {
+            Some(d) => base_dir.join(d).join(f),
+            None => base_dir.join(f),
+        });
+        let scale = a.partial::<3>("scale", [1.0; 3])?;
+        if scale.iter().any(|x| !x.is_finite()) {
+            return Err(a.err("scale", "must be finite"));
+        }
+        out.insert(name, super::world::MjMesh { file, scale });
+    }
+    Ok(out)
+}
+
 /// `<asset><material>` colours by name (`rgba`, MuJoCo's default white; class
 /// defaults applied), for the geoms that name them.
 pub(super) fn materials(

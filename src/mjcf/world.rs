@@ -158,6 +158,20 @@ pub struct World {
     pub tendons: Vec<super::tendons::MjTendon>,
     /// `<equality>` constraints in MuJoCo's order.
     pub equalities: Vec<super::equality::MjEquality>,
+    /// `<asset><mesh>`es by name (MuJoCo's: its `name`, else its file's name
+    /// without the extension).
+    pub meshes: std::collections::HashMap<String, MjMesh>,
     /// What urdyn does not model, one line a kind.
     pub warnings: Vec<String>,
+}
+
+/// An `<asset><mesh>`: its file (resolved as MuJoCo does: `meshdir`, else
+/// `assetdir`, else the model's directory) and its `scale` (class defaults
+/// applied). A mesh given inline (`vertex`/`face`) has no file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MjMesh {
+    /// The mesh file.
+    pub file: Option<std::path::PathBuf>,
+    /// Scale along x, y, z.
+    pub scale: [f64; 3],
 }

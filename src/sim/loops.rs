@@ -143,6 +143,17 @@ impl Loops {
             let mut ai = self.oa0[p];
             ai.lin += c.lin;
             ai.ang += c.ang;
+            if matches!(j.kind, crate::model::JointKind::Free) {
+                // The step moves a free joint's origin on a straight line
+                // (p += h R v, R ← R exp(hω): integrate_config), not on the
+                // constant-twist screw whose acceleration R(ω × v) a = 0 means:
+                // the subtree's second-order term is γ's less R(ω × v)
+                // (docs/theory.md §"Loops in the simulation").
+                let r = data.o_m_i[i].rot;
+                let vl = Vector3::new(v[j.iv], v[j.iv + 1], v[j.iv + 2]);
+                let w = Vector3::new(v[j.iv + 3], v[j.iv + 4], v[j.iv + 5]);
+                ai.lin -= r * w.cross(&vl);
+            }
             self.ov[i] = vi;
             self.oa0[i] = ai;
         }

@@ -5,14 +5,24 @@
 //! MuJoCo's renderer picks; defaults and classes already folded in by the
 //! importer). Spheres, capsules, cylinders, boxes and ellipsoids are drawn as
 //! they are; a plane other than the ground (which the page draws) as a thin
-//! box of its size (20 m a side where the size is 0: infinite); mesh and
-//! height-field geoms as a box of their bounding size where it is known, else
-//! the placeholder box, one warning line each kind.
+//! box of its size (20 m a side where the size is 0: infinite); mesh geoms as
+//! their `<asset><mesh>` file (STL, OBJ, read by [`crate::mesh`], scaled by the
+//! asset's `scale`, placed by the geom's pose as the file writes it: MuJoCo's
+//! compiler moves a mesh geom's frame to the mesh's centre of mass and moves the
+//! vertices back, which draws the same), in the geom's colour, simplified to the
+//! page's budget as a URDF's meshes are; a mesh whose file cannot be read (or an
+//! inline mesh) and height fields as the placeholder box, one warning line each.
 
-use super::{Geometry, Visual, VisualShape, PLACEHOLDER_BOX, PLACEHOLDER_RGBA};
+use super::{
+    Geometry, Visual, VisualShape, MAX_MESH_TRIANGLES, MAX_PAGE_TRIANGLES, PLACEHOLDER_BOX,
+    PLACEHOLDER_RGBA,
+};
+use crate::mesh::load_mesh_colored;
 use crate::mjcf::{MjGeomType, World};
 use crate::spatial::Se3;
 use crate::Model;
+use std::collections::HashMap;
+use std::path::PathBuf;
 
 /// Half-side (m) drawn for an infinite plane.
 const INFINITE_PLANE: f64 = 10.0;
@@ -21,7 +31,8 @@ const INFINITE_PLANE: f64 = 10.0;
 pub fn geometry(model: &Model, world: &World, file: &str) -> Geometry {
     let mut g = Geometry::default();
     let ground = crate::mjcf::ground_of(world);
-    let mut meshes = 0usize;
+    let mut placeholders = 0usize;
+    let mut mesh_index: HashMap<(PathBuf, [u64; 3]), Option<usize>> = HashMap::new();
     for geom in &world.geoms {
         let body = &world.bodies[geom.body];
         let (ub, at) = if geom.body == 0 {
@@ -67,8 +78,42 @@ pub fn geometry(model: &Model, world: &World, file: &str) -> Geometry {
                 )));
                 VisualShape::Box([2.0 * half(s[0]), 2.0 * half(s[1]), t])
             }
-            MjGeomType::Mesh | MjGeomType::Hfield => {
-                meshes += 1;
+            MjGeomType::Mesh => {
+                let asset = geom.asset.as_deref().and_then(|a| world.meshes.get(a));
+                let k = match asset.and_then(|m| m.file.clone().map(|f| (f, m.scale))) {
+                    Some((path, scale)) => {
+                        let key = (path.clone(), scale.map(f64::to_bits));
+                        *mesh_index.entry(key).or_insert_with(|| {
+                            match load_mesh_colored(&path, scale) {
+                                Ok((m, _)) => {
+                                    // the geom's rgba colours the whole mesh, as MuJoCo draws it
+                                    g.meshes.push(m);
+                                    g.mesh_colors.push(Vec::new());
+                                    Some(g.meshes.len() - 1)
+                                }
+                                Err(e) => {
+                                    g.warnings.push(format!(
+                                        "{file}: geom \"{}\": {e}: a placeholder box is drawn",
+                                        geom.name
+                                    ));
+                                    None
+                                }
+                            }
+                        })
+                    }
+                    None => None,
+                };
+                match k {
+                    Some(k) => VisualShape::Mesh(k),
+                    None => {
+                        placeholders += 1;
+                        rgba = PLACEHOLDER_RGBA;
+                        VisualShape::Box([PLACEHOLDER_BOX; 3])
+                    }
+                }
+            }
+            MjGeomType::Hfield => {
+                placeholders += 1;
                 rgba = PLACEHOLDER_RGBA;
                 VisualShape::Box([PLACEHOLDER_BOX; 3])
             }
@@ -88,10 +133,11 @@ pub fn geometry(model: &Model, world: &World, file: &str) -> Geometry {
             rgba,
         });
     }
-    if meshes > 0 {
+    if placeholders > 0 {
         g.warnings.push(format!(
-            "{file}: {meshes} mesh or height-field geom(s) drawn as placeholder boxes (their shapes are not drawn yet)"
+            "{file}: {placeholders} height-field or unread mesh geom(s) drawn as placeholder boxes"
         ));
     }
+    g.simplify_to(MAX_MESH_TRIANGLES, MAX_PAGE_TRIANGLES);
     g
 }
