@@ -274,17 +274,26 @@ pub(crate) fn minv_pass<T: Scalar>(
                     m[c0 + s + (c0 + r) * nv] = dinv[(r, s)];
                 }
             }
-            // H⁻¹[i, c] = −D⁻¹ Jᵀ F_c = −(J D⁻¹)ᵀ F_c over the strict subtree
-            // (D⁻¹ symmetric): G = J D⁻¹ once, then six axpys a row
-            let g = jm * dinv;
+            // H⁻¹[i, c] = −D⁻¹ Jᵀ F_c over the strict subtree: y = Jᵀ F into the
+            // rows, then x = −D⁻¹ y column by column
             for r in 0..ni {
                 let row = &mut m[(c0 + r) * nv + ce..(c0 + r) * nv + end];
                 row.fill(T::zero());
                 for k in 0..6 {
-                    let gk = -g[(k, r)];
-                    if gk != T::zero() {
-                        axpy(row, gk, &fs[k * nv + ce..k * nv + end]);
+                    axpy(row, jm[(k, r)], &fs[k * nv + ce..k * nv + end]);
+                }
+            }
+            for c in ce..end {
+                let y = Vector6::from_fn(|r, _| {
+                    if r < ni {
+                        m[c + (c0 + r) * nv]
+                    } else {
+                        T::zero()
                     }
+                });
+                let x = -(dinv * y);
+                for r in 0..ni {
+                    m[c + (c0 + r) * nv] = x[r];
                 }
             }
             if p != 0 {
@@ -416,13 +425,8 @@ pub(crate) fn minv_pass<T: Scalar>(
                         ok.fill(T::zero());
                     }
                     for r in 0..ni {
-                        // a free joint's J has structural zeros (S's linear
-                        // coordinates turn no angle)
-                        let jk = mv(&jcol[c0 + r])[k];
-                        if jk != T::zero() {
-                            let row = &m[(c0 + r) * nv + c0..(c0 + r + 1) * nv];
-                            axpy(ok, jk, row);
-                        }
+                        let row = &m[(c0 + r) * nv + c0..(c0 + r + 1) * nv];
+                        axpy(ok, mv(&jcol[c0 + r])[k], row);
                     }
                 }
             }

@@ -328,27 +328,14 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
         }
         for r in c0..ce {
             let s = jcol[r];
-            // rows of this joint, columns of its subtree: Jᵀ ∂F (a free joint's
-            // linear coordinates turn no angle: J's angular part is exactly zero)
-            if nvi > 1 && s.ang == Vector3::zeros() {
-                let sl = s.lin;
-                for c in c0..end {
-                    let at = r + c * n;
-                    if !K {
-                        ma[at] = crate::spatial::ops::dot(&sl, &dfda[c].lin);
-                    }
-                    mq[at] = crate::spatial::ops::dot(&sl, &dfdq[c].lin);
-                    mv[at] = crate::spatial::ops::dot(&sl, &dfdv[c].lin);
+            // rows of this joint, columns of its subtree: Jᵀ ∂F
+            for c in c0..end {
+                let at = r + c * n;
+                if !K {
+                    ma[at] = s.dot(&dfda[c]);
                 }
-            } else {
-                for c in c0..end {
-                    let at = r + c * n;
-                    if !K {
-                        ma[at] = s.dot(&dfda[c]);
-                    }
-                    mq[at] = s.dot(&dfdq[c]);
-                    mv[at] = s.dot(&dfdv[c]);
-                }
+                mq[at] = s.dot(&dfdq[c]);
+                mv[at] = s.dot(&dfdv[c]);
             }
             // rows of the strict subtree, columns of this joint
             let (aq, av, jr) = (dadq[r], dadv[r], s);
