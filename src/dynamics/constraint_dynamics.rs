@@ -344,8 +344,8 @@ pub fn constraint_dynamics<'c>(
             }
         }
     }
-    // K = Wᵀ D⁻¹ W = Σₖ D⁻¹ₖ W[k, :]ᵀ W[k, :]: the upper triangle by rank-1
-    // updates of contiguous columns (K[s, r] at s + r m), then mirrored; and
+    // K = Wᵀ D⁻¹ W = Σₖ D⁻¹ₖ W[k, :]ᵀ W[k, :]: by rank-1 updates of contiguous
+    // columns (K[s, r] at s + r m), the upper triangle then mirrored; and
     // −J_c q̈₀ = −Wᵀ D⁻¹ w₀ into cd.r
     let k = &mut cd.k.as_mut_slice()[..m * m];
     k.fill(0.0);
@@ -360,8 +360,10 @@ pub fn constraint_dynamics<'c>(
                 continue;
             }
             jq0[r] = madd(-xr, s0, jq0[r]);
+            // the whole column (a fixed m-wide axpy, vectorised): its entries
+            // below the diagonal are overwritten by the mirror that follows
             let a = xr * dinv;
-            for (y, &x) in k[r * m..r * m + r + 1].iter_mut().zip(xk) {
+            for (y, &x) in k[r * m..(r + 1) * m].iter_mut().zip(xk) {
                 *y = madd(a, x, *y);
             }
         }

@@ -17,6 +17,8 @@ use crate::spatial::{lit, Scalar};
 use nalgebra::{DMatrix, DVector};
 
 const NONE: usize = usize::MAX;
+/// The deepest ancestor list [`ltdl`] keeps on the stack (deeper paths walk λ).
+const MAX_DEPTH: usize = 128;
 
 /// Factorises the symmetric positive-definite `h` (full storage, tree-shaped
 /// sparsity given by `lambda`) as `Lᵀ D L` into `u` (layout above). Fails with the
@@ -63,13 +65,39 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
     // Slices (column-major, u[(i, k)] at i + k n): the walks below index
     // without nalgebra's per-access checks of both dimensions.
     let us = u.as_mut_slice();
+    // k's ancestors, nearest first, listed once per k: the elimination's double
+    // loop then reads the list instead of walking λ at every step (a chain of
+    // dependent loads), the same operations in the same order
+    // Eliminate coordinate k from its ancestors: for i, j on k's path with j
+    // ancestor-or-self of i, H[i, j] −= H[k, i] H[k, j] / D[k].
+    let mut anc = [0usize; MAX_DEPTH];
     for k in (0..n).rev() {
         let d = us[k + k * n];
         if !(d > tiny * h[(k, k)].abs()) || !d.is_finite() {
             return Err(k);
         }
-        // Eliminate coordinate k from its ancestors: for i, j on k's path with
-        // j ancestor-or-self of i, H[i, j] −= H[k, i] H[k, j] / D[k].
+        let mut len = 0;
+        let mut i = lambda[k];
+        while i != NONE && len < MAX_DEPTH {
+            anc[len] = i;
+            len += 1;
+            i = lambda[i];
+        }
+        if i == NONE {
+            let anc = &anc[..len];
+            let (left, right) = us.split_at_mut(k * n);
+            let colk = &mut right[..k];
+            for (t, &i) in anc.iter().enumerate() {
+                let a = colk[i] / d;
+                let coli = &mut left[i * n..i * n + i + 1];
+                for &j in &anc[t..] {
+                    coli[j] = madd(-a, colk[j], coli[j]);
+                }
+                colk[i] = a;
+            }
+            continue;
+        }
+        // deeper than the list: walk λ
         let mut i = lambda[k];
         while i != NONE {
             let a = us[i + k * n] / d;
