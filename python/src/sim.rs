@@ -41,8 +41,16 @@ pub(crate) fn start_state(
 }
 
 /// One step of `dt` of simulated time (an adaptive integrator may take several
-/// steps of its own to get there; the last lands exactly).
+/// steps of its own to get there; the last lands exactly). A fixed-step
+/// integrator at its own step takes exactly `dt`, as `urdyn simulate` steps
+/// (src/cli/simulate/record.rs), so the two agree bit for bit: landing on
+/// `time + dt` would take `(time + dt) - time`, an ulp off `dt` once time is
+/// not a multiple of it.
 pub(crate) fn advance(sim: &mut Simulation, dt: f64) -> Result<(), SimError> {
+    if dt == sim.dt() && !sim.integrator().is_adaptive() {
+        sim.step()?;
+        return Ok(());
+    }
     let target = sim.time() + dt;
     while sim.time() < target {
         sim.step_until(target)?;
