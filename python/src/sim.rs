@@ -2,6 +2,7 @@
 //! (rollout.rs) go through [`prototype_any`], [`start_state`] and [`advance`],
 //! so that a rollout's states equal, bit for bit, a `Simulation` stepped alone.
 
+use crate::args::named;
 use crate::args::{quat_offsets, read_count, read_q, read_threads, read_vec, value_error, Given};
 use crate::prototype::{prototype_any, start_loops};
 use crate::view::Frame;
@@ -146,9 +147,12 @@ impl PySimulation {
 #[pymethods]
 impl PySimulation {
     /// `ground=None`: no ground; `integrator=None`: the default for the scene
-    /// (`urdyn.integrators()` lists the names). Of a `Scene`: its ground,
-    /// friction, obstacles and start (`ground=`/`friction=` beside it are a
-    /// ValueError: the file decides). `sleep`, `threads` (scene.md §"Large
+    /// (`urdyn.integrators()` lists the names). Of a `Scene`: its ground
+    /// (height, friction, and the torsional and rolling friction of its
+    /// `"torsion"`/`"rolling"` keys, as `urdyn simulate --scene` reads them),
+    /// obstacles and start (`ground=`/`friction=` beside it are a ValueError:
+    /// the file decides). A step is exactly `dt` (a fixed-step integrator's),
+    /// as the CLI's, so the states equal its CSV's bit for bit. `sleep`, `threads` (scene.md §"Large
     /// scenes"): `None` takes the scene's settings (its `"sleep"`,
     /// `"threads"`, a model's own `"sleep": false`); a model alone is a
     /// one-model scene, so it sleeps by default on one thread, as `urdyn
@@ -165,12 +169,12 @@ impl PySimulation {
     #[allow(clippy::too_many_arguments)]
     fn new(
         model: &Bound<'_, PyAny>,
-        dt: f64,
+        #[pyo3(from_py_with = named::dt)] dt: f64,
         integrator: Option<&str>,
         ground: Given,
         friction: Given,
         package_dirs: Option<Vec<PathBuf>>,
-        sleep: Option<bool>,
+        #[pyo3(from_py_with = named::sleep)] sleep: Option<bool>,
         threads: Option<&Bound<'_, PyAny>>,
         constraints: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
@@ -220,7 +224,7 @@ impl PySimulation {
         &mut self,
         q: &Bound<'_, PyAny>,
         v: &Bound<'_, PyAny>,
-        time: Option<f64>,
+        #[pyo3(from_py_with = named::time)] time: Option<f64>,
     ) -> PyResult<()> {
         let m = &self.sim.model;
         let (mut qv, mut vv) = (DVector::zeros(m.nq), DVector::zeros(m.nv));
@@ -421,7 +425,11 @@ impl PySimulation {
     /// `record(True)` starts a recording, the current state its first frame
     /// (starting again clears it); `record(False)` stops it (kept for
     /// `write_html`).
-    fn record(&mut self, py: Python<'_>, on: bool) -> PyResult<()> {
+    fn record(
+        &mut self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = named::on)] on: bool,
+    ) -> PyResult<()> {
         if on {
             if self.stage.is_none() {
                 let ground = self.sim.options().ground;
@@ -529,7 +537,7 @@ impl PySimulation {
         py: Python<'py>,
         tau: Option<&Bound<'py, PyAny>>,
         method: &str,
-        eps: f64,
+        #[pyo3(from_py_with = named::eps)] eps: f64,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
         crate::control::transition_jacobians(py, &self.sim, tau, method, eps)
     }
@@ -575,7 +583,7 @@ pub fn linearize<'py>(
     tau: &Bound<'py, PyAny>,
     threads: Option<&Bound<'py, PyAny>>,
     method: &str,
-    eps: f64,
+    #[pyo3(from_py_with = named::eps)] eps: f64,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
     let threads = read_threads(threads)?;
     crate::control::linearize(py, &sim.sim, q, v, tau, threads, method, eps)
