@@ -60,15 +60,23 @@ pub(crate) fn advance(sim: &mut Simulation, dt: f64) -> Result<(), SimError> {
 }
 
 /// Constant joint torques (every free joint's part of `tau` ignored).
+/// No allocation (rollout calls it every step with per-step torques).
 pub(crate) fn set_torques(sim: &mut Simulation, tau: &[f64]) {
-    let free: Vec<usize> = sim.model.free_joints.iter().map(|f| f.iv).collect();
-    let t = sim.torques_mut();
-    for k in 0..t.len() {
-        t[k] = if free.iter().any(|&iv| (iv..iv + 6).contains(&k)) {
-            0.0
-        } else {
-            tau.get(k).copied().unwrap_or(0.0)
-        };
+    let n = sim.torques().len();
+    {
+        let t = sim.torques_mut();
+        for k in 0..n {
+            t[k] = tau.get(k).copied().unwrap_or(0.0);
+        }
+    }
+    // the free joints' six entries after, as sim.model and the torques are
+    // borrowed apart
+    for j in 0..sim.model.free_joints.len() {
+        let iv = sim.model.free_joints[j].iv;
+        let t = sim.torques_mut();
+        for k in iv..(iv + 6).min(n) {
+            t[k] = 0.0;
+        }
     }
 }
 
