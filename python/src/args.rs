@@ -211,3 +211,93 @@ pub fn read_array(x: &Bound<'_, PyAny>, name: &str) -> PyResult<(Vec<usize>, Vec
     }
     Ok((shape, data))
 }
+
+/// A number argument `name`: an int or a float (not a bool), else a `ValueError`
+/// naming `name` (pyo3's own conversion would raise a `TypeError`).
+pub fn read_real(x: &Bound<'_, PyAny>, name: &str) -> PyResult<f64> {
+    let bad = || {
+        let shown = x
+            .repr()
+            .map(|r| r.to_string())
+            .unwrap_or_else(|_| "?".into());
+        value_error(format!("{name} must be a number (got {shown})"))
+    };
+    if x.is_instance_of::<pyo3::types::PyBool>() {
+        return Err(bad());
+    }
+    x.extract::<f64>().map_err(|_| bad())
+}
+
+/// A flag argument `name`: `True` or `False` (a numpy bool too), else a
+/// `ValueError` naming `name`.
+pub fn read_flag(x: &Bound<'_, PyAny>, name: &str) -> PyResult<bool> {
+    let is_bool = x.is_instance_of::<pyo3::types::PyBool>()
+        || x.get_type()
+            .name()
+            .map(|n| n.to_string() == "bool" || n.to_string() == "bool_")
+            .unwrap_or(false);
+    let bad = || {
+        let shown = x
+            .repr()
+            .map(|r| r.to_string())
+            .unwrap_or_else(|_| "?".into());
+        value_error(format!("{name} must be True or False (got {shown})"))
+    };
+    if !is_bool {
+        return Err(bad());
+    }
+    x.is_truthy().map_err(|_| bad())
+}
+
+/// Readers of single keyword arguments for `#[pyo3(from_py_with = ...)]`: a
+/// wrong type is a `ValueError` naming the argument (python.md §"Introspection,
+/// contacts, batched control, pictures"), not pyo3's `TypeError`.
+pub mod named {
+    use super::{read_count, read_flag, read_real};
+    use pyo3::prelude::*;
+
+    macro_rules! real {
+        ($f:ident, $name:literal) => {
+            pub fn $f(x: &Bound<'_, PyAny>) -> PyResult<f64> {
+                read_real(x, $name)
+            }
+        };
+    }
+    macro_rules! real_or_none {
+        ($f:ident, $name:literal) => {
+            pub fn $f(x: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+                if x.is_none() {
+                    return Ok(None);
+                }
+                read_real(x, $name).map(Some)
+            }
+        };
+    }
+    macro_rules! flag {
+        ($f:ident, $name:literal) => {
+            pub fn $f(x: &Bound<'_, PyAny>) -> PyResult<bool> {
+                read_flag(x, $name)
+            }
+        };
+    }
+    macro_rules! flag_or_none {
+        ($f:ident, $name:literal) => {
+            pub fn $f(x: &Bound<'_, PyAny>) -> PyResult<Option<bool>> {
+                if x.is_none() {
+                    return Ok(None);
+                }
+                read_flag(x, $name).map(Some)
+            }
+        };
+    }
+    real!(dt, "dt");
+    real!(eps, "eps");
+    real_or_none!(time, "time");
+    flag!(on, "on");
+    flag!(floating_base, "floating_base");
+    flag_or_none!(sleep, "sleep");
+    /// `seed`: a whole number ≥ 0.
+    pub fn seed(x: &Bound<'_, PyAny>) -> PyResult<u64> {
+        read_count(x, "seed", 0).map(|k| k as u64)
+    }
+}

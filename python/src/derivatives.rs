@@ -2,6 +2,7 @@
 //! (python.md §"Configurations", §"Derivatives"): each checks its arguments,
 //! calls the library, and returns new arrays.
 
+use crate::args::named;
 use crate::args::{read3, read_vec, value_error};
 use crate::dynamics::{dyn_error, mat_out, read_qv, read_qvx, reference};
 use crate::model::{PyData, PyModel};
@@ -189,7 +190,7 @@ pub fn difference<'py>(
 pub fn random_configuration<'py>(
     py: Python<'py>,
     model: PyRef<'py, PyModel>,
-    seed: u64,
+    #[pyo3(from_py_with = named::seed)] seed: u64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let q = configuration::random_configuration(&model.model, seed);
     Ok(PyArray1::from_slice(py, q.as_slice()))

@@ -1,6 +1,7 @@
 //! `urdyn.Model` (the immutable model, its names, pickling) and `urdyn.Data`
 //! (the preallocated workspace).
 
+use crate::args::named;
 use crate::args::{not_found_error, quat_offsets, read3, read_q, value_error};
 use crate::introspect::{self, link_inertials, py_slice, LinkInertial};
 use numpy::{PyArray1, PyArray2};
@@ -176,7 +177,7 @@ impl PyModel {
     #[pyo3(signature = (path, floating_base=false, package_dirs=None))]
     fn from_urdf(
         path: PathBuf,
-        floating_base: bool,
+        #[pyo3(from_py_with = named::floating_base)] floating_base: bool,
         package_dirs: Option<Vec<PathBuf>>,
     ) -> PyResult<Self> {
         // a file that does not exist: FileNotFoundError, with the CLI's line
@@ -225,7 +226,7 @@ impl PyModel {
     #[pyo3(signature = (path, floating_base=false, package_dirs=None))]
     fn from_file(
         path: PathBuf,
-        floating_base: bool,
+        #[pyo3(from_py_with = named::floating_base)] floating_base: bool,
         package_dirs: Option<Vec<PathBuf>>,
     ) -> PyResult<Self> {
         match urdyn::load::file_format(&path) {
@@ -245,7 +246,10 @@ impl PyModel {
     /// Imports URDF text.
     #[staticmethod]
     #[pyo3(signature = (xml, floating_base=false))]
-    fn from_urdf_string(xml: String, floating_base: bool) -> PyResult<Self> {
+    fn from_urdf_string(
+        xml: String,
+        #[pyo3(from_py_with = named::floating_base)] floating_base: bool,
+    ) -> PyResult<Self> {
         Self::build(xml, "<string>".into(), floating_base, None, Vec::new())
     }
 

@@ -11,7 +11,7 @@ use crate::scene::PyScene;
 use crate::sim::integrators;
 use pyo3::prelude::*;
 use std::path::PathBuf;
-use urdyn::contact::ContactError;
+use urdyn::contact::{ContactError, ContactParams};
 use urdyn::model::Constraints;
 use urdyn::sim::{Integrator, SimError, SimOptions, Simulation};
 
@@ -68,10 +68,11 @@ fn prototype(
     dt: f64,
     integrator: Option<&str>,
     ground: Option<f64>,
-    friction: f64,
+    contact: ContactParams,
     package_dirs: Option<Vec<PathBuf>>,
     islands: Islands,
 ) -> PyResult<Simulation> {
+    let friction = contact.friction;
     if !(dt > 0.0 && dt.is_finite()) {
         return Err(value_error(format!(
             "dt must be a positive number (got {dt})"
@@ -98,7 +99,7 @@ fn prototype(
             ))
         })?),
     };
-    let mut opts = SimOptions {
+    let opts = SimOptions {
         dt,
         integrator,
         ground,
@@ -108,9 +109,9 @@ fn prototype(
         sleep_time: islands.sleep_time,
         threads: islands.threads,
         never_sleep: islands.never_sleep,
+        contact,
         ..SimOptions::default()
     };
-    opts.contact.friction = friction;
     Simulation::new(model.model.clone(), opts).map_err(|e| match e {
         // the library's message is neutral; the hint is Python's (the CLI names its flags)
         SimError::Contact(ContactError::MissingMesh { .. }) => not_found_error(format!(
@@ -145,7 +146,14 @@ fn prototype_scene(
     let s = &scene.scene;
     let model = scene.py_model();
     let ground = s.ground.map(|g| g.height);
-    let friction = s.ground.map_or(1.0, |g| g.friction);
+    // the ground's contact parameters as `urdyn simulate SCENE.json` reads them
+    // (src/cli/simulate/setup.rs): friction, and torsion/rolling where the file sets them
+    let mut contact = ContactParams::default();
+    if let Some(g) = s.ground {
+        contact.friction = g.friction;
+        contact.torsion = g.torsion.unwrap_or(contact.torsion);
+        contact.rolling = g.rolling.unwrap_or(contact.rolling);
+    }
     // as `urdyn simulate SCENE.json` (src/cli/simulate.rs): the file's settings
     // where the call gives none
     let spec = &s.spec;
@@ -166,7 +174,7 @@ fn prototype_scene(
         dt,
         integrator,
         ground,
-        friction,
+        contact,
         package_dirs,
         islands,
     )?;
@@ -239,7 +247,10 @@ pub(crate) fn prototype_any(
         dt,
         integrator,
         ground.ground(py)?,
-        friction.friction(py)?,
+        ContactParams {
+            friction: friction.friction(py)?,
+            ..ContactParams::default()
+        },
         package_dirs,
         Islands {
             sleep: sleep.unwrap_or(true),

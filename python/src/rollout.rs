@@ -5,6 +5,7 @@
 //! (the same [`prototype_any`], [`start_state`], [`set_torques`], `set_gains`,
 //! `set_targets` and [`advance`]).
 
+use crate::args::named;
 use crate::args::{
     normalize_quaternion_at, read_array, read_count, read_threads, value_error, Given,
 };
@@ -129,7 +130,7 @@ pub fn rollout<'py>(
     v0: &Bound<'py, PyAny>,
     tau: Option<&Bound<'py, PyAny>>,
     nstep: Option<&Bound<'py, PyAny>>,
-    dt: f64,
+    #[pyo3(from_py_with = named::dt)] dt: f64,
     threads: Option<&Bound<'py, PyAny>>,
     integrator: Option<&str>,
     ground: Given,
@@ -138,7 +139,7 @@ pub fn rollout<'py>(
     kd: Option<&Bound<'py, PyAny>>,
     q_ref: Option<&Bound<'py, PyAny>>,
     v_ref: Option<&Bound<'py, PyAny>>,
-    sleep: Option<bool>,
+    #[pyo3(from_py_with = named::sleep)] sleep: Option<bool>,
     constraints: Option<&Bound<'py, PyAny>>,
     controls: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {

@@ -2,6 +2,7 @@
 //! (rollout.rs) go through [`prototype_any`], [`start_state`] and [`advance`],
 //! so that a rollout's states equal, bit for bit, a `Simulation` stepped alone.
 
+use crate::args::named;
 use crate::args::{quat_offsets, read_count, read_q, read_threads, read_vec, value_error, Given};
 use crate::prototype::{prototype_any, start_loops};
 use crate::view::Frame;
@@ -41,8 +42,16 @@ pub(crate) fn start_state(
 }
 
 /// One step of `dt` of simulated time (an adaptive integrator may take several
-/// steps of its own to get there; the last lands exactly).
+/// steps of its own to get there; the last lands exactly). A fixed-step
+/// integrator at its own step takes exactly `dt`, as `urdyn simulate` steps
+/// (src/cli/simulate/record.rs), so the two agree bit for bit: landing on
+/// `time + dt` would take `(time + dt) - time`, an ulp off `dt` once time is
+/// not a multiple of it.
 pub(crate) fn advance(sim: &mut Simulation, dt: f64) -> Result<(), SimError> {
+    if dt == sim.dt() && !sim.integrator().is_adaptive() {
+        sim.step()?;
+        return Ok(());
+    }
     let target = sim.time() + dt;
     while sim.time() < target {
         sim.step_until(target)?;
@@ -51,15 +60,23 @@ pub(crate) fn advance(sim: &mut Simulation, dt: f64) -> Result<(), SimError> {
 }
 
 /// Constant joint torques (every free joint's part of `tau` ignored).
+/// No allocation (rollout calls it every step with per-step torques).
 pub(crate) fn set_torques(sim: &mut Simulation, tau: &[f64]) {
-    let free: Vec<usize> = sim.model.free_joints.iter().map(|f| f.iv).collect();
-    let t = sim.torques_mut();
-    for k in 0..t.len() {
-        t[k] = if free.iter().any(|&iv| (iv..iv + 6).contains(&k)) {
-            0.0
-        } else {
-            tau.get(k).copied().unwrap_or(0.0)
-        };
+    let n = sim.torques().len();
+    {
+        let t = sim.torques_mut();
+        for k in 0..n {
+            t[k] = tau.get(k).copied().unwrap_or(0.0);
+        }
+    }
+    // the free joints' six entries after, as sim.model and the torques are
+    // borrowed apart
+    for j in 0..sim.model.free_joints.len() {
+        let iv = sim.model.free_joints[j].iv;
+        let t = sim.torques_mut();
+        for k in iv..(iv + 6).min(n) {
+            t[k] = 0.0;
+        }
     }
 }
 
@@ -138,9 +155,12 @@ impl PySimulation {
 #[pymethods]
 impl PySimulation {
     /// `ground=None`: no ground; `integrator=None`: the default for the scene
-    /// (`urdyn.integrators()` lists the names). Of a `Scene`: its ground,
-    /// friction, obstacles and start (`ground=`/`friction=` beside it are a
-    /// ValueError: the file decides). `sleep`, `threads` (scene.md §"Large
+    /// (`urdyn.integrators()` lists the names). Of a `Scene`: its ground
+    /// (height, friction, and the torsional and rolling friction of its
+    /// `"torsion"`/`"rolling"` keys, as `urdyn simulate --scene` reads them),
+    /// obstacles and start (`ground=`/`friction=` beside it are a ValueError:
+    /// the file decides). A step is exactly `dt` (a fixed-step integrator's),
+    /// as the CLI's, so the states equal its CSV's bit for bit. `sleep`, `threads` (scene.md §"Large
     /// scenes"): `None` takes the scene's settings (its `"sleep"`,
     /// `"threads"`, a model's own `"sleep": false`); a model alone is a
     /// one-model scene, so it sleeps by default on one thread, as `urdyn
@@ -157,12 +177,12 @@ impl PySimulation {
     #[allow(clippy::too_many_arguments)]
     fn new(
         model: &Bound<'_, PyAny>,
-        dt: f64,
+        #[pyo3(from_py_with = named::dt)] dt: f64,
         integrator: Option<&str>,
         ground: Given,
         friction: Given,
         package_dirs: Option<Vec<PathBuf>>,
-        sleep: Option<bool>,
+        #[pyo3(from_py_with = named::sleep)] sleep: Option<bool>,
         threads: Option<&Bound<'_, PyAny>>,
         constraints: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
@@ -212,7 +232,7 @@ impl PySimulation {
         &mut self,
         q: &Bound<'_, PyAny>,
         v: &Bound<'_, PyAny>,
-        time: Option<f64>,
+        #[pyo3(from_py_with = named::time)] time: Option<f64>,
     ) -> PyResult<()> {
         let m = &self.sim.model;
         let (mut qv, mut vv) = (DVector::zeros(m.nq), DVector::zeros(m.nv));
@@ -413,7 +433,11 @@ impl PySimulation {
     /// `record(True)` starts a recording, the current state its first frame
     /// (starting again clears it); `record(False)` stops it (kept for
     /// `write_html`).
-    fn record(&mut self, py: Python<'_>, on: bool) -> PyResult<()> {
+    fn record(
+        &mut self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = named::on)] on: bool,
+    ) -> PyResult<()> {
         if on {
             if self.stage.is_none() {
                 let ground = self.sim.options().ground;
@@ -521,7 +545,7 @@ impl PySimulation {
         py: Python<'py>,
         tau: Option<&Bound<'py, PyAny>>,
         method: &str,
-        eps: f64,
+        #[pyo3(from_py_with = named::eps)] eps: f64,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
         crate::control::transition_jacobians(py, &self.sim, tau, method, eps)
     }
@@ -567,7 +591,7 @@ pub fn linearize<'py>(
     tau: &Bound<'py, PyAny>,
     threads: Option<&Bound<'py, PyAny>>,
     method: &str,
-    eps: f64,
+    #[pyo3(from_py_with = named::eps)] eps: f64,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
     let threads = read_threads(threads)?;
     crate::control::linearize(py, &sim.sim, q, v, tau, threads, method, eps)

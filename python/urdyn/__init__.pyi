@@ -150,8 +150,9 @@ class Scene:
 
 class Simulation:
     """One simulation stepped from Python. `ground=None`: no ground. Of a Scene:
-    its ground, friction, obstacles and starting state (`ground=`/`friction=` beside
-    a scene are a ValueError: the file decides)."""
+    its ground (height, friction, "torsion"/"rolling" as `urdyn simulate --scene`),
+    obstacles and starting state (`ground=`/`friction=` beside a scene are a
+    ValueError: the file decides). A wrong type of argument is a ValueError naming it."""
 
     def __init__(
         self,

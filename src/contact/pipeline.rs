@@ -106,7 +106,7 @@ impl Collision {
     pub fn body_spheres(&self) -> Vec<(usize, nalgebra::Vector3<f64>, f64)> {
         let mut out = Vec::new();
         if let Some(g) = &self.ground {
-            for s in &g.shapes {
+            for s in g.shapes.iter() {
                 out.push((s.body, s.placement.trans, s.bound));
             }
         }

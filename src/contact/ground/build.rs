@@ -237,7 +237,7 @@ impl GroundContact {
         let cap = shapes.iter().map(|s| s.nslots).max().unwrap_or(0);
         let nshapes = shapes.len();
         Ok(Some(Self {
-            shapes,
+            shapes: shapes.into(),
             ground,
             params,
             queries: 0,

@@ -75,7 +75,9 @@ pub struct GroundShape {
 #[derive(Clone, Debug)]
 pub struct GroundContact {
     /// Every collision shape of a moving link; [`ContactPoint::shape`] indexes it.
-    pub shapes: Vec<GroundShape>,
+    /// Shared, not copied, by a clone (they never change after the build: a
+    /// batch of simulations cloned from one holds its hulls once).
+    pub shapes: std::sync::Arc<[GroundShape]>,
     /// Ground height (the plane z = ground, normal +z).
     pub ground: f64,
     /// The contact parameters it was built with.
@@ -137,7 +139,7 @@ impl GroundContact {
     /// body's world pose; +∞ without shapes. Not counted as a query.
     pub fn lowest_point(&self, o_m_i: &[Se3<f64>]) -> f64 {
         let mut low = f64::INFINITY;
-        for s in &self.shapes {
+        for s in self.shapes.iter() {
             let Some(o_m_b) = o_m_i.get(s.body) else {
                 continue;
             };
