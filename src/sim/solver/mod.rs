@@ -99,6 +99,9 @@ pub struct Rows {
     /// W (n·t₁, n·t₂, t₁·t₂), so that a sweep reads the contact's path once.
     pub w_block: Vec<[f64; 3]>,
     is_block: Vec<bool>,
+    /// Scratch of [`Rows::form`]: a contact's three rows interleaved (one
+    /// entry per path slot, `stride` of them).
+    lanes: Vec<[f64; 4]>,
     /// Each row's velocity at its update in the last sweep.
     u_prev: Vec<f64>,
     /// Scratch of the subspace step ([`subspace_step`]).
@@ -140,6 +143,7 @@ impl Rows {
             path: vec![(0, 0); cap],
             w_block: vec![[0.0; 3]; cap],
             is_block: vec![false; cap],
+            lanes: vec![[0.0; 4]; stride],
             u_prev: vec![0.0; cap],
             sm: Subspace::new(nv, cap),
             polished: false,
