@@ -164,6 +164,11 @@ impl Rows {
     pub fn table(&self) -> &[usize] {
         &self.table
     }
+    /// The path table and J, borrowed apart (to write a row's entries on
+    /// its path).
+    pub(crate) fn table_and_j(&mut self) -> (&[usize], &mut [f64]) {
+        (&self.table, &mut self.j)
+    }
     /// Takes the path table out (no entry moved), for a solver that mutates
     /// the rows while reading it; [`Rows::put_table`] puts it back.
     pub(crate) fn take_table(&mut self) -> Vec<usize> {
