@@ -359,21 +359,9 @@ impl Constraints {
                 } else {
                     rows.union_path(body_path(pt.body), body_path(pt.other))
                 };
-                let Some(rn) = rows.push(RowKind::Normal, 0.0, warm[0], path) else {
+                let Some(rn) = rows.push_contact(pt.friction, warm, path) else {
                     break;
                 };
-                let tangent = RowKind::Tangent {
-                    normal: rn,
-                    mu: pt.friction,
-                };
-                if rows.push(tangent, 0.0, warm[1], path).is_none() {
-                    rows.pop(1);
-                    break;
-                }
-                if rows.push(RowKind::Tangent2, 0.0, warm[2], path).is_none() {
-                    rows.pop(2);
-                    break;
-                }
                 self.row_point.push(pi);
                 counts.contacts += 1;
                 // J's entries are added straight onto the rows' paths (zeroed

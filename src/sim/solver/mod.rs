@@ -263,6 +263,27 @@ impl Rows {
         self.path[r] = path;
         Some(r)
     }
+    /// A contact's three rows at once ([`Rows::push`] of a normal, its
+    /// tangent pair, on one path, targets 0): the normal's index, or `None`
+    /// (nothing pushed) when fewer than three rows are left.
+    #[inline]
+    pub fn push_contact(&mut self, mu: f64, warm: [f64; 3], path: (usize, usize)) -> Option<usize> {
+        if self.n + 3 > self.cap {
+            return None;
+        }
+        let r = self.n;
+        self.n += 3;
+        self.kind[r..r + 3].copy_from_slice(&[
+            RowKind::Normal,
+            RowKind::Tangent { normal: r, mu },
+            RowKind::Tangent2,
+        ]);
+        self.b[r..r + 3].fill(0.0);
+        self.lambda[r..r + 3].copy_from_slice(&warm);
+        self.bpos[r..r + 3].fill(0.0);
+        self.path[r..r + 3].fill(path);
+        Some(r)
+    }
     /// Where dof `d` lies on row `r`'s path (`None`: off it, J is 0 there).
     fn slot_of(&self, r: usize, d: usize) -> Option<usize> {
         let (ps, pl) = self.path[r];
