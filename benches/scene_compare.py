@@ -32,8 +32,11 @@ MuJoCo's scene is built from the same file with mujoco.MjSpec:
 Euler and implicitfast are both timed (perf_counter around a Python loop of mj_step on a
 fresh MjData); the faster is reported.
 
-urdyn: `urdyn simulate --scene FILE --duration T --dt DT --package-path ... --no-sleep --out CSV` (awake against awake);
-steps/s = steps / wall seconds of its stderr summary line (the stepping loop only).
+urdyn: `urdyn simulate --scene FILE --duration T --dt DT --package-path ... --no-sleep --every 1000000000
+--out /dev/null` (awake against awake; --every larger than the run: no per-step CSV formatting, as
+MuJoCo's timed loop records nothing); steps/s = steps / wall seconds of its stderr summary line (the
+stepping loop only). Its metrics (penetration, at rest, contacts) come from one extra untimed run
+writing every step (`--out CSV`).
 
 Per repeat: urdyn, then MuJoCo euler, then implicitfast; the table gives medians.
 Penetration: deepest over t >= --settle (0.5 s: after landing) and at the end; urdyn: the
@@ -342,8 +345,13 @@ def bench(name, args, tmp):
            "--dt", repr(args.dt), "--no-sleep"]
     for p in args.roots:
         cmd += ["--package-path", p]
-    cmd += ["--out", csvp]
+    # timed rounds write the final state only (--every larger than the run), as MuJoCo's
+    # timed loop records nothing; the metrics come from one extra untimed run writing
+    # every step (as benches/mjcf_compare.py does)
+    record = cmd + ["--out", csvp]
+    cmd = cmd + ["--every", str(10**9), "--out", os.devnull]
     r["urdyn_command"] = " ".join(shlex.quote(c) for c in cmd)
+    r["urdyn_record_command"] = " ".join(shlex.quote(c) for c in record)
     us, ms = [], {k: [] for k in INTEGRATORS}
     for rep in range(args.repeats):
         u = run_urdyn(cmd)
@@ -356,10 +364,15 @@ def bench(name, args, tmp):
         print("  %s round %d: urdyn %s, MuJoCo %s" % (
             name, rep + 1, "%.0f" % us[-1]["steps_per_s"] if us else "–",
             ", ".join("%s %.0f" % (k, v[-1]) for k, v in ms.items())), file=sys.stderr)
+    rec = run_urdyn(record) if us else {}
+    if us and rec.get("exit") != 0:
+        r["urdyn_error"] = (rec.get("stderr_other") or ["exit %s" % rec.get("exit")])[-1]
+        us = []
     if us:
         r["urdyn"] = {"steps_per_s": statistics.median(u["steps_per_s"] for u in us),
                       "runs": [u["steps_per_s"] for u in us], "integrator": us[-1]["integrator"],
                       "summary": us[-1]["summary"],
+                      "recording_steps_per_s": rec.get("steps_per_s"),
                       "warnings": sorted(set(w for u in us for w in u["stderr_other"]))}
         r["urdyn"].update(urdyn_metrics(csvp, args.settle))
     r["mujoco"] = {k: {"steps_per_s": statistics.median(v), "runs": v} for k, v in ms.items()}

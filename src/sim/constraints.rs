@@ -111,8 +111,14 @@ pub(crate) struct Constraints {
     /// The slots of `warm_contact` written by the last solve (only these are cleared).
     warm_slots: Vec<usize>,
     warm_joint: Vec<[f64; 3]>,
-    /// World-frame motion subspace columns of each body (≤ 6).
+    /// World-frame motion subspace columns of each body (≤ 6), set this
+    /// step where `sw_done` holds `sw_stamp`.
     sw: Vec<[Motion; 6]>,
+    sw_done: Vec<u64>,
+    sw_stamp: u64,
+    /// Where each dof lies on the current point's row path (scratch; valid
+    /// where the path holds that dof there).
+    slot: Vec<usize>,
     counts: RowCounts,
     dv: DVector<f64>,
     push: DVector<f64>,
@@ -186,6 +192,9 @@ impl Constraints {
             warm_slots: Vec::with_capacity(max_points),
             warm_joint: vec![[0.0; 3]; ndof],
             sw: vec![[Motion::zero(); 6]; model.nbodies],
+            sw_done: vec![0; model.nbodies],
+            sw_stamp: 0,
+            slot: vec![0; nv],
             counts: RowCounts::default(),
             dv: DVector::zeros(nv),
             push: DVector::zeros(nv),
@@ -315,12 +324,21 @@ impl Constraints {
         // limits) after the contacts have moved (talos_reduced, whose every
         // joint has friction, converged in fewer sweeps this way)
         if !points.is_empty() {
-            // world-frame motion subspace columns
-            for i in 1..model.nbodies {
-                let j = &model.joints[i];
-                let o = o_m_i[i];
-                for c in 0..j.nv().min(6) {
-                    self.sw[i][c] = o.act_motion(&j.subspace_column(c));
+            // world-frame motion subspace columns of the bodies the points'
+            // rows reach (each point's two bodies and their ancestors), once
+            self.sw_stamp = self.sw_stamp.wrapping_add(1).max(1);
+            for pt in points {
+                for start in [pt.body, pt.other] {
+                    let mut i = start;
+                    while i != 0 && i < model.nbodies && self.sw_done[i] != self.sw_stamp {
+                        self.sw_done[i] = self.sw_stamp;
+                        let j = &model.joints[i];
+                        let o = o_m_i[i];
+                        for c in 0..j.nv().min(6) {
+                            self.sw[i][c] = o.act_motion(&j.subspace_column(c));
+                        }
+                        i = model.parent[i];
+                    }
                 }
             }
             let nv = rows.nv;
@@ -341,23 +359,34 @@ impl Constraints {
                 } else {
                     rows.union_path(body_path(pt.body), body_path(pt.other))
                 };
-                let Some(rn) = rows.push(RowKind::Normal, 0.0, warm[0], path) else {
+                let Some(rn) = rows.push_contact(pt.friction, warm, path) else {
                     break;
                 };
-                let tangent = RowKind::Tangent {
-                    normal: rn,
-                    mu: pt.friction,
-                };
-                if rows.push(tangent, 0.0, warm[1], path).is_none() {
-                    rows.pop(1);
-                    break;
-                }
-                if rows.push(RowKind::Tangent2, 0.0, warm[2], path).is_none() {
-                    rows.pop(2);
-                    break;
-                }
                 self.row_point.push(pi);
                 counts.contacts += 1;
+                // J's entries are added straight onto the rows' paths (zeroed
+                // by `clear`): entry t of a row is dof path[t]
+                let st = rows.stride;
+                let (ps, pl) = path;
+                let (tab, jall) = rows.table_and_j();
+                let on_path = tab.get(ps..ps + pl).unwrap_or(&[]);
+                for (t, &d) in on_path.iter().enumerate() {
+                    if let Some(x) = self.slot.get_mut(d) {
+                        *x = t;
+                    }
+                }
+                let slot = &self.slot;
+                let jrows = &mut jall[rn * st..(rn + 3) * st];
+                let mut put = |col: usize, a: f64, b: f64, c: f64| {
+                    if let Some(&t) = slot.get(col)
+                        && on_path.get(t) == Some(&col)
+                        && t < st
+                    {
+                        jrows[t] += a;
+                        jrows[st + t] += b;
+                        jrows[2 * st + t] += c;
+                    }
+                };
                 if pt.other == 0 && pt.normal == Vector3::z() {
                     // the ground: rows n = z, t₁ = x, t₂ = y: the point velocity
                     // v_c + ω_c × p of each ancestor's world-frame subspace column c
@@ -369,9 +398,7 @@ impl Constraints {
                             let vp = s.lin + s.ang.cross(&pt.point);
                             let col = j.iv + c;
                             if col < nv {
-                                self.jd[col] += vp.z;
-                                self.jd[nv + col] += vp.x;
-                                self.jd[2 * nv + col] += vp.y;
+                                put(col, vp.z, vp.x, vp.y);
                             }
                         }
                         b = model.parent[b];
@@ -390,21 +417,13 @@ impl Constraints {
                                 let vp = (s.lin + s.ang.cross(&pt.point)) * sign;
                                 let col = j.iv + c;
                                 if col < nv {
-                                    self.jd[col] += pt.normal.dot(&vp);
-                                    self.jd[nv + col] += t1.dot(&vp);
-                                    self.jd[2 * nv + col] += t2.dot(&vp);
+                                    put(col, pt.normal.dot(&vp), t1.dot(&vp), t2.dot(&vp));
                                 }
                             }
                             b = model.parent[b];
                         }
                     }
                 }
-                // the dense rows onto the rows' paths (the scratch left zero)
-                let (j0, rest) = self.jd.split_at_mut(nv);
-                let (j1, j2) = rest.split_at_mut(nv);
-                rows.gather(rn, j0);
-                rows.gather(rn + 1, j1);
-                rows.gather(rn + 2, j2);
                 // normal target: speculative; restitution only above the speed below
                 // which a bounce of one step under gravity could gain energy:
                 // |u| > 4 g h e / (1 − e²)

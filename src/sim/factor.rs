@@ -405,6 +405,47 @@ impl MassFactor {
         }
     }
 
+    /// [`Self::row_transform3`] on rows held interleaved, `y[t] = [y₀ₜ, y₁ₜ,
+    /// y₂ₜ, pad]` (a contact's three rows, lane by lane): each lane takes
+    /// exactly the operations of [`Self::row_transform3`] in the same order (so
+    /// the same bits), four lanes at once. Tree factors only: returns false
+    /// (nothing done) on a dense one.
+    #[inline]
+    pub fn row_transform_lanes(&self, path: &[usize], y: &mut [[f64; 4]]) -> bool {
+        if !self.tree {
+            return false;
+        }
+        let len = path.len().min(y.len());
+        #[inline(always)]
+        fn sub(ys: &mut [f64; 4], l: f64, a: &[f64; 4]) {
+            for (x, &ai) in ys.iter_mut().zip(a) {
+                *x -= l * ai;
+            }
+        }
+        for t in (0..len).rev() {
+            let a = y[t];
+            match self.ancestors(path, t) {
+                Some((s0, anc)) => {
+                    for (ys, &l) in y[s0..t].iter_mut().zip(anc) {
+                        sub(ys, l, &a);
+                    }
+                }
+                None => {
+                    for s in 0..t {
+                        sub(&mut y[s], self.l_entry(path[t], path[s]), &a);
+                    }
+                }
+            }
+        }
+        for (yt, &k) in y[..len].iter_mut().zip(path) {
+            let d = self.inv_sqrt_d[k];
+            for x in yt.iter_mut() {
+                *x *= d;
+            }
+        }
+        true
+    }
+
     /// z ← R⁻¹ z (full length).
     pub fn half_solve(&self, z: &mut [f64]) {
         let n = self.n;

@@ -109,7 +109,13 @@ impl Islands {
         for p in self.parent.iter_mut().enumerate() {
             *p.1 = p.0;
         }
+        // a row on the same path as the row before it (a contact's tangents,
+        // the points of one pair) joins the same trees: skipped
+        let same = |r: usize| r > 0 && rows.path[r] == rows.path[r - 1];
         for r in 0..n {
+            if same(r) {
+                continue;
+            }
             if let Some((a, b)) = self.ends(rows, r) {
                 let (ra, rb) = (self.find(a), self.find(b));
                 if ra != rb {
@@ -118,9 +124,13 @@ impl Islands {
             }
         }
         for r in 0..n {
-            self.key[r] = match self.ends(rows, r) {
-                Some((a, _)) => self.find(a),
-                None => usize::MAX,
+            self.key[r] = if same(r) {
+                self.key[r - 1]
+            } else {
+                match self.ends(rows, r) {
+                    Some((a, _)) => self.find(a),
+                    None => usize::MAX,
+                }
             };
         }
         // runs of consecutive rows with one key, then grouped by key (stable:
@@ -147,6 +157,9 @@ impl Islands {
             while i < self.runs.len() && self.runs[i].0 == k {
                 let (_, s, e) = self.runs[i];
                 for q in s..e {
+                    if q > s && rows.path[q] == rows.path[q - 1] {
+                        continue;
+                    }
                     let (ps, pl) = rows.path[q];
                     for &d in table.get(ps..ps + pl).unwrap_or(&[]) {
                         if let Some(m) = self.mark.get_mut(d)

@@ -45,10 +45,6 @@ struct Pair {
     /// Member indices (a < b; a moves, or both do).
     a: usize,
     b: usize,
-    /// Its place in the visiting order: (lower geometry index)·G + higher (G
-    /// geometries), the order of the pairs of geometries i < j, whatever
-    /// order the pairs were made in.
-    ord: u64,
     /// The first of its slots (global).
     slot_base: usize,
     /// The features each of its slots held last step (`NO_KEY`: free).
@@ -80,6 +76,11 @@ pub struct PairContact {
     members: Vec<Member>,
     /// The pairs made so far (in the order they were made).
     pairs: Vec<Pair>,
+    /// Each pair's place in the visiting order: (lower geometry index)·G +
+    /// higher (G geometries), the order of the pairs of geometries i < j,
+    /// whatever order the pairs were made in. Apart from the pairs (sorted
+    /// by every step: a pair's whole state need not be loaded for that).
+    ords: Vec<u64>,
     /// `table[i·n + j]`: the pair of members i, j ([`NO_PAIR`]: none allowed;
     /// [`LAZY_PAIR`]: allowed, not made yet).
     table: Vec<u32>,
@@ -232,6 +233,7 @@ impl PairContact {
             max_points: maxp,
             slot_offset,
             pairs: Vec::new(),
+            ords: Vec::new(),
         };
         // self pairs now (rule 4 looks at them before the first step)
         for a in 0..n {
@@ -277,10 +279,11 @@ impl PairContact {
         self.table[b * n + a] = p;
         let maxp = self.max_points;
         let self_pair = self.model_of[a].is_some() && self.model_of[a] == self.model_of[b];
+        let ord = ga.min(gb) * self.ngeoms + ga.max(gb);
+        self.ords.push(ord);
         self.pairs.push(Pair {
             a,
             b,
-            ord: ga.min(gb) * self.ngeoms + ga.max(gb),
             slot_base: self.slot_offset + p as usize * maxp,
             keys: vec![NO_KEY; maxp],
             manifolds: Vec::new(),
@@ -355,7 +358,7 @@ impl PairContact {
             ids.push(self.make_pair(i as usize, j as usize));
         }
         self.overlapping
-            .extend(ids.iter().map(|&p| (self.pairs[p as usize].ord, p)));
+            .extend(ids.iter().map(|&p| (self.ords[p as usize], p)));
         self.sap_ids = ids;
         // the pairs not overlapping forget their points
         // (sorted: the same order every step, whatever the sweep's or the

@@ -32,6 +32,10 @@ impl Rows {
             for q in r..(r + k).min(self.is_block.len()) {
                 self.is_block[q] = block && q == r;
             }
+            if k == 3 && self.form_lanes(f, r, path, vfree) {
+                r += 3;
+                continue;
+            }
             for q in r..r + k {
                 let jr = &self.j[q * st..q * st + pl];
                 let yr = &mut self.y[q * st..q * st + pl];
@@ -63,6 +67,53 @@ impl Rows {
             *wi = if *w > 1e-14 { 1.0 / w } else { 0.0 };
         }
         self.table = table_v;
+    }
+
+    /// A contact's three rows `r..r + 3` on `path` formed as [`Rows::form`]
+    /// does, interleaved in [`Rows::lanes`] so that the three rows' operations
+    /// run side by side (each row's entries get the same operations in the
+    /// same order: the same bits). False (nothing done) on a dense factor.
+    fn form_lanes(&mut self, f: &MassFactor, r: usize, path: &[usize], vfree: &[f64]) -> bool {
+        let (st, pl) = (self.stride, path.len());
+        if !f.is_tree() || pl > self.lanes.len() || self.j.len() < (r + 3) * st {
+            return false;
+        }
+        let buf = &mut self.lanes[..pl];
+        let j = &self.j[r * st..(r + 3) * st];
+        let (j0, j1, j2) = (&j[..pl], &j[st..st + pl], &j[2 * st..2 * st + pl]);
+        // c = J v*, each row's sum from 0 in path order
+        let mut c = [0.0f64; 4];
+        for (t, (b, &d)) in buf.iter_mut().zip(path).enumerate() {
+            *b = [j0[t], j1[t], j2[t], 0.0];
+            let x = vfree[d];
+            for (ci, &bi) in c.iter_mut().zip(b.iter()) {
+                *ci += bi * x;
+            }
+        }
+        f.row_transform_lanes(path, buf);
+        // W's diagonal and the block's off-diagonal entries, each a sum in
+        // path order from −0 (as `Iterator::sum` of f64)
+        let (mut d, mut o) = ([-0.0f64; 4], [-0.0f64; 4]);
+        for b in buf.iter() {
+            let p = [b[0] * b[0], b[1] * b[1], b[2] * b[2], 0.0];
+            let q = [b[0] * b[1], b[0] * b[2], b[1] * b[2], 0.0];
+            for i in 0..4 {
+                d[i] += p[i];
+                o[i] += q[i];
+            }
+        }
+        let y = &mut self.y[r * st..(r + 3) * st];
+        let (y0, rest) = y.split_at_mut(st);
+        let (y1, y2) = rest.split_at_mut(st);
+        for (t, b) in buf.iter().enumerate() {
+            y0[t] = b[0];
+            y1[t] = b[1];
+            y2[t] = b[2];
+        }
+        self.c[r..r + 3].copy_from_slice(&c[..3]);
+        self.w[r..r + 3].copy_from_slice(&d[..3]);
+        self.w_block[r] = [o[0], o[1], o[2]];
+        true
     }
 
     /// Whether row r is a contact normal followed by its two tangent rows on

@@ -99,6 +99,9 @@ pub struct Rows {
     /// W (n·t₁, n·t₂, t₁·t₂), so that a sweep reads the contact's path once.
     pub w_block: Vec<[f64; 3]>,
     is_block: Vec<bool>,
+    /// Scratch of [`Rows::form`]: a contact's three rows interleaved (one
+    /// entry per path slot, `stride` of them).
+    lanes: Vec<[f64; 4]>,
     /// Each row's velocity at its update in the last sweep.
     u_prev: Vec<f64>,
     /// Scratch of the subspace step ([`subspace_step`]).
@@ -140,6 +143,7 @@ impl Rows {
             path: vec![(0, 0); cap],
             w_block: vec![[0.0; 3]; cap],
             is_block: vec![false; cap],
+            lanes: vec![[0.0; 4]; stride],
             u_prev: vec![0.0; cap],
             sm: Subspace::new(nv, cap),
             polished: false,
@@ -159,6 +163,11 @@ impl Rows {
     /// The dof paths rows index ([`Rows::path`]).
     pub fn table(&self) -> &[usize] {
         &self.table
+    }
+    /// The path table and J, borrowed apart (to write a row's entries on
+    /// its path).
+    pub(crate) fn table_and_j(&mut self) -> (&[usize], &mut [f64]) {
+        (&self.table, &mut self.j)
     }
     /// Takes the path table out (no entry moved), for a solver that mutates
     /// the rows while reading it; [`Rows::put_table`] puts it back.
@@ -252,6 +261,27 @@ impl Rows {
         self.lambda[r] = warm;
         self.bpos[r] = 0.0;
         self.path[r] = path;
+        Some(r)
+    }
+    /// A contact's three rows at once ([`Rows::push`] of a normal, its
+    /// tangent pair, on one path, targets 0): the normal's index, or `None`
+    /// (nothing pushed) when fewer than three rows are left.
+    #[inline]
+    pub fn push_contact(&mut self, mu: f64, warm: [f64; 3], path: (usize, usize)) -> Option<usize> {
+        if self.n + 3 > self.cap {
+            return None;
+        }
+        let r = self.n;
+        self.n += 3;
+        self.kind[r..r + 3].copy_from_slice(&[
+            RowKind::Normal,
+            RowKind::Tangent { normal: r, mu },
+            RowKind::Tangent2,
+        ]);
+        self.b[r..r + 3].fill(0.0);
+        self.lambda[r..r + 3].copy_from_slice(&warm);
+        self.bpos[r..r + 3].fill(0.0);
+        self.path[r..r + 3].fill(path);
         Some(r)
     }
     /// Where dof `d` lies on row `r`'s path (`None`: off it, J is 0 there).
