@@ -131,7 +131,7 @@ fn luxo_loops_close_and_constrained_dynamics_holds_floating() {
 /// closed below 1e-6 m. (Measured with these options, which leave out the scene's
 /// torsional and rolling friction: asleep at 2.12 s, violation 0 at rest.
 /// The examples and tests/loops_sim.rs run the scenes with them: the table drop
-/// sleeps at 1.94 s and the ground drop at 2.22 s, the loops below 1e-15 m after
+/// sleeps at 1.94 s and the ground drop at 2.21 s, the loops below 1e-15 m after
 /// landing and the energy never more than 1e-10 J above its lowest value so far,
 /// docs/mechanisms_examples.md.)
 #[test]

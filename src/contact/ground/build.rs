@@ -247,7 +247,6 @@ impl GroundContact {
             prev_flag: vec![false; n],
             prev_list: Vec::with_capacity(n),
             prev_range: vec![(0, 0); nshapes],
-            prev_deep: vec![usize::MAX; nshapes],
             reduce_dirs: reduce_directions(params.max_points_per_shape),
             last_low: vec![0; nshapes],
             visited: vec![0; n],

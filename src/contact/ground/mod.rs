@@ -12,7 +12,7 @@ use crate::spatial::Se3;
 use nalgebra::Vector3;
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, SupportMap};
-use reduce::{band_best, keep_penetrating, reduce, HOLD_DEEPEST, HOLD_EXTREME, MAX_DIRS};
+use reduce::{band_best, reduce, HOLD_DEEPEST, HOLD_EXTREME, MAX_DIRS};
 
 #[derive(Clone, Debug)]
 pub(super) enum ParryShape {
@@ -92,10 +92,6 @@ pub struct GroundContact {
     prev_list: Vec<usize>,
     /// Per shape, its slots in `prev_list` (a range).
     prev_range: Vec<(usize, usize)>,
-    /// Per shape, the slot its last reduction picked as the deepest
-    /// (`usize::MAX`: none): the pick stays while that point is kept and
-    /// within [`HOLD_DEEPEST`] of the deepest ([`reduce`]).
-    prev_deep: Vec<usize>,
     /// The horizontal directions a reduced manifold's extremes are taken along
     /// (cos, sin), computed once ([`reduce_directions`]).
     reduce_dirs: [(f64, f64); MAX_DIRS],
@@ -173,7 +169,6 @@ impl GroundContact {
         self.prev_flag.fill(false);
         self.prev_list.clear();
         self.prev_range.fill((0, 0));
-        self.prev_deep.fill(usize::MAX);
         self.last_low.fill(0);
         self.visited.fill(0);
         self.generation = 0;
@@ -250,14 +245,7 @@ impl GroundContact {
                             candidate(k);
                         }
                     }
-                    reduce(
-                        scratch,
-                        maxp,
-                        out,
-                        &self.prev_flag,
-                        &self.reduce_dirs,
-                        &mut self.prev_deep[si],
-                    );
+                    reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
                     continue;
                 }
                 // a hull: descend the vertex graph from the last lowest vertex
@@ -376,7 +364,6 @@ impl GroundContact {
                 };
                 if cand.len() <= maxp {
                     out.extend(cand.iter().map(|&i| point(i as usize)));
-                    self.prev_deep[si] = base + k;
                     continue;
                 }
                 // each criterion's choice as `reduce`'s: a point kept last step
@@ -390,17 +377,7 @@ impl GroundContact {
                 for (q, &bq) in best.iter().enumerate().take(dirs + 1) {
                     let hold = if q == 0 { HOLD_DEEPEST } else { HOLD_EXTREME };
                     let mut ch = usize::MAX;
-                    // the deepest pick: last step's while it is kept and
-                    // within the hold ([`reduce`] says why)
-                    let pd = self.prev_deep[si];
-                    let held = q == 0
-                        && kept.contains(&pd)
-                        && self.in_band[pd] == stamp
-                        && key(&o_m_g.act_point(&verts[pd - base]), 0) >= bq - hold;
-                    if held {
-                        ch = pd;
-                    }
-                    for &slot in kept.iter().filter(|_| !held) {
+                    for &slot in kept {
                         if slot < ch
                             && self.in_band[slot] == stamp
                             && key(&o_m_g.act_point(&verts[slot - base]), q) >= bq - hold
@@ -424,21 +401,11 @@ impl GroundContact {
                             kmin
                         }
                     };
-                    if q == 0 {
-                        self.prev_deep[si] = base + k;
-                    }
                     if out.len() - start >= maxp {
                         break;
                     }
                     if !out[start..].iter().any(|p| p.slot == base + k) {
                         out.push(point(k));
-                    }
-                }
-                // a point kept last step and still in the ground stays ahead of
-                // a picked one that does not touch it (`reduce`)
-                for &slot in kept {
-                    if self.in_band[slot] == stamp && !out[start..].iter().any(|p| p.slot == slot) {
-                        keep_penetrating(out, start, maxp, point(slot - base));
                     }
                 }
                 continue;
@@ -491,14 +458,7 @@ impl GroundContact {
                     }
                 }
             }
-            reduce(
-                scratch,
-                maxp,
-                out,
-                &self.prev_flag,
-                &self.reduce_dirs,
-                &mut self.prev_deep[si],
-            );
+            reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
         }
         for &k in &self.prev_list {
             self.prev_flag[k] = false;
