@@ -2,8 +2,12 @@
 //! the document walked with quick-xml, the scene graph placed, the primitives
 //! triangulated, the materials' diffuse colours bound.
 
-use super::dae_parts::{dae_local_ref, dae_snippet, dae_transform, keep_used, DaePrim, Mat4};
+#[path = "dae_doc.rs"]
+mod doc;
+
+use super::dae_parts::{dae_local_ref, dae_snippet, keep_used, DaePrim, Mat4};
 use super::Rgba;
+use doc::{finish, DaeNode, DaeText, DaeVisualScene};
 use std::collections::HashMap;
 
 /// Most node visits the scene walk makes (`<instance_node>` can form cycles or
@@ -11,40 +15,6 @@ use std::collections::HashMap;
 const MAX_DAE_NODE_VISITS: usize = 1_000_000;
 /// Most vertices the scene walk emits (one geometry can be instanced many times).
 const MAX_DAE_VERTICES: usize = 5_000_000;
-
-/// A `<node>` of a visual scene or of `<library_nodes>`.
-pub(super) struct DaeNode {
-    /// `id`, else `name`, for messages.
-    label: String,
-    /// Product of the node's transform elements, in document order.
-    local: Mat4,
-    /// A transform element that is not applied (`skew`, `lookat`).
-    unsupported: Option<&'static str>,
-    /// `<instance_geometry url>`s.
-    geometries: Vec<String>,
-    /// Per `<instance_geometry>`: its `<instance_material symbol>` → `target` id.
-    bindings: Vec<HashMap<String, String>>,
-    /// `<instance_node url>`s.
-    instances: Vec<String>,
-    children: Vec<usize>,
-}
-
-pub(super) struct DaeVisualScene {
-    id: Option<String>,
-    roots: Vec<usize>,
-}
-
-/// What the text being collected belongs to.
-pub(super) enum DaeText {
-    /// A `<float_array id>`.
-    Array(String),
-    /// A transform element (`matrix`, `translate`, `rotate`, `scale`) of a node.
-    Transform(&'static str, usize),
-    /// A `<vcount>` or `<p>` of the primitive being read.
-    Indices(&'static str),
-    /// The `<diffuse><color>` of an `<effect id>`.
-    Color(String),
-}
 
 /// Positions of a COLLADA document (see the module doc).
 #[cfg(test)]
@@ -108,45 +78,6 @@ pub(super) fn read_dae_colored(text: &str) -> Result<DaeMesh, String> {
     let mut current_material: Option<String> = None;
     let mut current_effect: Option<String> = None;
     let mut unit = 1.0;
-    // Ends the text being collected, `collecting`, into its array or node.
-    let finish = |collecting: DaeText,
-                  buf: &str,
-                  arrays: &mut HashMap<String, Vec<f64>>,
-                  nodes: &mut Vec<DaeNode>,
-                  colors: &mut HashMap<String, Rgba>|
-     -> Result<(), String> {
-        match collecting {
-            DaeText::Array(id) => {
-                let vals: Result<Vec<f64>, _> =
-                    buf.split_whitespace().map(str::parse::<f64>).collect();
-                let vals = vals.map_err(|_| {
-                    format!("float_array \"{}\": not a number list", dae_snippet(&id))
-                })?;
-                arrays.entry(id).or_default().extend(vals);
-            }
-            DaeText::Transform(kind, i) => {
-                if let Some(node) = nodes.get_mut(i) {
-                    let m = dae_transform(kind, buf, &node.label)?;
-                    node.local *= m;
-                }
-            }
-            // (read by the caller)
-            DaeText::Indices(_) => {}
-            DaeText::Color(effect) => {
-                // r g b [a]; a colour that is not numbers is no colour
-                let v: Vec<f64> = buf
-                    .split_whitespace()
-                    .filter_map(|x| x.parse::<f64>().ok())
-                    .filter(|x| x.is_finite())
-                    .collect();
-                if let [r, g, b, rest @ ..] = v.as_slice() {
-                    let a = rest.first().copied().unwrap_or(1.0);
-                    colors.insert(effect, [*r, *g, *b, a].map(|x| x.clamp(0.0, 1.0)));
-                }
-            }
-        }
-        Ok(())
-    };
     loop {
         let ev = reader
             .read_event()

@@ -444,7 +444,7 @@ pub(super) fn build(text: &str, file: &str) -> Result<Robot, UrdfError> {
                 let get = |k: &str| attrs.iter().find(|(a, _)| a == k).map(|(_, v)| v.clone());
                 robot.name = get("name").unwrap_or_default();
                 robot.version = get("version");
-                ctx.version = super::robot_version(robot.version.as_deref());
+                ctx.version = super::rules::robot_version(robot.version.as_deref());
                 false
             }
             1 => matches!(e.name().as_ref(), b"link" | b"joint"),
