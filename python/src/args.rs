@@ -249,12 +249,42 @@ pub fn read_flag(x: &Bound<'_, PyAny>, name: &str) -> PyResult<bool> {
     x.is_truthy().map_err(|_| bad())
 }
 
+/// A string argument `name` (a `str`, numpy's too), else a `ValueError` naming it.
+pub fn read_text(x: &Bound<'_, PyAny>, name: &str) -> PyResult<String> {
+    if !x.is_instance_of::<pyo3::types::PyString>() {
+        let shown = x
+            .repr()
+            .map(|r| r.to_string())
+            .unwrap_or_else(|_| "?".into());
+        return Err(value_error(format!(
+            "{name} must be a string (got {shown})"
+        )));
+    }
+    x.extract::<String>()
+        .map_err(|e| value_error(format!("{name}: {e}")))
+}
+
+/// A path argument `name` (a `str` or an `os.PathLike`), else a `ValueError`
+/// naming it.
+pub fn read_path(x: &Bound<'_, PyAny>, name: &str) -> PyResult<std::path::PathBuf> {
+    x.extract::<std::path::PathBuf>().map_err(|_| {
+        let shown = x
+            .repr()
+            .map(|r| r.to_string())
+            .unwrap_or_else(|_| "?".into());
+        value_error(format!(
+            "{name} must be a path: a str or os.PathLike (got {shown})"
+        ))
+    })
+}
+
 /// Readers of single keyword arguments for `#[pyo3(from_py_with = ...)]`: a
 /// wrong type is a `ValueError` naming the argument (python.md §"Introspection,
 /// contacts, batched control, pictures"), not pyo3's `TypeError`.
 pub mod named {
-    use super::{read_count, read_flag, read_real};
+    use super::{read_count, read_flag, read_path, read_real, read_text};
     use pyo3::prelude::*;
+    use std::path::PathBuf;
 
     macro_rules! real {
         ($f:ident, $name:literal) => {
@@ -289,6 +319,70 @@ pub mod named {
                 read_flag(x, $name).map(Some)
             }
         };
+    }
+    macro_rules! text {
+        ($f:ident, $name:literal) => {
+            pub fn $f(x: &Bound<'_, PyAny>) -> PyResult<String> {
+                read_text(x, $name)
+            }
+        };
+    }
+    macro_rules! text_or_none {
+        ($f:ident, $name:literal) => {
+            pub fn $f(x: &Bound<'_, PyAny>) -> PyResult<Option<String>> {
+                if x.is_none() {
+                    return Ok(None);
+                }
+                read_text(x, $name).map(Some)
+            }
+        };
+    }
+    macro_rules! path {
+        ($f:ident, $name:literal) => {
+            pub fn $f(x: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+                read_path(x, $name)
+            }
+        };
+    }
+    text!(link, "link");
+    text!(reference, "reference");
+    text!(method, "method");
+    text!(name, "name");
+    text!(xml, "xml");
+    text!(text, "text");
+    text_or_none!(integrator, "integrator");
+    path!(path, "path");
+    path!(base_dir, "base_dir");
+    /// `base_dir=None` or a path.
+    pub fn base_dir_or_none(x: &Bound<'_, PyAny>) -> PyResult<Option<PathBuf>> {
+        if x.is_none() {
+            return Ok(None);
+        }
+        read_path(x, "base_dir").map(Some)
+    }
+    /// `package_dirs=None` or a list of paths.
+    pub fn package_dirs(x: &Bound<'_, PyAny>) -> PyResult<Option<Vec<PathBuf>>> {
+        if x.is_none() {
+            return Ok(None);
+        }
+        let bad = || {
+            let shown = x
+                .repr()
+                .map(|r| r.to_string())
+                .unwrap_or_else(|_| "?".into());
+            super::value_error(format!(
+                "package_dirs must be a list of paths (got {shown})"
+            ))
+        };
+        if x.is_instance_of::<pyo3::types::PyString>() {
+            return Err(bad());
+        }
+        let mut out = Vec::new();
+        for item in x.try_iter().map_err(|_| bad())? {
+            let item = item.map_err(|_| bad())?;
+            out.push(read_path(&item, "package_dirs[...]")?);
+        }
+        Ok(Some(out))
     }
     real!(dt, "dt");
     real!(eps, "eps");

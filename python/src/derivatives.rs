@@ -114,20 +114,23 @@ pub fn aba_derivatives<'py>(
 /// The 6 × nv time variation of link `link`'s Jacobian at (q, v) (Pinocchio's
 /// `getFrameJacobianTimeVariation`, LOCAL_WORLD_ALIGNED or LOCAL).
 #[pyfunction]
-#[pyo3(signature = (model, data, q, v, link, reference="world_aligned"))]
+#[pyo3(
+    signature = (model, data, q, v, link, reference=String::from("world_aligned")),
+    text_signature = "(model, data, q, v, link, reference='world_aligned')"
+)]
 pub fn frame_jacobian_time_variation<'py>(
     py: Python<'py>,
     model: PyRef<'py, PyModel>,
     mut data: PyRefMut<'py, PyData>,
     q: &Bound<'py, PyAny>,
     v: &Bound<'py, PyAny>,
-    link: &str,
-    reference: &str,
+    #[pyo3(from_py_with = named::link)] link: String,
+    #[pyo3(from_py_with = named::reference)] reference: String,
 ) -> PyResult<Mat<'py>> {
-    let r = self::reference(reference)?;
+    let r = self::reference(&reference)?;
     let d = &mut *data;
     read_qv(&model, d, q, v)?;
-    let i = model.link(link, "link")?;
+    let i = model.link(&link, "link")?;
     let mut jd = DMatrix::zeros(6, model.model.nv);
     dynamics::frame_jacobian_time_variation(
         &model.model,

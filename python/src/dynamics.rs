@@ -297,12 +297,12 @@ pub fn frame_placement<'py>(
     model: PyRef<'py, PyModel>,
     mut data: PyRefMut<'py, PyData>,
     q: &Bound<'py, PyAny>,
-    link: &str,
+    #[pyo3(from_py_with = crate::args::named::link)] link: String,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let d = &mut *data;
     d.check(&model.model)?;
     read_q(d, q)?;
-    let i = model.link(link, "link")?;
+    let i = model.link(&link, "link")?;
     let x = link_pose(&model, d, i)?;
     let mut m = DMatrix::identity(4, 4);
     for r in 0..3 {
@@ -344,20 +344,23 @@ fn jacobian(
 /// The 6 × nv Jacobian of URDF link `link` at q; `reference` "world_aligned"
 /// (the contract's `jacobian`) or "local" (`jacobian_local`).
 #[pyfunction]
-#[pyo3(signature = (model, data, q, link, reference="world_aligned"))]
+#[pyo3(
+    signature = (model, data, q, link, reference=String::from("world_aligned")),
+    text_signature = "(model, data, q, link, reference='world_aligned')"
+)]
 pub fn frame_jacobian<'py>(
     py: Python<'py>,
     model: PyRef<'py, PyModel>,
     mut data: PyRefMut<'py, PyData>,
     q: &Bound<'py, PyAny>,
-    link: &str,
-    reference: &str,
+    #[pyo3(from_py_with = crate::args::named::link)] link: String,
+    #[pyo3(from_py_with = crate::args::named::reference)] reference: String,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let local = self::reference(reference)?;
+    let local = self::reference(&reference)?;
     let d = &mut *data;
     d.check(&model.model)?;
     read_q(d, q)?;
-    let i = model.link(link, "link")?;
+    let i = model.link(&link, "link")?;
     let j = jacobian(&model, d, i, local)?;
     Ok(mat_out(py, &j))
 }
@@ -365,20 +368,23 @@ pub fn frame_jacobian<'py>(
 /// The 6-vector [linear velocity of the link origin; angular velocity] of URDF
 /// link `link` at (q, v), world-aligned or local.
 #[pyfunction]
-#[pyo3(signature = (model, data, q, v, link, reference="world_aligned"))]
+#[pyo3(
+    signature = (model, data, q, v, link, reference=String::from("world_aligned")),
+    text_signature = "(model, data, q, v, link, reference='world_aligned')"
+)]
 pub fn frame_velocity<'py>(
     py: Python<'py>,
     model: PyRef<'py, PyModel>,
     mut data: PyRefMut<'py, PyData>,
     q: &Bound<'py, PyAny>,
     v: &Bound<'py, PyAny>,
-    link: &str,
-    reference: &str,
+    #[pyo3(from_py_with = crate::args::named::link)] link: String,
+    #[pyo3(from_py_with = crate::args::named::reference)] reference: String,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let local = self::reference(reference)?;
+    let local = self::reference(&reference)?;
     let d = &mut *data;
     read_qv(&model, d, q, v)?;
-    let i = model.link(link, "link")?;
+    let i = model.link(&link, "link")?;
     let j = jacobian(&model, d, i, local)?;
     let vel = j * &d.v;
     Ok(vec_out(py, vel.as_slice()))

@@ -176,9 +176,9 @@ impl PyModel {
     #[staticmethod]
     #[pyo3(signature = (path, floating_base=false, package_dirs=None))]
     fn from_urdf(
-        path: PathBuf,
+        #[pyo3(from_py_with = named::path)] path: PathBuf,
         #[pyo3(from_py_with = named::floating_base)] floating_base: bool,
-        package_dirs: Option<Vec<PathBuf>>,
+        #[pyo3(from_py_with = named::package_dirs)] package_dirs: Option<Vec<PathBuf>>,
     ) -> PyResult<Self> {
         // a file that does not exist: FileNotFoundError, with the CLI's line
         if let Err(e) = std::fs::metadata(&path) {
@@ -208,14 +208,17 @@ impl PyModel {
     /// `from_mujoco_qpos`/`from_mujoco_qvel` convert). Joint `armature` is in
     /// `crba` and `forward_dynamics` as in MuJoCo's qM (`model.armature`).
     #[staticmethod]
-    fn from_mjcf(path: PathBuf) -> PyResult<Self> {
+    fn from_mjcf(#[pyo3(from_py_with = named::path)] path: PathBuf) -> PyResult<Self> {
         crate::mjcf::from_mjcf(path)
     }
 
     /// Imports MJCF text; `<include>`s and meshes are read under `base_dir`.
     #[staticmethod]
     #[pyo3(signature = (xml, base_dir=PathBuf::from(".")))]
-    fn from_mjcf_string(xml: String, base_dir: PathBuf) -> PyResult<Self> {
+    fn from_mjcf_string(
+        #[pyo3(from_py_with = named::xml)] xml: String,
+        #[pyo3(from_py_with = named::base_dir)] base_dir: PathBuf,
+    ) -> PyResult<Self> {
         crate::mjcf::from_mjcf_string(xml, "<string>".into(), base_dir)
     }
 
@@ -225,9 +228,9 @@ impl PyModel {
     #[staticmethod]
     #[pyo3(signature = (path, floating_base=false, package_dirs=None))]
     fn from_file(
-        path: PathBuf,
+        #[pyo3(from_py_with = named::path)] path: PathBuf,
         #[pyo3(from_py_with = named::floating_base)] floating_base: bool,
-        package_dirs: Option<Vec<PathBuf>>,
+        #[pyo3(from_py_with = named::package_dirs)] package_dirs: Option<Vec<PathBuf>>,
     ) -> PyResult<Self> {
         match urdyn::load::file_format(&path) {
             urdyn::load::Format::Mjcf => {
@@ -247,7 +250,7 @@ impl PyModel {
     #[staticmethod]
     #[pyo3(signature = (xml, floating_base=false))]
     fn from_urdf_string(
-        xml: String,
+        #[pyo3(from_py_with = named::xml)] xml: String,
         #[pyo3(from_py_with = named::floating_base)] floating_base: bool,
     ) -> PyResult<Self> {
         Self::build(xml, "<string>".into(), floating_base, None, Vec::new())
@@ -328,20 +331,36 @@ impl PyModel {
 
     /// `slice` of joint `name`'s entries in q (Pinocchio's idx_q/nq; a continuous
     /// joint one entry, a floating base "base" / "MODEL/base" seven).
-    fn joint_q_slice<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        py_slice(py, &introspect::joint_ranges(&self.model, name)?.0)
+    fn joint_q_slice<'py>(
+        &self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = named::name)] name: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        py_slice(py, &introspect::joint_ranges(&self.model, &name)?.0)
     }
     /// `slice` of joint `name`'s entries in v (Pinocchio's idx_v/nv).
-    fn joint_v_slice<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        py_slice(py, &introspect::joint_ranges(&self.model, name)?.1)
+    fn joint_v_slice<'py>(
+        &self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = named::name)] name: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        py_slice(py, &introspect::joint_ranges(&self.model, &name)?.1)
     }
     /// `slice` of a scene model's entries in q (a lone URDF: "robot", all of q).
-    fn model_q_slice<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        py_slice(py, &introspect::model_ranges(&self.model, name)?.0)
+    fn model_q_slice<'py>(
+        &self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = named::name)] name: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        py_slice(py, &introspect::model_ranges(&self.model, &name)?.0)
     }
     /// `slice` of a scene model's entries in v.
-    fn model_v_slice<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        py_slice(py, &introspect::model_ranges(&self.model, name)?.1)
+    fn model_v_slice<'py>(
+        &self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = named::name)] name: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        py_slice(py, &introspect::model_ranges(&self.model, &name)?.1)
     }
     /// The models in q order: a scene's names, ["robot"] for a lone URDF.
     #[getter]
@@ -412,8 +431,8 @@ impl PyModel {
     /// A link's own `<inertial>` mass (kg; 0 without one); an MJCF body's
     /// own mass as MuJoCo's `body_mass` (from its geoms where it has no
     /// `<inertial>`).
-    fn link_mass(&self, link: &str) -> PyResult<f64> {
-        Ok(self.own_inertial(link)?.map_or(0.0, |i| i.mass))
+    fn link_mass(&self, #[pyo3(from_py_with = named::link)] link: String) -> PyResult<f64> {
+        Ok(self.own_inertial(&link)?.map_or(0.0, |i| i.mass))
     }
     /// A link's own (centre of mass (3), inertia about it (3, 3)), link frame
     /// (zeros without an `<inertial>`).
@@ -421,10 +440,10 @@ impl PyModel {
     fn link_inertia<'py>(
         &self,
         py: Python<'py>,
-        link: &str,
+        #[pyo3(from_py_with = named::link)] link: String,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
         let (c, i) = self
-            .own_inertial(link)?
+            .own_inertial(&link)?
             .map_or((Vector3::zeros(), urdyn::nalgebra::Matrix3::zeros()), |l| {
                 (l.com, l.inertia)
             });

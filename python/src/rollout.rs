@@ -132,7 +132,7 @@ pub fn rollout<'py>(
     nstep: Option<&Bound<'py, PyAny>>,
     #[pyo3(from_py_with = named::dt)] dt: f64,
     threads: Option<&Bound<'py, PyAny>>,
-    integrator: Option<&str>,
+    #[pyo3(from_py_with = named::integrator)] integrator: Option<String>,
     ground: Given,
     friction: Given,
     kp: Option<&Bound<'py, PyAny>>,
@@ -151,7 +151,7 @@ pub fn rollout<'py>(
     let start = prototype_any(
         model,
         dt,
-        integrator,
+        integrator.as_deref(),
         &ground,
         &friction,
         None,

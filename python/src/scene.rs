@@ -101,7 +101,10 @@ impl PyScene {
     /// Reads a scene file; its relative paths are taken against its folder.
     #[staticmethod]
     #[pyo3(signature = (path, package_dirs=None))]
-    fn from_file(path: PathBuf, package_dirs: Option<Vec<PathBuf>>) -> PyResult<Self> {
+    fn from_file(
+        #[pyo3(from_py_with = crate::args::named::path)] path: PathBuf,
+        #[pyo3(from_py_with = crate::args::named::package_dirs)] package_dirs: Option<Vec<PathBuf>>,
+    ) -> PyResult<Self> {
         let dirs = package_dirs.unwrap_or_default();
         let scene = Scene::from_file(&path, &dirs).map_err(scene_error)?;
         let text = std::fs::read_to_string(&path).map_err(|e| value_error(e.to_string()))?;
@@ -117,9 +120,9 @@ impl PyScene {
     #[staticmethod]
     #[pyo3(signature = (text, base_dir=None, package_dirs=None))]
     fn from_json(
-        text: String,
-        base_dir: Option<PathBuf>,
-        package_dirs: Option<Vec<PathBuf>>,
+        #[pyo3(from_py_with = crate::args::named::text)] text: String,
+        #[pyo3(from_py_with = crate::args::named::base_dir_or_none)] base_dir: Option<PathBuf>,
+        #[pyo3(from_py_with = crate::args::named::package_dirs)] package_dirs: Option<Vec<PathBuf>>,
     ) -> PyResult<Self> {
         Self::build(
             text,

@@ -178,7 +178,7 @@ impl PySimulation {
     fn new(
         model: &Bound<'_, PyAny>,
         #[pyo3(from_py_with = named::dt)] dt: f64,
-        integrator: Option<&str>,
+        #[pyo3(from_py_with = named::integrator)] integrator: Option<String>,
         ground: Given,
         friction: Given,
         package_dirs: Option<Vec<PathBuf>>,
@@ -190,7 +190,7 @@ impl PySimulation {
         let proto = prototype_any(
             model,
             dt,
-            integrator,
+            integrator.as_deref(),
             &ground,
             &friction,
             package_dirs,
@@ -367,13 +367,13 @@ impl PySimulation {
     }
     /// Whether the model `name` sleeps now (a scene's model name; a lone
     /// model's is its `models[0]`). An unknown name is a `ValueError`.
-    fn sleeping(&self, name: &str) -> PyResult<bool> {
+    fn sleeping(&self, #[pyo3(from_py_with = named::name)] name: String) -> PyResult<bool> {
         let trees = &self.sim.model.trees;
         let key = if trees.len() == 1 && trees[0].name.is_empty() {
             // a lone model's one tree is named "" in the library
             ""
         } else {
-            name
+            &name
         };
         let lone = trees.len() == 1 && trees[0].name.is_empty();
         if lone && !(name.is_empty() || name == "robot" || name == self.sim.model.name) {
@@ -451,7 +451,7 @@ impl PySimulation {
     }
     /// Writes the recording's replay page to `path` (the recording is kept);
     /// returns the number of frames the page holds (thinned for size).
-    fn write_html(&self, path: PathBuf) -> PyResult<usize> {
+    fn write_html(&self, #[pyo3(from_py_with = named::path)] path: PathBuf) -> PyResult<usize> {
         let Some(stage) = &self.stage else {
             return Err(value_error(
                 "write_html: nothing recorded (call sim.record(True) before stepping)",
@@ -538,25 +538,28 @@ impl PySimulation {
     /// foot stays on the ground), while "forward"/"central" (finite differences
     /// of the step, step `eps`, as MuJoCo's mjd_transitionFD) see a perturbation
     /// that lifts the foot leave the ground: one-sided, so they differ there.
-    #[pyo3(signature = (tau=None, method="analytic", eps=1e-6))]
+    #[pyo3(
+        signature = (tau=None, method=String::from("analytic"), eps=1e-6),
+        text_signature = "(self, tau=None, method='analytic', eps=1e-6)"
+    )]
     #[allow(clippy::type_complexity)]
     fn transition_jacobians<'py>(
         &self,
         py: Python<'py>,
         tau: Option<&Bound<'py, PyAny>>,
-        method: &str,
+        #[pyo3(from_py_with = named::method)] method: String,
         #[pyo3(from_py_with = named::eps)] eps: f64,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-        crate::control::transition_jacobians(py, &self.sim, tau, method, eps)
+        crate::control::transition_jacobians(py, &self.sim, tau, &method, eps)
     }
     /// (gyro, accel) of a link after the last step, link coordinates.
     #[allow(clippy::type_complexity)]
     fn imu<'py>(
         &mut self,
         py: Python<'py>,
-        link: &str,
+        #[pyo3(from_py_with = named::link)] link: String,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
-        crate::control::pair(py, self.sim.imu(link))
+        crate::control::pair(py, self.sim.imu(&link))
     }
     /// (force, torque) the parent exerts on a joint's child link, child link coordinates.
     #[allow(clippy::type_complexity)]
@@ -572,16 +575,19 @@ impl PySimulation {
     fn contact_wrench<'py>(
         &mut self,
         py: Python<'py>,
-        link: &str,
+        #[pyo3(from_py_with = named::link)] link: String,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
-        crate::control::pair(py, self.sim.contact_wrench(link))
+        crate::control::pair(py, self.sim.contact_wrench(&link))
     }
 }
 
 /// A and B at each of T states of a trajectory as `sim` would step them, in
 /// parallel on `threads` cores with the GIL released (python.md §"Control").
 #[pyfunction]
-#[pyo3(signature = (sim, q, v, tau, threads=None, method="analytic", eps=1e-6))]
+#[pyo3(
+    signature = (sim, q, v, tau, threads=None, method=String::from("analytic"), eps=1e-6),
+    text_signature = "(sim, q, v, tau, threads=None, method='analytic', eps=1e-6)"
+)]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn linearize<'py>(
     py: Python<'py>,
@@ -590,9 +596,9 @@ pub fn linearize<'py>(
     v: &Bound<'py, PyAny>,
     tau: &Bound<'py, PyAny>,
     threads: Option<&Bound<'py, PyAny>>,
-    method: &str,
+    #[pyo3(from_py_with = named::method)] method: String,
     #[pyo3(from_py_with = named::eps)] eps: f64,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
     let threads = read_threads(threads)?;
-    crate::control::linearize(py, &sim.sim, q, v, tau, threads, method, eps)
+    crate::control::linearize(py, &sim.sim, q, v, tau, threads, &method, eps)
 }

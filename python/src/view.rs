@@ -105,7 +105,7 @@ pub fn write(path: &Path, stage: &Stage, frames: &[Frame]) -> PyResult<usize> {
 #[pyfunction]
 #[pyo3(signature = (path, model_or_scene, q, t=None, dt=None))]
 pub fn write_html(
-    path: PathBuf,
+    #[pyo3(from_py_with = crate::args::named::path)] path: PathBuf,
     model_or_scene: &Bound<'_, PyAny>,
     q: &Bound<'_, PyAny>,
     t: Option<&Bound<'_, PyAny>>,
