@@ -21,10 +21,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         torsion: None,
         rolling: None,
     });
-    let mut contact = urdyn::contact::ContactParams::default();
-    contact.friction = ground.friction;
-    contact.torsion = ground.torsion.unwrap_or(contact.torsion);
-    contact.rolling = ground.rolling.unwrap_or(contact.rolling);
+    let mut contact = urdyn::contact::ContactParams::of_scene_ground(Some(&ground));
     let env = |k: &str| std::env::var(k).ok().and_then(|s| s.parse::<f64>().ok());
     if let Some(x) = env("TORSION") {
         contact.torsion = x;

@@ -147,13 +147,7 @@ fn prototype_scene(
     let model = scene.py_model();
     let ground = s.ground.map(|g| g.height);
     // the ground's contact parameters as `urdyn simulate SCENE.json` reads them
-    // (src/cli/simulate/setup.rs): friction, and torsion/rolling where the file sets them
-    let mut contact = ContactParams::default();
-    if let Some(g) = s.ground {
-        contact.friction = g.friction;
-        contact.torsion = g.torsion.unwrap_or(contact.torsion);
-        contact.rolling = g.rolling.unwrap_or(contact.rolling);
-    }
+    let contact = ContactParams::of_scene_ground(s.ground.as_ref());
     // as `urdyn simulate SCENE.json` (src/cli/simulate.rs): the file's settings
     // where the call gives none
     let spec = &s.spec;

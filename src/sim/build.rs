@@ -26,6 +26,22 @@ fn joint_springs(model: &Model, on: bool) -> Option<(DVector<f64>, DVector<f64>)
     Some((kp, q_ref))
 }
 
+impl ContactParams {
+    /// The contact parameters of a scene's ground, as `urdyn simulate SCENE.json`,
+    /// Python's `Simulation(scene)` and `rollout(scene)` read them: the defaults
+    /// with the ground's friction, and its torsion and rolling where the file
+    /// sets them (scene.md; none without a ground).
+    pub fn of_scene_ground(ground: Option<&crate::scene::Ground>) -> Self {
+        let mut contact = Self::default();
+        if let Some(g) = ground {
+            contact.friction = g.friction;
+            contact.torsion = g.torsion.unwrap_or(contact.torsion);
+            contact.rolling = g.rolling.unwrap_or(contact.rolling);
+        }
+        contact
+    }
+}
+
 impl Simulation {
     /// Sets up a simulation of `model` at its neutral configuration, at rest.
     /// Contact shapes (and meshes) are built here when `opts.ground` is set and a

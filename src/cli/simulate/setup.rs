@@ -103,12 +103,7 @@ pub(super) fn scene(
         frames: Vec::new(),
         derivatives: false,
     };
-    let mut contact = crate::contact::ContactParams::default();
-    if let Some(g) = scene.ground {
-        contact.friction = g.friction;
-        contact.torsion = g.torsion.unwrap_or(contact.torsion);
-        contact.rolling = g.rolling.unwrap_or(contact.rolling);
-    }
+    let contact = crate::contact::ContactParams::of_scene_ground(scene.ground.as_ref());
     let opts = SimOptions {
         dt: args.dt.unwrap_or(DEFAULT_DT),
         integrator,
