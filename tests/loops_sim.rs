@@ -391,16 +391,39 @@ struct LuxoDrop {
     z: f64,
 }
 
+impl LuxoDrop {
+    /// The loops closed below 1e-6 m after landing, the energy never more than
+    /// `allowed` above its lowest so far, and the lamp asleep within `within` s.
+    fn assert_closed_and_asleep(&self, place: &str, within: f64) {
+        eprintln!(
+            "luxo {place}: landed {:.3} s, violation {:.3e}, energy rise {:.3e} (allowed {:.3e}), asleep at {:?}",
+            self.landed, self.worst, self.rise, self.allowed, self.asleep
+        );
+        assert!(
+            self.worst < 1e-6,
+            "loops opened by {:.3e} m after landing",
+            self.worst
+        );
+        assert!(
+            self.rise <= self.allowed,
+            "energy rose {:.3e} J (allowed {:.3e})",
+            self.rise,
+            self.allowed
+        );
+        let asleep = self
+            .asleep
+            .unwrap_or_else(|| panic!("the lamp comes to rest within {within} s"));
+        assert!(asleep < within, "asleep at {asleep}");
+    }
+}
+
 /// Runs a Luxo scene (assets/) as the examples do (dt 1 ms, the scene's
 /// ground friction, sleep on) for `duration` s.
 fn luxo_drop(scene: &str, duration: f64) -> LuxoDrop {
     let root = env!("CARGO_MANIFEST_DIR");
     let scene = urdyn::scene::Scene::from_file(format!("{root}/assets/{scene}"), &[]).unwrap();
     let ground = scene.ground.unwrap();
-    let mut contact = urdyn::contact::ContactParams::default();
-    contact.friction = ground.friction;
-    contact.torsion = ground.torsion.unwrap_or(contact.torsion);
-    contact.rolling = ground.rolling.unwrap_or(contact.rolling);
+    let contact = urdyn::contact::ContactParams::of_scene_ground(Some(&ground));
     let opts = SimOptions {
         dt: 1e-3,
         ground: Some(ground.height),
@@ -459,24 +482,8 @@ fn luxo_drop(scene: &str, duration: f64) -> LuxoDrop {
 #[test]
 fn luxo_on_the_table_keeps_its_loops_closed_and_rests() {
     let d = luxo_drop("luxo_on_table.json", 4.0);
-    eprintln!(
-        "luxo on the table: landed {:.3} s, violation {:.3e}, energy rise {:.3e} (allowed {:.3e}), asleep at {:?}",
-        d.landed, d.worst, d.rise, d.allowed, d.asleep
-    );
+    d.assert_closed_and_asleep("on the table", 4.0);
     assert!((0.2..0.3).contains(&d.landed), "landed at {}", d.landed);
-    assert!(
-        d.worst < 1e-6,
-        "loops opened by {:.3e} m after landing",
-        d.worst
-    );
-    assert!(
-        d.rise <= d.allowed,
-        "energy rose {:.3e} J (allowed {:.3e})",
-        d.rise,
-        d.allowed
-    );
-    let asleep = d.asleep.expect("the lamp comes to rest within 4 s");
-    assert!(asleep < 4.0, "asleep at {asleep}");
     // resting on the table top (0.75 m), not fallen to the ground
     assert!(d.z > 0.75 - 3e-3, "base at z = {}", d.z);
 }
@@ -493,23 +500,7 @@ fn luxo_on_the_table_keeps_its_loops_closed_and_rests() {
 #[test]
 fn luxo_dropped_on_the_ground_rests_with_its_loops_closed() {
     let d = luxo_drop("luxo_drop.json", 8.0);
-    eprintln!(
-        "luxo on the ground: landed {:.3} s, violation {:.3e}, energy rise {:.3e} (allowed {:.3e}), asleep at {:?}",
-        d.landed, d.worst, d.rise, d.allowed, d.asleep
-    );
-    assert!(
-        d.worst < 1e-6,
-        "loops opened by {:.3e} m after landing",
-        d.worst
-    );
-    assert!(
-        d.rise <= d.allowed,
-        "energy rose {:.3e} J (allowed {:.3e})",
-        d.rise,
-        d.allowed
-    );
-    let asleep = d.asleep.expect("the lamp comes to rest within 8 s");
-    assert!(asleep < 8.0, "asleep at {asleep}");
+    d.assert_closed_and_asleep("on the ground", 8.0);
     // lying on the ground: the base's origin below its 0.11 m radius
     assert!(d.z > -1e-3 && d.z < 0.11, "base at z = {}", d.z);
 }

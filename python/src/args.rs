@@ -40,6 +40,13 @@ pub fn normalize_quaternion_at(quat: &mut [f64], name: &str, at: usize) -> PyRes
     }
 }
 
+/// `repr(x)` for an error message ("?" if it fails).
+pub fn shown(x: &Bound<'_, PyAny>) -> String {
+    x.repr()
+        .map(|r| r.to_string())
+        .unwrap_or_else(|_| "?".into())
+}
+
 /// A count (`n`, `nstep`, `threads`): a whole number ≥ `min`; a negative number,
 /// a float (`2.5`, even `2.0`), a bool or anything else is a `ValueError` naming
 /// `name`.
@@ -49,11 +56,7 @@ pub fn read_count(x: &Bound<'_, PyAny>, name: &str, min: i64) -> PyResult<usize>
             "{name} must be a whole number ≥ {min} (got {what})"
         ))
     };
-    let shown = || {
-        x.repr()
-            .map(|r| r.to_string())
-            .unwrap_or_else(|_| "?".into())
-    };
+    let shown = || shown(x);
     if x.is_instance_of::<pyo3::types::PyBool>() || x.is_instance_of::<pyo3::types::PyFloat>() {
         return Err(bad(shown()));
     }
@@ -216,10 +219,7 @@ pub fn read_array(x: &Bound<'_, PyAny>, name: &str) -> PyResult<(Vec<usize>, Vec
 /// naming `name` (pyo3's own conversion would raise a `TypeError`).
 pub fn read_real(x: &Bound<'_, PyAny>, name: &str) -> PyResult<f64> {
     let bad = || {
-        let shown = x
-            .repr()
-            .map(|r| r.to_string())
-            .unwrap_or_else(|_| "?".into());
+        let shown = shown(x);
         value_error(format!("{name} must be a number (got {shown})"))
     };
     if x.is_instance_of::<pyo3::types::PyBool>() {
@@ -237,10 +237,7 @@ pub fn read_flag(x: &Bound<'_, PyAny>, name: &str) -> PyResult<bool> {
             .map(|n| n.to_string() == "bool" || n.to_string() == "bool_")
             .unwrap_or(false);
     let bad = || {
-        let shown = x
-            .repr()
-            .map(|r| r.to_string())
-            .unwrap_or_else(|_| "?".into());
+        let shown = shown(x);
         value_error(format!("{name} must be True or False (got {shown})"))
     };
     if !is_bool {
@@ -252,10 +249,7 @@ pub fn read_flag(x: &Bound<'_, PyAny>, name: &str) -> PyResult<bool> {
 /// A string argument `name` (a `str`, numpy's too), else a `ValueError` naming it.
 pub fn read_text(x: &Bound<'_, PyAny>, name: &str) -> PyResult<String> {
     if !x.is_instance_of::<pyo3::types::PyString>() {
-        let shown = x
-            .repr()
-            .map(|r| r.to_string())
-            .unwrap_or_else(|_| "?".into());
+        let shown = shown(x);
         return Err(value_error(format!(
             "{name} must be a string (got {shown})"
         )));
@@ -268,10 +262,7 @@ pub fn read_text(x: &Bound<'_, PyAny>, name: &str) -> PyResult<String> {
 /// naming it.
 pub fn read_path(x: &Bound<'_, PyAny>, name: &str) -> PyResult<std::path::PathBuf> {
     x.extract::<std::path::PathBuf>().map_err(|_| {
-        let shown = x
-            .repr()
-            .map(|r| r.to_string())
-            .unwrap_or_else(|_| "?".into());
+        let shown = shown(x);
         value_error(format!(
             "{name} must be a path: a str or os.PathLike (got {shown})"
         ))
@@ -282,7 +273,7 @@ pub fn read_path(x: &Bound<'_, PyAny>, name: &str) -> PyResult<std::path::PathBu
 /// wrong type is a `ValueError` naming the argument (python.md §"Introspection,
 /// contacts, batched control, pictures"), not pyo3's `TypeError`.
 pub mod named {
-    use super::{read_count, read_flag, read_path, read_real, read_text};
+    use super::{read_count, read_flag, read_path, read_real, read_text, shown};
     use pyo3::prelude::*;
     use std::path::PathBuf;
 
@@ -366,10 +357,7 @@ pub mod named {
             return Ok(None);
         }
         let bad = || {
-            let shown = x
-                .repr()
-                .map(|r| r.to_string())
-                .unwrap_or_else(|_| "?".into());
+            let shown = shown(x);
             super::value_error(format!(
                 "package_dirs must be a list of paths (got {shown})"
             ))
