@@ -1153,6 +1153,58 @@ fn simulate_failures_leave_no_output_file() {
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
 
+/// `urdyn bench` on a robot of one link welded to the world (no degree of freedom)
+/// times every algorithm instead of failing on an empty output (it once stopped with
+/// "internal error ... Matrix index out of bounds"); with a free base the constrained
+/// algorithms run too, and the table's name column fits the longest name.
+#[test]
+fn bench_times_a_model_without_degrees_of_freedom() {
+    let ball = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/urdf/ball.urdf");
+    let ball = ball.to_str().unwrap();
+    let r = run(&[
+        "bench",
+        ball,
+        "--samples",
+        "5",
+        "--budget",
+        "0.05",
+        "--json",
+    ]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).expect("bench --json");
+    assert_eq!(v["nv"], 0);
+    assert_eq!(
+        v["results"].as_object().map(|o| o.len()),
+        Some(11),
+        "{}",
+        r.stdout
+    );
+    let r = run(&[
+        "bench",
+        ball,
+        "--floating-base",
+        "--samples",
+        "5",
+        "--budget",
+        "0.05",
+        "--algo",
+        "rnea",
+        "--algo",
+        "constraint-dynamics-derivatives",
+        "--hold",
+        "ball",
+    ]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let rows: Vec<&str> = r.stdout.lines().skip(1).collect();
+    assert_eq!(rows.len(), 3, "{}", r.stdout);
+    // right-aligned columns: the header and every row end at the same place
+    assert!(
+        rows.iter().all(|l| l.len() == rows[0].len()),
+        "{}",
+        r.stdout
+    );
+}
+
 /// `urdyn bench`: unknown algorithm, zero samples, bad budget, bad files.
 #[test]
 fn bench_bad_inputs_are_one_line() {

@@ -259,6 +259,11 @@ impl Default for BenchOptions {
 const POOL: usize = 64;
 const SEED: u64 = 0x5EED_0DD5;
 
+/// A matrix's (0, 0) entry, 0 when it is empty (a model without degrees of freedom).
+fn corner(m: &nalgebra::DMatrix<f64>) -> f64 {
+    m.get((0, 0)).copied().unwrap_or(0.0)
+}
+
 /// One call of `algo` on `s`; returns a number derived from the output (kept alive
 /// through `black_box`).
 #[inline(never)]
@@ -276,30 +281,54 @@ fn call(
                 .ok_or("needs constraints: --hold, --hold6 or --weld")?;
             if algo == Algo::ConstraintDynamics {
                 dynamics::constraint_dynamics(model, data, cd, c, &s.q, &s.v, &s.tau, None)
-                    .map_err(|e| e.to_string())?[0]
+                    .map_err(|e| e.to_string())?
+                    .get(0)
+                    .copied()
+                    .unwrap_or(0.0)
             } else {
                 dynamics::constraint_dynamics_derivatives(
                     model, data, cd, c, &s.q, &s.v, &s.tau, None,
                 )
                 .map_err(|e| e.to_string())?;
-                cd.dqdd_dq[(0, 0)] + cd.dqdd_dv[(0, 0)] + cd.dqdd_dtau[(0, 0)]
+                corner(&cd.dqdd_dq) + corner(&cd.dqdd_dv) + corner(&cd.dqdd_dtau)
             }
         }
-        Algo::Rnea => {
-            dynamics::rnea(model, data, &s.q, &s.v, &s.a, None).map_err(|e| e.to_string())?[0]
-        }
-        Algo::Bias => dynamics::bias(model, data, &s.q, &s.v, None).map_err(|e| e.to_string())?[0],
+        Algo::Rnea => dynamics::rnea(model, data, &s.q, &s.v, &s.a, None)
+            .map_err(|e| e.to_string())?
+            .get(0)
+            .copied()
+            .unwrap_or(0.0),
+        Algo::Bias => dynamics::bias(model, data, &s.q, &s.v, None)
+            .map_err(|e| e.to_string())?
+            .get(0)
+            .copied()
+            .unwrap_or(0.0),
         // H's upper triangle, the work of Pinocchio's crba (mass_matrix mirrors it)
-        Algo::Crba => dynamics::crba_upper(model, data, &s.q).map_err(|e| e.to_string())?[(0, 0)],
-        Algo::Aba => {
-            dynamics::aba(model, data, &s.q, &s.v, &s.tau, None).map_err(|e| e.to_string())?[0]
-        }
+        Algo::Crba => dynamics::crba_upper(model, data, &s.q)
+            .map_err(|e| e.to_string())?
+            .get((0, 0))
+            .copied()
+            .unwrap_or(0.0),
+        Algo::Aba => dynamics::aba(model, data, &s.q, &s.v, &s.tau, None)
+            .map_err(|e| e.to_string())?
+            .get(0)
+            .copied()
+            .unwrap_or(0.0),
         Algo::FdRnea => dynamics::forward_dynamics_rnea(model, data, &s.q, &s.v, &s.tau, None)
-            .map_err(|e| e.to_string())?[0],
+            .map_err(|e| e.to_string())?
+            .get(0)
+            .copied()
+            .unwrap_or(0.0),
         Algo::FdCrba => dynamics::forward_dynamics_crba(model, data, &s.q, &s.v, &s.tau, None)
-            .map_err(|e| e.to_string())?[0],
+            .map_err(|e| e.to_string())?
+            .get(0)
+            .copied()
+            .unwrap_or(0.0),
         Algo::Fd => dynamics::forward_dynamics(model, data, &s.q, &s.v, &s.tau, None)
-            .map_err(|e| e.to_string())?[0],
+            .map_err(|e| e.to_string())?
+            .get(0)
+            .copied()
+            .unwrap_or(0.0),
         Algo::Fk => {
             dynamics::forward_kinematics(model, data, &s.q).map_err(|e| e.to_string())?;
             dynamics::update_frames(model, data);
@@ -308,16 +337,18 @@ fn call(
         Algo::RneaDerivatives => {
             dynamics::rnea_derivatives(model, data, &s.q, &s.v, &s.a, None)
                 .map_err(|e| e.to_string())?;
-            data.dtau_dq[(0, 0)] + data.dtau_dv[(0, 0)]
+            corner(&data.dtau_dq) + corner(&data.dtau_dv)
         }
         Algo::AbaDerivatives => {
             dynamics::aba_derivatives(model, data, &s.q, &s.v, &s.tau, None)
                 .map_err(|e| e.to_string())?;
-            data.dqdd_dq[(0, 0)] + data.dqdd_dv[(0, 0)] + data.minv[(0, 0)]
+            corner(&data.dqdd_dq) + corner(&data.dqdd_dv) + corner(&data.minv)
         }
-        Algo::Jacobians => {
-            dynamics::joint_jacobians(model, data, &s.q).map_err(|e| e.to_string())?[(0, 0)]
-        }
+        Algo::Jacobians => dynamics::joint_jacobians(model, data, &s.q)
+            .map_err(|e| e.to_string())?
+            .get((0, 0))
+            .copied()
+            .unwrap_or(0.0),
     })
 }
 
@@ -434,8 +465,15 @@ pub fn to_json(model: &Model, results: &[(Algo, Timing)]) -> Value {
 
 /// A table for people.
 pub fn to_table(model: &Model, results: &[(Algo, Timing)]) -> String {
+    // the name column as wide as the longest name shown (at least 16)
+    let w = results
+        .iter()
+        .map(|(a, _)| a.name().len())
+        .max()
+        .unwrap_or(0)
+        .max(16);
     let mut s = format!(
-        "{}: nq {}, nv {}, {} bodies, fd method {:?}\n{:<16} {:>12} {:>12} {:>8} {:>7}\n",
+        "{}: nq {}, nv {}, {} bodies, fd method {:?}\n{:<w$} {:>12} {:>12} {:>8} {:>7}\n",
         model.name,
         model.nq,
         model.nv,
@@ -449,7 +487,7 @@ pub fn to_table(model: &Model, results: &[(Algo, Timing)]) -> String {
     );
     for (a, t) in results {
         s.push_str(&format!(
-            "{:<16} {:>12.1} {:>12.1} {:>8} {:>7}\n",
+            "{:<w$} {:>12.1} {:>12.1} {:>8} {:>7}\n",
             a.name(),
             t.median_ns,
             t.min_ns,
