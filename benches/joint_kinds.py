@@ -5,8 +5,11 @@ degree of freedom than a free base is today").
 Writes chains of N links (default 8) in a temporary folder, every joint of one kind:
 revolute (1 DoF each), spherical (3), planar (3) and floating (6: the free joint a free base
 uses, here at every link), and times them with `urdyn bench --json`, back to back, in
-interleaved rounds. Reports the median ns per call divided by nv, and each kind's ns/DoF as a
-ratio to the floating chain's (≤ 1: no slower per DoF than the free joint).
+interleaved rounds. Reports the median ns per call divided by nv, each kind's ns/DoF as a
+ratio to the floating chain's (≤ 1: no slower per DoF than the free joint), and the same ratio
+per body (per joint): a joint's fixed cost per body (its placement, spatial products) is shared
+by six DoF in a free joint and by three in a spherical or planar one, so per DoF a 3-DoF joint
+pays about twice the free joint's share of it even when each joint costs the same.
 
     python benches/joint_kinds.py --urdyn target/release/urdyn [--links 8] [--rounds 3] [--md OUT]
 """
@@ -92,15 +95,33 @@ def main():
         "|---|" + "---|" * len(ALGOS),
     ]
     worst = 0.0
+    worst_body = 0.0
+    body_rows = []
     for k in KINDS:
         cells = []
+        bcells = []
         for al in ALGOS:
             r = med[k][al] / med["floating"][al]
+            rb = r * KINDS[k] / KINDS["floating"]
             if k in ("spherical", "planar"):
                 worst = max(worst, r)
+                worst_body = max(worst_body, rb)
             cells.append(f"{med[k][al]:.1f} ({r:.2f})")
+            bcells.append(f"{med[k][al] * KINDS[k]:.0f} ({rb:.2f})")
         lines.append(f"| {k} ({nv[k]}) | " + " | ".join(cells) + " |")
-    lines += ["", f"Worst spherical/planar ratio to the free joint per DoF: {worst:.2f}."]
+        body_rows.append(f"| {k} ({nv[k]}) | " + " | ".join(bcells) + " |")
+    lines += [
+        "",
+        "Per body (ns per call ÷ links; in brackets the ratio to the floating chain's):",
+        "",
+        "| kind (nv) | " + " | ".join(ALGOS) + " |",
+        "|---|" + "---|" * len(ALGOS),
+    ] + body_rows
+    lines += [
+        "",
+        f"Worst spherical/planar ratio to the free joint: per DoF {worst:.2f}, "
+        f"per body {worst_body:.2f}.",
+    ]
     text = "\n".join(lines) + "\n"
     print(text)
     if a.md:
