@@ -86,7 +86,7 @@ pub(crate) fn mesh_geom_mass(
     let props = crate::mesh::mass_properties(&tri, mesh.inertia)
         .map_err(|e| format!("mesh \"{name}\" ({}): {e}", file.display()))?;
     let density = match mass {
-        Some(m) if m == 0.0 => 0.0,
+        Some(0.0) => 0.0,
         Some(m) if props.volume > 1e-14 => m / props.volume,
         Some(_) => 0.0,
         None => density,
