@@ -81,7 +81,7 @@ MODELS = [
     "gymnasium/walker2d", "gymnasium/walker2d_v5", "gymnasium/swimmer",
     "dm_control/humanoid", "dm_control/cheetah", "dm_control/walker", "dm_control/hopper",
     "dm_control/swimmer", "dm_control/fish", "dm_control/ball_in_cup", "dm_control/finger",
-    "dm_control/point_mass", "dm_control/stacker",
+    "dm_control/point_mass", "dm_control/stacker", "dm_control/dog",
 ]
 TWO_X = {"gymnasium/humanoid", "gymnasium/ant", "dm_control/quadruped", "dm_control/humanoid_CMU"}
 DYN_MODELS = ["gymnasium/ant", "gymnasium/humanoid", "gymnasium/half_cheetah",

@@ -41,6 +41,10 @@ const CASES: &[(&str, &[&str])] = &[
         &["<exclude name=\"e\">", "body2=\"ghost\""],
     ),
     (
+        "flat_mesh.xml",
+        &["<geom name=\"g\">", "mesh \"m\"", "volume"],
+    ),
+    (
         "free_below_top.xml",
         &["<freejoint name=\"f\">", "top-level"],
     ),

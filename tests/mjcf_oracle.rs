@@ -1,8 +1,8 @@
 //! MJCF import against MuJoCo 4.0 (fixtures by tests/oracle/make_mjcf_fixtures.py):
 //! per body mass, centre of mass and inertia within 1e-10; at 5 random states H with
 //! armature, bias, tau, qdd within 1e-10 relative and every body's pose within
-//! 1e-12, on every Gymnasium and dm_control model MuJoCo compiles (dog.xml's meshes
-//! wait for mesh inertia).
+//! 1e-12, on every Gymnasium and dm_control model MuJoCo compiles (dog.xml's bodies
+//! take their mass from its bone meshes).
 
 use nalgebra::{DMatrix, DVector};
 use serde_json::Value;

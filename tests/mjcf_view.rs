@@ -187,11 +187,62 @@ fn mjcf_page_of_a_menagerie_style_arm_draws_its_stl_meshes() {
 }
 
 #[test]
-fn a_mesh_geom_in_a_body_without_inertial_still_says_what_is_missing() {
+fn a_mesh_geom_gives_its_body_the_solid_it_bounds() {
+    // cube.obj is the unit cube [0, 1]³. Scaled to 2 × 1 × 1, turned 90° about z and
+    // raised by 1, at density 500 it is a 1000 kg box centred at R (1, ½, ½) + (0, 0, 1)
+    // = (−½, 1, 1½), its moments m (b² + c²)/12 = 1000·2/12 and 1000·5/12 swapped in
+    // x and y by the turn. As a shell of mass 3 (inertia="shell"), the unit cube is
+    // six plates of ½ kg: I = 5/18 M s² about each axis through its centre.
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("cube.obj"), CUBE_OBJ).unwrap();
-    let xml = r#"<mujoco><asset><mesh file="cube.obj"/></asset><worldbody>
-      <body><freejoint/><geom type="mesh" mesh="cube"/></body></worldbody></mujoco>"#;
-    let e = urdyn::mjcf::compile_str(xml, "m.xml", dir.path()).unwrap_err();
-    assert!(e.to_string().contains("mesh"), "{e}");
+    std::fs::write(
+        dir.path().join("flat.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let xml = r#"<mujoco><asset>
+        <mesh name="long" file="cube.obj" scale="2 1 1"/>
+        <mesh name="skin" file="cube.obj" inertia="shell"/>
+      </asset><worldbody>
+      <body name="solid"><freejoint/>
+        <geom type="mesh" mesh="long" density="500" pos="0 0 1" euler="0 0 90"/></body>
+      <body name="shell" pos="3 0 0"><freejoint/><geom type="mesh" mesh="skin" mass="3"/></body>
+      </worldbody></mujoco>"#;
+    let w = urdyn::mjcf::compile_str(xml, "m.xml", dir.path()).unwrap();
+    let near = |a: f64, b: f64| (a - b).abs() < 1e-9 * b.abs().max(1.0);
+    let solid = &w.bodies[1];
+    assert!(near(solid.mass, 1000.0), "{}", solid.mass);
+    for (k, c) in [-0.5, 1.0, 1.5].into_iter().enumerate() {
+        assert!(near(solid.com[k], c), "{}", solid.com);
+    }
+    let want = [
+        1000.0 * 5.0 / 12.0,
+        1000.0 * 2.0 / 12.0,
+        1000.0 * 5.0 / 12.0,
+    ];
+    for r in 0..3 {
+        for c in 0..3 {
+            let x = if r == c { want[r] } else { 0.0 };
+            assert!(
+                (solid.inertia[(r, c)] - x).abs() < 1e-9,
+                "{}",
+                solid.inertia
+            );
+        }
+    }
+    let shell = &w.bodies[2];
+    assert!(near(shell.mass, 3.0), "{}", shell.mass);
+    assert!((shell.com - nalgebra::Vector3::new(0.5, 0.5, 0.5)).norm() < 1e-12);
+    for r in 0..3 {
+        assert!(
+            near(shell.inertia[(r, r)], 5.0 / 18.0 * 3.0),
+            "{}",
+            shell.inertia
+        );
+    }
+    // a flat mesh bounds no solid: an error naming the geom's mesh
+    let flat = r#"<mujoco><asset><mesh file="flat.obj"/></asset><worldbody>
+      <body><freejoint/><geom type="mesh" mesh="flat"/></body></worldbody></mujoco>"#;
+    let e = urdyn::mjcf::compile_str(flat, "m.xml", dir.path()).unwrap_err();
+    assert!(e.to_string().contains("mesh \"flat\""), "{e}");
 }

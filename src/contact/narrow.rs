@@ -1,5 +1,6 @@
 //! The narrow phase of one pair of shapes: a hull on a flat face by the face
-//! path ([`super::face`]), everything else by parry's contact manifolds, and
+//! path ([`super::face`]), two spheres or capsules in closed form
+//! ([`prim`]), everything else by parry's contact manifolds, and
 //! the reduction of the points found to a persistent patch of at most
 //! `max_points_per_shape`.
 
@@ -14,6 +15,8 @@ use parry3d_f64::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
 use parry3d_f64::shape::ShapeType;
+
+mod prim;
 
 /// The key bit of a face-path point (its vertex index below it): never a key
 /// of parry's features (those fill at most bits 0–59).
@@ -64,6 +67,12 @@ pub(super) fn parry_points(
     workspace: &mut Option<ContactManifoldsWorkspace>,
     raw: &mut Vec<Raw>,
 ) {
+    // two spheres or capsules: their closed form (no manifold kept)
+    if prim::round_points(a, b, wa, wb, margin, raw) {
+        manifolds.clear();
+        *workspace = None;
+        return;
+    }
     let dispatcher = DefaultQueryDispatcher;
     let pos12 = to_pose(&wa.inverse().compose(wb));
     let query = |manifolds: &mut Vec<ContactManifold<(), ()>>,

@@ -36,6 +36,9 @@ pub(crate) struct PairShape {
     pub half: Vector3<f64>,
     /// Whether parry treats it as convex (a support map).
     pub convex: bool,
+    /// A sphere's or capsule's axis ends in parry's frame of it (equal for a
+    /// sphere) and radius: the closed-form pairs' (`narrow::prim`).
+    pub round: Option<(Vector3<f64>, Vector3<f64>, f64)>,
 }
 
 impl PairShape {
@@ -43,7 +46,15 @@ impl PairShape {
     /// parry's frame.
     pub fn new(shape: SharedShape, offset: Se3<f64>, convex: bool) -> Self {
         let b = shape.compute_local_aabb();
+        let round = if let Some(s) = shape.as_ball() {
+            Some((Vector3::zeros(), Vector3::zeros(), s.radius))
+        } else {
+            shape
+                .as_capsule()
+                .map(|c| (from_pvec(c.segment.a), from_pvec(c.segment.b), c.radius))
+        };
         Self {
+            round,
             mid: from_pvec(b.center()),
             half: from_pvec(b.half_extents()),
             shape,

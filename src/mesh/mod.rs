@@ -205,6 +205,8 @@ fn read_raw(path: &Path, with_triangles: bool) -> Result<RawMesh, MeshError> {
 }
 
 pub(crate) mod cache;
+mod inertia;
+pub use inertia::{mass_properties, MeshInertia, MeshMass};
 mod dae;
 mod paths;
 pub use paths::resolve_mesh_path;

@@ -546,6 +546,7 @@ fn geom(
     // inertiafromgeom="true"): a mesh there needs no mass properties
     let from_geoms =
         cx.world.bodies[b].explicit.is_none() || cx.set.inertia_from_geom == Some(true);
+    let mut mesh_mass = None;
     let (mass, inertia) = if kind == MjGeomType::Mesh && !from_geoms {
         (0.0, [0.0; 3])
     } else if b != 0 && in_group {
@@ -554,7 +555,17 @@ fn geom(
         if mass.is_some_and(|m| m < 0.0) {
             return Err(a.err("mass", "must not be negative"));
         }
-        super::inertia::geom_mass(kind, &size, mass, density).map_err(|m| el.err(m))?
+        match (kind, asset.as_deref()) {
+            (MjGeomType::Mesh, Some(mesh)) => {
+                let (m, c, i) =
+                    super::inertia::mesh_geom_mass(&cx.world.meshes, mesh, mass, density)
+                        .map_err(|m| el.err(m))?;
+                let r = quat.to_rotation_matrix().into_inner();
+                mesh_mass = Some((pos + r * c, r * i * r.transpose()));
+                (m, [0.0; 3])
+            }
+            _ => super::inertia::geom_mass(kind, &size, mass, density).map_err(|m| el.err(m))?,
+        }
     } else {
         (0.0, [0.0; 3])
     };
@@ -567,6 +578,7 @@ fn geom(
         quat,
         mass,
         inertia,
+        mesh_mass,
         contype: a.int("contype")?.unwrap_or(1),
         conaffinity: a.int("conaffinity")?.unwrap_or(1),
         condim,

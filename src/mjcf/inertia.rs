@@ -5,7 +5,9 @@
 //! `boundmass`/`boundinertia`, `balanceinertia` and `settotalmass`.
 
 use super::compile::{MjGeomType, Settings, World};
+use super::world::MjMesh;
 use nalgebra::{Matrix3, Vector3};
+use std::collections::HashMap;
 use std::f64::consts::PI;
 
 /// A geom's mass and principal moments about its centre (its own frame):
@@ -24,12 +26,7 @@ pub(crate) fn geom_mass(
         MjGeomType::Ellipsoid => 4.0 / 3.0 * PI * a * b * c,
         MjGeomType::Box => 8.0 * a * b * c,
         MjGeomType::Plane | MjGeomType::Hfield => return Ok((0.0, [0.0; 3])),
-        MjGeomType::Mesh => {
-            return Err(
-                "a mesh geom's mass properties are not supported by urdyn yet (give the body an <inertial>)"
-                    .into(),
-            )
-        }
+        MjGeomType::Mesh => return Err("a mesh geom's mass properties come from its mesh".into()),
     };
     let m = mass.unwrap_or(density * volume);
     let i = match kind {
@@ -67,6 +64,36 @@ pub(crate) fn geom_mass(
     Ok((m, i))
 }
 
+/// A mesh geom's mass, centre of mass and inertia about it (the geom's
+/// frame): its mesh's by MuJoCo's rule (`crate::mesh::mass_properties`),
+/// at `density`, or scaled to `mass` when given (MuJoCo: density = mass /
+/// volume).
+pub(crate) fn mesh_geom_mass(
+    meshes: &HashMap<String, MjMesh>,
+    name: &str,
+    mass: Option<f64>,
+    density: f64,
+) -> Result<(f64, Vector3<f64>, Matrix3<f64>), String> {
+    let mesh = meshes
+        .get(name)
+        .ok_or_else(|| format!("mesh=\"{name}\": no such <mesh> asset"))?;
+    let Some(file) = &mesh.file else {
+        return Err(format!(
+            "mesh \"{name}\": the mass properties of an inline mesh (vertex/face) are not supported by urdyn yet (give the body an <inertial>)"
+        ));
+    };
+    let tri = crate::mesh::load_mesh(file, mesh.scale).map_err(|e| e.to_string())?;
+    let props = crate::mesh::mass_properties(&tri, mesh.inertia)
+        .map_err(|e| format!("mesh \"{name}\" ({}): {e}", file.display()))?;
+    let density = match mass {
+        Some(0.0) => 0.0,
+        Some(m) if props.volume > 1e-14 => m / props.volume,
+        Some(_) => 0.0,
+        None => density,
+    };
+    Ok((density * props.volume, props.com, props.inertia * density))
+}
+
 /// Every body's mass, centre of mass and inertia (about the centre of mass, body
 /// frame), as MuJoCo's compiler.
 pub(crate) fn bodies(world: &mut World, set: &Settings) {
@@ -102,7 +129,7 @@ fn from_geoms(world: &World, b: usize) -> (f64, Vector3<f64>, Matrix3<f64>) {
     let mut c = Vector3::zeros();
     for g in geoms.clone() {
         m += g.mass;
-        c += g.mass * g.pos;
+        c += g.mass * g.mesh_mass.map_or(g.pos, |(at, _)| at);
     }
     if m <= 0.0 {
         return (0.0, Vector3::zeros(), Matrix3::zeros());
@@ -110,9 +137,18 @@ fn from_geoms(world: &World, b: usize) -> (f64, Vector3<f64>, Matrix3<f64>) {
     c /= m;
     let mut i = Matrix3::zeros();
     for g in geoms {
-        let r = g.quat.to_rotation_matrix().into_inner();
-        i += r * Matrix3::from_diagonal(&Vector3::from(g.inertia)) * r.transpose();
-        let d = g.pos - c;
+        let at = match g.mesh_mass {
+            Some((at, own)) => {
+                i += own;
+                at
+            }
+            None => {
+                let r = g.quat.to_rotation_matrix().into_inner();
+                i += r * Matrix3::from_diagonal(&Vector3::from(g.inertia)) * r.transpose();
+                g.pos
+            }
+        };
+        let d = at - c;
         i += g.mass * (Matrix3::identity() * d.dot(&d) - d * d.transpose());
     }
     (m, c, i)

@@ -202,7 +202,27 @@ pub(super) fn meshes(
         if scale.iter().any(|x| !x.is_finite()) {
             return Err(a.err("scale", "must be finite"));
         }
-        out.insert(name, super::world::MjMesh { file, scale });
+        use crate::mesh::MeshInertia;
+        let inertia = match a.get("inertia").unwrap_or("legacy") {
+            "legacy" => MeshInertia::Legacy,
+            "exact" => MeshInertia::Exact,
+            "convex" => MeshInertia::Convex,
+            "shell" => MeshInertia::Shell,
+            v => {
+                return Err(a.err(
+                    "inertia",
+                    format!("\"{v}\" is not legacy, exact, convex or shell"),
+                ))
+            }
+        };
+        out.insert(
+            name,
+            super::world::MjMesh {
+                file,
+                scale,
+                inertia,
+            },
+        );
     }
     Ok(out)
 }

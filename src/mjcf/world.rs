@@ -87,6 +87,10 @@ pub struct MjGeom {
     pub mass: f64,
     /// Principal moments about its centre in its own frame.
     pub inertia: [f64; 3],
+    /// A mesh geom's centre of mass and inertia about it, both in the body
+    /// frame (`inertia` unused), as MuJoCo's compiler takes them from the
+    /// mesh (`crate::mesh::mass_properties`).
+    pub mesh_mass: Option<(Vector3<f64>, nalgebra::Matrix3<f64>)>,
     /// `contype`, `conaffinity`, `condim`, `priority`, `group`.
     pub contype: i64,
     /// See `contype`.
@@ -174,4 +178,6 @@ pub struct MjMesh {
     pub file: Option<std::path::PathBuf>,
     /// Scale along x, y, z.
     pub scale: [f64; 3],
+    /// `inertia`: how its volume is taken (MuJoCo's default `legacy`).
+    pub inertia: crate::mesh::MeshInertia,
 }
