@@ -42,6 +42,43 @@ impl ContactParams {
     }
 }
 
+impl SimOptions {
+    /// Sleep and island threads (scene.md §"Large scenes") as `urdyn simulate`,
+    /// Python's `Simulation(...)` and `rollout(...)` read them: the caller's
+    /// `sleep` / `threads` (`--no-sleep`, `--threads`, `sleep=`, `threads=`)
+    /// over a scene file's `"sleep"` / `"threads"`, over these options'; the
+    /// file's `"sleep_velocity"`, `"sleep_time"` and its models with
+    /// `"sleep": false` over these options'. `scene` `None` (a model alone):
+    /// the caller's over these options'.
+    pub fn with_islands(
+        self,
+        scene: Option<&crate::scene::SceneSpec>,
+        sleep: Option<bool>,
+        threads: Option<usize>,
+    ) -> Self {
+        let Some(spec) = scene else {
+            return Self {
+                sleep: sleep.unwrap_or(self.sleep),
+                threads: threads.unwrap_or(self.threads),
+                ..self
+            };
+        };
+        Self {
+            sleep: sleep.or(spec.sleep).unwrap_or(self.sleep),
+            sleep_velocity: spec.sleep_velocity.unwrap_or(self.sleep_velocity),
+            sleep_time: spec.sleep_time.unwrap_or(self.sleep_time),
+            threads: threads.or(spec.threads).unwrap_or(self.threads),
+            never_sleep: spec
+                .models
+                .iter()
+                .filter(|m| m.sleep == Some(false))
+                .map(|m| m.name.clone())
+                .collect(),
+            ..self
+        }
+    }
+}
+
 impl Simulation {
     /// Sets up a simulation of `model` at its neutral configuration, at rest.
     /// Contact shapes (and meshes) are built here when `opts.ground` is set and a
