@@ -225,8 +225,11 @@ pub fn rollout<'py>(
         }
         Ok(())
     };
-    let qa = PyArray3::<f64>::zeros(py, [b, nstep + 1, nq], false);
-    let va = PyArray3::<f64>::zeros(py, [b, nstep + 1, nv], false);
+    // SAFETY: left uninitialised (no zeroing pass over memory every entry of
+    // which is written below: each run writes its rows 0..=nstep, or NaN from
+    // where it failed on); not seen by Python before that.
+    let qa = unsafe { PyArray3::<f64>::new(py, [b, nstep + 1, nq], false) };
+    let va = unsafe { PyArray3::<f64>::new(py, [b, nstep + 1, nv], false) };
     let failures = {
         // SAFETY: fresh C-contiguous arrays that no Python code has seen yet; the
         // GIL is released below but nothing else holds them.
@@ -293,11 +296,7 @@ pub fn rollout<'py>(
             };
             match threads {
                 None => Ok(work()),
-                Some(n) => rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build()
-                    .map(|pool| pool.install(work))
-                    .map_err(|e| e.to_string()),
+                Some(n) => crate::pool::pool(n).map(|pool| pool.install(work)),
             }
         })
         .map_err(|e| value_error(format!("threads: cannot start a thread pool: {e}")))?
