@@ -197,12 +197,12 @@ pub fn rollout<'py>(
     let q_refs = PerRun::read(q_ref, "q_ref", b, nstep, nq)?;
     let v_refs = PerRun::read(v_ref, "v_ref", b, nstep, nv)?;
     let nu = proto.model.actuators.len();
-    let controls = PerRun::read(controls, "controls", b, nstep, nu)?;
-    if nu == 0 && !matches!(controls, PerRun::None) {
+    if nu == 0 && controls.is_some_and(|c| !c.is_none()) {
         return Err(value_error(
             "controls: the model has no actuators (nu = 0; MJCF <actuator> elements give them)",
         ));
     }
+    let controls = PerRun::read(controls, "controls", b, nstep, nu)?;
     // with controls, each step's applied torques are made as `Simulation.step`
     // makes them: tau's row (or the start's torques) plus the actuators' forces
     let tau0 = proto.torques().clone();
