@@ -7,16 +7,20 @@ targets (the stance plus a per-environment offset of up to ±0.2 rad), kp = 5 N�
 2 threads. MuJoCo's model is the same URDF through its importer (benches/sim_compare.py's
 build_mujoco: floor, friction 1, no self-collision) with one position actuator per joint
 (gain kp, bias -kp q - kd v, the targets as controls); urdyn's is the URDF with its
-default contact (self-collision included). Prints steps/s of each (best of --repeats
-calls; wall time and the process's CPU time, the fairer measure on a shared machine) and
-the ratios, and checks that one urdyn environment equals a Simulation with
-the same gains and targets stepped alone, bit for bit.
+default contact (self-collision included). The two are timed in --rounds interleaved rounds (each
+round one call of each, the order alternating), so that a burst of other work on the
+machine hits both sides alike; each round prints steps/s of each (wall time, and the
+process's CPU time split into user and system) and the round's ratios, and the end the
+median and best round. Checks that one urdyn environment equals a Simulation with the
+same gains and targets stepped alone, bit for bit.
 
     /work/venv/bin/python benches/servo_rollout.py    # needs mujoco and urdyn installed
 """
 
 import argparse
 import os
+import resource
+import statistics
 import sys
 import time
 
@@ -34,16 +38,13 @@ URDF = os.path.join(ROOT, "assets", "robots", "solo12.urdf")
 KP, KD = 5.0, 0.1
 
 
-def best(f, repeats):
-    """(best wall seconds, best CPU seconds of this process) over `repeats` calls: on a
-    shared machine the CPU time is the fairer measure (both sides run 2 threads)."""
-    wall, cpu = [], []
-    for _ in range(repeats):
-        c0, t0 = time.process_time(), time.perf_counter()
-        f()
-        wall.append(time.perf_counter() - t0)
-        cpu.append(time.process_time() - c0)
-    return min(wall), min(cpu)
+def timed(f):
+    """(wall seconds, user CPU seconds, system CPU seconds) of this process for one call."""
+    r0, t0 = resource.getrusage(resource.RUSAGE_SELF), time.perf_counter()
+    f()
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_SELF)
+    return wall, r1.ru_utime - r0.ru_utime, r1.ru_stime - r0.ru_stime
 
 
 def main():
@@ -51,14 +52,14 @@ def main():
     ap.add_argument("--batch", type=int, default=64)
     ap.add_argument("--nstep", type=int, default=1000)
     ap.add_argument("--threads", type=int, default=2)
-    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--rounds", type=int, default=5)
     args = ap.parse_args()
     B, N = args.batch, args.nstep
     rng = np.random.default_rng(0)
 
     um = urdyn.Model.from_urdf(URDF, floating_base=True)
     nq, nv, nj = um.nq, um.nv, um.nv - 6
-    # the stance (hips 0, thighs ±0.8, knees ∓1.6; front legs first), the feet 1 cm up
+    # the stance (hips 0, thighs ±0.8, knees ∓1.6; front legs first), the feet 3 cm up
     stance = um.neutral()
     for k, name in enumerate(um.dof_names):
         front = name.startswith("F")
@@ -82,7 +83,6 @@ def main():
 
     urdyn.rollout(um, q0[:2], v0[:2], nstep=10, threads=args.threads, integrator="euler",
                   kp=kp, kd=kd, q_ref=q_ref[:2])
-    t_ur = best(run_urdyn, args.repeats)
     Q, V = run_urdyn()
     sim = urdyn.Simulation(um, integrator="euler")
     sim.set_state(q0[5], v0[5])
@@ -90,6 +90,7 @@ def main():
     sim.set_targets(q_ref[5])
     sim.step(n=N)
     same = bool(np.array_equal(sim.q, Q[5, -1]) and np.array_equal(sim.v, V[5, -1]))
+    del Q, V
 
     ma = mujoco_model()
     nu = ma.nu
@@ -100,13 +101,30 @@ def main():
     ctrl = np.repeat(q_ref[:, None, 7:], N, axis=1)
     datas = [mujoco.MjData(ma) for _ in range(args.threads)]
     mj_rollout.rollout(ma, datas, init[:2], ctrl[:2, :10], nstep=10)
-    t_mj = best(lambda: mj_rollout.rollout(ma, datas, init, ctrl, nstep=N), args.repeats)
-    (w_ur, c_ur), (w_mj, c_mj) = t_ur, t_mj
-    print(f"solo12, {B} environments x {N} steps, per-environment targets, {args.threads} threads:\n"
-          f"  wall: mujoco.rollout {B * N / w_mj:,.0f} steps/s, urdyn.rollout {B * N / w_ur:,.0f} "
-          f"steps/s, ratio {w_mj / w_ur:.2f}\n"
-          f"  CPU:  mujoco.rollout {B * N / c_mj:,.0f} steps/CPU-s, urdyn.rollout "
-          f"{B * N / c_ur:,.0f} steps/CPU-s, ratio {c_mj / c_ur:.2f}\n"
+
+    def run_mujoco():
+        return mj_rollout.rollout(ma, datas, init, ctrl, nstep=N)
+
+    print(f"solo12, {B} environments x {N} steps, per-environment targets, {args.threads} "
+          f"threads, {args.rounds} interleaved rounds (steps/s; CPU = user + system):")
+    print("  round | mujoco wall    CPU (sys)       | urdyn wall     CPU (sys)       "
+          "| ratio wall  CPU")
+    ratios = []
+    for r in range(args.rounds):
+        pair = [("mj", run_mujoco), ("ur", run_urdyn)]
+        if r % 2:
+            pair.reverse()
+        t = {name: timed(f) for name, f in pair}
+        (w_mj, u_mj, s_mj), (w_ur, u_ur, s_ur) = t["mj"], t["ur"]
+        c_mj, c_ur = u_mj + s_mj, u_ur + s_ur
+        ratios.append((w_mj / w_ur, c_mj / c_ur, B * N / w_mj, B * N / w_ur))
+        print(f"  {r:5d} | {B * N / w_mj:9,.0f} {B * N / c_mj:9,.0f} ({s_mj:.3f}s) "
+              f"| {B * N / w_ur:9,.0f} {B * N / c_ur:9,.0f} ({s_ur:.3f}s) "
+              f"| {w_mj / w_ur:5.2f} {c_mj / c_ur:5.2f}")
+    med = [statistics.median(x[k] for x in ratios) for k in range(4)]
+    print(f"  median: mujoco.rollout {med[2]:,.0f} steps/s, urdyn.rollout {med[3]:,.0f} steps/s, "
+          f"ratio wall {med[0]:.2f}, CPU {med[1]:.2f}; best round's wall ratio "
+          f"{max(x[0] for x in ratios):.2f}, worst {min(x[0] for x in ratios):.2f}\n"
           f"  urdyn environment 5 == a Simulation with the same gains and targets, bit for bit: {same}")
 
 

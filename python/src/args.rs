@@ -339,6 +339,7 @@ pub mod named {
     text!(reference, "reference");
     text!(method, "method");
     text!(name, "name");
+    text!(model_name, "model_name");
     text!(xml, "xml");
     text!(text, "text");
     text_or_none!(integrator, "integrator");

@@ -210,9 +210,7 @@ pub fn linearize<'py>(
         };
         match threads {
             None => work(),
-            Some(k) => rayon::ThreadPoolBuilder::new()
-                .num_threads(k)
-                .build()
+            Some(k) => crate::pool::pool(k)
                 .map_err(|e| format!("threads: cannot start a thread pool: {e}"))
                 .and_then(|pool| pool.install(work)),
         }

@@ -15,6 +15,7 @@ mod introspect;
 mod mjcf;
 mod model;
 mod pinocchio;
+mod pool;
 mod prototype;
 mod rollout;
 mod scene;

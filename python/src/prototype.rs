@@ -70,7 +70,7 @@ fn prototype(
     ground: Option<f64>,
     contact: ContactParams,
     package_dirs: Option<Vec<PathBuf>>,
-    islands: Islands,
+    islands: Islands<'_>,
 ) -> PyResult<Simulation> {
     let friction = contact.friction;
     if !(dt > 0.0 && dt.is_finite()) {
@@ -104,14 +104,10 @@ fn prototype(
         integrator,
         ground,
         package_paths: package_dirs.unwrap_or_else(|| model.package_dirs.clone()),
-        sleep: islands.sleep,
-        sleep_velocity: islands.sleep_velocity,
-        sleep_time: islands.sleep_time,
-        threads: islands.threads,
-        never_sleep: islands.never_sleep,
         contact,
         ..SimOptions::default()
-    };
+    }
+    .with_islands(islands.scene, islands.sleep, islands.threads);
     Simulation::new(model.model.clone(), opts).map_err(|e| match e {
         // the library's message is neutral; the hint is Python's (the CLI names its flags)
         SimError::Contact(ContactError::MissingMesh { .. }) => not_found_error(format!(
@@ -124,13 +120,11 @@ fn prototype(
 
 /// Sleep and threads (scene.md §"Large scenes"): a scene's from its file, a
 /// model alone's the defaults (it sleeps, one thread), `sleep=`/`threads=` of
-/// the call over either.
-pub(crate) struct Islands {
-    sleep: bool,
-    sleep_velocity: f64,
-    sleep_time: f64,
-    threads: usize,
-    never_sleep: Vec<String>,
+/// the call over either ([`SimOptions::with_islands`], as `urdyn simulate`).
+pub(crate) struct Islands<'a> {
+    scene: Option<&'a urdyn::scene::SceneSpec>,
+    sleep: Option<bool>,
+    threads: Option<usize>,
 }
 
 /// A simulation of a scene at its starting state (poses, `pose`, `initial`),
@@ -148,20 +142,11 @@ fn prototype_scene(
     let ground = s.ground.map(|g| g.height);
     // the ground's contact parameters as `urdyn simulate SCENE.json` reads them
     let contact = ContactParams::of_scene_ground(s.ground.as_ref());
-    // as `urdyn simulate SCENE.json` (src/cli/simulate.rs): the file's settings
-    // where the call gives none
-    let spec = &s.spec;
+    // as `urdyn simulate SCENE.json`: the file's settings where the call gives none
     let islands = Islands {
-        sleep: sleep.unwrap_or(spec.sleep.unwrap_or(true)),
-        sleep_velocity: spec.sleep_velocity.unwrap_or(1e-3),
-        sleep_time: spec.sleep_time.unwrap_or(0.5),
-        threads: threads.or(spec.threads).unwrap_or(1),
-        never_sleep: spec
-            .models
-            .iter()
-            .filter(|m| m.sleep == Some(false))
-            .map(|m| m.name.clone())
-            .collect(),
+        scene: Some(&s.spec),
+        sleep,
+        threads,
     };
     let mut sim = prototype(
         &model,
@@ -247,11 +232,9 @@ pub(crate) fn prototype_any(
         },
         package_dirs,
         Islands {
-            sleep: sleep.unwrap_or(true),
-            sleep_velocity: 1e-3,
-            sleep_time: 0.5,
-            threads: threads.unwrap_or(1),
-            never_sleep: Vec::new(),
+            scene: None,
+            sleep,
+            threads,
         },
     )?;
     let warnings = match &loops {

@@ -107,19 +107,28 @@ fn read_gains(
     Ok(Some(rows))
 }
 
-/// B simulations of `nstep` steps of `dt` from (q0[b], v0[b]), in parallel.
-/// Returns q (B, nstep + 1, nq) and v (B, nstep + 1, nv), initial states included.
-/// `threads`: the batch's workers, and each simulation's island threads
-/// (scene.md §"Large scenes"); `sleep`: whether still islands sleep. `None`
-/// takes the scene's settings (a model alone sleeps, one island thread); each
-/// batch entry equals a `Simulation` with the same `sleep`/`threads` stepped
-/// alone, bit for bit. `constraints`: a model's loops, as
-/// `Simulation(model, constraints=...)` (a scene's come from its file); each
-/// run starts them at its (q0[b], v0[b]) as `set_state` does. `controls`:
-/// an MJCF model's actuator controls, (B, nu) or (B, nstep, nu); each run
-/// equals a `Simulation` given `set_gains`, `set_targets` and then
-/// `set_controls` before its steps (the controls replace the servos' gains and
-/// targets, as `set_controls` does).
+/// B simulations of `nstep` steps of `dt` from (q0[b], v0[b]) (q0 (B, nq),
+/// v0 (B, nv)), in parallel with the GIL released. Returns q (B, nstep + 1,
+/// nq) and v (B, nstep + 1, nv), initial states included. `tau`: None, (B, nv)
+/// constant or (B, nstep, nv) (the base's part ignored, each torque clamped to
+/// its effort limit as in `Simulation.step`). Servos as `set_gains` /
+/// `set_targets`: `kp`, `kd` a number (every joint), (nv,) or (B, nv);
+/// `q_ref` (B, nq) or (B, nstep, nq) (step k takes `q_ref[:, k]`); `v_ref`
+/// (B, nv) or (B, nstep, nv). `controls`: an MJCF model's actuator controls,
+/// (B, nu) or (B, nstep, nu), as `set_controls` before each step (they
+/// replace the servos' gains and targets, as `set_controls` does).
+/// `threads`: the batch's workers (None: every core), and each simulation's
+/// island threads (None: the scene's setting, one for a model alone; scene.md
+/// §"Large scenes"); `sleep`: whether still islands sleep (None: the scene's
+/// setting; a model alone sleeps). `constraints`: a
+/// model's loops, as `Simulation(model, constraints=...)` (a scene's come
+/// from its file), started at each run's (q0[b], v0[b]) as `set_state` does.
+/// Each batch entry equals, bit for bit, a `Simulation` with the same
+/// arguments given the same calls and stepped alone. A wrong shape, a
+/// negative count, or `ground=`/`friction=`/`constraints=` beside a scene is
+/// a `ValueError` naming the argument; a run that turns non-finite raises
+/// `urdyn.SimulationError` naming its batch index, with the partial results
+/// as `.q` and `.v` (NaN after the failure).
 #[pyfunction]
 #[pyo3(signature = (model, q0, v0, tau=None, nstep=None, dt=1e-3, threads=None, integrator=None, ground=Given::Omitted, friction=Given::Omitted, kp=None, kd=None, q_ref=None, v_ref=None, sleep=None, constraints=None, controls=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
@@ -188,12 +197,12 @@ pub fn rollout<'py>(
     let q_refs = PerRun::read(q_ref, "q_ref", b, nstep, nq)?;
     let v_refs = PerRun::read(v_ref, "v_ref", b, nstep, nv)?;
     let nu = proto.model.actuators.len();
-    let controls = PerRun::read(controls, "controls", b, nstep, nu)?;
-    if nu == 0 && !matches!(controls, PerRun::None) {
+    if nu == 0 && controls.is_some_and(|c| !c.is_none()) {
         return Err(value_error(
             "controls: the model has no actuators (nu = 0; MJCF <actuator> elements give them)",
         ));
     }
+    let controls = PerRun::read(controls, "controls", b, nstep, nu)?;
     // with controls, each step's applied torques are made as `Simulation.step`
     // makes them: tau's row (or the start's torques) plus the actuators' forces
     let tau0 = proto.torques().clone();
@@ -225,8 +234,11 @@ pub fn rollout<'py>(
         }
         Ok(())
     };
-    let qa = PyArray3::<f64>::zeros(py, [b, nstep + 1, nq], false);
-    let va = PyArray3::<f64>::zeros(py, [b, nstep + 1, nv], false);
+    // SAFETY: left uninitialised (no zeroing pass over memory every entry of
+    // which is written below: each run writes its rows 0..=nstep, or NaN from
+    // where it failed on); not seen by Python before that.
+    let qa = unsafe { PyArray3::<f64>::new(py, [b, nstep + 1, nq], false) };
+    let va = unsafe { PyArray3::<f64>::new(py, [b, nstep + 1, nv], false) };
     let failures = {
         // SAFETY: fresh C-contiguous arrays that no Python code has seen yet; the
         // GIL is released below but nothing else holds them.
@@ -293,11 +305,7 @@ pub fn rollout<'py>(
             };
             match threads {
                 None => Ok(work()),
-                Some(n) => rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build()
-                    .map(|pool| pool.install(work))
-                    .map_err(|e| e.to_string()),
+                Some(n) => crate::pool::pool(n).map(|pool| pool.install(work)),
             }
         })
         .map_err(|e| value_error(format!("threads: cannot start a thread pool: {e}")))?

@@ -365,26 +365,33 @@ impl PySimulation {
     fn awake(&self) -> usize {
         self.sim.awake()
     }
-    /// Whether the model `name` sleeps now (a scene's model name; a lone
+    /// Whether the model `model_name` sleeps now (a scene's model name; a lone
     /// model's is its `models[0]`). An unknown name is a `ValueError`.
-    fn sleeping(&self, #[pyo3(from_py_with = named::name)] name: String) -> PyResult<bool> {
+    fn sleeping(
+        &self,
+        #[pyo3(from_py_with = named::model_name)] model_name: String,
+    ) -> PyResult<bool> {
         let trees = &self.sim.model.trees;
         let key = if trees.len() == 1 && trees[0].name.is_empty() {
             // a lone model's one tree is named "" in the library
             ""
         } else {
-            &name
+            &model_name
         };
         let lone = trees.len() == 1 && trees[0].name.is_empty();
-        if lone && !(name.is_empty() || name == "robot" || name == self.sim.model.name) {
+        if lone
+            && !(model_name.is_empty()
+                || model_name == "robot"
+                || model_name == self.sim.model.name)
+        {
             return Err(value_error(format!(
-                "sleeping: unknown model \"{name}\" (one model: \"robot\")"
+                "sleeping: unknown model \"{model_name}\" (one model: \"robot\")"
             )));
         }
         self.sim.sleeping(key).ok_or_else(|| {
             let names: Vec<&str> = trees.iter().map(|t| t.name.as_str()).collect();
             value_error(format!(
-                "sleeping: unknown model \"{name}\" (models: {})",
+                "sleeping: unknown model \"{model_name}\" (models: {})",
                 names.join(", ")
             ))
         })

@@ -77,7 +77,7 @@ def test_wrong_types_of_names_and_paths_are_value_errors_naming_the_argument():
         (lambda: sim.transition_jacobians(method=1), "method must be a string"),
         (lambda: urdyn.linearize(sim, q0, v0, v0, method=None), "method must be a string"),
         (lambda: sim.imu(0), "link must be a string"),
-        (lambda: sim.sleeping(0), "name must be a string"),
+        (lambda: sim.sleeping(0), "model_name must be a string"),
         (lambda: sim.write_html(12), "path must be a path"),
         (lambda: urdyn.write_html(12, model, q0), "path must be a path"),
     ]

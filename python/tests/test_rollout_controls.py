@@ -64,3 +64,14 @@ def test_rollout_controls_bad_shapes_and_no_actuators():
     with pytest.raises(ValueError, match="controls"):
         urdyn.rollout(ur5, ur5.neutral()[None], np.zeros((1, ur5.nv)), nstep=3,
                       controls=np.zeros((1, 1)))
+
+
+def test_controls_for_a_model_without_actuators_say_so_whatever_their_shape():
+    model = urdyn.Model.from_urdf(str(ROOT / "assets" / "robots" / "ur5.urdf"))
+    q0 = np.tile(model.neutral(), (2, 1))
+    v0 = np.zeros((2, model.nv))
+    for u in (np.ones((2, 1)), np.ones((2, 0))):
+        with pytest.raises(ValueError, match=r"^controls: the model has no actuators"):
+            urdyn.rollout(model, q0, v0, nstep=1, controls=u)
+    q, _ = urdyn.rollout(model, q0, v0, nstep=1, controls=None)
+    assert q.shape == (2, 2, model.nq)

@@ -200,6 +200,14 @@ class Simulation:
     # control and sensors (python.md "Control", "Sensors")
     def set_gains(self, kp: Union[float, ArrayLike], kd: Union[float, ArrayLike]) -> None: ...
     def set_targets(self, q_ref: ArrayLike, v_ref: Optional[ArrayLike] = None) -> None: ...
+    def set_controls(self, u: ArrayLike) -> None:
+        """An MJCF model's actuator controls (nu, the file's order, each clamped into its
+        ctrlrange), held until set again."""
+    def set_key(self, name: str) -> None:
+        """Starts from the MJCF model's keyframe `name`: its q, v and controls."""
+    @property
+    def controls(self) -> Vec:
+        """The actuator controls as last set (nu)."""
     def transition_jacobians(
         self, tau: Optional[ArrayLike] = None, method: str = "analytic", eps: float = 1e-6
     ) -> Tuple[Vec, Vec]: ...
@@ -254,6 +262,7 @@ def rollout(
     v_ref: Optional[ArrayLike] = None,
     sleep: Optional[bool] = None,
     constraints: Optional[Union["Constraints", Sequence[Dict[str, Any]]]] = None,
+    controls: Optional[ArrayLike] = None,
 ) -> Tuple[Vec, Vec]: ...
 
 class Constraints:

@@ -42,6 +42,43 @@ impl ContactParams {
     }
 }
 
+impl SimOptions {
+    /// Sleep and island threads (scene.md §"Large scenes") as `urdyn simulate`,
+    /// Python's `Simulation(...)` and `rollout(...)` read them: the caller's
+    /// `sleep` / `threads` (`--no-sleep`, `--threads`, `sleep=`, `threads=`)
+    /// over a scene file's `"sleep"` / `"threads"`, over these options'; the
+    /// file's `"sleep_velocity"`, `"sleep_time"` and its models with
+    /// `"sleep": false` over these options'. `scene` `None` (a model alone):
+    /// the caller's over these options'.
+    pub fn with_islands(
+        self,
+        scene: Option<&crate::scene::SceneSpec>,
+        sleep: Option<bool>,
+        threads: Option<usize>,
+    ) -> Self {
+        let Some(spec) = scene else {
+            return Self {
+                sleep: sleep.unwrap_or(self.sleep),
+                threads: threads.unwrap_or(self.threads),
+                ..self
+            };
+        };
+        Self {
+            sleep: sleep.or(spec.sleep).unwrap_or(self.sleep),
+            sleep_velocity: spec.sleep_velocity.unwrap_or(self.sleep_velocity),
+            sleep_time: spec.sleep_time.unwrap_or(self.sleep_time),
+            threads: threads.or(spec.threads).unwrap_or(self.threads),
+            never_sleep: spec
+                .models
+                .iter()
+                .filter(|m| m.sleep == Some(false))
+                .map(|m| m.name.clone())
+                .collect(),
+            ..self
+        }
+    }
+}
+
 impl Simulation {
     /// Sets up a simulation of `model` at its neutral configuration, at rest.
     /// Contact shapes (and meshes) are built here when `opts.ground` is set and a
@@ -233,5 +270,53 @@ impl Simulation {
         // the model's own loop constraints (MJCF <equality>): src/sim/equalities.rs
         sim.set_model_equalities()?;
         Ok(sim)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(json: &str) -> crate::scene::SceneSpec {
+        serde_json::from_str(json).expect("a valid scene document")
+    }
+
+    /// `with_islands`: the caller's sleep/threads over the file's over the
+    /// options'; the file's velocity, time and never-sleeping models (scene.md
+    /// §"Large scenes"), each value read off the document by hand.
+    #[test]
+    fn the_caller_beats_the_file_which_beats_the_options() {
+        let s = spec(
+            r#"{"models": [{"name": "a", "urdf": "a.urdf", "sleep": false},
+                           {"name": "b", "urdf": "b.urdf"}],
+                "sleep": false, "sleep_velocity": 0.002, "sleep_time": 0.25, "threads": 3}"#,
+        );
+        let o = SimOptions::default().with_islands(Some(&s), None, None);
+        assert!(!o.sleep);
+        assert_eq!(
+            (o.sleep_velocity, o.sleep_time, o.threads),
+            (0.002, 0.25, 3)
+        );
+        assert_eq!(o.never_sleep, vec!["a".to_string()]);
+        let o = SimOptions::default().with_islands(Some(&s), Some(true), Some(2));
+        assert!(o.sleep);
+        assert_eq!(o.threads, 2);
+        // a file without the keys: the options' values (here not the defaults)
+        let bare = spec(r#"{"models": [{"name": "a", "urdf": "a.urdf"}]}"#);
+        let base = SimOptions {
+            sleep: false,
+            sleep_velocity: 0.5,
+            sleep_time: 7.0,
+            threads: 4,
+            ..SimOptions::default()
+        };
+        let o = base.clone().with_islands(Some(&bare), None, None);
+        assert!(!o.sleep);
+        assert_eq!((o.sleep_velocity, o.sleep_time, o.threads), (0.5, 7.0, 4));
+        assert!(o.never_sleep.is_empty());
+        // a model alone: only the caller's over the options'
+        let o = base.with_islands(None, Some(true), None);
+        assert!(o.sleep);
+        assert_eq!((o.sleep_velocity, o.sleep_time, o.threads), (0.5, 7.0, 4));
     }
 }

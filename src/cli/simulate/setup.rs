@@ -65,10 +65,9 @@ pub(super) fn urdf(
         contact,
         package_paths: args.package_path.clone(),
         armature: args.armature,
-        sleep: !args.no_sleep,
-        threads: args.threads.unwrap_or(1),
         ..SimOptions::default()
-    };
+    }
+    .with_islands(None, args.no_sleep.then_some(false), args.threads);
     // The page's geometry is read before anything is simulated (a missing mesh
     // is reported at once).
     let geometry = match &args.html {
@@ -112,19 +111,13 @@ pub(super) fn scene(
         contact,
         package_paths: args.package_path.clone(),
         armature: args.armature,
-        sleep: !args.no_sleep && scene.spec.sleep.unwrap_or(true),
-        sleep_velocity: scene.spec.sleep_velocity.unwrap_or(1e-3),
-        sleep_time: scene.spec.sleep_time.unwrap_or(0.5),
-        threads: args.threads.or(scene.spec.threads).unwrap_or(1),
-        never_sleep: scene
-            .spec
-            .models
-            .iter()
-            .filter(|m| m.sleep == Some(false))
-            .map(|m| m.name.clone())
-            .collect(),
         ..SimOptions::default()
-    };
+    }
+    .with_islands(
+        Some(&scene.spec),
+        args.no_sleep.then_some(false),
+        args.threads,
+    );
     let geometry = match &args.html {
         Some(_) => Some(crate::cli::view::Geometry::load_scene(
             &scene,
