@@ -1,4 +1,4 @@
-//! Scenes (`../shared/spec/scene.md`): several URDF models, static obstacles
+//! Scenes (`../shared/spec/scene.md`): several URDF or MJCF models, static obstacles
 //! and an optional ground in one simulation. Import layer, beside
 //! [`crate::urdf`]: a SCENE.json (or a [`SceneSpec`] built in code) is checked
 //! key by key, its URDFs and SRDFs loaded, and the models joined into one
@@ -10,6 +10,7 @@
 mod file;
 mod forest;
 mod load;
+mod mjcf;
 mod obstacles;
 pub mod srdf;
 
@@ -68,8 +69,11 @@ pub struct Ground {
 pub struct SceneModel {
     /// Its name (the prefix of its names).
     pub name: String,
-    /// The URDF file (resolved against the scene file's folder).
+    /// The URDF file, or the MJCF file when `mjcf` (resolved against the
+    /// scene file's folder).
     pub urdf: PathBuf,
+    /// Whether `urdf` is an MJCF file (the model is its whole world).
+    pub mjcf: bool,
     /// Whether its root is on a free joint.
     pub floating: bool,
     /// `world_M_root` at the start.
