@@ -154,3 +154,20 @@ impl Loader<'_> {
         Ok(out)
     }
 }
+
+/// The SCENE.json text of an MJCF file's whole world alone (mjcf.md §"Entry
+/// points", Python's `Scene.from_mjcf`): one model named after the file's stem
+/// (`ant` for ant.xml), its file by name, relative to the file's folder.
+pub fn mjcf_scene_json(path: &std::path::Path) -> String {
+    let stem = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .map(|s| s.trim().replace('/', "_"))
+        .filter(|s| !s.is_empty() && !s.chars().any(char::is_control))
+        .unwrap_or_else(|| "model".to_string());
+    let file = path
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    serde_json::json!({"models": [{"name": stem, "mjcf": file}]}).to_string()
+}

@@ -19,6 +19,7 @@ pub use file::{
     RoundSpec, SceneSpec,
 };
 pub use forest::{forest, Part};
+pub use mjcf::mjcf_scene_json;
 
 use crate::model::{Model, Shape};
 use crate::spatial::Se3;
@@ -171,6 +172,19 @@ impl Scene {
             _ => PathBuf::from("."),
         };
         Self::from_json(&text, &name, &dir, package_paths)
+    }
+
+    /// The whole world of an MJCF file as a scene (mjcf.md §"Entry points"):
+    /// the scene [`mjcf_scene_json`] writes for it, one model named after the
+    /// file's stem, its names `STEM/NAME`.
+    pub fn from_mjcf(path: impl AsRef<Path>) -> Result<Self, SceneError> {
+        let path = path.as_ref();
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let text = mjcf_scene_json(path);
+        Self::from_json(&text, &path.display().to_string(), &dir, &[])
     }
 
     /// Loads SCENE.json text; `file` names it in messages, `base_dir` resolves
