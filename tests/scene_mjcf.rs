@@ -325,3 +325,38 @@ fn an_mjcf_world_of_several_trees_and_a_static_geom() {
     .unwrap_or_else(|e| panic!("{e}"));
     assert!(s2.exclude.contains(&("w/a".to_string(), "w/b".to_string())));
 }
+
+#[test]
+fn the_replay_page_of_a_scene_draws_an_mjcf_model_on_the_scenes_bodies() {
+    use urdyn::cli::view::Geometry;
+    let (alone, world) = mjcf::load_file_with_world(gym().join("ant.xml")).expect("loads");
+    let own = urdyn::cli::view::mjcf::geometry(&alone, &world, "ant.xml");
+    let lamp = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/lamp.urdf");
+    let json = format!(
+        r#"{{"models": [{{"name": "l", "urdf": "{}"}},
+                       {{"name": "ant", "mjcf": "ant.xml", "position": [1, 2, 0]}}]}}"#,
+        lamp.display()
+    );
+    let s = scene_in(&gym(), &json).unwrap_or_else(|e| panic!("{e}"));
+    let g = Geometry::load_scene(&s, &[]).expect("drawn");
+    let ant: Vec<_> = g
+        .visuals
+        .iter()
+        .filter(|v| v.link.starts_with("ant/"))
+        .collect();
+    assert_eq!(ant.len(), own.visuals.len());
+    // every drawn ant geom sits on the scene body of its link's frame
+    for v in &ant {
+        let f = s.model.frames.iter().find(|f| f.name == v.link);
+        if let Some(f) = f {
+            assert_eq!(v.body, f.body, "{}", v.link);
+        }
+    }
+    let torso = s
+        .model
+        .frames
+        .iter()
+        .find(|f| f.name == "ant/torso")
+        .unwrap();
+    assert!(ant.iter().any(|v| v.body == torso.body && torso.body > 0));
+}
