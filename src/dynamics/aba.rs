@@ -127,20 +127,24 @@ fn add_act_matrix6_ax<T: Scalar>(
         return add_act_matrix6(x, m, out);
     };
     let r = &x.rot;
-    // R b Rᵀ: N = R b by columns, then row i of N Rᵀ is R (row i of N).
-    let sandwich = |b: Matrix3<T>| -> Matrix3<T> {
-        let n0 = ax.rot_mul(r, &Vector3::new(b[(0, 0)], b[(1, 0)], b[(2, 0)]));
-        let n1 = ax.rot_mul(r, &Vector3::new(b[(0, 1)], b[(1, 1)], b[(2, 1)]));
-        let n2 = ax.rot_mul(r, &Vector3::new(b[(0, 2)], b[(1, 2)], b[(2, 2)]));
-        let p0 = ax.rot_mul(r, &Vector3::new(n0.x, n1.x, n2.x));
-        let p1 = ax.rot_mul(r, &Vector3::new(n0.y, n1.y, n2.y));
-        let p2 = ax.rot_mul(r, &Vector3::new(n0.z, n1.z, n2.z));
-        rows3(&p0, &p1, &p2)
-    };
-    let a = sandwich(block3(m, 0, 0));
-    let b = sandwich(block3(m, 0, 3));
-    let c = sandwich(block3(m, 3, 3));
+    let a = sandwich_ax(ax, r, &block3(m, 0, 0));
+    let b = sandwich_ax(ax, r, &block3(m, 0, 3));
+    let c = sandwich_ax(ax, r, &block3(m, 3, 3));
     add_translate6(&x.trans, &a, &b, &c, out)
+}
+
+/// `R b Rᵀ` for a rotation `r` about `ax`: N = R b by columns, then row i of
+/// N Rᵀ is R (row i of N) (a function, inlined: as a closure it was called out
+/// of line).
+#[inline(always)]
+fn sandwich_ax<T: Scalar>(ax: Axis<T>, r: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    let n0 = ax.rot_mul(r, &Vector3::new(b[(0, 0)], b[(1, 0)], b[(2, 0)]));
+    let n1 = ax.rot_mul(r, &Vector3::new(b[(0, 1)], b[(1, 1)], b[(2, 1)]));
+    let n2 = ax.rot_mul(r, &Vector3::new(b[(0, 2)], b[(1, 2)], b[(2, 2)]));
+    let p0 = ax.rot_mul(r, &Vector3::new(n0.x, n1.x, n2.x));
+    let p1 = ax.rot_mul(r, &Vector3::new(n0.y, n1.y, n2.y));
+    let p2 = ax.rot_mul(r, &Vector3::new(n0.z, n1.z, n2.z));
+    rows3(&p0, &p1, &p2)
 }
 
 /// `ᵃX*_b I ᵇX_a` ([`add_act_matrix6_ax`] into a zero matrix).
@@ -434,8 +438,7 @@ pub fn aba<'d, T: Scalar>(
             } else if jm.nv() == 3 {
                 aba_step3_outward(&jm, &ia[i], &uu[i], &a1, qdd).ok_or(DynamicsError::Singular(iv))?
             } else {
-                let chol = ia[i].cholesky().ok_or(DynamicsError::Singular(iv))?;
-                let x = chol.solve(&uu[i]);
+                let x = super::linalg::spd6_solve(&ia[i], &uu[i]).ok_or(DynamicsError::Singular(iv))?;
                 let ai = Motion::new(
                     Vector3::new(x[0], x[1], x[2]),
                     Vector3::new(x[3], x[4], x[5]),
