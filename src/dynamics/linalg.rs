@@ -346,3 +346,56 @@ pub fn spd6_inverse<T: Scalar>(a: &nalgebra::Matrix6<T>) -> Option<nalgebra::Mat
     }
     Some(x)
 }
+
+/// Solves `a x = b` for a symmetric positive-definite 6x6 `a` (lower triangle
+/// read) by `L D Lᵀ` with fixed loop bounds (as [`spd6_inverse`]); `None` when a
+/// pivot is at most 64 ε times its diagonal entry, or not finite.
+#[inline]
+pub(crate) fn spd6_solve<T: Scalar>(
+    a: &nalgebra::Matrix6<T>,
+    b: &nalgebra::Vector6<T>,
+) -> Option<nalgebra::Vector6<T>> {
+    let tiny = lit::<T>(64.0 * f64::EPSILON);
+    let mut l = [[T::zero(); 6]; 6];
+    let mut dinv = [T::zero(); 6];
+    let mut ld = [[T::zero(); 6]; 6];
+    for j in 0..6 {
+        let mut d = a[(j, j)];
+        for k in 0..j {
+            d = madd(-l[j][k], ld[j][k], d);
+        }
+        if !(d > tiny * a[(j, j)].abs()) || !d.is_finite() {
+            return None;
+        }
+        let di = T::one() / d;
+        dinv[j] = di;
+        for i in (j + 1)..6 {
+            let mut s = a[(i, j)];
+            for k in 0..j {
+                s = madd(-l[i][k], ld[j][k], s);
+            }
+            ld[i][j] = s;
+            l[i][j] = s * di;
+        }
+    }
+    // L y = b, z = D⁻¹ y, Lᵀ x = z
+    let mut x = [T::zero(); 6];
+    for i in 0..6 {
+        let mut s = b[i];
+        for k in 0..i {
+            s = madd(-l[i][k], x[k], s);
+        }
+        x[i] = s;
+    }
+    for i in 0..6 {
+        x[i] *= dinv[i];
+    }
+    for i in (0..6).rev() {
+        let mut s = x[i];
+        for k in (i + 1)..6 {
+            s = madd(-l[k][i], x[k], s);
+        }
+        x[i] = s;
+    }
+    Some(nalgebra::Vector6::from_column_slice(&x))
+}
