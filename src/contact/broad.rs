@@ -2,11 +2,27 @@
 //!
 //! Each shape's box is its own box (in its frame) at its pose, boxed again
 //! along the world axes (centre R·c + t, half extents |R|·h) and grown by the
-//! detection margin, refreshed every step for the shapes that move. The shapes
-//! are kept sorted by their boxes' lower x (an insertion sort: nearly sorted
-//! from step to step, O(n)); a sweep along x meets each shape only the shapes
-//! whose x-interval overlaps its own, and keeps the pairs that also overlap in
-//! y and z and that the pair filter allows (a table of pair indices).
+//! detection margin, refreshed every step for the shapes that move.
+//!
+//! Few shapes (fewer than [`STRIPS_FROM`]): the shapes are kept sorted by their
+//! boxes' lower x (an insertion sort: nearly sorted from step to step, O(n));
+//! a sweep along x meets each shape only the shapes whose x-interval overlaps
+//! its own, and keeps the pairs that also overlap in y and z and that the
+//! pair filter allows (a table of pair indices).
+//!
+//! Many shapes: one sweep along x meets, for each shape, every shape of its
+//! x-slab, O(n^1.5) for shapes spread over a square floor (a pile in a bin).
+//! The floor is cut into strips along y, each as wide as the widest y-extent
+//! of the ordinary shapes (those at most [`BIG`] times the median y-extent):
+//! two boxes that overlap in y then lie in one strip or in two neighbouring
+//! ones (by their lower y). The shapes are kept sorted by (strip, lower x)
+//! (the same insertion sort), and strip s is swept along x merged with strip
+//! s + 1, keeping the pairs with a member in s: each overlapping pair once,
+//! and a shape meets only the shapes of its slab in two strips (O(n) for a
+//! floor that grows with the pile). The few shapes wider than the strips (the
+//! walls of a bin, a long obstacle) are tested against every shape. Either
+//! way the pairs reported are exactly those whose boxes overlap (in another
+//! order: the caller sorts them).
 
 /// "No pair" in the pair table.
 pub(crate) const NO_PAIR: u32 = u32::MAX;
@@ -21,9 +37,24 @@ pub(crate) struct SweepAndPrune {
     pub lo: Vec<[f64; 3]>,
     /// Upper corners.
     pub hi: Vec<[f64; 3]>,
-    /// The shapes by their boxes' lower x.
+    /// The shapes by their boxes' lower x (with strips: the ordinary shapes
+    /// by (strip, lower x)).
     order: Vec<u32>,
+    /// Each shape's strip (strips only), and whether it is wider than a strip.
+    strip: Vec<i64>,
+    big: Vec<bool>,
+    /// Scratch: the y-extents (for their median), the shapes wider than a
+    /// strip, and two strips merged by lower x (shape, in the lower strip).
+    ext: Vec<f64>,
+    wide: Vec<u32>,
+    merged: Vec<(u32, bool)>,
 }
+
+/// Shapes from which the floor is cut into strips.
+pub(crate) const STRIPS_FROM: usize = 64;
+/// A shape whose y-extent is above this many times the median is tested
+/// against every shape (not put in a strip).
+const BIG: f64 = 4.0;
 
 impl SweepAndPrune {
     /// Room for `n` shapes (boxes empty until set).
@@ -32,6 +63,11 @@ impl SweepAndPrune {
             lo: vec![[f64::INFINITY; 3]; n],
             hi: vec![[f64::NEG_INFINITY; 3]; n],
             order: (0..n as u32).collect(),
+            strip: vec![0; n],
+            big: vec![false; n],
+            ext: Vec::with_capacity(n),
+            wide: Vec::with_capacity(n),
+            merged: Vec::with_capacity(n),
         }
     }
 
@@ -46,6 +82,39 @@ impl SweepAndPrune {
     /// of shapes i, j, or [`NO_PAIR`]), appended to `out`; those marked
     /// [`LAZY_PAIR`] (allowed, not made yet) as shapes (i, j) to `fresh`.
     pub fn overlaps(&mut self, table: &[u32], out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
+        let n = self.lo.len();
+        if n < STRIPS_FROM {
+            self.sweep_x(table, out, fresh);
+        } else {
+            self.sweep_strips(table, out, fresh);
+        }
+    }
+
+    /// Shapes i and j (both boxes known to overlap in x) reported if their
+    /// boxes overlap in y and z and the table allows the pair.
+    #[inline(always)]
+    fn report(
+        &self,
+        i: usize,
+        j: usize,
+        table: &[u32],
+        out: &mut Vec<u32>,
+        fresh: &mut Vec<(u32, u32)>,
+    ) {
+        let n = self.lo.len();
+        let (li, hi, lj, hj) = (self.lo[i], self.hi[i], self.lo[j], self.hi[j]);
+        if lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2] {
+            return;
+        }
+        match table.get(i * n + j) {
+            Some(&LAZY_PAIR) => fresh.push((i as u32, j as u32)),
+            Some(&p) if p != NO_PAIR => out.push(p),
+            _ => {}
+        }
+    }
+
+    /// One sweep along x over every shape.
+    fn sweep_x(&mut self, table: &[u32], out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
         let n = self.order.len();
         // insertion sort by lower x
         for k in 1..n {
@@ -59,22 +128,143 @@ impl SweepAndPrune {
         }
         for k in 0..n {
             let i = self.order[k] as usize;
-            let (li, hi) = (self.lo[i], self.hi[i]);
+            let hi = self.hi[i];
             for &j in &self.order[k + 1..] {
                 let j = j as usize;
-                let lj = self.lo[j];
-                if lj[0] > hi[0] {
+                if self.lo[j][0] > hi[0] {
                     break;
                 }
-                let hj = self.hi[j];
-                if lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2] {
+                self.report(i, j, table, out, fresh);
+            }
+        }
+    }
+
+    /// Strips along y, each swept along x with the next (module docs).
+    fn sweep_strips(&mut self, table: &[u32], out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
+        let n = self.lo.len();
+        // the strips' width: the widest ordinary y-extent
+        self.ext.clear();
+        self.ext.extend(
+            (0..n)
+                .map(|i| self.hi[i][1] - self.lo[i][1])
+                .filter(|e| e.is_finite()),
+        );
+        let w = if self.ext.is_empty() {
+            f64::INFINITY
+        } else {
+            let mid = self.ext.len() / 2;
+            let med = *self.ext.select_nth_unstable_by(mid, f64::total_cmp).1;
+            self.ext
+                .iter()
+                .copied()
+                .filter(|&e| e <= BIG * med)
+                .fold(0.0f64, f64::max)
+        };
+        let w = if w > 0.0 { w } else { f64::INFINITY };
+        self.wide.clear();
+        for i in 0..n {
+            let e = self.hi[i][1] - self.lo[i][1];
+            let ly = self.lo[i][1];
+            // a shape with no box (never set) or no finite strip: with the wide ones
+            let s = (ly / w).floor();
+            self.big[i] = !(e <= w) || !s.is_finite() || s.abs() > 1e15;
+            self.strip[i] = if self.big[i] { 0 } else { s as i64 };
+            if self.big[i] {
+                self.wide.push(i as u32);
+            }
+        }
+        // the ordinary shapes by (strip, lower x): last step's order, the
+        // wide ones out, then an insertion sort (nearly sorted)
+        let big = &self.big;
+        self.order.retain(|&i| !big[i as usize]);
+        if self.order.len() + self.wide.len() < n {
+            // a shape wide last step and ordinary now (or at the start)
+            let mut seen = vec![false; n];
+            for &i in &self.order {
+                seen[i as usize] = true;
+            }
+            for i in 0..n {
+                if !seen[i] && !self.big[i] {
+                    self.order.push(i as u32);
+                }
+            }
+        }
+        let before = |a: usize, b: usize, lo: &[[f64; 3]], st: &[i64]| {
+            st[a] > st[b] || (st[a] == st[b] && lo[a][0] > lo[b][0])
+        };
+        for k in 1..self.order.len() {
+            let mut m = k;
+            while m > 0
+                && before(
+                    self.order[m - 1] as usize,
+                    self.order[m] as usize,
+                    &self.lo,
+                    &self.strip,
+                )
+            {
+                self.order.swap(m - 1, m);
+                m -= 1;
+            }
+        }
+        // each strip merged with the next by lower x, swept
+        let mut merged = std::mem::take(&mut self.merged);
+        let len = self.order.len();
+        let mut a = 0;
+        while a < len {
+            let s = self.strip[self.order[a] as usize];
+            let mut b = a;
+            while b < len && self.strip[self.order[b] as usize] == s {
+                b += 1;
+            }
+            let mut c = b;
+            if b < len && self.strip[self.order[b] as usize] == s + 1 {
+                while c < len && self.strip[self.order[c] as usize] == s + 1 {
+                    c += 1;
+                }
+            }
+            merged.clear();
+            let (mut i, mut j) = (a, b);
+            while i < b || j < c {
+                let take_i = j >= c
+                    || (i < b
+                        && !(self.lo[self.order[i] as usize][0]
+                            > self.lo[self.order[j] as usize][0]));
+                if take_i {
+                    merged.push((self.order[i], true));
+                    i += 1;
+                } else {
+                    merged.push((self.order[j], false));
+                    j += 1;
+                }
+            }
+            for k in 0..merged.len() {
+                let (i, in_s) = merged[k];
+                let i = i as usize;
+                let hx = self.hi[i][0];
+                for &(j, jn_s) in &merged[k + 1..] {
+                    let j = j as usize;
+                    if self.lo[j][0] > hx {
+                        break;
+                    }
+                    if in_s || jn_s {
+                        self.report(i, j, table, out, fresh);
+                    }
+                }
+            }
+            a = b;
+        }
+        self.merged = merged;
+        // the wide shapes against every shape (a pair of two wide ones once)
+        for wi in 0..self.wide.len() {
+            let i = self.wide[wi] as usize;
+            for j in 0..n {
+                if j == i || (self.big[j] && j < i) {
                     continue;
                 }
-                match table.get(i * n + j) {
-                    Some(&LAZY_PAIR) => fresh.push((i as u32, j as u32)),
-                    Some(&p) if p != NO_PAIR => out.push(p),
-                    _ => {}
+                if self.lo[j][0] > self.hi[i][0] || self.lo[i][0] > self.hi[j][0] {
+                    continue;
                 }
+                self.report(i, j, table, out, fresh);
             }
         }
     }

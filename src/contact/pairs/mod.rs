@@ -47,12 +47,8 @@ struct Pair {
     b: usize,
     /// The first of its slots (global).
     slot_base: usize,
-    /// The features each of its slots held last step (`NO_KEY`: free).
-    keys: Vec<u64>,
     manifolds: Vec<ContactManifold<(), ()>>,
     workspace: Option<ContactManifoldsWorkspace>,
-    /// Dropped at the start (rule 4).
-    dropped: bool,
     /// A self pair (rule 4 applies).
     self_pair: bool,
     /// A unit axis (a's frame, from a toward b) that separated the two
@@ -81,6 +77,13 @@ pub struct PairContact {
     /// whatever order the pairs were made in. Apart from the pairs (sorted
     /// by every step: a pair's whole state need not be loaded for that).
     ords: Vec<u64>,
+    /// The features each pair's slots held last step (`NO_KEY`: free),
+    /// `max_points` a pair (pair p's at `p·max_points`): apart from the
+    /// pairs, in one array (no heap block of its own a pair).
+    keys: Vec<u64>,
+    /// Each pair dropped at the start (rule 4), apart from its state: the
+    /// visit tests it before loading the pair.
+    dropped: Vec<bool>,
     /// `table[i·n + j]`: the pair of members i, j ([`NO_PAIR`]: none allowed;
     /// [`LAZY_PAIR`]: allowed, not made yet).
     table: Vec<u32>,
@@ -234,6 +237,8 @@ impl PairContact {
             slot_offset,
             pairs: Vec::new(),
             ords: Vec::new(),
+            keys: Vec::new(),
+            dropped: Vec::new(),
         };
         // self pairs now (rule 4 looks at them before the first step)
         for a in 0..n {
@@ -281,14 +286,14 @@ impl PairContact {
         let self_pair = self.model_of[a].is_some() && self.model_of[a] == self.model_of[b];
         let ord = ga.min(gb) * self.ngeoms + ga.max(gb);
         self.ords.push(ord);
+        self.keys.extend(std::iter::repeat_n(NO_KEY, maxp));
+        self.dropped.push(false);
         self.pairs.push(Pair {
             a,
             b,
             slot_base: self.slot_offset + p as usize * maxp,
-            keys: vec![NO_KEY; maxp],
             manifolds: Vec::new(),
             workspace: None,
-            dropped: false,
             self_pair,
             axis: Vector3::zeros(),
             apart: None,
@@ -301,8 +306,8 @@ impl PairContact {
     /// Forgets every pair's manifolds and the features its slots held: the
     /// next detection finds what a newly built one would.
     pub fn forget_history(&mut self) {
+        self.keys.fill(NO_KEY);
         for pair in self.pairs.iter_mut() {
-            pair.keys.iter_mut().for_each(|k| *k = NO_KEY);
             pair.manifolds.clear();
             pair.workspace = None;
             pair.apart = None;
@@ -377,20 +382,31 @@ impl PairContact {
         }
         self.live.clear();
         let mut next = 0;
+        let maxp = self.max_points;
         for vi in 0..self.visit.len() {
             let (ord, pi) = self.visit[vi];
             let pi = pi as usize;
+            // the pair two visits on loaded now (its first cache line: a
+            // pile's pairs are far apart in memory), while this one is worked
+            if let Some(&(_, ahead)) = self.visit.get(vi + 2) {
+                if let Some(p) = self.pairs.get(ahead as usize) {
+                    std::hint::black_box(p.a);
+                }
+            }
             let hit = next < self.overlapping.len() && self.overlapping[next].1 as usize == pi;
             if hit {
                 next += 1;
             }
-            let Some(pair) = self.pairs.get_mut(pi) else {
+            let (Some(pair), Some(keys)) = (
+                self.pairs.get_mut(pi),
+                self.keys.get_mut(pi * maxp..(pi + 1) * maxp),
+            ) else {
                 continue;
             };
-            if !hit || pair.dropped {
+            if !hit || self.dropped[pi] {
                 pair.apart = None;
-                if pair.keys[0] != NO_KEY || !pair.manifolds.is_empty() {
-                    pair.keys.iter_mut().for_each(|k| *k = NO_KEY);
+                if keys[0] != NO_KEY || !pair.manifolds.is_empty() {
+                    keys.fill(NO_KEY);
                     pair.manifolds.clear();
                 }
                 continue;
@@ -479,7 +495,7 @@ impl PairContact {
                 fresh: true,
                 key: r.key,
             });
-            assign_slots(pair, &mut out[start..]);
+            assign_slots(pair.slot_base, keys, &mut out[start..]);
         }
     }
 
@@ -488,8 +504,8 @@ impl PairContact {
     /// before; returns them, with their links, from `model`.
     pub fn drop_start_overlaps(&mut self, model: &Model, o_m_i: &[Se3<f64>]) -> Vec<DroppedPair> {
         let mut out = Vec::new();
-        for pair in &mut self.pairs {
-            pair.dropped = false;
+        self.dropped.fill(false);
+        for (pi, pair) in self.pairs.iter_mut().enumerate() {
             if !pair.self_pair {
                 continue;
             }
@@ -504,9 +520,12 @@ impl PairContact {
             );
             if let Ok(Some(c)) = c {
                 if c.dist < -START_OVERLAP {
-                    pair.dropped = true;
+                    self.dropped[pi] = true;
                     pair.manifolds.clear();
-                    pair.keys.iter_mut().for_each(|k| *k = NO_KEY);
+                    let maxp = self.max_points;
+                    if let Some(k) = self.keys.get_mut(pi * maxp..(pi + 1) * maxp) {
+                        k.fill(NO_KEY);
+                    }
                     let link = |m: &Member| {
                         model
                             .collisions
@@ -531,7 +550,7 @@ impl PairContact {
 
     /// Whether a pair is dropped (rule 4), by its index ([`ContactPoint::shape`]).
     pub fn is_dropped(&self, pair: usize) -> bool {
-        self.pairs.get(pair).is_some_and(|p| p.dropped)
+        self.dropped.get(pair).copied().unwrap_or(false)
     }
 }
 
@@ -550,16 +569,16 @@ fn set_box(sap: &mut SweepAndPrune, k: usize, m: &Member, w: &Se3<f64>, margin: 
 
 /// Puts each of a pair's points in a slot: the one that held the same
 /// features last step (not fresh), else a free one (fresh).
-fn assign_slots(pair: &mut Pair, pts: &mut [ContactPoint]) {
-    let maxp = pair.keys.len();
+fn assign_slots(slot_base: usize, keys: &mut [u64], pts: &mut [ContactPoint]) {
+    let maxp = keys.len();
     let mut taken = [false; 64];
     let mut placed = [false; 64];
     for (k, p) in pts.iter_mut().enumerate().take(64) {
-        if let Some(s) = pair.keys.iter().position(|&key| key == p.key) {
+        if let Some(s) = keys.iter().position(|&key| key == p.key) {
             if !taken[s] {
                 taken[s] = true;
                 placed[k] = true;
-                p.slot = pair.slot_base + s;
+                p.slot = slot_base + s;
                 p.fresh = false;
             }
         }
@@ -570,13 +589,13 @@ fn assign_slots(pair: &mut Pair, pts: &mut [ContactPoint]) {
         }
         if let Some(s) = (0..maxp.min(64)).find(|&s| !taken[s]) {
             taken[s] = true;
-            p.slot = pair.slot_base + s;
+            p.slot = slot_base + s;
             p.fresh = true;
         }
     }
-    for (s, key) in pair.keys.iter_mut().enumerate() {
+    for (s, key) in keys.iter_mut().enumerate() {
         *key = NO_KEY;
-        if let Some(p) = pts.iter().find(|p| p.slot == pair.slot_base + s) {
+        if let Some(p) = pts.iter().find(|p| p.slot == slot_base + s) {
             *key = p.key;
         }
     }
