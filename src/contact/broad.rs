@@ -30,6 +30,68 @@ pub(crate) const NO_PAIR: u32 = u32::MAX;
 /// first overlap: a pile of n shapes allows n²/2 pairs and ever touches O(n)).
 pub(crate) const LAZY_PAIR: u32 = u32::MAX - 1;
 
+/// The pairs of shapes the filter allows, and the index of those made: a bit
+/// a pair of shapes (n²/8 bytes: a row of the table is two cache lines for a
+/// thousand shapes, where a table of pair indices, 4n² bytes, costs a cache
+/// miss per overlapping pair) and each shape's made pairs as (other, pair).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct PairTable {
+    n: usize,
+    words: usize,
+    bits: Vec<u64>,
+    made: Vec<Vec<(u32, u32)>>,
+}
+
+impl PairTable {
+    /// No pair allowed among `n` shapes.
+    pub fn new(n: usize) -> Self {
+        let words = n.div_ceil(64);
+        Self {
+            n,
+            words,
+            bits: vec![0; n * words],
+            made: vec![Vec::new(); n],
+        }
+    }
+    /// Allows the pair of shapes i, j (not made yet).
+    pub fn allow(&mut self, i: usize, j: usize) {
+        if i < self.n && j < self.n {
+            self.bits[i * self.words + j / 64] |= 1 << (j % 64);
+            self.bits[j * self.words + i / 64] |= 1 << (i % 64);
+        }
+    }
+    /// Whether the pair of shapes i, j is allowed.
+    #[inline]
+    pub fn allowed(&self, i: usize, j: usize) -> bool {
+        i < self.n && j < self.n && self.bits[i * self.words + j / 64] & (1 << (j % 64)) != 0
+    }
+    /// The pair of shapes i, j: its index, [`LAZY_PAIR`] (allowed, not made)
+    /// or [`NO_PAIR`].
+    #[inline]
+    pub fn get(&self, i: usize, j: usize) -> u32 {
+        if !self.allowed(i, j) {
+            return NO_PAIR;
+        }
+        // the shorter list (a wall meets many shapes, a box few)
+        let (k, other) = if self.made[i].len() <= self.made[j].len() {
+            (i, j)
+        } else {
+            (j, i)
+        };
+        self.made[k]
+            .iter()
+            .find(|e| e.0 as usize == other)
+            .map_or(LAZY_PAIR, |e| e.1)
+    }
+    /// Records pair `p` made for the allowed shapes i, j.
+    pub fn set(&mut self, i: usize, j: usize, p: u32) {
+        if self.allowed(i, j) {
+            self.made[i].push((j as u32, p));
+            self.made[j].push((i as u32, p));
+        }
+    }
+}
+
 /// The sweep's state.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SweepAndPrune {
@@ -78,10 +140,10 @@ impl SweepAndPrune {
         self.hi[i] = [c[0] + h[0], c[1] + h[1], c[2] + h[2]];
     }
 
-    /// The overlapping pairs the table allows (`table[i·n + j]` the pair index
-    /// of shapes i, j, or [`NO_PAIR`]), appended to `out`; those marked
+    /// The overlapping pairs the table allows (`table.get(i, j)` the pair
+    /// index of shapes i, j, or [`NO_PAIR`]), appended to `out`; those marked
     /// [`LAZY_PAIR`] (allowed, not made yet) as shapes (i, j) to `fresh`.
-    pub fn overlaps(&mut self, table: &[u32], out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
+    pub fn overlaps(&mut self, table: &PairTable, out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
         let n = self.lo.len();
         if n < STRIPS_FROM {
             self.sweep_x(table, out, fresh);
@@ -97,24 +159,23 @@ impl SweepAndPrune {
         &self,
         i: usize,
         j: usize,
-        table: &[u32],
+        table: &PairTable,
         out: &mut Vec<u32>,
         fresh: &mut Vec<(u32, u32)>,
     ) {
-        let n = self.lo.len();
         let (li, hi, lj, hj) = (self.lo[i], self.hi[i], self.lo[j], self.hi[j]);
         if lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2] {
             return;
         }
-        match table.get(i * n + j) {
-            Some(&LAZY_PAIR) => fresh.push((i as u32, j as u32)),
-            Some(&p) if p != NO_PAIR => out.push(p),
-            _ => {}
+        match table.get(i, j) {
+            LAZY_PAIR => fresh.push((i as u32, j as u32)),
+            NO_PAIR => {}
+            p => out.push(p),
         }
     }
 
     /// One sweep along x over every shape.
-    fn sweep_x(&mut self, table: &[u32], out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
+    fn sweep_x(&mut self, table: &PairTable, out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
         let n = self.order.len();
         // insertion sort by lower x
         for k in 1..n {
@@ -140,7 +201,7 @@ impl SweepAndPrune {
     }
 
     /// Strips along y, each swept along x with the next (module docs).
-    fn sweep_strips(&mut self, table: &[u32], out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
+    fn sweep_strips(&mut self, table: &PairTable, out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
         let n = self.lo.len();
         // the strips' width: the widest ordinary y-extent
         self.ext.clear();
@@ -282,14 +343,17 @@ mod tests {
             s.set(i, [x, 0.0, 0.0], [1.0; 3]);
         }
         // every pair allowed, pair index = 10·min + max
-        let mut table = vec![NO_PAIR; 16];
-        for i in 0..4 {
-            for j in 0..4 {
-                if i != j {
-                    table[i * 4 + j] = (10 * i.min(j) + i.max(j)) as u32;
+        let every = || {
+            let mut t = PairTable::new(4);
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    t.allow(i, j);
+                    t.set(i, j, (10 * i + j) as u32);
                 }
             }
-        }
+            t
+        };
+        let mut table = every();
         let mut out = Vec::new();
         s.overlaps(&table, &mut out, &mut Vec::new());
         out.sort();
@@ -301,19 +365,83 @@ mod tests {
         assert!(out.is_empty(), "{out:?}");
         // a pair the filter forbids is not reported
         s.set(2, [1.5, 0.0, 0.0], [1.0; 3]);
-        table[1 * 4 + 2] = NO_PAIR;
-        table[2 * 4 + 1] = NO_PAIR;
+        table = PairTable::new(4);
+        for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 3), (2, 3)] {
+            table.allow(i, j);
+            table.set(i, j, (10 * i + j) as u32);
+        }
         out.clear();
         s.overlaps(&table, &mut out, &mut Vec::new());
         assert_eq!(out, vec![23]);
         // a pair allowed but not made yet is reported by its shapes
-        table[1 * 4 + 2] = LAZY_PAIR;
-        table[2 * 4 + 1] = LAZY_PAIR;
+        table.allow(1, 2);
         out.clear();
         let mut fresh = Vec::new();
         s.overlaps(&table, &mut out, &mut fresh);
         assert_eq!(out, vec![23]);
         let fresh: Vec<_> = fresh.iter().map(|&(i, j)| (i.min(j), i.max(j))).collect();
         assert_eq!(fresh, vec![(1, 2)]);
+    }
+    #[test]
+    fn strips_find_exactly_the_overlapping_pairs() {
+        // 300 boxes of assorted sizes over a 4 m floor, four long walls and a
+        // box never set: the strips' pairs are those of a test of every pair
+        let n = 305;
+        let mut s = SweepAndPrune::new(n);
+        let mut table = PairTable::new(n);
+        for i in 0..n {
+            for j in i + 1..n {
+                if (i + 2 * j) % 7 != 0 {
+                    table.allow(i, j);
+                    if (i * j) % 3 == 0 {
+                        table.set(i, j, (i * n + j) as u32);
+                    }
+                }
+            }
+        }
+        let mut x = 12345u64;
+        let mut rnd = || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let walls = [
+            ([-2.05, 0.0, 0.3], [0.05, 2.1, 0.3]),
+            ([2.05, 0.0, 0.3], [0.05, 2.1, 0.3]),
+            ([0.0, -2.05, 0.3], [2.0, 0.05, 0.3]),
+            ([0.0, 2.05, 0.3], [2.0, 0.05, 0.3]),
+        ];
+        for round in 0..3 {
+            for i in 0..n - 1 {
+                if i < 4 {
+                    s.set(i, walls[i].0, walls[i].1);
+                } else if round == 0 || i % 3 == round {
+                    let c = [4.0 * rnd() - 2.0, 4.0 * rnd() - 2.0, rnd()];
+                    let h = 0.03 + 0.1 * rnd();
+                    s.set(i, c, [h, 0.5 * h + 0.05 * rnd(), h]);
+                }
+            }
+            let (mut out, mut fresh) = (Vec::new(), Vec::new());
+            s.overlaps(&table, &mut out, &mut fresh);
+            let mut got: Vec<(usize, usize)> = fresh
+                .iter()
+                .map(|&(i, j)| ((i as usize).min(j as usize), (i as usize).max(j as usize)))
+                .collect();
+            got.extend(out.iter().map(|&p| (p as usize / n, p as usize % n)));
+            got.sort();
+            let mut want = Vec::new();
+            for i in 0..n {
+                for j in i + 1..n {
+                    let (a, b, c, d) = (s.lo[i], s.hi[i], s.lo[j], s.hi[j]);
+                    let over = (0..3).all(|k| c[k] <= b[k] && a[k] <= d[k]);
+                    if over && table.allowed(i, j) {
+                        want.push((i, j));
+                    }
+                }
+            }
+            assert!(want.len() > 40, "{}", want.len());
+            assert_eq!(got, want, "round {round}");
+        }
     }
 }

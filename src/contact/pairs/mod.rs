@@ -13,7 +13,7 @@
 //! pair's slots: the slot of the same features last step (its impulse warm
 //! starts the solve), else a free one marked fresh (no warm start).
 
-use super::broad::{SweepAndPrune, LAZY_PAIR, NO_PAIR};
+use super::broad::{PairTable, SweepAndPrune, LAZY_PAIR};
 use super::filter::{is_self_pair, may_touch, DroppedPair, START_OVERLAP};
 use super::narrow::{face_kind, face_points, parry_points, reduce_pair, FaceScratch, Raw};
 use super::shapes::{from_pvec, pair_shape, to_pose, PairShape};
@@ -84,9 +84,9 @@ pub struct PairContact {
     /// Each pair dropped at the start (rule 4), apart from its state: the
     /// visit tests it before loading the pair.
     dropped: Vec<bool>,
-    /// `table[i·n + j]`: the pair of members i, j ([`NO_PAIR`]: none allowed;
-    /// [`LAZY_PAIR`]: allowed, not made yet).
-    table: Vec<u32>,
+    /// The pair of members i, j (`table.get(i, j)`: none allowed, allowed
+    /// and not made yet, or its index).
+    table: PairTable,
     /// Pairs the filter allows (made or not).
     allowed: usize,
     /// The friction of each member's geometry, and whether two members are
@@ -188,7 +188,7 @@ impl PairContact {
         }
         let n = members.len();
         let maxp = params.max_points_per_shape.max(1);
-        let mut table = vec![NO_PAIR; n * n];
+        let mut table = PairTable::new(n);
         let mut allowed = 0;
         let friction: Vec<f64> = members.iter().map(|m| g[m.geom].friction).collect();
         let model_of: Vec<Option<usize>> = members
@@ -208,8 +208,7 @@ impl PairContact {
                     continue; // two non-convex shapes (both static): never
                 }
                 allowed += 1;
-                table[a * n + b] = LAZY_PAIR;
-                table[b * n + a] = LAZY_PAIR;
+                table.allow(a, b);
             }
         }
         let mut made = Self {
@@ -244,7 +243,7 @@ impl PairContact {
         for a in 0..n {
             for b in a + 1..n {
                 let self_pair = made.model_of[a].is_some() && made.model_of[a] == made.model_of[b];
-                if self_pair && made.table[a * n + b] == LAZY_PAIR {
+                if self_pair && made.table.get(a, b) == LAZY_PAIR {
                     made.make_pair(a, b);
                 }
             }
@@ -266,7 +265,6 @@ impl PairContact {
     /// Makes the pair of members `i` and `j` (allowed, not made yet): its
     /// state, its slots (the next `max_points`), its place in the table.
     fn make_pair(&mut self, i: usize, j: usize) -> u32 {
-        let n = self.members.len();
         // members are in geometry order: the lower one first, as the filter
         // enumerated them (the sweep meets them in either order)
         let (i, j) = (i.min(j), i.max(j));
@@ -280,8 +278,7 @@ impl PairContact {
         };
         let (ga, gb) = (self.members[a].geom as u64, self.members[b].geom as u64);
         let p = self.pairs.len() as u32;
-        self.table[a * n + b] = p;
-        self.table[b * n + a] = p;
+        self.table.set(a, b, p);
         let maxp = self.max_points;
         let self_pair = self.model_of[a].is_some() && self.model_of[a] == self.model_of[b];
         let ord = ga.min(gb) * self.ngeoms + ga.max(gb);
@@ -325,7 +322,7 @@ impl PairContact {
     pub fn geoms(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
         let n = self.members.len();
         (0..n * n)
-            .filter(move |&k| k / n < k % n && self.table[k] != NO_PAIR)
+            .filter(move |&k| k / n < k % n && self.table.allowed(k / n, k % n))
             .map(move |k| (self.members[k / n].geom, self.members[k % n].geom))
     }
 
@@ -386,11 +383,15 @@ impl PairContact {
         for vi in 0..self.visit.len() {
             let (ord, pi) = self.visit[vi];
             let pi = pi as usize;
-            // the pair two visits on loaded now (its first cache line: a
-            // pile's pairs are far apart in memory), while this one is worked
-            if let Some(&(_, ahead)) = self.visit.get(vi + 2) {
-                if let Some(p) = self.pairs.get(ahead as usize) {
-                    std::hint::black_box(p.a);
+            // the pair four visits on fetched now (a pile's pairs lie far
+            // apart in memory: a cache miss each), while this one is worked
+            if let Some(&(_, ahead)) = self.visit.get(vi + 4) {
+                let ahead = ahead as usize;
+                if let Some(p) = self.pairs.get(ahead) {
+                    prefetch(p);
+                }
+                if let Some(k) = self.keys.get(ahead * maxp) {
+                    prefetch(k);
                 }
             }
             let hit = next < self.overlapping.len() && self.overlapping[next].1 as usize == pi;
@@ -552,6 +553,20 @@ impl PairContact {
     pub fn is_dropped(&self, pair: usize) -> bool {
         self.dropped.get(pair).copied().unwrap_or(false)
     }
+}
+
+/// Asks the cache for the line holding `x` (no effect on any result).
+#[inline(always)]
+fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        // SAFETY: a prefetch is a hint (it reads nothing into the program
+        // and cannot fault); SSE is part of x86_64.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast::<i8>()) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
 }
 
 /// Sets member `k`'s broad-phase box: its shape's box at the world pose `w`
