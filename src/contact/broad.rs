@@ -30,66 +30,74 @@ pub(crate) const NO_PAIR: u32 = u32::MAX;
 /// first overlap: a pile of n shapes allows n²/2 pairs and ever touches O(n)).
 pub(crate) const LAZY_PAIR: u32 = u32::MAX - 1;
 
-/// The pairs of shapes the filter allows, and the index of those made: a bit
-/// a pair of shapes (n²/8 bytes: a row of the table is two cache lines for a
-/// thousand shapes, where a table of pair indices, 4n² bytes, costs a cache
-/// miss per overlapping pair) and each shape's made pairs as (other, pair).
+/// The pairs of shapes the filter allows, and the index of those made: one
+/// entry a pair of shapes (`idx[i·n + j]`: a pair index, [`LAZY_PAIR`] or
+/// [`NO_PAIR`]).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct PairTable {
     n: usize,
-    words: usize,
-    bits: Vec<u64>,
-    made: Vec<Vec<(u32, u32)>>,
+    idx: Vec<u32>,
 }
 
 impl PairTable {
     /// No pair allowed among `n` shapes.
     pub fn new(n: usize) -> Self {
-        let words = n.div_ceil(64);
         Self {
             n,
-            words,
-            bits: vec![0; n * words],
-            made: vec![Vec::new(); n],
+            idx: vec![NO_PAIR; n * n],
         }
     }
     /// Allows the pair of shapes i, j (not made yet).
     pub fn allow(&mut self, i: usize, j: usize) {
         if i < self.n && j < self.n {
-            self.bits[i * self.words + j / 64] |= 1 << (j % 64);
-            self.bits[j * self.words + i / 64] |= 1 << (i % 64);
+            self.idx[i * self.n + j] = LAZY_PAIR;
+            self.idx[j * self.n + i] = LAZY_PAIR;
         }
     }
     /// Whether the pair of shapes i, j is allowed.
     #[inline]
     pub fn allowed(&self, i: usize, j: usize) -> bool {
-        i < self.n && j < self.n && self.bits[i * self.words + j / 64] & (1 << (j % 64)) != 0
+        self.get(i, j) != NO_PAIR
     }
     /// The pair of shapes i, j: its index, [`LAZY_PAIR`] (allowed, not made)
     /// or [`NO_PAIR`].
     #[inline]
     pub fn get(&self, i: usize, j: usize) -> u32 {
-        if !self.allowed(i, j) {
-            return NO_PAIR;
-        }
-        // the shorter list (a wall meets many shapes, a box few)
-        let (k, other) = if self.made[i].len() <= self.made[j].len() {
-            (i, j)
+        if i < self.n && j < self.n {
+            self.idx[i * self.n + j]
         } else {
-            (j, i)
-        };
-        self.made[k]
-            .iter()
-            .find(|e| e.0 as usize == other)
-            .map_or(LAZY_PAIR, |e| e.1)
+            NO_PAIR
+        }
+    }
+    /// Asks the cache for the entry of shapes i, j (a table of a thousand
+    /// shapes is 4 MB: an entry read cold is a cache miss).
+    #[inline(always)]
+    fn fetch(&self, i: usize, j: usize) {
+        if let Some(x) = self.idx.get(i * self.n + j) {
+            prefetch(x);
+        }
     }
     /// Records pair `p` made for the allowed shapes i, j.
     pub fn set(&mut self, i: usize, j: usize, p: u32) {
         if self.allowed(i, j) {
-            self.made[i].push((j as u32, p));
-            self.made[j].push((i as u32, p));
+            self.idx[i * self.n + j] = p;
+            self.idx[j * self.n + i] = p;
         }
     }
+}
+
+/// Asks the cache for the line holding `x` (no effect on any result).
+#[inline(always)]
+pub(crate) fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        // SAFETY: a prefetch is a hint (it reads nothing into the program
+        // and cannot fault); SSE is part of x86_64.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast::<i8>()) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
 }
 
 /// The sweep's state.
@@ -110,6 +118,9 @@ pub(crate) struct SweepAndPrune {
     ext: Vec<f64>,
     wide: Vec<u32>,
     merged: Vec<(u32, bool)>,
+    /// The sweep's pairs whose boxes overlap, in the sweep's order, before
+    /// the table is read (then read a few ahead of use).
+    cand: Vec<(u32, u32)>,
 }
 
 /// Shapes from which the floor is cut into strips.
@@ -130,6 +141,7 @@ impl SweepAndPrune {
             ext: Vec::with_capacity(n),
             wide: Vec::with_capacity(n),
             merged: Vec::with_capacity(n),
+            cand: Vec::new(),
         }
     }
 
@@ -145,37 +157,42 @@ impl SweepAndPrune {
     /// [`LAZY_PAIR`] (allowed, not made yet) as shapes (i, j) to `fresh`.
     pub fn overlaps(&mut self, table: &PairTable, out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
         let n = self.lo.len();
+        let mut cand = std::mem::take(&mut self.cand);
+        cand.clear();
         if n < STRIPS_FROM {
-            self.sweep_x(table, out, fresh);
+            self.sweep_x(&mut cand);
         } else {
-            self.sweep_strips(table, out, fresh);
+            self.sweep_strips(&mut cand);
         }
+        // the table read in the sweep's order, eight pairs ahead fetched
+        const AHEAD: usize = 8;
+        for k in 0..cand.len() {
+            if let Some(&(i, j)) = cand.get(k + AHEAD) {
+                table.fetch(i as usize, j as usize);
+            }
+            let (i, j) = cand[k];
+            match table.get(i as usize, j as usize) {
+                LAZY_PAIR => fresh.push((i, j)),
+                NO_PAIR => {}
+                p => out.push(p),
+            }
+        }
+        self.cand = cand;
     }
 
-    /// Shapes i and j (both boxes known to overlap in x) reported if their
-    /// boxes overlap in y and z and the table allows the pair.
+    /// Shapes i and j (both boxes known to overlap in x) kept if their
+    /// boxes overlap in y and z.
     #[inline(always)]
-    fn report(
-        &self,
-        i: usize,
-        j: usize,
-        table: &PairTable,
-        out: &mut Vec<u32>,
-        fresh: &mut Vec<(u32, u32)>,
-    ) {
+    fn report(&self, i: usize, j: usize, cand: &mut Vec<(u32, u32)>) {
         let (li, hi, lj, hj) = (self.lo[i], self.hi[i], self.lo[j], self.hi[j]);
         if lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2] {
             return;
         }
-        match table.get(i, j) {
-            LAZY_PAIR => fresh.push((i as u32, j as u32)),
-            NO_PAIR => {}
-            p => out.push(p),
-        }
+        cand.push((i as u32, j as u32));
     }
 
     /// One sweep along x over every shape.
-    fn sweep_x(&mut self, table: &PairTable, out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
+    fn sweep_x(&mut self, cand: &mut Vec<(u32, u32)>) {
         let n = self.order.len();
         // insertion sort by lower x
         for k in 1..n {
@@ -195,13 +212,13 @@ impl SweepAndPrune {
                 if self.lo[j][0] > hi[0] {
                     break;
                 }
-                self.report(i, j, table, out, fresh);
+                self.report(i, j, cand);
             }
         }
     }
 
     /// Strips along y, each swept along x with the next (module docs).
-    fn sweep_strips(&mut self, table: &PairTable, out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
+    fn sweep_strips(&mut self, cand: &mut Vec<(u32, u32)>) {
         let n = self.lo.len();
         // the strips' width: the widest ordinary y-extent
         self.ext.clear();
@@ -308,7 +325,7 @@ impl SweepAndPrune {
                         break;
                     }
                     if in_s || jn_s {
-                        self.report(i, j, table, out, fresh);
+                        self.report(i, j, cand);
                     }
                 }
             }
@@ -325,7 +342,7 @@ impl SweepAndPrune {
                 if self.lo[j][0] > self.hi[i][0] || self.lo[i][0] > self.hi[j][0] {
                     continue;
                 }
-                self.report(i, j, table, out, fresh);
+                self.report(i, j, cand);
             }
         }
     }

@@ -13,7 +13,7 @@
 //! pair's slots: the slot of the same features last step (its impulse warm
 //! starts the solve), else a free one marked fresh (no warm start).
 
-use super::broad::{PairTable, SweepAndPrune, LAZY_PAIR};
+use super::broad::{prefetch, PairTable, SweepAndPrune, LAZY_PAIR};
 use super::filter::{is_self_pair, may_touch, DroppedPair, START_OVERLAP};
 use super::narrow::{face_kind, face_points, parry_points, reduce_pair, FaceScratch, Raw};
 use super::shapes::{from_pvec, pair_shape, to_pose, PairShape};
@@ -553,20 +553,6 @@ impl PairContact {
     pub fn is_dropped(&self, pair: usize) -> bool {
         self.dropped.get(pair).copied().unwrap_or(false)
     }
-}
-
-/// Asks the cache for the line holding `x` (no effect on any result).
-#[inline(always)]
-fn prefetch<T>(x: &T) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        // SAFETY: a prefetch is a hint (it reads nothing into the program
-        // and cannot fault); SSE is part of x86_64.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast::<i8>()) };
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
 }
 
 /// Sets member `k`'s broad-phase box: its shape's box at the world pose `w`
