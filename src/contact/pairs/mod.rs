@@ -25,7 +25,9 @@ use parry3d_f64::query::{ContactManifold, ContactManifoldsWorkspace};
 use std::path::PathBuf;
 
 mod apart;
+mod order;
 use apart::{apart_along, still_apart};
+use order::assign_slots;
 
 /// One shape of pair contact.
 #[derive(Clone, Debug)]
@@ -84,6 +86,8 @@ pub struct PairContact {
     /// Each pair dropped at the start (rule 4), apart from its state: the
     /// visit tests it before loading the pair.
     dropped: Vec<bool>,
+    /// Pairs made since they were last put in visiting order ([`order`]).
+    made_since_sort: usize,
     /// The pair of members i, j (`table.get(i, j)`: none allowed, allowed
     /// and not made yet, or its index).
     table: PairTable,
@@ -238,6 +242,7 @@ impl PairContact {
             ords: Vec::new(),
             keys: Vec::new(),
             dropped: Vec::new(),
+            made_since_sort: 0,
         };
         // self pairs now (rule 4 looks at them before the first step)
         for a in 0..n {
@@ -285,6 +290,7 @@ impl PairContact {
         self.ords.push(ord);
         self.keys.extend(std::iter::repeat_n(NO_KEY, maxp));
         self.dropped.push(false);
+        self.made_since_sort += 1;
         self.pairs.push(Pair {
             a,
             b,
@@ -344,6 +350,7 @@ impl PairContact {
     /// they held and are not queried.
     pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
         let margin = self.margin;
+        self.keep_in_order();
         for &k in &self.moving {
             let m = &self.members[k];
             let w = world(m, o_m_i);
@@ -566,38 +573,4 @@ fn set_box(sap: &mut SweepAndPrune, k: usize, m: &Member, w: &Se3<f64>, margin: 
     let e =
         |i: usize| r[(i, 0)].abs() * h.x + r[(i, 1)].abs() * h.y + r[(i, 2)].abs() * h.z + margin;
     sap.set(k, [c.x, c.y, c.z], [e(0), e(1), e(2)]);
-}
-
-/// Puts each of a pair's points in a slot: the one that held the same
-/// features last step (not fresh), else a free one (fresh).
-fn assign_slots(slot_base: usize, keys: &mut [u64], pts: &mut [ContactPoint]) {
-    let maxp = keys.len();
-    let mut taken = [false; 64];
-    let mut placed = [false; 64];
-    for (k, p) in pts.iter_mut().enumerate().take(64) {
-        if let Some(s) = keys.iter().position(|&key| key == p.key) {
-            if !taken[s] {
-                taken[s] = true;
-                placed[k] = true;
-                p.slot = slot_base + s;
-                p.fresh = false;
-            }
-        }
-    }
-    for (k, p) in pts.iter_mut().enumerate().take(64) {
-        if placed[k] {
-            continue;
-        }
-        if let Some(s) = (0..maxp.min(64)).find(|&s| !taken[s]) {
-            taken[s] = true;
-            p.slot = slot_base + s;
-            p.fresh = true;
-        }
-    }
-    for (s, key) in keys.iter_mut().enumerate() {
-        *key = NO_KEY;
-        if let Some(p) = pts.iter().find(|p| p.slot == slot_base + s) {
-            *key = p.key;
-        }
-    }
 }
