@@ -245,7 +245,8 @@ impl SweepAndPrune {
             let ly = self.lo[i][1];
             // a shape with no box (never set) or no finite strip: with the wide ones
             let s = (ly / w).floor();
-            self.big[i] = !(e <= w) || !s.is_finite() || s.abs() > 1e15;
+            let ordinary = e <= w && s.is_finite() && s.abs() <= 1e15;
+            self.big[i] = !ordinary;
             self.strip[i] = if self.big[i] { 0 } else { s as i64 };
             if self.big[i] {
                 self.wide.push(i as u32);
@@ -261,8 +262,8 @@ impl SweepAndPrune {
             for &i in &self.order {
                 seen[i as usize] = true;
             }
-            for i in 0..n {
-                if !seen[i] && !self.big[i] {
+            for (i, (&seen, &big)) in seen.iter().zip(&self.big).enumerate() {
+                if !seen && !big {
                     self.order.push(i as u32);
                 }
             }
@@ -303,10 +304,12 @@ impl SweepAndPrune {
             merged.clear();
             let (mut i, mut j) = (a, b);
             while i < b || j < c {
+                // (as the sort: i first unless its lower x is greater)
                 let take_i = j >= c
                     || (i < b
-                        && !(self.lo[self.order[i] as usize][0]
-                            > self.lo[self.order[j] as usize][0]));
+                        && self.lo[self.order[i] as usize][0]
+                            .partial_cmp(&self.lo[self.order[j] as usize][0])
+                            != Some(std::cmp::Ordering::Greater));
                 if take_i {
                     merged.push((self.order[i], true));
                     i += 1;
