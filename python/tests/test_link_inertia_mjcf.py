@@ -27,8 +27,13 @@ def test_link_mass_and_inertia_are_mujocos(name):
         assert abs(mass - want["mass"]) <= 1e-10 * max(1.0, want["mass"]), (body, mass, want["mass"])
         com, inertia = m.link_inertia(body)
         np.testing.assert_allclose(com, want["com"], rtol=0, atol=1e-10)
-        scale = max(1e-3, np.max(np.abs(want["inertia"])))
-        np.testing.assert_allclose(inertia, want["inertia"], rtol=0, atol=1e-9 * scale)
+        # within 1e-10 as the issue and tests/mjcf_oracle.rs read it (absolute below
+        # 1 kg·m²): MuJoCo stores a body's inertia as principal values and a
+        # quaternion (body_iquat), and rebuilding the matrix from them carries its
+        # eigen-decomposition's error, ~2e-11 kg·m² on dog's off-diagonals (5e-9 of
+        # the body's largest moment)
+        scale = max(1.0, np.max(np.abs(want["inertia"])))
+        np.testing.assert_allclose(inertia, want["inertia"], rtol=0, atol=1e-10 * scale)
 
 
 def test_a_body_with_geoms_only_has_their_mass_and_pickles_with_it():

@@ -2,17 +2,103 @@
 //!
 //! Each shape's box is its own box (in its frame) at its pose, boxed again
 //! along the world axes (centre R·c + t, half extents |R|·h) and grown by the
-//! detection margin, refreshed every step for the shapes that move. The shapes
-//! are kept sorted by their boxes' lower x (an insertion sort: nearly sorted
-//! from step to step, O(n)); a sweep along x meets each shape only the shapes
-//! whose x-interval overlaps its own, and keeps the pairs that also overlap in
-//! y and z and that the pair filter allows (a table of pair indices).
+//! detection margin, refreshed every step for the shapes that move.
+//!
+//! Few shapes (fewer than [`STRIPS_FROM`]): the shapes are kept sorted by their
+//! boxes' lower x (an insertion sort: nearly sorted from step to step, O(n));
+//! a sweep along x meets each shape only the shapes whose x-interval overlaps
+//! its own, and keeps the pairs that also overlap in y and z and that the
+//! pair filter allows (a table of pair indices).
+//!
+//! Many shapes: one sweep along x meets, for each shape, every shape of its
+//! x-slab, O(n^1.5) for shapes spread over a square floor (a pile in a bin).
+//! The floor is cut into strips along y, each as wide as the widest y-extent
+//! of the ordinary shapes (those at most [`BIG`] times the median y-extent):
+//! two boxes that overlap in y then lie in one strip or in two neighbouring
+//! ones (by their lower y). The shapes are kept sorted by (strip, lower x)
+//! (the same insertion sort), and strip s is swept along x merged with strip
+//! s + 1, keeping the pairs with a member in s: each overlapping pair once,
+//! and a shape meets only the shapes of its slab in two strips (O(n) for a
+//! floor that grows with the pile). The few shapes wider than the strips (the
+//! walls of a bin, a long obstacle) are tested against every shape. Either
+//! way the pairs reported are exactly those whose boxes overlap (in another
+//! order: the caller sorts them).
 
 /// "No pair" in the pair table.
 pub(crate) const NO_PAIR: u32 = u32::MAX;
 /// A pair the filter allows whose state is not made yet (made when its boxes
 /// first overlap: a pile of n shapes allows n²/2 pairs and ever touches O(n)).
 pub(crate) const LAZY_PAIR: u32 = u32::MAX - 1;
+
+/// The pairs of shapes the filter allows, and the index of those made: one
+/// entry a pair of shapes (`idx[i·n + j]`: a pair index, [`LAZY_PAIR`] or
+/// [`NO_PAIR`]).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct PairTable {
+    n: usize,
+    idx: Vec<u32>,
+}
+
+impl PairTable {
+    /// No pair allowed among `n` shapes.
+    pub fn new(n: usize) -> Self {
+        Self {
+            n,
+            idx: vec![NO_PAIR; n * n],
+        }
+    }
+    /// Allows the pair of shapes i, j (not made yet).
+    pub fn allow(&mut self, i: usize, j: usize) {
+        if i < self.n && j < self.n {
+            self.idx[i * self.n + j] = LAZY_PAIR;
+            self.idx[j * self.n + i] = LAZY_PAIR;
+        }
+    }
+    /// Whether the pair of shapes i, j is allowed.
+    #[inline]
+    pub fn allowed(&self, i: usize, j: usize) -> bool {
+        self.get(i, j) != NO_PAIR
+    }
+    /// The pair of shapes i, j: its index, [`LAZY_PAIR`] (allowed, not made)
+    /// or [`NO_PAIR`].
+    #[inline]
+    pub fn get(&self, i: usize, j: usize) -> u32 {
+        if i < self.n && j < self.n {
+            self.idx[i * self.n + j]
+        } else {
+            NO_PAIR
+        }
+    }
+    /// Asks the cache for the entry of shapes i, j (a table of a thousand
+    /// shapes is 4 MB: an entry read cold is a cache miss).
+    #[inline(always)]
+    fn fetch(&self, i: usize, j: usize) {
+        if let Some(x) = self.idx.get(i * self.n + j) {
+            prefetch(x);
+        }
+    }
+    /// Records pair `p` made for the allowed shapes i, j.
+    pub fn set(&mut self, i: usize, j: usize, p: u32) {
+        if self.allowed(i, j) {
+            self.idx[i * self.n + j] = p;
+            self.idx[j * self.n + i] = p;
+        }
+    }
+}
+
+/// Asks the cache for the line holding `x` (no effect on any result).
+#[inline(always)]
+pub(crate) fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        // SAFETY: a prefetch is a hint (it reads nothing into the program
+        // and cannot fault); SSE is part of x86_64.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast::<i8>()) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
 
 /// The sweep's state.
 #[derive(Clone, Debug, Default)]
@@ -21,9 +107,27 @@ pub(crate) struct SweepAndPrune {
     pub lo: Vec<[f64; 3]>,
     /// Upper corners.
     pub hi: Vec<[f64; 3]>,
-    /// The shapes by their boxes' lower x.
+    /// The shapes by their boxes' lower x (with strips: the ordinary shapes
+    /// by (strip, lower x)).
     order: Vec<u32>,
+    /// Each shape's strip (strips only), and whether it is wider than a strip.
+    strip: Vec<i64>,
+    big: Vec<bool>,
+    /// Scratch: the y-extents (for their median), the shapes wider than a
+    /// strip, and two strips merged by lower x (shape, in the lower strip).
+    ext: Vec<f64>,
+    wide: Vec<u32>,
+    merged: Vec<(u32, bool)>,
+    /// The sweep's pairs whose boxes overlap, in the sweep's order, before
+    /// the table is read (then read a few ahead of use).
+    cand: Vec<(u32, u32)>,
 }
+
+/// Shapes from which the floor is cut into strips.
+pub(crate) const STRIPS_FROM: usize = 64;
+/// A shape whose y-extent is above this many times the median is tested
+/// against every shape (not put in a strip).
+const BIG: f64 = 4.0;
 
 impl SweepAndPrune {
     /// Room for `n` shapes (boxes empty until set).
@@ -32,6 +136,12 @@ impl SweepAndPrune {
             lo: vec![[f64::INFINITY; 3]; n],
             hi: vec![[f64::NEG_INFINITY; 3]; n],
             order: (0..n as u32).collect(),
+            strip: vec![0; n],
+            big: vec![false; n],
+            ext: Vec::with_capacity(n),
+            wide: Vec::with_capacity(n),
+            merged: Vec::with_capacity(n),
+            cand: Vec::new(),
         }
     }
 
@@ -42,10 +152,47 @@ impl SweepAndPrune {
         self.hi[i] = [c[0] + h[0], c[1] + h[1], c[2] + h[2]];
     }
 
-    /// The overlapping pairs the table allows (`table[i·n + j]` the pair index
-    /// of shapes i, j, or [`NO_PAIR`]), appended to `out`; those marked
+    /// The overlapping pairs the table allows (`table.get(i, j)` the pair
+    /// index of shapes i, j, or [`NO_PAIR`]), appended to `out`; those marked
     /// [`LAZY_PAIR`] (allowed, not made yet) as shapes (i, j) to `fresh`.
-    pub fn overlaps(&mut self, table: &[u32], out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
+    pub fn overlaps(&mut self, table: &PairTable, out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
+        let n = self.lo.len();
+        let mut cand = std::mem::take(&mut self.cand);
+        cand.clear();
+        if n < STRIPS_FROM {
+            self.sweep_x(&mut cand);
+        } else {
+            self.sweep_strips(&mut cand);
+        }
+        // the table read in the sweep's order, eight pairs ahead fetched
+        const AHEAD: usize = 8;
+        for k in 0..cand.len() {
+            if let Some(&(i, j)) = cand.get(k + AHEAD) {
+                table.fetch(i as usize, j as usize);
+            }
+            let (i, j) = cand[k];
+            match table.get(i as usize, j as usize) {
+                LAZY_PAIR => fresh.push((i, j)),
+                NO_PAIR => {}
+                p => out.push(p),
+            }
+        }
+        self.cand = cand;
+    }
+
+    /// Shapes i and j (both boxes known to overlap in x) kept if their
+    /// boxes overlap in y and z.
+    #[inline(always)]
+    fn report(&self, i: usize, j: usize, cand: &mut Vec<(u32, u32)>) {
+        let (li, hi, lj, hj) = (self.lo[i], self.hi[i], self.lo[j], self.hi[j]);
+        if lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2] {
+            return;
+        }
+        cand.push((i as u32, j as u32));
+    }
+
+    /// One sweep along x over every shape.
+    fn sweep_x(&mut self, cand: &mut Vec<(u32, u32)>) {
         let n = self.order.len();
         // insertion sort by lower x
         for k in 1..n {
@@ -59,22 +206,146 @@ impl SweepAndPrune {
         }
         for k in 0..n {
             let i = self.order[k] as usize;
-            let (li, hi) = (self.lo[i], self.hi[i]);
+            let hi = self.hi[i];
             for &j in &self.order[k + 1..] {
                 let j = j as usize;
-                let lj = self.lo[j];
-                if lj[0] > hi[0] {
+                if self.lo[j][0] > hi[0] {
                     break;
                 }
-                let hj = self.hi[j];
-                if lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2] {
+                self.report(i, j, cand);
+            }
+        }
+    }
+
+    /// Strips along y, each swept along x with the next (module docs).
+    fn sweep_strips(&mut self, cand: &mut Vec<(u32, u32)>) {
+        let n = self.lo.len();
+        // the strips' width: the widest ordinary y-extent
+        self.ext.clear();
+        self.ext.extend(
+            (0..n)
+                .map(|i| self.hi[i][1] - self.lo[i][1])
+                .filter(|e| e.is_finite()),
+        );
+        let w = if self.ext.is_empty() {
+            f64::INFINITY
+        } else {
+            let mid = self.ext.len() / 2;
+            let med = *self.ext.select_nth_unstable_by(mid, f64::total_cmp).1;
+            self.ext
+                .iter()
+                .copied()
+                .filter(|&e| e <= BIG * med)
+                .fold(0.0f64, f64::max)
+        };
+        let w = if w > 0.0 { w } else { f64::INFINITY };
+        self.wide.clear();
+        for i in 0..n {
+            let e = self.hi[i][1] - self.lo[i][1];
+            let ly = self.lo[i][1];
+            // a shape with no box (never set) or no finite strip: with the wide ones
+            let s = (ly / w).floor();
+            let ordinary = e <= w && s.is_finite() && s.abs() <= 1e15;
+            self.big[i] = !ordinary;
+            self.strip[i] = if self.big[i] { 0 } else { s as i64 };
+            if self.big[i] {
+                self.wide.push(i as u32);
+            }
+        }
+        // the ordinary shapes by (strip, lower x): last step's order, the
+        // wide ones out, then an insertion sort (nearly sorted)
+        let big = &self.big;
+        self.order.retain(|&i| !big[i as usize]);
+        if self.order.len() + self.wide.len() < n {
+            // a shape wide last step and ordinary now (or at the start)
+            let mut seen = vec![false; n];
+            for &i in &self.order {
+                seen[i as usize] = true;
+            }
+            for (i, (&seen, &big)) in seen.iter().zip(&self.big).enumerate() {
+                if !seen && !big {
+                    self.order.push(i as u32);
+                }
+            }
+        }
+        let before = |a: usize, b: usize, lo: &[[f64; 3]], st: &[i64]| {
+            st[a] > st[b] || (st[a] == st[b] && lo[a][0] > lo[b][0])
+        };
+        for k in 1..self.order.len() {
+            let mut m = k;
+            while m > 0
+                && before(
+                    self.order[m - 1] as usize,
+                    self.order[m] as usize,
+                    &self.lo,
+                    &self.strip,
+                )
+            {
+                self.order.swap(m - 1, m);
+                m -= 1;
+            }
+        }
+        // each strip merged with the next by lower x, swept
+        let mut merged = std::mem::take(&mut self.merged);
+        let len = self.order.len();
+        let mut a = 0;
+        while a < len {
+            let s = self.strip[self.order[a] as usize];
+            let mut b = a;
+            while b < len && self.strip[self.order[b] as usize] == s {
+                b += 1;
+            }
+            let mut c = b;
+            if b < len && self.strip[self.order[b] as usize] == s + 1 {
+                while c < len && self.strip[self.order[c] as usize] == s + 1 {
+                    c += 1;
+                }
+            }
+            merged.clear();
+            let (mut i, mut j) = (a, b);
+            while i < b || j < c {
+                // (as the sort: i first unless its lower x is greater)
+                let take_i = j >= c
+                    || (i < b
+                        && self.lo[self.order[i] as usize][0]
+                            .partial_cmp(&self.lo[self.order[j] as usize][0])
+                            != Some(std::cmp::Ordering::Greater));
+                if take_i {
+                    merged.push((self.order[i], true));
+                    i += 1;
+                } else {
+                    merged.push((self.order[j], false));
+                    j += 1;
+                }
+            }
+            for k in 0..merged.len() {
+                let (i, in_s) = merged[k];
+                let i = i as usize;
+                let hx = self.hi[i][0];
+                for &(j, jn_s) in &merged[k + 1..] {
+                    let j = j as usize;
+                    if self.lo[j][0] > hx {
+                        break;
+                    }
+                    if in_s || jn_s {
+                        self.report(i, j, cand);
+                    }
+                }
+            }
+            a = b;
+        }
+        self.merged = merged;
+        // the wide shapes against every shape (a pair of two wide ones once)
+        for wi in 0..self.wide.len() {
+            let i = self.wide[wi] as usize;
+            for j in 0..n {
+                if j == i || (self.big[j] && j < i) {
                     continue;
                 }
-                match table.get(i * n + j) {
-                    Some(&LAZY_PAIR) => fresh.push((i as u32, j as u32)),
-                    Some(&p) if p != NO_PAIR => out.push(p),
-                    _ => {}
+                if self.lo[j][0] > self.hi[i][0] || self.lo[i][0] > self.hi[j][0] {
+                    continue;
                 }
+                self.report(i, j, cand);
             }
         }
     }
@@ -92,14 +363,17 @@ mod tests {
             s.set(i, [x, 0.0, 0.0], [1.0; 3]);
         }
         // every pair allowed, pair index = 10·min + max
-        let mut table = vec![NO_PAIR; 16];
-        for i in 0..4 {
-            for j in 0..4 {
-                if i != j {
-                    table[i * 4 + j] = (10 * i.min(j) + i.max(j)) as u32;
+        let every = || {
+            let mut t = PairTable::new(4);
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    t.allow(i, j);
+                    t.set(i, j, (10 * i + j) as u32);
                 }
             }
-        }
+            t
+        };
+        let mut table = every();
         let mut out = Vec::new();
         s.overlaps(&table, &mut out, &mut Vec::new());
         out.sort();
@@ -111,19 +385,83 @@ mod tests {
         assert!(out.is_empty(), "{out:?}");
         // a pair the filter forbids is not reported
         s.set(2, [1.5, 0.0, 0.0], [1.0; 3]);
-        table[1 * 4 + 2] = NO_PAIR;
-        table[2 * 4 + 1] = NO_PAIR;
+        table = PairTable::new(4);
+        for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 3), (2, 3)] {
+            table.allow(i, j);
+            table.set(i, j, (10 * i + j) as u32);
+        }
         out.clear();
         s.overlaps(&table, &mut out, &mut Vec::new());
         assert_eq!(out, vec![23]);
         // a pair allowed but not made yet is reported by its shapes
-        table[1 * 4 + 2] = LAZY_PAIR;
-        table[2 * 4 + 1] = LAZY_PAIR;
+        table.allow(1, 2);
         out.clear();
         let mut fresh = Vec::new();
         s.overlaps(&table, &mut out, &mut fresh);
         assert_eq!(out, vec![23]);
         let fresh: Vec<_> = fresh.iter().map(|&(i, j)| (i.min(j), i.max(j))).collect();
         assert_eq!(fresh, vec![(1, 2)]);
+    }
+    #[test]
+    fn strips_find_exactly_the_overlapping_pairs() {
+        // 300 boxes of assorted sizes over a 4 m floor, four long walls and a
+        // box never set: the strips' pairs are those of a test of every pair
+        let n = 305;
+        let mut s = SweepAndPrune::new(n);
+        let mut table = PairTable::new(n);
+        for i in 0..n {
+            for j in i + 1..n {
+                if (i + 2 * j) % 7 != 0 {
+                    table.allow(i, j);
+                    if (i * j) % 3 == 0 {
+                        table.set(i, j, (i * n + j) as u32);
+                    }
+                }
+            }
+        }
+        let mut x = 12345u64;
+        let mut rnd = || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let walls = [
+            ([-2.05, 0.0, 0.3], [0.05, 2.1, 0.3]),
+            ([2.05, 0.0, 0.3], [0.05, 2.1, 0.3]),
+            ([0.0, -2.05, 0.3], [2.0, 0.05, 0.3]),
+            ([0.0, 2.05, 0.3], [2.0, 0.05, 0.3]),
+        ];
+        for round in 0..3 {
+            for i in 0..n - 1 {
+                if i < 4 {
+                    s.set(i, walls[i].0, walls[i].1);
+                } else if round == 0 || i % 3 == round {
+                    let c = [4.0 * rnd() - 2.0, 4.0 * rnd() - 2.0, rnd()];
+                    let h = 0.03 + 0.1 * rnd();
+                    s.set(i, c, [h, 0.5 * h + 0.05 * rnd(), h]);
+                }
+            }
+            let (mut out, mut fresh) = (Vec::new(), Vec::new());
+            s.overlaps(&table, &mut out, &mut fresh);
+            let mut got: Vec<(usize, usize)> = fresh
+                .iter()
+                .map(|&(i, j)| ((i as usize).min(j as usize), (i as usize).max(j as usize)))
+                .collect();
+            got.extend(out.iter().map(|&p| (p as usize / n, p as usize % n)));
+            got.sort();
+            let mut want = Vec::new();
+            for i in 0..n {
+                for j in i + 1..n {
+                    let (a, b, c, d) = (s.lo[i], s.hi[i], s.lo[j], s.hi[j]);
+                    let over = (0..3).all(|k| c[k] <= b[k] && a[k] <= d[k]);
+                    if over && table.allowed(i, j) {
+                        want.push((i, j));
+                    }
+                }
+            }
+            assert!(want.len() > 40, "{}", want.len());
+            assert_eq!(got, want, "round {round}");
+        }
     }
 }

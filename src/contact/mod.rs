@@ -96,7 +96,9 @@ pub struct ContactParams {
     /// most 3, a box 4): the deepest, then the extremes in this many minus one
     /// horizontal directions, each preferring last step's points. 4 with that
     /// persistent patch settles every robot of the sweep (without persistence, 4
-    /// left solo12 rocking on its mesh links and needed 8).
+    /// left solo12 rocking on its mesh links and needed 8). A hull may add as
+    /// many points kept from last step that are still in the ground
+    /// (docs/theory.md §"Contact geometry").
     pub max_points_per_shape: usize,
     /// Torsional friction coefficient μ_τ (m): a contact resists spinning
     /// about its normal with a torque up to μ_τ fₙ (MuJoCo's second friction

@@ -4,103 +4,163 @@ use super::rnea::{act_force_ax, inv_act_motion_ax};
 use super::{CompositeInertia, DynamicsError};
 use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
 use crate::spatial::ops::{cross, madd, mat_mat};
-use crate::spatial::{skew, Force, Motion, Scalar, Se3};
+use crate::spatial::{Force, Motion, Scalar, Se3};
 use nalgebra::{DVector, Matrix3, Matrix6, Matrix6x3, Vector3, Vector6};
 
 /// The 6x6 angular-first matrix of a rigid-body inertia in origin form (the
 /// model's `inertias_origin`, computed at load), docs/theory.md §"Spatial inertia":
 /// `[I_o, h*; h*ᵀ, m 1]` with `h = m c` and `I_o = I_c − m c*c*`.
 #[inline(always)]
-fn inertia_matrix<T: Scalar>(i: &CompositeInertia<T>) -> Matrix6<T> {
-    let hx = skew(&i.h);
+fn inertia_matrix<T: Scalar>(y: &CompositeInertia<T>) -> Matrix6<T> {
+    // entry by entry (nalgebra's block copies went through an out-of-line
+    // iterator): [I_o, h*; h*ᵀ, m 1] with h* = [0 −h_z h_y; h_z 0 −h_x; −h_y h_x 0]
+    let (io, h, z) = (&y.io, &y.h, T::zero());
     let mut m = Matrix6::zeros();
-    m.fixed_view_mut::<3, 3>(0, 0).copy_from(&i.io);
-    m.fixed_view_mut::<3, 3>(0, 3).copy_from(&hx);
-    m.fixed_view_mut::<3, 3>(3, 0).copy_from(&hx.transpose());
-    m[(3, 3)] = i.m;
-    m[(4, 4)] = i.m;
-    m[(5, 5)] = i.m;
+    for j in 0..3 {
+        for i in 0..3 {
+            m[(i, j)] = io[(i, j)];
+        }
+    }
+    let hx = [[z, -h.z, h.y], [h.z, z, -h.x], [-h.y, h.x, z]];
+    for i in 0..3 {
+        for j in 0..3 {
+            m[(i, j + 3)] = hx[i][j];
+            m[(j + 3, i)] = hx[i][j];
+        }
+    }
+    m[(3, 3)] = y.m;
+    m[(4, 4)] = y.m;
+    m[(5, 5)] = y.m;
     m
 }
 
-/// `ᵃX*_b I ᵇX_a`: a 6x6 spatial inertia (angular-first, blocks `[A B; Bᵀ C]`)
-/// moved from frame b to frame a, given `aMb = (R, t)` (docs/theory.md
-/// §"Plücker transforms").
+/// The 3x3 block of `m` at `(r0, c0)`, entry by entry (nalgebra's
+/// `fixed_view(..).into_owned()` and `from_rows` went through an out-of-line
+/// iterator copy).
+#[inline(always)]
+fn block3<T: Scalar>(m: &Matrix6<T>, r0: usize, c0: usize) -> Matrix3<T> {
+    Matrix3::new(
+        m[(r0, c0)],
+        m[(r0, c0 + 1)],
+        m[(r0, c0 + 2)],
+        m[(r0 + 1, c0)],
+        m[(r0 + 1, c0 + 1)],
+        m[(r0 + 1, c0 + 2)],
+        m[(r0 + 2, c0)],
+        m[(r0 + 2, c0 + 1)],
+        m[(r0 + 2, c0 + 2)],
+    )
+}
+
+/// The matrix with rows `r0`, `r1`, `r2`.
+#[inline(always)]
+fn rows3<T: Scalar>(r0: &Vector3<T>, r1: &Vector3<T>, r2: &Vector3<T>) -> Matrix3<T> {
+    Matrix3::new(r0.x, r0.y, r0.z, r1.x, r1.y, r1.z, r2.x, r2.y, r2.z)
+}
+
+/// `out += ᵃX*_b I ᵇX_a`: a 6x6 spatial inertia (angular-first, blocks
+/// `[A B; Bᵀ C]`) moved from frame b to frame a, given `aMb = (R, t)`
+/// (docs/theory.md §"Plücker transforms"), added to `out`.
 /// Rotation: every block becomes `R · Rᵀ`; then translation by `T = t*`:
 /// `C' = C`, `B' = B + T C`, `A' = A − W − Wᵀ − T C T` with `W = B T`.
 #[inline(always)]
-fn act_matrix6<T: Scalar>(x: &Se3<T>, m: &Matrix6<T>) -> Matrix6<T> {
+fn add_act_matrix6<T: Scalar>(x: &Se3<T>, m: &Matrix6<T>, out: &mut Matrix6<T>) {
     let r = &x.rot;
-    let a: Matrix3<T> = m.fixed_view::<3, 3>(0, 0).into_owned();
-    let b: Matrix3<T> = m.fixed_view::<3, 3>(0, 3).into_owned();
-    let c: Matrix3<T> = m.fixed_view::<3, 3>(3, 3).into_owned();
     let rt = r.transpose();
-    let a = mat_mat(&mat_mat(r, &a), &rt);
-    let b = mat_mat(&mat_mat(r, &b), &rt);
-    let c = mat_mat(&mat_mat(r, &c), &rt);
-    translate6(&x.trans, &a, &b, &c)
+    let a = mat_mat(&mat_mat(r, &block3(m, 0, 0)), &rt);
+    let b = mat_mat(&mat_mat(r, &block3(m, 0, 3)), &rt);
+    let c = mat_mat(&mat_mat(r, &block3(m, 3, 3)), &rt);
+    add_translate6(&x.trans, &a, &b, &c, out)
 }
 
-/// The translation part of [`act_matrix6`] on rotated blocks `[A B; Bᵀ C]`, with
-/// `T = t*` applied as cross products (`T M` column by column, `M T` row by row;
-/// no products with the zeros of `t*`).
+/// `out +=` the translation part of [`add_act_matrix6`] on rotated blocks
+/// `[A B; Bᵀ C]`, with `T = t*` applied as cross products (`T M` column by
+/// column, `M T` row by row; no products with the zeros of `t*`).
 #[inline(always)]
-fn translate6<T: Scalar>(
+fn add_translate6<T: Scalar>(
     t: &Vector3<T>,
     a: &Matrix3<T>,
     b: &Matrix3<T>,
     c: &Matrix3<T>,
-) -> Matrix6<T> {
+    out: &mut Matrix6<T>,
+) {
     // T M: column j is t × M_j.
     let skew_mul = |m: &Matrix3<T>| -> Matrix3<T> {
-        Matrix3::from_columns(&[
-            cross(t, &m.column(0).into()),
-            cross(t, &m.column(1).into()),
-            cross(t, &m.column(2).into()),
-        ])
+        let c0 = cross(t, &Vector3::new(m[(0, 0)], m[(1, 0)], m[(2, 0)]));
+        let c1 = cross(t, &Vector3::new(m[(0, 1)], m[(1, 1)], m[(2, 1)]));
+        let c2 = cross(t, &Vector3::new(m[(0, 2)], m[(1, 2)], m[(2, 2)]));
+        Matrix3::new(c0.x, c1.x, c2.x, c0.y, c1.y, c2.y, c0.z, c1.z, c2.z)
     };
     // M T: row i is M_i × t (M_i the i-th row as a vector).
     let mul_skew = |m: &Matrix3<T>| -> Matrix3<T> {
         let r0 = cross(&Vector3::new(m[(0, 0)], m[(0, 1)], m[(0, 2)]), t);
         let r1 = cross(&Vector3::new(m[(1, 0)], m[(1, 1)], m[(1, 2)]), t);
         let r2 = cross(&Vector3::new(m[(2, 0)], m[(2, 1)], m[(2, 2)]), t);
-        Matrix3::from_rows(&[r0.transpose(), r1.transpose(), r2.transpose()])
+        rows3(&r0, &r1, &r2)
     };
     let tc = skew_mul(c);
     let w = mul_skew(b);
-    let a2 = a - w - w.transpose() - mul_skew(&tc);
-    let b2 = b + tc;
-    let mut out = Matrix6::zeros();
-    out.fixed_view_mut::<3, 3>(0, 0).copy_from(&a2);
-    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&b2);
-    out.fixed_view_mut::<3, 3>(3, 0).copy_from(&b2.transpose());
-    out.fixed_view_mut::<3, 3>(3, 3).copy_from(c);
-    out
+    let tct = mul_skew(&tc);
+    for j in 0..3 {
+        for i in 0..3 {
+            let a2 = a[(i, j)] - w[(i, j)] - w[(j, i)] - tct[(i, j)];
+            let b2 = b[(i, j)] + tc[(i, j)];
+            out[(i, j)] += a2;
+            out[(i, j + 3)] += b2;
+            out[(j + 3, i)] += b2;
+            out[(i + 3, j + 3)] += c[(i, j)];
+        }
+    }
 }
 
-/// [`act_matrix6`] for `x` whose rotation is a rotation about `ax` (see
+/// [`add_act_matrix6`] for `x` whose rotation is a rotation about `ax` (see
 /// [`crate::model::Joint::axis_rotation`]): each `R · Rᵀ` is six axis rotations of
 /// 3-vectors (24 products instead of 54).
 #[inline(always)]
-fn act_matrix6_ax<T: Scalar>(x: &Se3<T>, ax: Option<Axis<T>>, m: &Matrix6<T>) -> Matrix6<T> {
+fn add_act_matrix6_ax<T: Scalar>(
+    x: &Se3<T>,
+    ax: Option<Axis<T>>,
+    m: &Matrix6<T>,
+    out: &mut Matrix6<T>,
+) {
     let Some(ax) = ax else {
-        return act_matrix6(x, m);
+        return add_act_matrix6(x, m, out);
     };
     let r = &x.rot;
-    // R b Rᵀ: N = R b by columns, then row i of N Rᵀ is R (row i of N).
-    let sandwich = |b: Matrix3<T>| -> Matrix3<T> {
-        let n0 = ax.rot_mul(r, &b.column(0).into());
-        let n1 = ax.rot_mul(r, &b.column(1).into());
-        let n2 = ax.rot_mul(r, &b.column(2).into());
-        let p0 = ax.rot_mul(r, &Vector3::new(n0.x, n1.x, n2.x));
-        let p1 = ax.rot_mul(r, &Vector3::new(n0.y, n1.y, n2.y));
-        let p2 = ax.rot_mul(r, &Vector3::new(n0.z, n1.z, n2.z));
-        Matrix3::from_rows(&[p0.transpose(), p1.transpose(), p2.transpose()])
-    };
-    let a = sandwich(m.fixed_view::<3, 3>(0, 0).into_owned());
-    let b = sandwich(m.fixed_view::<3, 3>(0, 3).into_owned());
-    let c = sandwich(m.fixed_view::<3, 3>(3, 3).into_owned());
-    translate6(&x.trans, &a, &b, &c)
+    let a = sandwich_ax(ax, r, &block3(m, 0, 0));
+    let b = sandwich_ax(ax, r, &block3(m, 0, 3));
+    let c = sandwich_ax(ax, r, &block3(m, 3, 3));
+    add_translate6(&x.trans, &a, &b, &c, out)
+}
+
+/// `R b Rᵀ` for a rotation `r` about `ax`: N = R b by columns, then row i of
+/// N Rᵀ is R (row i of N) (a function, inlined: as a closure it was called out
+/// of line).
+#[inline(always)]
+fn sandwich_ax<T: Scalar>(ax: Axis<T>, r: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    let n0 = ax.rot_mul(r, &Vector3::new(b[(0, 0)], b[(1, 0)], b[(2, 0)]));
+    let n1 = ax.rot_mul(r, &Vector3::new(b[(0, 1)], b[(1, 1)], b[(2, 1)]));
+    let n2 = ax.rot_mul(r, &Vector3::new(b[(0, 2)], b[(1, 2)], b[(2, 2)]));
+    let p0 = ax.rot_mul(r, &Vector3::new(n0.x, n1.x, n2.x));
+    let p1 = ax.rot_mul(r, &Vector3::new(n0.y, n1.y, n2.y));
+    let p2 = ax.rot_mul(r, &Vector3::new(n0.z, n1.z, n2.z));
+    rows3(&p0, &p1, &p2)
+}
+
+/// `ᵃX*_b I ᵇX_a` ([`add_act_matrix6_ax`] into a zero matrix).
+#[inline(always)]
+fn act_matrix6_ax<T: Scalar>(x: &Se3<T>, ax: Option<Axis<T>>, m: &Matrix6<T>) -> Matrix6<T> {
+    let mut out = Matrix6::zeros();
+    add_act_matrix6_ax(x, ax, m, &mut out);
+    out
+}
+
+/// `a += b` on 6x6 matrices (inlined: nalgebra's `+=` was an out-of-line call).
+#[inline(always)]
+fn add6<T: Scalar>(a: &mut Matrix6<T>, b: &Matrix6<T>) {
+    for (x, &y) in a.as_mut_slice().iter_mut().zip(b.as_slice()) {
+        *x += y;
+    }
 }
 
 /// What a joint passes to its parent: `ᵖX*ᵢ Iᵃ ⁱXₚ` and `ᵖX*ᵢ pᵃ`.
@@ -334,7 +394,7 @@ pub fn aba<'d, T: Scalar>(
                         }
                     }
                     let ax = jm.rot_axis();
-                    ia_head[p] += act_matrix6_ax(li, ax, &ia_a);
+                    add_act_matrix6_ax(li, ax, &ia_a, &mut ia_head[p]);
                     pa_head[p] += act_force_ax(li, ax, &vforce(&pa_a));
                 }
             } else if jm.nv() == 3 {
@@ -344,7 +404,7 @@ pub fn aba<'d, T: Scalar>(
                         .ok_or(DynamicsError::Singular(iv))?;
                 uu[i] = ui;
                 if p != 0 {
-                    ia_head[p] += pass.0;
+                    add6(&mut ia_head[p], &pass.0);
                     pa_head[p] += pass.1;
                 }
             } else {
@@ -378,8 +438,7 @@ pub fn aba<'d, T: Scalar>(
             } else if jm.nv() == 3 {
                 aba_step3_outward(&jm, &ia[i], &uu[i], &a1, qdd).ok_or(DynamicsError::Singular(iv))?
             } else {
-                let chol = ia[i].cholesky().ok_or(DynamicsError::Singular(iv))?;
-                let x = chol.solve(&uu[i]);
+                let x = super::linalg::spd6_solve(&ia[i], &uu[i]).ok_or(DynamicsError::Singular(iv))?;
                 let ai = Motion::new(
                     Vector3::new(x[0], x[1], x[2]),
                     Vector3::new(x[3], x[4], x[5]),

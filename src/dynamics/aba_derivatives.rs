@@ -141,7 +141,11 @@ fn gemv2_add<T: Scalar, const K: usize>(
     neg: bool,
 ) {
     let n = xq.len();
-    let c: [&[T]; K] = std::array::from_fn(|k| &cols[k * n..(k + 1) * n]);
+    // filled in a loop (`array::from_fn` was an out-of-line call)
+    let mut c: [&[T]; K] = [&[]; K];
+    for (k, ck) in c.iter_mut().enumerate() {
+        *ck = &cols[k * n..(k + 1) * n];
+    }
     let xv = &mut xv[..n];
     for i in 0..n {
         let (mut sq, mut sv) = (xq[i], xv[i]);
@@ -343,7 +347,7 @@ pub(super) fn neg_mul_tree<T: Scalar>(
 ) {
     let n = a.nrows();
     let a = a.as_slice();
-    let bs = bs.map(|b| b.as_slice());
+    let bs = [bs[0].as_slice(), bs[1].as_slice()];
     let [x0, x1] = xs;
     let mut xs = [x0.as_mut_slice(), x1.as_mut_slice()];
     // panels of 2 MR rows, then MR, the last one ending at n (overlapping rows get
@@ -421,7 +425,11 @@ fn tile<T: Scalar, const R: usize, const C: usize>(
     own: (usize, usize),
 ) {
     let mut acc = [[T::zero(); R]; C];
-    let bcols: [&[T]; C] = std::array::from_fn(|c| &b[(j0 + c) * n..(j0 + c + 1) * n]);
+    // filled in a loop (`array::from_fn` was an out-of-line call)
+    let mut bcols: [&[T]; C] = [&[]; C];
+    for (c, bc) in bcols.iter_mut().enumerate() {
+        *bc = &b[(j0 + c) * n..(j0 + c + 1) * n];
+    }
     for &(lo, hi) in anc.iter().chain(std::iter::once(&own)) {
         for k in lo..hi {
             let ak = &a[k * n + i0..k * n + i0 + R];

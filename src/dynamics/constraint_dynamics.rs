@@ -14,7 +14,10 @@
 
 use super::kkt::{mul_add, KktFactor};
 use super::{check_massless, check_sizes, forward_dynamics_crba, linalg, DynamicsError};
-use crate::model::{Attachment, ConstraintKind, Constraints, Data, DimensionError, Model};
+use crate::model::{
+    dispatch_joint, Attachment, ConstraintKind, Constraints, Data, DimensionError, JointModel,
+    Model,
+};
 use crate::spatial::ops::madd;
 use crate::spatial::{Force, Motion};
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -138,20 +141,27 @@ fn add_side_rows(
     jc: &mut DMatrix<f64>,
 ) {
     let p = side_point(data, s);
+    let m = jc.nrows();
+    let jc = jc.as_mut_slice();
     let mut b = s.body;
     while b != 0 {
-        let joint = &model.joints[b];
-        for k in 0..joint.nv() {
-            let sw = data.o_m_i[b].act_motion(&joint.subspace_column(k));
-            let lin = sw.lin + sw.ang.cross(&p);
-            let col = joint.iv + k;
-            for r in 0..3 {
-                jc[(row + r, col)] += sign * lin[r];
-                if frame {
-                    jc[(row + 3 + r, col)] += sign * sw.ang[r];
+        let om = &data.o_m_i[b];
+        // the joint's world columns `⁰X̂ S` through its joint model (a
+        // coordinate axis picks a column of the rotation)
+        dispatch_joint!(&model.joints[b], model.placement_identity[b], jm => {
+            let iv = jm.joint().iv;
+            for k in 0..jm.nv() {
+                let sw = jm.subspace_in(k, om);
+                let lin = sw.lin + sw.ang.cross(&p);
+                let col = &mut jc[(iv + k) * m + row..(iv + k) * m + row + if frame { 6 } else { 3 }];
+                for r in 0..3 {
+                    col[r] = madd(sign, lin[r], col[r]);
+                    if frame {
+                        col[3 + r] = madd(sign, sw.ang[r], col[3 + r]);
+                    }
                 }
             }
-        }
+        });
         b = model.parent[b];
     }
 }

@@ -289,13 +289,12 @@ fn chol_backward_n<const N: usize>(l: &[f64], n: usize, x: &mut [f64]) {
     }
 }
 
-/// The inverse of a symmetric positive-definite 6 × 6 matrix (its lower
-/// triangle read) by `L D Lᵀ` with fixed loop bounds the compiler unrolls:
-/// `A⁻¹ = L⁻ᵀ D⁻¹ L⁻¹`, about 200 multiply-adds against a generic Cholesky's
-/// two triangular solves on six columns. `None` when a pivot is at most 64 ε
+/// `A = L D Lᵀ` of a symmetric positive-definite 6 × 6 matrix (its lower
+/// triangle read) with fixed loop bounds the compiler unrolls: L's strict lower
+/// triangle (unit diagonal implied) and D⁻¹. `None` when a pivot is at most 64 ε
 /// times its diagonal entry, or not finite (as [`cholesky`]).
-#[inline]
-pub fn spd6_inverse<T: Scalar>(a: &nalgebra::Matrix6<T>) -> Option<nalgebra::Matrix6<T>> {
+#[inline(always)]
+fn spd6_ldl<T: Scalar>(a: &nalgebra::Matrix6<T>) -> Option<([[T; 6]; 6], [T; 6])> {
     let tiny = lit::<T>(64.0 * f64::EPSILON);
     let mut l = [[T::zero(); 6]; 6];
     let mut dinv = [T::zero(); 6];
@@ -320,6 +319,17 @@ pub fn spd6_inverse<T: Scalar>(a: &nalgebra::Matrix6<T>) -> Option<nalgebra::Mat
             l[i][j] = s * di;
         }
     }
+    Some((l, dinv))
+}
+
+/// The inverse of a symmetric positive-definite 6 × 6 matrix (its lower
+/// triangle read) by `L D Lᵀ` with fixed loop bounds the compiler unrolls:
+/// `A⁻¹ = L⁻ᵀ D⁻¹ L⁻¹`, about 200 multiply-adds against a generic Cholesky's
+/// two triangular solves on six columns. `None` when a pivot is at most 64 ε
+/// times its diagonal entry, or not finite (as [`cholesky`]).
+#[inline]
+pub fn spd6_inverse<T: Scalar>(a: &nalgebra::Matrix6<T>) -> Option<nalgebra::Matrix6<T>> {
+    let (l, dinv) = spd6_ldl(a)?;
     // M = L⁻¹ (unit lower triangular), column by column
     let mut m = [[T::zero(); 6]; 6];
     for j in 0..6 {
@@ -345,4 +355,35 @@ pub fn spd6_inverse<T: Scalar>(a: &nalgebra::Matrix6<T>) -> Option<nalgebra::Mat
         }
     }
     Some(x)
+}
+
+/// Solves `a x = b` for a symmetric positive-definite 6x6 `a` (lower triangle
+/// read) by `L D Lᵀ` with fixed loop bounds (as [`spd6_inverse`]); `None` when a
+/// pivot is at most 64 ε times its diagonal entry, or not finite.
+#[inline]
+pub(crate) fn spd6_solve<T: Scalar>(
+    a: &nalgebra::Matrix6<T>,
+    b: &nalgebra::Vector6<T>,
+) -> Option<nalgebra::Vector6<T>> {
+    let (l, dinv) = spd6_ldl(a)?;
+    // L y = b, z = D⁻¹ y, Lᵀ x = z
+    let mut x = [T::zero(); 6];
+    for i in 0..6 {
+        let mut s = b[i];
+        for k in 0..i {
+            s = madd(-l[i][k], x[k], s);
+        }
+        x[i] = s;
+    }
+    for i in 0..6 {
+        x[i] *= dinv[i];
+    }
+    for i in (0..6).rev() {
+        let mut s = x[i];
+        for k in (i + 1)..6 {
+            s = madd(-l[k][i], x[k], s);
+        }
+        x[i] = s;
+    }
+    Some(nalgebra::Vector6::from_column_slice(&x))
 }

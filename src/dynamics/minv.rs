@@ -59,7 +59,15 @@ fn rows6_mut<T>(x: &mut [T], w: usize, lo: usize, hi: usize) -> [&mut [T]; 6] {
     let (r3, x) = x.split_at_mut(w);
     let (r4, x) = x.split_at_mut(w);
     let r5 = &mut x[..w];
-    [r0, r1, r2, r3, r4, r5].map(|r| &mut r[lo..hi])
+    // built entry by entry (`[..].map` was an out-of-line call)
+    [
+        &mut r0[lo..hi],
+        &mut r1[lo..hi],
+        &mut r2[lo..hi],
+        &mut r3[lo..hi],
+        &mut r4[lo..hi],
+        &mut r5[lo..hi],
+    ]
 }
 
 /// `a += b` on 6x6 matrices (inlined: nalgebra's `+=` was an out-of-line call).
@@ -361,7 +369,9 @@ pub(crate) fn minv_pass<T: Scalar>(
             (&[], &mut acol[acol_off[i]..acol_off[i] + sz])
         };
         let ap: [&[T]; 6] = if p != 0 {
-            std::array::from_fn(|k| &ap_buf[k * nv + c0..(k + 1) * nv])
+            // entry by entry (`array::from_fn` was an out-of-line call)
+            let row = |k: usize| &ap_buf[k * nv + c0..(k + 1) * nv];
+            [row(0), row(1), row(2), row(3), row(4), row(5)]
         } else {
             [&[]; 6]
         };

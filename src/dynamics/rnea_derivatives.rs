@@ -304,13 +304,20 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
         let nvi = joints[i].nv();
         let ce = c0 + nvi;
         let end = sub_end[i];
+        // a root body's columns have ∂v/∂q = v̂₀ × J = 0 (the world is at rest):
+        // the terms it multiplies are left out
+        let root = p == 0;
         for k in c0..ce {
             let s = jcol[k];
             // τ = Jᵀ F
             tau[col_iv[k]] += s.dot(&fi);
             // ∂F/∂a = Y J, ∂F/∂q = Ẏ ∂v/∂q + Y ∂a/∂q, ∂F/∂v = Ẏ J + Y ∂a/∂v, Ẏᵀ J
             dfda[k] = yi.mul_motion(&s);
-            dfdq[k] = variation_mul(&doyi, &hmi, &dvdq[k]) + yi.mul_motion(&dadq[k]);
+            dfdq[k] = if root {
+                yi.mul_motion(&dadq[k])
+            } else {
+                variation_mul(&doyi, &hmi, &dvdq[k]) + yi.mul_motion(&dadq[k])
+            };
             dfdv[k] = variation_mul(&doyi, &hmi, &s) + yi.mul_motion(&dadv[k]);
             ytj[k] = variation_tr_mul(&doyi, &hmi, &s);
             if F {
@@ -342,7 +349,11 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
             let (dv, ang) = (dvdq[r], s.ang);
             for c in ce..end {
                 let at = c + r * n;
-                let mut x = aq.dot(&dfda[c]) + dv.dot(&ytj[c]);
+                let mut x = if root {
+                    aq.dot(&dfda[c])
+                } else {
+                    aq.dot(&dfda[c]) + dv.dot(&ytj[c])
+                };
                 if F {
                     x += crate::spatial::ops::dot(&ang, &ext_e[c].ang);
                 }

@@ -1,7 +1,7 @@
 //! The model's own loop constraints in a simulation (MJCF `<equality>`,
 //! mjcf.md §"Details": `Model::equalities`): a [`Simulation`] starts with them
 //! as it would with a scene's `"constraints"` ([`Simulation::set_constraints`],
-//! src/sim/loops.rs), those marked inactive switched off
+//! src/sim/loops/mod.rs), those marked inactive switched off
 //! ([`Simulation::set_constraint_active`] turns them on).
 
 use super::{SimError, Simulation};

@@ -422,17 +422,37 @@ impl MassFactor {
                 *x -= l * ai;
             }
         }
+        // `next` carries y[t − 1] as the step at t leaves it (held in a
+        // register, not read back from the store just made: the leaf-to-root
+        // chain is the form's latency)
+        let mut next = match len {
+            0 => [0.0; 4],
+            _ => y[len - 1],
+        };
         for t in (0..len).rev() {
-            let a = y[t];
+            let a = next;
             match self.ancestors(path, t) {
-                Some((s0, anc)) => {
-                    for (ys, &l) in y[s0..t].iter_mut().zip(anc) {
+                Some((s0, anc)) if s0 < t => {
+                    let (ys, last) = y[s0..t].split_at_mut(t - 1 - s0);
+                    for (ys, &l) in ys.iter_mut().zip(anc) {
                         sub(ys, l, &a);
+                    }
+                    let mut v = last[0];
+                    sub(&mut v, anc[t - 1 - s0], &a);
+                    last[0] = v;
+                    next = v;
+                }
+                Some(_) => {
+                    if t > 0 {
+                        next = y[t - 1];
                     }
                 }
                 None => {
                     for s in 0..t {
                         sub(&mut y[s], self.l_entry(path[t], path[s]), &a);
+                    }
+                    if t > 0 {
+                        next = y[t - 1];
                     }
                 }
             }

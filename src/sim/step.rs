@@ -90,6 +90,7 @@ impl Simulation {
         self.fk_valid = false;
         self.refresh_contacts();
         if self.cons.loops.is_some() {
+            self.project_loops();
             self.clip_loop_energy();
         }
         self.update_sleep(h);

@@ -93,7 +93,12 @@ pub struct GroundContact {
     prev_flag: Vec<bool>,
     prev_list: Vec<usize>,
     /// Per shape, its slots in `prev_list` (a range).
-    prev_range: Vec<(usize, usize)>,
+    prev_range: Vec<(usize, usize, usize)>,
+    /// Per shape, how many of this detection's points are picks (the rest,
+    /// after them: points kept from last step still in the ground); `usize::MAX`:
+    /// all. Last step's picks are `prev_list[a..b]`, its extras `[b..c]` for
+    /// `prev_range` (a, b, c): only picks are preferred by the picks.
+    picks: Vec<usize>,
     /// The horizontal directions a reduced manifold's extremes are taken along
     /// (cos, sin), computed once ([`reduce_directions`]).
     reduce_dirs: [(f64, f64); MAX_DIRS],
@@ -170,7 +175,8 @@ impl GroundContact {
     pub fn forget_history(&mut self) {
         self.prev_flag.fill(false);
         self.prev_list.clear();
-        self.prev_range.fill((0, 0));
+        self.prev_range.fill((0, 0, 0));
+        self.picks.fill(usize::MAX);
         self.last_low.fill(0);
         self.visited.fill(0);
         self.generation = 0;
@@ -184,7 +190,13 @@ impl GroundContact {
     pub fn max_points(&self) -> usize {
         self.shapes
             .iter()
-            .map(|s| s.nslots.min(self.params.max_points_per_shape.max(1)))
+            .map(|s| {
+                // a hull's patch: its picks and at most as many points kept
+                // from last step that are still in the ground (`detect`)
+                let maxp = self.params.max_points_per_shape.max(1);
+                let hull = s.manifold == Manifold::Vertices && !s.adj.is_empty();
+                s.nslots.min(if hull { 2 * maxp } else { maxp })
+            })
             .sum()
     }
 
@@ -372,8 +384,9 @@ impl GroundContact {
                 // (this shape's, at most maxp, looked at directly) within its
                 // hold of the best, the lowest slot; else the lowest slot within
                 // 1e-6 of the best (a scan of the band, only then)
-                let (pa, pb) = self.prev_range[si];
+                let (pa, pb, pc) = self.prev_range[si];
                 let kept = &self.prev_list[pa..pb];
+                let kept_all = &self.prev_list[pa..pc];
                 let stamp = self.band_gen[si];
                 let start = out.len();
                 for (q, &bq) in best.iter().enumerate().take(dirs + 1) {
@@ -408,6 +421,28 @@ impl GroundContact {
                     }
                     if !out[start..].iter().any(|p| p.slot == base + k) {
                         out.push(point(k));
+                    }
+                }
+                // a point kept last step and still in the ground that no
+                // criterion picked stays in the patch beside the picks (never
+                // in place of one: a pick above the ground may be the point
+                // about to be hit), at most maxp of them: a point that
+                // carries the body does not lose its row because another
+                // became the deepest or an extreme (docs/theory.md §"Contact
+                // geometry"; borinot's rocking, docs/robots.md)
+                self.picks[si] = out.len() - start;
+                let mut extra = 0;
+                for &slot in kept_all {
+                    if extra >= maxp {
+                        break;
+                    }
+                    if out[start..].iter().any(|p| p.slot == slot) {
+                        continue;
+                    }
+                    let p = point(slot - base);
+                    if p.gap < 0.0 {
+                        out.push(p);
+                        extra += 1;
                     }
                 }
                 continue;
@@ -466,18 +501,24 @@ impl GroundContact {
             self.prev_flag[k] = false;
         }
         self.prev_list.clear();
-        self.prev_range.fill((0, 0));
+        self.prev_range.fill((0, 0, 0));
         for p in out.iter() {
             if let Some(f) = self.prev_flag.get_mut(p.slot) {
                 *f = true;
-                // a shape's points are contiguous in `out`
+                // a shape's points are contiguous in `out`, its picks first
                 let r = &mut self.prev_range[p.shape];
-                if r.1 == 0 {
+                if r.2 == 0 {
                     r.0 = self.prev_list.len();
+                    r.1 = r.0;
                 }
+                let pick = self.prev_list.len() - r.0 < self.picks[p.shape];
                 self.prev_list.push(p.slot);
-                r.1 = self.prev_list.len();
+                r.2 = self.prev_list.len();
+                if pick {
+                    r.1 = r.2;
+                }
             }
         }
+        self.picks.fill(usize::MAX);
     }
 }

@@ -13,7 +13,7 @@
 //! pair's slots: the slot of the same features last step (its impulse warm
 //! starts the solve), else a free one marked fresh (no warm start).
 
-use super::broad::{SweepAndPrune, LAZY_PAIR, NO_PAIR};
+use super::broad::{prefetch, PairTable, SweepAndPrune, LAZY_PAIR};
 use super::filter::{is_self_pair, may_touch, DroppedPair, START_OVERLAP};
 use super::narrow::{face_kind, face_points, parry_points, reduce_pair, FaceScratch, Raw};
 use super::shapes::{from_pvec, pair_shape, to_pose, PairShape};
@@ -25,7 +25,9 @@ use parry3d_f64::query::{ContactManifold, ContactManifoldsWorkspace};
 use std::path::PathBuf;
 
 mod apart;
+mod order;
 use apart::{apart_along, still_apart};
+use order::assign_slots;
 
 /// One shape of pair contact.
 #[derive(Clone, Debug)]
@@ -47,12 +49,8 @@ struct Pair {
     b: usize,
     /// The first of its slots (global).
     slot_base: usize,
-    /// The features each of its slots held last step (`NO_KEY`: free).
-    keys: Vec<u64>,
     manifolds: Vec<ContactManifold<(), ()>>,
     workspace: Option<ContactManifoldsWorkspace>,
-    /// Dropped at the start (rule 4).
-    dropped: bool,
     /// A self pair (rule 4 applies).
     self_pair: bool,
     /// A unit axis (a's frame, from a toward b) that separated the two
@@ -81,9 +79,18 @@ pub struct PairContact {
     /// whatever order the pairs were made in. Apart from the pairs (sorted
     /// by every step: a pair's whole state need not be loaded for that).
     ords: Vec<u64>,
-    /// `table[i·n + j]`: the pair of members i, j ([`NO_PAIR`]: none allowed;
-    /// [`LAZY_PAIR`]: allowed, not made yet).
-    table: Vec<u32>,
+    /// The features each pair's slots held last step (`NO_KEY`: free),
+    /// `max_points` a pair (pair p's at `p·max_points`): apart from the
+    /// pairs, in one array (no heap block of its own a pair).
+    keys: Vec<u64>,
+    /// Each pair dropped at the start (rule 4), apart from its state: the
+    /// visit tests it before loading the pair.
+    dropped: Vec<bool>,
+    /// Pairs made since they were last put in visiting order ([`order`]).
+    made_since_sort: usize,
+    /// The pair of members i, j (`table.get(i, j)`: none allowed, allowed
+    /// and not made yet, or its index).
+    table: PairTable,
     /// Pairs the filter allows (made or not).
     allowed: usize,
     /// The friction of each member's geometry, and whether two members are
@@ -185,7 +192,7 @@ impl PairContact {
         }
         let n = members.len();
         let maxp = params.max_points_per_shape.max(1);
-        let mut table = vec![NO_PAIR; n * n];
+        let mut table = PairTable::new(n);
         let mut allowed = 0;
         let friction: Vec<f64> = members.iter().map(|m| g[m.geom].friction).collect();
         let model_of: Vec<Option<usize>> = members
@@ -205,8 +212,7 @@ impl PairContact {
                     continue; // two non-convex shapes (both static): never
                 }
                 allowed += 1;
-                table[a * n + b] = LAZY_PAIR;
-                table[b * n + a] = LAZY_PAIR;
+                table.allow(a, b);
             }
         }
         let mut made = Self {
@@ -234,12 +240,15 @@ impl PairContact {
             slot_offset,
             pairs: Vec::new(),
             ords: Vec::new(),
+            keys: Vec::new(),
+            dropped: Vec::new(),
+            made_since_sort: 0,
         };
         // self pairs now (rule 4 looks at them before the first step)
         for a in 0..n {
             for b in a + 1..n {
                 let self_pair = made.model_of[a].is_some() && made.model_of[a] == made.model_of[b];
-                if self_pair && made.table[a * n + b] == LAZY_PAIR {
+                if self_pair && made.table.get(a, b) == LAZY_PAIR {
                     made.make_pair(a, b);
                 }
             }
@@ -261,7 +270,6 @@ impl PairContact {
     /// Makes the pair of members `i` and `j` (allowed, not made yet): its
     /// state, its slots (the next `max_points`), its place in the table.
     fn make_pair(&mut self, i: usize, j: usize) -> u32 {
-        let n = self.members.len();
         // members are in geometry order: the lower one first, as the filter
         // enumerated them (the sweep meets them in either order)
         let (i, j) = (i.min(j), i.max(j));
@@ -275,20 +283,20 @@ impl PairContact {
         };
         let (ga, gb) = (self.members[a].geom as u64, self.members[b].geom as u64);
         let p = self.pairs.len() as u32;
-        self.table[a * n + b] = p;
-        self.table[b * n + a] = p;
+        self.table.set(a, b, p);
         let maxp = self.max_points;
         let self_pair = self.model_of[a].is_some() && self.model_of[a] == self.model_of[b];
         let ord = ga.min(gb) * self.ngeoms + ga.max(gb);
         self.ords.push(ord);
+        self.keys.extend(std::iter::repeat_n(NO_KEY, maxp));
+        self.dropped.push(false);
+        self.made_since_sort += 1;
         self.pairs.push(Pair {
             a,
             b,
             slot_base: self.slot_offset + p as usize * maxp,
-            keys: vec![NO_KEY; maxp],
             manifolds: Vec::new(),
             workspace: None,
-            dropped: false,
             self_pair,
             axis: Vector3::zeros(),
             apart: None,
@@ -301,8 +309,8 @@ impl PairContact {
     /// Forgets every pair's manifolds and the features its slots held: the
     /// next detection finds what a newly built one would.
     pub fn forget_history(&mut self) {
+        self.keys.fill(NO_KEY);
         for pair in self.pairs.iter_mut() {
-            pair.keys.iter_mut().for_each(|k| *k = NO_KEY);
             pair.manifolds.clear();
             pair.workspace = None;
             pair.apart = None;
@@ -320,7 +328,7 @@ impl PairContact {
     pub fn geoms(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
         let n = self.members.len();
         (0..n * n)
-            .filter(move |&k| k / n < k % n && self.table[k] != NO_PAIR)
+            .filter(move |&k| k / n < k % n && self.table.allowed(k / n, k % n))
             .map(move |k| (self.members[k / n].geom, self.members[k % n].geom))
     }
 
@@ -342,6 +350,7 @@ impl PairContact {
     /// they held and are not queried.
     pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
         let margin = self.margin;
+        self.keep_in_order();
         for &k in &self.moving {
             let m = &self.members[k];
             let w = world(m, o_m_i);
@@ -377,20 +386,35 @@ impl PairContact {
         }
         self.live.clear();
         let mut next = 0;
+        let maxp = self.max_points;
         for vi in 0..self.visit.len() {
             let (ord, pi) = self.visit[vi];
             let pi = pi as usize;
+            // the pair four visits on fetched now (a pile's pairs lie far
+            // apart in memory: a cache miss each), while this one is worked
+            if let Some(&(_, ahead)) = self.visit.get(vi + 4) {
+                let ahead = ahead as usize;
+                if let Some(p) = self.pairs.get(ahead) {
+                    prefetch(p);
+                }
+                if let Some(k) = self.keys.get(ahead * maxp) {
+                    prefetch(k);
+                }
+            }
             let hit = next < self.overlapping.len() && self.overlapping[next].1 as usize == pi;
             if hit {
                 next += 1;
             }
-            let Some(pair) = self.pairs.get_mut(pi) else {
+            let (Some(pair), Some(keys)) = (
+                self.pairs.get_mut(pi),
+                self.keys.get_mut(pi * maxp..(pi + 1) * maxp),
+            ) else {
                 continue;
             };
-            if !hit || pair.dropped {
+            if !hit || self.dropped[pi] {
                 pair.apart = None;
-                if pair.keys[0] != NO_KEY || !pair.manifolds.is_empty() {
-                    pair.keys.iter_mut().for_each(|k| *k = NO_KEY);
+                if keys[0] != NO_KEY || !pair.manifolds.is_empty() {
+                    keys.fill(NO_KEY);
                     pair.manifolds.clear();
                 }
                 continue;
@@ -479,7 +503,7 @@ impl PairContact {
                 fresh: true,
                 key: r.key,
             });
-            assign_slots(pair, &mut out[start..]);
+            assign_slots(pair.slot_base, keys, &mut out[start..]);
         }
     }
 
@@ -488,8 +512,8 @@ impl PairContact {
     /// before; returns them, with their links, from `model`.
     pub fn drop_start_overlaps(&mut self, model: &Model, o_m_i: &[Se3<f64>]) -> Vec<DroppedPair> {
         let mut out = Vec::new();
-        for pair in &mut self.pairs {
-            pair.dropped = false;
+        self.dropped.fill(false);
+        for (pi, pair) in self.pairs.iter_mut().enumerate() {
             if !pair.self_pair {
                 continue;
             }
@@ -504,9 +528,12 @@ impl PairContact {
             );
             if let Ok(Some(c)) = c {
                 if c.dist < -START_OVERLAP {
-                    pair.dropped = true;
+                    self.dropped[pi] = true;
                     pair.manifolds.clear();
-                    pair.keys.iter_mut().for_each(|k| *k = NO_KEY);
+                    let maxp = self.max_points;
+                    if let Some(k) = self.keys.get_mut(pi * maxp..(pi + 1) * maxp) {
+                        k.fill(NO_KEY);
+                    }
                     let link = |m: &Member| {
                         model
                             .collisions
@@ -531,7 +558,7 @@ impl PairContact {
 
     /// Whether a pair is dropped (rule 4), by its index ([`ContactPoint::shape`]).
     pub fn is_dropped(&self, pair: usize) -> bool {
-        self.pairs.get(pair).is_some_and(|p| p.dropped)
+        self.dropped.get(pair).copied().unwrap_or(false)
     }
 }
 
@@ -546,38 +573,4 @@ fn set_box(sap: &mut SweepAndPrune, k: usize, m: &Member, w: &Se3<f64>, margin: 
     let e =
         |i: usize| r[(i, 0)].abs() * h.x + r[(i, 1)].abs() * h.y + r[(i, 2)].abs() * h.z + margin;
     sap.set(k, [c.x, c.y, c.z], [e(0), e(1), e(2)]);
-}
-
-/// Puts each of a pair's points in a slot: the one that held the same
-/// features last step (not fresh), else a free one (fresh).
-fn assign_slots(pair: &mut Pair, pts: &mut [ContactPoint]) {
-    let maxp = pair.keys.len();
-    let mut taken = [false; 64];
-    let mut placed = [false; 64];
-    for (k, p) in pts.iter_mut().enumerate().take(64) {
-        if let Some(s) = pair.keys.iter().position(|&key| key == p.key) {
-            if !taken[s] {
-                taken[s] = true;
-                placed[k] = true;
-                p.slot = pair.slot_base + s;
-                p.fresh = false;
-            }
-        }
-    }
-    for (k, p) in pts.iter_mut().enumerate().take(64) {
-        if placed[k] {
-            continue;
-        }
-        if let Some(s) = (0..maxp.min(64)).find(|&s| !taken[s]) {
-            taken[s] = true;
-            p.slot = pair.slot_base + s;
-            p.fresh = true;
-        }
-    }
-    for (s, key) in pair.keys.iter_mut().enumerate() {
-        *key = NO_KEY;
-        if let Some(p) = pts.iter().find(|p| p.slot == pair.slot_base + s) {
-            *key = p.key;
-        }
-    }
 }

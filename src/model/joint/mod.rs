@@ -26,7 +26,7 @@ pub(crate) use revolute::RevoluteJ;
 pub(crate) use spherical::SphericalJ;
 
 use crate::spatial::{CompositeInertia, Force, Motion, Scalar, Se3};
-use nalgebra::{DVector, Matrix6, Vector6};
+use nalgebra::{DVector, Matrix6, Vector3, Vector6};
 
 /// The kind of a body's joint to its parent.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -239,75 +239,196 @@ pub(super) fn dot6<T: Scalar>(x: &Vector6<T>, off: usize, ax: Axis<T>, mult: T) 
     d * mult
 }
 
+/// How [`dispatch_joint!`] runs a joint: its kind and axis, a negative
+/// coordinate axis `−eₖ` (MJCF's `axis="0 -1 0"`, a URDF's `<axis xyz="0 -1
+/// 0"/>`) folded onto `+eₖ`.
+#[derive(Clone, Copy)]
+pub(crate) enum Dispatch<T: Scalar> {
+    RevX,
+    RevY,
+    RevZ,
+    RevU(Vector3<T>),
+    PriX,
+    PriY,
+    PriZ,
+    PriU(Vector3<T>),
+    Free,
+    Spherical,
+    Planar,
+}
+
+/// The joint's [`Dispatch`] and the `(mult, offset)` its 1-DoF joint model runs
+/// with: a joint about or along `−eₖ` runs as the same joint on `+eₖ` with its
+/// coordinate negated, `q_j = mult·q + offset` about `−eₖ` being
+/// `−q_j = (−mult)·q + (−offset)` about `eₖ` (the same transform, and
+/// `S = −eₖ·mult` the same column), so the body steps take the coordinate-axis
+/// paths (docs/theory.md §"Joints and motion subspace").
+#[inline(always)]
+pub(crate) fn dispatch_of<T: Scalar>(j: &Joint<T>) -> (Dispatch<T>, T, T) {
+    let (z, m) = (T::zero(), -T::one());
+    // the coordinate axis of a unit axis −eₖ (0, 1, 2), else 3
+    let negative = |u: &Vector3<T>| {
+        if u.x == m && u.y == z && u.z == z {
+            0
+        } else if u.x == z && u.y == m && u.z == z {
+            1
+        } else if u.x == z && u.y == z && u.z == m {
+            2
+        } else {
+            3
+        }
+    };
+    let (key, neg) = match &j.kind {
+        JointKind::Revolute(Axis::X) => (Dispatch::RevX, false),
+        JointKind::Revolute(Axis::Y) => (Dispatch::RevY, false),
+        JointKind::Revolute(Axis::Z) => (Dispatch::RevZ, false),
+        JointKind::Revolute(Axis::Unit(u)) => match negative(u) {
+            0 => (Dispatch::RevX, true),
+            1 => (Dispatch::RevY, true),
+            2 => (Dispatch::RevZ, true),
+            _ => (Dispatch::RevU(*u), false),
+        },
+        JointKind::Prismatic(Axis::X) => (Dispatch::PriX, false),
+        JointKind::Prismatic(Axis::Y) => (Dispatch::PriY, false),
+        JointKind::Prismatic(Axis::Z) => (Dispatch::PriZ, false),
+        JointKind::Prismatic(Axis::Unit(u)) => match negative(u) {
+            0 => (Dispatch::PriX, true),
+            1 => (Dispatch::PriY, true),
+            2 => (Dispatch::PriZ, true),
+            _ => (Dispatch::PriU(*u), false),
+        },
+        JointKind::Free => (Dispatch::Free, false),
+        JointKind::Spherical => (Dispatch::Spherical, false),
+        JointKind::Planar => (Dispatch::Planar, false),
+    };
+    if neg {
+        (key, -j.mult, -j.offset)
+    } else {
+        (key, j.mult, j.offset)
+    }
+}
+
 /// Runs `$body` with `$jm` bound to the [`JointModel`] of joint `$joint`
 /// (`&Joint<T>`) whose placement rotation is the identity iff `$ident`: the joint
 /// kind is matched here, once, and `$body` is compiled once per joint model.
 macro_rules! dispatch_joint {
     ($joint:expr, $ident:expr, $jm:ident => $body:expr) => {{
         use $crate::model::joint::{
-            AxU, AxX, AxY, AxZ, Axis, FreeJ, JointKind, PlanarJ, PrismaticJ, RevoluteJ, SphericalJ,
+            AxU, AxX, AxY, AxZ, Dispatch, FreeJ, PlanarJ, PrismaticJ, RevoluteJ, SphericalJ,
         };
+        // the kind matched once (a negative coordinate axis folded onto the
+        // positive one, `dispatch_of`)
         let j__ = $joint;
-        match (&j__.kind, $ident) {
-            (JointKind::Revolute(Axis::X), true) => {
-                let $jm = RevoluteJ::<_, _, true> { ax: AxX, j: j__ };
+        let (key__, mult__, off__) = $crate::model::joint::dispatch_of(j__);
+        match (key__, $ident) {
+            (Dispatch::RevX, true) => {
+                let $jm = RevoluteJ::<_, _, true> {
+                    ax: AxX,
+                    j: j__,
+                    mult: mult__,
+                    offset: off__,
+                };
                 $body
             }
-            (JointKind::Revolute(Axis::Y), true) => {
-                let $jm = RevoluteJ::<_, _, true> { ax: AxY, j: j__ };
+            (Dispatch::RevY, true) => {
+                let $jm = RevoluteJ::<_, _, true> {
+                    ax: AxY,
+                    j: j__,
+                    mult: mult__,
+                    offset: off__,
+                };
                 $body
             }
-            (JointKind::Revolute(Axis::Z), true) => {
-                let $jm = RevoluteJ::<_, _, true> { ax: AxZ, j: j__ };
+            (Dispatch::RevZ, true) => {
+                let $jm = RevoluteJ::<_, _, true> {
+                    ax: AxZ,
+                    j: j__,
+                    mult: mult__,
+                    offset: off__,
+                };
                 $body
             }
-            (JointKind::Revolute(Axis::X), false) => {
-                let $jm = RevoluteJ::<_, _, false> { ax: AxX, j: j__ };
-                $body
-            }
-            (JointKind::Revolute(Axis::Y), false) => {
-                let $jm = RevoluteJ::<_, _, false> { ax: AxY, j: j__ };
-                $body
-            }
-            (JointKind::Revolute(Axis::Z), false) => {
-                let $jm = RevoluteJ::<_, _, false> { ax: AxZ, j: j__ };
-                $body
-            }
-            (JointKind::Revolute(Axis::Unit(u)), _) => {
+            (Dispatch::RevX, false) => {
                 let $jm = RevoluteJ::<_, _, false> {
-                    ax: AxU(*u),
+                    ax: AxX,
                     j: j__,
+                    mult: mult__,
+                    offset: off__,
                 };
                 $body
             }
-            (JointKind::Prismatic(Axis::X), _) => {
-                let $jm = PrismaticJ { ax: AxX, j: j__ };
+            (Dispatch::RevY, false) => {
+                let $jm = RevoluteJ::<_, _, false> {
+                    ax: AxY,
+                    j: j__,
+                    mult: mult__,
+                    offset: off__,
+                };
                 $body
             }
-            (JointKind::Prismatic(Axis::Y), _) => {
-                let $jm = PrismaticJ { ax: AxY, j: j__ };
+            (Dispatch::RevZ, false) => {
+                let $jm = RevoluteJ::<_, _, false> {
+                    ax: AxZ,
+                    j: j__,
+                    mult: mult__,
+                    offset: off__,
+                };
                 $body
             }
-            (JointKind::Prismatic(Axis::Z), _) => {
-                let $jm = PrismaticJ { ax: AxZ, j: j__ };
+            (Dispatch::RevU(u), _) => {
+                let $jm = RevoluteJ::<_, _, false> {
+                    ax: AxU(u),
+                    j: j__,
+                    mult: mult__,
+                    offset: off__,
+                };
                 $body
             }
-            (JointKind::Prismatic(Axis::Unit(u)), _) => {
+            (Dispatch::PriX, _) => {
                 let $jm = PrismaticJ {
-                    ax: AxU(*u),
+                    ax: AxX,
                     j: j__,
+                    mult: mult__,
+                    offset: off__,
                 };
                 $body
             }
-            (JointKind::Free, _) => {
+            (Dispatch::PriY, _) => {
+                let $jm = PrismaticJ {
+                    ax: AxY,
+                    j: j__,
+                    mult: mult__,
+                    offset: off__,
+                };
+                $body
+            }
+            (Dispatch::PriZ, _) => {
+                let $jm = PrismaticJ {
+                    ax: AxZ,
+                    j: j__,
+                    mult: mult__,
+                    offset: off__,
+                };
+                $body
+            }
+            (Dispatch::PriU(u), _) => {
+                let $jm = PrismaticJ {
+                    ax: AxU(u),
+                    j: j__,
+                    mult: mult__,
+                    offset: off__,
+                };
+                $body
+            }
+            (Dispatch::Free, _) => {
                 let $jm = FreeJ { j: j__ };
                 $body
             }
-            (JointKind::Spherical, _) => {
+            (Dispatch::Spherical, _) => {
                 let $jm = SphericalJ { j: j__ };
                 $body
             }
-            (JointKind::Planar, _) => {
+            (Dispatch::Planar, _) => {
                 let $jm = PlanarJ { j: j__ };
                 $body
             }

@@ -13,6 +13,12 @@ use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 pub(crate) struct RevoluteJ<'j, T: Scalar, A, const AXROT: bool> {
     pub ax: A,
     pub j: &'j Joint<T>,
+    /// The coordinate's multiplier and offset (`q_j = mult·q + offset`): the
+    /// joint's, negated for a joint on a negative coordinate axis run on the
+    /// positive one (`super::dispatch_of`).
+    pub mult: T,
+    /// See `mult`.
+    pub offset: T,
 }
 impl<'j, T: Scalar, A: AxisOf<T>, const AXROT: bool> JointModel<T> for RevoluteJ<'j, T, A, AXROT> {
     const NV: usize = 1;
@@ -26,7 +32,7 @@ impl<'j, T: Scalar, A: AxisOf<T>, const AXROT: bool> JointModel<T> for RevoluteJ
     }
     #[inline(always)]
     fn placement(&self, xt: &Se3<T>, q: &[T]) -> Se3<T> {
-        let (s, c) = sin_cos(self.j.mult * q[self.j.iq] + self.j.offset);
+        let (s, c) = sin_cos(self.mult * q[self.j.iq] + self.offset);
         let ax = self.ax.get();
         if AXROT {
             let (z, o) = (T::zero(), T::one());
@@ -44,54 +50,54 @@ impl<'j, T: Scalar, A: AxisOf<T>, const AXROT: bool> JointModel<T> for RevoluteJ
     fn add_motion(&self, m: &mut Motion<T>, x: &[T]) {
         self.ax
             .get()
-            .add_scaled(&mut m.ang, self.j.mult * x[self.j.iv]);
+            .add_scaled(&mut m.ang, self.mult * x[self.j.iv]);
     }
     #[inline(always)]
     fn add_cross_motion(&self, m: &mut Motion<T>, vi: &Motion<T>, x: &[T]) {
         let ax = self.ax.get();
-        let s = self.j.mult * x[self.j.iv];
+        let s = self.mult * x[self.j.iv];
         ax.add_cross_scaled(&mut m.ang, &vi.ang, s);
         ax.add_cross_scaled(&mut m.lin, &vi.lin, s);
     }
     #[inline(always)]
     fn project_add(&self, f: &Force<T>, tau: &mut [T]) {
-        tau[self.j.iv] += self.j.mult * self.ax.get().dot(&f.ang);
+        tau[self.j.iv] += self.mult * self.ax.get().dot(&f.ang);
     }
     #[inline(always)]
     fn project_column(&self, _c: usize, f: &Force<T>) -> T {
-        self.j.mult * self.ax.get().dot(&f.ang)
+        self.mult * self.ax.get().dot(&f.ang)
     }
     #[inline(always)]
     fn subspace(&self, _c: usize) -> Motion<T> {
-        Motion::new(self.ax.get().vector() * self.j.mult, Vector3::zeros())
+        Motion::new(self.ax.get().vector() * self.mult, Vector3::zeros())
     }
     #[inline(always)]
     fn subspace_in(&self, _c: usize, m: &Se3<T>) -> Motion<T> {
-        let w = self.ax.get().mat_mul(&m.rot) * self.j.mult;
+        let w = self.ax.get().mat_mul(&m.rot) * self.mult;
         Motion::new(w, m.trans.cross(&w))
     }
     #[inline(always)]
     fn mul_subspace(&self, ic: &CompositeInertia<T>, _c: usize) -> Force<T> {
         let ax = self.ax.get();
         match ax {
-            Axis::Unit(u) => ic.mul_motion(&Motion::new(u * self.j.mult, Vector3::zeros())),
+            Axis::Unit(u) => ic.mul_motion(&Motion::new(u * self.mult, Vector3::zeros())),
             _ => Force {
-                ang: ax.mat_mul(&ic.io) * self.j.mult,
-                lin: ax.cross_from(&ic.h) * (-self.j.mult),
+                ang: ax.mat_mul(&ic.io) * self.mult,
+                lin: ax.cross_from(&ic.h) * (-self.mult),
             },
         }
     }
     #[inline(always)]
     fn mat6_subspace(&self, m: &Matrix6<T>) -> Vector6<T> {
-        mat6_col(m, 0, self.ax.get(), self.j.mult)
+        mat6_col(m, 0, self.ax.get(), self.mult)
     }
     #[inline(always)]
     fn subspace_dot6(&self, x: &Vector6<T>) -> T {
-        dot6(x, 0, self.ax.get(), self.j.mult)
+        dot6(x, 0, self.ax.get(), self.mult)
     }
     #[inline(always)]
     fn add_subspace_scaled(&self, m: &mut Motion<T>, x: T) {
-        self.ax.get().add_scaled(&mut m.ang, self.j.mult * x);
+        self.ax.get().add_scaled(&mut m.ang, self.mult * x);
     }
     #[inline(always)]
     fn joint(&self) -> &Joint<T> {

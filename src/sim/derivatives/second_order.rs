@@ -294,30 +294,8 @@ fn side_gamma_terms(
 /// The residual φ of each row of loop constraint `k` at the current poses
 /// (`data.o_m_i`), as the step's position target reads it (sim/loops.rs).
 pub(super) fn loop_residual(sim: &Simulation, k: usize) -> [f64; 6] {
-    let mut phi = [0.0; 6];
     let Some(l) = sim.cons.loops.as_ref() else {
-        return phi;
+        return [0.0; 6];
     };
-    let c = &l.set.items[k];
-    match &c.kind {
-        ConstraintKind::Joint {
-            q1,
-            second,
-            ratio,
-            offset,
-            ..
-        } => phi[0] = sim.q[*q1] - second.map_or(0.0, |(q2, _)| ratio * sim.q[q2]) - offset,
-        kind => {
-            let m1 = sim.data.o_m_i[c.a.body].compose(&c.a.local);
-            let m2 = sim.data.o_m_i[c.b.body].compose(&c.b.local);
-            let d = m1.trans - m2.trans;
-            phi[..3].copy_from_slice(d.as_slice());
-            if *kind == ConstraintKind::Frame {
-                let r = m1.rot * m2.rot.transpose();
-                let e = nalgebra::Rotation3::from_matrix_unchecked(r).scaled_axis();
-                phi[3..].copy_from_slice(e.as_slice());
-            }
-        }
-    }
-    phi
+    crate::sim::loops::residual(&l.set.items[k], &sim.data, sim.q.as_slice())
 }

@@ -12,6 +12,11 @@
 //! capped (a start far off the constraint closes at a capped rate: gently,
 //! without entering v).
 
+mod project;
+mod residual;
+
+pub(in crate::sim) use residual::residual;
+
 use super::factor::MassFactor;
 use super::solver::{RowKind, Rows};
 use crate::dynamics::constraint_dynamics::{bias_rows, jacobian_rows};
@@ -70,6 +75,12 @@ pub(crate) struct Loops {
     e_ref: Option<f64>,
     /// Scratch: each constraint's violation.
     viol: Vec<f64>,
+    /// Per set row (the first `kept` of each constraint, along its kept
+    /// directions): the residual the step's position target aims at, eᵀφ + h·close
+    /// (0 unless a violated start closes at the capped rate).
+    aim: Vec<f64>,
+    /// The projection's scratch (project.rs).
+    proj: project::Scratch,
 }
 
 impl Loops {
@@ -108,6 +119,8 @@ impl Loops {
             dense: vec![0.0; model.nv],
             e_ref: None,
             viol: vec![0.0; set.items.len()],
+            aim: vec![0.0; m],
+            proj: project::Scratch::new(m, model.nv),
             set,
         }
     }
@@ -203,29 +216,7 @@ impl Loops {
                 }
                 _ => rows.union_path(body_path(c.a.body), body_path(c.b.body)),
             };
-            // the residual φ of each row
-            let mut phi = [0.0; 6];
-            match &c.kind {
-                ConstraintKind::Joint {
-                    q1,
-                    second,
-                    ratio,
-                    offset,
-                    ..
-                } => phi[0] = q[*q1] - second.map_or(0.0, |(q2, _)| ratio * q[q2]) - offset,
-                kind => {
-                    let m1 = data.o_m_i[c.a.body].compose(&c.a.local);
-                    let m2 = data.o_m_i[c.b.body].compose(&c.b.local);
-                    let d = m1.trans - m2.trans;
-                    phi[..3].copy_from_slice(d.as_slice());
-                    if *kind == ConstraintKind::Frame {
-                        // the rotation error R₁R₂ᵀ's axis · angle (world)
-                        let r = m1.rot * m2.rot.transpose();
-                        let e = nalgebra::Rotation3::from_matrix_unchecked(r).scaled_axis();
-                        phi[3..].copy_from_slice(e.as_slice());
-                    }
-                }
-            }
+            let phi = residual(c, data, q.as_slice());
             let first = self.first[k];
             let m = c.rows();
             let kept = directions(&self.jc, first, m, &mut self.basis[k]);
@@ -245,6 +236,7 @@ impl Loops {
                 }
                 rows.gather(r, &mut self.dense);
                 let close = (-along(&phi[..m]) / h).clamp(-cap, cap);
+                self.aim[first + t] = along(&phi[..m]) + h * close;
                 let gamma = along(&self.gamma.as_slice()[first..first + m]);
                 rows.bpos[r] = close - 0.5 * h * gamma;
                 violated |= rows.bpos[r] != 0.0;
