@@ -46,6 +46,7 @@ mod pinocchio_derivatives;
 mod pinocchio_fixtures;
 mod scene;
 mod scene_bad;
+mod scene_mjcf;
 mod scene_physics;
 mod seed_examples;
 mod sensors;

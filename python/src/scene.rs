@@ -15,7 +15,8 @@ use std::sync::Arc;
 use urdyn::nalgebra::Vector3;
 use urdyn::scene::{Scene, SceneError};
 
-/// A scene (`Scene.from_file(path)`, `Scene.from_json(text, base_dir=None)`).
+/// A scene (`Scene.from_file(path)`, `Scene.from_json(text, base_dir=None)`,
+/// `Scene.from_mjcf(path)`).
 #[pyclass(name = "Scene", module = "urdyn")]
 #[derive(Clone)]
 pub struct PyScene {
@@ -113,6 +114,19 @@ impl PyScene {
             text,
             package_dirs: dirs,
         })
+    }
+
+    /// The whole world of an MJCF file as a scene (mjcf.md §"Entry points"):
+    /// one model named after the file's stem (names `STEM/NAME`), its static
+    /// geoms obstacles, its floor plane the ground.
+    #[staticmethod]
+    fn from_mjcf(#[pyo3(from_py_with = crate::args::named::path)] path: PathBuf) -> PyResult<Self> {
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let text = urdyn::scene::mjcf_scene_json(&path);
+        Self::build(text, &path.display().to_string(), dir, Vec::new())
     }
 
     /// A scene from JSON text; relative paths against `base_dir` (default: the

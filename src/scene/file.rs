@@ -73,17 +73,23 @@ pub enum BaseSpec {
     Floating,
 }
 
-/// One URDF model of the scene.
+/// One model of the scene: a URDF, or an MJCF file's whole world (mjcf.md
+/// §"Entry points").
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
     /// Unique among models and obstacles, no `/`.
     pub name: String,
-    /// The URDF file, relative to the scene file.
-    pub urdf: String,
-    /// `"fixed"` (default) or `"floating"`.
-    #[serde(default)]
-    pub base: BaseSpec,
+    /// The URDF file, relative to the scene file (exactly one of `urdf`, `mjcf`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub urdf: Option<String>,
+    /// The MJCF file, relative to the scene file: its whole world (bodies,
+    /// static geoms and ground plane) placed by `position`/`orientation_xyzw`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mjcf: Option<String>,
+    /// `"fixed"` (default) or `"floating"` (a URDF's only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base: Option<BaseSpec>,
     /// World position of the URDF's root frame (m, default the origin).
     #[serde(default)]
     pub position: Option<[f64; 3]>,

@@ -4,10 +4,21 @@
 //! in the given order. A fixed model's links welded to the world move to its
 //! pose; a floating model's free joint starts at the world origin (its pose is
 //! its starting q). Every name becomes `MODEL/NAME`.
+//!
+//! A part may itself be a forest (an MJCF file's world: one tree per child of
+//! `<worldbody>`): each of its trees stays a tree here, named after the part;
+//! its children of the world on a free joint keep their identity placement,
+//! their q (from the part's `qpos0`) is placed by the part's pose (a free
+//! joint's q is a world pose); its shapes on the world stay obstacles; its
+//! actuators come along, renamed `MODEL/NAME` and shifted to the forest's
+//! coordinates.
 
-use crate::model::{CollisionFilter, CollisionGeom, FreeJoint, Model, Topology, Tree};
+use crate::model::{
+    CollisionFilter, CollisionGeom, FreeJoint, JointKind, Model, Topology, Tree, OBSTACLE,
+};
 use crate::spatial::Se3;
 use nalgebra::Vector3;
+use nalgebra::{Rotation3, UnitQuaternion};
 
 /// One model of the forest: its name, the model as loaded (fixed or floating),
 /// and, for a fixed one, where its root frame is welded.
@@ -70,6 +81,8 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
         equalities: Default::default(),
         equality_active: Vec::new(),
     };
+    let any_qpos0 = parts.iter().any(|p| p.model.qpos0.is_some());
+    let mut qpos0: Vec<f64> = Vec::new();
     for (i, part) in parts.into_iter().enumerate() {
         let p = &part.model;
         if i == 0 {
@@ -89,8 +102,10 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
             j.iq += q0;
             j.iv += v0;
             m.joints.push(j);
-            // a child of the world hangs from the model's pose
-            let x = if p.parent[b] == 0 {
+            // a child of the world hangs from the model's pose (but a free
+            // joint's q is its world pose)
+            let free_root = p.parent[b] == 0 && matches!(p.joints[b].kind, JointKind::Free);
+            let x = if p.parent[b] == 0 && !free_root {
                 weld.compose(&p.placements[b])
             } else {
                 p.placements[b]
@@ -120,7 +135,10 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
                 c.placement = weld.compose(&c.placement);
             }
             c.body = body(c.body);
-            c.model = i;
+            // a part's own obstacles (an MJCF world's static geoms) stay obstacles
+            if c.model != OBSTACLE {
+                c.model = i;
+            }
             c.friction = part.friction;
             m.collisions.push(c);
         }
@@ -171,18 +189,66 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
             });
             m.free_joints.len() - 1
         });
+        for a in &p.actuators {
+            let mut a = a.clone();
+            a.name = prefixed(pre, &a.name);
+            a.dof = a.dof.map(|(iv, iq)| (iv + v0, iq + q0));
+            for (iv, _) in &mut a.moment {
+                *iv += v0;
+            }
+            m.actuators.push(a);
+        }
+        if any_qpos0 {
+            let mut q = p.neutral().as_slice().to_vec();
+            // the part's free roots: world poses, placed by the part's pose
+            for b in 1..p.nbodies {
+                let j = &p.joints[b];
+                if floating || p.parent[b] != 0 || !matches!(j.kind, JointKind::Free) {
+                    continue;
+                }
+                let x = &q[j.iq..j.iq + 7];
+                let r = UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+                    x[6], x[3], x[4], x[5],
+                ));
+                let wr = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
+                    weld.rot,
+                ));
+                let t = weld.rot * nalgebra::Vector3::new(x[0], x[1], x[2]) + weld.trans;
+                let o = wr * r;
+                q[j.iq..j.iq + 7].copy_from_slice(&[t.x, t.y, t.z, o.i, o.j, o.k, o.w]);
+            }
+            qpos0.extend(q);
+        }
         m.nbodies += p.nbodies - 1;
         m.nq += p.nq;
         m.nv += p.nv;
-        m.trees.push(Tree {
-            name: part.name.clone(),
-            bodies: b0..m.nbodies,
-            frames: f0..m.frames.len(),
-            dofs: d0..m.dofs.len(),
-            q: q0..m.nq,
-            v: v0..m.nv,
-            free,
-        });
+        if p.trees.len() > 1 && !floating {
+            // a forest itself (an MJCF world): each of its trees
+            for t in &p.trees {
+                m.trees.push(Tree {
+                    name: part.name.clone(),
+                    bodies: b0 + t.bodies.start - 1..b0 + t.bodies.end - 1,
+                    frames: f0 + t.frames.start..f0 + t.frames.end,
+                    dofs: d0 + t.dofs.start..d0 + t.dofs.end,
+                    q: q0 + t.q.start..q0 + t.q.end,
+                    v: v0 + t.v.start..v0 + t.v.end,
+                    free: None,
+                });
+            }
+        } else {
+            m.trees.push(Tree {
+                name: part.name.clone(),
+                bodies: b0..m.nbodies,
+                frames: f0..m.frames.len(),
+                dofs: d0..m.dofs.len(),
+                q: q0..m.nq,
+                v: v0..m.nv,
+                free,
+            });
+        }
+    }
+    if any_qpos0 {
+        m.qpos0 = Some(qpos0);
     }
     m.floating_base = m.free_joints.first().is_some_and(|f| f.body == 1);
     m.topology = Topology::new(&m.dof_parent, m.nbodies, m.has_mimic);

@@ -169,25 +169,58 @@ impl Loader<'_> {
         let mut models = Vec::new();
         let mut srdfs = Vec::new();
         let mut warnings = Vec::new();
+        let mut grounds = super::mjcf::Grounds { planes: Vec::new() };
+        // (first collision in the forest, the file's own frictions) of each
+        // MJCF model without a "friction": its geoms keep theirs
+        let mut own_friction: Vec<(usize, Vec<f64>)> = Vec::new();
+        let mut ncollisions = 0usize;
         for (i, m) in spec.models.iter().enumerate() {
             let key = format!("models[{i}]");
             let pose = self.pose(&key, m.position, m.orientation_xyzw)?;
-            let urdf = self.existing(&format!("{key}.urdf"), &m.urdf)?;
-            let floating = m.base == BaseSpec::Floating;
-            let mut model = load_file(
-                &urdf,
-                LoadOptions {
-                    floating_base: floating,
-                },
-            )
-            .map_err(|e| self.err(format!("{key}.urdf"), e.to_string()))?;
-            for c in &mut model.collisions {
-                if let Shape::Mesh { filename, .. } = &mut c.shape {
-                    if let Some(p) = resolve_mesh_path(filename, Some(&urdf), self.package_paths) {
-                        *filename = p.display().to_string();
+            let (model, urdf, floating) = match (&m.urdf, &m.mjcf) {
+                (Some(u), None) => {
+                    let urdf = self.existing(&format!("{key}.urdf"), u)?;
+                    let floating = m.base == Some(BaseSpec::Floating);
+                    let mut model = load_file(
+                        &urdf,
+                        LoadOptions {
+                            floating_base: floating,
+                        },
+                    )
+                    .map_err(|e| self.err(format!("{key}.urdf"), e.to_string()))?;
+                    for c in &mut model.collisions {
+                        if let Shape::Mesh { filename, .. } = &mut c.shape {
+                            if let Some(p) =
+                                resolve_mesh_path(filename, Some(&urdf), self.package_paths)
+                            {
+                                *filename = p.display().to_string();
+                            }
+                        }
                     }
+                    (model, urdf, floating)
                 }
-            }
+                (None, Some(x)) => {
+                    let mm = self.mjcf_model(&key, m, x, &pose, &mut warnings)?;
+                    if let Some((h, mu)) = mm.ground {
+                        grounds.planes.push((i, h, mu));
+                    }
+                    if m.friction.is_none() {
+                        let mus = mm.model.collisions.iter().map(|c| c.friction).collect();
+                        own_friction.push((ncollisions, mus));
+                    }
+                    (mm.model, mm.path, false)
+                }
+                (u, _) => {
+                    return Err(self.err(
+                        &key,
+                        format!(
+                            "a model needs exactly one of \"urdf\" and \"mjcf\" (got {})",
+                            if u.is_some() { "both" } else { "neither" }
+                        ),
+                    ))
+                }
+            };
+            ncollisions += model.collisions.len();
             let srdf = match &m.srdf {
                 None => None,
                 Some(s) => {
@@ -260,7 +293,7 @@ impl Loader<'_> {
                         } else {
                             "elements"
                         },
-                        m.urdf,
+                        m.urdf.as_deref().unwrap_or_default(),
                         shown.join(", "),
                         if unknown.len() > shown.len() {
                             ", ..."
@@ -274,6 +307,7 @@ impl Loader<'_> {
             models.push(SceneModel {
                 name: m.name.clone(),
                 urdf,
+                mjcf: m.mjcf.is_some(),
                 floating,
                 pose,
                 friction: self.friction(&format!("{key}.friction"), m.friction)?,
@@ -295,6 +329,12 @@ impl Loader<'_> {
             .filter(|s| !s.is_empty())
             .unwrap_or("scene");
         let mut model = forest(name, parts, Vector3::from(gravity));
+        for (at, mus) in own_friction {
+            for (c, mu) in model.collisions[at..].iter_mut().zip(mus) {
+                c.friction = mu;
+            }
+        }
+        let ground = self.merge_grounds(ground, &grounds, &mut warnings)?;
 
         // obstacles: collision geometry on the world body
         let mut obstacles = Vec::new();
@@ -344,7 +384,7 @@ impl Loader<'_> {
         let mut tau0 = DVector::zeros(model.nv);
         for (i, m) in spec.models.iter().enumerate() {
             let key = format!("models[{i}]");
-            let tree = model.trees[i].clone();
+            let tree = part_tree(&model, &m.name);
             let pre = tree.prefix();
             let mut position = m.position.unwrap_or([0.0; 3]);
             let mut orientation =
@@ -377,7 +417,7 @@ impl Loader<'_> {
                                 .unwrap_or_default();
                             return Err(self.err(
                                 k,
-                                format!("unknown joint \"{joint}\" (not a movable, non-mimic joint of {}{near})", m.urdf),
+                                format!("unknown joint \"{joint}\" (not a movable, non-mimic joint of {}{near})", m.urdf.as_deref().or(m.mjcf.as_deref()).unwrap_or_default()),
                             ));
                         };
                         self.finite(&k, &[x])?;
@@ -477,8 +517,9 @@ impl Loader<'_> {
         if spec.obstacles.iter().any(|o| o.name == name) {
             return Ok(vec![name.to_string()]);
         }
-        if let Some(t) = model.trees.iter().find(|t| t.name == name) {
-            return Ok(model.frames[t.frames.clone()]
+        if model.trees.iter().any(|t| t.name == name) {
+            let t = part_tree(model, name);
+            return Ok(model.frames[t.frames]
                 .iter()
                 .map(|f| f.name.clone())
                 .collect());
@@ -504,4 +545,24 @@ impl Loader<'_> {
         };
         Err(self.err(key, what))
     }
+}
+
+/// The one tree of the scene model `name`, or the span of its trees (an MJCF
+/// world of several, contiguous; `free` the first's).
+pub(super) fn part_tree(model: &Model, name: &str) -> crate::model::Tree {
+    let mut ts = model.trees.iter().filter(|t| t.name == name);
+    let Some(first) = ts.next() else {
+        let mut t = crate::model::Tree::whole(1, 0, 0, 0, 0, false);
+        t.name = name.to_string();
+        return t;
+    };
+    let mut t = first.clone();
+    for u in ts {
+        t.bodies.end = u.bodies.end;
+        t.frames.end = u.frames.end;
+        t.dofs.end = u.dofs.end;
+        t.q.end = u.q.end;
+        t.v.end = u.v.end;
+    }
+    t
 }

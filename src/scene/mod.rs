@@ -1,4 +1,4 @@
-//! Scenes (`../shared/spec/scene.md`): several URDF models, static obstacles
+//! Scenes (`../shared/spec/scene.md`): several URDF or MJCF models, static obstacles
 //! and an optional ground in one simulation. Import layer, beside
 //! [`crate::urdf`]: a SCENE.json (or a [`SceneSpec`] built in code) is checked
 //! key by key, its URDFs and SRDFs loaded, and the models joined into one
@@ -10,6 +10,7 @@
 mod file;
 mod forest;
 mod load;
+mod mjcf;
 mod obstacles;
 pub mod srdf;
 
@@ -18,6 +19,7 @@ pub use file::{
     RoundSpec, SceneSpec,
 };
 pub use forest::{forest, Part};
+pub use mjcf::mjcf_scene_json;
 
 use crate::model::{Model, Shape};
 use crate::spatial::Se3;
@@ -68,8 +70,11 @@ pub struct Ground {
 pub struct SceneModel {
     /// Its name (the prefix of its names).
     pub name: String,
-    /// The URDF file (resolved against the scene file's folder).
+    /// The URDF file, or the MJCF file when `mjcf` (resolved against the
+    /// scene file's folder).
     pub urdf: PathBuf,
+    /// Whether `urdf` is an MJCF file (the model is its whole world).
+    pub mjcf: bool,
     /// Whether its root is on a free joint.
     pub floating: bool,
     /// `world_M_root` at the start.
@@ -167,6 +172,19 @@ impl Scene {
             _ => PathBuf::from("."),
         };
         Self::from_json(&text, &name, &dir, package_paths)
+    }
+
+    /// The whole world of an MJCF file as a scene (mjcf.md §"Entry points"):
+    /// the scene [`mjcf_scene_json`] writes for it, one model named after the
+    /// file's stem, its names `STEM/NAME`.
+    pub fn from_mjcf(path: impl AsRef<Path>) -> Result<Self, SceneError> {
+        let path = path.as_ref();
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let text = mjcf_scene_json(path);
+        Self::from_json(&text, &path.display().to_string(), &dir, &[])
     }
 
     /// Loads SCENE.json text; `file` names it in messages, `base_dir` resolves

@@ -67,12 +67,16 @@ impl Geometry {
     pub fn load_scene(scene: &Scene, package_paths: &[PathBuf]) -> Result<Self, ViewError> {
         let mut all = Geometry::default();
         for m in &scene.models {
-            let g = Geometry::load_prefixed(
-                &scene.model,
-                &m.urdf,
-                &format!("{}/", m.name),
-                package_paths,
-            )?;
+            let g = if m.mjcf {
+                mjcf_model_geometry(scene, m)?
+            } else {
+                Geometry::load_prefixed(
+                    &scene.model,
+                    &m.urdf,
+                    &format!("{}/", m.name),
+                    package_paths,
+                )?
+            };
             all.append(g);
         }
         for o in &scene.obstacles {
@@ -121,6 +125,32 @@ impl Geometry {
             v
         }));
     }
+}
+
+/// An MJCF model of a scene drawn as `urdyn view FILE.xml` draws the file
+/// (view/mjcf.rs), its bodies moved to the scene's (the forest keeps a part's
+/// bodies contiguous from its first tree's first body), its links `MODEL/LINK`,
+/// the file's world geoms placed by the model's pose.
+fn mjcf_model_geometry(scene: &Scene, m: &crate::scene::SceneModel) -> Result<Geometry, ViewError> {
+    let name = m.urdf.display().to_string();
+    let (alone, world) = crate::mjcf::load_file_with_world(&m.urdf)
+        .map_err(|e| ViewError::Geometry(format!("{}: {name}: {e}", scene.file)))?;
+    let mut g = super::mjcf::geometry(&alone, &world, &name);
+    let b0 = scene
+        .model
+        .trees
+        .iter()
+        .find(|t| t.name == m.name)
+        .map_or(1, |t| t.bodies.start);
+    for v in &mut g.visuals {
+        v.link = format!("{}/{}", m.name, v.link);
+        if v.body == 0 {
+            v.placement = m.pose.compose(&v.placement);
+        } else {
+            v.body += b0 - 1;
+        }
+    }
+    Ok(g)
 }
 
 /// The height field's surface: one vertex a grid point (rows along y from −y,
