@@ -1,5 +1,5 @@
 //! Diagnostic: which contacts hold the Luxo lamp and how fast each point moves.
-//! `cargo run --release --example luxo_probe [SCENE] [T...]`
+//! `cargo run --release --features tools --example luxo_probe [SCENE] [T...]`
 use nalgebra::DVector;
 use urdyn::sim::{SimOptions, Simulation};
 

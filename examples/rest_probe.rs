@@ -1,7 +1,7 @@
 //! Diagnostic: a lone URDF dropped as `urdyn simulate --floating-base
 //! --above-ground H` drops it; prints, for the steps in [T0, T1), every
 //! contact point (link, slot, gap, force, point velocity) and the largest
-//! generalized speed. `cargo run --release --example rest_probe URDF [T0 T1]`
+//! generalized speed. `cargo run --release --features tools --example rest_probe URDF [T0 T1]`
 //! (package paths from `PKG`, colon-separated; `H` from `LIFT`, default 0.3).
 use urdyn::sim::{SimOptions, Simulation};
 

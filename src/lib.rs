@@ -9,9 +9,12 @@
 //! Inverse dynamics then forward dynamics of the UR5 (fixed base, nq = nv = 6):
 //! [`dynamics::rnea`] gives the joint torques τ = H(q) a + C(q, v) (N·m) that
 //! produce an acceleration, [`dynamics::forward_dynamics`] the acceleration those
-//! torques produce (docs/theory.md §"Equation of motion").
+//! torques produce (docs/theory.md §"Equation of motion"). (This example is
+//! compiled and run by `cargo test` in the integration tests, tests/doc_examples.rs,
+//! rather than as a doctest: rustdoc would instantiate the generic dynamics again,
+//! unoptimised, for it alone.)
 //!
-//! ```
+//! ```ignore
 //! use urdyn::nalgebra::DVector;
 //! use urdyn::{dynamics, Data, LoadOptions};
 //!
@@ -73,8 +76,3 @@ pub use model::{Data, Model};
 pub use nalgebra;
 pub use scene::{Scene, SceneError};
 pub use urdf::{load_file, load_str, LoadOptions, UrdfError};
-
-/// The README's Rust examples, compiled and run by `cargo test` (doctests).
-#[cfg(doctest)]
-#[doc = include_str!("../README.md")]
-pub struct ReadmeDoctests;

@@ -23,6 +23,7 @@ mod constraint_dynamics;
 mod contact_pairs;
 mod contact_spin;
 mod derivatives;
+mod doc_examples;
 mod eval_constrained;
 mod eval_singular;
 mod example_scenes;
