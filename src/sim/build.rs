@@ -84,6 +84,38 @@ impl Simulation {
     /// Contact shapes (and meshes) are built here when `opts.ground` is set and a
     /// moving link has collision geometry.
     pub fn new(model: Model, opts: SimOptions) -> Result<Self, SimError> {
+        Self::build(model, opts, None)
+    }
+
+    /// [`Simulation::new`] followed by [`Simulation::set_state`]`(q, v)`, except
+    /// that contacts are looked for once, at `q`, not first at the neutral
+    /// configuration too: there a scene's models all sit at the origin, every
+    /// pair of them overlaps, and that one detection costs O(N²) (33 s and
+    /// 0.8 GB for a 1024-object mixed pile). What it left in the pairs' caches
+    /// (parry's last normals of pairs overlapping at both poses) is not there:
+    /// no trajectory of benches/scenes changes by a bit (tests/islands.rs
+    /// checks a mixed pile). A model with loop constraints of its own (MJCF
+    /// equalities, placed at the construction's state) is set up as `new` then
+    /// `set_state` do.
+    pub fn new_at(
+        model: Model,
+        opts: SimOptions,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+    ) -> Result<Self, SimError> {
+        if !model.equalities.items.is_empty() {
+            let mut sim = Self::new(model, opts)?;
+            sim.set_state(q, v)?;
+            return Ok(sim);
+        }
+        Self::build(model, opts, Some((q, v)))
+    }
+
+    fn build(
+        model: Model,
+        opts: SimOptions,
+        start: Option<(&DVector<f64>, &DVector<f64>)>,
+    ) -> Result<Self, SimError> {
         let positive = |x: f64, name: &str| {
             if x.is_finite() && x > 0.0 {
                 Ok(())
@@ -266,7 +298,11 @@ impl Simulation {
             sim.set_gains(&kp, &DVector::zeros(nv))?;
         }
         sim.cons.set_threads(sim.opts.threads);
-        sim.state_changed();
+        match start {
+            // set_state's checks and state_changed, once
+            Some((q, v)) => sim.set_state(q, v)?,
+            None => sim.state_changed(),
+        }
         // the model's own loop constraints (MJCF <equality>): src/sim/equalities.rs
         sim.set_model_equalities()?;
         Ok(sim)

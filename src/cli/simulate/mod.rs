@@ -222,9 +222,14 @@ pub fn run(args: &SimulateArgs) -> Result<Summary, SimulateError> {
         urdf: urdf_name.clone(),
         error,
     };
-    let mut sim = Simulation::new(model, opts).map_err(sim_err)?;
+    // at the start state at once: contacts are not looked for with every
+    // model of a scene at the origin first (O(N²))
+    let mut sim = match &init {
+        Some(sv) => Simulation::new_at(model, opts, &sv.q, &sv.v),
+        None => Simulation::new(model, opts),
+    }
+    .map_err(sim_err)?;
     if let Some(sv) = &init {
-        sim.set_state(&sv.q, &sv.v).map_err(sim_err)?;
         sim.torques_mut().copy_from(&sv.tau);
     }
     // loop constraints: world anchors left out are placed at the start state; a
