@@ -246,16 +246,24 @@ impl MassFactor {
             if !(d > tiny * self.hdiag[k].abs()) || !d.is_finite() {
                 return Err(k);
             }
-            // eliminate k from its ancestors i = path_k[t], t = depth(i)
+            // eliminate k from its ancestors i = path_k[t], t = depth(i): i's
+            // packed path (t + 1 entries, ending at D[i]) lies before k's (i < k),
+            // so the two are disjoint slices and each entry's update, one fused
+            // multiply-add independent of the others, runs in vector lanes
+            // (the same operation per entry as one at a time: the same bits)
+            let (head, tail) = self.anc.split_at_mut(sk);
             for t in (0..lk - 1).rev() {
                 let i = self.table[sk + t];
                 let si = self.start[i];
-                let a = self.anc[sk + t] / d;
-                for s in (0..=t).rev() {
-                    let hkj = self.anc[sk + s];
-                    self.anc[si + s] = madd(-a, hkj, self.anc[si + s]);
+                let a = tail[t] / d;
+                let (Some(row_i), Some(row_k)) = (head.get_mut(si..si + t + 1), tail.get(..t + 1))
+                else {
+                    return Err(k);
+                };
+                for (x, &hkj) in row_i.iter_mut().zip(row_k) {
+                    *x = madd(-a, hkj, *x);
                 }
-                self.anc[sk + t] = a;
+                tail[t] = a;
             }
         }
         for k in k0..k1 {

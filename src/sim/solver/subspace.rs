@@ -13,6 +13,8 @@ pub(super) struct Subspace {
     pub(super) w: Vec<f64>,
     pub(super) rhs: Vec<f64>,
     pub(super) lam: Vec<f64>,
+    /// A row scattered to full width (nv entries, zero between uses).
+    pub(super) x: Vec<f64>,
     /// At a tangent pair's first row: it lay on its cone's boundary (sliding).
     pub(super) sliding: Vec<bool>,
     /// The loop rows' exact block ([`LoopBlock`]).
@@ -20,13 +22,14 @@ pub(super) struct Subspace {
 }
 
 impl Subspace {
-    pub(super) fn new(_nv: usize, cap: usize) -> Self {
+    pub(super) fn new(nv: usize, cap: usize) -> Self {
         let m = cap.min(SUBSPACE_MAX);
         Self {
             rows: Vec::with_capacity(m),
             w: vec![0.0; m * m],
             rhs: vec![0.0; m],
             lam: vec![0.0; m],
+            x: vec![0.0; nv],
             sliding: vec![false; cap],
             loops: LoopBlock::new(cap),
         }
@@ -155,33 +158,40 @@ pub(super) fn subspace_step(
     if m == 0 || m > SUBSPACE_MAX {
         return false;
     }
-    let _ = nv;
-    // the residuals b − u and the lower triangle of W_FF = Y_F Y_Fᵀ, each
-    // entry a merge of two ascending paths (no row scattered to full width:
-    // the cost follows the rows' paths, never nv)
+    // the residuals b − u and the lower triangle of W_FF = Y_F Y_Fᵀ: row r
+    // scattered onto its path's dofs in `x` (zeros elsewhere, put back after),
+    // each entry then a sum over the other row's path in its order. A dof off
+    // r's path adds y·0 = ±0, which leaves every partial sum as it was: the
+    // same bits as summing over the two paths' common dofs only, without the
+    // merge's branches (the cost follows the rows' paths, never nv)
+    if sm.x.len() < nv {
+        return false;
+    }
     for (a, &r) in sm.rows.iter().enumerate() {
         let pa = path(r);
+        let yr = &y[r * st..r * st + pa.len()];
         let mut u = c[r];
-        for (t, &k) in pa.iter().enumerate() {
-            u += y[r * st + t] * dv[k];
+        for (&yt, &k) in yr.iter().zip(pa) {
+            u += yt * dv[k];
+            sm.x[k] = yt;
         }
         let target = match kinds[r] {
             RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
             _ => b[r],
         };
         sm.rhs[a] = target - u;
+        let x = &sm.x[..nv];
         for (bb, &q) in sm.rows.iter().enumerate().take(a + 1) {
             let pq = path(q);
-            let (mut s, mut i) = (0.0, 0);
-            for (t, &k) in pq.iter().enumerate() {
-                while i < pa.len() && pa[i] < k {
-                    i += 1;
-                }
-                if i < pa.len() && pa[i] == k {
-                    s += y[q * st + t] * y[r * st + i];
-                }
+            let yq = &y[q * st..q * st + pq.len()];
+            let mut s = 0.0;
+            for (&yt, &k) in yq.iter().zip(pq) {
+                s += yt * x[k];
             }
             sm.w[a * m + bb] = s;
+        }
+        for &k in pa {
+            sm.x[k] = 0.0;
         }
     }
     // W_FF = L D Lᵀ; a pivot that lost all but 1e-10 of its diagonal is a
