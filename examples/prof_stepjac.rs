@@ -1,5 +1,5 @@
 //! Profiling driver for the analytic step Jacobians (ur5, no contact, Euler, dt 1 ms):
-//! `cargo run --release --example prof_stepjac -- N` (perf record on it).
+//! `cargo run --release --features tools --example prof_stepjac -- N` (perf record on it).
 use nalgebra::DVector;
 use std::hint::black_box;
 use urdyn::sim::{Integrator, JacobianMethod, SimOptions, Simulation};

@@ -36,6 +36,7 @@ use super::second_order::{add_second_order, loop_gamma_derivatives, loop_rows};
 use super::smooth::Tableau;
 use super::TransitionJacobians;
 use crate::contact::{ContactPoint, NO_GEOM};
+use crate::dynamics::linalg::{by_size, cholesky_fast, cholesky_solve_rows};
 use crate::dynamics::{rnea_derivatives, DynamicsError};
 use crate::model::Shape;
 use crate::sim::integrators::dop853_tableau::{A, B, N_STAGES};
@@ -63,6 +64,7 @@ pub(in crate::sim) struct Scratch {
     kq_diag: Vec<f64>,
     kv_diag: Vec<f64>,
     minv: DMatrix<f64>,
+    l: DMatrix<f64>,
     kk: DMatrix<f64>,
     z0: DMatrix<f64>,
 }
@@ -84,8 +86,31 @@ impl Default for Scratch {
             kq_diag: Vec::new(),
             kv_diag: Vec::new(),
             minv: m.clone(),
+            l: m.clone(),
             kk: m.clone(),
             z0: m,
+        }
+    }
+}
+
+/// Column c of Z0 += K[k, c] · column k of H̃⁻¹ over the 2n columns of K
+/// (contiguous columns, K's structural zeros skipped); `N`: n when known at
+/// compile time, else 0.
+#[inline(always)]
+fn z0_product<const N: usize>(zs: &mut [f64], ms: &[f64], ks: &[f64], n: usize) {
+    let n = if N == 0 { n } else { N };
+    if zs.len() < 2 * n * n || ms.len() < n * n || ks.len() < 2 * n * n {
+        return;
+    }
+    for c in 0..2 * n {
+        let zc = &mut zs[c * n..(c + 1) * n];
+        for k in 0..n {
+            let x = ks[k + c * n];
+            if x != 0.0 {
+                for (z, &mi) in zc.iter_mut().zip(&ms[k * n..(k + 1) * n]) {
+                    *z += mi * x;
+                }
+            }
         }
     }
 }
@@ -292,6 +317,10 @@ impl Simulation {
             *x -= &self.data.dtau_dq;
         }
         self.fk_valid = true;
+        // a dense factor (a short chain): H̃⁻¹ below from a Cholesky factor of
+        // H̃ solved against all n unit columns at once, the step's factor
+        // left alone (nothing after this reads it: the next step forms its own)
+        let dense = !self.model.has_mimic && !self.mass.f.is_tree();
         if self.model.has_mimic {
             self.factor_mass(h)?;
         } else {
@@ -301,10 +330,16 @@ impl Simulation {
                 self.data.h[(k, k)] +=
                     self.armature[k] + h * self.damping[k] + self.servo.diag(k, h);
             }
-            self.mass
-                .f
-                .factor(&self.data.h)
-                .map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)))?;
+            if dense {
+                shape(&mut sc.l, n, n);
+                cholesky_fast(&self.data.h, &mut sc.l)
+                    .map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)))?;
+            } else {
+                self.mass
+                    .f
+                    .factor(&self.data.h)
+                    .map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)))?;
+            }
         }
         // the diagonal terms of K_q (Kp) and K_v (D + Kd + h Kp), the effort clamp's
         let s = &self.servo;
@@ -352,11 +387,18 @@ impl Simulation {
             sc.col = DVector::zeros(n);
         }
         let (minv, col) = (&mut sc.minv, &mut sc.col);
-        for c in 0..n {
-            col.fill(0.0);
-            col[c] = 1.0;
-            self.mass.f.solve(col);
-            minv.column_mut(c).copy_from(col);
+        if dense {
+            // the rows of the solution against 1 are H̃⁻¹'s (symmetric)
+            minv.fill(0.0);
+            minv.fill_diagonal(1.0);
+            cholesky_solve_rows(&sc.l, n, minv.as_mut_slice());
+        } else {
+            for c in 0..n {
+                col.fill(0.0);
+                col[c] = 1.0;
+                self.mass.f.solve(col);
+                minv.column_mut(c).copy_from(col);
+            }
         }
         let minv = &sc.minv;
         let y = DMatrix::from_fn(n, m, |i, r| dot_rows(minv, i, &jac, r));
@@ -380,20 +422,8 @@ impl Simulation {
         sc.z0.fill(0.0);
         let z0 = &mut sc.z0;
         {
-            // column c of Z0 += K[k, c] · column k of H̃⁻¹ (contiguous columns,
-            // K's structural zeros skipped)
             let (zs, ms, ks) = (z0.as_mut_slice(), minv.as_slice(), kk.as_slice());
-            for c in 0..2 * n {
-                let zc = &mut zs[c * n..(c + 1) * n];
-                for k in 0..n {
-                    let x = ks[k + c * n];
-                    if x != 0.0 {
-                        for (z, &mi) in zc.iter_mut().zip(&ms[k * n..(k + 1) * n]) {
-                            *z += mi * x;
-                        }
-                    }
-                }
-            }
+            by_size!(n, N => z0_product::<N>(zs, ms, ks, n));
         }
         for k in 0..n {
             z0[(k, n + k)] += 1.0;
