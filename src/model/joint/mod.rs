@@ -144,7 +144,7 @@ impl<T: Scalar> Joint<T> {
         dispatch_joint!(self, false, jm => jm.add_motion(m, x.as_slice()))
     }
     /// The axis of `λ(i)Mi`'s rotation when it is a plain rotation about an
-    /// axis-aligned joint axis: a revolute (or planar: θ about z) joint whose placement rotation is the
+    /// axis-aligned joint axis: a revolute joint whose placement rotation is the
     /// identity (`placement_identity`, decided once at model load). `λ(i)Mi`'s
     /// rotation then has a row and a column of the identity, and [`Axis::rot_mul`],
     /// [`Axis::rot_tr_mul`], [`Axis::mul_rot`] apply it with 4 products a vector.
@@ -424,20 +424,12 @@ macro_rules! dispatch_joint {
                 let $jm = FreeJ { j: j__ };
                 $body
             }
-            (Dispatch::Spherical, true) => {
-                let $jm = SphericalJ::<_, true> { j: j__ };
+            (Dispatch::Spherical, _) => {
+                let $jm = SphericalJ { j: j__ };
                 $body
             }
-            (Dispatch::Spherical, false) => {
-                let $jm = SphericalJ::<_, false> { j: j__ };
-                $body
-            }
-            (Dispatch::Planar, true) => {
-                let $jm = PlanarJ::<_, true> { j: j__ };
-                $body
-            }
-            (Dispatch::Planar, false) => {
-                let $jm = PlanarJ::<_, false> { j: j__ };
+            (Dispatch::Planar, _) => {
+                let $jm = PlanarJ { j: j__ };
                 $body
             }
         }

@@ -9,16 +9,13 @@ use super::{Joint, JointModel};
 use crate::spatial::{sin_cos, Axis, CompositeInertia, Force, Motion, Scalar, Se3};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
-/// The 3-DoF planar joint (the xy plane of the joint frame); `AXROT`: its
-/// placement's rotation is the identity (`placement_identity`), so `λ(i)Mi`'s
-/// rotation is the turn θ about z, applied as an axis rotation
-/// ([`JointModel::rot_axis`], 4 products a vector instead of 9).
+/// The 3-DoF planar joint (the xy plane of the joint frame).
 #[derive(Clone, Copy)]
-pub(crate) struct PlanarJ<'j, T: Scalar, const AXROT: bool> {
+pub(crate) struct PlanarJ<'j, T: Scalar> {
     pub j: &'j Joint<T>,
 }
 
-impl<'j, T: Scalar, const AXROT: bool> PlanarJ<'j, T, AXROT> {
+impl<'j, T: Scalar> PlanarJ<'j, T> {
     /// `S x` for the joint's coordinates of `x`.
     #[inline(always)]
     fn motion(&self, x: &[T]) -> Motion<T> {
@@ -28,15 +25,11 @@ impl<'j, T: Scalar, const AXROT: bool> PlanarJ<'j, T, AXROT> {
     }
 }
 
-impl<'j, T: Scalar, const AXROT: bool> JointModel<T> for PlanarJ<'j, T, AXROT> {
+impl<'j, T: Scalar> JointModel<T> for PlanarJ<'j, T> {
     const NV: usize = 3;
     #[inline(always)]
     fn rot_axis(&self) -> Option<Axis<T>> {
-        if AXROT {
-            Some(Axis::Z)
-        } else {
-            None
-        }
+        None
     }
     #[inline(always)]
     fn placement(&self, xt: &Se3<T>, q: &[T]) -> Se3<T> {
@@ -44,11 +37,6 @@ impl<'j, T: Scalar, const AXROT: bool> JointModel<T> for PlanarJ<'j, T, AXROT> {
         let (s, c) = sin_cos(q[2]);
         let (z, o) = (T::zero(), T::one());
         let rot = Matrix3::new(c, -s, z, s, c, z, z, z, o);
-        if AXROT {
-            // X_tree's rotation is the identity: no product with it
-            let t = &xt.trans;
-            return Se3::new(rot, Vector3::new(t.x + q[0], t.y + q[1], t.z));
-        }
         Se3::new(
             xt.rot * rot,
             xt.trans + xt.rot.column(0) * q[0] + xt.rot.column(1) * q[1],

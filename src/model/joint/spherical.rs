@@ -7,14 +7,13 @@ use super::{Joint, JointModel};
 use crate::spatial::{quat_to_matrix, Axis, CompositeInertia, Force, Motion, Scalar, Se3};
 use nalgebra::{Matrix6, Vector3, Vector6};
 
-/// The 3-DoF spherical joint; `IDENT`: its placement's rotation is the
-/// identity (`placement_identity`: no product with it in the placement).
+/// The 3-DoF spherical joint.
 #[derive(Clone, Copy)]
-pub(crate) struct SphericalJ<'j, T: Scalar, const IDENT: bool> {
+pub(crate) struct SphericalJ<'j, T: Scalar> {
     pub j: &'j Joint<T>,
 }
 
-impl<'j, T: Scalar, const IDENT: bool> SphericalJ<'j, T, IDENT> {
+impl<'j, T: Scalar> SphericalJ<'j, T> {
     /// `S x`: the angular velocity `x[iv..iv + 3]`.
     #[inline(always)]
     fn motion(&self, x: &[T]) -> Motion<T> {
@@ -23,7 +22,7 @@ impl<'j, T: Scalar, const IDENT: bool> SphericalJ<'j, T, IDENT> {
     }
 }
 
-impl<'j, T: Scalar, const IDENT: bool> JointModel<T> for SphericalJ<'j, T, IDENT> {
+impl<'j, T: Scalar> JointModel<T> for SphericalJ<'j, T> {
     const NV: usize = 3;
     #[inline(always)]
     fn rot_axis(&self) -> Option<Axis<T>> {
@@ -32,11 +31,7 @@ impl<'j, T: Scalar, const IDENT: bool> JointModel<T> for SphericalJ<'j, T, IDENT
     #[inline(always)]
     fn placement(&self, xt: &Se3<T>, q: &[T]) -> Se3<T> {
         let q = &q[self.j.iq..self.j.iq + 4];
-        let r = quat_to_matrix(q[0], q[1], q[2], q[3]);
-        if IDENT {
-            return Se3::new(r, xt.trans);
-        }
-        Se3::new(xt.rot * r, xt.trans)
+        Se3::new(xt.rot * quat_to_matrix(q[0], q[1], q[2], q[3]), xt.trans)
     }
     #[inline(always)]
     fn add_motion(&self, m: &mut Motion<T>, x: &[T]) {
