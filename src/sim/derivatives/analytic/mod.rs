@@ -246,11 +246,9 @@ impl Simulation {
             sc.vplus += self.cons.impulse_velocity();
         }
         set(&mut sc.vtot, &sc.vplus);
-        if rows_used {
-            if let Some(w) = self.cons.push_velocity() {
-                sc.vtot += w;
-                push = Some(w.clone());
-            }
+        if rows_used && let Some(w) = self.cons.push_velocity() {
+            sc.vtot += w;
+            push = Some(w.clone());
         }
         let (q0, v0, points) = (&sc.q0, &sc.v0, &sc.points[..]);
         let (vplus, vtot) = (&sc.vplus, &sc.vtot);
