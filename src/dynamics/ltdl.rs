@@ -85,13 +85,30 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
         }
         if i == NONE {
             let anc = &anc[..len];
+            // the list ends with the run tl − 1, …, 1, 0 (a free base's six
+            // coordinates, and whatever chain continues them): the updates
+            // over that tail are one contiguous axpy (the same operations on
+            // the same entries as the gather over the list)
+            let mut tl = 0;
+            while tl < len && anc[len - 1 - tl] == tl {
+                tl += 1;
+            }
+            let head = len - tl;
             let (left, right) = us.split_at_mut(k * n);
             let colk = &mut right[..k];
             for (t, &i) in anc.iter().enumerate() {
                 let a = colk[i] / d;
                 let coli = &mut left[i * n..i * n + i + 1];
-                for &j in &anc[t..] {
-                    coli[j] = madd(-a, colk[j], coli[j]);
+                let run = if t < head {
+                    for &j in &anc[t..head] {
+                        coli[j] = madd(-a, colk[j], coli[j]);
+                    }
+                    tl
+                } else {
+                    i + 1
+                };
+                for (x, &y) in coli[..run].iter_mut().zip(&colk[..run]) {
+                    *x = madd(-a, y, *x);
                 }
                 colk[i] = a;
             }

@@ -30,9 +30,14 @@ use std::sync::{Arc, Mutex, TryLockError};
 
 /// The copy of a simulation its transition Jacobians are computed in, kept
 /// between calls (a clone of the simulation starts without one; a call that
-/// finds it in use by another thread works in a copy of its own).
+/// finds it in use by another thread works in a copy of its own); and, in
+/// that copy, the analytic route's scratch matrices, sized at its first call
+/// and reused (nothing in them is carried from one call to the next).
 #[derive(Default)]
-pub(in crate::sim) struct Workspace(Mutex<Option<Box<Simulation>>>);
+pub(in crate::sim) struct Workspace {
+    slot: Mutex<Option<Box<Simulation>>>,
+    scratch: analytic::Scratch,
+}
 
 impl Clone for Workspace {
     fn clone(&self) -> Self {
@@ -101,7 +106,7 @@ impl Simulation {
         method: JacobianMethod,
         eps: f64,
     ) -> Result<TransitionJacobians, SimError> {
-        let mut slot = match self.deriv.0.try_lock() {
+        let mut slot = match self.deriv.slot.try_lock() {
             Ok(s) => s,
             Err(TryLockError::Poisoned(p)) => p.into_inner(),
             Err(TryLockError::WouldBlock) => {
@@ -148,6 +153,13 @@ impl Simulation {
         let mut work = self.clone();
         // a perturbed step is not a passive run to guard
         work.opts.max_energy_rise = None;
+        // a new simulation cannot fall asleep within its first `dt` (an
+        // island sleeps after `sleep_time` still): the workspace skips the
+        // sleep test, whose stillness timers would otherwise run on from one
+        // call to the next
+        if work.opts.sleep_time > work.dt {
+            work.sleep.on = false;
+        }
         work
     }
 
@@ -227,10 +239,14 @@ impl Simulation {
 
     /// The applied torques: `tau`'s joint entries, the floating base's zero.
     pub(in crate::sim) fn set_joint_torques(&mut self, tau: &DVector<f64>) {
-        let free: Vec<bool> = (0..tau.len()).map(|k| self.servo.iq[k] == FREE).collect();
-        let t = self.torques_mut();
-        for k in 0..t.len() {
-            t[k] = if free[k] { 0.0 } else { tau[k] };
+        let n = tau.len().min(self.tau_applied.len());
+        self.torques_mut();
+        for k in 0..n {
+            self.tau_applied[k] = if self.servo.iq[k] == FREE {
+                0.0
+            } else {
+                tau[k]
+            };
         }
     }
 }

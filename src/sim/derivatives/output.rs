@@ -32,12 +32,23 @@ impl Simulation {
                 out.b[(r, c - 2 * n)] = x;
             }
         };
-        // joints: δq' = δq + h δv⁺, δv' = δv⁺
-        for c in 0..3 * n {
-            for k in 0..n {
-                let dq = if c < n && c == k { 1.0 } else { 0.0 };
-                put(&mut out, k, c, dq + h * dvtot[(k, c)]);
-                put(&mut out, n + k, c, dvplus[(k, c)]);
+        // joints: δq' = δq + h δv⁺, δv' = δv⁺ (column by column, contiguous)
+        let (dt, dp) = (dvtot.as_slice(), dvplus.as_slice());
+        if dt.len() == 3 * n * n && dp.len() == 3 * n * n {
+            for c in 0..3 * n {
+                let col = if c < 2 * n {
+                    &mut out.a.as_mut_slice()[c * 2 * n..(c + 1) * 2 * n]
+                } else {
+                    &mut out.b.as_mut_slice()[(c - 2 * n) * 2 * n..(c - 2 * n + 1) * 2 * n]
+                };
+                let (top, bottom) = col.split_at_mut(n);
+                for (t, &x) in top.iter_mut().zip(&dt[c * n..(c + 1) * n]) {
+                    *t = h * x;
+                }
+                if c < n {
+                    top[c] += 1.0;
+                }
+                bottom.copy_from_slice(&dp[c * n..(c + 1) * n]);
             }
         }
         if self.model.floating_base {

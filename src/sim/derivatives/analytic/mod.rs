@@ -36,6 +36,7 @@ use super::second_order::{add_second_order, loop_gamma_derivatives, loop_rows};
 use super::smooth::Tableau;
 use super::TransitionJacobians;
 use crate::contact::{ContactPoint, NO_GEOM};
+use crate::dynamics::linalg::{by_size, cholesky_fast, cholesky_solve_rows};
 use crate::dynamics::{rnea_derivatives, DynamicsError};
 use crate::model::Shape;
 use crate::sim::integrators::dop853_tableau::{A, B, N_STAGES};
@@ -45,6 +46,91 @@ use crate::sim::{Integrator, SimError, Simulation};
 use crate::spatial::skew;
 use nalgebra::{DMatrix, DVector, Vector3};
 use std::ops::AddAssign;
+
+/// The analytic route's scratch vectors and matrices, kept in the derivative
+/// workspace and resized only when the model's size changes: every entry is
+/// written before it is read in each call (nothing is carried between calls).
+pub(in crate::sim) struct Scratch {
+    q0: DVector<f64>,
+    v0: DVector<f64>,
+    q1: DVector<f64>,
+    v1: DVector<f64>,
+    vplus: DVector<f64>,
+    vtot: DVector<f64>,
+    acc: DVector<f64>,
+    col: DVector<f64>,
+    points: Vec<ContactPoint>,
+    u_free: Vec<f64>,
+    kq_diag: Vec<f64>,
+    kv_diag: Vec<f64>,
+    minv: DMatrix<f64>,
+    l: DMatrix<f64>,
+    kk: DMatrix<f64>,
+    z0: DMatrix<f64>,
+}
+
+impl Default for Scratch {
+    fn default() -> Self {
+        let (v, m) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+        Self {
+            q0: v.clone(),
+            v0: v.clone(),
+            q1: v.clone(),
+            v1: v.clone(),
+            vplus: v.clone(),
+            vtot: v.clone(),
+            acc: v.clone(),
+            col: v,
+            points: Vec::new(),
+            u_free: Vec::new(),
+            kq_diag: Vec::new(),
+            kv_diag: Vec::new(),
+            minv: m.clone(),
+            l: m.clone(),
+            kk: m.clone(),
+            z0: m,
+        }
+    }
+}
+
+/// Column c of Z0 += K[k, c] · column k of H̃⁻¹ over the 2n columns of K
+/// (contiguous columns, K's structural zeros skipped); `N`: n when known at
+/// compile time, else 0.
+#[inline(always)]
+fn z0_product<const N: usize>(zs: &mut [f64], ms: &[f64], ks: &[f64], n: usize) {
+    let n = if N == 0 { n } else { N };
+    if zs.len() < 2 * n * n || ms.len() < n * n || ks.len() < 2 * n * n {
+        return;
+    }
+    for c in 0..2 * n {
+        let zc = &mut zs[c * n..(c + 1) * n];
+        for k in 0..n {
+            let x = ks[k + c * n];
+            if x != 0.0 {
+                for (z, &mi) in zc.iter_mut().zip(&ms[k * n..(k + 1) * n]) {
+                    *z += mi * x;
+                }
+            }
+        }
+    }
+}
+
+/// `dst` ← `src`, reallocating only on a change of length.
+fn set(dst: &mut DVector<f64>, src: &DVector<f64>) {
+    if dst.len() == src.len() {
+        dst.copy_from(src);
+    } else {
+        *dst = src.clone();
+    }
+}
+
+/// `m` of shape r × c, reallocated only on a change of shape (its entries
+/// are left as they were: the caller writes every one it reads, or zeroes).
+fn shape(m: &mut DMatrix<f64>, r: usize, c: usize) {
+    if m.shape() != (r, c) {
+        *m = DMatrix::zeros(r, c);
+    }
+}
 
 impl Simulation {
     /// A and B through the step's own equations, from the fresh state (set by
@@ -66,10 +152,22 @@ impl Simulation {
             return Ok(None);
         }
         self.set_joint_torques(tau);
+        let mut sc = std::mem::take(&mut self.deriv.scratch);
+        let r = self.steps_jacobian(tau, &mut sc);
+        self.deriv.scratch = sc;
+        r
+    }
+
+    /// [`Simulation::analytic_jacobians`]' steps, composed.
+    fn steps_jacobian(
+        &mut self,
+        tau: &DVector<f64>,
+        sc: &mut Scratch,
+    ) -> Result<Option<TransitionJacobians>, SimError> {
         let dt = self.dt;
         let mut out: Option<TransitionJacobians> = None;
         while self.t < dt {
-            let Some(j) = self.substep_jacobian(dt, tau)? else {
+            let Some(j) = self.substep_jacobian(dt, tau, sc)? else {
                 return Ok(None);
             };
             out = Some(match out {
@@ -90,9 +188,11 @@ impl Simulation {
         &mut self,
         t_end: f64,
         tau: &DVector<f64>,
+        sc: &mut Scratch,
     ) -> Result<Option<TransitionJacobians>, SimError> {
-        let (q0, v0) = (self.q.clone(), self.v.clone());
-        let points = self.points.clone();
+        set(&mut sc.q0, &self.q);
+        set(&mut sc.v0, &self.v);
+        sc.points.clone_from(&self.points);
         // the step's scheme, as step_until chooses it
         let h_fixed = crate::sim::land(self.dt, t_end - self.t);
         let counts = self.assemble_rows(h_fixed);
@@ -117,23 +217,22 @@ impl Simulation {
                 },
                 _ => Tableau { a: &dop_a, b: &B },
             };
-            let j = self.smooth_step_jacobian(&q0, &v0, &q1, tau, h, &tab)?;
+            let j = self.smooth_step_jacobian(&sc.q0, &sc.v0, &q1, tau, h, &tab)?;
             let n = self.model.nv;
             return Ok(Some(TransitionJacobians {
                 a: j.columns(0, 2 * n).into_owned(),
                 b: j.columns(2 * n, n).into_owned(),
             }));
         }
-        self.implicit_step_jacobian(&q0, &v0, &points, counts, h, tau)
+        self.implicit_step_jacobian(sc, counts, h, tau)
     }
 
-    /// The Jacobian of the time-stepping step just taken from (q0, v0) with
-    /// the contact points `points` and rows `counts`, of length `h`.
+    /// The Jacobian of the time-stepping step just taken from (`sc.q0`,
+    /// `sc.v0`) with the contact points `sc.points` and rows `counts`, of
+    /// length `h`.
     fn implicit_step_jacobian(
         &mut self,
-        q0: &DVector<f64>,
-        v0: &DVector<f64>,
-        points: &[crate::contact::ContactPoint],
+        sc: &mut Scratch,
         counts: crate::sim::constraints::RowCounts,
         h: f64,
         tau: &DVector<f64>,
@@ -141,17 +240,18 @@ impl Simulation {
         let n = self.model.nv;
         let rows_used = self.cons.rows_len() > 0 && counts.total() > 0;
         // v⁺ in the start frame (before the base velocity's rotation), w
-        let mut vplus = self.mass.vfree.clone();
-        let mut vtot = vplus.clone();
+        set(&mut sc.vplus, &self.mass.vfree);
         let mut push: Option<DVector<f64>> = None;
         if rows_used {
-            vplus += self.cons.impulse_velocity();
-            vtot.copy_from(&vplus);
-            if let Some(w) = self.cons.push_velocity() {
-                vtot += w;
-                push = Some(w.clone());
-            }
+            sc.vplus += self.cons.impulse_velocity();
         }
+        set(&mut sc.vtot, &sc.vplus);
+        if rows_used && let Some(w) = self.cons.push_velocity() {
+            sc.vtot += w;
+            push = Some(w.clone());
+        }
+        let (q0, v0, points) = (&sc.q0, &sc.v0, &sc.points[..]);
+        let (vplus, vtot) = (&sc.vplus, &sc.vtot);
         // the loop constraints' rows (after every other row)
         let loops = if rows_used {
             match loop_rows(self, self.cons.rows_view()) {
@@ -168,23 +268,31 @@ impl Simulation {
         };
         // back at the start: poses and H̃ (the step's saturation set); the
         // step's end state is put back at the end
-        let (q1, v1) = (self.q.clone(), self.v.clone());
+        set(&mut sc.q1, &self.q);
+        set(&mut sc.v1, &self.v);
         self.q.copy_from(q0);
         self.v.copy_from(v0);
         let floating = self.model.floating_base;
         let vo = self.model.joint_v_offset();
         // a = (v⁺ − v)/h − frame rate
-        let mut acc = (&vplus - v0) / h;
+        if sc.acc.len() != n {
+            sc.acc = DVector::zeros(n);
+        }
+        let acc = &mut sc.acc;
+        for i in 0..n {
+            acc[i] = (vplus[i] - v0[i]) / h;
+        }
         if floating {
             let fr = omega(v0).cross(&lin(v0));
             for i in 0..3 {
                 acc[i] -= fr[i];
             }
         }
+        let acc = &sc.acc;
         // ∂(H w)/∂q = ∂ID/∂q (q, v, a + w) − ∂ID/∂q (q, v, a) (ID is affine in a)
         let mut hw_q = None;
         if let Some(w) = push.as_ref() {
-            rnea_derivatives(&self.model, &mut self.data, q0, v0, &(&acc + w), None)?;
+            rnea_derivatives(&self.model, &mut self.data, q0, v0, &(acc + w), None)?;
             hw_q = Some(self.data.dtau_dq.clone());
         }
         // the loop rows' ∂γ/∂q, ∂γ/∂v from a pass at (q, v, 0)
@@ -202,11 +310,15 @@ impl Simulation {
         }
         // ∂ID/∂q, ∂ID/∂v at (q, v, a) in data.dtau_dq, dtau_dv, ∂ID/∂a = H in
         // data.h, the poses at q
-        rnea_derivatives(&self.model, &mut self.data, q0, v0, &acc, None)?;
+        rnea_derivatives(&self.model, &mut self.data, q0, v0, acc, None)?;
         if let Some(x) = hw_q.as_mut() {
             *x -= &self.data.dtau_dq;
         }
         self.fk_valid = true;
+        // a dense factor (a short chain): H̃⁻¹ below from a Cholesky factor of
+        // H̃ solved against all n unit columns at once, the step's factor
+        // left alone (nothing after this reads it: the next step forms its own)
+        let dense = !self.model.has_mimic && !self.mass.f.is_tree();
         if self.model.has_mimic {
             self.factor_mass(h)?;
         } else {
@@ -216,16 +328,26 @@ impl Simulation {
                 self.data.h[(k, k)] +=
                     self.armature[k] + h * self.damping[k] + self.servo.diag(k, h);
             }
-            self.mass
-                .f
-                .factor(&self.data.h)
-                .map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)))?;
+            if dense {
+                shape(&mut sc.l, n, n);
+                cholesky_fast(&self.data.h, &mut sc.l)
+                    .map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)))?;
+            } else {
+                self.mass
+                    .f
+                    .factor(&self.data.h)
+                    .map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)))?;
+            }
         }
         // the diagonal terms of K_q (Kp) and K_v (D + Kd + h Kp), the effort clamp's
         let s = &self.servo;
-        let mut u_free = vec![0.0; n];
-        let mut kq_diag = vec![0.0; n];
-        let mut kv_diag = self.damping.as_slice().to_vec();
+        let (u_free, kq_diag, kv_diag) = (&mut sc.u_free, &mut sc.kq_diag, &mut sc.kv_diag);
+        u_free.clear();
+        u_free.resize(n, 0.0);
+        kq_diag.clear();
+        kq_diag.resize(n, 0.0);
+        kv_diag.clear();
+        kv_diag.extend_from_slice(self.damping.as_slice());
         for k in 0..n {
             if k >= vo && s.saturated[k] == 0 {
                 u_free[k] = 1.0;
@@ -255,49 +377,51 @@ impl Simulation {
         // (no rows: no second-order terms, nothing allocated)
         let mut gc = DMatrix::<f64>::zeros(if m > 0 { n } else { 0 }, if m > 0 { n } else { 0 });
         if m > 0 {
-            add_second_order(self, points, &loops, &rows.lambda, &vplus, &mut gc, &mut jq);
+            add_second_order(self, points, &loops, &rows.lambda, vplus, &mut gc, &mut jq);
         }
         // H̃⁻¹ (n solves), Y = H̃⁻¹Jᵀ, W = J Y
-        let mut minv = DMatrix::zeros(n, n);
-        let mut col = DVector::zeros(n);
-        for c in 0..n {
-            col.fill(0.0);
-            col[c] = 1.0;
-            self.mass.f.solve(&mut col);
-            minv.column_mut(c).copy_from(&col);
+        shape(&mut sc.minv, n, n);
+        if sc.col.len() != n {
+            sc.col = DVector::zeros(n);
         }
-        let y = DMatrix::from_fn(n, m, |i, r| dot_rows(&minv, i, &jac, r));
+        let (minv, col) = (&mut sc.minv, &mut sc.col);
+        if dense {
+            // the rows of the solution against 1 are H̃⁻¹'s (symmetric)
+            minv.fill(0.0);
+            minv.fill_diagonal(1.0);
+            cholesky_solve_rows(&sc.l, n, minv.as_mut_slice());
+        } else {
+            for c in 0..n {
+                col.fill(0.0);
+                col[c] = 1.0;
+                self.mass.f.solve(col);
+                minv.column_mut(c).copy_from(col);
+            }
+        }
+        let minv = &sc.minv;
+        let y = DMatrix::from_fn(n, m, |i, r| dot_rows(minv, i, &jac, r));
         let w = DMatrix::from_fn(m, m, |a, b| (0..n).map(|k| jac[(a, k)] * y[(k, b)]).sum());
         // Z0: δv⁺ without the impulses' variation, columns (δq, δv, δτ):
         // H̃⁻¹ [∂(Jᵀλ)/∂q − h K_q, −h K_v, h U] + [0, 1, 0] with K_q = ∂ID/∂q + Kp,
         // K_v = ∂ID/∂v + D + Kd + h Kp
-        let mut kk = DMatrix::zeros(n, 2 * n);
+        shape(&mut sc.kk, n, 2 * n);
+        let kk = &mut sc.kk;
         kk.columns_mut(0, n).copy_from(&self.data.dtau_dq);
         kk.columns_mut(n, n).copy_from(&self.data.dtau_dv);
         for k in 0..n {
             kk[(k, k)] += kq_diag[k];
             kk[(k, n + k)] += kv_diag[k];
         }
-        kk *= -h;
+        *kk *= -h;
         if m > 0 {
             kk.columns_mut(0, n).add_assign(&gc);
         }
-        let mut z0 = DMatrix::zeros(n, 3 * n);
+        shape(&mut sc.z0, n, 3 * n);
+        sc.z0.fill(0.0);
+        let z0 = &mut sc.z0;
         {
-            // column c of Z0 += K[k, c] · column k of H̃⁻¹ (contiguous columns,
-            // K's structural zeros skipped)
             let (zs, ms, ks) = (z0.as_mut_slice(), minv.as_slice(), kk.as_slice());
-            for c in 0..2 * n {
-                let zc = &mut zs[c * n..(c + 1) * n];
-                for k in 0..n {
-                    let x = ks[k + c * n];
-                    if x != 0.0 {
-                        for (z, &mi) in zc.iter_mut().zip(&ms[k * n..(k + 1) * n]) {
-                            *z += mi * x;
-                        }
-                    }
-                }
-            }
+            by_size!(n, N => z0_product::<N>(zs, ms, ks, n));
         }
         for k in 0..n {
             z0[(k, n + k)] += 1.0;
@@ -316,10 +440,8 @@ impl Simulation {
             }
         }
         // the active set's equations M δλ = R
-        let dvplus = if m == 0 {
-            z0
-        } else {
-            let mut cq = &jac * &z0;
+        if m > 0 {
+            let mut cq = &jac * &*z0;
             for r in 0..m {
                 for c in 0..n {
                     cq[(r, c)] += jq[(r, c)];
@@ -344,8 +466,8 @@ impl Simulation {
                             }
                         } else {
                             let ut = Vector3::new(
-                                cq_row_dot(&jac, r + 1, &vplus),
-                                cq_row_dot(&jac, r + 2, &vplus),
+                                cq_row_dot(&jac, r + 1, vplus),
+                                cq_row_dot(&jac, r + 2, vplus),
                                 0.0,
                             );
                             let lt = (l1 * l1 + l2 * l2).sqrt();
@@ -384,7 +506,7 @@ impl Simulation {
                     RowKind::Tangent { normal, mu } if r + 1 < m => {
                         // a torsional or rolling pair (sim/constraints/spin.rs)
                         let ln = rows.lambda.get(normal).copied().unwrap_or(0.0);
-                        let ut = [cq_row_dot(&jac, r, &vplus), cq_row_dot(&jac, r + 1, &vplus)];
+                        let ut = [cq_row_dot(&jac, r, vplus), cq_row_dot(&jac, r + 1, vplus)];
                         let lt = rows.lambda[r].hypot(rows.lambda[r + 1]);
                         let un = ut[0].hypot(ut[1]);
                         if ln <= 0.0 {
@@ -458,8 +580,9 @@ impl Simulation {
             } else {
                 solve_basic(mm, rr, 1e-12)
             };
-            z0 + &y * dl
-        };
+            z0.gemm(1.0, &y, &dl, 1.0);
+        }
+        let dvplus = &sc.z0;
         // the position pass's δw (docs/theory.md §"Loops and the position pass
         // in the step Jacobians"): added to the configuration's velocity only
         let mut dvtot = None;
@@ -471,7 +594,7 @@ impl Simulation {
                 jac: &jac,
                 y: &y,
                 w: &w,
-                minv: &minv,
+                minv,
                 h_w_q: hwq,
                 gc_mu: &gcm,
                 jq_w: &jqw,
@@ -480,14 +603,14 @@ impl Simulation {
                 loops: &loops,
                 h,
             };
-            dvtot = Some(&dvplus + self.position_pass_jacobian(&pass));
+            dvtot = Some(dvplus + self.position_pass_jacobian(&pass));
         }
-        self.q.copy_from(&q1);
-        self.v.copy_from(&v1);
+        self.q.copy_from(&sc.q1);
+        self.v.copy_from(&sc.v1);
         self.fk_valid = false;
         // without the position pass δv_tot = δv⁺ (no copy)
-        let dvtot = dvtot.as_ref().unwrap_or(&dvplus);
-        Ok(Some(self.output_map(&vtot, &vplus, dvtot, &dvplus, h)))
+        let dvtot = dvtot.as_ref().unwrap_or(dvplus);
+        Ok(Some(self.output_map(vtot, vplus, dvtot, dvplus, h)))
     }
 
     /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces): the
