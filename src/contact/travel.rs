@@ -148,7 +148,7 @@ mod tests {
             (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         };
         for _ in 0..200 {
-            let mut pose = |rnd: &mut dyn FnMut() -> f64| {
+            let pose = |rnd: &mut dyn FnMut() -> f64| {
                 let axis = Unit::new_normalize(Vector3::new(rnd(), rnd(), rnd()));
                 let r: Matrix3<f64> = Rotation3::from_axis_angle(&axis, 3.0 * rnd()).into_inner();
                 Se3::new(r, Vector3::new(rnd(), rnd(), rnd()))
