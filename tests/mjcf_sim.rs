@@ -2,10 +2,13 @@
 //! hopper and ant on their floor plane, a pendulum whose armature sets its
 //! period (closed form), a damped double pendulum with springs against
 //! MuJoCo's trajectory (tests/oracle/make_mjcf_sim_fixture.py), keyframes and
-//! the CLI's MJCF path.
+//! the CLI's MJCF path; the speculative margin (docs/theory.md §"Speculative
+//! margin"): Gymnasium's humanoid lands at its 3 ms step less than 1 mm deep,
+//! and a slow scene's run is the constant margin's bit for bit.
 
 use nalgebra::DVector;
 use std::path::{Path, PathBuf};
+use urdyn::contact::ContactParams;
 use urdyn::mjcf;
 use urdyn::sim::{Integrator, SimOptions, Simulation};
 
@@ -269,4 +272,84 @@ fn a_disabled_contact_flag_leaves_no_collision_shape() {
     )
     .unwrap();
     assert!(!on.collisions.is_empty());
+}
+
+/// The deepest penetration of Gymnasium's humanoid dropped from its default
+/// pose, stepped 1 s at its file's dt (3 ms) as `urdyn simulate` steps it,
+/// with the speculative margin's factor `c` (0: the constant δ alone).
+fn humanoid_deepest(c: f64) -> f64 {
+    let (model, world) = mjcf::load_file_with_world(fixture("gymnasium/humanoid.xml")).unwrap();
+    let ground = mjcf::ground_of(&world).expect("a floor");
+    let mut opts = SimOptions {
+        dt: world.timestep,
+        integrator: Some(Integrator::SemiImplicitEuler),
+        ground: Some(ground.height),
+        sleep: false,
+        ..SimOptions::default()
+    };
+    opts.contact.friction = ground.friction;
+    opts.contact.travel_factor = c;
+    let mut sim = Simulation::new(model, opts).unwrap();
+    let (mut deepest, mut landed) = (0.0f64, false);
+    while sim.time() < 1.0 {
+        sim.step().unwrap();
+        deepest = deepest.max(sim.penetration());
+        landed |= sim.active_contacts() > 0;
+    }
+    assert!(landed);
+    deepest
+}
+
+#[test]
+fn gymnasium_humanoid_lands_at_its_file_dt_less_than_a_millimetre_deep() {
+    assert_eq!(
+        mjcf::load_file_with_world(fixture("gymnasium/humanoid.xml"))
+            .unwrap()
+            .1
+            .timestep,
+        0.003
+    );
+    // falling at 3 m/s and turning, a limb travels ~9 mm in a 3 ms step, more
+    // than δ = 5 mm: with δ alone its first contact is found 2.6 mm deep
+    // (0.78 s); with the margin grown to c·(last step's travel) it is found
+    // before the impact and the speculative row stops it at the floor
+    let late = humanoid_deepest(0.0);
+    assert!(late > 2e-3, "δ alone: {late} m");
+    let deepest = humanoid_deepest(ContactParams::TRAVEL);
+    assert!(deepest < 1e-3, "penetration {deepest} m");
+}
+
+#[test]
+fn a_slow_scene_keeps_the_constant_margin_bit_for_bit() {
+    // the lamp dropped 0.5 m onto the table at dt 1 ms: it moves at most
+    // 3.1 mm a step, c·s = 4.7 mm < δ = 5 mm: the margin never grows, and the
+    // run is the constant margin's exactly
+    let s = urdyn::scene::Scene::from_file(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/assets/lamp_on_table.json"),
+        &[],
+    )
+    .unwrap();
+    let run = |c: f64| {
+        let g = s.ground.expect("a ground");
+        let mut opts = SimOptions {
+            ground: Some(g.height),
+            ..SimOptions::default()
+        };
+        opts.contact.friction = g.friction;
+        opts.contact.travel_factor = c;
+        let mut sim = Simulation::new(s.model.clone(), opts).unwrap();
+        sim.set_state(&s.q0, &s.v0).unwrap();
+        let (mut qs, mut fastest) = (Vec::new(), 0.0f64);
+        while sim.time() < 1.0 {
+            sim.step().unwrap();
+            qs.extend_from_slice(sim.q().as_slice());
+            fastest = fastest.max(sim.v().amax());
+        }
+        assert!(sim.active_contacts() > 0, "on the table");
+        (qs, fastest)
+    };
+    let (grown, fastest) = run(ContactParams::TRAVEL);
+    let (constant, _) = run(0.0);
+    assert!(fastest > 3.0, "it fell at {fastest} m/s");
+    assert!(grown == constant, "the trajectories differ");
 }

@@ -4,7 +4,8 @@
 //! moves as `urdyn simulate ant.xml` (the same simulation, built as
 //! tests/mjcf_sim.rs builds it) with every link pose moved by that pose; the
 //! keys that do not apply to an MJCF model are errors naming them; an ant
-//! beside a URDF lamp; an MJCF world of several trees and a static geom.
+//! beside a URDF lamp; an MJCF world of several trees and a static geom;
+//! `initial` arrays for an MJCF model's ball and free joints.
 
 use nalgebra::{DVector, Matrix3, Vector3};
 use std::path::{Path, PathBuf};
@@ -359,4 +360,84 @@ fn the_replay_page_of_a_scene_draws_an_mjcf_model_on_the_scenes_bodies() {
         .find(|f| f.name == "ant/torso")
         .unwrap();
     assert!(ant.iter().any(|v| v.body == torso.body && torso.body > 0));
+}
+
+#[test]
+fn initial_sets_an_mjcf_models_ball_and_free_joints_with_arrays() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("ball.xml"),
+        r#"<mujoco model="ball">
+  <worldbody>
+    <body name="a" pos="0 0 0.5"><freejoint name="fa"/><geom type="sphere" size="0.1"/>
+      <body name="b" pos="0 0 -0.2"><joint name="sb" type="ball"/><geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.05"/></body>
+    </body>
+  </worldbody>
+</mujoco>"#,
+    )
+    .unwrap();
+    // the model turned 90° about z and moved to (2, 3, 0.5); its free
+    // joint given in the file's frame, its ball joint turned 60° about x
+    let (s60, c60) = (30f64.to_radians().sin(), 30f64.to_radians().cos());
+    let json = format!(
+        r#"{{"models": [{{"name": "w", "mjcf": "ball.xml", "position": [2, 3, 0.5],
+        "orientation_xyzw": [0, 0, {h}, {h}],
+        "initial": {{"q": {{"fa": [1, 0, 0.25, 0, 0, 0, 1], "sb": [{s60}, 0, 0, {c60}]}},
+                    "v": {{"fa": [0.1, 0.2, 0.3, 0.4, 0.5, 0.6], "sb": [1, 2, 3]}},
+                    "tau": {{"sb": [0, 0, 0.5]}}}}}}]}}"#,
+        h = std::f64::consts::FRAC_1_SQRT_2
+    );
+    let s = scene_in(dir.path(), &json).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((s.model.nq, s.model.nv), (11, 9));
+    let q = s.q0.as_slice();
+    // (1, 0, 0.25) turned 90° about z is (0, 1, 0.25), moved by the position
+    let want = [2.0, 4.0, 0.75];
+    for k in 0..3 {
+        assert!((q[k] - want[k]).abs() < 1e-12, "{q:?}");
+    }
+    // the orientation is the pose's
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    for (k, w) in [0.0, 0.0, h, h].iter().enumerate() {
+        assert!((q[3 + k] - w).abs() < 1e-12, "{q:?}");
+    }
+    // the ball joint's quaternion as given (a joint's own frame)
+    for (k, w) in [s60, 0.0, 0.0, c60].iter().enumerate() {
+        assert!((q[7 + k] - w).abs() < 1e-15, "{q:?}");
+    }
+    // child-frame velocities and torques as given
+    assert_eq!(
+        s.v0.as_slice(),
+        &[0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 1.0, 2.0, 3.0]
+    );
+    assert_eq!(
+        s.tau0.as_slice(),
+        &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5]
+    );
+    // a quaternion within 1e-3 of unit norm is normalised
+    let near = json.replace(&format!("[{s60}, 0, 0, {c60}]"), "[0, 0, 0, 1.0005]");
+    let s = scene_in(dir.path(), &near).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(&s.q0.as_slice()[7..11], &[0.0, 0.0, 0.0, 1.0]);
+    // errors name the key and what the joint takes
+    for (text, key, says) in [
+        (
+            json.replace(&format!("[{s60}, 0, 0, {c60}]"), "[0, 0, 0, 2]"),
+            "models[0].initial.q.sb",
+            "unit quaternion",
+        ),
+        (
+            json.replace(&format!("[{s60}, 0, 0, {c60}]"), "0.5"),
+            "models[0].initial.q.sb",
+            "a spherical joint takes an array of 4 numbers [qx, qy, qz, qw], found a number",
+        ),
+        (
+            json.replace("\"sb\": [1, 2, 3]", "\"sb\": [1, 2]"),
+            "models[0].initial.v.sb",
+            "an array of 3 numbers [wx, wy, wz], found an array of 2",
+        ),
+    ] {
+        let e = scene_in(dir.path(), &text)
+            .expect_err("refused")
+            .to_string();
+        assert!(e.contains(key) && e.contains(says), "{e}");
+    }
 }

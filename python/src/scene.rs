@@ -4,7 +4,7 @@
 //! pickles as its JSON text and the folder its paths are resolved against.
 
 use crate::args::value_error;
-use crate::introspect::link_inertials;
+use crate::introspect::{link_inertials, mjcf_inertials};
 use crate::model::{PyModel, Rebuild};
 use numpy::PyArray1;
 use pyo3::exceptions::PyFileNotFoundError;
@@ -42,8 +42,19 @@ impl PyScene {
         let s = &self.scene;
         let mut inertials = std::collections::HashMap::new();
         for m in &s.models {
-            if let Ok(text) = std::fs::read_to_string(&m.urdf) {
-                inertials.extend(link_inertials(&text, &format!("{}/", m.name)));
+            let Ok(text) = std::fs::read_to_string(&m.urdf) else {
+                continue;
+            };
+            let pre = format!("{}/", m.name);
+            if m.mjcf {
+                // an MJCF model: each body's own inertial in its body frame,
+                // as the forest carries it (`MODEL/BODY`)
+                let dir = m.urdf.parent().unwrap_or(std::path::Path::new("."));
+                let file = m.urdf.display().to_string();
+                let own = mjcf_inertials(&text, &file, dir);
+                inertials.extend(own.into_iter().map(|(k, v)| (format!("{pre}{k}"), v)));
+            } else {
+                inertials.extend(link_inertials(&text, &pre));
             }
         }
         // unpickled: `_scene_model_from_state` of the scene's text, file,

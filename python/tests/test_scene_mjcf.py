@@ -39,3 +39,19 @@ def test_scene_from_mjcf_of_a_missing_file_names_it():
         assert "no_such.xml" in str(e)
     else:
         raise AssertionError("a missing file loaded")
+
+
+def test_scene_model_link_inertias_of_an_mjcf_model_are_the_files():
+    # Scene.from_mjcf(ant).model: each MODEL/BODY's own inertial as
+    # Model.from_mjcf gives it (its own frame: the scene's pose does not move it)
+    s = urdyn.Scene.from_mjcf(ANT)
+    m = urdyn.Model.from_mjcf(ANT)
+    for link in m.link_names:
+        c0, i0 = m.link_inertia(link)
+        c, i = s.model.link_inertia("ant/" + link)
+        np.testing.assert_array_equal(np.asarray(c), np.asarray(c0))
+        np.testing.assert_array_equal(np.asarray(i), np.asarray(i0))
+    # the torso: a sphere of radius 0.25 at density 5 (ant.xml's default)
+    c, i = s.model.link_inertia("ant/torso")
+    mass = 5.0 * 4.0 / 3.0 * np.pi * 0.25**3
+    np.testing.assert_allclose(np.diag(np.asarray(i)), [0.4 * mass * 0.25**2] * 3, rtol=1e-12)

@@ -3,7 +3,8 @@
 //! `crate::mjcf`), its upward-facing plane as the ground with the plane's
 //! friction, joint damping, frictionloss, springs, limits and armature (the
 //! simulation reads them from the model's degrees of freedom), `<option>`'s
-//! timestep (unless `--dt`) and gravity, and `--key NAME` starting states.
+//! timestep (unless `--dt`) and gravity, and `--key NAME` starting states;
+//! contact with the speculative margin of MuJoCo's large steps.
 //! What is not simulated is one warning line each (the import report's).
 //! Actuators are driven by `--controls FILE.csv` (cli.md) and a key's `ctrl`.
 
@@ -67,6 +68,9 @@ pub(crate) fn setup(
     if let Some(g) = &ground {
         contact.friction = g.friction;
     }
+    // MuJoCo's steps (2–10 ms) outrun δ: the speculative margin
+    // (docs/theory.md §"Speculative margin")
+    contact.travel_factor = crate::contact::ContactParams::TRAVEL;
     let dt = args.dt.unwrap_or(if world.timestep > 0.0 {
         world.timestep
     } else {

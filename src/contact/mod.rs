@@ -17,7 +17,11 @@
 //!
 //! # Detection
 //! Per step, a shape whose bounding sphere is clear of the plane by more than
-//! the margin `δ` (5 mm) is skipped from its origin's height alone. Otherwise
+//! the margin is skipped from its origin's height alone. The margin is
+//! `δ` (5 mm), or, with [`ContactParams::travel_factor`] c > 0 (an MJCF
+//! world), c times the distance the shape travelled in the last step when
+//! that is more (a speculative margin: a fast impact is found before it,
+//! docs/theory.md §"Speculative margin", `travel`). Otherwise
 //! (one query, counted in [`GroundContact::queries`]) its contact *manifold* is
 //! its points within `δ` of the plane, found without a general support query
 //! (a plane's cheap special cases, as MuJoCo's colliders): a box's corners, a hull's vertices, a
@@ -67,6 +71,7 @@ mod narrow;
 pub mod pairs;
 mod pipeline;
 pub(crate) mod shapes;
+mod travel;
 
 pub use crate::mesh::resolve_mesh_path;
 pub use filter::DroppedPair;
@@ -113,6 +118,14 @@ pub struct ContactParams {
     /// hard floor (c_rr = μ_r/R ≈ 0.01 at R = 0.1 m): a 0.1 m ball rolled at
     /// 1 m/s stops after about 7 m.
     pub rolling: f64,
+    /// The speculative margin's factor c: a shape that moved s in the last
+    /// step (toward the ground; in a pair, the two shapes' farthest points
+    /// summed) is searched within max(δ, c·s) this step, so that an impact
+    /// faster than δ a step is found before it, not millimetres deep
+    /// (docs/theory.md §"Speculative margin"). 0 (the default): δ alone;
+    /// [`Self::TRAVEL`] for an MJCF world's large steps (`urdyn simulate
+    /// MODEL.xml`).
+    pub travel_factor: f64,
 }
 
 impl Default for ContactParams {
@@ -127,8 +140,14 @@ impl Default for ContactParams {
             max_points_per_shape: 4,
             torsion: 0.0,
             rolling: 0.0,
+            travel_factor: 0.0,
         }
     }
+}
+
+impl ContactParams {
+    /// The speculative margin's factor of an MJCF world ([`Self::travel_factor`]).
+    pub const TRAVEL: f64 = 1.5;
 }
 
 /// Why ground contact could not be set up.

@@ -87,6 +87,18 @@ impl Collision {
         }
     }
 
+    /// The next detection follows a step: the speculative margin measures
+    /// each shape's travel in it, times `scale` (the next step's length over
+    /// this one's), docs/theory.md §"Speculative margin".
+    pub fn stepped(&mut self, scale: f64) {
+        if let Some(g) = self.ground.as_mut() {
+            g.stepped(scale);
+        }
+        if let Some(p) = self.pairs.as_mut() {
+            p.stepped(scale);
+        }
+    }
+
     /// Every contact point at the body poses `o_m_i`, into `out` (cleared).
     /// Bodies flagged in `asleep` (indexed by body; empty: none) are not
     /// searched against the static world or each other (a sleeping island's

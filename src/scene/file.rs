@@ -122,18 +122,29 @@ pub struct ModelSpec {
 #[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
-    /// Joint positions (rad or m).
+    /// Joint positions (rad or m; an array for a ball or free joint).
     #[serde(default)]
-    pub q: Option<BTreeMap<String, f64>>,
+    pub q: Option<BTreeMap<String, InitialValue>>,
     /// Joint velocities.
     #[serde(default)]
-    pub v: Option<BTreeMap<String, f64>>,
+    pub v: Option<BTreeMap<String, InitialValue>>,
     /// Constant joint torques (N·m or N).
     #[serde(default)]
-    pub tau: Option<BTreeMap<String, f64>>,
+    pub tau: Option<BTreeMap<String, InitialValue>>,
     /// The floating base.
     #[serde(default)]
     pub base: Option<InitialBaseSpec>,
+}
+
+/// A joint's value in `initial`: a number for a 1-DoF joint, an array for a
+/// joint of several degrees of freedom (mechanisms.md §"In `eval`").
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum InitialValue {
+    /// A revolute, prismatic or continuous joint's value.
+    Number(f64),
+    /// A ball, planar or free joint's values.
+    Array(Vec<f64>),
 }
 
 /// The floating base's part of a model's starting state.

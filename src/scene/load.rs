@@ -403,11 +403,19 @@ impl Loader<'_> {
             }
             if let Some(init) = &m.initial {
                 let maps = [(&init.q, "q"), (&init.v, "v"), (&init.tau, "tau")];
+                // an MJCF model's free roots are placed by its pose (no
+                // "base" beside "mjcf": the pose is final here)
+                let o = orientation;
+                let pose = Se3::new(
+                    quat_to_matrix(o[0], o[1], o[2], o[3]),
+                    Vector3::from(position),
+                );
+                let world_pose = models[i].mjcf.then_some(&pose);
                 for (map, which) in maps {
-                    for (joint, &x) in map.iter().flat_map(|m| m.iter()) {
+                    for (joint, x) in map.iter().flat_map(|m| m.iter()) {
                         let k = format!("{key}.initial.{which}.{joint}");
                         let full = format!("{pre}{joint}");
-                        let (Ok(iq), Ok(iv)) = (model.q_index(&full), model.v_index(&full)) else {
+                        if model.q_index(&full).is_err() || model.v_index(&full).is_err() {
                             let own: Vec<&str> = model.dofs[tree.dofs.clone()]
                                 .iter()
                                 .map(|d| &d.name[pre.len()..])
@@ -420,25 +428,19 @@ impl Loader<'_> {
                                 format!("unknown joint \"{joint}\" (not a movable, non-mimic joint of {}{near})", m.urdf.as_deref().or(m.mjcf.as_deref()).unwrap_or_default()),
                             ));
                         };
-                        self.finite(&k, &[x])?;
-                        if let Some(d) = model
-                            .dofs
-                            .iter()
-                            .find(|d| d.name == full && d.kind.nv() != 1)
-                        {
-                            return Err(self.err(
-                                k,
-                                format!(
-                                    "joint \"{joint}\" is {}: a scene's initial state sets 1-DoF joints only",
-                                    d.kind.name()
-                                ),
-                            ));
+                        let (at, vals) =
+                            self.initial_joint(&k, &model, &full, which, x, world_pose)?;
+                        if let Some(f) = tree.free.map(|f| &model.free_joints[f]) {
+                            if at == if which == "q" { f.iq } else { f.iv } {
+                                return Err(self.err(k, "the floating base: its pose and velocities are \"initial.base\"'s"));
+                            }
                         }
-                        match which {
-                            "q" => q0[iq] = x,
-                            "v" => v0[iv] = x,
-                            _ => tau0[iv] = x,
-                        }
+                        let dst = match which {
+                            "q" => &mut q0,
+                            "v" => &mut v0,
+                            _ => &mut tau0,
+                        };
+                        dst.rows_mut(at, vals.len()).copy_from_slice(&vals);
                     }
                 }
                 if let Some(b) = &init.base {

@@ -9,14 +9,15 @@
 
 mod file;
 mod forest;
+mod initial;
 mod load;
 mod mjcf;
 mod obstacles;
 pub mod srdf;
 
 pub use file::{
-    BaseSpec, GroundSpec, HeightFieldSpec, InitialBaseSpec, InitialSpec, ModelSpec, ObstacleSpec,
-    RoundSpec, SceneSpec,
+    BaseSpec, GroundSpec, HeightFieldSpec, InitialBaseSpec, InitialSpec, InitialValue, ModelSpec,
+    ObstacleSpec, RoundSpec, SceneSpec,
 };
 pub use forest::{forest, Part};
 pub use mjcf::mjcf_scene_json;

@@ -88,6 +88,11 @@ impl Simulation {
         // 3. the new state: finite, its contacts, its energy
         self.check_finite()?;
         self.fk_valid = false;
+        if let Some(c) = self.contact.as_mut() {
+            // the speculative margin measures this step's travel (its next
+            // step may be the full dt)
+            c.stepped(if h > 0.0 { (self.dt / h).max(1.0) } else { 1.0 });
+        }
         self.refresh_contacts();
         if self.cons.loops.is_some() {
             self.project_loops();

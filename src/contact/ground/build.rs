@@ -259,6 +259,8 @@ impl GroundContact {
             rim_len: vec![0; nshapes],
             band_gen: vec![0; nshapes],
             stack: Vec::with_capacity(n),
+            anchor: vec![[f64::NAN; 4]; nshapes],
+            travel: super::Travel::new(&params, vec![false; nshapes]),
         }))
     }
 }

@@ -7,6 +7,7 @@ mod build;
 mod reduce;
 
 use super::shapes::to_pose;
+use super::travel::{self, Travel};
 use super::{ContactParams, ContactPoint};
 use crate::spatial::Se3;
 use nalgebra::Vector3;
@@ -120,6 +121,11 @@ pub struct GroundContact {
     rim_len: Vec<usize>,
     band_gen: Vec<u32>,
     stack: Vec<u32>,
+    /// The speculative margin ([`travel`]): per shape, the height of its
+    /// geometry origin and the third row of its body's rotation at the last
+    /// detection, and how far down it moved in the last step.
+    anchor: Vec<[f64; 4]>,
+    travel: Travel,
 }
 
 impl GroundShape {
@@ -184,6 +190,12 @@ impl GroundContact {
         self.band_len.fill(0);
         self.rim_len.fill(0);
         self.band_gen.fill(0);
+        self.travel.forget();
+    }
+
+    /// The next detection follows a step ([`super::Collision::stepped`]).
+    pub fn stepped(&mut self, scale: f64) {
+        self.travel.stepped(scale);
     }
 
     /// The largest number of points [`detect`](Self::detect) can return.
@@ -207,8 +219,8 @@ impl GroundContact {
     pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
         out.clear();
         let ground = self.ground;
-        let margin = self.params.margin;
         let maxp = self.params.max_points_per_shape.max(1);
+        let stepped = self.travel.begin();
         for (si, s) in self.shapes.iter().enumerate() {
             let Some(o_m_b) = o_m_i.get(s.body) else {
                 continue;
@@ -221,6 +233,15 @@ impl GroundContact {
             let r = &o_m_b.rot;
             let pt = &s.placement.trans;
             let z = r[(2, 0)] * pt.x + r[(2, 1)] * pt.y + r[(2, 2)] * pt.z + o_m_b.trans.z;
+            // the speculative margin: max(δ, c·s), s how far down the shape
+            // moved in the last step (docs/theory.md §"Speculative margin")
+            let row = [r[(2, 0)], r[(2, 1)], r[(2, 2)]];
+            if stepped > 0.0 {
+                let down = travel::dropped(&self.anchor[si], z, row, s.bound);
+                self.travel.set(si, down * stepped);
+            }
+            self.anchor[si] = [z, row[0], row[1], row[2]];
+            let margin = self.travel.margin(si);
             if z - ground - s.bound > margin {
                 continue;
             }

@@ -17,6 +17,7 @@ use super::broad::{prefetch, PairTable, SweepAndPrune, LAZY_PAIR};
 use super::filter::{is_self_pair, may_touch, DroppedPair, START_OVERLAP};
 use super::narrow::{face_kind, face_points, parry_points, reduce_pair, FaceScratch, Raw};
 use super::shapes::{from_pvec, pair_shape, to_pose, PairShape};
+use super::travel::{moved, Travel};
 use super::{ContactError, ContactParams, ContactPoint};
 use crate::model::Model;
 use crate::spatial::Se3;
@@ -123,7 +124,8 @@ pub struct PairContact {
     pub nslots: usize,
     /// Narrow-phase queries performed so far (one a pair whose boxes overlap).
     pub queries: u64,
-    margin: f64,
+    /// Each member's travel in the last step: the speculative margin.
+    travel: Travel,
     max_points: usize,
     /// The first slot of pair contact in the whole pipeline.
     slot_offset: usize,
@@ -235,7 +237,7 @@ impl PairContact {
             raw: Vec::new(),
             moving: Vec::new(),
             queries: 0,
-            margin: params.margin,
+            travel: Travel::new(params, Vec::new()),
             max_points: maxp,
             slot_offset,
             pairs: Vec::new(),
@@ -256,6 +258,8 @@ impl PairContact {
         if allowed == 0 {
             return Ok(None);
         }
+        let fixed = made.members.iter().map(|m| m.body == 0).collect();
+        made.travel = Travel::new(params, fixed);
         for (k, m) in made.members.iter().enumerate() {
             made.poses.push(m.placement);
             if m.body == 0 {
@@ -315,6 +319,12 @@ impl PairContact {
             pair.workspace = None;
             pair.apart = None;
         }
+        self.travel.forget();
+    }
+
+    /// The next detection follows a step ([`super::Collision::stepped`]).
+    pub fn stepped(&mut self, scale: f64) {
+        self.travel.stepped(scale);
     }
 
     /// The most points a step can report: each pair's limit, for at most 8
@@ -349,12 +359,18 @@ impl PairContact {
     /// Pairs whose two bodies are flagged in `asleep` (or static) keep what
     /// they held and are not queried.
     pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
-        let margin = self.margin;
+        let stepped = self.travel.begin();
         self.keep_in_order();
         for &k in &self.moving {
             let m = &self.members[k];
             let w = world(m, o_m_i);
-            set_box(&mut self.sap, k, m, &w, margin);
+            // the speculative margin: max(δ, c·s), s how far the member
+            // moved in the last step (docs/theory.md §"Speculative margin")
+            if stepped > 0.0 {
+                let s = moved(&self.poses[k], &w, &m.shape.mid, m.shape.half.norm());
+                self.travel.set(k, s * stepped);
+            }
+            set_box(&mut self.sap, k, m, &w, self.travel.margin(k));
             self.poses[k] = w;
         }
         self.overlapping.clear();
@@ -426,6 +442,7 @@ impl PairContact {
             }
             let (ma, mb) = (&self.members[pair.a], &self.members[pair.b]);
             let (wa, wb) = (self.poses[pair.a], self.poses[pair.b]);
+            let margin = self.travel.pair_margin(pair.a, pair.b);
             self.queries += 1;
             self.raw.clear();
             // a hull on a box's face or a flat height field: the plane
