@@ -111,6 +111,9 @@ pub(crate) struct Constraints {
     /// The slots of `warm_contact` written by the last solve (only these are cleared).
     warm_slots: Vec<usize>,
     warm_joint: Vec<[f64; 3]>,
+    /// This step's warm starts of the points, gathered before the rows are
+    /// built (the loads are independent there: their cache misses overlap).
+    warm_points: Vec<[f64; 3]>,
     /// World-frame motion subspace columns of each body (≤ 6), set this
     /// step where `sw_done` holds `sw_stamp`.
     sw: Vec<[Motion; 6]>,
@@ -191,6 +194,7 @@ impl Constraints {
             warm_contact: vec![[0.0; 3]; nslots],
             warm_slots: Vec::with_capacity(max_points),
             warm_joint: vec![[0.0; 3]; ndof],
+            warm_points: Vec::with_capacity(max_points),
             sw: vec![[Motion::zero(); 6]; model.nbodies],
             sw_done: vec![0; model.nbodies],
             sw_stamp: 0,
@@ -341,17 +345,19 @@ impl Constraints {
                     }
                 }
             }
+            self.warm_points.clear();
+            let wc = &self.warm_contact;
+            self.warm_points
+                .extend(points.iter().map(|pt| match pt.fresh {
+                    true => [0.0; 3],
+                    false => wc.get(pt.slot).copied().unwrap_or([0.0; 3]),
+                }));
             let nv = rows.nv;
             let body_path = |b: usize| {
                 let jb = &model.joints[b];
                 f.path_of((jb.iv + jb.nv()).saturating_sub(1))
             };
-            for (pi, pt) in points.iter().enumerate() {
-                let warm = if pt.fresh {
-                    [0.0; 3]
-                } else {
-                    self.warm_contact.get(pt.slot).copied().unwrap_or([0.0; 3])
-                };
+            for (pi, (pt, &warm)) in points.iter().zip(&self.warm_points).enumerate() {
                 // the body's path to the root: its joint's last dof and every
                 // ancestor; against another body, the union with that body's
                 let path = if pt.other == 0 {

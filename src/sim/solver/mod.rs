@@ -236,9 +236,19 @@ impl Rows {
     /// Zeroes the Jacobian entries of rows `from..to`.
     fn zero_rows(&mut self, from: usize, to: usize) {
         let st = self.stride;
+        // rows whose path fills the stride lie back to back: one fill for a
+        // run of them (a pile's contact rows), not one call per row
+        let mut run = from * st;
         for r in from..to.min(self.cap) {
             let pl = self.path[r].1.min(st);
-            self.j[r * st..r * st + pl].fill(0.0);
+            if pl < st {
+                self.j[run..r * st + pl].fill(0.0);
+                run = (r + 1) * st;
+            }
+        }
+        let end = to.min(self.cap) * st;
+        if run < end {
+            self.j[run..end].fill(0.0);
         }
     }
     /// Adds a row (zeroed Jacobian: rows are zeroed by [`Rows::clear`]) and returns
