@@ -16,6 +16,7 @@
 mod common;
 
 mod alloc;
+mod ant_rest;
 mod api;
 mod bad_inputs;
 mod cli_errors;

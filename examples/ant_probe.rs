@@ -1,0 +1,94 @@
+//! Diagnostic: Gymnasium's ant at rest on its plane (`urdyn simulate ant.xml
+//! --no-sleep --integrator euler`); prints every `EVERY`-th step from T0 to T1:
+//! time, largest |v|, sweeps of the step, contacts, penetration, root yaw rate.
+//! `cargo run --release --features tools --example ant_probe [T0 T1]`
+//! (env: DT, ITERS, TOL, RELAX, SLOP, BAUM, PUSH, MARGIN, MU, ARM, EVERY; FORCES=1
+//! also prints each contact's force and |f_t|/f_n).
+use urdyn::mjcf;
+use urdyn::sim::{Integrator, SimOptions, Simulation};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let t0: f64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(0.0);
+    let t1: f64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(40.0);
+    let env = |k: &str| std::env::var(k).ok().and_then(|s| s.parse::<f64>().ok());
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/mjcf/gymnasium/ant.xml"
+    );
+    let (model, world) = mjcf::load_file_with_world(path)?;
+    let ground = mjcf::ground_of(&world);
+    let mut opts = SimOptions {
+        dt: env("DT").unwrap_or(world.timestep),
+        integrator: Integrator::from_name("euler"),
+        ground: ground.as_ref().map(|g| g.height),
+        sleep: false,
+        ..SimOptions::default()
+    };
+    if let Some(g) = &ground {
+        opts.contact.friction = g.friction;
+    }
+    if let Some(x) = env("ITERS") {
+        opts.solver_iterations = x as usize;
+    }
+    if let Some(x) = env("TOL") {
+        opts.solver_tol = x;
+    }
+    if let Some(x) = env("RELAX") {
+        opts.solver_relaxation = x;
+    }
+    if let Some(x) = env("SLOP") {
+        opts.contact.slop = x;
+    }
+    if let Some(x) = env("BAUM") {
+        opts.contact.baumgarte = x;
+    }
+    if let Some(x) = env("PUSH") {
+        opts.limit_push_speed = x;
+    }
+    if let Some(x) = env("MARGIN") {
+        opts.contact.margin = x;
+    }
+    if let Some(x) = env("MU") {
+        opts.contact.friction = x;
+    }
+    if let Some(x) = env("ARM") {
+        opts.armature = x;
+    }
+    let every = env("EVERY").unwrap_or(100.0) as u64;
+    let mut sim = Simulation::new(model, opts)?;
+    let mut k = 0u64;
+    while sim.time() < t1 - 1e-9 {
+        let s0 = sim.pgs_sweeps;
+        sim.step()?;
+        k += 1;
+        if sim.time() >= t0 - 1e-9 && k % every == 0 {
+            println!(
+                "t {:.2} vmax {:.3e} sweeps {} contacts {} pen {:.2e} wz {:.3e}",
+                sim.time(),
+                sim.v().amax(),
+                sim.pgs_sweeps - s0,
+                sim.active_contacts(),
+                sim.penetration(),
+                sim.v()[5]
+            );
+            if std::env::var_os("FORCES").is_some() {
+                for f in sim.contact_forces() {
+                    let ft = (f.force.x * f.force.x + f.force.y * f.force.y).sqrt();
+                    println!(
+                        "   body {} p ({:.4},{:.4},{:.4}) F ({:.4},{:.4},{:.4}) ratio {:.6}",
+                        f.point.body,
+                        f.point.point.x,
+                        f.point.point.y,
+                        f.point.point.z,
+                        f.force.x,
+                        f.force.y,
+                        f.force.z,
+                        ft / f.force.z
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,48 @@
+//! Gymnasium's ant at rest on its four feet stays at rest (issue 29: "each
+//! lands, stays finite and ends at rest"). Today it does not: from about 2 s
+//! a twist of the whole ant (torso yaw, the four hips turning together, the
+//! feet planted) grows by ×1.78 every 2 s (1.6e-6 m/s at 2 s, 5.4e-3 at 30 s),
+//! then it chatters on its feet until ~86 s, and the twist grows again.
+//! Not the solve's tolerance (200 sweeps at 1e-10 grow as fast); the rate
+//! shrinks with the step (dt 5 ms: ×1.6 every 2 s; 2 ms: none); see
+//! benches/mjcf_results.md §"ant's twist at rest".
+
+use std::path::Path;
+use urdyn::mjcf;
+use urdyn::sim::{Integrator, SimOptions, Simulation};
+
+#[test]
+#[ignore = "fails today: ant's twist mode grows at rest (benches/mjcf_results.md)"]
+fn gymnasium_ant_at_rest_stays_at_rest() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mjcf/gymnasium/ant.xml");
+    let (model, world) = mjcf::load_file_with_world(path).expect("loads");
+    let ground = mjcf::ground_of(&world);
+    let mut opts = SimOptions {
+        dt: world.timestep,
+        integrator: Integrator::from_name("euler"),
+        ground: ground.as_ref().map(|g| g.height),
+        sleep: false,
+        ..SimOptions::default()
+    };
+    if let Some(g) = &ground {
+        opts.contact.friction = g.friction;
+    }
+    let mut sim = Simulation::new(model, opts).expect("sim");
+    // landed and still by 2 s (|v| ~ 1e-6: the solve's tolerance)
+    while sim.time() < 2.0 - 1e-9 {
+        sim.step().expect("step");
+    }
+    assert!(sim.v().amax() < 1e-5, "|v| = {} at 2 s", sim.v().amax());
+    // nothing drives it after: with the hips' damping every speed decays,
+    // so |v| stays at the tolerance's level (today: 5.4e-3 by 30 s)
+    let mut worst: f64 = 0.0;
+    while sim.time() < 30.0 - 1e-9 {
+        sim.step().expect("step");
+        worst = worst.max(sim.v().amax());
+    }
+    assert!(
+        worst < 1e-4,
+        "|v| reached {worst} at rest between 2 s and 30 s"
+    );
+    assert!(sim.active_contacts() >= 4);
+}
