@@ -2,8 +2,9 @@
 //! `Simulation.set_gains`, `set_targets`, `transition_jacobians`, the sensors
 //! and `urdyn.linearize` (the methods themselves are thin, in `sim.rs`).
 
-use crate::args::{read_array, read_vec, value_error};
+use crate::args::{named, read_array, read_vec, value_error, Given};
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
+use pyo3::intern;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use urdyn::nalgebra::{DMatrix, DVector, Vector3};
@@ -71,20 +72,66 @@ pub fn method(name: &str) -> PyResult<JacobianMethod> {
     })
 }
 
-/// A numpy copy of a matrix.
+/// A numpy copy of a matrix (C order): the matrix's contiguous columns
+/// scattered into a new array's rows, every entry written once (no zeroing).
 pub fn mat_out<'py>(py: Python<'py>, m: &DMatrix<f64>) -> Bound<'py, PyArray2<f64>> {
     let (r, c) = m.shape();
-    let a = PyArray2::<f64>::zeros(py, [r, c], false);
+    // SAFETY: uninitialised, but every one of its r·c entries is written below
+    // before Python can see it
+    let a = unsafe { PyArray2::<f64>::new(py, [r, c], false) };
     // SAFETY: a fresh C-contiguous array of r·c entries, not shared yet
     if let Ok(s) = unsafe { a.as_slice_mut() } {
-        for i in 0..r {
-            for j in 0..c {
-                s[i * c + j] = m[(i, j)];
+        if r > 0 {
+            for (j, col) in m.as_slice().chunks_exact(r).enumerate() {
+                for (x, out) in col.iter().zip(s[j..].iter_mut().step_by(c)) {
+                    *out = *x;
+                }
             }
         }
     }
     a
 }
+
+/// `method=` of `transition_jacobians`: omitted → analytic; the three names
+/// matched by identity with interned strings first (a literal in Python code
+/// is interned: no text is read), any other value through [`method`].
+pub fn jacobian_method(py: Python<'_>, x: &Given) -> PyResult<JacobianMethod> {
+    let Given::Value(obj) = x else {
+        return Ok(JacobianMethod::Analytic);
+    };
+    let obj = obj.bind(py);
+    if obj.is(intern!(py, "analytic")) {
+        return Ok(JacobianMethod::Analytic);
+    }
+    if obj.is(intern!(py, "forward")) {
+        return Ok(JacobianMethod::Forward);
+    }
+    if obj.is(intern!(py, "central")) {
+        return Ok(JacobianMethod::Central);
+    }
+    method(&named::method(obj)?)
+}
+
+/// `tau=` of `transition_jacobians` into `out` (nv): a float64 numpy vector
+/// read directly, anything else through [`read_vec`].
+fn read_tau(x: &Bound<'_, PyAny>, out: &mut DVector<f64>) -> PyResult<()> {
+    if let Ok(a) = x.cast::<PyArray1<f64>>() {
+        // SAFETY: the GIL is held and the entries are copied out at once; no
+        // Rust code of this package keeps a mutable view of a caller's array
+        if let Ok(s) = unsafe { a.as_slice() } {
+            if s.len() == out.len() && s.iter().all(|x| x.is_finite()) {
+                out.as_mut_slice().copy_from_slice(s);
+                return Ok(());
+            }
+        }
+    }
+    read_vec(x, "tau", "nv", out)
+}
+
+/// The most degrees of freedom for which an analytic call keeps the GIL: a
+/// fixed-base arm's call takes a few µs, less than releasing and re-taking
+/// the GIL is worth; longer calls (more dofs, finite differences) release it.
+const HOLD_GIL_MAX_NV: usize = 12;
 
 /// `sim.transition_jacobians(tau=None, method="analytic", eps=1e-6)`.
 #[allow(clippy::type_complexity)]
@@ -92,22 +139,25 @@ pub fn transition_jacobians<'py>(
     py: Python<'py>,
     sim: &Simulation,
     tau: Option<&Bound<'py, PyAny>>,
-    method_name: &str,
+    method_arg: &Given,
     eps: f64,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-    let m = method(method_name)?;
+    let m = jacobian_method(py, method_arg)?;
     let mut t = DVector::zeros(sim.model.nv);
     if let Some(x) = tau.filter(|x| !x.is_none()) {
-        read_vec(x, "tau", "nv", &mut t)?;
+        read_tau(x, &mut t)?;
     }
     if !(eps > 0.0 && eps.is_finite()) {
         return Err(value_error(format!(
             "eps must be a positive number (got {eps})"
         )));
     }
-    let j = py
-        .detach(|| sim.transition_jacobians(&t, m, eps))
-        .map_err(|e| value_error(e.to_string()))?;
+    let j = if m == JacobianMethod::Analytic && sim.model.nv <= HOLD_GIL_MAX_NV {
+        sim.transition_jacobians(&t, m, eps)
+    } else {
+        py.detach(|| sim.transition_jacobians(&t, m, eps))
+    }
+    .map_err(|e| value_error(e.to_string()))?;
     Ok((mat_out(py, &j.a), mat_out(py, &j.b)))
 }
 

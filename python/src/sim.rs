@@ -546,7 +546,7 @@ impl PySimulation {
     /// of the step, step `eps`, as MuJoCo's mjd_transitionFD) see a perturbation
     /// that lifts the foot leave the ground: one-sided, so they differ there.
     #[pyo3(
-        signature = (tau=None, method=String::from("analytic"), eps=1e-6),
+        signature = (tau=None, method=Given::Omitted, eps=1e-6),
         text_signature = "(self, tau=None, method='analytic', eps=1e-6)"
     )]
     #[allow(clippy::type_complexity)]
@@ -554,7 +554,7 @@ impl PySimulation {
         &self,
         py: Python<'py>,
         tau: Option<&Bound<'py, PyAny>>,
-        #[pyo3(from_py_with = named::method)] method: String,
+        method: Given,
         #[pyo3(from_py_with = named::eps)] eps: f64,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
         crate::control::transition_jacobians(py, &self.sim, tau, &method, eps)
