@@ -13,6 +13,7 @@ use pyo3::prelude::*;
 use std::path::PathBuf;
 use urdyn::contact::{ContactError, ContactParams};
 use urdyn::model::Constraints;
+use urdyn::nalgebra::DVector;
 use urdyn::sim::{Integrator, SimError, SimOptions, Simulation};
 
 /// A starting simulation with what a run with loops needs to start again.
@@ -71,6 +72,7 @@ fn prototype(
     contact: ContactParams,
     package_dirs: Option<Vec<PathBuf>>,
     islands: Islands<'_>,
+    start: Option<(&DVector<f64>, &DVector<f64>)>,
 ) -> PyResult<Simulation> {
     let friction = contact.friction;
     if !(dt > 0.0 && dt.is_finite()) {
@@ -108,7 +110,13 @@ fn prototype(
         ..SimOptions::default()
     }
     .with_islands(islands.scene, islands.sleep, islands.threads);
-    Simulation::new(model.model.clone(), opts).map_err(|e| match e {
+    // At a given start, contacts are found once, there (a scene's models all sit at the
+    // origin before it: every pair of a pile would overlap).
+    let sim = match start {
+        Some((q, v)) => Simulation::new_at(model.model.clone(), opts, q, v),
+        None => Simulation::new(model.model.clone(), opts),
+    };
+    sim.map_err(|e| match e {
         // the library's message is neutral; the hint is Python's (the CLI names its flags)
         SimError::Contact(ContactError::MissingMesh { .. }) => not_found_error(format!(
             "{}: {e} (give its package root with package_dirs=[...] or ROS_PACKAGE_PATH, or pass ground=None for no contact)",
@@ -156,9 +164,8 @@ fn prototype_scene(
         contact,
         package_dirs,
         islands,
+        Some((&s.q0, &s.v0)),
     )?;
-    sim.set_state(&s.q0, &s.v0)
-        .map_err(|e| value_error(format!("{}: {e}", s.file)))?;
     sim.torques_mut().copy_from(&s.tau0);
     Ok(sim)
 }
@@ -236,6 +243,7 @@ pub(crate) fn prototype_any(
             sleep,
             threads,
         },
+        None,
     )?;
     let warnings = match &loops {
         Some(set) => {
