@@ -4,7 +4,10 @@
 Usage:
     python benches/mjcf_compare.py [--urdyn target/release/urdyn] [--models NAME,...]
         [--repeats 3] [--duration 3] [--no-dynamics] [--pinocchio PATH]
-        [--md benches/mjcf_results.md] [--json benches/mjcf_results.json]
+        [--md benches/mjcf_results.md] [--json benches/mjcf_results.json] [--base OTHER_URDYN]
+
+--base: an A/B of two urdyn binaries: OTHER_URDYN is timed in the same rounds as --urdyn
+(just before it in each round), and the markdown gets a table of both beside MuJoCo.
 
 The models are the committed, unmodified copies in tests/fixtures/mjcf (Gymnasium 1.4.0's
 envs/mujoco/assets, dm_control 1.0.50's suite; names below are DIR/STEM).
@@ -277,6 +280,17 @@ def write_md(path, rows, dyn, meta):
             r["model"], star, r["nv"], r["dt"], r["urdyn_sps"], r["mujoco_sps"], r["mujoco_integrator"],
             r["ratio"], fmt_t(u["lands"]), fmt_t(mj["lands"]), fmt_end(u), fmt_end(mj),
             1e3 * u["max_pen"], 1e3 * mj["max_pen"]))
+    ab = [r for r in rows if "base_sps" in r]
+    if ab:
+        L += ["", "A/B: `%s` (base) timed in the same rounds, just before `--urdyn`:" % meta["base"], "",
+              "| model | base steps/s (ratio) | this steps/s (ratio) | max pen. base / this (mm) "
+              "| end base / this |", "|---|---|---|---|---|"]
+        for r in ab:
+            bm = r.get("base_metrics", {})
+            L.append("| %s | %.0f (%.2f) | %.0f (%.2f) | %s / %.3f | %s / %s |" % (
+                r["model"], r["base_sps"], r["base_ratio"], r["urdyn_sps"], r["ratio"],
+                "%.3f" % (1e3 * bm["max_pen"]) if bm else "–", 1e3 * r["urdyn_metrics"]["max_pen"],
+                fmt_end(bm) if bm else "–", fmt_end(r["urdyn_metrics"])))
     warn = [(r["model"], w) for r in rows for w in r.get("urdyn_warnings", [])]
     if warn:
         L += ["", "urdyn's warnings (import report and start state):", ""]
@@ -323,6 +337,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--urdyn", default=os.path.join(REPO, "target", "release", "urdyn"))
     ap.add_argument("--models", action="append")
+    # A/B: another urdyn binary timed in the same rounds (its run first in each
+    # round, then --urdyn's, then MuJoCo's two), reported beside --urdyn's
+    ap.add_argument("--base")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--duration", type=float, default=3.0)
     ap.add_argument("--no-dynamics", action="store_true")
@@ -347,8 +364,12 @@ def main():
             steps = int(round(args.duration / dt))
             r.update(nv=int(m.nv), dt=dt, steps=steps)
             csvp = os.path.join(tmp, name.replace("/", "_") + ".csv")
-            us, mjs = [], {"EULER": [], "IMPLICITFAST": []}
+            us, bs, mjs = [], [], {"EULER": [], "IMPLICITFAST": []}
             for _ in range(args.repeats):
+                if args.base:
+                    b = run_urdyn(args.base, name, args.duration, csvp)
+                    if b.get("steps_per_s"):
+                        bs.append(b["steps_per_s"])
                 u = run_urdyn(args.urdyn, name, args.duration, csvp)
                 if u["exit"] != 0 or not u.get("steps_per_s"):
                     r["error"] = "urdyn: %s" % ((u["warnings"] or ["exit %d" % u["exit"]])[-1])
@@ -366,20 +387,26 @@ def main():
                      mujoco_sps=med[best], mujoco_integrator=best.lower(),
                      urdyn_command=u["command"], urdyn_warnings=u["warnings"])
             r["ratio"] = r["urdyn_sps"] / r["mujoco_sps"]
+            if bs:
+                r.update(base_sps=max(bs), base_all=bs, base_ratio=max(bs) / r["mujoco_sps"])
+                brec = run_urdyn(args.base, name, args.duration, csvp, record=True)
+                if brec["exit"] == 0:
+                    r["base_metrics"] = urdyn_metrics(csvp)
             rec = run_urdyn(args.urdyn, name, args.duration, csvp, record=True)
             r["urdyn_record_sps"] = rec.get("steps_per_s")
             r["urdyn_metrics"] = urdyn_metrics(csvp)
             r["mujoco_metrics"] = mujoco_metrics(m, getattr(mujoco.mjtIntegrator, "mjINT_" + best), steps)
-            print("%s: urdyn %.0f, MuJoCo %.0f (%s), ratio %.2f; urdyn %s, MuJoCo %s" % (
-                name, r["urdyn_sps"], r["mujoco_sps"], best, r["ratio"], r["urdyn_metrics"],
-                r["mujoco_metrics"]), file=sys.stderr)
+            print("%s: urdyn %.0f, MuJoCo %.0f (%s), ratio %.2f%s; urdyn %s, MuJoCo %s" % (
+                name, r["urdyn_sps"], r["mujoco_sps"], best, r["ratio"],
+                " (base %.0f, %.2f)" % (r["base_sps"], r["base_ratio"]) if bs else "",
+                r["urdyn_metrics"], r["mujoco_metrics"]), file=sys.stderr)
             rows.append(r)
     dyn = [] if args.no_dynamics else dynamics(args.urdyn, args.pinocchio, DYN_MODELS)
     meta = {"command": "python benches/mjcf_compare.py " + " ".join(sys.argv[1:]),
             "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
             "wall_s": time.time() - started, "commit": commit(), "mujoco": mujoco.__version__,
             "machine": machine(), "load": "%.1f" % load[0], "duration": args.duration,
-            "repeats": args.repeats}
+            "repeats": args.repeats, "base": args.base}
     write_md(args.md, rows, dyn, meta)
     with open(args.json, "w") as fh:
         json.dump({"meta": meta, "simulation": rows, "dynamics": dyn}, fh, indent=1)

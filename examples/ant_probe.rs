@@ -2,7 +2,8 @@
 //! --no-sleep --integrator euler`); prints every `EVERY`-th step from T0 to T1:
 //! time, largest |v|, sweeps of the step, contacts, penetration, root yaw rate.
 //! `cargo run --release --features tools --example ant_probe [T0 T1]`
-//! (env: DT, ITERS, TOL, RELAX, SLOP, BAUM, PUSH, MARGIN, MU, ARM, EVERY; FORCES=1
+//! (env: DT, ITERS, TOL, RELAX, SLOP, BAUM, PUSH, MARGIN, MU, ARM, TRAVEL (the
+//! speculative margin's factor; `urdyn simulate` uses 1.5), EVERY; FORCES=1
 //! also prints each contact's force and |f_t|/f_n).
 use urdyn::mjcf;
 use urdyn::sim::{Integrator, SimOptions, Simulation};
@@ -51,6 +52,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Some(x) = env("MU") {
         opts.contact.friction = x;
+    }
+    if let Some(x) = env("TRAVEL") {
+        opts.contact.travel_factor = x;
     }
     if let Some(x) = env("ARM") {
         opts.armature = x;

@@ -36,6 +36,17 @@ impl Subspace {
     }
 }
 
+/// A pivot of W_FF's LDLᵀ below this fraction of its diagonal is a row
+/// dependent on earlier ones, dropped from the step: the pivot kept is the
+/// squared sine of the angle (in the W metric) between the row and the span
+/// of the rows before it. An exactly dependent row's pivot is its rounding,
+/// which reached 7e-9 of the diagonal on Gymnasium's ant standing on four
+/// feet with its ankles on their limits (16 rows on 14 dofs, the hips'
+/// armature 1 against light legs): kept (the bound was 1e-10), it turned the
+/// step's residual into impulses of 1e7 N·s (docs/theory.md §"Constraint
+/// solve").
+const DEPENDENT: f64 = 1e-6;
+
 /// The read-only view of the rows a subspace step needs.
 pub(super) struct Solved<'a> {
     pub(super) n: usize,
@@ -194,9 +205,9 @@ pub(super) fn subspace_step(
             sm.x[k] = 0.0;
         }
     }
-    // W_FF = L D Lᵀ; a pivot that lost all but 1e-10 of its diagonal is a
-    // row dependent on earlier ones (redundant contacts): dropped (δ = 0)
-    ldlt_dropping(&mut sm.w[..m * m], m, 1e-10);
+    // W_FF = L D Lᵀ; a pivot that lost all but `DEPENDENT` of its diagonal
+    // is a row dependent on earlier ones (redundant contacts): dropped (δ = 0)
+    ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
     ldlt_dropping_solve(&sm.w[..m * m], m, &mut sm.rhs[..m]);
     // the new impulses (none taken if one is not finite)
     for (a, &r) in sm.rows.iter().enumerate() {
