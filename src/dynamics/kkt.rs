@@ -23,6 +23,8 @@ pub(crate) struct KktFactor {
     ev: DVector<f64>,
     /// Scratch of size m.
     t: DVector<f64>,
+    /// The reciprocals of the Cholesky factor's diagonal (m).
+    dinv: Vec<f64>,
     /// Whether `f` is a Cholesky factor (K of full rank).
     pub full_rank: bool,
 }
@@ -35,6 +37,7 @@ impl KktFactor {
             w: DMatrix::zeros(m, m),
             ev: DVector::zeros(m),
             t: DVector::zeros(m),
+            dinv: vec![0.0; m],
             full_rank: true,
         }
     }
@@ -42,7 +45,7 @@ impl KktFactor {
     /// Factorises K (its lower triangle is read).
     pub fn factor(&mut self, k: &DMatrix<f64>) {
         let m = k.nrows();
-        self.full_rank = cholesky(k, &mut self.f);
+        self.full_rank = cholesky(k, &mut self.f, &mut self.dinv);
         if self.full_rank {
             return;
         }
@@ -69,18 +72,22 @@ impl KktFactor {
         if self.full_rank {
             // L (column-major): L[i, k] at i + k m
             let l = self.f.as_slice();
+            let dinv = &self.dinv[..m];
             let x = &mut x[..m];
             for k in 0..m {
-                let xk = x[k] / l[k + k * m];
+                let xk = x[k] * dinv[k];
                 x[k] = xk;
                 for (xi, &lik) in x[k + 1..].iter_mut().zip(&l[k * m + k + 1..(k + 1) * m]) {
-                    *xi -= lik * xk;
+                    *xi = madd(-lik, xk, *xi);
                 }
             }
             for i in (0..m).rev() {
                 let col = &l[i * m + i + 1..(i + 1) * m];
-                let s: f64 = col.iter().zip(&x[i + 1..]).map(|(a, b)| a * b).sum();
-                x[i] = (x[i] - s) / l[i + i * m];
+                let mut s = x[i];
+                for (&a, &b) in col.iter().zip(&x[i + 1..]) {
+                    s = madd(-a, b, s);
+                }
+                x[i] = s * dinv[i];
             }
             return;
         }
@@ -154,26 +161,38 @@ impl KktFactor {
     }
 }
 
-/// `k = L Lᵀ` into `l` (lower triangle); false when a pivot is at most
-/// [`RANK_TOL`] of its diagonal entry (or not finite).
-fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>) -> bool {
+/// `k = L Lᵀ` into `l` (lower triangle, column-major) and the reciprocals of
+/// L's diagonal into `dinv`; false when a pivot is at most [`RANK_TOL`] of its
+/// diagonal entry (or not finite). Right-looking: column j is scaled by one
+/// reciprocal, then subtracted from the columns after it as contiguous axpys.
+fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>, dinv: &mut [f64]) -> bool {
     let m = k.nrows();
+    let ks = k.as_slice();
+    let ls = l.as_mut_slice();
     for j in 0..m {
-        let mut d = k[(j, j)];
-        for p in 0..j {
-            d -= l[(j, p)] * l[(j, p)];
-        }
-        if d.is_nan() || d <= RANK_TOL * k[(j, j)].abs() || !d.is_finite() {
+        ls[j * m + j..(j + 1) * m].copy_from_slice(&ks[j * m + j..(j + 1) * m]);
+    }
+    for j in 0..m {
+        let (done, rest) = ls.split_at_mut((j + 1) * m);
+        let colj = &mut done[j * m + j..];
+        let d = colj[0];
+        if d.is_nan() || d <= RANK_TOL * ks[j + j * m].abs() || !d.is_finite() {
             return false;
         }
         let d = d.sqrt();
-        l[(j, j)] = d;
-        for i in j + 1..m {
-            let mut s = k[(i, j)];
-            for p in 0..j {
-                s -= l[(i, p)] * l[(j, p)];
+        let r = 1.0 / d;
+        colj[0] = d;
+        dinv[j] = r;
+        for x in colj[1..].iter_mut() {
+            *x *= r;
+        }
+        // columns p > j: L[p.., p] −= L[p, j] L[p.., j]
+        for p in j + 1..m {
+            let lpj = colj[p - j];
+            let colp = &mut rest[(p - j - 1) * m + p..(p - j) * m];
+            for (y, &x) in colp.iter_mut().zip(&colj[p - j..]) {
+                *y = madd(-lpj, x, *y);
             }
-            l[(i, j)] = s / d;
         }
     }
     true
