@@ -82,34 +82,8 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
             i = lambda[i];
         }
         if i == NONE {
-            let anc = &anc[..len];
-            // the list ends with the run tl − 1, …, 1, 0 (a free base's six
-            // coordinates, and whatever chain continues them): the updates
-            // over that tail are one contiguous axpy (the same operations on
-            // the same entries as the gather over the list)
-            let mut tl = 0;
-            while tl < len && anc[len - 1 - tl] == tl {
-                tl += 1;
-            }
-            let head = len - tl;
             let (left, right) = us.split_at_mut(k * n);
-            let colk = &mut right[..k];
-            for (t, &i) in anc.iter().enumerate() {
-                let a = colk[i] * dinv;
-                let coli = &mut left[i * n..i * n + i + 1];
-                let run = if t < head {
-                    for &j in &anc[t..head] {
-                        coli[j] = madd(-a, colk[j], coli[j]);
-                    }
-                    tl
-                } else {
-                    i + 1
-                };
-                for (x, &y) in coli[..run].iter_mut().zip(&colk[..run]) {
-                    *x = madd(-a, y, *x);
-                }
-                colk[i] = a;
-            }
+            eliminate_list(&mut right[..k], left, n, &anc[..len], dinv, |_, _| {});
             continue;
         }
         // deeper than the list: walk λ
@@ -127,6 +101,77 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
         }
     }
     Ok(())
+}
+
+/// Eliminates coordinate k (column `colk` = H̃[0..k, k], pivot reciprocal
+/// `dinv`) from its ancestors `anc` (nearest first, the whole path): for i on
+/// the path, H̃[j, i] −= L[k, i] H̃[j, k] for j ancestor-or-self of i on it
+/// (`left` holds the columns before k), then L[k, i] into `colk[i]`; `each(i,
+/// L[k, i])` after each ancestor's step (the right-hand sides of
+/// [`ltdl_rows`]). The list ends with the run tl − 1, …, 1, 0 (a free base's six
+/// coordinates, and whatever chain continues them): the updates over that tail
+/// are contiguous axpys; a free base's six (tl ≥ 6: the rest of the run joins
+/// the gathered head) are fixed 6-wide, unrolled. The same operations on the
+/// same entries in every branch.
+#[inline(always)]
+fn eliminate_list<T: Scalar>(
+    colk: &mut [T],
+    left: &mut [T],
+    n: usize,
+    anc: &[usize],
+    dinv: T,
+    mut each: impl FnMut(usize, T),
+) {
+    let len = anc.len();
+    let mut tl = 0;
+    while tl < len && anc[len - 1 - tl] == tl {
+        tl += 1;
+    }
+    if tl >= 6 {
+        let head = len - 6;
+        let k6: [T; 6] = [colk[0], colk[1], colk[2], colk[3], colk[4], colk[5]];
+        for (t, &i) in anc[..head].iter().enumerate() {
+            let a = colk[i] * dinv;
+            let coli = &mut left[i * n..i * n + i + 1];
+            for &j in &anc[t..head] {
+                coli[j] = madd(-a, colk[j], coli[j]);
+            }
+            for r in 0..6 {
+                coli[r] = madd(-a, k6[r], coli[r]);
+            }
+            colk[i] = a;
+            each(i, a);
+        }
+        // the base block: H̃[j, i] −= L[k, i] H̃[j, k], j ≤ i < 6
+        for i in (0..6).rev() {
+            let a = k6[i] * dinv;
+            let coli = &mut left[i * n..i * n + 6];
+            for r in 0..=i {
+                coli[r] = madd(-a, k6[r], coli[r]);
+            }
+            colk[i] = a;
+            each(i, a);
+        }
+        return;
+    }
+    let head = len - tl;
+    for (t, &i) in anc.iter().enumerate() {
+        let a = colk[i] * dinv;
+        let coli = &mut left[i * n..i * n + i + 1];
+        let run = if t < head {
+            for &j in &anc[t..head] {
+                coli[j] = madd(-a, colk[j], coli[j]);
+            }
+            tl
+        } else {
+            i + 1
+        };
+        for (x, &y) in coli[..run].iter_mut().zip(&colk[..run]) {
+            *x = madd(-a, y, *x);
+        }
+        colk[i] = a;
+        each(i, a);
+    }
 }
 
 /// H's pattern into `u` (column k: k and its ancestors). On small models the
@@ -195,35 +240,14 @@ pub(crate) fn ltdl_rows<T: Scalar>(
         let (left, right) = us.split_at_mut(k * n);
         let colk = &mut right[..k];
         if i == NONE {
-            let anc = &anc[..len];
-            // the tail run tl − 1, …, 1, 0 as in `ltdl`
-            let mut tl = 0;
-            while tl < len && anc[len - 1 - tl] == tl {
-                tl += 1;
-            }
-            let head = len - tl;
-            for (t, &i) in anc.iter().enumerate() {
-                let a = colk[i] * dinv;
-                let coli = &mut left[i * n..i * n + i + 1];
-                let run = if t < head {
-                    for &j in &anc[t..head] {
-                        coli[j] = madd(-a, colk[j], coli[j]);
-                    }
-                    tl
-                } else {
-                    i + 1
-                };
-                for (x, &y) in coli[..run].iter_mut().zip(&colk[..run]) {
-                    *x = madd(-a, y, *x);
-                }
-                colk[i] = a;
+            eliminate_list(colk, left, n, &anc[..len], dinv, |i, a| {
                 if rows {
                     for (y, &x) in wa[i * m..(i + 1) * m].iter_mut().zip(wk) {
                         *y = madd(-a, x, *y);
                     }
                 }
                 b[i] = madd(-a, bk, b[i]);
-            }
+            });
             continue;
         }
         // deeper than the list: walk λ
