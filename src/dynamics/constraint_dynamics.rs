@@ -85,6 +85,8 @@ pub struct ConstraintData {
     pub(crate) path: Vec<(usize, usize, Motion<f64>)>,
     /// Derivatives: per body, the world velocity-product acceleration.
     pub(crate) oa0: Vec<Motion<f64>>,
+    /// Scratch (nv): D⁻¹ of H's tree-sparse factor.
+    pub(crate) dinv: Vec<f64>,
 }
 
 impl ConstraintData {
@@ -111,6 +113,7 @@ impl ConstraintData {
             av: DMatrix::zeros(nv, m),
             path: Vec::with_capacity(model.nv),
             oa0: vec![Motion::zero(); model.nbodies],
+            dinv: vec![0.0; nv],
         }
     }
 }
@@ -334,8 +337,10 @@ pub fn constraint_dynamics<'c>(
     let jq0 = cd.r.as_mut_slice();
     jq0.fill(0.0);
     let Data { h, chol, qdd, .. } = &mut *data;
-    ltdl::ltdl_rows(h, lam, chol, m, w, qdd.as_mut_slice(), |_, d, xk, bc| {
+    let dv = &mut cd.dinv[..n];
+    ltdl::ltdl_rows(h, lam, chol, m, w, qdd.as_mut_slice(), |c, d, xk, bc| {
         let dinv = 1.0 / d;
+        dv[c] = dinv;
         let s0 = bc * dinv;
         for (r, &xr) in xk.iter().enumerate() {
             if xr == 0.0 {
@@ -364,12 +369,13 @@ pub fn constraint_dynamics<'c>(
     let lambda = cd.lambda.as_slice();
     let b = data.qdd.as_slice();
     let t = cd.qdd.as_mut_slice();
+    let dv = &cd.dinv[..n];
     for c in 0..n {
         let mut acc = b[c];
         for (&x, &l) in w[c * m..(c + 1) * m].iter().zip(lambda) {
             acc = madd(x, l, acc);
         }
-        t[c] = acc / u[c + c * n];
+        t[c] = acc * dv[c];
     }
     for i in 0..n {
         let mut s1 = t[i];
@@ -390,7 +396,7 @@ pub fn constraint_dynamics<'c>(
         t[i] = s1;
     }
     data.qdd.copy_from(&cd.qdd);
-    cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
+    generalized_force(cd);
     Ok(&cd.qdd)
 }
 
@@ -403,8 +409,27 @@ pub(crate) fn solve_rows(
     mul_add(&mut cd.k, 1.0, &cd.jc, &cd.y, 0.0);
     solve_lambda(cd, constraints)?;
     cd.qdd.gemv(1.0, &cd.y, &cd.lambda, 1.0);
-    cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
+    generalized_force(cd);
     Ok(())
+}
+
+/// `cd.generalized_force` = J_cᵀ λ: per coordinate one dot of J_c's column
+/// (m contiguous entries) with λ.
+fn generalized_force(cd: &mut ConstraintData) {
+    let m = cd.rows;
+    let g = cd.generalized_force.as_mut_slice();
+    if m == 0 {
+        g.fill(0.0);
+        return;
+    }
+    let l = cd.lambda.as_slice();
+    for (gc, col) in g.iter_mut().zip(cd.jc.as_slice().chunks_exact(m)) {
+        let mut s = 0.0;
+        for (&x, &y) in col.iter().zip(l) {
+            s = madd(x, y, s);
+        }
+        *gc = s;
+    }
 }
 
 /// With `cd.k` = K, `cd.qdd` = q̈₀, `cd.jc`, `cd.gamma` set: K's factor, λ = K⁺ r

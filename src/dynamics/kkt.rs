@@ -1,6 +1,6 @@
 //! The least-norm solve of the constraint rows' operator `K = J_c H⁻¹ J_cᵀ`
 //! (symmetric positive semi-definite, m × m), docs/theory.md §"Constrained
-//! dynamics", "Redundant rows": a Cholesky factor when K is well inside full
+//! dynamics", "Redundant rows": an L D Lᵀ factor when K is well inside full
 //! rank, else K's eigendecomposition by cyclic Jacobi rotations and the
 //! pseudo-inverse `K⁺ = V Λ⁺ Vᵀ`, which gives the least-norm λ of a consistent
 //! system. No allocation: every buffer is sized once.
@@ -15,7 +15,8 @@ const RANK_TOL: f64 = 1e-10;
 /// The factor of K and the buffers of its solves.
 #[derive(Clone, Debug)]
 pub(crate) struct KktFactor {
-    /// m × m: the Cholesky factor (lower) or the eigenvectors (columns).
+    /// m × m: the unit lower factor L of K = L D Lᵀ (strict lower triangle)
+    /// or the eigenvectors (columns).
     f: DMatrix<f64>,
     /// m × m: K, rotated to its eigenvalues (eigen route only).
     w: DMatrix<f64>,
@@ -23,9 +24,9 @@ pub(crate) struct KktFactor {
     ev: DVector<f64>,
     /// Scratch of size m.
     t: DVector<f64>,
-    /// The reciprocals of the Cholesky factor's diagonal (m).
+    /// D⁻¹ of K = L D Lᵀ (m).
     dinv: Vec<f64>,
-    /// Whether `f` is a Cholesky factor (K of full rank).
+    /// Whether `f` is the L D Lᵀ factor (K of full rank).
     pub full_rank: bool,
 }
 
@@ -45,7 +46,7 @@ impl KktFactor {
     /// Factorises K (its lower triangle is read).
     pub fn factor(&mut self, k: &DMatrix<f64>) {
         let m = k.nrows();
-        self.full_rank = cholesky(k, &mut self.f, &mut self.dinv);
+        self.full_rank = ldlt(k, &mut self.f, &mut self.dinv);
         if self.full_rank {
             return;
         }
@@ -74,12 +75,15 @@ impl KktFactor {
             let l = self.f.as_slice();
             let dinv = &self.dinv[..m];
             let x = &mut x[..m];
+            // L y = x (unit), z = D⁻¹ y, Lᵀ x = z
             for k in 0..m {
-                let xk = x[k] * dinv[k];
-                x[k] = xk;
+                let xk = x[k];
                 for (xi, &lik) in x[k + 1..].iter_mut().zip(&l[k * m + k + 1..(k + 1) * m]) {
                     *xi = madd(-lik, xk, *xi);
                 }
+            }
+            for (xi, &d) in x.iter_mut().zip(dinv) {
+                *xi *= d;
             }
             for i in (0..m).rev() {
                 let col = &l[i * m + i + 1..(i + 1) * m];
@@ -87,7 +91,7 @@ impl KktFactor {
                 for (&a, &b) in col.iter().zip(&x[i + 1..]) {
                     s = madd(-a, b, s);
                 }
-                x[i] = s * dinv[i];
+                x[i] = s;
             }
             return;
         }
@@ -128,12 +132,14 @@ impl KktFactor {
 
 impl KktFactor {
     /// `y ← y S` for an n × m `y`, with `K⁺ = S Sᵀ` (docs/theory.md
-    /// §"Constrained dynamics", "Derivatives"): `S = L⁻ᵀ` at full rank (the
+    /// §"Constrained dynamics", "Derivatives"): `S = L⁻ᵀ D^{−½}` for K = L D Lᵀ at full rank (the
     /// columns by forward substitution, in place), else `S = V Λ^{+½}` (the
     /// dropped eigenvalues' columns zero; `scratch` n × m).
     pub fn right_half(&self, y: &mut DMatrix<f64>, scratch: &mut DMatrix<f64>) {
         let (n, m) = (y.nrows(), self.t.len());
         if self.full_rank {
+            // S = L⁻ᵀ D^{−½}: Z = y L⁻ᵀ column by column (Z Lᵀ = y, L unit),
+            // then each column scaled
             let l = self.f.as_slice();
             let ys = y.as_mut_slice();
             for j in 0..m {
@@ -145,8 +151,10 @@ impl KktFactor {
                         *x = madd(-ljk, z, *x);
                     }
                 }
-                let d = 1.0 / l[j + j * m];
-                yj.iter_mut().for_each(|x| *x *= d);
+            }
+            for j in 0..m {
+                let d = self.dinv[j].sqrt();
+                ys[j * n..(j + 1) * n].iter_mut().for_each(|x| *x *= d);
             }
             return;
         }
@@ -161,11 +169,13 @@ impl KktFactor {
     }
 }
 
-/// `k = L Lᵀ` into `l` (lower triangle, column-major) and the reciprocals of
-/// L's diagonal into `dinv`; false when a pivot is at most [`RANK_TOL`] of its
-/// diagonal entry (or not finite). Right-looking: column j is scaled by one
-/// reciprocal, then subtracted from the columns after it as contiguous axpys.
-fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>, dinv: &mut [f64]) -> bool {
+/// `k = L D Lᵀ` (L unit lower) into `l` (strict lower triangle, column-major)
+/// and D⁻¹ into `dinv`; false when a pivot D[j] is at most [`RANK_TOL`] of its
+/// diagonal entry of K (or not finite): the pivots and the test of the
+/// Cholesky factor's squared diagonal, without square roots on the chain from
+/// pivot to pivot. Right-looking: the columns after j are updated by
+/// contiguous axpys of column j, then column j is scaled by D[j]⁻¹.
+fn ldlt(k: &DMatrix<f64>, l: &mut DMatrix<f64>, dinv: &mut [f64]) -> bool {
     let m = k.nrows();
     let ks = k.as_slice();
     let ls = l.as_mut_slice();
@@ -179,20 +189,18 @@ fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>, dinv: &mut [f64]) -> bool {
         if d.is_nan() || d <= RANK_TOL * ks[j + j * m].abs() || !d.is_finite() {
             return false;
         }
-        let d = d.sqrt();
         let r = 1.0 / d;
-        colj[0] = d;
         dinv[j] = r;
-        for x in colj[1..].iter_mut() {
-            *x *= r;
-        }
-        // columns p > j: L[p.., p] −= L[p, j] L[p.., j]
+        // columns p > j: A[p.., p] −= (A[p, j] / D[j]) A[p.., j]
         for p in j + 1..m {
-            let lpj = colj[p - j];
+            let lpj = colj[p - j] * r;
             let colp = &mut rest[(p - j - 1) * m + p..(p - j) * m];
             for (y, &x) in colp.iter_mut().zip(&colj[p - j..]) {
                 *y = madd(-lpj, x, *y);
             }
+        }
+        for x in colj[1..].iter_mut() {
+            *x *= r;
         }
     }
     true
