@@ -65,7 +65,7 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
     // dependent loads), the same operations in the same order
     // Eliminate coordinate k from its ancestors: for i, j on k's path with j
     // ancestor-or-self of i, H[i, j] −= H[k, i] H[k, j] / D[k].
-    let mut anc = [0usize; MAX_DEPTH];
+    let mut anc = AncList::new();
     for k in (0..n).rev() {
         let d = us[k + k * n];
         if !(d > tiny * h[(k, k)].abs()) || !d.is_finite() {
@@ -74,16 +74,9 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
         // one division per pivot: L[k, i] = H̃[k, i] · D[k]⁻¹ (a division
         // per entry stalled the updates that wait for it)
         let dinv = T::one() / d;
-        let mut len = 0;
-        let mut i = lambda[k];
-        while i != NONE && len < MAX_DEPTH {
-            anc[len] = i;
-            len += 1;
-            i = lambda[i];
-        }
-        if i == NONE {
+        if let Some(list) = anc.of(lambda, k) {
             let (left, right) = us.split_at_mut(k * n);
-            eliminate_list(&mut right[..k], left, n, &anc[..len], dinv, |_, _| {});
+            eliminate_list(&mut right[..k], left, n, list, dinv, |_, _| {});
             continue;
         }
         // deeper than the list: walk λ
@@ -101,6 +94,54 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
         }
     }
     Ok(())
+}
+
+/// Coordinate k's ancestors, nearest first, for k = n − 1 down to 0: where
+/// λ(k + 1) = k (a chain, most of every tree in depth-first order) k's list is
+/// that of k + 1 without its first entry, otherwise λ is walked (a chain of
+/// dependent loads) into the buffer.
+struct AncList {
+    buf: [usize; MAX_DEPTH],
+    /// The list is `buf[s..e]`.
+    s: usize,
+    e: usize,
+    /// Whether the list reaches the root (not cut at `MAX_DEPTH`).
+    whole: bool,
+}
+
+impl AncList {
+    fn new() -> Self {
+        Self {
+            buf: [0; MAX_DEPTH],
+            s: 0,
+            e: 0,
+            whole: false,
+        }
+    }
+
+    /// k's ancestors (called for k descending), `None` when deeper than the buffer.
+    #[inline(always)]
+    fn of(&mut self, lambda: &[usize], k: usize) -> Option<&[usize]> {
+        if self.whole && self.s < self.e && self.buf[self.s] == k {
+            self.s += 1;
+        } else {
+            let mut len = 0;
+            let mut i = lambda[k];
+            while i != NONE && len < MAX_DEPTH {
+                self.buf[len] = i;
+                len += 1;
+                i = lambda[i];
+            }
+            self.s = 0;
+            self.e = len;
+            self.whole = i == NONE;
+        }
+        if self.whole {
+            Some(&self.buf[self.s..self.e])
+        } else {
+            None
+        }
+    }
 }
 
 /// Eliminates coordinate k (column `colk` = H̃[0..k, k], pivot reciprocal
@@ -218,7 +259,7 @@ pub(crate) fn ltdl_rows<T: Scalar>(
     let tiny = lit::<T>(64.0 * f64::EPSILON);
     copy_pattern(h, lambda, u);
     let us = u.as_mut_slice();
-    let mut anc = [0usize; MAX_DEPTH];
+    let mut anc = AncList::new();
     for k in (0..n).rev() {
         let d = us[k + k * n];
         if !(d > tiny * h[(k, k)].abs()) || !d.is_finite() {
@@ -230,17 +271,10 @@ pub(crate) fn ltdl_rows<T: Scalar>(
         let bk = b[k];
         pivot(k, d, wk, bk);
         let rows = wk.iter().any(|&x| x != T::zero());
-        let mut len = 0;
-        let mut i = lambda[k];
-        while i != NONE && len < MAX_DEPTH {
-            anc[len] = i;
-            len += 1;
-            i = lambda[i];
-        }
         let (left, right) = us.split_at_mut(k * n);
         let colk = &mut right[..k];
-        if i == NONE {
-            eliminate_list(colk, left, n, &anc[..len], dinv, |i, a| {
+        if let Some(list) = anc.of(lambda, k) {
+            eliminate_list(colk, left, n, list, dinv, |i, a| {
                 if rows {
                     for (y, &x) in wa[i * m..(i + 1) * m].iter_mut().zip(wk) {
                         *y = madd(-a, x, *y);
