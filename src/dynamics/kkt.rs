@@ -179,6 +179,9 @@ fn ldlt(k: &DMatrix<f64>, l: &mut DMatrix<f64>, dinv: &mut [f64]) -> bool {
     let m = k.nrows();
     let ks = k.as_slice();
     let ls = l.as_mut_slice();
+    if m <= PAD {
+        return ldlt_padded(ks, m, ls, dinv);
+    }
     for j in 0..m {
         ls[j * m + j..(j + 1) * m].copy_from_slice(&ks[j * m + j..(j + 1) * m]);
     }
@@ -201,6 +204,44 @@ fn ldlt(k: &DMatrix<f64>, l: &mut DMatrix<f64>, dinv: &mut [f64]) -> bool {
         }
         for x in colj[1..].iter_mut() {
             *x *= r;
+        }
+    }
+    true
+}
+
+/// The rows of [`ldlt_padded`]'s columns.
+const PAD: usize = 16;
+
+/// [`ldlt`] for m ≤ [`PAD`], on a stack copy of K whose columns are [`PAD`]
+/// entries long: every column update is the same fixed 16-wide axpy
+/// (unrolled, no loop remainder), also over rows at or above the pivot, whose
+/// values are never read (the entries below row j of the columns after j are
+/// exactly those of [`ldlt`]; the padding rows stay 0).
+fn ldlt_padded(ks: &[f64], m: usize, ls: &mut [f64], dinv: &mut [f64]) -> bool {
+    let mut a = [[0.0f64; PAD]; PAD];
+    // K's lower triangle, mirrored
+    for c in 0..m {
+        for r in 0..m {
+            a[c][r] = if r >= c { ks[r + c * m] } else { ks[c + r * m] };
+        }
+    }
+    for j in 0..m {
+        let d = a[j][j];
+        if d.is_nan() || d <= RANK_TOL * ks[j + j * m].abs() || !d.is_finite() {
+            return false;
+        }
+        let r = 1.0 / d;
+        dinv[j] = r;
+        let colj = a[j];
+        for col in a[j + 1..m].iter_mut().enumerate() {
+            let (p, cp) = (col.0 + j + 1, col.1);
+            let lpj = colj[p] * r;
+            for t in 0..PAD {
+                cp[t] = madd(-lpj, colj[t], cp[t]);
+            }
+        }
+        for t in j + 1..m {
+            ls[t + j * m] = colj[t] * r;
         }
     }
     true
