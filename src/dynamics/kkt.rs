@@ -1,6 +1,6 @@
 //! The least-norm solve of the constraint rows' operator `K = J_c H⁻¹ J_cᵀ`
 //! (symmetric positive semi-definite, m × m), docs/theory.md §"Constrained
-//! dynamics", "Redundant rows": an L D Lᵀ factor when K is well inside full
+//! dynamics", "Redundant rows": a Cholesky factor when K is well inside full
 //! rank, else K's eigendecomposition by cyclic Jacobi rotations and the
 //! pseudo-inverse `K⁺ = V Λ⁺ Vᵀ`, which gives the least-norm λ of a consistent
 //! system. No allocation: every buffer is sized once.
@@ -15,8 +15,7 @@ const RANK_TOL: f64 = 1e-10;
 /// The factor of K and the buffers of its solves.
 #[derive(Clone, Debug)]
 pub(crate) struct KktFactor {
-    /// m × m: the unit lower factor L of K = L D Lᵀ (strict lower triangle)
-    /// or the eigenvectors (columns).
+    /// m × m: the Cholesky factor (lower) or the eigenvectors (columns).
     f: DMatrix<f64>,
     /// m × m: K, rotated to its eigenvalues (eigen route only).
     w: DMatrix<f64>,
@@ -24,9 +23,7 @@ pub(crate) struct KktFactor {
     ev: DVector<f64>,
     /// Scratch of size m.
     t: DVector<f64>,
-    /// D⁻¹ of K = L D Lᵀ (m).
-    dinv: Vec<f64>,
-    /// Whether `f` is the L D Lᵀ factor (K of full rank).
+    /// Whether `f` is a Cholesky factor (K of full rank).
     pub full_rank: bool,
 }
 
@@ -38,7 +35,6 @@ impl KktFactor {
             w: DMatrix::zeros(m, m),
             ev: DVector::zeros(m),
             t: DVector::zeros(m),
-            dinv: vec![0.0; m],
             full_rank: true,
         }
     }
@@ -46,7 +42,7 @@ impl KktFactor {
     /// Factorises K (its lower triangle is read).
     pub fn factor(&mut self, k: &DMatrix<f64>) {
         let m = k.nrows();
-        self.full_rank = ldlt(k, &mut self.f, &mut self.dinv);
+        self.full_rank = cholesky(k, &mut self.f);
         if self.full_rank {
             return;
         }
@@ -73,25 +69,18 @@ impl KktFactor {
         if self.full_rank {
             // L (column-major): L[i, k] at i + k m
             let l = self.f.as_slice();
-            let dinv = &self.dinv[..m];
             let x = &mut x[..m];
-            // L y = x (unit), z = D⁻¹ y, Lᵀ x = z
             for k in 0..m {
-                let xk = x[k];
+                let xk = x[k] / l[k + k * m];
+                x[k] = xk;
                 for (xi, &lik) in x[k + 1..].iter_mut().zip(&l[k * m + k + 1..(k + 1) * m]) {
-                    *xi = madd(-lik, xk, *xi);
+                    *xi -= lik * xk;
                 }
-            }
-            for (xi, &d) in x.iter_mut().zip(dinv) {
-                *xi *= d;
             }
             for i in (0..m).rev() {
                 let col = &l[i * m + i + 1..(i + 1) * m];
-                let mut s = x[i];
-                for (&a, &b) in col.iter().zip(&x[i + 1..]) {
-                    s = madd(-a, b, s);
-                }
-                x[i] = s;
+                let s: f64 = col.iter().zip(&x[i + 1..]).map(|(a, b)| a * b).sum();
+                x[i] = (x[i] - s) / l[i + i * m];
             }
             return;
         }
@@ -132,14 +121,12 @@ impl KktFactor {
 
 impl KktFactor {
     /// `y ← y S` for an n × m `y`, with `K⁺ = S Sᵀ` (docs/theory.md
-    /// §"Constrained dynamics", "Derivatives"): `S = L⁻ᵀ D^{−½}` for K = L D Lᵀ at full rank (the
+    /// §"Constrained dynamics", "Derivatives"): `S = L⁻ᵀ` at full rank (the
     /// columns by forward substitution, in place), else `S = V Λ^{+½}` (the
     /// dropped eigenvalues' columns zero; `scratch` n × m).
     pub fn right_half(&self, y: &mut DMatrix<f64>, scratch: &mut DMatrix<f64>) {
         let (n, m) = (y.nrows(), self.t.len());
         if self.full_rank {
-            // S = L⁻ᵀ D^{−½}: Z = y L⁻ᵀ column by column (Z Lᵀ = y, L unit),
-            // then each column scaled
             let l = self.f.as_slice();
             let ys = y.as_mut_slice();
             for j in 0..m {
@@ -151,10 +138,8 @@ impl KktFactor {
                         *x = madd(-ljk, z, *x);
                     }
                 }
-            }
-            for j in 0..m {
-                let d = self.dinv[j].sqrt();
-                ys[j * n..(j + 1) * n].iter_mut().for_each(|x| *x *= d);
+                let d = 1.0 / l[j + j * m];
+                yj.iter_mut().for_each(|x| *x *= d);
             }
             return;
         }
@@ -169,79 +154,26 @@ impl KktFactor {
     }
 }
 
-/// `k = L D Lᵀ` (L unit lower) into `l` (strict lower triangle, column-major)
-/// and D⁻¹ into `dinv`; false when a pivot D[j] is at most [`RANK_TOL`] of its
-/// diagonal entry of K (or not finite): the pivots and the test of the
-/// Cholesky factor's squared diagonal, without square roots on the chain from
-/// pivot to pivot. Right-looking: the columns after j are updated by
-/// contiguous axpys of column j, then column j is scaled by D[j]⁻¹.
-fn ldlt(k: &DMatrix<f64>, l: &mut DMatrix<f64>, dinv: &mut [f64]) -> bool {
+/// `k = L Lᵀ` into `l` (lower triangle); false when a pivot is at most
+/// [`RANK_TOL`] of its diagonal entry (or not finite).
+fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>) -> bool {
     let m = k.nrows();
-    let ks = k.as_slice();
-    let ls = l.as_mut_slice();
-    if m <= PAD {
-        return ldlt_padded(ks, m, ls, dinv);
-    }
     for j in 0..m {
-        ls[j * m + j..(j + 1) * m].copy_from_slice(&ks[j * m + j..(j + 1) * m]);
-    }
-    for j in 0..m {
-        let (done, rest) = ls.split_at_mut((j + 1) * m);
-        let colj = &mut done[j * m + j..];
-        let d = colj[0];
-        if d.is_nan() || d <= RANK_TOL * ks[j + j * m].abs() || !d.is_finite() {
+        let mut d = k[(j, j)];
+        for p in 0..j {
+            d -= l[(j, p)] * l[(j, p)];
+        }
+        if d.is_nan() || d <= RANK_TOL * k[(j, j)].abs() || !d.is_finite() {
             return false;
         }
-        let r = 1.0 / d;
-        dinv[j] = r;
-        // columns p > j: A[p.., p] −= (A[p, j] / D[j]) A[p.., j]
-        for p in j + 1..m {
-            let lpj = colj[p - j] * r;
-            let colp = &mut rest[(p - j - 1) * m + p..(p - j) * m];
-            for (y, &x) in colp.iter_mut().zip(&colj[p - j..]) {
-                *y = madd(-lpj, x, *y);
+        let d = d.sqrt();
+        l[(j, j)] = d;
+        for i in j + 1..m {
+            let mut s = k[(i, j)];
+            for p in 0..j {
+                s -= l[(i, p)] * l[(j, p)];
             }
-        }
-        for x in colj[1..].iter_mut() {
-            *x *= r;
-        }
-    }
-    true
-}
-
-/// The rows of [`ldlt_padded`]'s columns.
-const PAD: usize = 16;
-
-/// [`ldlt`] for m ≤ [`PAD`], on a stack copy of K whose columns are [`PAD`]
-/// entries long: every column update is the same fixed 16-wide axpy
-/// (unrolled, no loop remainder), also over rows at or above the pivot, whose
-/// values are never read (the entries below row j of the columns after j are
-/// exactly those of [`ldlt`]; the padding rows stay 0).
-fn ldlt_padded(ks: &[f64], m: usize, ls: &mut [f64], dinv: &mut [f64]) -> bool {
-    let mut a = [[0.0f64; PAD]; PAD];
-    // K's lower triangle, mirrored
-    for c in 0..m {
-        for r in 0..m {
-            a[c][r] = if r >= c { ks[r + c * m] } else { ks[c + r * m] };
-        }
-    }
-    for j in 0..m {
-        let d = a[j][j];
-        if d.is_nan() || d <= RANK_TOL * ks[j + j * m].abs() || !d.is_finite() {
-            return false;
-        }
-        let r = 1.0 / d;
-        dinv[j] = r;
-        let colj = a[j];
-        for col in a[j + 1..m].iter_mut().enumerate() {
-            let (p, cp) = (col.0 + j + 1, col.1);
-            let lpj = colj[p] * r;
-            for t in 0..PAD {
-                cp[t] = madd(-lpj, colj[t], cp[t]);
-            }
-        }
-        for t in j + 1..m {
-            ls[t + j * m] = colj[t] * r;
+            l[(i, j)] = s / d;
         }
     }
     true
