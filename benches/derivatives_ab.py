@@ -7,7 +7,9 @@ CASE is one of the names in CASES (e.g. solo12.abad, talos.cd, hopper.aba). In e
 every case is timed by Pinocchio (with --pin), then by BIN_A and BIN_B in alternating order
 (`urdyn bench ... --json --samples 200`); printed per case: the medians of each side's
 median ns, the median and range of the per-round ratios B/A, and with --pin A/Pinocchio and
-B/Pinocchio. Used for the round-4 before/after tables of benches/derivatives_results.md
+B/Pinocchio. With --min, each run's minimum sample (min_ns, both sides) replaces its
+median (steadier while other jobs load the machine: preempted ~50 µs batches land in the
+upper tail). Used for the round-4 before/after tables of benches/derivatives_results.md
 and benches/constraint_results.md (BIN_A: main's build, BIN_B: the branch's)."""
 import json
 import os
@@ -43,17 +45,18 @@ def run(cmd):
         return None
     res = js.get("results", js)
     return res
+KEY = "min_ns" if "--min" in sys.argv else "median_ns"
 def timing(bin_, case, samples):
     model, flags, algo = CASES[case]
     r = run(f"{bin_} bench {model} {flags} --algo {algo} --json --samples {samples}")
-    return r[algo]["median_ns"] if r and algo in r else float("nan")
+    return r[algo][KEY] if r and algo in r else float("nan")
 def pin(case, samples):
     model, flags, algo = CASES[case]
     base = case.split(".")[0]
     if algo in ("constraint-dynamics", "constraint-dynamics-derivatives") and base in PINMODEL:
         model = PINMODEL[base]
     r = run(f"/work/shared/tools/pinocchio-bench/run {model} {flags} --native --algo {algo} --json --samples {samples}")
-    return r[algo]["median_ns"] if r and algo in r else float("nan")
+    return r[algo][KEY] if r and algo in r else float("nan")
 
 args = sys.argv[1:]
 rounds = int(args[0]); bins = args[1:3]; rest = args[3:]
@@ -70,7 +73,7 @@ for r in range(rounds):
             data[c][b].append(timing(b, c, samples))
 with open("/proc/loadavg") as f:
     load = f.read().split()[:3]
-print("load", load)
+print("load", load, "per-run statistic:", KEY)
 for c in cases:
     d = data[c]
     a, b = d[bins[0]], d[bins[1]]

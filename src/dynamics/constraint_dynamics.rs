@@ -13,6 +13,7 @@
 //! q̈ = q̈₀ + Y λ.
 
 use super::kkt::{mul_add, KktFactor};
+use super::ltdl;
 use super::{check_massless, check_sizes, forward_dynamics_crba, linalg, DynamicsError};
 use crate::model::{
     dispatch_joint, Attachment, ConstraintKind, Constraints, Data, DimensionError, JointModel,
@@ -84,6 +85,8 @@ pub struct ConstraintData {
     pub(crate) path: Vec<(usize, usize, Motion<f64>)>,
     /// Derivatives: per body, the world velocity-product acceleration.
     pub(crate) oa0: Vec<Motion<f64>>,
+    /// Scratch (nv): D⁻¹ of H's tree-sparse factor.
+    pub(crate) dinv: Vec<f64>,
 }
 
 impl ConstraintData {
@@ -110,6 +113,7 @@ impl ConstraintData {
             av: DMatrix::zeros(nv, m),
             path: Vec::with_capacity(model.nv),
             oa0: vec![Motion::zero(); model.nbodies],
+            dinv: vec![0.0; nv],
         }
     }
 }
@@ -275,7 +279,8 @@ pub fn constraint_dynamics<'c>(
     if dense {
         forward_dynamics_crba(model, data, q, v, tau, fext)?;
     } else {
-        super::factor_crba(model, data, q, v, fext)?;
+        // H's factor comes below, fused with the elimination of J_cᵀ
+        super::bias_and_crba(model, data, q, v, fext);
         data.qdd.copy_from(tau);
         data.qdd -= &data.bias;
     }
@@ -316,44 +321,14 @@ pub fn constraint_dynamics<'c>(
     // w₀ = L⁻ᵀ (τ − C), eliminated with W, and J_c q̈₀ = Wᵀ D⁻¹ w₀ formed with K
     // (docs/theory.md §"Constrained dynamics", "Solving"). W is kept
     // coordinate-major (W[k, r] at k m + r, J_c's own column-major storage):
-    // every elimination step is one m-wide axpy over all the rows at once.
+    // every elimination step is one m-wide axpy over all the rows at once. The
+    // elimination runs inside H's factorisation (`ltdl_rows`: one walk of the
+    // tree), and K gathers each coordinate's term as its row becomes final.
     let (n, m) = (model.nv, cd.rows);
     let lam = &model.dof_parent;
     let direct = data.deriv_direct;
-    let (runs, run0) = (&data.deriv_anc_runs, &data.deriv_anc_run0);
-    let u = data.chol.as_slice();
-    let b = data.qdd.as_mut_slice();
     let w = &mut cd.y.as_mut_slice()[..n * m];
     w.copy_from_slice(&cd.jc.as_slice()[..n * m]);
-    for i in (0..n).rev() {
-        let (above, rest) = w.split_at_mut(i * m);
-        let xi = &rest[..m];
-        let bi = b[i];
-        let rows = xi.iter().any(|&x| x != 0.0);
-        if !rows && bi == 0.0 {
-            continue;
-        }
-        let mut step = |j: usize| {
-            let l = u[j + i * n];
-            if rows {
-                for (y, &x) in above[j * m..(j + 1) * m].iter_mut().zip(xi) {
-                    *y = madd(-l, x, *y);
-                }
-            }
-            b[j] = madd(-l, bi, b[j]);
-        };
-        if direct {
-            for &(lo, hi) in &runs[run0[i]..run0[i + 1]] {
-                (lo..hi).for_each(&mut step);
-            }
-        } else {
-            let mut j = lam[i];
-            while j != usize::MAX {
-                step(j);
-                j = lam[j];
-            }
-        }
-    }
     // K = Wᵀ D⁻¹ W = Σₖ D⁻¹ₖ W[k, :]ᵀ W[k, :]: by rank-1 updates of contiguous
     // columns (K[s, r] at s + r m), the upper triangle then mirrored; and
     // −J_c q̈₀ = −Wᵀ D⁻¹ w₀ into cd.r
@@ -361,10 +336,12 @@ pub fn constraint_dynamics<'c>(
     k.fill(0.0);
     let jq0 = cd.r.as_mut_slice();
     jq0.fill(0.0);
-    for c in 0..n {
-        let xk = &w[c * m..(c + 1) * m];
-        let dinv = 1.0 / u[c + c * n];
-        let s0 = b[c] * dinv;
+    let Data { h, chol, qdd, .. } = &mut *data;
+    let dv = &mut cd.dinv[..n];
+    ltdl::ltdl_rows(h, lam, chol, m, w, qdd.as_mut_slice(), |c, d, xk, bc| {
+        let dinv = 1.0 / d;
+        dv[c] = dinv;
+        let s0 = bc * dinv;
         for (r, &xr) in xk.iter().enumerate() {
             if xr == 0.0 {
                 continue;
@@ -377,24 +354,28 @@ pub fn constraint_dynamics<'c>(
                 *y = madd(a, x, *y);
             }
         }
-    }
+    })
+    .map_err(DynamicsError::Singular)?;
     for r in 0..m {
         for s2 in 0..r {
             k[r + s2 * m] = k[s2 + r * m];
         }
     }
+    let (runs, run0) = (&data.deriv_anc_runs, &data.deriv_anc_run0);
+    let u = data.chol.as_slice();
     solve_lambda_r(cd, constraints)?;
     // t = D⁻¹ (w₀ + W λ), then q̈ = L⁻¹ t (root outwards)
     let w = &cd.y.as_slice()[..n * m];
     let lambda = cd.lambda.as_slice();
     let b = data.qdd.as_slice();
     let t = cd.qdd.as_mut_slice();
+    let dv = &cd.dinv[..n];
     for c in 0..n {
         let mut acc = b[c];
         for (&x, &l) in w[c * m..(c + 1) * m].iter().zip(lambda) {
             acc = madd(x, l, acc);
         }
-        t[c] = acc / u[c + c * n];
+        t[c] = acc * dv[c];
     }
     for i in 0..n {
         let mut s1 = t[i];
@@ -415,7 +396,7 @@ pub fn constraint_dynamics<'c>(
         t[i] = s1;
     }
     data.qdd.copy_from(&cd.qdd);
-    cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
+    generalized_force(cd);
     Ok(&cd.qdd)
 }
 
@@ -428,8 +409,27 @@ pub(crate) fn solve_rows(
     mul_add(&mut cd.k, 1.0, &cd.jc, &cd.y, 0.0);
     solve_lambda(cd, constraints)?;
     cd.qdd.gemv(1.0, &cd.y, &cd.lambda, 1.0);
-    cd.generalized_force.gemv_tr(1.0, &cd.jc, &cd.lambda, 0.0);
+    generalized_force(cd);
     Ok(())
+}
+
+/// `cd.generalized_force` = J_cᵀ λ: per coordinate one dot of J_c's column
+/// (m contiguous entries) with λ.
+fn generalized_force(cd: &mut ConstraintData) {
+    let m = cd.rows;
+    let g = cd.generalized_force.as_mut_slice();
+    if m == 0 {
+        g.fill(0.0);
+        return;
+    }
+    let l = cd.lambda.as_slice();
+    for (gc, col) in g.iter_mut().zip(cd.jc.as_slice().chunks_exact(m)) {
+        let mut s = 0.0;
+        for (&x, &y) in col.iter().zip(l) {
+            s = madd(x, y, s);
+        }
+        *gc = s;
+    }
 }
 
 /// With `cd.k` = K, `cd.qdd` = q̈₀, `cd.jc`, `cd.gamma` set: K's factor, λ = K⁺ r

@@ -19,6 +19,8 @@ use nalgebra::{DMatrix, DVector};
 const NONE: usize = usize::MAX;
 /// The deepest ancestor list [`ltdl`] keeps on the stack (deeper paths walk λ).
 const MAX_DEPTH: usize = 128;
+/// Up to this many coordinates [`ltdl`] copies H's upper columns whole.
+const SMALL: usize = 64;
 
 /// Factorises the symmetric positive-definite `h` (full storage, tree-shaped
 /// sparsity given by `lambda`) as `Lᵀ D L` into `u` (layout above). Fails with the
@@ -27,15 +29,7 @@ const MAX_DEPTH: usize = 128;
 pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> Result<(), usize> {
     let n = lambda.len();
     let tiny = lit::<T>(64.0 * f64::EPSILON);
-    // Copy the pattern of H (column k: k and its ancestors).
-    for k in 0..n {
-        u[(k, k)] = h[(k, k)];
-        let mut i = lambda[k];
-        while i != NONE {
-            u[(i, k)] = h[(i, k)];
-            i = lambda[i];
-        }
-    }
+    copy_pattern(h, lambda, u);
     // A chain (λ(k) = k − 1): the same elimination on contiguous column ranges,
     // as axpy sweeps the compiler vectorises.
     if lambda
@@ -49,10 +43,11 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
             if !(d > tiny * h[(k, k)].abs()) || !d.is_finite() {
                 return Err(k);
             }
+            let dinv = T::one() / d;
             let (left, right) = us.split_at_mut(k * n);
             let colk = &mut right[..k];
             for i in (0..k).rev() {
-                let a = colk[i] / d;
+                let a = colk[i] * dinv;
                 let coli = &mut left[i * n..i * n + i + 1];
                 for (x, y) in coli.iter_mut().zip(colk[..=i].iter()) {
                     *x = madd(-a, *y, *x);
@@ -70,54 +65,24 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
     // dependent loads), the same operations in the same order
     // Eliminate coordinate k from its ancestors: for i, j on k's path with j
     // ancestor-or-self of i, H[i, j] −= H[k, i] H[k, j] / D[k].
-    let mut anc = [0usize; MAX_DEPTH];
+    let mut anc = AncList::new();
     for k in (0..n).rev() {
         let d = us[k + k * n];
         if !(d > tiny * h[(k, k)].abs()) || !d.is_finite() {
             return Err(k);
         }
-        let mut len = 0;
-        let mut i = lambda[k];
-        while i != NONE && len < MAX_DEPTH {
-            anc[len] = i;
-            len += 1;
-            i = lambda[i];
-        }
-        if i == NONE {
-            let anc = &anc[..len];
-            // the list ends with the run tl − 1, …, 1, 0 (a free base's six
-            // coordinates, and whatever chain continues them): the updates
-            // over that tail are one contiguous axpy (the same operations on
-            // the same entries as the gather over the list)
-            let mut tl = 0;
-            while tl < len && anc[len - 1 - tl] == tl {
-                tl += 1;
-            }
-            let head = len - tl;
+        // one division per pivot: L[k, i] = H̃[k, i] · D[k]⁻¹ (a division
+        // per entry stalled the updates that wait for it)
+        let dinv = T::one() / d;
+        if let Some(list) = anc.of(lambda, k) {
             let (left, right) = us.split_at_mut(k * n);
-            let colk = &mut right[..k];
-            for (t, &i) in anc.iter().enumerate() {
-                let a = colk[i] / d;
-                let coli = &mut left[i * n..i * n + i + 1];
-                let run = if t < head {
-                    for &j in &anc[t..head] {
-                        coli[j] = madd(-a, colk[j], coli[j]);
-                    }
-                    tl
-                } else {
-                    i + 1
-                };
-                for (x, &y) in coli[..run].iter_mut().zip(&colk[..run]) {
-                    *x = madd(-a, y, *x);
-                }
-                colk[i] = a;
-            }
+            eliminate_list(&mut right[..k], left, n, list, dinv, |_, _| {});
             continue;
         }
         // deeper than the list: walk λ
         let mut i = lambda[k];
         while i != NONE {
-            let a = us[i + k * n] / d;
+            let a = us[i + k * n] * dinv;
             let mut j = i;
             while j != NONE {
                 let hkj = us[j + k * n];
@@ -125,6 +90,216 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
                 j = lambda[j];
             }
             us[i + k * n] = a;
+            i = lambda[i];
+        }
+    }
+    Ok(())
+}
+
+/// Coordinate k's ancestors, nearest first, for k = n − 1 down to 0: where
+/// λ(k + 1) = k (a chain, most of every tree in depth-first order) k's list is
+/// that of k + 1 without its first entry, otherwise λ is walked (a chain of
+/// dependent loads) into the buffer.
+struct AncList {
+    buf: [usize; MAX_DEPTH],
+    /// The list is `buf[s..e]`.
+    s: usize,
+    e: usize,
+    /// Whether the list reaches the root (not cut at `MAX_DEPTH`).
+    whole: bool,
+}
+
+impl AncList {
+    fn new() -> Self {
+        Self {
+            buf: [0; MAX_DEPTH],
+            s: 0,
+            e: 0,
+            whole: false,
+        }
+    }
+
+    /// k's ancestors (called for k descending), `None` when deeper than the buffer.
+    #[inline(always)]
+    fn of(&mut self, lambda: &[usize], k: usize) -> Option<&[usize]> {
+        if self.whole && self.s < self.e && self.buf[self.s] == k {
+            self.s += 1;
+        } else {
+            let mut len = 0;
+            let mut i = lambda[k];
+            while i != NONE && len < MAX_DEPTH {
+                self.buf[len] = i;
+                len += 1;
+                i = lambda[i];
+            }
+            self.s = 0;
+            self.e = len;
+            self.whole = i == NONE;
+        }
+        if self.whole {
+            Some(&self.buf[self.s..self.e])
+        } else {
+            None
+        }
+    }
+}
+
+/// Eliminates coordinate k (column `colk` = H̃[0..k, k], pivot reciprocal
+/// `dinv`) from its ancestors `anc` (nearest first, the whole path): for i on
+/// the path, H̃[j, i] −= L[k, i] H̃[j, k] for j ancestor-or-self of i on it
+/// (`left` holds the columns before k), then L[k, i] into `colk[i]`; `each(i,
+/// L[k, i])` after each ancestor's step (the right-hand sides of
+/// [`ltdl_rows`]). The list ends with the run tl − 1, …, 1, 0 (a free base's six
+/// coordinates, and whatever chain continues them): the updates over that tail
+/// are contiguous axpys; a free base's six (tl ≥ 6: the rest of the run joins
+/// the gathered head) are fixed 6-wide, unrolled. The same operations on the
+/// same entries in every branch.
+#[inline(always)]
+fn eliminate_list<T: Scalar>(
+    colk: &mut [T],
+    left: &mut [T],
+    n: usize,
+    anc: &[usize],
+    dinv: T,
+    mut each: impl FnMut(usize, T),
+) {
+    let len = anc.len();
+    let mut tl = 0;
+    while tl < len && anc[len - 1 - tl] == tl {
+        tl += 1;
+    }
+    if tl >= 6 {
+        let head = len - 6;
+        let k6: [T; 6] = [colk[0], colk[1], colk[2], colk[3], colk[4], colk[5]];
+        for (t, &i) in anc[..head].iter().enumerate() {
+            let a = colk[i] * dinv;
+            let coli = &mut left[i * n..i * n + i + 1];
+            for &j in &anc[t..head] {
+                coli[j] = madd(-a, colk[j], coli[j]);
+            }
+            for r in 0..6 {
+                coli[r] = madd(-a, k6[r], coli[r]);
+            }
+            colk[i] = a;
+            each(i, a);
+        }
+        // the base block: H̃[j, i] −= L[k, i] H̃[j, k], j ≤ i < 6
+        for i in (0..6).rev() {
+            let a = k6[i] * dinv;
+            let coli = &mut left[i * n..i * n + 6];
+            for r in 0..=i {
+                coli[r] = madd(-a, k6[r], coli[r]);
+            }
+            colk[i] = a;
+            each(i, a);
+        }
+        return;
+    }
+    let head = len - tl;
+    for (t, &i) in anc.iter().enumerate() {
+        let a = colk[i] * dinv;
+        let coli = &mut left[i * n..i * n + i + 1];
+        let run = if t < head {
+            for &j in &anc[t..head] {
+                coli[j] = madd(-a, colk[j], coli[j]);
+            }
+            tl
+        } else {
+            i + 1
+        };
+        for (x, &y) in coli[..run].iter_mut().zip(&colk[..run]) {
+            *x = madd(-a, y, *x);
+        }
+        colk[i] = a;
+        each(i, a);
+    }
+}
+
+/// H's pattern into `u` (column k: k and its ancestors). On small models the
+/// whole upper column `0..=k` (the pattern and H's structural zeros beside it,
+/// which nothing reads) as one contiguous copy each: O(n²) moves, cheaper there
+/// than the walk of λ with a store per entry.
+fn copy_pattern<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) {
+    let n = lambda.len();
+    if n <= SMALL {
+        let (hs, us) = (h.as_slice(), u.as_mut_slice());
+        for k in 0..n {
+            us[k * n..k * n + k + 1].copy_from_slice(&hs[k * n..k * n + k + 1]);
+        }
+        return;
+    }
+    for k in 0..n {
+        u[(k, k)] = h[(k, k)];
+        let mut i = lambda[k];
+        while i != NONE {
+            u[(i, k)] = h[(i, k)];
+            i = lambda[i];
+        }
+    }
+}
+
+/// [`ltdl`] fused with the elimination `Lᵀ⁻¹` of `m` right-hand sides kept
+/// coordinate-major (row k, coordinate k of each, at `w[k m..(k + 1) m]`) and
+/// of one more, `b`: as coordinate k is eliminated from its ancestors i, so are
+/// its rows (`w[i] −= L[k, i] w[k]`, `b[i] −= L[k, i] b[k]`, the steps of
+/// [`ltdl_solve_rows`]' first sweep), leaving `L⁻ᵀ w`, `L⁻ᵀ b` and the factor of
+/// [`ltdl`] (the same operations on it). `pivot(k, D[k], w[k], b[k])` sees each
+/// final row before its ancestors' updates (leaves inwards). One walk of the
+/// tree instead of two (docs/theory.md §"Constrained dynamics", "Solving").
+pub(crate) fn ltdl_rows<T: Scalar>(
+    h: &DMatrix<T>,
+    lambda: &[usize],
+    u: &mut DMatrix<T>,
+    m: usize,
+    w: &mut [T],
+    b: &mut [T],
+    mut pivot: impl FnMut(usize, T, &[T], T),
+) -> Result<(), usize> {
+    let n = lambda.len();
+    let tiny = lit::<T>(64.0 * f64::EPSILON);
+    copy_pattern(h, lambda, u);
+    let us = u.as_mut_slice();
+    let mut anc = AncList::new();
+    for k in (0..n).rev() {
+        let d = us[k + k * n];
+        if !(d > tiny * h[(k, k)].abs()) || !d.is_finite() {
+            return Err(k);
+        }
+        let dinv = T::one() / d;
+        let (wa, wr) = w.split_at_mut(k * m);
+        let wk = &wr[..m];
+        let bk = b[k];
+        pivot(k, d, wk, bk);
+        let rows = wk.iter().any(|&x| x != T::zero());
+        let (left, right) = us.split_at_mut(k * n);
+        let colk = &mut right[..k];
+        if let Some(list) = anc.of(lambda, k) {
+            eliminate_list(colk, left, n, list, dinv, |i, a| {
+                if rows {
+                    for (y, &x) in wa[i * m..(i + 1) * m].iter_mut().zip(wk) {
+                        *y = madd(-a, x, *y);
+                    }
+                }
+                b[i] = madd(-a, bk, b[i]);
+            });
+            continue;
+        }
+        // deeper than the list: walk λ
+        let mut i = lambda[k];
+        while i != NONE {
+            let a = colk[i] * dinv;
+            let mut j = i;
+            while j != NONE {
+                left[j + i * n] = madd(-a, colk[j], left[j + i * n]);
+                j = lambda[j];
+            }
+            colk[i] = a;
+            if rows {
+                for (y, &x) in wa[i * m..(i + 1) * m].iter_mut().zip(wk) {
+                    *y = madd(-a, x, *y);
+                }
+            }
+            b[i] = madd(-a, bk, b[i]);
             i = lambda[i];
         }
     }

@@ -181,17 +181,30 @@ pub(crate) fn factor_crba<T: Scalar>(
     v: &DVector<T>,
     fext: Option<&[Force<T>]>,
 ) -> Result<(), DynamicsError> {
+    bias_and_crba(model, data, q, v, fext);
+    if dense_factor(model) {
+        linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)
+    } else {
+        ltdl::ltdl(&data.h, &model.dof_parent, &mut data.chol).map_err(DynamicsError::Singular)
+    }
+}
+
+/// `data.bias` = C (with the pass's body velocities, accelerations and joint
+/// placements) and H (`data.h`, the upper triangle at least): [`factor_crba`]
+/// without the factor.
+pub(crate) fn bias_and_crba<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+    fext: Option<&[Force<T>]>,
+) {
     rnea::bias_pass(model, data, q, v, fext);
     // the bias pass left the joint placements at q: the local-frame CRBA reads
     // them (no second sin/cos and transform per joint) where it runs; LTDL
     // reads H's upper triangle only (mirrored for the dense Cholesky)
     if !crba::crba_at_placements(model, data) {
         crba::crba_dispatch(model, data, q, model.has_mimic);
-    }
-    if dense_factor(model) {
-        linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)
-    } else {
-        ltdl::ltdl(&data.h, &model.dof_parent, &mut data.chol).map_err(DynamicsError::Singular)
     }
 }
 
