@@ -22,10 +22,10 @@ pub struct LinkInertial {
 /// Every link's `<inertial>` of the URDF `text`, names prefixed by `prefix`
 /// (a scene's `MODEL/`). The origin's rotation R turns the URDF's inertia
 /// (about the centre of mass, in the inertial frame) into the link frame:
-/// I_link = R I Rᵀ, R = Rz(yaw) Ry(pitch) Rx(roll) as URDF's rpy. A text urdf-rs
+/// I_link = R I Rᵀ, R = Rz(yaw) Ry(pitch) Rx(roll) as URDF's rpy. A text urdyn
 /// cannot read gives none (the model's import read it already).
 pub fn link_inertials(text: &str, prefix: &str) -> HashMap<String, LinkInertial> {
-    let Ok(robot) = urdf_rs::read_from_string(text) else {
+    let Ok(robot) = urdyn::urdf::read_robot(text, "") else {
         return HashMap::new();
     };
     robot

@@ -1,14 +1,14 @@
-//! Builds the urdf-rs [`Robot`](urdf_rs::Robot) from URDF text with quick-xml,
+//! Builds the [`Robot`](super::super::types::Robot) from URDF text with quick-xml,
 //! following urdf-rs 0.10's reading of URDF 1.0–1.2 (defaults, `quat_xyzw` from 1.1,
 //! limit defaults and checks from 1.2). The text has passed the checking scan, so
 //! required attributes exist and numbers parse; every access is still fallible.
 
-use super::super::UrdfError;
-use quick_xml::events::{BytesStart, Event};
-use urdf_rs::{
+use super::super::types::{
     Axis, Calibration, Collision, Dynamics, Geometry, Inertia, Inertial, Joint, JointLimit,
     JointType, Link, LinkName, Mass, Mimic, Pose, Robot, SafetyController, Vec3,
 };
+use super::super::UrdfError;
+use quick_xml::events::{BytesStart, Event};
 
 /// A small element tree: one top-level `<link>` or `<joint>`.
 struct El {
@@ -193,7 +193,6 @@ impl Ctx<'_> {
             name,
             inertial,
             // Visuals are not used by dynamics: the scan checks them (warnings only).
-            visual: Vec::new(),
             collision,
         })
     }
@@ -407,11 +406,10 @@ pub(super) fn build(text: &str, file: &str) -> Result<Robot, UrdfError> {
         version: None,
         links: Vec::new(),
         joints: Vec::new(),
-        materials: Vec::new(),
     };
     // The open top-level element (depth 1) and its open descendants.
     let mut stack: Vec<El> = Vec::new();
-    // A finished top-level element becomes urdf-rs data at once (its tree is dropped).
+    // A finished top-level element becomes a `Link`/`Joint` at once (its tree is dropped).
     let finish = |ctx: &Ctx, robot: &mut Robot, t: El| -> Result<(), UrdfError> {
         match t.tag.as_str() {
             "link" => robot.links.push(ctx.link(&t)?),

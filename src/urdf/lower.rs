@@ -3,6 +3,7 @@
 //! of mass and inertias combined exactly); each link stays a frame on its body.
 
 use super::parse::Parsed;
+use super::types::JointType;
 use super::validate::{is_movable, Checked};
 use super::{LoadOptions, UrdfError};
 use crate::model::{
@@ -10,19 +11,18 @@ use crate::model::{
 };
 use crate::spatial::{rpy_to_matrix, Inertia, Se3};
 use nalgebra::{Matrix3, Vector3};
-use urdf_rs::JointType;
 
 /// Tree lines deeper than this are indented no further (their depth is printed).
 const MAX_INDENT: usize = 32;
 
-fn pose(p: &urdf_rs::Pose) -> Se3<f64> {
+fn pose(p: &super::types::Pose) -> Se3<f64> {
     let [r, pi, y] = p.rpy.0;
     Se3::new(rpy_to_matrix(r, pi, y), Vector3::from(p.xyz.0))
 }
 
 /// A link's inertia in its own frame: the `<inertial>` origin's rpy rotates the
 /// given inertia tensor, its xyz places the centre of mass.
-fn link_inertia(l: &urdf_rs::Link) -> Inertia<f64> {
+fn link_inertia(l: &super::types::Link) -> Inertia<f64> {
     let i = &l.inertial;
     let t = &i.inertia;
     let ic = Matrix3::new(
@@ -31,8 +31,8 @@ fn link_inertia(l: &urdf_rs::Link) -> Inertia<f64> {
     pose(&i.origin).act_inertia(&Inertia::new(i.mass.value, Vector3::zeros(), ic))
 }
 
-fn shape(g: &urdf_rs::Geometry) -> Shape {
-    use urdf_rs::Geometry as G;
+fn shape(g: &super::types::Geometry) -> Shape {
+    use super::types::Geometry as G;
     match g {
         G::Box { size } => Shape::Box { size: size.0 },
         G::Cylinder { radius, length } => Shape::Cylinder {
@@ -51,7 +51,7 @@ fn shape(g: &urdf_rs::Geometry) -> Shape {
     }
 }
 
-fn limits(j: &urdf_rs::Joint) -> JointLimits {
+fn limits(j: &super::types::Joint) -> JointLimits {
     let l = &j.limit;
     let pos = |x: f64| x.is_finite().then_some(x);
     let positive = |x: f64| (x.is_finite() && x > 0.0).then_some(x);

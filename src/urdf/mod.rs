@@ -1,4 +1,5 @@
-//! URDF import: **parse** (urdf-rs, behind an entity guard) → **validate** (names,
+//! URDF import: **parse** (quick-xml into urdf-rs's data model, [`types`], behind an
+//! entity guard) → **validate** (names,
 //! tree, numbers, inertias, mimic relations) → **lower** (bodies merged through
 //! fixed joints into a flat, parent-before-child [`Model`]), with an
 //! [`ImportReport`](crate::model::ImportReport) of what was merged, ignored or
@@ -6,6 +7,7 @@
 
 mod lower;
 mod parse;
+pub mod types;
 mod validate;
 
 pub use crate::mesh::resolve_mesh_path;
@@ -69,4 +71,10 @@ pub fn load_str(text: &str, file: &str, options: LoadOptions) -> Result<Model, U
     let parsed = parse::parse(text, file)?;
     let checked = validate::validate(&parsed, file)?;
     lower::lower(&parsed, &checked, file, options)
+}
+
+/// The URDF text's links and joints as read (checked, not validated or lowered):
+/// each link's own `<inertial>`, as the Python package's introspection reports it.
+pub fn read_robot(text: &str, file: &str) -> Result<types::Robot, UrdfError> {
+    parse::parse(text, file).map(|p| p.robot)
 }

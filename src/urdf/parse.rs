@@ -1,7 +1,8 @@
 //! Parsing: an entity guard, a checking scan that names the offending element of
-//! any malformed input, then the urdf-rs data structures built directly from the
-//! XML with quick-xml (urdf-rs's own reader, through xml-rs and serde, reads about
-//! 3 MB/s and its errors do not name the element; its types and its URDF 1.0–1.2
+//! any malformed input, then urdf-rs's data model (`types.rs`, adapted from urdf-rs
+//! 0.10) built directly from the XML with quick-xml (urdf-rs's own reader, through
+//! xml-rs and serde, reads about 3 MB/s, its errors do not name the element, and its
+//! dependencies were a fifth of the first build; its types and its URDF 1.0–1.2
 //! semantics are kept).
 
 use super::UrdfError;
@@ -20,7 +21,7 @@ use rules::{
 /// reads, are checked by the scan but not built) plus what the scan found.
 pub(crate) struct Parsed {
     /// The robot as urdf-rs reads it.
-    pub robot: urdf_rs::Robot,
+    pub robot: super::types::Robot,
     /// Elements skipped whole (`<gazebo>`, `<transmission>`, `<sensor>`, xacro
     /// leftovers), one line a kind, as the import report prints them.
     pub ignored_tags: Vec<String>,

@@ -3,9 +3,9 @@
 //! a warning in the import report.
 
 use super::parse::Parsed;
+use super::types::JointType;
 use super::UrdfError;
 use std::collections::HashMap;
-use urdf_rs::JointType;
 
 /// What validation established about the parsed robot.
 pub(crate) struct Checked {
@@ -156,7 +156,7 @@ pub(crate) fn validate(parsed: &Parsed, file: &str) -> Result<Checked, UrdfError
             if !finite3(&c.origin.xyz.0) || !finite3(&c.origin.rpy.0) {
                 return Err(err(el, "non-finite <origin>".into()));
             }
-            use urdf_rs::Geometry as G;
+            use super::types::Geometry as G;
             let ok = match &c.geometry {
                 G::Box { size } => size.0.iter().all(|x| x.is_finite() && *x >= 0.0),
                 G::Cylinder { radius, length } | G::Capsule { radius, length } => {
