@@ -13,11 +13,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let t0: f64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(0.0);
     let t1: f64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(40.0);
     let env = |k: &str| std::env::var(k).ok().and_then(|s| s.parse::<f64>().ok());
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/fixtures/mjcf/gymnasium/ant.xml"
+    // MODEL: another fixture under tests/fixtures/mjcf (e.g. dm_control/dog)
+    let name = std::env::var("MODEL").unwrap_or_else(|_| "gymnasium/ant".into());
+    let path = format!(
+        "{}/tests/fixtures/mjcf/{name}.xml",
+        env!("CARGO_MANIFEST_DIR")
     );
-    let (model, world) = mjcf::load_file_with_world(path)?;
+    let (model, world) = mjcf::load_file_with_world(&path)?;
     let ground = mjcf::ground_of(&world);
     let mut opts = SimOptions {
         dt: env("DT").unwrap_or(world.timestep),
@@ -66,6 +68,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let s0 = sim.pgs_sweeps;
         sim.step()?;
         k += 1;
+        if let Some(d) = env("DEEP") {
+            // every step with a contact deeper than DEEP metres: that contact
+            let deepest = sim
+                .contact_points()
+                .iter()
+                .max_by(|a, b| (-a.gap).total_cmp(&-b.gap));
+            if let Some(p) = deepest.filter(|p| -p.gap > d) {
+                println!(
+                    "DEEP t {:.3} sweeps {} contacts {} gap {:.3e} body {} link {} geom {} other {} slot {} fresh {} n ({:.3},{:.3},{:.3}) p ({:.4},{:.4},{:.4})",
+                    sim.time(),
+                    sim.pgs_sweeps - s0,
+                    sim.active_contacts(),
+                    p.gap,
+                    p.body,
+                    sim.contact_link(p).unwrap_or("?"),
+                    p.geom,
+                    p.other,
+                    p.slot,
+                    p.fresh,
+                    p.normal.x,
+                    p.normal.y,
+                    p.normal.z,
+                    p.point.x,
+                    p.point.y,
+                    p.point.z
+                );
+            }
+        }
         if sim.time() >= t0 - 1e-9 && k % every == 0 {
             println!(
                 "t {:.2} vmax {:.3e} sweeps {} contacts {} pen {:.2e} wz {:.3e}",

@@ -223,3 +223,52 @@ fn mjcf_comparison_sees_a_difference() {
     assert!(close("mass", &[torso.mass], &[m], 1e-10).is_ok());
     assert!(close("mass", &[torso.mass * (1.0 + 1e-9)], &[m], 1e-10).is_err());
 }
+
+/// `<joint springdamper="τ ζ">` (dm_control dog's 21 tail joints): stiffness and
+/// damping as MuJoCo 4.0.0 compiles them (`m.jnt_stiffness`, `m.dof_damping` printed
+/// by `mujoco.MjModel.from_xml_path(dog.xml)`, 2026-12-03); urdyn read the attribute
+/// and left both 0 before.
+#[test]
+fn mjcf_springdamper_matches_mujocos_compiled_stiffness_and_damping() {
+    let model = urdyn::mjcf::load_file(dir().join("dm_control/dog.xml")).expect("dog.xml");
+    let want = [
+        ("Ca_1_extend", 0.0806406488611183, 0.4032032443055914),
+        ("Ca_10_bend", 0.04962579130133998, 0.24812895650669986),
+        ("Ca_15_extend", 0.04544200341892538, 0.22721001709462688),
+        ("Ca_19_extend", 0.04063014961672653, 0.20315074808363262),
+    ];
+    for (name, k, b) in want {
+        let d = model
+            .dofs
+            .iter()
+            .find(|d| d.name == name)
+            .unwrap_or_else(|| panic!("no dof {name}"));
+        assert!(
+            (d.stiffness - k).abs() <= 1e-9 * k && (d.damping - b).abs() <= 1e-9 * b,
+            "{name}: stiffness {} damping {}, MuJoCo {k} {b}",
+            d.stiffness,
+            d.damping
+        );
+    }
+}
+
+/// The closed form on one hinge fixed to the world: m = I_axis + armature, so
+/// k = m / (τ² ζ²), b = 2 m / τ (a sphere of mass 2, radius 0.1 at 0.3 from the
+/// axis: I = 2·(0.4·0.01 + 0.09) = 0.188; armature 0.012 gives m = 0.2).
+#[test]
+fn mjcf_springdamper_on_a_pendulum_is_the_closed_form() {
+    let xml = r#"<mujoco><worldbody><body>
+        <joint name="h" type="hinge" axis="0 1 0" armature="0.012" stiffness="7" damping="9" springdamper="0.02 0.5"/>
+        <geom type="sphere" size="0.1" pos="0.3 0 0" mass="2"/>
+      </body></worldbody></mujoco>"#;
+    let model = urdyn::mjcf::load_str(xml, "pend.xml", Path::new(".")).expect("pendulum");
+    let d = &model.dofs[0];
+    let m = 2.0 * (0.4 * 0.01 + 0.09) + 0.012;
+    let (k, b) = (m / (0.02f64.powi(2) * 0.25), 2.0 * m / 0.02);
+    assert!(
+        (d.stiffness - k).abs() <= 1e-12 * k,
+        "{} vs {k}",
+        d.stiffness
+    );
+    assert!((d.damping - b).abs() <= 1e-12 * b, "{} vs {b}", d.damping);
+}

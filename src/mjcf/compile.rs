@@ -460,6 +460,9 @@ fn joint(
         frictionloss: a.nonneg("frictionloss", 0.0)?,
         stiffness: a.nonneg("stiffness", 0.0)?,
         springref: conv(a.num("springref")?.unwrap_or(0.0)),
+        springdamper: a
+            .arr::<2>("springdamper")?
+            .and_then(|[t, z]| (t > 0.0 && z > 0.0).then_some((t, z))),
         label: el.label(),
     };
     cx.world.joints.push(j);

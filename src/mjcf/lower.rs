@@ -46,6 +46,7 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
     let mut depth = vec![0usize; nb];
     let (mut nq, mut nv) = (0usize, 0usize);
     let mut qpos0 = Vec::new();
+    let mut springdampers = Vec::new();
     for b in 1..nb {
         let body = &world.bodies[b];
         let p = body.parent;
@@ -126,6 +127,13 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
                 qpos0.push(jt.reference);
             }
             let one_dof = nvj == 1;
+            if let Some((timeconst, dampratio)) = jt.springdamper {
+                springdampers.push(super::springdamper::SpringDamper {
+                    dof: dofs.len(),
+                    timeconst,
+                    dampratio,
+                });
+            }
             dofs.push(DofInfo {
                 name: jt.name.clone(),
                 kind,
@@ -324,6 +332,8 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
         equalities: Default::default(),
         equality_active: Vec::new(),
     };
+    // before the tendons fold their springs onto the dofs (actuators::lower)
+    super::springdamper::apply(&mut model, &springdampers);
     super::actuators::lower(world, &mut model)?;
     super::equality::lower(world, &ub, &ub_m, &mut model)?;
     Ok(model)

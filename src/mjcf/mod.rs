@@ -26,6 +26,7 @@ mod inertia;
 mod lower;
 mod orient;
 mod sections;
+mod springdamper;
 mod tendons;
 mod world;
 mod xml;

@@ -43,6 +43,9 @@ pub struct MjJoint {
     pub stiffness: f64,
     /// Spring rest position.
     pub springref: f64,
+    /// `springdamper` (τ s, ζ) when both are positive: stiffness and damping are
+    /// then set from the joint's inertia at qpos0 (src/mjcf/springdamper.rs).
+    pub springdamper: Option<(f64, f64)>,
     /// How errors name its element (`<joint name="…">` or `<joint> (line N)`).
     pub(crate) label: String,
 }
