@@ -19,8 +19,18 @@ fn fixture(rel: &str) -> PathBuf {
 }
 
 /// The simulation `urdyn simulate MODEL.xml` runs: the file's ground plane,
-/// its friction and timestep.
+/// its friction and timestep (the speculative margin's factor left at 0).
 fn world_sim(rel: &str, integrator: Option<Integrator>) -> (Simulation, mjcf::World) {
+    world_sim_travel(rel, integrator, 0.0)
+}
+
+/// [`world_sim`] with the speculative margin's factor `c` (`urdyn simulate`
+/// sets [`ContactParams::TRAVEL`]; 0: the constant δ alone).
+fn world_sim_travel(
+    rel: &str,
+    integrator: Option<Integrator>,
+    c: f64,
+) -> (Simulation, mjcf::World) {
     let (model, world) = mjcf::load_file_with_world(fixture(rel)).expect("loads");
     let ground = mjcf::ground_of(&world);
     let mut opts = SimOptions {
@@ -33,6 +43,7 @@ fn world_sim(rel: &str, integrator: Option<Integrator>) -> (Simulation, mjcf::Wo
     if let Some(g) = &ground {
         opts.contact.friction = g.friction;
     }
+    opts.contact.travel_factor = c;
     (Simulation::new(model, opts).expect("sim"), world)
 }
 
@@ -278,18 +289,12 @@ fn a_disabled_contact_flag_leaves_no_collision_shape() {
 /// pose, stepped 1 s at its file's dt (3 ms) as `urdyn simulate` steps it,
 /// with the speculative margin's factor `c` (0: the constant δ alone).
 fn humanoid_deepest(c: f64) -> f64 {
-    let (model, world) = mjcf::load_file_with_world(fixture("gymnasium/humanoid.xml")).unwrap();
-    let ground = mjcf::ground_of(&world).expect("a floor");
-    let mut opts = SimOptions {
-        dt: world.timestep,
-        integrator: Some(Integrator::SemiImplicitEuler),
-        ground: Some(ground.height),
-        sleep: false,
-        ..SimOptions::default()
-    };
-    opts.contact.friction = ground.friction;
-    opts.contact.travel_factor = c;
-    let mut sim = Simulation::new(model, opts).unwrap();
+    let (mut sim, world) = world_sim_travel(
+        "gymnasium/humanoid.xml",
+        Some(Integrator::SemiImplicitEuler),
+        c,
+    );
+    assert!(mjcf::ground_of(&world).is_some(), "a floor");
     let (mut deepest, mut landed) = (0.0f64, false);
     while sim.time() < 1.0 {
         sim.step().unwrap();
@@ -362,19 +367,13 @@ fn gymnasium_ant_lands_under_a_millimetre_and_rests_with_the_margin() {
     // pivot for a row and gave impulses of 1e7 N·s: every later step then hit
     // the sweep cap, a foot was left moving into the floor at 0.275 m/s and
     // sank 2.7 mm at 0.36 s (benches/mjcf_results.md, round 6)
-    let (model, world) = mjcf::load_file_with_world(fixture("gymnasium/ant.xml")).unwrap();
-    let ground = mjcf::ground_of(&world).expect("a floor");
-    let mut opts = SimOptions {
-        dt: world.timestep,
-        integrator: Some(Integrator::SemiImplicitEuler),
-        ground: Some(ground.height),
-        sleep: false,
-        ..SimOptions::default()
-    };
-    opts.contact.friction = ground.friction;
-    opts.contact.travel_factor = ContactParams::TRAVEL;
-    let cap = opts.solver_iterations as u64;
-    let mut sim = Simulation::new(model, opts).unwrap();
+    let (mut sim, world) = world_sim_travel(
+        "gymnasium/ant.xml",
+        Some(Integrator::SemiImplicitEuler),
+        ContactParams::TRAVEL,
+    );
+    assert!(mjcf::ground_of(&world).is_some(), "a floor");
+    let cap = SimOptions::default().solver_iterations as u64;
     let (mut deepest, mut capped_at_rest) = (0.0f64, 0);
     while sim.time() < 3.0 - 1e-9 {
         let s0 = sim.pgs_sweeps;
