@@ -20,17 +20,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         env!("CARGO_MANIFEST_DIR")
     );
     let (model, world) = mjcf::load_file_with_world(&path)?;
-    let ground = mjcf::ground_of(&world);
+    // `urdyn simulate MODEL.xml --no-sleep --integrator euler` (TRAVEL: 0
+    // unless given)
+    let world_opts = SimOptions::of_mjcf_world(&world);
     let mut opts = SimOptions {
-        dt: env("DT").unwrap_or(world.timestep),
+        dt: env("DT").unwrap_or(world_opts.dt),
         integrator: Integrator::from_name("euler"),
-        ground: ground.as_ref().map(|g| g.height),
         sleep: false,
-        ..SimOptions::default()
+        ..world_opts
     };
-    if let Some(g) = &ground {
-        opts.contact.friction = g.friction;
-    }
+    opts.contact.travel_factor = 0.0;
     if let Some(x) = env("ITERS") {
         opts.solver_iterations = x as usize;
     }

@@ -20,17 +20,14 @@ use urdyn::sim::{Integrator, SimOptions, Simulation};
 fn gymnasium_ant_at_rest_stays_at_rest() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mjcf/gymnasium/ant.xml");
     let (model, world) = mjcf::load_file_with_world(path).expect("loads");
-    let ground = mjcf::ground_of(&world);
+    // `urdyn simulate ant.xml --no-sleep --integrator euler`, without the
+    // speculative margin (see above)
     let mut opts = SimOptions {
-        dt: world.timestep,
         integrator: Integrator::from_name("euler"),
-        ground: ground.as_ref().map(|g| g.height),
         sleep: false,
-        ..SimOptions::default()
+        ..SimOptions::of_mjcf_world(&world)
     };
-    if let Some(g) = &ground {
-        opts.contact.friction = g.friction;
-    }
+    opts.contact.travel_factor = 0.0;
     let mut sim = Simulation::new(model, opts).expect("sim");
     // landed and still by 2 s (|v| ~ 1e-6: the solve's tolerance)
     while sim.time() < 2.0 - 1e-9 {

@@ -32,17 +32,11 @@ fn world_sim_travel(
     c: f64,
 ) -> (Simulation, mjcf::World) {
     let (model, world) = mjcf::load_file_with_world(fixture(rel)).expect("loads");
-    let ground = mjcf::ground_of(&world);
     let mut opts = SimOptions {
-        dt: world.timestep,
         integrator,
-        ground: ground.as_ref().map(|g| g.height),
         sleep: false,
-        ..SimOptions::default()
+        ..SimOptions::of_mjcf_world(&world)
     };
-    if let Some(g) = &ground {
-        opts.contact.friction = g.friction;
-    }
     opts.contact.travel_factor = c;
     (Simulation::new(model, opts).expect("sim"), world)
 }

@@ -25,19 +25,15 @@ fn scene_in(dir: &Path, json: &str) -> Result<Scene, urdyn::SceneError> {
 }
 
 /// `urdyn simulate ant.xml`'s simulation (src/cli/simulate_mjcf.rs): the
-/// file's ground plane and its friction, its timestep.
+/// file's ground plane and its friction, its timestep; without the speculative
+/// margin, as a scene's contact.
 fn ant_alone() -> Simulation {
     let (model, world) = mjcf::load_file_with_world(gym().join("ant.xml")).expect("loads");
-    let ground = mjcf::ground_of(&world);
     let mut opts = SimOptions {
-        dt: world.timestep,
-        ground: ground.as_ref().map(|g| g.height),
         sleep: false,
-        ..SimOptions::default()
+        ..SimOptions::of_mjcf_world(&world)
     };
-    if let Some(g) = &ground {
-        opts.contact.friction = g.friction;
-    }
+    opts.contact.travel_factor = 0.0;
     Simulation::new(model, opts).expect("sim")
 }
 

@@ -8,7 +8,7 @@
 //! What is not simulated is one warning line each (the import report's).
 //! Actuators are driven by `--controls FILE.csv` (cli.md) and a key's `ctrl`.
 
-use super::simulate::{warn, Setup, SimulateArgs, SimulateError, DEFAULT_DT};
+use super::simulate::{warn, Setup, SimulateArgs, SimulateError};
 use crate::cli::state;
 use crate::mjcf;
 use crate::sim::{Integrator, SimOptions};
@@ -63,30 +63,18 @@ pub(crate) fn setup(
         }
         (None, None) => None,
     };
-    let ground = mjcf::ground_of(&world);
-    let mut contact = crate::contact::ContactParams::default();
-    if let Some(g) = &ground {
-        contact.friction = g.friction;
-    }
-    // MuJoCo's steps (2–10 ms) outrun δ: the speculative margin
-    // (docs/theory.md §"Speculative margin")
-    contact.travel_factor = crate::contact::ContactParams::TRAVEL;
-    let dt = args.dt.unwrap_or(if world.timestep > 0.0 {
-        world.timestep
-    } else {
-        DEFAULT_DT
-    });
+    // the file's step, ground, friction and the speculative margin
+    // (docs/theory.md §"Speculative margin"), the command's options over them
+    let world_opts = SimOptions::of_mjcf_world(&world);
     let opts = SimOptions {
-        dt,
+        dt: args.dt.unwrap_or(world_opts.dt),
         integrator,
         tol: args.tol,
-        ground: ground.as_ref().map(|g| g.height),
-        contact,
         package_paths: args.package_path.clone(),
         armature: args.armature,
         sleep: !args.no_sleep,
         threads: args.threads.unwrap_or(1),
-        ..SimOptions::default()
+        ..world_opts
     };
     // --html: every geom of the world in its colour (src/cli/view/mjcf.rs)
     let geometry = args

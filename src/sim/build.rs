@@ -43,6 +43,33 @@ impl ContactParams {
 }
 
 impl SimOptions {
+    /// The options `urdyn simulate MODEL.xml` runs an MJCF world with
+    /// (mjcf.md §"What the file becomes"): `<option timestep>` as the step (the
+    /// defaults' where the file's is 0), the world's upward plane as the ground
+    /// with the plane's friction (no ground without one), and the speculative
+    /// margin of MuJoCo's large steps ([`ContactParams::TRAVEL`], docs/theory.md
+    /// §"Speculative margin"); everything else the defaults'. The CLI sets its
+    /// options (`--dt`, `--integrator`, `--no-sleep`, …) over these.
+    pub fn of_mjcf_world(world: &crate::mjcf::World) -> Self {
+        let ground = crate::mjcf::ground_of(world);
+        let defaults = Self::default();
+        let mut contact = ContactParams::default();
+        if let Some(g) = &ground {
+            contact.friction = g.friction;
+        }
+        contact.travel_factor = ContactParams::TRAVEL;
+        Self {
+            dt: if world.timestep > 0.0 {
+                world.timestep
+            } else {
+                defaults.dt
+            },
+            ground: ground.as_ref().map(|g| g.height),
+            contact,
+            ..defaults
+        }
+    }
+
     /// Sleep and island threads (scene.md §"Large scenes") as `urdyn simulate`,
     /// Python's `Simulation(...)` and `rollout(...)` read them: the caller's
     /// `sleep` / `threads` (`--no-sleep`, `--threads`, `sleep=`, `threads=`)
