@@ -94,7 +94,7 @@ fn crba_mimic<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     }
     // Mimic joints accumulate into H (a joint's terms land on its leader's
     // coordinate), so H starts from zero.
-    data.h.fill(T::zero());
+    data.h.as_mut_slice().fill(T::zero());
     let h = &mut data.h;
     for i in (1..nb).rev() {
         let ji = &joints[i];

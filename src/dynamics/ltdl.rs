@@ -279,9 +279,11 @@ fn copy_pattern<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>)
 /// of one more, `b`: as coordinate k is eliminated from its ancestors i, so are
 /// its rows (`w[i] −= L[k, i] w[k]`, `b[i] −= L[k, i] b[k]`, the steps of
 /// [`ltdl_solve_rows`]' first sweep), leaving `L⁻ᵀ w`, `L⁻ᵀ b` and the factor of
-/// [`ltdl`] (the same operations on it). `pivot(k, D[k], w[k], b[k])` sees each
-/// final row before its ancestors' updates (leaves inwards). One walk of the
-/// tree instead of two (docs/theory.md §"Constrained dynamics", "Solving").
+/// [`ltdl`] (the same operations on it). `pivot(k, D[k], lo, w[k][lo..hi], b[k])`
+/// sees each final row, by its nonzero span `lo..hi` (empty for a zero row; the
+/// steps update that span alone: rows held on two feet are zero on the other
+/// leg's coordinates), before its ancestors' updates (leaves inwards). One walk
+/// of the tree instead of two (docs/theory.md §"Constrained dynamics", "Solving").
 pub(crate) fn ltdl_rows<T: Scalar>(
     h: &DMatrix<T>,
     lambda: &[usize],
@@ -289,14 +291,15 @@ pub(crate) fn ltdl_rows<T: Scalar>(
     m: usize,
     w: &mut [T],
     b: &mut [T],
-    pivot: impl FnMut(usize, T, &[T], T),
+    pivot: impl FnMut(usize, T, usize, &[T], T),
 ) -> Result<(), usize> {
     let mut hook = RowsHook {
         m,
         w,
         b,
         pivot,
-        rows: false,
+        lo: 0,
+        hi: 0,
         bk: T::zero(),
     };
     factor(h, lambda, u, &mut hook)
@@ -308,28 +311,33 @@ struct RowsHook<'a, T, P> {
     w: &'a mut [T],
     b: &'a mut [T],
     pivot: P,
-    /// Whether row k of `w` has a nonzero entry (else its steps are skipped).
-    rows: bool,
+    /// Row k of `w` is zero outside `lo..hi` (its nonzero span, empty when
+    /// the row is zero): its steps update that span only.
+    lo: usize,
+    hi: usize,
     /// b[k] (final once k's pivot is).
     bk: T,
 }
 
-impl<T: Scalar, P: FnMut(usize, T, &[T], T)> Hook<T> for RowsHook<'_, T, P> {
+impl<T: Scalar, P: FnMut(usize, T, usize, &[T], T)> Hook<T> for RowsHook<'_, T, P> {
     #[inline(always)]
     fn pivot(&mut self, k: usize, d: T) {
         let m = self.m;
         let wk = &self.w[k * m..(k + 1) * m];
         self.bk = self.b[k];
-        (self.pivot)(k, d, wk, self.bk);
-        self.rows = wk.iter().any(|&x| x != T::zero());
+        let z = T::zero();
+        let lo = wk.iter().position(|&x| x != z).unwrap_or(m);
+        let hi = wk.iter().rposition(|&x| x != z).map_or(lo, |e| e + 1);
+        (self.lo, self.hi) = (lo, hi);
+        (self.pivot)(k, d, lo, &wk[lo..hi], self.bk);
     }
 
     #[inline(always)]
     fn step(&mut self, k: usize, i: usize, a: T) {
-        let m = self.m;
-        if self.rows {
+        let (m, lo, hi) = (self.m, self.lo, self.hi);
+        if lo < hi {
             let (wa, wr) = self.w.split_at_mut(k * m);
-            for (y, &x) in wa[i * m..(i + 1) * m].iter_mut().zip(&wr[..m]) {
+            for (y, &x) in wa[i * m + lo..i * m + hi].iter_mut().zip(&wr[lo..hi]) {
                 *y = madd(-a, x, *y);
             }
         }
