@@ -276,11 +276,13 @@ pub fn constraint_dynamics<'c>(
     // the dense route also q̈₀, the tree route leaves τ − C in data.qdd (its
     // solve shares the elimination of J_cᵀ below)
     let dense = super::dense_factor(model);
+    let mut placed = false;
     if dense {
         forward_dynamics_crba(model, data, q, v, tau, fext)?;
     } else {
-        // H's factor comes below, fused with the elimination of J_cᵀ
-        super::bias_and_crba(model, data, q, v, fext);
+        // H's factor comes below, fused with the elimination of J_cᵀ (H's
+        // pattern written into the factor's storage by the CRBA where it can)
+        placed = super::bias_and_crba_factor(model, data, q, v, fext);
         data.qdd.copy_from(tau);
         data.qdd -= &data.bias;
     }
@@ -345,6 +347,7 @@ pub fn constraint_dynamics<'c>(
         m,
         w,
         qdd.as_mut_slice(),
+        placed,
         |c, d, lo, xk, bc| {
             let dinv = 1.0 / d;
             dv[c] = dinv;

@@ -27,7 +27,20 @@ const SMALL: usize = 64;
 /// coordinate index of the first pivot that is at most 64 ε times its diagonal
 /// entry of H, or not finite — the same test as [`super::linalg::cholesky`].
 pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> Result<(), usize> {
-    factor(h, lambda, u, &mut NoHook)
+    factor(h, lambda, u, false, &mut NoHook)
+}
+
+/// [`ltdl`]; `placed`: `u`'s upper triangle already holds H's entries on the
+/// tree pattern (the CRBA wrote them there, `super::bias_and_crba_factor`),
+/// so they are not copied from `h` first (`h`'s diagonal is still read by the
+/// pivot test).
+pub(crate) fn factor_placed<T: Scalar>(
+    h: &DMatrix<T>,
+    lambda: &[usize],
+    u: &mut DMatrix<T>,
+    placed: bool,
+) -> Result<(), usize> {
+    factor(h, lambda, u, placed, &mut NoHook)
 }
 
 /// What runs beside the elimination of each coordinate (leaves inwards):
@@ -57,11 +70,14 @@ fn factor<T: Scalar, K: Hook<T>>(
     h: &DMatrix<T>,
     lambda: &[usize],
     u: &mut DMatrix<T>,
+    placed: bool,
     hook: &mut K,
 ) -> Result<(), usize> {
     let n = lambda.len();
     let tiny = lit::<T>(64.0 * f64::EPSILON);
-    copy_pattern(h, lambda, u);
+    if !placed {
+        copy_pattern(h, lambda, u);
+    }
     // A chain (λ(k) = k − 1): the same elimination on contiguous column ranges,
     // as axpy sweeps the compiler vectorises.
     if lambda
@@ -291,6 +307,7 @@ pub(crate) fn ltdl_rows<T: Scalar>(
     m: usize,
     w: &mut [T],
     b: &mut [T],
+    placed: bool,
     pivot: impl FnMut(usize, T, usize, &[T], T),
 ) -> Result<(), usize> {
     let mut hook = RowsHook {
@@ -302,7 +319,7 @@ pub(crate) fn ltdl_rows<T: Scalar>(
         hi: 0,
         bk: T::zero(),
     };
-    factor(h, lambda, u, &mut hook)
+    factor(h, lambda, u, placed, &mut hook)
 }
 
 /// [`ltdl_rows`]' right-hand sides, eliminated with the factor.
