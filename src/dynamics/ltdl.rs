@@ -300,6 +300,7 @@ fn copy_pattern<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>)
 /// steps update that span alone: rows held on two feet are zero on the other
 /// leg's coordinates), before its ancestors' updates (leaves inwards). One walk
 /// of the tree instead of two (docs/theory.md §"Constrained dynamics", "Solving").
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn ltdl_rows<T: Scalar>(
     h: &DMatrix<T>,
     lambda: &[usize],
