@@ -100,7 +100,7 @@ pub fn aba_derivatives<T: Scalar>(
     let mut minv = std::mem::replace(&mut data.minv, empty());
     let mut xt = std::mem::replace(&mut data.deriv_scratch, empty());
     // H⁻¹ = solve(H, 1) (symmetric: its rows are its columns)
-    minv.fill(T::zero());
+    minv.as_mut_slice().fill(T::zero());
     for k in 0..nv {
         minv[(k, k)] = T::one();
     }

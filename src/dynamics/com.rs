@@ -53,7 +53,7 @@ pub fn center_of_mass_jacobian<T: Scalar>(
 ) -> Result<(), DynamicsError> {
     DimensionError::check("com jacobian rows", 3, jc.nrows())?;
     DimensionError::check("com jacobian columns", model.nv, jc.ncols())?;
-    jc.fill(T::zero());
+    jc.as_mut_slice().fill(T::zero());
     let total = model.total_mass();
     if total <= T::zero() {
         return Ok(());

@@ -172,7 +172,7 @@ fn add_side_rows(
 
 /// J_c into `jc` (zeroed first) from `data.o_m_i`.
 pub(crate) fn jacobian_rows(model: &Model, data: &Data, c: &Constraints, jc: &mut DMatrix<f64>) {
-    jc.fill(0.0);
+    jc.as_mut_slice().fill(0.0);
     let mut row = 0;
     for con in &c.items {
         match &con.kind {
@@ -276,11 +276,13 @@ pub fn constraint_dynamics<'c>(
     // the dense route also q̈₀, the tree route leaves τ − C in data.qdd (its
     // solve shares the elimination of J_cᵀ below)
     let dense = super::dense_factor(model);
+    let mut placed = false;
     if dense {
         forward_dynamics_crba(model, data, q, v, tau, fext)?;
     } else {
-        // H's factor comes below, fused with the elimination of J_cᵀ
-        super::bias_and_crba(model, data, q, v, fext);
+        // H's factor comes below, fused with the elimination of J_cᵀ (H's
+        // pattern written into the factor's storage by the CRBA where it can)
+        placed = super::bias_and_crba_factor(model, data, q, v, fext);
         data.qdd.copy_from(tau);
         data.qdd -= &data.bias;
     }
@@ -338,23 +340,33 @@ pub fn constraint_dynamics<'c>(
     jq0.fill(0.0);
     let Data { h, chol, qdd, .. } = &mut *data;
     let dv = &mut cd.dinv[..n];
-    ltdl::ltdl_rows(h, lam, chol, m, w, qdd.as_mut_slice(), |c, d, xk, bc| {
-        let dinv = 1.0 / d;
-        dv[c] = dinv;
-        let s0 = bc * dinv;
-        for (r, &xr) in xk.iter().enumerate() {
-            if xr == 0.0 {
-                continue;
+    ltdl::ltdl_rows(
+        h,
+        lam,
+        chol,
+        m,
+        w,
+        qdd.as_mut_slice(),
+        placed,
+        |c, d, lo, xk, bc| {
+            let dinv = 1.0 / d;
+            dv[c] = dinv;
+            let s0 = bc * dinv;
+            // xk: row c of W on its nonzero span lo..lo + len (zero elsewhere)
+            for (r, &xr) in (lo..).zip(xk) {
+                if xr == 0.0 {
+                    continue;
+                }
+                jq0[r] = madd(-xr, s0, jq0[r]);
+                // the span of the column (an axpy, vectorised): its entries below
+                // the diagonal are overwritten by the mirror that follows
+                let a = xr * dinv;
+                for (y, &x) in k[r * m + lo..r * m + lo + xk.len()].iter_mut().zip(xk) {
+                    *y = madd(a, x, *y);
+                }
             }
-            jq0[r] = madd(-xr, s0, jq0[r]);
-            // the whole column (a fixed m-wide axpy, vectorised): its entries
-            // below the diagonal are overwritten by the mirror that follows
-            let a = xr * dinv;
-            for (y, &x) in k[r * m..(r + 1) * m].iter_mut().zip(xk) {
-                *y = madd(a, x, *y);
-            }
-        }
-    })
+        },
+    )
     .map_err(DynamicsError::Singular)?;
     for r in 0..m {
         for s2 in 0..r {

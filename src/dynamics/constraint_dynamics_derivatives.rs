@@ -78,7 +78,7 @@ pub fn constraint_dynamics_derivatives(
         // H⁻¹ = solve(H, 1), all columns at once (symmetric: rows are columns)
         let nv = model.nv;
         let mut minv = std::mem::replace(&mut data.minv, DMatrix::zeros(0, 0));
-        minv.fill(0.0);
+        minv.as_mut_slice().fill(0.0);
         for c in 0..nv {
             minv[(c, c)] = 1.0;
         }
@@ -118,8 +118,8 @@ pub fn constraint_dynamics_derivatives(
     }
     data.deriv_tmp = a;
     // G_q −= ∂(J_cᵀ λ)/∂q; ∂A/∂q, ∂A/∂v
-    cd.aq.fill(0.0);
-    cd.av.fill(0.0);
+    cd.aq.as_mut_slice().fill(0.0);
+    cd.av.as_mut_slice().fill(0.0);
     let mut row = 0;
     for con in &constraints.items {
         let n = con.rows();

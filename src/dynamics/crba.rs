@@ -94,7 +94,7 @@ fn crba_mimic<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     }
     // Mimic joints accumulate into H (a joint's terms land on its leader's
     // coordinate), so H starts from zero.
-    data.h.fill(T::zero());
+    data.h.as_mut_slice().fill(T::zero());
     let h = &mut data.h;
     for i in (1..nb).rev() {
         let ji = &joints[i];
@@ -269,7 +269,7 @@ fn mirror_blocked<T: Scalar>(a: &mut [T], n: usize) {
 /// the moves are rotations about the joint axis ([`CompositeInertia::act_ax`],
 /// `act_force_ax`).
 fn crba_local<T: Scalar>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
-    crba_local_pass::<T, false>(model, data, q.as_slice());
+    crba_local_pass::<T, false, false>(model, data, q.as_slice());
 }
 
 /// [`crba`] (sizes checked by the caller) at the q whose joint placements
@@ -282,7 +282,20 @@ pub(crate) fn crba_at_placements<T: Scalar>(model: &Model<T>, data: &mut Data<T>
     if model.has_mimic || !model.topology.crba_local {
         return false;
     }
-    crba_local_pass::<T, true>(model, data, &[]);
+    crba_local_pass::<T, true, false>(model, data, &[]);
+    true
+}
+
+/// [`crba_at_placements`] that also writes H's entries on the tree pattern
+/// into the upper triangle of `data.chol` (row ≤ column, the entries the
+/// tree-sparse LTDL starts from, `ltdl::factor_placed`): no copy of H's
+/// pattern before the factorisation. Returns false, computing nothing, where
+/// that variant does not run.
+pub(crate) fn crba_at_placements_factor<T: Scalar>(model: &Model<T>, data: &mut Data<T>) -> bool {
+    if model.has_mimic || !model.topology.crba_local {
+        return false;
+    }
+    crba_local_pass::<T, true, true>(model, data, &[]);
     true
 }
 
@@ -341,24 +354,46 @@ pub(crate) fn crba_packed<T: Scalar>(
 
 /// The local-frame pass into `data.h` (both triangles); `PLACED`:
 /// `data.li_m_i` holds the joint placements at q (then `q` is not read), else
-/// they are computed from `q` and stored.
-fn crba_local_pass<T: Scalar, const PLACED: bool>(model: &Model<T>, data: &mut Data<T>, q: &[T]) {
+/// they are computed from `q` and stored; `FACTOR`: the entries also into
+/// `data.chol`'s upper triangle (the tree pattern's, row ≤ column).
+fn crba_local_pass<T: Scalar, const PLACED: bool, const FACTOR: bool>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &[T],
+) {
     let nv = model.nv;
     let mut h = std::mem::replace(&mut data.h, nalgebra::DMatrix::zeros(0, 0));
+    let mut u = if FACTOR {
+        std::mem::replace(&mut data.chol, nalgebra::DMatrix::zeros(0, 0))
+    } else {
+        nalgebra::DMatrix::zeros(0, 0)
+    };
     let hs = h.as_mut_slice();
     assert!(hs.len() >= nv * nv, "H is nv x nv");
     let hp = hs.as_mut_ptr();
+    let us = u.as_mut_slice();
+    assert!(!FACTOR || us.len() >= nv * nv, "the factor is nv x nv");
+    let up = us.as_mut_ptr();
     let all = [(1, model.nbodies)];
     local_pass::<T, PLACED, _>(model, data, q, &all, |row, c, val| {
         // SAFETY: row < nv and c < nv (local_pass asserts it before every
         // write), so both row + c nv and c + row nv are < nv² ≤ the length
-        // of `hs` (asserted above), which outlives the pass.
+        // of `hs` (asserted above), and of `us` with FACTOR (asserted above);
+        // both outlive the pass.
         unsafe {
             *hp.add(row + c * nv) = val;
             *hp.add(c + row * nv) = val;
+            if FACTOR {
+                // row is a coordinate of an ancestor-or-self of c's joint:
+                // row ≤ c, the upper triangle
+                *up.add(row + c * nv) = val;
+            }
         }
     });
     data.h = h;
+    if FACTOR {
+        data.chol = u;
+    }
 }
 
 /// The local-frame pass: every entry `H[row, c]` on the tree pattern (row a

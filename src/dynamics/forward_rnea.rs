@@ -17,7 +17,7 @@ pub fn mass_matrix_rnea<T: Scalar>(
     super::check_sizes(model, q, &[], None)?;
     let nv = model.nv;
     let mut delta = std::mem::replace(&mut data.tmp_a, DVector::zeros(0));
-    delta.fill(T::zero());
+    delta.as_mut_slice().fill(T::zero());
     for i in 0..nv {
         delta[i] = T::one();
         rnea_impl(model, data, q, None, Some(&delta), false, None);

@@ -53,7 +53,7 @@ pub fn frame_jacobian<T: Scalar>(
     DimensionError::check("jacobian rows", 6, j.nrows())?;
     DimensionError::check("jacobian columns", model.nv, j.ncols())?;
     let (body, o_m_f) = frame_pose(model, data, frame)?;
-    j.fill(T::zero());
+    j.as_mut_slice().fill(T::zero());
     let p = o_m_f.trans;
     let rt = o_m_f.rot.transpose();
     let mut b = body;

@@ -60,7 +60,7 @@ pub fn frame_jacobian_time_variation<T: Scalar>(
     let vf = data.deriv_ov[fb];
     // ṗ = v₀ + ω × p, the frame origin's velocity
     let pdot = add_cross(&vf.lin, &vf.ang, &pf);
-    out.fill(T::zero());
+    out.as_mut_slice().fill(T::zero());
     let mut b = fb;
     while b != 0 {
         let joint = &model.joints[b];

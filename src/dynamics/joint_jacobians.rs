@@ -20,7 +20,7 @@ pub fn joint_jacobians<'d, T: Scalar>(
     let nb = model.nbodies;
     let qs = q.as_slice();
     if model.has_mimic {
-        data.jacobians.fill(T::zero());
+        data.jacobians.as_mut_slice().fill(T::zero());
     }
     for i in 1..nb {
         let op = data.o_m_i[model.parent[i]];

@@ -23,6 +23,8 @@ pub(crate) struct KktFactor {
     ev: DVector<f64>,
     /// Scratch of size m.
     t: DVector<f64>,
+    /// The reciprocals of the Cholesky factor's diagonal (full rank).
+    dinv: Vec<f64>,
     /// Whether `f` is a Cholesky factor (K of full rank).
     pub full_rank: bool,
 }
@@ -35,6 +37,7 @@ impl KktFactor {
             w: DMatrix::zeros(m, m),
             ev: DVector::zeros(m),
             t: DVector::zeros(m),
+            dinv: vec![0.0; m],
             full_rank: true,
         }
     }
@@ -42,7 +45,7 @@ impl KktFactor {
     /// Factorises K (its lower triangle is read).
     pub fn factor(&mut self, k: &DMatrix<f64>) {
         let m = k.nrows();
-        self.full_rank = cholesky(k, &mut self.f);
+        self.full_rank = cholesky(k, &mut self.f, &mut self.dinv);
         if self.full_rank {
             return;
         }
@@ -69,18 +72,22 @@ impl KktFactor {
         if self.full_rank {
             // L (column-major): L[i, k] at i + k m
             let l = self.f.as_slice();
+            let dinv = &self.dinv[..m];
             let x = &mut x[..m];
             for k in 0..m {
-                let xk = x[k] / l[k + k * m];
+                let xk = x[k] * dinv[k];
                 x[k] = xk;
                 for (xi, &lik) in x[k + 1..].iter_mut().zip(&l[k * m + k + 1..(k + 1) * m]) {
-                    *xi -= lik * xk;
+                    *xi = madd(-lik, xk, *xi);
                 }
             }
             for i in (0..m).rev() {
                 let col = &l[i * m + i + 1..(i + 1) * m];
-                let s: f64 = col.iter().zip(&x[i + 1..]).map(|(a, b)| a * b).sum();
-                x[i] = (x[i] - s) / l[i + i * m];
+                let mut s = x[i];
+                for (&a, &b) in col.iter().zip(&x[i + 1..]) {
+                    s = madd(-a, b, s);
+                }
+                x[i] = s * dinv[i];
             }
             return;
         }
@@ -154,26 +161,35 @@ impl KktFactor {
     }
 }
 
-/// `k = L Lᵀ` into `l` (lower triangle); false when a pivot is at most
-/// [`RANK_TOL`] of its diagonal entry (or not finite).
-fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>) -> bool {
+/// `k = L Lᵀ` into `l` (lower triangle), the reciprocals of L's diagonal into
+/// `dinv`; false when a pivot is at most [`RANK_TOL`] of its diagonal entry (or
+/// not finite). Column by column (left-looking): column j of L is K's column j
+/// below the diagonal less the earlier columns' contiguous axpys, then scaled
+/// by one reciprocal.
+fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>, dinv: &mut [f64]) -> bool {
     let m = k.nrows();
+    let ks = &k.as_slice()[..m * m];
+    let ls = &mut l.as_mut_slice()[..m * m];
     for j in 0..m {
-        let mut d = k[(j, j)];
+        let (done, rest) = ls.split_at_mut(j * m);
+        let colj = &mut rest[j..m];
+        colj.copy_from_slice(&ks[j * m + j..(j + 1) * m]);
         for p in 0..j {
-            d -= l[(j, p)] * l[(j, p)];
+            let ljp = done[j + p * m];
+            for (x, &y) in colj.iter_mut().zip(&done[p * m + j..(p + 1) * m]) {
+                *x = madd(-ljp, y, *x);
+            }
         }
-        if d.is_nan() || d <= RANK_TOL * k[(j, j)].abs() || !d.is_finite() {
+        let d = colj[0];
+        if d.is_nan() || d <= RANK_TOL * ks[j + j * m].abs() || !d.is_finite() {
             return false;
         }
         let d = d.sqrt();
-        l[(j, j)] = d;
-        for i in j + 1..m {
-            let mut s = k[(i, j)];
-            for p in 0..j {
-                s -= l[(i, p)] * l[(j, p)];
-            }
-            l[(i, j)] = s / d;
+        let r = 1.0 / d;
+        colj[0] = d;
+        dinv[j] = r;
+        for x in colj[1..].iter_mut() {
+            *x *= r;
         }
     }
     true
@@ -184,7 +200,7 @@ fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>) -> bool {
 /// receives the eigenvectors as columns.
 fn jacobi_eigen(v: &mut DMatrix<f64>, q: &mut DMatrix<f64>, ev: &mut DVector<f64>) {
     let m = v.nrows();
-    q.fill(0.0);
+    q.as_mut_slice().fill(0.0);
     for i in 0..m {
         q[(i, i)] = 1.0;
     }

@@ -27,9 +27,57 @@ const SMALL: usize = 64;
 /// coordinate index of the first pivot that is at most 64 ε times its diagonal
 /// entry of H, or not finite — the same test as [`super::linalg::cholesky`].
 pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> Result<(), usize> {
+    factor(h, lambda, u, false, &mut NoHook)
+}
+
+/// [`ltdl`]; `placed`: `u`'s upper triangle already holds H's entries on the
+/// tree pattern (the CRBA wrote them there, `super::bias_and_crba_factor`),
+/// so they are not copied from `h` first (`h`'s diagonal is still read by the
+/// pivot test).
+pub(crate) fn factor_placed<T: Scalar>(
+    h: &DMatrix<T>,
+    lambda: &[usize],
+    u: &mut DMatrix<T>,
+    placed: bool,
+) -> Result<(), usize> {
+    factor(h, lambda, u, placed, &mut NoHook)
+}
+
+/// What runs beside the elimination of each coordinate (leaves inwards):
+/// [`ltdl`] runs none, [`ltdl_rows`] eliminates its right-hand sides.
+trait Hook<T> {
+    /// Coordinate k's pivot D[k] is final, before its elimination.
+    fn pivot(&mut self, k: usize, d: T);
+    /// After ancestor i's step of k's elimination: L[k, i] = `a`.
+    fn step(&mut self, k: usize, i: usize, a: T);
+}
+
+/// No work beside the factorisation.
+struct NoHook;
+
+impl<T> Hook<T> for NoHook {
+    #[inline(always)]
+    fn pivot(&mut self, _: usize, _: T) {}
+    #[inline(always)]
+    fn step(&mut self, _: usize, _: usize, _: T) {}
+}
+
+/// The factorisation of [`ltdl`], calling `hook` as each pivot becomes final
+/// and after each ancestor's step: one elimination for [`ltdl`] and
+/// [`ltdl_rows`], the same operations on the factor in both.
+#[inline(always)]
+fn factor<T: Scalar, K: Hook<T>>(
+    h: &DMatrix<T>,
+    lambda: &[usize],
+    u: &mut DMatrix<T>,
+    placed: bool,
+    hook: &mut K,
+) -> Result<(), usize> {
     let n = lambda.len();
     let tiny = lit::<T>(64.0 * f64::EPSILON);
-    copy_pattern(h, lambda, u);
+    if !placed {
+        copy_pattern(h, lambda, u);
+    }
     // A chain (λ(k) = k − 1): the same elimination on contiguous column ranges,
     // as axpy sweeps the compiler vectorises.
     if lambda
@@ -43,6 +91,7 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
             if !(d > tiny * h[(k, k)].abs()) || !d.is_finite() {
                 return Err(k);
             }
+            hook.pivot(k, d);
             let dinv = T::one() / d;
             let (left, right) = us.split_at_mut(k * n);
             let colk = &mut right[..k];
@@ -53,6 +102,7 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
                     *x = madd(-a, *y, *x);
                 }
                 colk[i] = a;
+                hook.step(k, i, a);
             }
         }
         return Ok(());
@@ -71,25 +121,27 @@ pub fn ltdl<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>) -> 
         if !(d > tiny * h[(k, k)].abs()) || !d.is_finite() {
             return Err(k);
         }
+        hook.pivot(k, d);
         // one division per pivot: L[k, i] = H̃[k, i] · D[k]⁻¹ (a division
         // per entry stalled the updates that wait for it)
         let dinv = T::one() / d;
+        let (left, right) = us.split_at_mut(k * n);
+        let colk = &mut right[..k];
         if let Some(list) = anc.of(lambda, k) {
-            let (left, right) = us.split_at_mut(k * n);
-            eliminate_list(&mut right[..k], left, n, list, dinv, |_, _| {});
+            eliminate_list(colk, left, n, list, dinv, |i, a| hook.step(k, i, a));
             continue;
         }
         // deeper than the list: walk λ
         let mut i = lambda[k];
         while i != NONE {
-            let a = us[i + k * n] * dinv;
+            let a = colk[i] * dinv;
             let mut j = i;
             while j != NONE {
-                let hkj = us[j + k * n];
-                us[j + i * n] = madd(-a, hkj, us[j + i * n]);
+                left[j + i * n] = madd(-a, colk[j], left[j + i * n]);
                 j = lambda[j];
             }
-            us[i + k * n] = a;
+            colk[i] = a;
+            hook.step(k, i, a);
             i = lambda[i];
         }
     }
@@ -243,9 +295,12 @@ fn copy_pattern<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>)
 /// of one more, `b`: as coordinate k is eliminated from its ancestors i, so are
 /// its rows (`w[i] −= L[k, i] w[k]`, `b[i] −= L[k, i] b[k]`, the steps of
 /// [`ltdl_solve_rows`]' first sweep), leaving `L⁻ᵀ w`, `L⁻ᵀ b` and the factor of
-/// [`ltdl`] (the same operations on it). `pivot(k, D[k], w[k], b[k])` sees each
-/// final row before its ancestors' updates (leaves inwards). One walk of the
-/// tree instead of two (docs/theory.md §"Constrained dynamics", "Solving").
+/// [`ltdl`] (the same operations on it). `pivot(k, D[k], lo, w[k][lo..hi], b[k])`
+/// sees each final row, by its nonzero span `lo..hi` (empty for a zero row; the
+/// steps update that span alone: rows held on two feet are zero on the other
+/// leg's coordinates), before its ancestors' updates (leaves inwards). One walk
+/// of the tree instead of two (docs/theory.md §"Constrained dynamics", "Solving").
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn ltdl_rows<T: Scalar>(
     h: &DMatrix<T>,
     lambda: &[usize],
@@ -253,57 +308,59 @@ pub(crate) fn ltdl_rows<T: Scalar>(
     m: usize,
     w: &mut [T],
     b: &mut [T],
-    mut pivot: impl FnMut(usize, T, &[T], T),
+    placed: bool,
+    pivot: impl FnMut(usize, T, usize, &[T], T),
 ) -> Result<(), usize> {
-    let n = lambda.len();
-    let tiny = lit::<T>(64.0 * f64::EPSILON);
-    copy_pattern(h, lambda, u);
-    let us = u.as_mut_slice();
-    let mut anc = AncList::new();
-    for k in (0..n).rev() {
-        let d = us[k + k * n];
-        if !(d > tiny * h[(k, k)].abs()) || !d.is_finite() {
-            return Err(k);
-        }
-        let dinv = T::one() / d;
-        let (wa, wr) = w.split_at_mut(k * m);
-        let wk = &wr[..m];
-        let bk = b[k];
-        pivot(k, d, wk, bk);
-        let rows = wk.iter().any(|&x| x != T::zero());
-        let (left, right) = us.split_at_mut(k * n);
-        let colk = &mut right[..k];
-        if let Some(list) = anc.of(lambda, k) {
-            eliminate_list(colk, left, n, list, dinv, |i, a| {
-                if rows {
-                    for (y, &x) in wa[i * m..(i + 1) * m].iter_mut().zip(wk) {
-                        *y = madd(-a, x, *y);
-                    }
-                }
-                b[i] = madd(-a, bk, b[i]);
-            });
-            continue;
-        }
-        // deeper than the list: walk λ
-        let mut i = lambda[k];
-        while i != NONE {
-            let a = colk[i] * dinv;
-            let mut j = i;
-            while j != NONE {
-                left[j + i * n] = madd(-a, colk[j], left[j + i * n]);
-                j = lambda[j];
-            }
-            colk[i] = a;
-            if rows {
-                for (y, &x) in wa[i * m..(i + 1) * m].iter_mut().zip(wk) {
-                    *y = madd(-a, x, *y);
-                }
-            }
-            b[i] = madd(-a, bk, b[i]);
-            i = lambda[i];
-        }
+    let mut hook = RowsHook {
+        m,
+        w,
+        b,
+        pivot,
+        lo: 0,
+        hi: 0,
+        bk: T::zero(),
+    };
+    factor(h, lambda, u, placed, &mut hook)
+}
+
+/// [`ltdl_rows`]' right-hand sides, eliminated with the factor.
+struct RowsHook<'a, T, P> {
+    m: usize,
+    w: &'a mut [T],
+    b: &'a mut [T],
+    pivot: P,
+    /// Row k of `w` is zero outside `lo..hi` (its nonzero span, empty when
+    /// the row is zero): its steps update that span only.
+    lo: usize,
+    hi: usize,
+    /// b[k] (final once k's pivot is).
+    bk: T,
+}
+
+impl<T: Scalar, P: FnMut(usize, T, usize, &[T], T)> Hook<T> for RowsHook<'_, T, P> {
+    #[inline(always)]
+    fn pivot(&mut self, k: usize, d: T) {
+        let m = self.m;
+        let wk = &self.w[k * m..(k + 1) * m];
+        self.bk = self.b[k];
+        let z = T::zero();
+        let lo = wk.iter().position(|&x| x != z).unwrap_or(m);
+        let hi = wk.iter().rposition(|&x| x != z).map_or(lo, |e| e + 1);
+        (self.lo, self.hi) = (lo, hi);
+        (self.pivot)(k, d, lo, &wk[lo..hi], self.bk);
     }
-    Ok(())
+
+    #[inline(always)]
+    fn step(&mut self, k: usize, i: usize, a: T) {
+        let (m, lo, hi) = (self.m, self.lo, self.hi);
+        if lo < hi {
+            let (wa, wr) = self.w.split_at_mut(k * m);
+            for (y, &x) in wa[i * m + lo..i * m + hi].iter_mut().zip(&wr[lo..hi]) {
+                *y = madd(-a, x, *y);
+            }
+        }
+        self.b[i] = madd(-a, self.bk, self.b[i]);
+    }
 }
 
 /// Solves `Lᵀ D L x = b` in place with the factor from [`ltdl`]: `Lᵀ y = b`

@@ -181,12 +181,32 @@ pub(crate) fn factor_crba<T: Scalar>(
     v: &DVector<T>,
     fext: Option<&[Force<T>]>,
 ) -> Result<(), DynamicsError> {
-    bias_and_crba(model, data, q, v, fext);
     if dense_factor(model) {
+        bias_and_crba(model, data, q, v, fext);
         linalg::cholesky(&data.h, &mut data.chol).map_err(DynamicsError::Singular)
     } else {
-        ltdl::ltdl(&data.h, &model.dof_parent, &mut data.chol).map_err(DynamicsError::Singular)
+        let placed = bias_and_crba_factor(model, data, q, v, fext);
+        ltdl::factor_placed(&data.h, &model.dof_parent, &mut data.chol, placed)
+            .map_err(DynamicsError::Singular)
     }
+}
+
+/// [`bias_and_crba`] that, where the local-frame CRBA runs, also leaves H's
+/// tree-pattern entries in `data.chol`'s upper triangle (returns true; the
+/// tree-sparse LTDL then starts there, [`ltdl::factor_placed`]).
+pub(crate) fn bias_and_crba_factor<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+    fext: Option<&[Force<T>]>,
+) -> bool {
+    rnea::bias_pass(model, data, q, v, fext);
+    if crba::crba_at_placements_factor(model, data) {
+        return true;
+    }
+    crba::crba_dispatch(model, data, q, model.has_mimic);
+    false
 }
 
 /// `data.bias` = C (with the pass's body velocities, accelerations and joint

@@ -278,12 +278,12 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
 
     // Sweep 2, leaves inwards: composite Y, Ẏ, F; the blocks of each body's rows
     // and columns against its subtree.
-    tau.fill(T::zero());
+    tau.as_mut_slice().fill(T::zero());
     let n = if direct { model.nv } else { col_iv.len() };
     let [fq, fv, fa] = full;
     let (mq, mv, ma) = if direct {
         if !K {
-            h.fill(T::zero());
+            h.as_mut_slice().fill(T::zero());
         }
         (
             dtau_dq.as_mut_slice(),
@@ -384,7 +384,7 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
     if !direct {
         // The reduced system: Gᵀ M_full G (G's multipliers are inside J).
         for (m_out, m_full) in [(dtau_dq, &*fq), (dtau_dv, &*fv), (h, &*fa)] {
-            m_out.fill(T::zero());
+            m_out.as_mut_slice().fill(T::zero());
             for c in 0..n {
                 for r in 0..n {
                     let x = m_full[(r, c)];

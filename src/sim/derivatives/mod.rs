@@ -214,7 +214,7 @@ impl Simulation {
         if let Some(c) = self.contact.as_mut() {
             c.forget_history();
             self.q = self.model.neutral();
-            self.v.fill(0.0);
+            self.v.as_mut_slice().fill(0.0);
             self.state_changed();
         }
         self.set_state(q, v)

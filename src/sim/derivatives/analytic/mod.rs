@@ -387,7 +387,7 @@ impl Simulation {
         let (minv, col) = (&mut sc.minv, &mut sc.col);
         if dense {
             // the rows of the solution against 1 are H̃⁻¹'s (symmetric)
-            minv.fill(0.0);
+            minv.as_mut_slice().fill(0.0);
             minv.fill_diagonal(1.0);
             cholesky_solve_rows(&sc.l, n, minv.as_mut_slice());
         } else {
@@ -417,7 +417,7 @@ impl Simulation {
             kk.columns_mut(0, n).add_assign(&gc);
         }
         shape(&mut sc.z0, n, 3 * n);
-        sc.z0.fill(0.0);
+        sc.z0.as_mut_slice().fill(0.0);
         let z0 = &mut sc.z0;
         {
             let (zs, ms, ks) = (z0.as_mut_slice(), minv.as_slice(), kk.as_slice());
