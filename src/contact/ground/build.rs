@@ -196,6 +196,20 @@ impl GroundContact {
                 Manifold::Capsule { half, radius } => half + radius,
                 Manifold::Cylinder { half, radius } => half.hypot(radius),
             };
+            // a vertex shape's box in the body frame
+            let low_box = (manifold == Manifold::Vertices && !verts.is_empty()).then(|| {
+                let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+                for v in &verts {
+                    let p = g.placement.act_point(v);
+                    for a in 0..3 {
+                        lo[a] = lo[a].min(p[a]);
+                        hi[a] = hi[a].max(p[a]);
+                    }
+                }
+                let c = [0, 1, 2].map(|a| (lo[a] + hi[a]) / 2.0);
+                let e = [0, 1, 2].map(|a| (hi[a] - lo[a]) / 2.0);
+                (c, e)
+            });
             shapes.push(GroundShape {
                 body: g.body,
                 geom: gi,
@@ -223,6 +237,7 @@ impl GroundContact {
                 adj: graph.1,
                 nslots,
                 bound,
+                low_box,
             });
         }
         if shapes.is_empty() {
@@ -253,8 +268,11 @@ impl GroundContact {
             visited: vec![0; n],
             generation: 0,
             in_band: vec![0; n],
+            band_place: vec![0; n],
+            band_pts: super::patch::Soa::zeros(cap),
+            band_xyz: super::patch::Soa::zeros(n),
+            rim_xyz: super::patch::Soa::zeros(n),
             band_order: vec![0; n],
-            band_rim: vec![0; n],
             band_len: vec![0; nshapes],
             rim_len: vec![0; nshapes],
             band_gen: vec![0; nshapes],

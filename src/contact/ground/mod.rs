@@ -4,6 +4,7 @@
 //! patch (see the module doc of [`super`]).
 
 mod build;
+mod patch;
 mod reduce;
 
 use super::shapes::to_pose;
@@ -13,7 +14,7 @@ use crate::spatial::Se3;
 use nalgebra::Vector3;
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, SupportMap};
-use reduce::{band_best, reduce, HOLD_DEEPEST, HOLD_EXTREME, MAX_DIRS};
+use reduce::{reduce, MAX_DIRS};
 
 #[derive(Clone, Debug)]
 pub(super) enum ParryShape {
@@ -70,6 +71,11 @@ pub struct GroundShape {
     /// shape whose origin is higher than this above the ground (plus the margin)
     /// cannot touch it, and is skipped without a narrow-phase query.
     pub bound: f64,
+    /// A vertex shape's box in the body frame (centre, half extents): its
+    /// lowest point is no lower than the box's lowest corner, a tighter test
+    /// than `bound` for a long link (solo12's base and shanks stand within
+    /// their spheres' reach of the ground without their boxes' reaching it).
+    low_box: Option<([f64; 3], [f64; 3])>,
 }
 
 /// The ground plane and every shape that can touch it.
@@ -112,11 +118,19 @@ pub struct GroundContact {
     /// generation of the search that found it in the band (`in_band`); in the
     /// shape's slot range, the band's vertices in search order (`band_order`,
     /// `band_len[shape]` of them) and its rim, the vertices next to the band
-    /// outside it (`band_rim`, `rim_len[shape]`); per shape, the generation
+    /// outside it (`rim_xyz`, `rim_len[shape]`); per shape, the generation
     /// of its band (`band_gen`).
     in_band: Vec<u32>,
+    /// Per slot, its place in its shape's band search order (valid where
+    /// `in_band` holds the shape's `band_gen`).
+    band_place: Vec<u32>,
+    /// The current band's world points, in its search order ([`patch`]).
+    band_pts: patch::Soa,
+    /// In each shape's slot range, its band's and rim's vertices (geometry
+    /// frame) in search order ([`patch`]).
+    band_xyz: patch::Soa,
+    rim_xyz: patch::Soa,
     band_order: Vec<u32>,
-    band_rim: Vec<u32>,
     band_len: Vec<usize>,
     rim_len: Vec<usize>,
     band_gen: Vec<u32>,
@@ -221,7 +235,9 @@ impl GroundContact {
         let ground = self.ground;
         let maxp = self.params.max_points_per_shape.max(1);
         let stepped = self.travel.begin();
-        for (si, s) in self.shapes.iter().enumerate() {
+        // (the shapes never change: held apart from `self`, which the search mutates)
+        let shapes = std::sync::Arc::clone(&self.shapes);
+        for (si, s) in shapes.iter().enumerate() {
             let Some(o_m_b) = o_m_i.get(s.body) else {
                 continue;
             };
@@ -245,11 +261,24 @@ impl GroundContact {
             if z - ground - s.bound > margin {
                 continue;
             }
+            if let Some((c, e)) = &s.low_box {
+                let zc = row[0] * c[0] + row[1] * c[1] + row[2] * c[2] + o_m_b.trans.z;
+                let reach = row[0].abs() * e[0] + row[1].abs() * e[1] + row[2].abs() * e[2];
+                // (a nanometre of slack for the rounding of the two ways)
+                if zc - reach - ground > margin + 1e-9 {
+                    continue;
+                }
+            }
             let o_m_g = o_m_b.compose(&s.placement);
             self.queries += 1;
             // a hull or point set: its lowest vertex is its support point toward
             // −z; only the heights are needed to find it and the candidates
             // (one dot product a vertex, no parry query)
+            if s.manifold == Manifold::Vertices && !s.adj.is_empty() {
+                // a hull: its patch from its vertex graph ([`patch`])
+                self.hull_patch(si, s, &o_m_g, margin, maxp, out);
+                continue;
+            }
             if s.manifold == Manifold::Vertices {
                 let r = &o_m_g.rot;
                 let (rx, ry, rz) = (r[(2, 0)], r[(2, 1)], r[(2, 2)]);
@@ -269,203 +298,17 @@ impl GroundContact {
                         ..s.template
                     });
                 };
-                if s.adj.is_empty() {
-                    // a small vertex set: scanned whole
-                    let low = s.verts.iter().map(height).fold(f64::INFINITY, f64::min);
-                    if low > margin {
-                        continue;
-                    }
-                    for (k, v) in s.verts.iter().enumerate() {
-                        if height(v) <= margin {
-                            candidate(k);
-                        }
-                    }
-                    reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
+                // a small vertex set: scanned whole
+                let low = s.verts.iter().map(height).fold(f64::INFINITY, f64::min);
+                if low > margin {
                     continue;
                 }
-                // a hull: descend the vertex graph from the last lowest vertex
-                // (a vertex of a convex polytope with no lower neighbour is
-                // the lowest), then collect the vertices within the margin,
-                // a connected set on the graph
-                let nbrs = |k: usize| {
-                    let (a, b) = (s.adj_start[k] as usize, s.adj_start[k + 1] as usize);
-                    &s.adj[a..b]
-                };
-                let mut k = self.last_low[si].min(s.verts.len() - 1);
-                let mut zk = height(&s.verts[k]);
-                loop {
-                    let mut best = None;
-                    for &j in nbrs(k) {
-                        let zj = height(&s.verts[j as usize]);
-                        if zj < zk {
-                            zk = zj;
-                            best = Some(j as usize);
-                        }
-                    }
-                    match best {
-                        Some(j) => k = j,
-                        None => break,
+                for (k, v) in s.verts.iter().enumerate() {
+                    if height(v) <= margin {
+                        candidate(k);
                     }
                 }
-                self.last_low[si] = k;
-                if zk > margin {
-                    continue;
-                }
-                // the band the patch is chosen from: within BAND of the
-                // lowest vertex (a face lying flat on the ground is all
-                // inside it; the vertices further up a rounded edge are not
-                // needed to span the patch)
-                let band = margin.min(zk + BAND);
-                let verts = &s.verts[..];
-                let order = &mut self.band_order[base..base + verts.len()];
-                let rim = &mut self.band_rim[base..base + verts.len()];
-                // last step's band (in its search order) and its rim (the
-                // vertices next to it outside it): from the same lowest vertex,
-                // the band is the same set, searched in the same order, when
-                // every band vertex is still in it and no rim vertex is (a
-                // height a vertex, no graph walk: a patch at rest)
-                let (bl, rl) = (self.band_len[si], self.rim_len[si]);
-                let same = bl > 0
-                    && order[0] as usize == k
-                    && order[1..bl]
-                        .iter()
-                        .all(|&j| height(&verts[j as usize]) <= band)
-                    && !rim[..rl]
-                        .iter()
-                        .any(|&j| height(&verts[j as usize]) <= band);
-                if !same {
-                    // the band's vertices by a search from the lowest; a
-                    // vertex is marked when its height is first taken (one
-                    // height a vertex, in or out of the band), the band's
-                    // stamped with this search's generation
-                    self.generation = self.generation.wrapping_add(1).max(1);
-                    let stamp = self.generation;
-                    let visited = &mut self.visited[base..base + verts.len()];
-                    let in_band = &mut self.in_band[base..base + verts.len()];
-                    let stack = &mut self.stack;
-                    stack.clear();
-                    stack.push(k as u32);
-                    visited[k] = stamp;
-                    let (mut bl, mut rl) = (0, 0);
-                    while let Some(i) = stack.pop() {
-                        order[bl] = i;
-                        bl += 1;
-                        in_band[i as usize] = stamp;
-                        for &j in nbrs(i as usize) {
-                            let j = j as usize;
-                            if visited[j] != stamp {
-                                visited[j] = stamp;
-                                if height(&verts[j]) <= band {
-                                    stack.push(j as u32);
-                                } else {
-                                    rim[rl] = j as u32;
-                                    rl += 1;
-                                }
-                            }
-                        }
-                    }
-                    self.band_len[si] = bl;
-                    self.rim_len[si] = rl;
-                    self.band_gen[si] = stamp;
-                }
-                let cand = &order[..self.band_len[si]];
-                // a band vertex only gets its world point p and its criteria
-                // (`reduce`: −φ, cᵢ·x + sᵢ·y), their maxima: no ContactPoint
-                // until chosen
-                let dirs = maxp.saturating_sub(1).clamp(1, MAX_DIRS);
-                let dir = &self.reduce_dirs;
-                let key = |p: &Vector3<f64>, q: usize| -> f64 {
-                    if q == 0 {
-                        -(p.z - ground)
-                    } else {
-                        let (c, sn) = dir[q - 1];
-                        c * p.x + sn * p.y
-                    }
-                };
-                let best = match dirs {
-                    3 => band_best::<3>(&o_m_g, verts, cand, ground, dir),
-                    _ => band_best::<0>(&o_m_g, verts, cand, ground, dir),
-                };
-                let point = |k: usize| {
-                    let p = o_m_g.act_point(&verts[k]);
-                    ContactPoint {
-                        shape: si,
-                        slot: base + k,
-                        body: s.body,
-                        point: p,
-                        gap: p.z - ground,
-                        ..s.template
-                    }
-                };
-                if cand.len() <= maxp {
-                    out.extend(cand.iter().map(|&i| point(i as usize)));
-                    continue;
-                }
-                // each criterion's choice as `reduce`'s: a point kept last step
-                // (this shape's, at most maxp, looked at directly) within its
-                // hold of the best, the lowest slot; else the lowest slot within
-                // 1e-6 of the best (a scan of the band, only then)
-                let (pa, pb, pc) = self.prev_range[si];
-                let kept = &self.prev_list[pa..pb];
-                let kept_all = &self.prev_list[pa..pc];
-                let stamp = self.band_gen[si];
-                let start = out.len();
-                for (q, &bq) in best.iter().enumerate().take(dirs + 1) {
-                    let hold = if q == 0 { HOLD_DEEPEST } else { HOLD_EXTREME };
-                    let mut ch = usize::MAX;
-                    for &slot in kept {
-                        if slot < ch
-                            && self.in_band[slot] == stamp
-                            && key(&o_m_g.act_point(&verts[slot - base]), q) >= bq - hold
-                        {
-                            ch = slot;
-                        }
-                    }
-                    let k = if ch != usize::MAX {
-                        ch - base
-                    } else {
-                        let mut kmin = usize::MAX;
-                        for &i in cand {
-                            let i = i as usize;
-                            if i < kmin && key(&o_m_g.act_point(&verts[i]), q) >= bq - 1e-6 {
-                                kmin = i;
-                            }
-                        }
-                        if kmin == usize::MAX {
-                            cand[0] as usize
-                        } else {
-                            kmin
-                        }
-                    };
-                    if out.len() - start >= maxp {
-                        break;
-                    }
-                    if !out[start..].iter().any(|p| p.slot == base + k) {
-                        out.push(point(k));
-                    }
-                }
-                // a point kept last step and still in the ground that no
-                // criterion picked stays in the patch beside the picks (never
-                // in place of one: a pick above the ground may be the point
-                // about to be hit), at most maxp of them: a point that
-                // carries the body does not lose its row because another
-                // became the deepest or an extreme (docs/theory.md §"Contact
-                // geometry"; borinot's rocking, docs/robots.md)
-                self.picks[si] = out.len() - start;
-                let mut extra = 0;
-                for &slot in kept_all {
-                    if extra >= maxp {
-                        break;
-                    }
-                    if out[start..].iter().any(|p| p.slot == slot) {
-                        continue;
-                    }
-                    let p = point(slot - base);
-                    if p.gap < 0.0 {
-                        out.push(p);
-                        extra += 1;
-                    }
-                }
+                reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
                 continue;
             }
             // a sphere, capsule or cylinder: its manifold points are computed

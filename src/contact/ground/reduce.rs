@@ -1,19 +1,17 @@
 //! The reduction of a shape's ground points to a persistent patch.
 
+use super::patch::Soa;
 use super::ContactPoint;
-use crate::spatial::Se3;
-use nalgebra::Vector3;
 
 /// The maxima of `reduce`'s criteria (−φ, then cᵢ·x + sᵢ·y for the
-/// directions `dir`) over the vertices `verts[i]`, i in `cand`, placed by `m`
-/// (φ = z − ground); `D`: the number of directions when it is known at compile
-/// time (the default 3), else 0 and every direction of `dir` is taken (the
-/// unused ones are (0, 0): their maxima are not looked at).
+/// directions `dir`) over the first `n` world points of `pts` (φ = z − ground); `D`: the
+/// number of directions when it is known at compile time (the default 3), else
+/// 0 and every direction of `dir` is taken (the unused ones are (0, 0): their
+/// maxima are not looked at).
 #[inline(always)]
 pub(super) fn band_best<const D: usize>(
-    m: &Se3<f64>,
-    verts: &[Vector3<f64>],
-    cand: &[u32],
+    pts: &Soa,
+    n: usize,
     ground: f64,
     dir: &[(f64, f64); MAX_DIRS],
 ) -> [f64; MAX_DIRS + 1] {
@@ -22,12 +20,12 @@ pub(super) fn band_best<const D: usize>(
     let up = |b: f64, k: f64| if k > b { k } else { b };
     let nd = if D == 0 { MAX_DIRS } else { D };
     let mut best = [f64::NEG_INFINITY; MAX_DIRS + 1];
-    for &i in cand {
-        let p = m.act_point(&verts[i as usize]);
-        best[0] = up(best[0], -(p.z - ground));
+    let (xs, ys, zs) = (&pts.x[..n], &pts.y[..n], &pts.z[..n]);
+    for ((x, y), z) in xs.iter().zip(ys).zip(zs) {
+        best[0] = up(best[0], -(z - ground));
         for q in 0..nd {
             let (c, sn) = dir[q];
-            best[q + 1] = up(best[q + 1], c * p.x + sn * p.y);
+            best[q + 1] = up(best[q + 1], c * x + sn * y);
         }
     }
     best
