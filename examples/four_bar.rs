@@ -14,8 +14,7 @@
 mod constrained;
 #[path = "common/four_bar_setup.rs"]
 mod four_bar_setup;
-#[path = "common/png_out.rs"]
-mod png_out;
+use urdyn_example_plot as png_out;
 
 use std::error::Error;
 use std::io::Write;
@@ -69,19 +68,19 @@ fn main() -> Result<(), Box<dyn Error>> {
                 "crank angle",
                 "q crank (rad)",
                 &crank,
-                plotters::style::RGBColor(200, 40, 30),
+                urdyn_example_plot::plotters::style::RGBColor(200, 40, 30),
             ),
             panel(
                 "loop violation |p1 - p2| (1e-15 m = fm)",
                 "fm",
                 &violation,
-                plotters::style::RGBColor(30, 90, 200),
+                urdyn_example_plot::plotters::style::RGBColor(30, 90, 200),
             ),
             panel(
                 "energy - E0 (1e-12 J = pJ; E0 = 1.286 J)",
                 "pJ",
                 &energy,
-                plotters::style::RGBColor(30, 150, 60),
+                urdyn_example_plot::plotters::style::RGBColor(30, 150, 60),
             ),
         ],
     )?;

@@ -7,11 +7,10 @@
 //! `OUT_DIR/lamp_drop.png` and the 3D replay page `OUT_DIR/lamp_drop.html` (as
 //! `simulate --html` writes it; OUT_DIR defaults to `target`).
 
-#[path = "common/png_out.rs"]
-mod png_out;
+use urdyn_example_plot as png_out;
 
-use plotters::style::colors::{BLACK, BLUE, RED};
 use std::path::PathBuf;
+use urdyn_example_plot::plotters::style::colors::{BLACK, BLUE, RED};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));

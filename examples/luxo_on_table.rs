@@ -11,8 +11,7 @@
 
 #[path = "common/luxo_run.rs"]
 mod luxo_run;
-#[path = "common/png_out.rs"]
-mod png_out;
+use urdyn_example_plot as png_out;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let summary = luxo_run::run(

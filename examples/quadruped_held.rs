@@ -14,15 +14,14 @@
 
 #[path = "common/constrained.rs"]
 mod constrained;
-#[path = "common/png_out.rs"]
-mod png_out;
+use urdyn_example_plot as png_out;
 #[path = "common/quadruped_setup.rs"]
 mod quadruped_setup;
 
-use plotters::style::RGBColor;
 use std::error::Error;
 use std::io::Write;
 use std::path::PathBuf;
+use urdyn_example_plot::plotters::style::RGBColor;
 
 fn main() -> Result<(), Box<dyn Error>> {
     let out_dir = PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| "target".into()));

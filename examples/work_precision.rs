@@ -11,13 +11,12 @@
 //! writes `OUT_DIR/work_precision.md` and `OUT_DIR/work_precision.png` (default `target`).
 
 use nalgebra::DVector;
-#[path = "common/png_out.rs"]
-mod png_out;
+use urdyn_example_plot as png_out;
 
-use plotters::prelude::*;
 use std::path::PathBuf;
 use std::time::Instant;
 use urdyn::sim::{Integrator, SimOptions, Simulation};
+use urdyn_example_plot::plotters::prelude::*;
 
 struct Run {
     integ: Integrator,

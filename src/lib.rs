@@ -67,6 +67,8 @@ pub mod model;
 pub mod scene;
 pub mod sim;
 pub mod spatial;
+#[doc(hidden)]
+pub mod testing;
 pub mod urdf;
 
 pub use load::{load_model, LoadError};

@@ -61,6 +61,7 @@ mod simulate_cli;
 mod simulate_trust;
 mod sleep;
 mod step_jacobians;
+mod unit;
 mod view;
 
 /// Every `tests/*.rs` file is a module of this binary (with `autotests = false` a file

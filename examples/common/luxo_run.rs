@@ -3,9 +3,9 @@
 //! the lamp's base height, the energy, the loops' largest violation and the
 //! contact count against time (docs/mechanisms_examples.md).
 
-use plotters::style::colors::{BLACK, BLUE, RED};
-use plotters::style::RGBColor;
 use std::path::{Path, PathBuf};
+use urdyn_example_plot::plotters::style::colors::{BLACK, BLUE, RED};
+use urdyn_example_plot::plotters::style::RGBColor;
 
 /// The run's length (s).
 pub const DURATION: f64 = 8.0;

@@ -34,21 +34,21 @@ pub(crate) const LAZY_PAIR: u32 = u32::MAX - 1;
 /// entry a pair of shapes (`idx[i·n + j]`: a pair index, [`LAZY_PAIR`] or
 /// [`NO_PAIR`]).
 #[derive(Clone, Debug, Default)]
-pub(crate) struct PairTable {
+pub struct PairTable {
     n: usize,
     idx: Vec<u32>,
 }
 
 impl PairTable {
     /// No pair allowed among `n` shapes.
-    pub fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         Self {
             n,
             idx: vec![NO_PAIR; n * n],
         }
     }
     /// Allows the pair of shapes i, j (not made yet).
-    pub fn allow(&mut self, i: usize, j: usize) {
+    pub(crate) fn allow(&mut self, i: usize, j: usize) {
         if i < self.n && j < self.n {
             self.idx[i * self.n + j] = LAZY_PAIR;
             self.idx[j * self.n + i] = LAZY_PAIR;
@@ -56,13 +56,13 @@ impl PairTable {
     }
     /// Whether the pair of shapes i, j is allowed.
     #[inline]
-    pub fn allowed(&self, i: usize, j: usize) -> bool {
+    pub(crate) fn allowed(&self, i: usize, j: usize) -> bool {
         self.get(i, j) != NO_PAIR
     }
     /// The pair of shapes i, j: its index, [`LAZY_PAIR`] (allowed, not made)
     /// or [`NO_PAIR`].
     #[inline]
-    pub fn get(&self, i: usize, j: usize) -> u32 {
+    pub(crate) fn get(&self, i: usize, j: usize) -> u32 {
         if i < self.n && j < self.n {
             self.idx[i * self.n + j]
         } else {
@@ -78,7 +78,7 @@ impl PairTable {
         }
     }
     /// Records pair `p` made for the allowed shapes i, j.
-    pub fn set(&mut self, i: usize, j: usize, p: u32) {
+    pub(crate) fn set(&mut self, i: usize, j: usize, p: u32) {
         if self.allowed(i, j) {
             self.idx[i * self.n + j] = p;
             self.idx[j * self.n + i] = p;
@@ -102,7 +102,7 @@ pub(crate) fn prefetch<T>(x: &T) {
 
 /// The sweep's state.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct SweepAndPrune {
+pub struct SweepAndPrune {
     /// Lower and upper corners of each shape's box.
     pub lo: Vec<[f64; 3]>,
     /// Upper corners.
@@ -131,7 +131,7 @@ const BIG: f64 = 4.0;
 
 impl SweepAndPrune {
     /// Room for `n` shapes (boxes empty until set).
-    pub fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         Self {
             lo: vec![[f64::INFINITY; 3]; n],
             hi: vec![[f64::NEG_INFINITY; 3]; n],
@@ -147,7 +147,7 @@ impl SweepAndPrune {
 
     /// Sets shape `i`'s box to centre c ± half extents h.
     #[inline]
-    pub fn set(&mut self, i: usize, c: [f64; 3], h: [f64; 3]) {
+    pub(crate) fn set(&mut self, i: usize, c: [f64; 3], h: [f64; 3]) {
         self.lo[i] = [c[0] - h[0], c[1] - h[1], c[2] - h[2]];
         self.hi[i] = [c[0] + h[0], c[1] + h[1], c[2] + h[2]];
     }
@@ -155,7 +155,12 @@ impl SweepAndPrune {
     /// The overlapping pairs the table allows (`table.get(i, j)` the pair
     /// index of shapes i, j, or [`NO_PAIR`]), appended to `out`; those marked
     /// [`LAZY_PAIR`] (allowed, not made yet) as shapes (i, j) to `fresh`.
-    pub fn overlaps(&mut self, table: &PairTable, out: &mut Vec<u32>, fresh: &mut Vec<(u32, u32)>) {
+    pub(crate) fn overlaps(
+        &mut self,
+        table: &PairTable,
+        out: &mut Vec<u32>,
+        fresh: &mut Vec<(u32, u32)>,
+    ) {
         let n = self.lo.len();
         let mut cand = std::mem::take(&mut self.cand);
         cand.clear();
@@ -347,121 +352,6 @@ impl SweepAndPrune {
                 }
                 self.report(i, j, cand);
             }
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn finds_exactly_the_overlapping_allowed_pairs() {
-        // four unit spheres on the x axis at 0, 1.5, 3, 10: 0–1 and 1–2 overlap
-        let mut s = SweepAndPrune::new(4);
-        for (i, x) in [10.0, 0.0, 1.5, 3.0].into_iter().enumerate() {
-            s.set(i, [x, 0.0, 0.0], [1.0; 3]);
-        }
-        // every pair allowed, pair index = 10·min + max
-        let every = || {
-            let mut t = PairTable::new(4);
-            for i in 0..4 {
-                for j in i + 1..4 {
-                    t.allow(i, j);
-                    t.set(i, j, (10 * i + j) as u32);
-                }
-            }
-            t
-        };
-        let mut table = every();
-        let mut out = Vec::new();
-        s.overlaps(&table, &mut out, &mut Vec::new());
-        out.sort();
-        assert_eq!(out, vec![12, 23]);
-        // moved apart in z: none
-        s.set(2, [1.5, 0.0, 5.0], [1.0; 3]);
-        out.clear();
-        s.overlaps(&table, &mut out, &mut Vec::new());
-        assert!(out.is_empty(), "{out:?}");
-        // a pair the filter forbids is not reported
-        s.set(2, [1.5, 0.0, 0.0], [1.0; 3]);
-        table = PairTable::new(4);
-        for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 3), (2, 3)] {
-            table.allow(i, j);
-            table.set(i, j, (10 * i + j) as u32);
-        }
-        out.clear();
-        s.overlaps(&table, &mut out, &mut Vec::new());
-        assert_eq!(out, vec![23]);
-        // a pair allowed but not made yet is reported by its shapes
-        table.allow(1, 2);
-        out.clear();
-        let mut fresh = Vec::new();
-        s.overlaps(&table, &mut out, &mut fresh);
-        assert_eq!(out, vec![23]);
-        let fresh: Vec<_> = fresh.iter().map(|&(i, j)| (i.min(j), i.max(j))).collect();
-        assert_eq!(fresh, vec![(1, 2)]);
-    }
-    #[test]
-    fn strips_find_exactly_the_overlapping_pairs() {
-        // 300 boxes of assorted sizes over a 4 m floor, four long walls and a
-        // box never set: the strips' pairs are those of a test of every pair
-        let n = 305;
-        let mut s = SweepAndPrune::new(n);
-        let mut table = PairTable::new(n);
-        for i in 0..n {
-            for j in i + 1..n {
-                if (i + 2 * j) % 7 != 0 {
-                    table.allow(i, j);
-                    if (i * j) % 3 == 0 {
-                        table.set(i, j, (i * n + j) as u32);
-                    }
-                }
-            }
-        }
-        let mut x = 12345u64;
-        let mut rnd = || {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let walls = [
-            ([-2.05, 0.0, 0.3], [0.05, 2.1, 0.3]),
-            ([2.05, 0.0, 0.3], [0.05, 2.1, 0.3]),
-            ([0.0, -2.05, 0.3], [2.0, 0.05, 0.3]),
-            ([0.0, 2.05, 0.3], [2.0, 0.05, 0.3]),
-        ];
-        for round in 0..3 {
-            for i in 0..n - 1 {
-                if i < 4 {
-                    s.set(i, walls[i].0, walls[i].1);
-                } else if round == 0 || i % 3 == round {
-                    let c = [4.0 * rnd() - 2.0, 4.0 * rnd() - 2.0, rnd()];
-                    let h = 0.03 + 0.1 * rnd();
-                    s.set(i, c, [h, 0.5 * h + 0.05 * rnd(), h]);
-                }
-            }
-            let (mut out, mut fresh) = (Vec::new(), Vec::new());
-            s.overlaps(&table, &mut out, &mut fresh);
-            let mut got: Vec<(usize, usize)> = fresh
-                .iter()
-                .map(|&(i, j)| ((i as usize).min(j as usize), (i as usize).max(j as usize)))
-                .collect();
-            got.extend(out.iter().map(|&p| (p as usize / n, p as usize % n)));
-            got.sort();
-            let mut want = Vec::new();
-            for i in 0..n {
-                for j in i + 1..n {
-                    let (a, b, c, d) = (s.lo[i], s.hi[i], s.lo[j], s.hi[j]);
-                    let over = (0..3).all(|k| c[k] <= b[k] && a[k] <= d[k]);
-                    if over && table.allowed(i, j) {
-                        want.push((i, j));
-                    }
-                }
-            }
-            assert!(want.len() > 40, "{}", want.len());
-            assert_eq!(got, want, "round {round}");
         }
     }
 }

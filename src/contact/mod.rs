@@ -62,16 +62,16 @@
 //! unconditionally stable at any step (no stiffness).
 
 pub mod broad;
-mod face;
+pub(crate) mod face;
 pub mod filter;
 pub mod frame;
 pub mod ground;
-mod hull;
-mod narrow;
+pub(crate) mod hull;
+pub(crate) mod narrow;
 pub mod pairs;
 mod pipeline;
 pub(crate) mod shapes;
-mod travel;
+pub(crate) mod travel;
 
 pub use crate::mesh::resolve_mesh_path;
 pub use filter::DroppedPair;

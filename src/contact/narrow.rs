@@ -16,7 +16,7 @@ use parry3d_f64::query::{
 };
 use parry3d_f64::shape::ShapeType;
 
-mod prim;
+pub(crate) mod prim;
 
 /// The key bit of a face-path point (its vertex index below it): never a key
 /// of parry's features (those fill at most bits 0–59).
@@ -46,10 +46,14 @@ pub(super) fn face_kind(a: &PairShape, b: &PairShape) -> Option<bool> {
 
 /// A raw point of a manifold before the reduction.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Raw {
+pub struct Raw {
+    /// The contact point (world, m).
     pub point: Vector3<f64>,
+    /// The unit normal from b toward a (world).
     pub normal: Vector3<f64>,
+    /// The signed distance (m, negative in penetration).
     pub gap: f64,
+    /// The point's features, the same from step to step.
     pub key: u64,
 }
 
@@ -57,7 +61,7 @@ pub(super) struct Raw {
 /// contact manifolds (`manifolds` and `workspace` kept between steps),
 /// appended to `raw`.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn parry_points(
+pub(crate) fn parry_points(
     a: &PairShape,
     b: &PairShape,
     wa: &Se3<f64>,
@@ -292,7 +296,7 @@ pub(super) fn face_points(
 /// vertices at a time, swapping every few steps, and crept down the slope
 /// at 0.05 rad/s; within 0.3 mm both are kept and it rests (v = 0 by 0.7 s).
 /// (2 mm, the ground's band, still left it creeping.)
-pub(super) const EXTREME_BAND: f64 = 3e-4;
+pub(crate) const EXTREME_BAND: f64 = 3e-4;
 
 /// (sin, cos) of direction `d` of `dirs` evenly spread ones.
 fn direction(d: usize, dirs: usize) -> (f64, f64) {
@@ -326,7 +330,7 @@ fn directions(dirs: usize) -> Option<&'static [(f64, f64)]> {
 /// within a hold of the best, as the ground's reduction does, left points
 /// deeper than the kept ones unchosen: solo12 landing on the box step sank
 /// 2 mm instead of 0.06.)
-pub(super) fn reduce_pair(
+pub(crate) fn reduce_pair(
     raw: &[Raw],
     maxp: usize,
     out: &mut Vec<ContactPoint>,
@@ -367,77 +371,5 @@ pub(super) fn reduce_pair(
         if !out[start..].iter().any(|p| p.key == raw[best].key) {
             out.push(make(&raw[best]));
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::contact::hull::superellipsoid;
-    use nalgebra::{Rotation3, Vector3};
-    use parry3d_f64::shape::SharedShape;
-
-    /// A rounded slab's hull (the climbing kind: hundreds of vertices).
-    fn slab() -> PairShape {
-        let h = superellipsoid([0.05, 0.04, 0.02], 0.3);
-        PairShape::new(SharedShape::new(h), Se3::identity(), true)
-    }
-
-    fn pose(angle: f64, t: Vector3<f64>) -> Se3<f64> {
-        let r = Rotation3::from_axis_angle(&Vector3::x_axis(), angle)
-            * Rotation3::from_axis_angle(&Vector3::y_axis(), 0.5 * angle);
-        Se3::new(r.into_inner(), t)
-    }
-
-    /// The points of b at `wb` on a: from scratch, and with the manifolds
-    /// `kept` from earlier queries.
-    fn points(
-        a: &PairShape,
-        b: &PairShape,
-        wb: &Se3<f64>,
-        kept: Option<&mut Vec<ContactManifold<(), ()>>>,
-    ) -> Vec<Raw> {
-        let wa = Se3::identity();
-        let mut fresh = Vec::new();
-        let manifolds = kept.unwrap_or(&mut fresh);
-        let (mut ws, mut raw) = (None, Vec::new());
-        parry_points(a, b, &wa, wb, 0.005, manifolds, &mut ws, &mut raw);
-        raw
-    }
-
-    fn deepest(raw: &[Raw]) -> f64 {
-        raw.iter().map(|r| r.gap).fold(f64::INFINITY, f64::min)
-    }
-
-    #[test]
-    fn kept_points_measure_the_gaps_a_fresh_query_finds() {
-        let (a, b) = (slab(), slab());
-        // b lies on a, tilted a little: it touches with a corner region
-        let w0 = pose(0.03, Vector3::new(0.004, -0.002, 0.0399));
-        let mut kept = Vec::new();
-        let first = points(&a, &b, &w0, Some(&mut kept));
-        assert!(!first.is_empty() && deepest(&first) < 0.0, "{first:?}");
-        // moved well within the kept points' tolerance (µm and 10⁻⁶ rad):
-        // the points stand, the gaps are this pose's
-        for k in 1..=5 {
-            let s = k as f64;
-            let w = pose(
-                0.03 + 1e-6 * s,
-                Vector3::new(0.004 + 1e-6 * s, -0.002, 0.0399 - 2e-6 * s),
-            );
-            let again = points(&a, &b, &w, Some(&mut kept));
-            let fresh = points(&a, &b, &w, None);
-            let keys = |r: &[Raw]| r.iter().map(|p| p.key).collect::<Vec<_>>();
-            assert_eq!(keys(&again), keys(&first), "kept points, same features");
-            let (d1, d2) = (deepest(&again), deepest(&fresh));
-            assert!((d1 - d2).abs() < 1e-9, "step {k}: kept {d1}, fresh {d2}");
-            assert!((d1 - deepest(&first)).abs() > 1e-6, "the gaps moved with b");
-        }
-        // moved by a millimetre and tilted by 0.02 rad: found anew, as a
-        // fresh query finds them
-        let w = pose(0.05, Vector3::new(0.005, -0.002, 0.0399));
-        let again = points(&a, &b, &w, Some(&mut kept));
-        let fresh = points(&a, &b, &w, None);
-        assert!((deepest(&again) - deepest(&fresh)).abs() < 1e-9);
     }
 }

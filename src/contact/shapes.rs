@@ -24,7 +24,7 @@ use std::path::PathBuf;
 
 /// A collision geometry as parry sees it.
 #[derive(Clone)]
-pub(crate) struct PairShape {
+pub struct PairShape {
     /// The parry shape, in its own frame.
     pub shape: SharedShape,
     /// `geom_M_parry`: parry's frame in the geometry frame.
@@ -44,7 +44,7 @@ pub(crate) struct PairShape {
 impl PairShape {
     /// A parry shape at `offset` in its geometry frame, with its box in
     /// parry's frame.
-    pub fn new(shape: SharedShape, offset: Se3<f64>, convex: bool) -> Self {
+    pub(crate) fn new(shape: SharedShape, offset: Se3<f64>, convex: bool) -> Self {
         let b = shape.compute_local_aabb();
         let round = if let Some(s) = shape.as_ball() {
             Some((Vector3::zeros(), Vector3::zeros(), s.radius))

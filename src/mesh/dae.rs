@@ -16,30 +16,19 @@ const MAX_DAE_NODE_VISITS: usize = 1_000_000;
 /// Most vertices the scene walk emits (one geometry can be instanced many times).
 const MAX_DAE_VERTICES: usize = 5_000_000;
 
-/// Positions of a COLLADA document (see the module doc).
-#[cfg(test)]
-pub(super) fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
-    read_dae(text).map(|(p, _)| p)
-}
-
-/// Positions of a COLLADA document (see the module doc) and the triangles of the
-/// placed geometries' primitives.
-#[cfg(test)]
-pub(super) fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
-    read_dae_colored(text).map(|d| (d.positions, d.triangles))
-}
-
 /// What [`read_dae_colored`] reads.
-pub(super) struct DaeMesh {
-    pub(super) positions: Vec<[f64; 3]>,
-    pub(super) triangles: Vec<[u32; 3]>,
+pub struct DaeMesh {
+    /// The placed positions (m).
+    pub positions: Vec<[f64; 3]>,
+    /// The placed primitives' triangles, indices into `positions`.
+    pub triangles: Vec<[u32; 3]>,
     /// One a triangle.
-    pub(super) colors: Vec<Option<Rgba>>,
+    pub colors: Vec<Option<Rgba>>,
 }
 
 /// Positions, triangles and triangle colours of a COLLADA document (see the
 /// module doc).
-pub(super) fn read_dae_colored(text: &str) -> Result<DaeMesh, String> {
+pub(crate) fn read_dae_colored(text: &str) -> Result<DaeMesh, String> {
     use quick_xml::events::Event;
     let mut reader = quick_xml::Reader::from_str(text);
     let mut arrays: HashMap<String, Vec<f64>> = HashMap::new();

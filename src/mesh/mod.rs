@@ -207,13 +207,8 @@ fn read_raw(path: &Path, with_triangles: bool) -> Result<RawMesh, MeshError> {
 pub(crate) mod cache;
 mod inertia;
 pub use inertia::{mass_properties, MeshInertia, MeshMass};
-mod dae;
+pub(crate) mod dae;
 mod paths;
 pub use paths::resolve_mesh_path;
 mod dae_parts;
 use dae::read_dae_colored;
-#[cfg(test)]
-use dae::{read_dae, read_dae_positions};
-
-#[cfg(test)]
-mod tests;

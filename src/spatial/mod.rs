@@ -110,6 +110,3 @@ pub fn axis_angle<T: Scalar>(u: &Vector3<T>, q: T) -> Matrix3<T> {
     let k = skew(u);
     Matrix3::identity() + k * s + k * k * (T::one() - c)
 }
-
-#[cfg(test)]
-mod tests;

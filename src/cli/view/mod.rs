@@ -22,12 +22,12 @@ use crate::cli::output::write_atomic;
 use crate::{LoadOptions, Model};
 use std::path::{Path, PathBuf};
 
-mod geometry;
+pub(crate) mod geometry;
 pub mod mjcf;
-mod page;
-mod scene;
+pub(crate) mod page;
+pub(crate) mod scene;
 mod trajectory;
-mod visuals;
+pub(crate) mod visuals;
 
 pub(crate) use geometry::PLACEHOLDER_RGBA;
 pub use geometry::{simplify, simplify_keeping, Geometry, Visual, VisualShape, PLACEHOLDER_BOX};

@@ -11,10 +11,12 @@ use std::collections::HashMap;
 
 /// A `<visual>` or `<collision>` element.
 #[derive(Clone, Debug, PartialEq)]
-pub(super) struct Piece {
+pub struct Piece {
     /// `link_M_piece`: rotation and translation.
     pub rot: Matrix3<f64>,
+    /// (m, link frame).
     pub xyz: Vector3<f64>,
+    /// The `<geometry>`.
     pub shape: Shape,
     /// `<material name>` of a visual.
     pub material: Option<String>,
@@ -24,18 +26,24 @@ pub(super) struct Piece {
 
 /// A link's pieces.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub(super) struct LinkPieces {
+pub struct LinkPieces {
+    /// `<link name>`.
     pub name: String,
+    /// Its `<visual>`s, in file order.
     pub visuals: Vec<Piece>,
+    /// Its `<collision>`s, in file order.
     pub collisions: Vec<Piece>,
 }
 
 /// What a URDF draws: its links' pieces, the named material colours and the
 /// warnings about pieces left out.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub(super) struct Drawables {
+pub struct Drawables {
+    /// In file order.
     pub links: Vec<LinkPieces>,
+    /// The top-level `<material>`s' colours by name.
     pub materials: HashMap<String, [f64; 4]>,
+    /// One line a piece left out.
     pub warnings: Vec<String>,
 }
 
@@ -128,7 +136,7 @@ fn shape(e: &BytesStart, name: &str) -> Result<Option<Shape>, String> {
 
 /// Reads the drawable elements of URDF text (already accepted by the import, so
 /// well-formed XML without entities; an XML error here is still an error).
-pub(super) fn read(text: &str) -> Result<Drawables, String> {
+pub(crate) fn read(text: &str) -> Result<Drawables, String> {
     let mut reader = quick_xml::Reader::from_str(text);
     let mut out = Drawables::default();
     let mut stack: Vec<String> = Vec::new();
@@ -299,65 +307,5 @@ fn finish(piece: &mut Option<Open>, link: &mut Option<LinkPieces>, warnings: &mu
             l.name,
             bad.unwrap_or_default()
         )),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn pieces_materials_and_malformed_ones() {
-        let d = read(
-            r#"<robot name="r">
-<material name="red"><color rgba="1 0 0 1"/></material>
-<link name="a">
-  <visual><origin xyz="1 2 3" rpy="0 0 1.5707963267948966"/>
-    <geometry><mesh filename="package://p/m.dae" scale="2 2 2"/></geometry>
-    <material name="red"><texture/></material></visual>
-  <visual><geometry><sphere radius="oops"/></geometry></visual>
-  <visual><origin quat_xyzw="0 0 0 1"/><geometry><cylinder radius="1" length="2"/></geometry>
-    <material name=""><color rgba="0 1 0 0.5"/></material></visual>
-  <collision><geometry><box size="1 2 3"/></geometry></collision>
-  <visual/>
-</link>
-<gazebo reference="a"><material>Gazebo/Red</material></gazebo>
-<link name="b"/>
-</robot>"#,
-        )
-        .unwrap();
-        assert_eq!(d.materials.get("red"), Some(&[1.0, 0.0, 0.0, 1.0]));
-        assert_eq!(d.links.len(), 2);
-        let a = &d.links[0];
-        assert_eq!(a.visuals.len(), 2);
-        assert_eq!(
-            a.visuals[0].shape,
-            Shape::Mesh {
-                filename: "package://p/m.dae".into(),
-                scale: [2.0; 3]
-            }
-        );
-        assert_eq!(a.visuals[0].material.as_deref(), Some("red"));
-        assert_eq!(a.visuals[0].xyz, Vector3::new(1.0, 2.0, 3.0));
-        // rpy (0, 0, π/2) maps x to y.
-        assert!((a.visuals[0].rot * Vector3::x() - Vector3::y()).norm() < 1e-15);
-        assert_eq!(
-            a.visuals[1].shape,
-            Shape::Cylinder {
-                radius: 1.0,
-                length: 2.0
-            }
-        );
-        assert_eq!(a.visuals[1].color, Some([0.0, 1.0, 0.0, 0.5]));
-        assert_eq!(a.visuals[1].material, None);
-        assert_eq!(
-            a.collisions[0].shape,
-            Shape::Box {
-                size: [1.0, 2.0, 3.0]
-            }
-        );
-        assert_eq!(d.warnings.len(), 2, "{:?}", d.warnings);
-        assert!(d.warnings[0].contains("link \"a\": <visual> <sphere radius=\"oops\">"));
-        assert!(d.warnings[1].contains("has no <geometry>"));
     }
 }

@@ -94,7 +94,7 @@ impl<'a> HullRef<'a> {
 
 /// The face a hull may rest on, in the other shape's frame.
 #[derive(Clone, Copy)]
-pub(crate) enum FaceShape<'a> {
+pub enum FaceShape<'a> {
     /// A box (half extents).
     Cuboid(&'a Cuboid),
     /// A height field (parry's: its grid in its x–z plane, heights along y).
@@ -103,7 +103,7 @@ pub(crate) enum FaceShape<'a> {
 
 impl<'a> FaceShape<'a> {
     /// The face shape of a parry shape, if it is one.
-    pub fn of(shape: &'a dyn Shape) -> Option<Self> {
+    pub(crate) fn of(shape: &'a dyn Shape) -> Option<Self> {
         if let Some(c) = shape.as_cuboid() {
             Some(Self::Cuboid(c))
         } else {
@@ -116,7 +116,7 @@ impl<'a> FaceShape<'a> {
 /// face's plane (negative: below) and the plane's unit normal, all in the
 /// face shape's frame.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct FacePoint {
+pub struct FacePoint {
     /// The hull's vertex index.
     pub vertex: usize,
     /// The vertex in the face shape's frame.
@@ -127,11 +127,11 @@ pub(crate) struct FacePoint {
 
 /// The points are the vertices at most this far (m) above the lowest one
 /// (and within the margin), as the ground path's patch (`BAND` there).
-const BAND: f64 = 2e-3;
+pub(crate) const BAND: f64 = 2e-3;
 
 /// What the fast path found.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum FaceContact {
+pub enum FaceContact {
     /// The plane contact applies: the points (within the margin) were
     /// appended; the plane's unit normal in the face shape's frame.
     Plane(Vector3<f64>),
@@ -141,8 +141,9 @@ pub(crate) enum FaceContact {
     Other,
 }
 
+/// parry's vector as nalgebra's.
 #[inline]
-fn to_v(p: PVec) -> Vector3<f64> {
+pub(crate) fn to_v(p: PVec) -> Vector3<f64> {
     Vector3::new(p.x, p.y, p.z)
 }
 
@@ -533,6 +534,3 @@ fn collect(
         }
     }
 }
-
-#[cfg(test)]
-mod tests;

@@ -25,20 +25,22 @@ use nalgebra::Vector3;
 use parry3d_f64::query::{ContactManifold, ContactManifoldsWorkspace};
 use std::path::PathBuf;
 
-mod apart;
+pub(crate) mod apart;
 mod order;
 use apart::{apart_along, still_apart};
 use order::assign_slots;
 
 /// One shape of pair contact.
 #[derive(Clone, Debug)]
-struct Member {
+pub struct Member {
     /// Index into the model's collisions.
-    geom: usize,
-    body: usize,
+    pub geom: usize,
+    /// Its body.
+    pub body: usize,
     /// `body_M_parry`.
-    placement: Se3<f64>,
-    shape: PairShape,
+    pub placement: Se3<f64>,
+    /// The shape (parry's, and its sphere/capsule form).
+    pub shape: PairShape,
 }
 
 /// The persistent state of one allowed pair, made when its boxes first

@@ -1,8 +1,8 @@
 //! Property tests of the spatial algebra (proptest): structured forms against the
-//! 6x6 matrices, group identities and invariants.
-use super::*;
-use nalgebra::{Matrix6, Vector3, Vector6};
+//! 6x6 matrices, group identities and invariants (formerly `src/spatial/tests.rs`).
 use proptest::prelude::*;
+use urdyn::nalgebra::{self, Matrix6, Vector3, Vector6};
+use urdyn::spatial::*;
 
 fn v3() -> impl Strategy<Value = Vector3<f64>> {
     (-2.0..2.0f64, -2.0..2.0f64, -2.0..2.0f64).prop_map(|(a, b, c)| Vector3::new(a, b, c))
@@ -132,7 +132,7 @@ proptest! {
     /// the rounding of the fused products on an FMA build, bit-equal otherwise).
     #[test]
     fn ops_kernels_match_nalgebra(a in v3(), b in v3(), x in se3(), y in se3()) {
-        use super::ops::*;
+        use urdyn::spatial::ops::*;
         let close = |p: &Vector3<f64>, q: &Vector3<f64>| (p - q).norm() <= 1e-14 * (1.0 + q.norm());
         prop_assert!(close(&cross(&a, &b), &a.cross(&b)));
         prop_assert!(close(&add_cross(&b, &a, &b), &(b + a.cross(&b))));

@@ -1,6 +1,20 @@
-//! The mesh readers' tests.
+//! The mesh readers' tests (formerly `src/mesh/tests.rs`).
 
-use super::*;
+use std::path::Path;
+use urdyn::mesh::*;
+use urdyn::nalgebra::Vector3;
+use urdyn::testing::mesh::read_dae_colored;
+
+/// Positions of a COLLADA document (`src/mesh/mod.rs`'s module doc).
+fn read_dae_positions(text: &str) -> Result<Vec<[f64; 3]>, String> {
+    read_dae(text).map(|(p, _)| p)
+}
+
+/// Positions of a COLLADA document and the triangles of the placed geometries'
+/// primitives.
+fn read_dae(text: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), String> {
+    read_dae_colored(text).map(|d| (d.positions, d.triangles))
+}
 
 #[test]
 fn dae_positions_and_unit() {

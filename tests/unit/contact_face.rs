@@ -1,16 +1,21 @@
 //! The face path's tests: against parry's distances, and the dense first
-//! pass against the whole band.
+//! pass against the whole band (formerly `src/contact/face/tests.rs`).
 
-use super::*;
-use crate::contact::narrow::{reduce_pair, Raw, EXTREME_BAND};
-use crate::contact::ContactPoint;
-use parry3d_f64::math::Pose;
-use parry3d_f64::shape::SharedShape;
+use super::superellipsoid;
+use parry3d_f64::math::{Pose, Vector as PVec};
+use parry3d_f64::shape::{Cuboid, Shape, SharedShape};
+use urdyn::contact::ContactPoint;
+use urdyn::nalgebra::{self, Vector3};
+use urdyn::spatial::Se3;
+use urdyn::testing::contact::{
+    hull_on_face, reduce_pair, to_pose, to_v, FaceContact, FacePoint, FaceShape, Raw, TestHull,
+    BAND, EXTREME_BAND,
+};
 
 /// A rounded box hull (many vertices: the climbing kind): points on a
 /// superellipsoid of half extents 0.05 × 0.03 × 0.02.
-fn rounded() -> ClimbHull {
-    crate::contact::hull::superellipsoid([0.05, 0.03, 0.02], 0.4)
+fn rounded() -> TestHull {
+    superellipsoid([0.05, 0.03, 0.02], 0.4)
 }
 
 fn at(x: f64, y: f64, z: f64, roll: f64) -> Se3<f64> {
@@ -21,35 +26,27 @@ fn at(x: f64, y: f64, z: f64, roll: f64) -> Se3<f64> {
     }
 }
 
-fn run(h: &ClimbHull, pose: &Se3<f64>, face: FaceShape<'_>) -> (FaceContact, Vec<FacePoint>) {
+fn run(h: &TestHull, pose: &Se3<f64>, face: FaceShape<'_>) -> (FaceContact, Vec<FacePoint>) {
     run_dense(h, pose, face, None)
 }
 
 fn run_dense(
-    h: &ClimbHull,
+    h: &TestHull,
     pose: &Se3<f64>,
     face: FaceShape<'_>,
     dense: Option<(f64, usize)>,
 ) -> (FaceContact, Vec<FacePoint>) {
     let (mut out, mut stack, mut seen) = (Vec::new(), Vec::new(), Vec::new());
     let c = hull_on_face(
-        HullRef::Climb(h),
-        pose,
-        face,
-        0.005,
-        dense,
-        &mut out,
-        &mut stack,
-        &mut seen,
-        1,
+        h, pose, face, 0.005, dense, &mut out, &mut stack, &mut seen, 1,
     );
     (c, out)
 }
 
 /// parry's signed distance between the hull at `pose` and `other`.
-fn parry_dist(h: &ClimbHull, pose: &Se3<f64>, other: &dyn Shape) -> f64 {
-    let p = crate::contact::shapes::to_pose(pose);
-    parry3d_f64::query::contact(&p, h, &Pose::IDENTITY, other, 1.0)
+fn parry_dist(h: &TestHull, pose: &Se3<f64>, other: &dyn Shape) -> f64 {
+    let p = to_pose(pose);
+    parry3d_f64::query::contact(&p, h.shape(), &Pose::IDENTITY, other, 1.0)
         .ok()
         .flatten()
         .map_or(f64::INFINITY, |c| c.dist)
@@ -161,7 +158,7 @@ fn reduced(pts: &[FacePoint], n: Vector3<f64>) -> Vec<(u64, f64, Vector3<f64>)> 
         })
         .collect();
     let mut out = Vec::new();
-    reduce_pair(&raw, 4, &mut out, |r| ContactPoint {
+    reduce_pair(&raw, 4, &mut out, &|r| ContactPoint {
         shape: 0,
         slot: 0,
         body: 1,
@@ -188,7 +185,7 @@ fn the_dense_first_pass_keeps_what_the_reduction_of_the_whole_band_keeps() {
     let mut fewer = 0;
     for (k, roll) in [0.0, 0.01, 0.05, 0.3, 1.0].into_iter().enumerate() {
         for depth in [0.0005, -0.001, -0.004] {
-            let z = 0.1 + h.compute_local_aabb().half_extents().z + depth;
+            let z = 0.1 + h.shape().compute_local_aabb().half_extents().z + depth;
             let pose = at(0.02 * k as f64 - 0.04, 0.01, z, roll);
             let full = run_dense(&h, &pose, FaceShape::Cuboid(&b), None);
             let dense = run_dense(&h, &pose, FaceShape::Cuboid(&b), Some((EXTREME_BAND, 5)));

@@ -2,6 +2,13 @@
 //! (`BitMapBackend::with_buffer`), the `png` crate writes it. Text is drawn in
 //! the DejaVu Sans shipped in `assets/fonts/` (plotters' pure-Rust `ab_glyph`
 //! renderer): no system font library or font is needed.
+//!
+//! A crate of its own (a dev-dependency of urdyn, by path), not a `#[path]` module of
+//! each example: plotters' generic drawing code is compiled and optimised once here,
+//! beside the library's build, instead of once in every example that plots (six of
+//! them in `cargo test --release`; README §"Two commands").
+
+pub use plotters;
 
 use std::error::Error;
 use std::path::Path;
@@ -9,7 +16,7 @@ use std::path::Path;
 /// Registers the shipped DejaVu Sans as plotters' `"sans-serif"` (call once,
 /// before drawing any text).
 pub fn register_font() -> Result<(), Box<dyn Error>> {
-    static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+    static DEJAVU_SANS: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
     plotters::style::register_font(
         "sans-serif",
         plotters::style::FontStyle::Normal,
@@ -46,7 +53,6 @@ pub fn write_png(path: &Path, rgb: &[u8], size: (u32, u32)) -> Result<(), Box<dy
 
 /// The columns `names` of the CSV trajectory `csv` (as `urdyn simulate --out`
 /// writes it), each a vector of its rows' values.
-#[allow(dead_code)] // not every example reads a trajectory back
 pub fn read_columns(csv: &Path, names: &[&str]) -> Result<Vec<Vec<f64>>, Box<dyn Error>> {
     let text = std::fs::read_to_string(csv)?;
     let mut lines = text.lines();
@@ -72,7 +78,6 @@ pub fn read_columns(csv: &Path, names: &[&str]) -> Result<Vec<Vec<f64>>, Box<dyn
 
 /// One panel of [`plot_panels`]: its title, its y axis label (with units), its
 /// values, its colour, and whether they are a count (integer ticks from 0).
-#[allow(dead_code)]
 pub struct Panel<'a> {
     pub title: &'a str,
     pub ylabel: &'a str,
@@ -83,7 +88,6 @@ pub struct Panel<'a> {
 
 /// Plots `panels` one above the other against the time `t` (s, 0 to `t_end`),
 /// 1000 px wide and 300 px a panel, into the PNG `png`.
-#[allow(dead_code)]
 pub fn plot_panels(
     png: &Path,
     t: &[f64],

@@ -1,0 +1,298 @@
+//! Internals that the tests under `tests/unit/` exercise: not part of the API (hidden
+//! from the documentation, no stability promised). These tests were `#[cfg(test)]`
+//! modules in `src/`; out here, `cargo test --release` no longer compiles the whole
+//! library a second time as a test harness (`[lib] test = false` in Cargo.toml, README
+//! §"Two commands").
+//!
+//! Only thin wrappers are exported: each `pub fn` here calls a `pub(crate)` function
+//! of the engine, which keeps its crate-internal linkage (rustc exports only what is
+//! reachable from outside the crate; an internal function can be internalised and
+//! inlined at its call sites as before). So the wrappers are neither generic nor
+//! `#[inline]` (either would make what they call reachable), types may be `pub` (a
+//! type's visibility does not change its code), but their methods that the engine
+//! calls stay `pub(crate)`, called here; a type with trait impls on the engine's hot
+//! path (the climbing hull's support map) stays `pub(crate)` behind a newtype. A new
+//! test of an internal goes under `tests/unit/` and, if it needs one, a wrapper here.
+
+/// Mesh files: the COLLADA reader and the cache of made meshes.
+pub mod mesh {
+    pub use crate::mesh::dae::DaeMesh;
+    use std::path::Path;
+    use std::sync::Arc;
+
+    /// `mesh::dae::read_dae_colored`.
+    pub fn read_dae_colored(text: &str) -> Result<DaeMesh, String> {
+        crate::mesh::dae::read_dae_colored(text)
+    }
+
+    /// `mesh::cache::cached` for a text made by `make`.
+    pub fn cached_text(
+        kind: &'static str,
+        path: &Path,
+        scale: [f64; 3],
+        make: &dyn Fn() -> Result<String, String>,
+    ) -> Result<Arc<String>, String> {
+        crate::mesh::cache::cached(kind, path, scale, make)
+    }
+}
+
+/// Contact: the hull that climbs to its support point, the face path, the
+/// narrow phase's points, the pairs' "still apart" test and the travel bounds.
+pub mod contact {
+    use crate::contact::face::HullRef;
+    use crate::contact::hull::ClimbHull;
+    use crate::spatial::Se3;
+    use nalgebra::Vector3;
+    use parry3d_f64::math::{Pose, Vector as PVec};
+    use parry3d_f64::query::{ContactManifold, ContactManifoldsWorkspace};
+    use parry3d_f64::shape::{
+        ConvexPolyhedron, PolygonalFeature, PolygonalFeatureMap, Shape, SharedShape,
+    };
+
+    pub use crate::contact::broad::{PairTable, SweepAndPrune};
+    pub use crate::contact::face::{FaceContact, FacePoint, FaceShape};
+    pub use crate::contact::narrow::prim::Round;
+    pub use crate::contact::narrow::Raw;
+    pub use crate::contact::pairs::Member;
+    pub use crate::contact::shapes::PairShape;
+    pub use crate::contact::ContactPoint;
+
+    /// `contact::face::BAND`.
+    pub const BAND: f64 = crate::contact::face::BAND;
+    /// `contact::narrow::EXTREME_BAND`.
+    pub const EXTREME_BAND: f64 = crate::contact::narrow::EXTREME_BAND;
+
+    /// A climbing hull (`contact::hull::ClimbHull`, which stays crate-internal with
+    /// its parry trait impls).
+    #[derive(Clone, Debug)]
+    pub struct TestHull(ClimbHull);
+
+    impl TestHull {
+        /// `ClimbHull::of_points`.
+        pub fn of_points(points: &[PVec]) -> Option<Result<Self, ConvexPolyhedron>> {
+            ClimbHull::of_points(points).map(|r| r.map(Self))
+        }
+        /// `ClimbHull::support_index`.
+        pub fn support_index(&self, d: PVec) -> (usize, f64) {
+            self.0.support_index(d)
+        }
+        /// `ClimbHull::points`.
+        pub fn points(&self) -> &[PVec] {
+            self.0.points()
+        }
+        /// Its parry hull of the points.
+        pub fn hull(&self) -> &ConvexPolyhedron {
+            &self.0.hull
+        }
+        /// `ClimbHull`'s `PolygonalFeatureMap::local_support_feature`.
+        pub fn support_feature(&self, d: PVec, out: &mut PolygonalFeature) {
+            self.0.local_support_feature(d, out)
+        }
+        /// The hull as a parry shape (its own trait impls, through their vtable).
+        pub fn shape(&self) -> &dyn Shape {
+            &self.0
+        }
+        /// The hull as a shared parry shape.
+        pub fn shared(self) -> SharedShape {
+            SharedShape::new(self.0)
+        }
+    }
+
+    /// `contact::face::hull_on_face` of a climbing hull.
+    #[allow(clippy::too_many_arguments)]
+    pub fn hull_on_face(
+        hull: &TestHull,
+        b_m_a: &Se3<f64>,
+        face: FaceShape<'_>,
+        margin: f64,
+        dense: Option<(f64, usize)>,
+        out: &mut Vec<FacePoint>,
+        stack: &mut Vec<u32>,
+        seen: &mut Vec<u32>,
+        stamp: u32,
+    ) -> FaceContact {
+        crate::contact::face::hull_on_face(
+            HullRef::Climb(&hull.0),
+            b_m_a,
+            face,
+            margin,
+            dense,
+            out,
+            stack,
+            seen,
+            stamp,
+        )
+    }
+
+    /// `contact::face::to_v`.
+    pub fn to_v(p: PVec) -> Vector3<f64> {
+        crate::contact::face::to_v(p)
+    }
+
+    /// `contact::shapes::to_pose`.
+    pub fn to_pose(m: &Se3<f64>) -> Pose {
+        crate::contact::shapes::to_pose(m)
+    }
+
+    /// `PairShape::new`.
+    pub fn pair_shape(shape: SharedShape, offset: Se3<f64>, convex: bool) -> PairShape {
+        PairShape::new(shape, offset, convex)
+    }
+
+    /// `contact::narrow::reduce_pair`, each kept point made by `make`.
+    pub fn reduce_pair(
+        raw: &[Raw],
+        maxp: usize,
+        out: &mut Vec<ContactPoint>,
+        make: &dyn Fn(&Raw) -> ContactPoint,
+    ) {
+        crate::contact::narrow::reduce_pair(raw, maxp, out, make)
+    }
+
+    /// `contact::narrow::parry_points`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn parry_points(
+        a: &PairShape,
+        b: &PairShape,
+        wa: &Se3<f64>,
+        wb: &Se3<f64>,
+        margin: f64,
+        manifolds: &mut Vec<ContactManifold<(), ()>>,
+        workspace: &mut Option<ContactManifoldsWorkspace>,
+        raw: &mut Vec<Raw>,
+    ) {
+        crate::contact::narrow::parry_points(a, b, wa, wb, margin, manifolds, workspace, raw)
+    }
+
+    /// `Round::of`.
+    pub fn round_of(s: &PairShape, w: &Se3<f64>) -> Option<Round> {
+        Round::of(s, w)
+    }
+
+    /// `contact::narrow::prim::round_points`.
+    pub fn round_points(
+        a: &PairShape,
+        b: &PairShape,
+        wa: &Se3<f64>,
+        wb: &Se3<f64>,
+        margin: f64,
+        raw: &mut Vec<Raw>,
+    ) -> bool {
+        crate::contact::narrow::prim::round_points(a, b, wa, wb, margin, raw)
+    }
+
+    /// `contact::pairs::apart::apart_along`.
+    pub fn apart_along(
+        u: &Vector3<f64>,
+        a: &Member,
+        b: &Member,
+        wa: &Se3<f64>,
+        wb: &Se3<f64>,
+    ) -> f64 {
+        crate::contact::pairs::apart::apart_along(u, a, b, wa, wb)
+    }
+
+    /// `contact::pairs::apart::still_apart`.
+    pub fn still_apart(
+        then: Option<&(f64, Se3<f64>, Se3<f64>)>,
+        a: &Member,
+        b: &Member,
+        wa: &Se3<f64>,
+        wb: &Se3<f64>,
+        margin: f64,
+    ) -> bool {
+        crate::contact::pairs::apart::still_apart(then, a, b, wa, wb, margin)
+    }
+
+    /// `contact::travel::margin`.
+    pub fn margin(delta: f64, c: f64, s: f64) -> f64 {
+        crate::contact::travel::margin(delta, c, s)
+    }
+
+    /// `contact::travel::moved`.
+    pub fn moved(w0: &Se3<f64>, w: &Se3<f64>, mid: &Vector3<f64>, radius: f64) -> f64 {
+        crate::contact::travel::moved(w0, w, mid, radius)
+    }
+
+    /// `contact::travel::dropped`.
+    pub fn dropped(then: &[f64; 4], z: f64, r: [f64; 3], radius: f64) -> f64 {
+        crate::contact::travel::dropped(then, z, r, radius)
+    }
+
+    /// `PairTable::new`.
+    pub fn table_new(n: usize) -> PairTable {
+        PairTable::new(n)
+    }
+
+    /// `PairTable::allow`.
+    pub fn table_allow(t: &mut PairTable, i: usize, j: usize) {
+        t.allow(i, j)
+    }
+
+    /// `PairTable::allowed`.
+    pub fn table_allowed(t: &PairTable, i: usize, j: usize) -> bool {
+        t.allowed(i, j)
+    }
+
+    /// `PairTable::set`.
+    pub fn table_set(t: &mut PairTable, i: usize, j: usize, p: u32) {
+        t.set(i, j, p)
+    }
+
+    /// `SweepAndPrune::new`.
+    pub fn sap_new(n: usize) -> SweepAndPrune {
+        SweepAndPrune::new(n)
+    }
+
+    /// `SweepAndPrune::set`.
+    pub fn sap_set(s: &mut SweepAndPrune, i: usize, c: [f64; 3], h: [f64; 3]) {
+        s.set(i, c, h)
+    }
+
+    /// `SweepAndPrune::overlaps`.
+    pub fn sap_overlaps(
+        s: &mut SweepAndPrune,
+        table: &PairTable,
+        out: &mut Vec<u32>,
+        fresh: &mut Vec<(u32, u32)>,
+    ) {
+        s.overlaps(table, out, fresh)
+    }
+}
+
+/// The replay page's pieces (the `cli` feature).
+#[cfg(feature = "cli")]
+pub mod view {
+    pub use crate::cli::view::visuals::{Drawables, LinkPieces, Piece};
+    use crate::mesh::TriMesh;
+    use crate::scene::HeightFieldSpec;
+    use nalgebra::Vector3;
+
+    /// `cli::view::geometry::DEFAULT_RGBA`.
+    pub const DEFAULT_RGBA: [f64; 4] = crate::cli::view::geometry::DEFAULT_RGBA;
+
+    /// `cli::view::geometry::triangle_limit`.
+    pub fn triangle_limit(counts: &[usize], per_mesh: usize, total: usize) -> usize {
+        crate::cli::view::geometry::triangle_limit(counts, per_mesh, total)
+    }
+
+    /// `cli::view::geometry::bounds`.
+    pub fn bounds(m: &TriMesh) -> (Vector3<f64>, Vector3<f64>) {
+        crate::cli::view::geometry::bounds(m)
+    }
+
+    /// `cli::view::page::base64`.
+    pub fn base64(bytes: &[u8]) -> String {
+        crate::cli::view::page::base64(bytes)
+    }
+
+    /// `cli::view::scene::height_field_mesh`.
+    pub fn height_field_mesh(h: &HeightFieldSpec) -> TriMesh {
+        crate::cli::view::scene::height_field_mesh(h)
+    }
+
+    /// `cli::view::visuals::read`.
+    pub fn read_visuals(text: &str) -> Result<Drawables, String> {
+        crate::cli::view::visuals::read(text)
+    }
+}

@@ -1,0 +1,54 @@
+//! The library's unit tests: formerly `#[cfg(test)]` modules in `src/` (each file
+//! names its source), now modules of this binary, so that `cargo test --release`
+//! compiles the library once, not a second time as a test harness (Cargo.toml's
+//! `[lib] test = false`). The internals they exercise come from the hidden
+//! `urdyn::testing` (src/testing.rs); a new test of an internal goes here.
+
+mod cli_output;
+mod contact_apart;
+mod contact_broad;
+mod contact_face;
+mod contact_hull;
+mod contact_narrow;
+mod contact_prim;
+mod contact_travel;
+mod mesh_cache;
+mod mesh_dae;
+mod mesh_inertia;
+mod scene_srdf;
+mod sim_build;
+mod spatial;
+mod view_geometry;
+mod view_page;
+mod view_scene;
+mod view_trajectory;
+mod view_visuals;
+
+use parry3d_f64::math::Vector as PVec;
+use urdyn::testing::contact::TestHull;
+
+/// A superellipsoid's hull of 266 points (`|x/a|^(2/p) + ... = 1` sampled on
+/// a 24 × 11 grid plus the poles): the climbing kind of hull, many vertices.
+pub(crate) fn superellipsoid(half: [f64; 3], power: f64) -> TestHull {
+    let mut pts = Vec::new();
+    for i in 0..24 {
+        for j in 1..12 {
+            let (th, ph) = (
+                std::f64::consts::TAU * i as f64 / 24.0,
+                std::f64::consts::PI * j as f64 / 12.0,
+            );
+            let f = |c: f64| c.signum() * c.abs().powf(power);
+            pts.push(PVec::new(
+                half[0] * f(ph.sin() * th.cos()),
+                half[1] * f(ph.sin() * th.sin()),
+                half[2] * f(ph.cos()),
+            ));
+        }
+    }
+    pts.push(PVec::new(0.0, 0.0, half[2]));
+    pts.push(PVec::new(0.0, 0.0, -half[2]));
+    match TestHull::of_points(&pts) {
+        Some(Ok(h)) => h,
+        _ => panic!("a large hull"),
+    }
+}
