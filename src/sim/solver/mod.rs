@@ -129,7 +129,7 @@ pub struct Rows {
 }
 
 /// Every how many steps a jointed island's self-stress is shed (stress.rs).
-pub const SHED_EVERY: u64 = 10;
+pub const SHED_EVERY: u64 = 50;
 
 /// Most rows a subspace step solves directly (its dense W_FF is this square).
 pub const SUBSPACE_MAX: usize = 16;
