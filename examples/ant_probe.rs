@@ -4,8 +4,12 @@
 //! `cargo run --release --features tools --example ant_probe [T0 T1]`
 //! (env: DT, ITERS, TOL, RELAX, SLOP, BAUM, PUSH, MARGIN, MU, ARM, TRAVEL (the
 //! speculative margin's factor; `urdyn simulate` uses 1.5), EVERY; FORCES=1
-//! also prints each contact's force and |f_t|/f_n).
+//! also prints each contact's force and |f_t|/f_n). `SCENE=FILE.json` runs a
+//! scene instead (sleep off, `WINDOW` s windows, default 0.25): per window
+//! the solve's work a step (rows × sweeps, `Simulation::solve_work`), the
+//! most sweeps a step, contacts and largest |v|, and the totals at the end.
 use urdyn::mjcf;
+use urdyn::scene::Scene;
 use urdyn::sim::{Integrator, SimOptions, Simulation};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -13,6 +17,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let t0: f64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(0.0);
     let t1: f64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(40.0);
     let env = |k: &str| std::env::var(k).ok().and_then(|s| s.parse::<f64>().ok());
+    if let Ok(scene) = std::env::var("SCENE") {
+        return scene_probe(&scene, t0, t1, env("WINDOW").unwrap_or(0.25));
+    }
     // MODEL: another fixture under tests/fixtures/mjcf (e.g. dm_control/dog)
     let name = std::env::var("MODEL").unwrap_or_else(|_| "gymnasium/ant".into());
     let path = format!(
@@ -123,5 +130,52 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
+    Ok(())
+}
+
+/// `SCENE=FILE.json`: per window of `w` s from 0 to `t1` (sleep off), the
+/// solve's work a step, the most sweeps of a step, contacts and |v|max.
+fn scene_probe(file: &str, t0: f64, t1: f64, w: f64) -> Result<(), Box<dyn std::error::Error>> {
+    let scene = Scene::from_file(file, &[])?;
+    let mut opts = SimOptions {
+        ground: scene.ground.map(|g| g.height),
+        sleep: false,
+        ..SimOptions::default()
+    };
+    if let Some(g) = scene.ground {
+        opts.contact.friction = g.friction;
+    }
+    let mut sim = Simulation::new_at(scene.model.clone(), opts, &scene.q0, &scene.v0)?;
+    let (mut work0, mut steps, mut most) = (sim.solve_work(), 0u64, 0u64);
+    let mut next = w;
+    let start = std::time::Instant::now();
+    while sim.time() < t1 - 1e-9 {
+        let s0 = sim.pgs_sweeps;
+        sim.step()?;
+        steps += 1;
+        most = most.max(sim.pgs_sweeps - s0);
+        if sim.time() >= next - 1e-9 {
+            if sim.time() >= t0 - 1e-9 {
+                println!(
+                    "t {:.2} work/step {:.1} max sweeps {} contacts {} vmax {:.3e}",
+                    sim.time(),
+                    (sim.solve_work() - work0) as f64 / steps as f64,
+                    most,
+                    sim.active_contacts(),
+                    sim.v().amax()
+                );
+            }
+            work0 = sim.solve_work();
+            steps = 0;
+            most = 0;
+            next += w;
+        }
+    }
+    println!(
+        "total work {} sweeps {} wall {:.3} s",
+        sim.solve_work(),
+        sim.pgs_sweeps,
+        start.elapsed().as_secs_f64()
+    );
     Ok(())
 }

@@ -26,7 +26,7 @@ use super::newton::Newton;
 use super::solver::{RowKind, Rows, Scratch};
 use super::{ContactForce, Solver};
 use crate::contact::{tangents, ContactPoint};
-use crate::model::Model;
+use crate::model::{JointKind, Model};
 use crate::spatial::{Force, Motion, Se3};
 use nalgebra::{DVector, Vector3};
 
@@ -185,6 +185,17 @@ impl Constraints {
         let longest = (0..nv).map(|d| f.path_of(d).1).max().unwrap_or(0);
         let mut rows = Rows::new(nv, cap, 2 * longest);
         rows.set_table(f.table(), pair_points);
+        // the dofs of joints other than free ones: islands reaching one shed
+        // their self-stress (solver/stress.rs)
+        let mut jointed = vec![false; nv];
+        for j in model.joints.iter().skip(1) {
+            if j.kind != JointKind::Free {
+                for x in jointed.iter_mut().skip(j.iv).take(j.nv()) {
+                    *x = true;
+                }
+            }
+        }
+        rows.set_jointed(&jointed);
         let rows_scratch = rows.scratch();
         Self {
             rows,
@@ -243,6 +254,8 @@ impl Constraints {
 
     /// Forgets the warm starts (a new state was set).
     pub fn reset_warm_start(&mut self) {
+        // the self-stress shedding's count of solves goes with them
+        self.rows.forget_solves();
         self.warm_contact.iter_mut().for_each(|w| *w = [0.0; 3]);
         self.spin.reset();
         if let Some(l) = self.loops.as_mut() {

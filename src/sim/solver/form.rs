@@ -6,7 +6,7 @@ use super::{MassFactor, RowKind, Rows};
 impl Rows {
     /// Fills y with the rows of Y = J R⁻ᵀ (H̃ = RᵀR, [`MassFactor`]), each over
     /// its path, the Delassus diagonal Wᵣᵣ = jᵣ·H̃⁻¹jᵣ = ‖yᵣ‖² and c = J v* for
-    /// the free velocity `vfree`.
+    /// the free velocity `vfree`; counts the step ([`Rows::begin_solve`]).
     pub fn form(&mut self, f: &MassFactor, vfree: &[f64]) {
         let (nv, n, st) = (self.nv, self.n, self.stride);
         if vfree.len() < nv || self.j.len() < n * st || self.y.len() < n * st {
@@ -67,6 +67,7 @@ impl Rows {
             *wi = if *w > 1e-14 { 1.0 / w } else { 0.0 };
         }
         self.table = table_v;
+        self.begin_solve();
     }
 
     /// A contact's three rows `r..r + 3` on `path` formed as [`Rows::form`]

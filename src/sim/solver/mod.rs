@@ -23,6 +23,7 @@ mod form;
 mod loop_block;
 mod pgs;
 mod position;
+mod stress;
 mod subspace;
 
 pub(crate) use pgs::{IslandOut, Scratch};
@@ -117,7 +118,18 @@ pub struct Rows {
     static_len: usize,
     /// The last union made: its two paths and where it is.
     last_union: ((usize, usize), (usize, usize), (usize, usize)),
+    /// Each dof: a joint's other than a free one ([`Rows::set_jointed`]).
+    jointed: Vec<bool>,
+    /// Some dof is jointed.
+    any_jointed: bool,
+    /// Solves so far ([`Rows::begin_solve`]).
+    solves: u64,
+    /// This solve sheds the self-stress of its jointed islands.
+    shed_now: bool,
 }
+
+/// Every how many steps a jointed island's self-stress is shed (stress.rs).
+pub const SHED_EVERY: u64 = 50;
 
 /// Most rows a subspace step solves directly (its dense W_FF is this square).
 pub const SUBSPACE_MAX: usize = 16;
@@ -151,6 +163,10 @@ impl Rows {
             table: Vec::new(),
             static_len: 0,
             last_union: ((0, 0), (0, 0), (0, 0)),
+            jointed: vec![false; nv],
+            any_jointed: false,
+            solves: 0,
+            shed_now: false,
         }
     }
     /// Takes the factor's path table (`base`, [`MassFactor::table`]) with room
@@ -293,6 +309,25 @@ impl Rows {
         self.bpos[r..r + 3].fill(0.0);
         self.path[r..r + 3].fill(path);
         Some(r)
+    }
+    /// Marks the dofs of joints other than free ones (`jointed[d]`, nv
+    /// entries): the contacts whose rows reach one get
+    /// the self-stress shedding of stress.rs.
+    pub fn set_jointed(&mut self, jointed: &[bool]) {
+        self.jointed = jointed.to_vec();
+        self.any_jointed = jointed.iter().any(|&j| j);
+    }
+    /// Counts the step's solve: every [`SHED_EVERY`]-th one sheds the
+    /// self-stress of jointed islands (stress.rs).
+    pub fn begin_solve(&mut self) {
+        self.solves = self.solves.wrapping_add(1);
+        self.shed_now = self.any_jointed && self.solves % SHED_EVERY == 0;
+    }
+    /// Forgets the solves counted (with the warm starts: a state set anew
+    /// steps as a new simulation does).
+    pub fn forget_solves(&mut self) {
+        self.solves = 0;
+        self.shed_now = false;
     }
     /// Where dof `d` lies on row `r`'s path (`None`: off it, J is 0 there).
     fn slot_of(&self, r: usize, d: usize) -> Option<usize> {

@@ -197,6 +197,7 @@ impl Rows {
         let mut finishing = false;
         let mut attempts = 0;
         let mut polished = false;
+        let mut converged = false;
         while it < max_iter {
             it += 1;
             let plain = it <= PLAIN || finishing || polished || 2 * it > max_iter || relax == 1.0;
@@ -343,6 +344,7 @@ impl Rows {
                 change = change.max(lb.solve(&view, Some(c), b, lambda, dv));
             }
             if finishing || (change <= tol && plain) {
+                converged = true;
                 break;
             }
             if change <= tol {
@@ -372,6 +374,10 @@ impl Rows {
                     }
                 }
             }
+        }
+        // a converged island on joints: its self-stress shed (stress.rs)
+        if converged && !block && self.sheds(dofs) {
+            self.shed_self_stress(&mut out.sm.0, runs, lambda, dv, tol);
         }
         out.sm.0.loops = lb;
         (it, polished)

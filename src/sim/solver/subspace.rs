@@ -19,6 +19,11 @@ pub(super) struct Subspace {
     pub(super) sliding: Vec<bool>,
     /// The loop rows' exact block ([`LoopBlock`]).
     pub(super) loops: LoopBlock,
+    /// W_FF's null vectors, one a column of `rows.len()` entries
+    /// (stress.rs).
+    pub(super) null: Vec<f64>,
+    /// Their Gram matrix in the W-diagonal metric (stress.rs).
+    pub(super) gram: Vec<f64>,
 }
 
 impl Subspace {
@@ -32,6 +37,8 @@ impl Subspace {
             x: vec![0.0; nv],
             sliding: vec![false; cap],
             loops: LoopBlock::new(cap),
+            null: vec![0.0; m * m],
+            gram: vec![0.0; m * m],
         }
     }
 }
@@ -45,7 +52,7 @@ impl Subspace {
 /// armature 1 against light legs): kept (the bound was 1e-10), it turned the
 /// step's residual into impulses of 1e7 N·s (docs/theory.md §"Constraint
 /// solve").
-const DEPENDENT: f64 = 1e-6;
+pub(super) const DEPENDENT: f64 = 1e-6;
 
 /// The read-only view of the rows a subspace step needs.
 pub(super) struct Solved<'a> {
