@@ -153,6 +153,20 @@ impl GroundShape {
             _ => 0.0,
         }
     }
+
+    /// Shape `si`'s contact point at slot `slot` (in the detection's slot
+    /// numbering), world point `p`, its gap above the ground at `ground`.
+    #[inline]
+    fn contact_at(&self, si: usize, slot: usize, p: Vector3<f64>, ground: f64) -> ContactPoint {
+        ContactPoint {
+            shape: si,
+            slot,
+            body: self.body,
+            point: p,
+            gap: p.z - ground,
+            ..self.template
+        }
+    }
 }
 
 /// A large hull's patch is chosen among its vertices at most this far (m)
@@ -289,14 +303,7 @@ impl GroundContact {
                 scratch.clear();
                 let mut candidate = |k: usize| {
                     let p = o_m_g.act_point(&s.verts[k]);
-                    scratch.push(ContactPoint {
-                        shape: si,
-                        slot: base + k,
-                        body: s.body,
-                        point: p,
-                        gap: p.z - ground,
-                        ..s.template
-                    });
+                    scratch.push(s.contact_at(si, base + k, p, ground));
                 };
                 // a small vertex set: scanned whole
                 let low = s.verts.iter().map(height).fold(f64::INFINITY, f64::min);
@@ -321,14 +328,7 @@ impl GroundContact {
             let mut push = |slot: usize, p: Vector3<f64>| {
                 let gap = p.z - ground;
                 if gap <= margin {
-                    scratch.push(ContactPoint {
-                        shape: si,
-                        slot: base + slot,
-                        body: s.body,
-                        point: p,
-                        gap,
-                        ..s.template
-                    });
+                    scratch.push(s.contact_at(si, base + slot, p, ground));
                 }
             };
             let down = Vector3::new(0.0, 0.0, -1.0);

@@ -203,14 +203,7 @@ impl GroundContact {
                 c * p.x + sn * p.y
             }
         };
-        let point = |k: usize, p: Vector3<f64>| ContactPoint {
-            shape: si,
-            slot: base + k,
-            body: s.body,
-            point: p,
-            gap: p.z - ground,
-            ..s.template
-        };
+        let point = |k: usize, p: Vector3<f64>| s.contact_at(si, base + k, p, ground);
         if cand.len() <= maxp {
             out.extend(
                 cand.iter()

@@ -122,25 +122,7 @@ impl Rows {
             return false;
         }
         // W_FF's lower triangle (as the subspace step forms it)
-        for (a, &r) in sm.rows.iter().enumerate() {
-            let pa = path(r);
-            let yr = &self.y[r * st..r * st + pa.len()];
-            for (&yt, &k) in yr.iter().zip(pa) {
-                sm.x[k] = yt;
-            }
-            for (b, &q) in sm.rows.iter().enumerate().take(a + 1) {
-                let pq = path(q);
-                let yq = &self.y[q * st..q * st + pq.len()];
-                let mut s = 0.0;
-                for (&yt, &k) in yq.iter().zip(pq) {
-                    s += yt * sm.x[k];
-                }
-                sm.w[a * m + b] = s;
-            }
-            for &k in pa {
-                sm.x[k] = 0.0;
-            }
-        }
+        sm.form_w_ff(&self.y, st, &self.path, table);
         ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
         // null vectors n = L⁻ᵀ eⱼ of the dropped rows j (L unit lower, a
         // dropped row's column below zero: n lives on j and the kept rows

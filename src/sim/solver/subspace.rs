@@ -41,6 +41,47 @@ impl Subspace {
             gram: vec![0.0; m * m],
         }
     }
+
+    /// The lower triangle of W_FF = Y_F Y_Fᵀ over `self.rows` (m of them) into
+    /// `self.w` (m × m, row-major): row r scattered onto its path's dofs in `x`
+    /// (zeros elsewhere, put back after), each entry then a sum over the other
+    /// row's path in its order. A dof off r's path adds y·0 = ±0, which leaves
+    /// every partial sum as it was: the same bits as summing over the two
+    /// paths' common dofs only, without the merge's branches (the cost follows
+    /// the rows' paths, never nv). Rows `r` of `y` have room `st`; row r's
+    /// dofs are `table[paths[r]]`. `x` must hold nv entries, `w` m².
+    pub(super) fn form_w_ff(
+        &mut self,
+        y: &[f64],
+        st: usize,
+        paths: &[(usize, usize)],
+        table: &[usize],
+    ) {
+        let m = self.rows.len();
+        let path = |r: usize| {
+            let (s, l) = paths[r];
+            &table[s..s + l]
+        };
+        for (a, &r) in self.rows.iter().enumerate() {
+            let pa = path(r);
+            let yr = &y[r * st..r * st + pa.len()];
+            for (&yt, &k) in yr.iter().zip(pa) {
+                self.x[k] = yt;
+            }
+            for (bb, &q) in self.rows.iter().enumerate().take(a + 1) {
+                let pq = path(q);
+                let yq = &y[q * st..q * st + pq.len()];
+                let mut s = 0.0;
+                for (&yt, &k) in yq.iter().zip(pq) {
+                    s += yt * self.x[k];
+                }
+                self.w[a * m + bb] = s;
+            }
+            for &k in pa {
+                self.x[k] = 0.0;
+            }
+        }
+    }
 }
 
 /// A pivot of W_FF's LDLᵀ below this fraction of its diagonal is a row
@@ -176,12 +217,7 @@ pub(super) fn subspace_step(
     if m == 0 || m > SUBSPACE_MAX {
         return false;
     }
-    // the residuals b − u and the lower triangle of W_FF = Y_F Y_Fᵀ: row r
-    // scattered onto its path's dofs in `x` (zeros elsewhere, put back after),
-    // each entry then a sum over the other row's path in its order. A dof off
-    // r's path adds y·0 = ±0, which leaves every partial sum as it was: the
-    // same bits as summing over the two paths' common dofs only, without the
-    // merge's branches (the cost follows the rows' paths, never nv)
+    // the residuals b − u, then the lower triangle of W_FF = Y_F Y_Fᵀ
     if sm.x.len() < nv {
         return false;
     }
@@ -191,27 +227,14 @@ pub(super) fn subspace_step(
         let mut u = c[r];
         for (&yt, &k) in yr.iter().zip(pa) {
             u += yt * dv[k];
-            sm.x[k] = yt;
         }
         let target = match kinds[r] {
             RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
             _ => b[r],
         };
         sm.rhs[a] = target - u;
-        let x = &sm.x[..nv];
-        for (bb, &q) in sm.rows.iter().enumerate().take(a + 1) {
-            let pq = path(q);
-            let yq = &y[q * st..q * st + pq.len()];
-            let mut s = 0.0;
-            for (&yt, &k) in yq.iter().zip(pq) {
-                s += yt * x[k];
-            }
-            sm.w[a * m + bb] = s;
-        }
-        for &k in pa {
-            sm.x[k] = 0.0;
-        }
     }
+    sm.form_w_ff(y, st, paths, table);
     // W_FF = L D Lᵀ; a pivot that lost all but `DEPENDENT` of its diagonal
     // is a row dependent on earlier ones (redundant contacts): dropped (δ = 0)
     ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
