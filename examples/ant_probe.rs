@@ -137,14 +137,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// solve's work a step, the most sweeps of a step, contacts and |v|max.
 fn scene_probe(file: &str, t0: f64, t1: f64, w: f64) -> Result<(), Box<dyn std::error::Error>> {
     let scene = Scene::from_file(file, &[])?;
-    let mut opts = SimOptions {
-        ground: scene.ground.map(|g| g.height),
+    let opts = SimOptions {
         sleep: false,
-        ..SimOptions::default()
+        ..SimOptions::of_scene(&scene)
     };
-    if let Some(g) = scene.ground {
-        opts.contact.friction = g.friction;
-    }
     let mut sim = Simulation::new_at(scene.model.clone(), opts, &scene.q0, &scene.v0)?;
     let (mut work0, mut steps, mut most) = (sim.solve_work(), 0u64, 0u64);
     let mut next = w;

@@ -34,13 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let path = root.join(format!("benches/scenes/pile_boxes_{n}.json"));
     let scene = Scene::from_file(&path, &[])?;
-    let mut opts = SimOptions {
-        ground: scene.ground.map(|g| g.height),
-        ..SimOptions::default()
-    };
-    if let Some(g) = scene.ground {
-        opts.contact.friction = g.friction;
-    }
+    let opts = SimOptions::of_scene(&scene);
     let mut sim = Simulation::new(scene.model.clone(), opts)?;
     sim.set_state(&scene.q0, &scene.v0)?;
     let falling = best(&sim, 500, 3)?;

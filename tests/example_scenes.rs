@@ -6,7 +6,6 @@
 //! the humanoid on the ground without passing through itself.
 
 use std::path::{Path, PathBuf};
-use urdyn::contact::ContactParams;
 use urdyn::scene::Scene;
 use urdyn::sim::{SimOptions, Simulation};
 
@@ -16,16 +15,7 @@ fn example(name: &str) -> PathBuf {
 
 /// The scene's simulation with the CLI's defaults (dt, integrator, ground).
 fn simulation(scene: &Scene) -> Simulation {
-    let mut contact = ContactParams::default();
-    if let Some(g) = scene.ground {
-        contact.friction = g.friction;
-    }
-    let opts = SimOptions {
-        ground: scene.ground.map(|g| g.height),
-        contact,
-        ..SimOptions::default()
-    };
-    let mut sim = Simulation::new(scene.model.clone(), opts).unwrap();
+    let mut sim = Simulation::new(scene.model.clone(), SimOptions::of_scene(scene)).unwrap();
     sim.set_state(&scene.q0, &scene.v0).unwrap();
     sim
 }

@@ -43,14 +43,10 @@ fn joined(a: Value, b: Value) -> Value {
 fn work(s: &Value) -> u64 {
     let scene = Scene::from_json(&s.to_string(), "piles.json", &dir(), &[])
         .unwrap_or_else(|e| panic!("{e}"));
-    let mut opts = SimOptions {
-        ground: scene.ground.map(|g| g.height),
+    let opts = SimOptions {
         sleep: false,
-        ..SimOptions::default()
+        ..SimOptions::of_scene(&scene)
     };
-    if let Some(g) = scene.ground {
-        opts.contact.friction = g.friction;
-    }
     let mut sim = Simulation::new(scene.model.clone(), opts).unwrap();
     sim.set_state(&scene.q0, &scene.v0).unwrap();
     while sim.time() < 1.0 {
@@ -133,13 +129,7 @@ fn built_at_the_start_state_steps_as_new_then_set_state() {
     let s = spec("pile_mixed_16.json");
     let scene = Scene::from_json(&s.to_string(), "pile.json", &dir(), &[])
         .unwrap_or_else(|e| panic!("{e}"));
-    let mut opts = SimOptions {
-        ground: scene.ground.map(|g| g.height),
-        ..SimOptions::default()
-    };
-    if let Some(g) = scene.ground {
-        opts.contact.friction = g.friction;
-    }
+    let opts = SimOptions::of_scene(&scene);
     let mut a = Simulation::new(scene.model.clone(), opts.clone()).unwrap();
     a.set_state(&scene.q0, &scene.v0).unwrap();
     let mut b = Simulation::new_at(scene.model.clone(), opts, &scene.q0, &scene.v0).unwrap();

@@ -329,12 +329,8 @@ fn a_slow_scene_keeps_the_constant_margin_bit_for_bit() {
     )
     .unwrap();
     let run = |c: f64| {
-        let g = s.ground.expect("a ground");
-        let mut opts = SimOptions {
-            ground: Some(g.height),
-            ..SimOptions::default()
-        };
-        opts.contact.friction = g.friction;
+        assert!(s.ground.is_some(), "a ground");
+        let mut opts = SimOptions::of_scene(&s);
         opts.contact.travel_factor = c;
         let mut sim = Simulation::new(s.model.clone(), opts).unwrap();
         sim.set_state(&s.q0, &s.v0).unwrap();

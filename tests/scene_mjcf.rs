@@ -42,10 +42,8 @@ fn ant_alone() -> Simulation {
 fn scene_sim(s: &Scene) -> Simulation {
     let opts = SimOptions {
         dt: 0.01,
-        ground: s.ground.map(|g| g.height),
-        contact: urdyn::contact::ContactParams::of_scene_ground(s.ground.as_ref()),
         sleep: false,
-        ..SimOptions::default()
+        ..SimOptions::of_scene(s)
     };
     let mut sim = Simulation::new(s.model.clone(), opts).expect("sim");
     sim.set_state(&s.q0, &s.v0).expect("state");

@@ -14,14 +14,7 @@ fn scene(json: &str) -> Scene {
 
 /// A simulation of the scene at its start, with its ground and friction.
 fn simulation(s: &Scene) -> Simulation {
-    let mut opts = SimOptions {
-        ground: s.ground.map(|g| g.height),
-        ..SimOptions::default()
-    };
-    if let Some(g) = s.ground {
-        opts.contact.friction = g.friction;
-    }
-    let mut sim = Simulation::new(s.model.clone(), opts).unwrap();
+    let mut sim = Simulation::new(s.model.clone(), SimOptions::of_scene(s)).unwrap();
     sim.set_state(&s.q0, &s.v0).unwrap();
     sim
 }

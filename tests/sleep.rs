@@ -18,14 +18,10 @@ fn pile(n: usize) -> Scene {
 }
 
 fn simulation(s: &Scene, sleep: bool) -> Simulation {
-    let mut opts = SimOptions {
-        ground: s.ground.map(|g| g.height),
+    let opts = SimOptions {
         sleep,
-        ..SimOptions::default()
+        ..SimOptions::of_scene(s)
     };
-    if let Some(g) = s.ground {
-        opts.contact.friction = g.friction;
-    }
     let mut sim = Simulation::new(s.model.clone(), opts).unwrap();
     sim.set_state(&s.q0, &s.v0).unwrap();
     sim

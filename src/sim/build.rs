@@ -70,6 +70,22 @@ impl SimOptions {
         }
     }
 
+    /// The options `urdyn simulate SCENE.json`, Python's `Simulation(scene)` and
+    /// `rollout(scene)` run a scene with (scene.md): its ground's height, and
+    /// its contact parameters as [`ContactParams::of_scene_ground`] reads them
+    /// (friction, torsion, rolling; no ground without one), its sleep and
+    /// threads settings as [`SimOptions::with_islands`] reads them with no
+    /// caller's override; everything else the defaults'. Callers set their own
+    /// options (`--dt`, `--integrator`, …) over these.
+    pub fn of_scene(scene: &crate::scene::Scene) -> Self {
+        Self {
+            ground: scene.ground.map(|g| g.height),
+            contact: ContactParams::of_scene_ground(scene.ground.as_ref()),
+            ..Self::default()
+        }
+        .with_islands(Some(&scene.spec), None, None)
+    }
+
     /// Sleep and island threads (scene.md §"Large scenes") as `urdyn simulate`,
     /// Python's `Simulation(...)` and `rollout(...)` read them: the caller's
     /// `sleep` / `threads` (`--no-sleep`, `--threads`, `sleep=`, `threads=`)

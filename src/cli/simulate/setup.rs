@@ -102,22 +102,15 @@ pub(super) fn scene(
         frames: Vec::new(),
         derivatives: false,
     };
-    let contact = crate::contact::ContactParams::of_scene_ground(scene.ground.as_ref());
     let opts = SimOptions {
         dt: args.dt.unwrap_or(DEFAULT_DT),
         integrator,
         tol: args.tol,
-        ground: scene.ground.map(|g| g.height),
-        contact,
         package_paths: args.package_path.clone(),
         armature: args.armature,
-        ..SimOptions::default()
+        ..SimOptions::of_scene(&scene)
     }
-    .with_islands(
-        Some(&scene.spec),
-        args.no_sleep.then_some(false),
-        args.threads,
-    );
+    .with_islands(None, args.no_sleep.then_some(false), args.threads);
     let geometry = match &args.html {
         Some(_) => Some(crate::cli::view::Geometry::load_scene(
             &scene,
