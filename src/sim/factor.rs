@@ -16,6 +16,7 @@
 use crate::dynamics::crba_packed;
 use crate::dynamics::linalg::{by_size, cholesky_fast};
 use crate::model::{Data, Model};
+use super::factor_dense::{dense_backward, dense_forward};
 use crate::spatial::ops::madd;
 use nalgebra::{DMatrix, DVector};
 
@@ -55,6 +56,10 @@ pub struct MassFactor {
     start: Vec<usize>,
     len: Vec<usize>,
     x: DVector<f64>,
+    /// Tree: D (the pivots), contiguous (the solve divides in vector lanes).
+    dval: Vec<f64>,
+    /// Tree: scratch of the elimination, a dof's multipliers L[k, ·].
+    mult: Vec<f64>,
 }
 
 impl MassFactor {
@@ -111,6 +116,8 @@ impl MassFactor {
             start,
             len,
             x: DVector::zeros(n),
+            dval: vec![1.0; if tree { n } else { 0 }],
+            mult: vec![0.0; if tree { n } else { 0 }],
         }
     }
 
@@ -240,9 +247,10 @@ impl MassFactor {
         for k in k0..k1 {
             self.hdiag[k] = self.anc[self.start[k] + self.len[k] - 1];
         }
+        let (anc, table, start, len) = (&mut self.anc, &self.table, &self.start, &self.len);
         for k in (k0..k1).rev() {
-            let (sk, lk) = (self.start[k], self.len[k]);
-            let d = self.anc[sk + lk - 1];
+            let (sk, lk) = (start[k], len[k]);
+            let d = anc[sk + lk - 1];
             if !(d > tiny * self.hdiag[k].abs()) || !d.is_finite() {
                 return Err(k);
             }
@@ -251,23 +259,34 @@ impl MassFactor {
             // so the two are disjoint slices and each entry's update, one fused
             // multiply-add independent of the others, runs in vector lanes
             // (the same operation per entry as one at a time: the same bits)
-            let (head, tail) = self.anc.split_at_mut(sk);
-            for t in (0..lk - 1).rev() {
-                let i = self.table[sk + t];
-                let si = self.start[i];
-                let a = tail[t] / d;
-                let (Some(row_i), Some(row_k)) = (head.get_mut(si..si + t + 1), tail.get(..t + 1))
+            let (head, tail) = anc.split_at_mut(sk);
+            let m = lk - 1;
+            let (Some(row), Some(mult)) = (tail.get_mut(..m), self.mult.get_mut(..m)) else {
+                return Err(k);
+            };
+            // the multipliers L[k, i] = H̃[k, i] / D[k] first, all at once: the
+            // divisions are independent (vector lanes, each the correctly
+            // rounded quotient it was one at a time), and no update below
+            // waits on a division's latency
+            for (a, &x) in mult.iter_mut().zip(row.iter()) {
+                *a = x / d;
+            }
+            for t in (0..m).rev() {
+                let si = start[table[sk + t]];
+                let a = mult[t];
+                let (Some(row_i), Some(row_k)) = (head.get_mut(si..si + t + 1), row.get(..t + 1))
                 else {
                     return Err(k);
                 };
                 for (x, &hkj) in row_i.iter_mut().zip(row_k) {
                     *x = madd(-a, hkj, *x);
                 }
-                tail[t] = a;
             }
+            row.copy_from_slice(mult);
         }
         for k in k0..k1 {
             let d = self.anc[self.start[k] + self.len[k] - 1];
+            self.dval[k] = d;
             self.sqrt_d[k] = d.sqrt();
             self.inv_sqrt_d[k] = 1.0 / self.sqrt_d[k];
         }
@@ -317,8 +336,10 @@ impl MassFactor {
                         x[j] = madd(-self.anc[s + t], xi, x[j]);
                     }
                 }
-                for i in k0..k1 {
-                    x[i] /= self.anc[self.start[i] + self.len[i] - 1];
+                if let (Some(x), Some(d)) = (x.get_mut(k0..k1), self.dval.get(k0..k1)) {
+                    for (x, &d) in x.iter_mut().zip(d) {
+                        *x /= d;
+                    }
                 }
                 for i in k0..k1 {
                     let mut acc = x[i];
@@ -540,55 +561,5 @@ impl MassFactor {
         let r = x.rows(0, l).norm_squared();
         self.x = x;
         r
-    }
-}
-
-/// L x' = x in place for K vectors at once (forward substitution; L lower,
-/// column-major n × n, `inv` its reciprocal diagonal). `N = 0`: the length `n`
-/// at run time, else `N = n`. Does nothing when a length does not fit.
-#[inline(always)]
-fn dense_forward<const N: usize, const K: usize>(
-    l: &[f64],
-    inv: &[f64],
-    n: usize,
-    x: [&mut [f64]; K],
-) {
-    let n = if N == 0 { n } else { N };
-    if l.len() < n * n || inv.len() < n || x.iter().any(|x| x.len() < n) {
-        return;
-    }
-    let mut x = x.map(|x| &mut x[..n]);
-    let (l, inv) = (&l[..n * n], &inv[..n]);
-    for k in 0..n {
-        let mut xk = [0.0; K];
-        for (a, xs) in xk.iter_mut().zip(x.iter_mut()) {
-            *a = xs[k] * inv[k];
-            xs[k] = *a;
-        }
-        let col = &l[k * n..(k + 1) * n];
-        for i in k + 1..n {
-            let lik = col[i];
-            for (a, xs) in xk.iter().zip(x.iter_mut()) {
-                xs[i] -= lik * a;
-            }
-        }
-    }
-}
-
-/// Lᵀ x' = x in place (back substitution), as [`dense_forward`].
-#[inline(always)]
-fn dense_backward<const N: usize>(l: &[f64], inv: &[f64], n: usize, x: &mut [f64]) {
-    let n = if N == 0 { n } else { N };
-    if l.len() < n * n || inv.len() < n || x.len() < n {
-        return;
-    }
-    let (l, inv, x) = (&l[..n * n], &inv[..n], &mut x[..n]);
-    for k in (0..n).rev() {
-        let col = &l[k * n..(k + 1) * n];
-        let mut s = 0.0;
-        for i in k + 1..n {
-            s += x[i] * col[i];
-        }
-        x[k] = (x[k] - s) * inv[k];
     }
 }

@@ -65,6 +65,7 @@ mod contact_view;
 pub mod derivatives;
 mod equalities;
 pub mod factor;
+mod factor_dense;
 mod loops;
 mod tendons;
 pub use loops::LoopForce;

@@ -76,7 +76,7 @@ impl Servo {
 
     /// The implicit diagonal c·kd + c²·kp of v coordinate `k` (0 when saturated
     /// or inactive), c the step (0: the explicit stiffness tests).
-    #[inline]
+    #[inline(always)]
     pub fn diag(&self, k: usize, c: f64) -> f64 {
         if !self.active || self.saturated[k] != 0 {
             return 0.0;
@@ -105,7 +105,7 @@ impl Servo {
     }
 
     /// The unclamped servo torque of v coordinate `iv` (q coordinate `iq`) at (q, v).
-    #[inline]
+    #[inline(always)]
     pub fn torque(&self, iq: usize, iv: usize, q: f64, v: f64) -> f64 {
         self.kp[iv] * (self.q_ref[iq] - q) + self.kd[iv] * (self.v_ref[iv] - v)
     }
@@ -309,7 +309,7 @@ impl Simulation {
 
     /// The servo's explicit part e = kp (q_ref − q − h v) + kd (v_ref − v) of v
     /// coordinate `k` (0 on base entries).
-    #[inline]
+    #[inline(always)]
     fn servo_explicit(&self, k: usize, h: f64) -> f64 {
         let iq = self.servo.iq[k];
         if iq == FREE {
@@ -321,7 +321,7 @@ impl Simulation {
 
     /// τ_ff + the servo torque of joint coordinate `k` at the end of the step,
     /// q⁺ ≈ q + h v*, v⁺ = v* (`mass.vfree`).
-    #[inline]
+    #[inline(always)]
     fn servo_torque_after(&self, k: usize, h: f64) -> f64 {
         let iq = self.servo.iq[k];
         let v1 = self.mass.vfree[k];
