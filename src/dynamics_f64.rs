@@ -89,21 +89,13 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &DVector<f64>) -> R<&'d DM
 
 /// [`crate::dynamics::crba_upper`] for `f64`.
 #[inline(never)]
-pub fn crba_upper<'d>(
-    model: &Model,
-    data: &'d mut Data,
-    q: &DVector<f64>,
-) -> R<&'d DMatrix<f64>> {
+pub fn crba_upper<'d>(model: &Model, data: &'d mut Data, q: &DVector<f64>) -> R<&'d DMatrix<f64>> {
     generic::crba_upper(model, data, q)
 }
 
 /// [`crate::dynamics::mass_matrix`] for `f64`.
 #[inline(never)]
-pub fn mass_matrix<'d>(
-    model: &Model,
-    data: &'d mut Data,
-    q: &DVector<f64>,
-) -> R<&'d DMatrix<f64>> {
+pub fn mass_matrix<'d>(model: &Model, data: &'d mut Data, q: &DVector<f64>) -> R<&'d DMatrix<f64>> {
     generic::mass_matrix(model, data, q)
 }
 
