@@ -28,7 +28,7 @@
 use nalgebra::{DMatrix, DVector, Vector3};
 use std::path::PathBuf;
 use urdyn::cli::view::{write_page, Geometry, Recorder};
-use urdyn::dynamics::{self, Reference};
+use urdyn::dynamics_f64::{self as dynamics, Reference};
 use urdyn::model::configuration::difference;
 use urdyn::sim::{JacobianMethod, SimOptions, Simulation};
 use urdyn::{Data, LoadOptions};

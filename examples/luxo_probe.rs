@@ -71,7 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let (q, v) = (sim.q().clone(), sim.v().clone());
         let a = DVector::zeros(model.nv);
-        urdyn::dynamics::forward_kinematics_second_order(&model, &mut data, &q, &v, &a)?;
+        urdyn::dynamics_f64::forward_kinematics_second_order(&model, &mut data, &q, &v, &a)?;
         println!(
             "t = {:.3}  E = {:.6}  awake {}",
             sim.time(),

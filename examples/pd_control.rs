@@ -36,7 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("   t (s)   max |q - q*| (rad)   max |v| (rad/s)   energy (J)");
     while sim.time() < 3.0 - 1e-12 {
         let (q, v) = (sim.q().clone(), sim.v().clone());
-        let g = urdyn::dynamics::bias(&model, &mut data, &q, &zero, None)?.clone();
+        let g = urdyn::dynamics_f64::bias(&model, &mut data, &q, &zero, None)?.clone();
         let tau = (&target - &q).component_mul(&kp) - v.component_mul(&kd) + g;
         sim.torques_mut().copy_from(&tau);
         sim.step_until(3.0)?;

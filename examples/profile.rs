@@ -3,7 +3,7 @@
 //! whose instruction counts are stable on a shared, noisy machine).
 use std::hint::black_box;
 use urdyn::cli::bench::random_states;
-use urdyn::{dynamics, Data, LoadOptions};
+use urdyn::{dynamics_f64 as dynamics, Data, LoadOptions};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -60,6 +60,8 @@
 pub mod cli;
 pub mod contact;
 pub mod dynamics;
+#[doc(hidden)]
+pub mod dynamics_f64;
 pub mod load;
 pub mod mesh;
 pub mod mjcf;

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 use urdyn::cli::bench::random_states;
-use urdyn::dynamics;
+use urdyn::dynamics_f64 as dynamics;
 use urdyn::{Data, LoadOptions};
 
 use crate::common::counting_alloc::{allocations, measure_this_thread};

@@ -3,7 +3,7 @@
 //! entry point, contact forces named by link, and `Simulation::energy(&self)`.
 
 use std::path::PathBuf;
-use urdyn::dynamics::{self, DynamicsError, Reference};
+use urdyn::dynamics_f64::{self as dynamics, DynamicsError, Reference};
 use urdyn::model::configuration::{difference, integrate, random_configuration};
 use urdyn::model::{DimensionError, FrameId, JointId, NameError};
 use urdyn::nalgebra::{DMatrix, DVector, Vector3};
@@ -96,10 +96,10 @@ fn wrong_lengths_are_errors_at_every_entry_point() {
                 dim("v", nv, lv)
             );
             for fd in [
-                dynamics::aba::<f64>,
-                dynamics::forward_dynamics::<f64>,
-                dynamics::forward_dynamics_crba::<f64>,
-                dynamics::forward_dynamics_rnea::<f64>,
+                dynamics::aba,
+                dynamics::forward_dynamics,
+                dynamics::forward_dynamics_crba,
+                dynamics::forward_dynamics_rnea,
             ] {
                 assert_eq!(
                     e(fd(&m, d, &qb, &z, &z, None).map(|_| ())),

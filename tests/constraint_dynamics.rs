@@ -10,7 +10,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde_json::Value;
 use std::path::PathBuf;
-use urdyn::dynamics::{self, ConstraintData};
+use urdyn::dynamics_f64::{self as dynamics, ConstraintData};
 use urdyn::model::Constraints;
 use urdyn::{Data, LoadOptions};
 

@@ -355,7 +355,7 @@ fn post_lower_overlap(sim: &Simulation) -> f64 {
     use parry3d_f64::shape::Cuboid;
     let model = &sim.model;
     let mut data = urdyn::model::Data::new(model);
-    urdyn::dynamics::forward_kinematics(model, &mut data, sim.q()).unwrap();
+    urdyn::dynamics_f64::forward_kinematics(model, &mut data, sim.q()).unwrap();
     let pose = |m: &Se3<f64>| {
         let r = nalgebra::UnitQuaternion::from_matrix(&m.rot);
         Pose::from_parts(

@@ -7,7 +7,7 @@
 use nalgebra::{DMatrix, DVector, Vector3};
 use std::path::PathBuf;
 use urdyn::cli::bench::{random_states, State};
-use urdyn::dynamics::{self, LinkWrench, Reference};
+use urdyn::dynamics_f64::{self as dynamics, LinkWrench, Reference};
 use urdyn::model::configuration::{
     difference, difference_jacobians, integrate, integrate_jacobians,
 };

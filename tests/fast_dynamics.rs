@@ -5,7 +5,7 @@
 use nalgebra::{DMatrix, DVector};
 use std::path::PathBuf;
 use urdyn::cli::bench::{random_states, State};
-use urdyn::dynamics::{self, ltdl};
+use urdyn::dynamics_f64::{self as dynamics, ltdl};
 use urdyn::model::FdMethod;
 use urdyn::{Data, LoadOptions, Model};
 

@@ -11,7 +11,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde_json::Value;
 use std::path::PathBuf;
-use urdyn::dynamics::{self, Reference};
+use urdyn::dynamics_f64::{self as dynamics, Reference};
 use urdyn::model::configuration;
 use urdyn::model::Data;
 use urdyn::LoadOptions;

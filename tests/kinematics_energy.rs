@@ -4,7 +4,9 @@
 //! momentum against the centre of mass's velocity.
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
-use urdyn::dynamics::{self, center_of_mass, forward_kinematics, update_frames, Reference};
+use urdyn::dynamics_f64::{
+    self as dynamics, center_of_mass, forward_kinematics, update_frames, Reference,
+};
 use urdyn::model::FrameId;
 use urdyn::{Data, LoadOptions, Model};
 

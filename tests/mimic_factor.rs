@@ -8,7 +8,7 @@
 use nalgebra::DMatrix;
 use std::path::PathBuf;
 use urdyn::cli::bench::random_states;
-use urdyn::dynamics::{self, ConstraintData};
+use urdyn::dynamics_f64::{self as dynamics, ConstraintData};
 use urdyn::model::Constraints;
 use urdyn::{Data, LoadOptions, Model};
 

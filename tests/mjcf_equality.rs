@@ -229,7 +229,7 @@ fn mjcf_equality_simulation_closes_and_keeps_them() {
     // the inactive site connect is off until switched on
     let mut out = vec![0.0; 5];
     let mut data = urdyn::Data::new(m);
-    urdyn::dynamics::constraint_violation(m, &mut data, &set, &q, &mut out).unwrap();
+    urdyn::dynamics_f64::constraint_violation(m, &mut data, &set, &q, &mut out).unwrap();
     assert!(out[4] > 1e-3, "loose is off: its sites stay apart");
     sim.set_constraint_active("loose", true).unwrap();
     assert!(sim.constraint_violation() > 1e-3, "loose is on now");

@@ -7,7 +7,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde_json::Value;
 use std::path::Path;
-use urdyn::dynamics;
+use urdyn::dynamics_f64 as dynamics;
 
 fn dir() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mjcf")

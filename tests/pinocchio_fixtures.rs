@@ -329,18 +329,20 @@ fn forward_dynamics_inverts_inverse_dynamics_on_every_fixture() {
                 .unwrap();
             // the state's external wrenches, by link, onto their bodies
             let mut fext = vec![urdyn::spatial::Force::zero(); model.nbodies];
-            urdyn::dynamics::forward_kinematics(&model, &mut data, &sv.q).unwrap();
+            urdyn::dynamics_f64::forward_kinematics(&model, &mut data, &sv.q).unwrap();
             for (link, f, t) in &sv.fext {
-                urdyn::dynamics::add_link_wrench(&model, &data, *link, f, t, &mut fext).unwrap();
+                urdyn::dynamics_f64::add_link_wrench(&model, &data, *link, f, t, &mut fext)
+                    .unwrap();
             }
             pushed += usize::from(!sv.fext.is_empty());
             let fx = Some(fext.as_slice());
-            let tau = urdyn::dynamics::rnea(&model, &mut data, &sv.q, &sv.v, &sv.a, fx)
+            let tau = urdyn::dynamics_f64::rnea(&model, &mut data, &sv.q, &sv.v, &sv.a, fx)
                 .unwrap()
                 .clone();
-            let qdd = urdyn::dynamics::forward_dynamics(&model, &mut data, &sv.q, &sv.v, &tau, fx)
-                .unwrap()
-                .clone();
+            let qdd =
+                urdyn::dynamics_f64::forward_dynamics(&model, &mut data, &sv.q, &sv.v, &tau, fx)
+                    .unwrap()
+                    .clone();
             worst = worst.max((&qdd - &sv.a).amax() / (1.0f64).max(sv.a.amax()));
         }
         println!("{name:24} FD(ID(a)) relative error {worst:.2e} ({pushed} states with fext)");

@@ -3,7 +3,7 @@
 //! forest equal to each model alone.
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
-use urdyn::dynamics::{self, Reference};
+use urdyn::dynamics_f64::{self as dynamics, Reference};
 use urdyn::model::configuration::random_configuration;
 use urdyn::scene::Scene;
 use urdyn::sim::{column_names, SimOptions, Simulation};

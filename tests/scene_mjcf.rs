@@ -9,7 +9,7 @@
 
 use nalgebra::{DVector, Matrix3, Vector3};
 use std::path::{Path, PathBuf};
-use urdyn::dynamics::{forward_kinematics, update_frames};
+use urdyn::dynamics_f64::{forward_kinematics, update_frames};
 use urdyn::mjcf;
 use urdyn::scene::Scene;
 use urdyn::sim::{SimOptions, Simulation};

@@ -3,7 +3,7 @@
 //! both moving in the x–y plane with gravity along −y (docs/theory.md §"Gravity").
 
 use nalgebra::{DVector, Vector3};
-use urdyn::dynamics::{self, forward_dynamics, forward_kinematics, rnea};
+use urdyn::dynamics_f64::{self as dynamics, forward_dynamics, forward_kinematics, rnea};
 use urdyn::{Data, LoadOptions, Model};
 
 const G: f64 = 9.81;

@@ -27,7 +27,10 @@ type AlgoFn<T> = fn(&Model<T>, &mut Data<T>, &Input<T>) -> Result<DVector<T>, St
 /// The algorithms under test, by name; each returns its output vector (H is
 /// flattened column by column). Forward-dynamics methods are named `fd…` or `aba`
 /// (they get a backward error and the κ_fd bound).
-fn algorithms<T: Scalar>() -> Vec<(&'static str, AlgoFn<T>)> {
+/// The f64 entry points (`urdyn::dynamics_f64`, compiled in the library: this binary
+/// instantiates the generic algorithms for DD only).
+fn algorithms() -> Vec<(&'static str, AlgoFn<f64>)> {
+    use urdyn::dynamics_f64 as dynamics;
     vec![
         ("rnea", |m, d, s| {
             Ok(dynamics::rnea(m, d, &s.q, &s.v, &s.a, None)
@@ -177,7 +180,7 @@ fn evaluate(case: &Case) -> Row {
     let mdd: Model<DD> = m64.cast::<DD>();
     let mut d64 = Data::new(m64);
     let mut ddd = Data::new(&mdd);
-    let a64 = algorithms::<f64>();
+    let a64 = algorithms();
     let mut worst: Vec<(f64, Option<f64>)> = vec![(0.0, None); a64.len()];
     let mut cond = 0.0f64;
     let mut roundtrip = 0.0f64;

@@ -19,7 +19,7 @@
 #![allow(dead_code)]
 
 use nalgebra::{DMatrix, DVector};
-use urdyn::dynamics::{self, ConstraintData};
+use urdyn::dynamics_f64::{self as dynamics, ConstraintData};
 use urdyn::model::{ConstraintKind, Constraints};
 use urdyn::{Data, Model};
 

@@ -20,7 +20,7 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, UnitQuaternion, Vector3};
 use std::f64::consts::PI;
-use urdyn::dynamics;
+use urdyn::dynamics_f64 as dynamics;
 use urdyn::model::Constraints;
 use urdyn::LoadOptions;
 

@@ -12,7 +12,7 @@
 
 use nalgebra::{DMatrix, DVector};
 use std::path::PathBuf;
-use urdyn::dynamics::{self, ConstraintData};
+use urdyn::dynamics_f64::{self as dynamics, ConstraintData};
 use urdyn::model::configuration::integrate;
 use urdyn::model::Constraints;
 use urdyn::{Data, LoadOptions, Model};
