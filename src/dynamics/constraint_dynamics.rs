@@ -87,6 +87,11 @@ pub struct ConstraintData {
     pub(crate) oa0: Vec<Motion<f64>>,
     /// Scratch (nv): D⁻¹ of H's tree-sparse factor.
     pub(crate) dinv: Vec<f64>,
+    /// Scratch (nv): per coordinate, the span `lo..hi` of rows of J_c (and of
+    /// W = L⁻ᵀ J_cᵀ) that can be non-zero in its column (`constrained_paths`).
+    pub(crate) span: Vec<(usize, usize)>,
+    /// Scratch: one side's path of bodies.
+    pub(crate) bodies: Vec<usize>,
 }
 
 impl ConstraintData {
@@ -114,14 +119,75 @@ impl ConstraintData {
             path: Vec::with_capacity(model.nv),
             oa0: vec![Motion::zero(); model.nbodies],
             dinv: vec![0.0; nv],
+            span: vec![(0, 0); nv],
+            bodies: Vec::with_capacity(model.nbodies),
         }
     }
 }
 
-/// `data.o_m_i` from `data.li_m_i` (the passes that leave world poses out).
-pub(crate) fn world_poses(model: &Model, data: &mut Data) {
-    for i in 1..model.nbodies {
-        data.o_m_i[i] = data.o_m_i[model.parent[i]].compose(&data.li_m_i[i]);
+/// The world poses `data.o_m_i` (from `data.li_m_i`, left by the passes that
+/// leave world poses out) of the bodies on the constraints' paths to the root,
+/// the only ones J_c and γ_c read (the other bodies' are left as they were),
+/// and `span[k]`: the rows `lo..hi` of J_c that can be non-zero in column k,
+/// from the constraints whose sides' paths (a `joint` constraint: its
+/// coordinates' ancestors-or-self) hold coordinate k (empty, lo ≥ hi, when
+/// none does). A coordinate's span covers its descendants', so the rows of
+/// W = L⁻ᵀ J_cᵀ, which gather their descendants' in the elimination, keep to
+/// the spans too (`ltdl::ltdl_rows`).
+fn constrained_paths(
+    model: &Model,
+    data: &mut Data,
+    c: &Constraints,
+    span: &mut [(usize, usize)],
+    bodies: &mut Vec<usize>,
+) {
+    let nv = model.nv;
+    span[..nv].fill((usize::MAX, 0));
+    fn mark(span: &mut [(usize, usize)], k: usize, r0: usize, r1: usize) {
+        let s = &mut span[k];
+        *s = (s.0.min(r0), s.1.max(r1));
+    }
+    let mut row = 0;
+    for con in &c.items {
+        let (r0, r1) = (row, row + con.rows());
+        match &con.kind {
+            ConstraintKind::Joint { v1, second, .. } => {
+                for v in std::iter::once(*v1).chain(second.map(|(_, v2)| v2)) {
+                    let mut k = v;
+                    while k != usize::MAX {
+                        mark(span, k, r0, r1);
+                        k = model.dof_parent[k];
+                    }
+                }
+            }
+            _ => {
+                for side in [&con.a, &con.b] {
+                    bodies.clear();
+                    let mut b = side.body;
+                    while b != 0 {
+                        bodies.push(b);
+                        b = model.parent[b];
+                    }
+                    // root outwards: the same compositions as a whole pass
+                    for &b in bodies.iter().rev() {
+                        data.o_m_i[b] = data.o_m_i[model.parent[b]].compose(&data.li_m_i[b]);
+                        let jt = &model.joints[b];
+                        for k in jt.iv..jt.iv + jt.nv() {
+                            mark(span, k, r0, r1);
+                        }
+                    }
+                }
+            }
+        }
+        row = r1;
+    }
+    // every ancestor's span covers its descendants' (λ(k) < k)
+    for k in (0..nv).rev() {
+        let p = model.dof_parent[k];
+        if p != usize::MAX {
+            let (lo, hi) = span[k];
+            mark(span, p, lo, hi);
+        }
     }
 }
 
@@ -286,7 +352,7 @@ pub fn constraint_dynamics<'c>(
         data.qdd.copy_from(tau);
         data.qdd -= &data.bias;
     }
-    world_poses(model, data);
+    constrained_paths(model, data, constraints, &mut cd.span, &mut cd.bodies);
     jacobian_rows(model, data, constraints, &mut cd.jc);
     let g = model.gravity;
     let d: &Data = data;
@@ -347,6 +413,7 @@ pub fn constraint_dynamics<'c>(
         m,
         w,
         qdd.as_mut_slice(),
+        &cd.span,
         placed,
         |c, d, lo, xk, bc| {
             let dinv = 1.0 / d;
@@ -382,10 +449,15 @@ pub fn constraint_dynamics<'c>(
     let b = data.qdd.as_slice();
     let t = cd.qdd.as_mut_slice();
     let dv = &cd.dinv[..n];
+    let span = &cd.span[..n];
     for c in 0..n {
+        // row c of W is zero outside its span
+        let (lo, hi) = span[c];
         let mut acc = b[c];
-        for (&x, &l) in w[c * m..(c + 1) * m].iter().zip(lambda) {
-            acc = madd(x, l, acc);
+        if lo < hi {
+            for (&x, &l) in w[c * m + lo..c * m + hi].iter().zip(&lambda[lo..hi]) {
+                acc = madd(x, l, acc);
+            }
         }
         t[c] = acc * dv[c];
     }
@@ -408,7 +480,19 @@ pub fn constraint_dynamics<'c>(
         t[i] = s1;
     }
     data.qdd.copy_from(&cd.qdd);
-    generalized_force(cd);
+    // J_cᵀ λ: column c of J_c is zero outside its span
+    let g = cd.generalized_force.as_mut_slice();
+    let l = cd.lambda.as_slice();
+    for (c, gc) in g.iter_mut().enumerate() {
+        let (lo, hi) = cd.span[c];
+        let mut s = 0.0;
+        if lo < hi {
+            for (&x, &y) in cd.jc.as_slice()[c * m + lo..c * m + hi].iter().zip(&l[lo..hi]) {
+                s = madd(x, y, s);
+            }
+        }
+        *gc = s;
+    }
     Ok(&cd.qdd)
 }
 

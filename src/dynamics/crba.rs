@@ -375,7 +375,7 @@ fn crba_local_pass<T: Scalar, const PLACED: bool, const FACTOR: bool>(
     assert!(!FACTOR || us.len() >= nv * nv, "the factor is nv x nv");
     let up = us.as_mut_ptr();
     let all = [(1, model.nbodies)];
-    local_pass::<T, PLACED, _>(model, data, q, &all, |row, c, val| {
+    local_pass::<T, PLACED, _>(model, data, q, &all, move |row, c, val| {
         // SAFETY: row < nv and c < nv (local_pass asserts it before every
         // write), so both row + c nv and c + row nv are < nv² ≤ the length
         // of `hs` (asserted above), and of `us` with FACTOR (asserted above);
@@ -421,10 +421,20 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
     ic.copy_from_slice(inertias);
     // Subtree forces F = I^c S per coordinate.
     let fc = &mut data.crba_fc[..nv];
+    // a child whose parent is the next body down (p = i − 1) hands its moved
+    // composite inertia over in registers (the same sums in the same order, no
+    // store read back at once; as the RNEA's backward pass)
+    let mut carry = ic[0];
+    let mut carry_to = 0;
     for i in bodies.iter().flat_map(|&(b0, b1)| (b0..b1).rev()) {
         let p = parent[i];
         let (head, tail) = ic.split_at_mut(i);
-        let ici = tail[0];
+        let mut ici = tail[0];
+        if carry_to == i {
+            ici.add_assign(&carry);
+            tail[0] = ici;
+        }
+        carry_to = 0;
         let li = dispatch_joint!(&joints[i], ident[i], jm => {
             let li = if PLACED { li_m_i[i] } else { jm.placement(&placements[i], q) };
             let k0 = jm.joint().iv;
@@ -450,7 +460,12 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
                     *f = act_force_ax(&li, ax, f);
                 }
                 // I^c_p += ₚX̂ᵢ* I^c_i ⁱX̂ₚ
-                head[p].add_assign(&ici.act_ax(&li, ax));
+                let moved = ici.act_ax(&li, ax);
+                if p + 1 == i {
+                    (carry, carry_to) = (moved, p);
+                } else {
+                    head[p].add_assign(&moved);
+                }
             }
             li
         });

@@ -295,11 +295,14 @@ fn copy_pattern<T: Scalar>(h: &DMatrix<T>, lambda: &[usize], u: &mut DMatrix<T>)
 /// of one more, `b`: as coordinate k is eliminated from its ancestors i, so are
 /// its rows (`w[i] −= L[k, i] w[k]`, `b[i] −= L[k, i] b[k]`, the steps of
 /// [`ltdl_solve_rows`]' first sweep), leaving `L⁻ᵀ w`, `L⁻ᵀ b` and the factor of
-/// [`ltdl`] (the same operations on it). `pivot(k, D[k], lo, w[k][lo..hi], b[k])`
-/// sees each final row, by its nonzero span `lo..hi` (empty for a zero row; the
-/// steps update that span alone: rows held on two feet are zero on the other
-/// leg's coordinates), before its ancestors' updates (leaves inwards). One walk
-/// of the tree instead of two (docs/theory.md §"Constrained dynamics", "Solving").
+/// [`ltdl`] (the same operations on it). `span[k] = (lo, hi)`: row k of `w` is
+/// zero outside `lo..hi` before and after the elimination (empty, lo ≥ hi, for
+/// a zero row: rows held on two feet are zero on the other leg's coordinates,
+/// on the arms' all zero), which the caller knows from the rows' structure
+/// (every ancestor's span covering its descendants'); the steps update that
+/// span alone. `pivot(k, D[k], lo, w[k][lo..hi], b[k])` sees each final row
+/// before its ancestors' updates (leaves inwards). One walk of the tree
+/// instead of two (docs/theory.md §"Constrained dynamics", "Solving").
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn ltdl_rows<T: Scalar>(
     h: &DMatrix<T>,
@@ -308,6 +311,7 @@ pub(crate) fn ltdl_rows<T: Scalar>(
     m: usize,
     w: &mut [T],
     b: &mut [T],
+    span: &[(usize, usize)],
     placed: bool,
     pivot: impl FnMut(usize, T, usize, &[T], T),
 ) -> Result<(), usize> {
@@ -315,6 +319,7 @@ pub(crate) fn ltdl_rows<T: Scalar>(
         m,
         w,
         b,
+        span,
         pivot,
         lo: 0,
         hi: 0,
@@ -328,6 +333,8 @@ struct RowsHook<'a, T, P> {
     m: usize,
     w: &'a mut [T],
     b: &'a mut [T],
+    /// Each row's nonzero span (`ltdl_rows`).
+    span: &'a [(usize, usize)],
     pivot: P,
     /// Row k of `w` is zero outside `lo..hi` (its nonzero span, empty when
     /// the row is zero): its steps update that span only.
@@ -343,9 +350,9 @@ impl<T: Scalar, P: FnMut(usize, T, usize, &[T], T)> Hook<T> for RowsHook<'_, T, 
         let m = self.m;
         let wk = &self.w[k * m..(k + 1) * m];
         self.bk = self.b[k];
-        let z = T::zero();
-        let lo = wk.iter().position(|&x| x != z).unwrap_or(m);
-        let hi = wk.iter().rposition(|&x| x != z).map_or(lo, |e| e + 1);
+        let (lo, hi) = self.span[k];
+        let (lo, hi) = (lo.min(m), hi.min(m));
+        let hi = hi.max(lo);
         (self.lo, self.hi) = (lo, hi);
         (self.pivot)(k, d, lo, &wk[lo..hi], self.bk);
     }

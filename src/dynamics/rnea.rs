@@ -185,10 +185,21 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
     }
     let tau = data.tau.as_mut_slice();
     tau.fill(T::zero());
+    // A child whose parent is the next body down (p = i − 1, a chain) hands its
+    // force over in registers, added when the parent is reached: the parent's
+    // other children (higher indices) were added before it, so the sums are
+    // the same in the same order, and the parent's force is not read back right
+    // after a store of different width (a stalled store-to-load forward per body).
+    let mut carry = Force::zero();
+    let mut carry_to = 0;
     for i in (1..nb).rev() {
         let p = parent[i];
         let (head, tail) = frc.split_at_mut(i);
-        let fi = tail[0];
+        let mut fi = tail[0];
+        if carry_to == i {
+            fi += carry;
+            tail[0] = fi;
+        }
         let li = &li_m_i[i];
         dispatch_joint!(&joints[i], ident[i], jm => {
             // docs/theory.md §"Joint-force projection": Qᵢ = ŝᵢᵀ f̂ᵢ (a mimic joint adds
@@ -196,7 +207,12 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
             jm.project_add(&fi, tau);
             // docs/theory.md §"Force recursion" (children part): f̂ₚ += ₚX̂ᵢ f̂ᵢ
             if p != 0 {
-                head[p] += act_force_ax(li, jm.rot_axis(), &fi);
+                let x = act_force_ax(li, jm.rot_axis(), &fi);
+                if p + 1 == i {
+                    (carry, carry_to) = (x, p);
+                } else {
+                    head[p] += x;
+                }
             }
         });
     }
