@@ -487,7 +487,10 @@ pub fn constraint_dynamics<'c>(
         let (lo, hi) = cd.span[c];
         let mut s = 0.0;
         if lo < hi {
-            for (&x, &y) in cd.jc.as_slice()[c * m + lo..c * m + hi].iter().zip(&l[lo..hi]) {
+            for (&x, &y) in cd.jc.as_slice()[c * m + lo..c * m + hi]
+                .iter()
+                .zip(&l[lo..hi])
+            {
                 s = madd(x, y, s);
             }
         }

@@ -13,10 +13,10 @@
 //! tree-sparse `mj_factorI` / `mj_solveM` idea). With mimic joints H̃ is not
 //! tree-shaped: a dense Cholesky H̃ = L Lᵀ (R = Lᵀ) and full-length rows.
 
+use super::factor_dense::{dense_backward, dense_forward};
 use crate::dynamics::crba_packed;
 use crate::dynamics::linalg::{by_size, cholesky_fast};
 use crate::model::{Data, Model};
-use super::factor_dense::{dense_backward, dense_forward};
 use crate::spatial::ops::madd;
 use nalgebra::{DMatrix, DVector};
 
