@@ -62,19 +62,23 @@ fn read_constraints(model: &PyModel, c: &Bound<'_, PyAny>) -> PyResult<Constrain
     )))
 }
 
-/// A simulation of `model` at its neutral configuration, at rest, with the
-/// options of `Simulation(...)` / `rollout(...)`.
+/// A simulation of `model` at its neutral configuration (or at `start`), at
+/// rest, with the options of `Simulation(...)` / `rollout(...)` over `base`:
+/// the ground and contact parameters come from `base` (a scene's
+/// [`SimOptions::of_scene`], or a model's `ground=` / `friction=`), the step,
+/// integrator, package roots, sleep and threads from the call.
+#[allow(clippy::too_many_arguments)]
 fn prototype(
     model: &PyModel,
+    base: SimOptions,
     dt: f64,
     integrator: Option<&str>,
-    ground: Option<f64>,
-    contact: ContactParams,
     package_dirs: Option<Vec<PathBuf>>,
     islands: Islands<'_>,
     start: Option<(&DVector<f64>, &DVector<f64>)>,
 ) -> PyResult<Simulation> {
-    let friction = contact.friction;
+    let friction = base.contact.friction;
+    let ground = base.ground;
     if !(dt > 0.0 && dt.is_finite()) {
         return Err(value_error(format!(
             "dt must be a positive number (got {dt})"
@@ -104,10 +108,8 @@ fn prototype(
     let opts = SimOptions {
         dt,
         integrator,
-        ground,
         package_paths: package_dirs.unwrap_or_else(|| model.package_dirs.clone()),
-        contact,
-        ..SimOptions::default()
+        ..base
     }
     .with_islands(islands.scene, islands.sleep, islands.threads);
     // At a given start, contacts are found once, there (a scene's models all sit at the
@@ -147,21 +149,19 @@ fn prototype_scene(
 ) -> PyResult<Simulation> {
     let s = &scene.scene;
     let model = scene.py_model();
-    let ground = s.ground.map(|g| g.height);
-    // the ground's contact parameters as `urdyn simulate SCENE.json` reads them
-    let contact = ContactParams::of_scene_ground(s.ground.as_ref());
     // as `urdyn simulate SCENE.json`: the file's settings where the call gives none
     let islands = Islands {
         scene: Some(&s.spec),
         sleep,
         threads,
     };
+    // the ground, its contact parameters and the file's islands settings as
+    // `urdyn simulate SCENE.json` reads them
     let mut sim = prototype(
         &model,
+        SimOptions::of_scene(s),
         dt,
         integrator,
-        ground,
-        contact,
         package_dirs,
         islands,
         Some((&s.q0, &s.v0)),
@@ -228,15 +228,19 @@ pub(crate) fn prototype_any(
         .transpose()?
         .filter(|c| !c.items.is_empty());
     let py = source.py();
-    let mut sim = prototype(
-        &model,
-        dt,
-        integrator,
-        ground.ground(py)?,
-        ContactParams {
+    let base = SimOptions {
+        ground: ground.ground(py)?,
+        contact: ContactParams {
             friction: friction.friction(py)?,
             ..ContactParams::default()
         },
+        ..SimOptions::default()
+    };
+    let mut sim = prototype(
+        &model,
+        base,
+        dt,
+        integrator,
         package_dirs,
         Islands {
             scene: None,
