@@ -2,8 +2,8 @@
 
 use crate::dynamics::rnea::act_force_ax;
 use crate::model::{dispatch_joint, Data, JointModel, Model};
-use crate::spatial::{Force, Motion, Scalar};
-use nalgebra::{DVector, Vector3};
+use crate::spatial::{Axis, CompositeInertia, Force, Motion, Scalar, Se3};
+use nalgebra::{DVector, Matrix3, Vector3};
 
 /// The joint-space inertia matrix H(q) by the CRBA (Featherstone, RBDA §6.2),
 /// written to `data.h` (the whole symmetric matrix; `data.li_m_i` is updated).
@@ -330,6 +330,8 @@ pub(crate) fn crba_packed<T: Scalar>(
     if model.has_mimic || !model.topology.crba_local || !fits || (!placed && q.len() != model.nq) {
         return false;
     }
+    // (fits: both hold nv entries; sliced so that an index below nv needs no test)
+    let (start, len) = (&start[..nv], &len[..nv]);
     let write = |row: usize, c: usize, val: T| {
         // the upper triangle (row an ancestor-or-self of c, so row ≤ c): the
         // entry the factor reads; the lower one is its mirror
@@ -426,6 +428,7 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
     // store read back at once; as the RNEA's backward pass)
     let mut carry = ic[0];
     let mut carry_to = 0;
+    let exact = is_f64::<T>();
     for i in bodies.iter().flat_map(|&(b0, b1)| (b0..b1).rev()) {
         let p = parent[i];
         let (head, tail) = ic.split_at_mut(i);
@@ -456,11 +459,26 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
             if p != 0 {
                 // The subtree's forces to the parent frame: ᵖX̂ᵢ* F
                 let ax = jm.rot_axis();
-                for f in fsub.iter_mut() {
-                    *f = act_force_ax(&li, ax, f);
-                }
                 // I^c_p += ₚX̂ᵢ* I^c_i ⁱX̂ₚ
-                let moved = ici.act_ax(&li, ax);
+                let moved = match ax {
+                    // a joint frame at its parent's origin (a body's second and
+                    // later joints in MJCF): the moves are rotations alone
+                    Some(ax) if exact && zero_trans(&li) => {
+                        for f in fsub.iter_mut() {
+                            *f = Force {
+                                ang: ax.rot_mul(&li.rot, &f.ang),
+                                lin: ax.rot_mul(&li.rot, &f.lin),
+                            };
+                        }
+                        rotate_composite(&ici, &li.rot, &ax)
+                    }
+                    _ => {
+                        for f in fsub.iter_mut() {
+                            *f = act_force_ax(&li, ax, f);
+                        }
+                        ici.act_ax(&li, ax)
+                    }
+                };
                 if p + 1 == i {
                     (carry, carry_to) = (moved, p);
                 } else {
@@ -470,5 +488,48 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
             li
         });
         li_m_i[i] = li;
+    }
+}
+
+/// Whether `T` is `f64`: the shortcuts for exact zeros below compare values,
+/// which for a number type carrying more than its value (a dual number's
+/// derivative part) would not say the whole number is zero.
+#[inline(always)]
+pub(crate) fn is_f64<T: Scalar>() -> bool {
+    std::any::TypeId::of::<T>() == std::any::TypeId::of::<f64>()
+}
+
+/// Whether `m`'s translation is exactly zero (either sign): moving a force or
+/// an inertia by `m` is then its rotation alone. Each term the translation
+/// enters (`t × f`, `m t`, the parallel-axis shift) is a product with a zero
+/// added to a value, so leaving them out gives the same numbers (at most a
+/// zero's sign differs: −0 + 0 is +0).
+#[inline(always)]
+pub(crate) fn zero_trans<T: Scalar>(m: &Se3<T>) -> bool {
+    m.trans.iter().all(|x| *x == T::zero())
+}
+
+/// [`CompositeInertia::act_ax`] for a rotation `r` about `ax` with a zero
+/// translation: `h' = R h`, `I_o' = R I_o Rᵀ` (the same products in the same
+/// order; the translation's terms, all zero, left out).
+#[inline(always)]
+fn rotate_composite<T: Scalar>(
+    c: &CompositeInertia<T>,
+    r: &Matrix3<T>,
+    ax: &Axis<T>,
+) -> CompositeInertia<T> {
+    let h = ax.rot_mul(r, &c.h);
+    let io = &c.io;
+    let m0 = ax.rot_mul(r, &io.column(0).into());
+    let m1 = ax.rot_mul(r, &io.column(1).into());
+    let m2 = ax.rot_mul(r, &io.column(2).into());
+    let e0 = ax.rot_mul(r, &Vector3::new(m0.x, m1.x, m2.x));
+    let e1 = ax.rot_mul(r, &Vector3::new(m0.y, m1.y, m2.y));
+    let e2 = ax.rot_mul(r, &Vector3::new(m0.z, m1.z, m2.z));
+    let (xx, yy, zz, xy, xz, yz) = (e0.x, e1.y, e2.z, e1.x, e2.x, e2.y);
+    CompositeInertia {
+        m: c.m,
+        h,
+        io: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
     }
 }

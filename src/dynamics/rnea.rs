@@ -1,7 +1,8 @@
+use super::crba::{is_f64, zero_trans};
 use super::{check_sizes, DynamicsError};
 use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
 use crate::spatial::ops::add_cross;
-use crate::spatial::{Force, Motion, Scalar, Se3};
+use crate::spatial::{Force, Inertia, Motion, Scalar, Se3};
 use nalgebra::DVector;
 
 /// Recursive Newton–Euler inverse dynamics (docs/theory.md §"Recursive Newton–Euler"):
@@ -134,6 +135,7 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
     let vel = &mut data.v[..nb];
     let acc = &mut data.a[..nb];
     let frc = &mut data.f[..nb];
+    let exact = is_f64::<T>();
     // docs/theory.md §"Gravity": v̂₀ = 0, â₀ = [0; −g]
     vel[0] = Motion::zero();
     acc[0] = if gravity {
@@ -148,14 +150,24 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
             // ᵢXₚ at q, or (K) as forward kinematics left it at this q
             let li = if K { li_m_i[i] } else { jm.placement(&placements[i], q) };
             let ax = jm.rot_axis();
+            // (the bias pass: a joint frame at its parent's origin moves
+            // motions by its rotation alone, crba::zero_trans)
+            let rot = K && exact && ax.is_some() && zero_trans(&li);
+            let mv = |x: &Motion<T>| match ax {
+                Some(ax) if rot => Motion {
+                    ang: ax.rot_tr_mul(&li.rot, &x.ang),
+                    lin: ax.rot_tr_mul(&li.rot, &x.lin),
+                },
+                _ => inv_act_motion_ax(&li, ax, x),
+            };
             // docs/theory.md §"Velocity recursion": v̂ᵢ = ᵢX̂ₚ v̂ₚ + ŝᵢ q̇ᵢ
             let mut vi = Motion::zero();
             if V {
-                vi = inv_act_motion_ax(&li, ax, &vp);
+                vi = mv(&vp);
                 jm.add_motion(&mut vi, v);
             }
             // docs/theory.md §"Acceleration recursion": âᵢ = ᵢX̂ₚ âₚ + v̂ᵢ × ŝᵢ q̇ᵢ + ŝᵢ q̈ᵢ
-            let mut ai = inv_act_motion_ax(&li, ax, &ap);
+            let mut ai = mv(&ap);
             if V {
                 jm.add_cross_motion(&mut ai, &vi, v);
             }
@@ -170,9 +182,14 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
         // docs/theory.md §"Force recursion" (own part):
         // f̂ᵢ = Îᵢ âᵢ + v̂ᵢ ×* Îᵢ v̂ᵢ − ᵢX̂₀ f̂ᵢˣ
         let inertia = &inertias[i];
-        let mut fi = inertia.mul_motion(&ai);
-        if V {
-            fi += vi.cross_force(&inertia.mul_motion(&vi));
+        // (the bias pass: a massless body's own force is zero, its products
+        // with the zero inertia left out)
+        let mut fi = Force::zero();
+        if !(K && exact && massless(inertia)) {
+            fi = inertia.mul_motion(&ai);
+            if V {
+                fi += vi.cross_force(&inertia.mul_motion(&vi));
+            }
         }
         if let (true, Some(fext)) = (F, fext) {
             let o_m = o_m_i[p].compose(&li);
@@ -207,7 +224,13 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
             jm.project_add(&fi, tau);
             // docs/theory.md §"Force recursion" (children part): f̂ₚ += ₚX̂ᵢ f̂ᵢ
             if p != 0 {
-                let x = act_force_ax(li, jm.rot_axis(), &fi);
+                let x = match jm.rot_axis() {
+                    Some(ax) if K && exact && zero_trans(li) => Force {
+                        ang: ax.rot_mul(&li.rot, &fi.ang),
+                        lin: ax.rot_mul(&li.rot, &fi.lin),
+                    },
+                    ax => act_force_ax(li, ax, &fi),
+                };
                 if p + 1 == i {
                     (carry, carry_to) = (x, p);
                 } else {
@@ -248,4 +271,14 @@ pub(crate) fn act_force_ax<T: Scalar>(m: &Se3<T>, ax: Option<Axis<T>>, f: &Force
             }
         }
     }
+}
+
+/// Whether a body's inertia is exactly zero (mass, centre of mass and
+/// rotational inertia): its own force `Î a + v ×* Î v` is then zero (each
+/// term a product with a zero; at most a zero's sign differs).
+#[inline(always)]
+fn massless<T: Scalar>(i: &Inertia<T>) -> bool {
+    i.mass == T::zero()
+        && i.com.iter().all(|x| *x == T::zero())
+        && i.inertia_c.iter().all(|x| *x == T::zero())
 }

@@ -13,6 +13,8 @@
 //! tree-sparse `mj_factorI` / `mj_solveM` idea). With mimic joints H̃ is not
 //! tree-shaped: a dense Cholesky H̃ = L Lᵀ (R = Lᵀ) and full-length rows.
 
+mod elim;
+
 use super::factor_dense::{dense_backward, dense_forward};
 use crate::dynamics::crba_packed;
 use crate::dynamics::linalg::{by_size, cholesky_fast};
@@ -58,7 +60,8 @@ pub struct MassFactor {
     x: DVector<f64>,
     /// Tree: D (the pivots), contiguous (the solve divides in vector lanes).
     dval: Vec<f64>,
-    /// Tree: scratch of the elimination, a dof's multipliers L[k, ·].
+    /// Tree: scratch of the elimination, a dof's multipliers L[k, ·] (and
+    /// its parent's beside them: 2 nv).
     mult: Vec<f64>,
 }
 
@@ -117,7 +120,7 @@ impl MassFactor {
             len,
             x: DVector::zeros(n),
             dval: vec![1.0; if tree { n } else { 0 }],
-            mult: vec![0.0; if tree { n } else { 0 }],
+            mult: vec![0.0; if tree { 2 * n } else { 0 }],
         }
     }
 
@@ -242,57 +245,6 @@ impl MassFactor {
         Ok(())
     }
 
-    /// [`Self::factor_packed`] on the dofs `[k0, k1)` (whole trees).
-    fn factor_range(&mut self, k0: usize, k1: usize, tiny: f64) -> Result<(), usize> {
-        for k in k0..k1 {
-            self.hdiag[k] = self.anc[self.start[k] + self.len[k] - 1];
-        }
-        let (anc, table, start, len) = (&mut self.anc, &self.table, &self.start, &self.len);
-        for k in (k0..k1).rev() {
-            let (sk, lk) = (start[k], len[k]);
-            let d = anc[sk + lk - 1];
-            if !(d > tiny * self.hdiag[k].abs()) || !d.is_finite() {
-                return Err(k);
-            }
-            // eliminate k from its ancestors i = path_k[t], t = depth(i): i's
-            // packed path (t + 1 entries, ending at D[i]) lies before k's (i < k),
-            // so the two are disjoint slices and each entry's update, one fused
-            // multiply-add independent of the others, runs in vector lanes
-            // (the same operation per entry as one at a time: the same bits)
-            let (head, tail) = anc.split_at_mut(sk);
-            let m = lk - 1;
-            let (Some(row), Some(mult)) = (tail.get_mut(..m), self.mult.get_mut(..m)) else {
-                return Err(k);
-            };
-            // the multipliers L[k, i] = H̃[k, i] / D[k] first, all at once: the
-            // divisions are independent (vector lanes, each the correctly
-            // rounded quotient it was one at a time), and no update below
-            // waits on a division's latency
-            for (a, &x) in mult.iter_mut().zip(row.iter()) {
-                *a = x / d;
-            }
-            for t in (0..m).rev() {
-                let si = start[table[sk + t]];
-                let a = mult[t];
-                let (Some(row_i), Some(row_k)) = (head.get_mut(si..si + t + 1), row.get(..t + 1))
-                else {
-                    return Err(k);
-                };
-                for (x, &hkj) in row_i.iter_mut().zip(row_k) {
-                    *x = madd(-a, hkj, *x);
-                }
-            }
-            row.copy_from_slice(mult);
-        }
-        for k in k0..k1 {
-            let d = self.anc[self.start[k] + self.len[k] - 1];
-            self.dval[k] = d;
-            self.sqrt_d[k] = d.sqrt();
-            self.inv_sqrt_d[k] = 1.0 / self.sqrt_d[k];
-        }
-        Ok(())
-    }
-
     /// Tree: L[k, j] for j an ancestor of k (0 otherwise).
     #[inline(always)]
     fn l_entry(&self, k: usize, j: usize) -> f64 {
@@ -328,9 +280,27 @@ impl MassFactor {
             // [`crate::dynamics::ltdl::ltdl_solve`] on the packed factor
             let x = &mut x.as_mut_slice()[..self.n];
             for &(k0, k1) in self.ranges() {
-                for i in (k0..k1).rev() {
+                let mut i = k1;
+                while i > k0 {
+                    i -= 1;
                     let xi = x[i];
                     let (s, l) = (self.start[i], self.len[i]);
+                    // i − 1 is i's parent (a chain): i's term reaches x[i − 1]
+                    // first, then each common ancestor's entry takes i's term and
+                    // i − 1's in turn, in registers (the same two fused
+                    // multiply-adds in the same order: the same bits)
+                    if l >= 2 && i > k0 && self.table[s + l - 2] == i - 1 {
+                        let xp = madd(-self.anc[s + l - 2], xi, x[i - 1]);
+                        x[i - 1] = xp;
+                        let sp = self.start[i - 1];
+                        for t in (0..l - 2).rev() {
+                            let j = self.table[s + t];
+                            let y = madd(-self.anc[s + t], xi, x[j]);
+                            x[j] = madd(-self.anc[sp + t], xp, y);
+                        }
+                        i -= 1;
+                        continue;
+                    }
                     for t in (0..l - 1).rev() {
                         let j = self.table[s + t];
                         x[j] = madd(-self.anc[s + t], xi, x[j]);

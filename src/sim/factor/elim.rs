@@ -1,0 +1,123 @@
+//! The tree-sparse LTDL elimination of [`MassFactor`] on one range of dofs
+//! (docs/theory.md §"Tree-sparse LTDL"), a dof and its parent at once where
+//! they form a chain.
+
+use super::MassFactor;
+use crate::spatial::ops::madd;
+
+impl MassFactor {
+    /// [`Self::factor_packed`] on the dofs `[k0, k1)` (whole trees).
+    ///
+    /// Where dof k − 1 is k's parent (a chain: most dofs), k and k − 1 are
+    /// eliminated together: k's update of row k − 1 (its first) comes first,
+    /// then k − 1's multipliers, then one sweep over their common ancestors'
+    /// rows applies k's update and k − 1's to each entry in turn — each
+    /// entry gets the same two fused multiply-adds in the same order as one
+    /// dof after the other (the same bits), with half the loads, stores and
+    /// loop set-ups.
+    pub(super) fn factor_range(&mut self, k0: usize, k1: usize, tiny: f64) -> Result<(), usize> {
+        for k in k0..k1 {
+            self.hdiag[k] = self.anc[self.start[k] + self.len[k] - 1];
+        }
+        let (anc, table, start, len) = (&mut self.anc, &self.table, &self.start, &self.len);
+        let (hdiag, mult_all) = (&self.hdiag, &mut self.mult);
+        // the pivot test of dof k, D[k] = d
+        let pivot_ok = |k: usize, d: f64| d > tiny * hdiag[k].abs() && d.is_finite();
+        let mut k = k1;
+        while k > k0 {
+            k -= 1;
+            let (sk, lk) = (start[k], len[k]);
+            let d = anc[sk + lk - 1];
+            if !pivot_ok(k, d) {
+                return Err(k);
+            }
+            // eliminate k from its ancestors i = path_k[t], t = depth(i): i's
+            // packed path (t + 1 entries, ending at D[i]) lies before k's (i < k),
+            // so the two are disjoint slices and each entry's update, one fused
+            // multiply-add independent of the others, runs in vector lanes
+            // (the same operation per entry as one at a time: the same bits)
+            let (head, tail) = anc.split_at_mut(sk);
+            let m = lk - 1;
+            let (Some(row), Some(mult)) = (tail.get_mut(..m), mult_all.get_mut(..m)) else {
+                return Err(k);
+            };
+            // the multipliers L[k, i] = H̃[k, i] / D[k] first, all at once: the
+            // divisions are independent (vector lanes, each the correctly
+            // rounded quotient it was one at a time), and no update below
+            // waits on a division's latency
+            for (a, &x) in mult.iter_mut().zip(row.iter()) {
+                *a = x / d;
+            }
+            // k − 1 is k's parent (and in the range): the pair
+            let pair = m >= 1 && k > k0 && table[sk + m - 1] == k - 1;
+            let mut t_end = m;
+            if pair {
+                // k's update of row k − 1 (t = m − 1), D[k − 1] included
+                let sp = start[k - 1];
+                let Some(row_p) = head.get_mut(sp..sp + m) else {
+                    return Err(k);
+                };
+                let a = mult[m - 1];
+                for (x, &hkj) in row_p.iter_mut().zip(row.iter()) {
+                    *x = madd(-a, hkj, *x);
+                }
+                t_end = m - 1;
+                let dp = row_p[m - 1];
+                if pivot_ok(k - 1, dp) {
+                    // row k − 1's entries off its diagonal (read below, then
+                    // replaced by its multipliers), apart from its ancestors' rows
+                    let (head, rest) = head.split_at_mut(sp);
+                    let row_p = &mut rest[..m - 1];
+                    // k − 1's multipliers L[k − 1, i] = H̃'[k − 1, i] / D[k − 1]
+                    // (`mult` holds 2 nv: k's and k − 1's side by side)
+                    let (ml, mh) = mult_all.split_at_mut(m);
+                    let (mult, mult_p) = (&ml[..m], &mut mh[..m - 1]);
+                    for (a, &x) in mult_p.iter_mut().zip(row_p.iter()) {
+                        *a = x / dp;
+                    }
+                    for t in (0..m - 1).rev() {
+                        let si = start[table[sk + t]];
+                        let (a, b) = (mult[t], mult_p[t]);
+                        let (Some(row_i), Some(row_k), Some(row_q)) = (
+                            head.get_mut(si..si + t + 1),
+                            row.get(..t + 1),
+                            row_p.get(..t + 1),
+                        ) else {
+                            return Err(k);
+                        };
+                        for ((x, &hkj), &hqj) in row_i.iter_mut().zip(row_k).zip(row_q) {
+                            *x = madd(-b, hqj, madd(-a, hkj, *x));
+                        }
+                    }
+                    row.copy_from_slice(mult);
+                    row_p.copy_from_slice(mult_p);
+                    k -= 1;
+                    continue;
+                }
+            }
+            for t in (0..t_end).rev() {
+                let si = start[table[sk + t]];
+                let a = mult[t];
+                let (Some(row_i), Some(row_k)) = (head.get_mut(si..si + t + 1), row.get(..t + 1))
+                else {
+                    return Err(k);
+                };
+                for (x, &hkj) in row_i.iter_mut().zip(row_k) {
+                    *x = madd(-a, hkj, *x);
+                }
+            }
+            row.copy_from_slice(mult);
+            if pair {
+                // k − 1's pivot failed the test
+                return Err(k - 1);
+            }
+        }
+        for k in k0..k1 {
+            let d = self.anc[self.start[k] + self.len[k] - 1];
+            self.dval[k] = d;
+            self.sqrt_d[k] = d.sqrt();
+            self.inv_sqrt_d[k] = 1.0 / self.sqrt_d[k];
+        }
+        Ok(())
+    }
+}
