@@ -399,7 +399,7 @@ pub(super) fn neg_mul_tree<T: Scalar>(
     let [x0, x1] = xs;
     let mut xs = [x0.as_mut_slice(), x1.as_mut_slice()];
     // panels of 2 MR rows, then MR, the last one ending at n (overlapping rows get
-    // the same sums again); 4 or single rows below MR
+    // the same sums again); one panel of n rows for 4 ≤ n < MR, single rows below
     if n >= MR {
         let mut i0 = 0;
         while i0 + 2 * MR <= n {
@@ -412,8 +412,13 @@ pub(super) fn neg_mul_tree<T: Scalar>(
             i0 += MR;
         }
     } else if n >= 4 {
-        panel::<T, 4>(n, a, bs, &mut xs, 0, pat, starts);
-        panel::<T, 4>(n, a, bs, &mut xs, n - 4, pat, starts);
+        // one panel of all n rows (the same sums as two overlapping ones of 4)
+        match n {
+            5 => panel::<T, 5>(n, a, bs, &mut xs, 0, pat, starts),
+            6 => panel::<T, 6>(n, a, bs, &mut xs, 0, pat, starts),
+            7 => panel::<T, 7>(n, a, bs, &mut xs, 0, pat, starts),
+            _ => panel::<T, 4>(n, a, bs, &mut xs, 0, pat, starts),
+        }
     } else {
         for i0 in 0..n {
             panel::<T, 1>(n, a, bs, &mut xs, i0, pat, starts);
