@@ -30,6 +30,7 @@ CASES = {
  "talos.cd": (W+"/assets/robots/talos_reduced.urdf", "--floating-base --hold6 left_sole_link --hold6 right_sole_link", "constraint-dynamics"),
  "solo12.cd": (W+"/assets/robots/solo12.urdf", "--floating-base --hold FL_FOOT --hold FR_FOOT --hold HL_FOOT --hold HR_FOOT", "constraint-dynamics"),
  "talos.cdd": (W+"/assets/robots/talos_reduced.urdf", "--floating-base --hold6 left_sole_link --hold6 right_sole_link", "constraint-dynamics-derivatives"),
+ "solo12.cdd": (W+"/assets/robots/solo12.urdf", "--floating-base --hold FL_FOOT --hold FR_FOOT --hold HL_FOOT --hold HR_FOOT", "constraint-dynamics-derivatives"),
  "talos.fdcrba": (W+"/assets/robots/talos_reduced.urdf", "--floating-base", "fd-crba"),
 }
 for m in ["ant", "humanoid", "half_cheetah", "walker2d", "hopper"]:

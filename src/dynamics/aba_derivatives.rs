@@ -8,7 +8,7 @@ use super::rnea_derivatives::{
     check_wrenches, rnea_derivatives_pass, rnea_derivatives_pass_after_minv, LinkWrench,
 };
 use super::{check_massless, check_sizes, minv, DynamicsError};
-use crate::model::{Data, Model};
+use crate::model::{Data, JointKind, Model};
 use crate::spatial::ops::madd;
 use crate::spatial::{Force, Scalar};
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -24,8 +24,12 @@ use nalgebra::{DMatrix, DVector, Vector3};
 /// register-tiled products that read only ∂τ/∂x's tree pattern, or on long chains
 /// from ∂τ/∂x's low-rank parts in O(nv²) ("The products", `data.deriv_low_rank`).
 /// With mimic joints: q̈ by the engine's forward dynamics, H by the derivative
-/// sweep, dense Cholesky solves against the identity and both Jacobians. Also
-/// leaves `data.dtau_dq`, `data.dtau_dv` (at a = q̈); `data.h` only with mimic joints. No allocation.
+/// sweep, dense Cholesky solves against the identity and both Jacobians. A free
+/// root without wrenches: its columns of ∂q̈/∂q and linear-velocity columns of
+/// ∂q̈/∂v in closed form (docs/theory.md §"Derivatives: a free root's columns").
+/// Also leaves `data.dtau_dq`, `data.dtau_dv` (at a = q̈; with a free root and no
+/// wrenches, except those nine columns, left as they were); `data.h` only with
+/// mimic joints. No allocation.
 pub fn aba_derivatives<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,
@@ -53,10 +57,14 @@ pub fn aba_derivatives<T: Scalar>(
         let r = minv::minv_pass(model, data, q, v, tau, fext.map(|_| fb.as_slice()));
         data.deriv_fext = fb;
         r?;
+        // A free root (body 1, coordinates 0..6) without wrenches: its columns of
+        // ∂q̈/∂q and its linear-velocity columns of ∂q̈/∂v are known in closed form
+        // (`free_root_columns`); ∂τ/∂x's are not formed for them.
+        let free_root = fext.is_none() && !data.deriv_low_rank && free_root(model);
         // ∂τ/∂q, ∂τ/∂v at a = q̈
         let mut a = std::mem::replace(&mut data.deriv_tmp, DVector::zeros(0));
         a.copy_from(&data.qdd);
-        rnea_derivatives_pass_after_minv(model, data, q, v, &a, fext);
+        rnea_derivatives_pass_after_minv(model, data, q, v, &a, fext, free_root);
         data.deriv_tmp = a;
         if data.deriv_low_rank {
             // ∂q̈/∂x = −H⁻¹ ∂τ/∂x from ∂τ/∂x's low-rank parts (long chains)
@@ -80,7 +88,11 @@ pub fn aba_derivatives<T: Scalar>(
             runs,
             run0,
         };
-        neg_mul_tree(minv, [dtau_dq, dtau_dv], [dqdd_dq, dqdd_dv], &pat);
+        let starts = if free_root { [6, 3] } else { [0, 0] };
+        neg_mul_tree(minv, [dtau_dq, dtau_dv], [dqdd_dq, dqdd_dv], &pat, starts);
+        if free_root {
+            free_root_columns(model, data, v);
+        }
         return Ok(());
     }
     // mimic joints: q̈ through H's factor (dense, or tree-sparse where the
@@ -127,6 +139,41 @@ pub fn aba_derivatives<T: Scalar>(
     data.minv = minv;
     data.deriv_scratch = xt;
     Ok(())
+}
+
+/// Whether body 1 is a root on a free joint at coordinates 0..6.
+fn free_root<T: Scalar>(model: &Model<T>) -> bool {
+    model.nbodies > 1
+        && model.parent[1] == 0
+        && model.joints[1].iv == 0
+        && matches!(model.joints[1].kind, JointKind::Free)
+}
+
+/// A free root's columns of ∂q̈/∂q and its linear-velocity columns of ∂q̈/∂v,
+/// without wrenches (docs/theory.md §"Derivatives", "A free root"): moving or
+/// turning the whole tree, or adding a uniform velocity, changes no joint's q̈
+/// (a body in free fall in a uniform field); the root's own body-frame
+/// acceleration has gravity `Rᵀg` in its linear part, and `−ω × v` from its
+/// velocity. So `∂q̈/∂q[:, 0..3] = 0`, `∂q̈/∂q[:, 3..6] = [(Rᵀg)×; 0]` and
+/// `∂q̈/∂v[:, 0..3] = [−ω×; 0]` (R, ω: the root's world rotation and body
+/// angular velocity).
+fn free_root_columns<T: Scalar>(model: &Model<T>, data: &mut Data<T>, v: &DVector<T>) {
+    let n = model.nv;
+    let u = data.o_m_i[1].rot.tr_mul(&model.gravity);
+    let w = Vector3::new(v[3], v[4], v[5]);
+    let (xq, xv) = (data.dqdd_dq.as_mut_slice(), data.dqdd_dv.as_mut_slice());
+    xq[..6 * n].fill(T::zero());
+    xv[..3 * n].fill(T::zero());
+    // column k of a×: a × eₖ
+    for k in 0..3 {
+        let mut e = Vector3::zeros();
+        e[k] = T::one();
+        let (cu, cw) = (u.cross(&e), w.cross(&e));
+        for r in 0..3 {
+            xq[r + (3 + k) * n] = cu[r];
+            xv[r + k * n] = -cw[r];
+        }
+    }
 }
 
 /// `(xq, xv) += Σₖ cols[k n..(k + 1) n] (cq[k], cv[k])` over the first `K`
@@ -216,8 +263,6 @@ fn neg_mul_low_rank<T: Scalar>(model: &Model<T>, data: &mut Data<T>, ext: bool) 
         deriv_dadv: dadv,
         deriv_dfdq: dfdq,
         deriv_dfdv: dfdv,
-        minv_acol: pbuf,
-        minv_acol_off: poff,
         deriv_prod_s: sbuf,
         deriv_prod_s_off: soff,
         ..
@@ -280,7 +325,11 @@ fn neg_mul_low_rank<T: Scalar>(model: &Model<T>, data: &mut Data<T>, ext: bool) 
         }
     }
     // Root outwards: P_i = P_λ + H⁻¹[:, λ] J_λᵀ; x[:, c] = −(x[:, c] + P_i G_c).
+    // P lives in S's buffer (free now) and slots: an only child updates its
+    // parent's P in place, the children of a branching body start from a copy.
     let psz = 6 * n;
+    let pbuf = sbuf;
+    let poff = soff;
     for i in 1..nb {
         let p = parent[i];
         let (c0, ni) = (joints[i].iv, joints[i].nv());
@@ -289,14 +338,12 @@ fn neg_mul_low_rank<T: Scalar>(model: &Model<T>, data: &mut Data<T>, ext: bool) 
             pbuf[o..o + psz].fill(T::zero());
         } else {
             let r0 = poff[p];
-            let (src, dst): (&[T], &mut [T]) = if r0 < o {
+            if r0 != o {
+                // a deeper slot (r0 < o)
                 let (lo, hi) = pbuf.split_at_mut(o);
-                (&lo[r0..r0 + psz], &mut hi[..psz])
-            } else {
-                let (lo, hi) = pbuf.split_at_mut(r0);
-                (&hi[..psz], &mut lo[o..o + psz])
-            };
-            dst.copy_from_slice(src);
+                hi[..psz].copy_from_slice(&lo[r0..r0 + psz]);
+            }
+            let dst = &mut pbuf[o..o + psz];
             let (cp, np) = (joints[p].iv, joints[p].nv());
             for r in cp..cp + np {
                 let jr = coef12([&jc[r].ang, &jc[r].lin, &zero, &zero]);
@@ -344,6 +391,7 @@ pub(super) fn neg_mul_tree<T: Scalar>(
     bs: [&DMatrix<T>; 2],
     xs: [&mut DMatrix<T>; 2],
     pat: &TreePattern,
+    starts: [usize; 2],
 ) {
     let n = a.nrows();
     let a = a.as_slice();
@@ -351,30 +399,36 @@ pub(super) fn neg_mul_tree<T: Scalar>(
     let [x0, x1] = xs;
     let mut xs = [x0.as_mut_slice(), x1.as_mut_slice()];
     // panels of 2 MR rows, then MR, the last one ending at n (overlapping rows get
-    // the same sums again); 4 or single rows below MR
+    // the same sums again); one panel of n rows for 4 ≤ n < MR, single rows below
     if n >= MR {
         let mut i0 = 0;
         while i0 + 2 * MR <= n {
-            panel::<T, { 2 * MR }>(n, a, bs, &mut xs, i0, pat);
+            panel::<T, { 2 * MR }>(n, a, bs, &mut xs, i0, pat, starts);
             i0 += 2 * MR;
         }
         while i0 < n {
             i0 = i0.min(n - MR);
-            panel::<T, MR>(n, a, bs, &mut xs, i0, pat);
+            panel::<T, MR>(n, a, bs, &mut xs, i0, pat, starts);
             i0 += MR;
         }
     } else if n >= 4 {
-        panel::<T, 4>(n, a, bs, &mut xs, 0, pat);
-        panel::<T, 4>(n, a, bs, &mut xs, n - 4, pat);
+        // one panel of all n rows (the same sums as two overlapping ones of 4)
+        match n {
+            5 => panel::<T, 5>(n, a, bs, &mut xs, 0, pat, starts),
+            6 => panel::<T, 6>(n, a, bs, &mut xs, 0, pat, starts),
+            7 => panel::<T, 7>(n, a, bs, &mut xs, 0, pat, starts),
+            _ => panel::<T, 4>(n, a, bs, &mut xs, 0, pat, starts),
+        }
     } else {
         for i0 in 0..n {
-            panel::<T, 1>(n, a, bs, &mut xs, i0, pat);
+            panel::<T, 1>(n, a, bs, &mut xs, i0, pat, starts);
         }
     }
 }
 
-/// Rows `i0..i0 + R` of both products: blocks of NR columns, the last one ending
-/// at n (overlapping its predecessor); single columns below NR.
+/// Rows `i0..i0 + R` of both products, product k from column `starts[k]` on:
+/// blocks of NR columns, the last one ending at n (overlapping its
+/// predecessor); single columns where fewer than NR are left.
 #[inline(always)]
 fn panel<T: Scalar, const R: usize>(
     n: usize,
@@ -383,30 +437,29 @@ fn panel<T: Scalar, const R: usize>(
     xs: &mut [&mut [T]; 2],
     i0: usize,
     pat: &TreePattern,
+    starts: [usize; 2],
 ) {
-    if n < NR {
-        for j in 0..n {
-            let anc = &pat.runs[pat.run0[j]..pat.run0[j + 1]];
-            let own = (j, pat.dof_end[j].max(j + 1));
-            for (b, x) in bs.iter().zip(xs.iter_mut()) {
+    for ((b, x), s) in bs.iter().zip(xs.iter_mut()).zip(starts) {
+        if n - s < NR {
+            for j in s..n {
+                let anc = &pat.runs[pat.run0[j]..pat.run0[j + 1]];
+                let own = (j, pat.dof_end[j].max(j + 1));
                 tile::<T, R, 1>(n, a, b, x, i0, j, anc, own);
             }
+            continue;
         }
-        return;
-    }
-    let mut j0 = 0;
-    loop {
-        let anc = &pat.runs[pat.run0[j0]..pat.run0[j0 + 1]];
-        let end = pat.dof_end[j0..j0 + NR]
-            .iter()
-            .fold(j0 + NR, |e, &d| e.max(d));
-        for (b, x) in bs.iter().zip(xs.iter_mut()) {
+        let mut j0 = s;
+        loop {
+            let anc = &pat.runs[pat.run0[j0]..pat.run0[j0 + 1]];
+            let end = pat.dof_end[j0..j0 + NR]
+                .iter()
+                .fold(j0 + NR, |e, &d| e.max(d));
             tile::<T, R, NR>(n, a, b, x, i0, j0, anc, (j0, end));
+            if j0 + NR == n {
+                break;
+            }
+            j0 = (j0 + NR).min(n - NR);
         }
-        if j0 + NR == n {
-            break;
-        }
-        j0 = (j0 + NR).min(n - NR);
     }
 }
 

@@ -114,7 +114,7 @@ pub fn constraint_dynamics_derivatives(
         rnea_derivatives_pass(model, data, q, v, &a, fext);
     } else {
         // the poses and world columns of minv_pass
-        rnea_derivatives_pass_after_minv(model, data, q, v, &a, fext);
+        rnea_derivatives_pass_after_minv(model, data, q, v, &a, fext, false);
     }
     data.deriv_tmp = a;
     // G_q −= ∂(J_cᵀ λ)/∂q; ∂A/∂q, ∂A/∂v
@@ -165,6 +165,7 @@ pub fn constraint_dynamics_derivatives(
             [dtau_dq, dtau_dv],
             [&mut cd.dqdd_dq, &mut cd.dqdd_dv],
             &pat,
+            [0, 0],
         );
     }
     if cd.rows == 0 {

@@ -71,8 +71,8 @@ pub(crate) fn rnea_derivatives_pass<T: Scalar>(
     fext: Option<&[LinkWrench<T>]>,
 ) {
     match fext {
-        Some(w) if !w.is_empty() => pass::<T, true, false>(model, data, q, v, a, w),
-        _ => pass::<T, false, false>(model, data, q, v, a, &[]),
+        Some(w) if !w.is_empty() => pass::<T, true, false>(model, data, q, v, a, w, false),
+        _ => pass::<T, false, false>(model, data, q, v, a, &[], false),
     }
 }
 
@@ -81,7 +81,10 @@ pub(crate) fn rnea_derivatives_pass<T: Scalar>(
 /// the world columns `data.minv_j`, the world inertias `data.deriv_oy` and
 /// momenta `data.deriv_hm` it left are reused (no joint placement, no sin/cos, no
 /// inertia turned to the world). Its callers have H⁻¹ and read only ∂τ/∂q,
-/// ∂τ/∂v: `data.h` is not written.
+/// ∂τ/∂v: `data.h` is not written. `free_root` (body 1 a root on a free joint at
+/// coordinates 0..6, no wrenches): the root's 6 columns of ∂τ/∂q and its 3
+/// linear-velocity columns of ∂τ/∂v are not formed (`aba_derivatives` has the
+/// matching columns of ∂q̈ in closed form); they keep what they held.
 pub(crate) fn rnea_derivatives_pass_after_minv<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,
@@ -89,11 +92,12 @@ pub(crate) fn rnea_derivatives_pass_after_minv<T: Scalar>(
     v: &DVector<T>,
     a: &DVector<T>,
     fext: Option<&[LinkWrench<T>]>,
+    free_root: bool,
 ) {
     debug_assert!(data.deriv_direct);
     match fext {
-        Some(w) if !w.is_empty() => pass::<T, true, true>(model, data, q, v, a, w),
-        _ => pass::<T, false, true>(model, data, q, v, a, &[]),
+        Some(w) if !w.is_empty() => pass::<T, true, true>(model, data, q, v, a, w, false),
+        _ => pass::<T, false, true>(model, data, q, v, a, &[], free_root),
     }
 }
 
@@ -139,7 +143,8 @@ fn variation_tr_mul<T: Scalar>(s: &Matrix3<T>, hm: &Force<T>, x: &Motion<T>) -> 
 
 /// The two sweeps; `F`: external wrenches present; `K`: the poses, world
 /// columns, world inertias and momenta are those `minv_pass` left (direct columns
-/// only), and H is not written.
+/// only), and H is not written; `free_root`: body 1's columns as
+/// [`rnea_derivatives_pass_after_minv`] says.
 fn pass<T: Scalar, const F: bool, const K: bool>(
     model: &Model<T>,
     data: &mut Data<T>,
@@ -147,6 +152,7 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
     v: &DVector<T>,
     a: &DVector<T>,
     fext: &[LinkWrench<T>],
+    free_root: bool,
 ) {
     let nb = model.nbodies;
     let (q, v, a) = (q.as_slice(), v.as_slice(), a.as_slice());
@@ -307,6 +313,35 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
         // a root body's columns have ∂v/∂q = v̂₀ × J = 0 (the world is at rest):
         // the terms it multiplies are left out
         let root = p == 0;
+        if K && !F && free_root && i == 1 {
+            // the free root: τ, the root's rows against the later columns and its
+            // angular-velocity columns of ∂τ/∂v (a root has nothing to pass on)
+            for k in c0..ce {
+                let s = jcol[k];
+                tau[col_iv[k]] += s.dot(&fi);
+                if k >= c0 + 3 {
+                    dfdv[k] = variation_mul(&doyi, &hmi, &s) + yi.mul_motion(&dadv[k]);
+                }
+            }
+            for r in c0..ce {
+                let s = jcol[r];
+                for c in c0 + 3..ce {
+                    mv[r + c * n] = s.dot(&dfdv[c]);
+                }
+                for c in ce..end {
+                    let at = r + c * n;
+                    mq[at] = s.dot(&dfdq[c]);
+                    mv[at] = s.dot(&dfdv[c]);
+                }
+            }
+            for r in c0 + 3..ce {
+                let (av, jr) = (dadv[r], jcol[r]);
+                for c in ce..end {
+                    mv[c + r * n] = av.dot(&dfda[c]) + jr.dot(&ytj[c]);
+                }
+            }
+            continue;
+        }
         for k in c0..ce {
             let s = jcol[k];
             // τ = Jᵀ F
