@@ -1,9 +1,10 @@
 //! The subspace-minimisation step of projected Gauss–Seidel (PGS-SM): the
 //! free rows solved exactly by a dense LDLᵀ.
 
+use super::dense::ldlt_dropping;
 use super::loop_block::LoopBlock;
 use super::{RowKind, SUBSPACE_MAX};
-use crate::dynamics::linalg::{ldlt_dropping, ldlt_dropping_solve};
+use crate::dynamics::linalg::ldlt_dropping_solve;
 
 /// Preallocated scratch of [`subspace_step`]: the free rows, their dense
 /// Delassus block and right-hand side, their Y rows scattered to full width.
@@ -24,6 +25,10 @@ pub(super) struct Subspace {
     pub(super) null: Vec<f64>,
     /// Their Gram matrix in the W-diagonal metric (stress.rs).
     pub(super) gram: Vec<f64>,
+    /// `w` holds the LDLᵀ of W_FF over `factored_rows`, made in this solve
+    /// of an island's rows (cleared when one starts, [`Subspace::forget`]).
+    pub(super) factored: bool,
+    pub(super) factored_rows: Vec<usize>,
 }
 
 impl Subspace {
@@ -39,7 +44,15 @@ impl Subspace {
             loops: LoopBlock::new(cap),
             null: vec![0.0; m * m],
             gram: vec![0.0; m * m],
+            factored: false,
+            factored_rows: Vec::with_capacity(m),
         }
+    }
+
+    /// Forgets the factor kept in `w` (a new solve, or `w` overwritten).
+    #[inline]
+    pub(super) fn forget(&mut self) {
+        self.factored = false;
     }
 
     /// The lower triangle of W_FF = Y_F Y_Fᵀ over `self.rows` (m of them) into
@@ -68,14 +81,38 @@ impl Subspace {
             for (&yt, &k) in yr.iter().zip(pa) {
                 self.x[k] = yt;
             }
-            for (bb, &q) in self.rows.iter().enumerate().take(a + 1) {
+            // rows q on one path (a contact's three) summed side by side:
+            // each entry the same sum in the same order
+            let x = &self.x[..];
+            let mut bb = 0;
+            while bb <= a {
+                let q = self.rows[bb];
                 let pq = path(q);
-                let yq = &y[q * st..q * st + pq.len()];
+                let same = |i: usize| {
+                    bb + i <= a && self.rows[bb + i] == q + i && paths[q + i] == paths[q]
+                };
+                let yq = |i: usize| &y[(q + i) * st..(q + i) * st + pq.len()];
+                if same(1) && same(2) {
+                    let (y0, y1, y2) = (yq(0), yq(1), yq(2));
+                    let (mut s0, mut s1, mut s2) = (0.0, 0.0, 0.0);
+                    for (t, &k) in pq.iter().enumerate() {
+                        let xk = x[k];
+                        s0 += y0[t] * xk;
+                        s1 += y1[t] * xk;
+                        s2 += y2[t] * xk;
+                    }
+                    self.w[a * m + bb] = s0;
+                    self.w[a * m + bb + 1] = s1;
+                    self.w[a * m + bb + 2] = s2;
+                    bb += 3;
+                    continue;
+                }
                 let mut s = 0.0;
-                for (&yt, &k) in yq.iter().zip(pq) {
-                    s += yt * self.x[k];
+                for (&yt, &k) in yq(0).iter().zip(pq) {
+                    s += yt * x[k];
                 }
                 self.w[a * m + bb] = s;
+                bb += 1;
             }
             for &k in pa {
                 self.x[k] = 0.0;
@@ -234,10 +271,16 @@ pub(super) fn subspace_step(
         };
         sm.rhs[a] = target - u;
     }
-    sm.form_w_ff(y, st, paths, table);
     // W_FF = L D Lᵀ; a pivot that lost all but `DEPENDENT` of its diagonal
-    // is a row dependent on earlier ones (redundant contacts): dropped (δ = 0)
-    ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
+    // is a row dependent on earlier ones (redundant contacts): dropped (δ = 0).
+    // The rows' y are fixed within a solve: a step on the same free rows as
+    // the last one of this solve reuses its factor (the same bits)
+    if !(sm.factored && sm.factored_rows == sm.rows) {
+        sm.form_w_ff(y, st, paths, table);
+        ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
+        sm.factored_rows.clone_from(&sm.rows);
+        sm.factored = true;
+    }
     ldlt_dropping_solve(&sm.w[..m * m], m, &mut sm.rhs[..m]);
     // the new impulses (none taken if one is not finite)
     for (a, &r) in sm.rows.iter().enumerate() {
