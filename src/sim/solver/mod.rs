@@ -19,6 +19,7 @@
 //! 0 ≤ μ ⊥ J w − b_pos ≥ 0 on the unilateral rows, b_pos = min(βφ⁻/Δt, cap),
 //! moves q but never enters v.
 
+mod dense;
 mod form;
 mod loop_block;
 mod pgs;

@@ -114,6 +114,8 @@ impl Rows {
         let (y, paths) = (&self.y[..], &self.path[..n]);
         let (kinds, c, b) = (&self.kind[..n], &self.c[..n], &self.b[..n]);
         let contact = &self.is_block[..n];
+        // no factor of an earlier solve's W_FF is reused (subspace.rs)
+        out.sm.0.forget();
         // the loop rows as one exact block, every other row seen through them
         // (the reduced W', loop_block.rs): taken out for the solve
         let mut lb = std::mem::take(&mut out.sm.0.loops);

@@ -2,9 +2,10 @@
 //! that moves nothing, chosen least-norm
 //! (docs/theory.md §"Self-stress of a sticking stance").
 
+use super::dense::ldlt_dropping;
 use super::subspace::{Subspace, DEPENDENT};
 use super::{RowKind, Rows, SUBSPACE_MAX};
-use crate::dynamics::linalg::{ldlt_dropping, ldlt_dropping_solve};
+use crate::dynamics::linalg::ldlt_dropping_solve;
 
 impl Rows {
     /// Whether this step's solve of the island on `dofs` (`None`: every dof)
@@ -122,6 +123,7 @@ impl Rows {
             return false;
         }
         // W_FF's lower triangle (as the subspace step forms it)
+        sm.forget();
         sm.form_w_ff(&self.y, st, &self.path, table);
         ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
         // null vectors n = L⁻ᵀ eⱼ of the dropped rows j (L unit lower, a

@@ -1,9 +1,10 @@
 //! The subspace-minimisation step of projected Gauss–Seidel (PGS-SM): the
 //! free rows solved exactly by a dense LDLᵀ.
 
+use super::dense::ldlt_dropping;
 use super::loop_block::LoopBlock;
 use super::{RowKind, SUBSPACE_MAX};
-use crate::dynamics::linalg::{ldlt_dropping, ldlt_dropping_solve};
+use crate::dynamics::linalg::ldlt_dropping_solve;
 
 /// Preallocated scratch of [`subspace_step`]: the free rows, their dense
 /// Delassus block and right-hand side, their Y rows scattered to full width.
@@ -15,6 +16,9 @@ pub(super) struct Subspace {
     pub(super) lam: Vec<f64>,
     /// A row scattered to full width (nv entries, zero between uses).
     pub(super) x: Vec<f64>,
+    /// A contact's three rows scattered side by side (nv entries, zero
+    /// between uses).
+    pub(super) x3: Vec<[f64; 3]>,
     /// At a tangent pair's first row: it lay on its cone's boundary (sliding).
     pub(super) sliding: Vec<bool>,
     /// The loop rows' exact block ([`LoopBlock`]).
@@ -24,6 +28,10 @@ pub(super) struct Subspace {
     pub(super) null: Vec<f64>,
     /// Their Gram matrix in the W-diagonal metric (stress.rs).
     pub(super) gram: Vec<f64>,
+    /// `w` holds the LDLᵀ of W_FF over `factored_rows`, made in this solve
+    /// of an island's rows (cleared when one starts, [`Subspace::forget`]).
+    pub(super) factored: bool,
+    pub(super) factored_rows: Vec<usize>,
 }
 
 impl Subspace {
@@ -35,11 +43,20 @@ impl Subspace {
             rhs: vec![0.0; m],
             lam: vec![0.0; m],
             x: vec![0.0; nv],
+            x3: vec![[0.0; 3]; nv],
             sliding: vec![false; cap],
             loops: LoopBlock::new(cap),
             null: vec![0.0; m * m],
             gram: vec![0.0; m * m],
+            factored: false,
+            factored_rows: Vec::with_capacity(m),
         }
+    }
+
+    /// Forgets the factor kept in `w` (a new solve, or `w` overwritten).
+    #[inline]
+    pub(super) fn forget(&mut self) {
+        self.factored = false;
     }
 
     /// The lower triangle of W_FF = Y_F Y_Fᵀ over `self.rows` (m of them) into
@@ -62,24 +79,125 @@ impl Subspace {
             let (s, l) = paths[r];
             &table[s..s + l]
         };
-        for (a, &r) in self.rows.iter().enumerate() {
+        let rows = &self.rows[..];
+        // rows a.., q.. on one path from a: a contact's three rows
+        let three = |a: usize, hi: usize| {
+            let r = rows[a];
+            a + 2 <= hi
+                && rows[a + 1] == r + 1
+                && rows[a + 2] == r + 2
+                && paths[r + 1] == paths[r]
+                && paths[r + 2] == paths[r]
+        };
+        let yrow = |q: usize, len: usize| &y[q * st..q * st + len];
+        let mut a = 0;
+        while a < m {
+            let r = rows[a];
             let pa = path(r);
-            let yr = &y[r * st..r * st + pa.len()];
+            if a + 2 < m && three(a, m - 1) {
+                // a contact's three rows at once: every entry (a + i, bb + j),
+                // bb + j ≤ a + i, the same sum in the same order as below
+                let (y0, y1, y2) = (
+                    yrow(r, pa.len()),
+                    yrow(r + 1, pa.len()),
+                    yrow(r + 2, pa.len()),
+                );
+                for (t, &k) in pa.iter().enumerate() {
+                    self.x3[k] = [y0[t], y1[t], y2[t]];
+                }
+                let x3 = &self.x3[..];
+                let hi = a + 2;
+                let mut bb = 0;
+                while bb <= hi {
+                    let q = rows[bb];
+                    let pq = path(q);
+                    if three(bb, hi) {
+                        let (z0, z1, z2) = (
+                            yrow(q, pq.len()),
+                            yrow(q + 1, pq.len()),
+                            yrow(q + 2, pq.len()),
+                        );
+                        let mut sum = [[0.0f64; 3]; 3];
+                        for (t, &k) in pq.iter().enumerate() {
+                            let xk = x3[k];
+                            let zt = [z0[t], z1[t], z2[t]];
+                            for (si, &xi) in sum.iter_mut().zip(&xk) {
+                                for (sij, &zj) in si.iter_mut().zip(&zt) {
+                                    *sij += zj * xi;
+                                }
+                            }
+                        }
+                        for (i, si) in sum.iter().enumerate() {
+                            for (j, &sij) in si.iter().enumerate() {
+                                if bb + j <= a + i {
+                                    self.w[(a + i) * m + bb + j] = sij;
+                                }
+                            }
+                        }
+                        bb += 3;
+                        continue;
+                    }
+                    let mut sum = [0.0f64; 3];
+                    for (&yt, &k) in yrow(q, pq.len()).iter().zip(pq) {
+                        let xk = x3[k];
+                        for (si, &xi) in sum.iter_mut().zip(&xk) {
+                            *si += yt * xi;
+                        }
+                    }
+                    for (i, &si) in sum.iter().enumerate() {
+                        if bb <= a + i {
+                            self.w[(a + i) * m + bb] = si;
+                        }
+                    }
+                    bb += 1;
+                }
+                for &k in pa {
+                    self.x3[k] = [0.0; 3];
+                }
+                a += 3;
+                continue;
+            }
+            let yr = yrow(r, pa.len());
             for (&yt, &k) in yr.iter().zip(pa) {
                 self.x[k] = yt;
             }
-            for (bb, &q) in self.rows.iter().enumerate().take(a + 1) {
+            // rows q on one path (a contact's three) summed side by side:
+            // each entry the same sum in the same order
+            let x = &self.x[..];
+            let mut bb = 0;
+            while bb <= a {
+                let q = rows[bb];
                 let pq = path(q);
-                let yq = &y[q * st..q * st + pq.len()];
+                if three(bb, a) {
+                    let (y0, y1, y2) = (
+                        yrow(q, pq.len()),
+                        yrow(q + 1, pq.len()),
+                        yrow(q + 2, pq.len()),
+                    );
+                    let (mut s0, mut s1, mut s2) = (0.0, 0.0, 0.0);
+                    for (t, &k) in pq.iter().enumerate() {
+                        let xk = x[k];
+                        s0 += y0[t] * xk;
+                        s1 += y1[t] * xk;
+                        s2 += y2[t] * xk;
+                    }
+                    self.w[a * m + bb] = s0;
+                    self.w[a * m + bb + 1] = s1;
+                    self.w[a * m + bb + 2] = s2;
+                    bb += 3;
+                    continue;
+                }
                 let mut s = 0.0;
-                for (&yt, &k) in yq.iter().zip(pq) {
-                    s += yt * self.x[k];
+                for (&yt, &k) in yrow(q, pq.len()).iter().zip(pq) {
+                    s += yt * x[k];
                 }
                 self.w[a * m + bb] = s;
+                bb += 1;
             }
             for &k in pa {
                 self.x[k] = 0.0;
             }
+            a += 1;
         }
     }
 }
@@ -221,23 +339,53 @@ pub(super) fn subspace_step(
     if sm.x.len() < nv {
         return false;
     }
-    for (a, &r) in sm.rows.iter().enumerate() {
+    let target = |r: usize| match kinds[r] {
+        RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
+        _ => b[r],
+    };
+    let mut a = 0;
+    while a < m {
+        let r = sm.rows[a];
         let pa = path(r);
-        let yr = &y[r * st..r * st + pa.len()];
+        let yr = |i: usize| &y[(r + i) * st..(r + i) * st + pa.len()];
+        if a + 2 < m
+            && sm.rows[a + 1] == r + 1
+            && sm.rows[a + 2] == r + 2
+            && paths[r + 1] == paths[r]
+            && paths[r + 2] == paths[r]
+        {
+            // a contact's three rows in one pass, each sum in its order
+            let (y0, y1, y2) = (yr(0), yr(1), yr(2));
+            let (mut u0, mut u1, mut u2) = (c[r], c[r + 1], c[r + 2]);
+            for (t, &k) in pa.iter().enumerate() {
+                let x = dv[k];
+                u0 += y0[t] * x;
+                u1 += y1[t] * x;
+                u2 += y2[t] * x;
+            }
+            sm.rhs[a] = target(r) - u0;
+            sm.rhs[a + 1] = target(r + 1) - u1;
+            sm.rhs[a + 2] = target(r + 2) - u2;
+            a += 3;
+            continue;
+        }
         let mut u = c[r];
-        for (&yt, &k) in yr.iter().zip(pa) {
+        for (&yt, &k) in yr(0).iter().zip(pa) {
             u += yt * dv[k];
         }
-        let target = match kinds[r] {
-            RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
-            _ => b[r],
-        };
-        sm.rhs[a] = target - u;
+        sm.rhs[a] = target(r) - u;
+        a += 1;
     }
-    sm.form_w_ff(y, st, paths, table);
     // W_FF = L D Lᵀ; a pivot that lost all but `DEPENDENT` of its diagonal
-    // is a row dependent on earlier ones (redundant contacts): dropped (δ = 0)
-    ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
+    // is a row dependent on earlier ones (redundant contacts): dropped (δ = 0).
+    // The rows' y are fixed within a solve: a step on the same free rows as
+    // the last one of this solve reuses its factor (the same bits)
+    if !(sm.factored && sm.factored_rows == sm.rows) {
+        sm.form_w_ff(y, st, paths, table);
+        ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
+        sm.factored_rows.clone_from(&sm.rows);
+        sm.factored = true;
+    }
     ldlt_dropping_solve(&sm.w[..m * m], m, &mut sm.rhs[..m]);
     // the new impulses (none taken if one is not finite)
     for (a, &r) in sm.rows.iter().enumerate() {

@@ -1,0 +1,77 @@
+//! The subspace step's dense LDLᵀ of W_FF (subspace.rs, stress.rs): the
+//! operations of [`crate::dynamics::linalg::ldlt_dropping`] on the same
+//! numbers in the same order (each entry the same bits), laid out for a
+//! small m: four rows' sums carried side by side (independent chains, so
+//! that one does not wait on another's latency) and no test on a dropped
+//! pivot in the inner loops.
+//!
+//! Why the test can go: a pivot dropped at column k (D = 0) leaves its column
+//! of L exactly +0 below the diagonal, so every term lᵢₖ lⱼₖ dₖ of a later
+//! entry is (+0 · +0) · (+0) = +0, and x − (+0) is x for every x (−0, NaN and
+//! ±∞ included): skipping the term and subtracting it agree bit for bit.
+
+use crate::dynamics::linalg;
+
+/// Most rows taken here (more: the library's loop).
+const CAP: usize = 64;
+
+/// [`linalg::ldlt_dropping`] (the lower triangle of the row-major m × m `a`
+/// factored as L D Lᵀ, a pivot below `drop` of its diagonal dropped), the
+/// same bits.
+pub(super) fn ldlt_dropping(a: &mut [f64], m: usize, drop: f64) {
+    if m > CAP || a.len() < m * m {
+        linalg::ldlt_dropping(a, m, drop);
+        return;
+    }
+    let a = &mut a[..m * m];
+    let mut d = [0.0f64; CAP];
+    for j in 0..m {
+        let (head, tail) = a.split_at_mut((j + 1) * m);
+        let (rowj, diag) = {
+            let r = &head[j * m..j * m + j + 1];
+            (&r[..j], r[j])
+        };
+        let mut dj = diag;
+        for (&l, &dk) in rowj.iter().zip(&d[..j]) {
+            dj -= l * l * dk;
+        }
+        let dj = if dj > drop * diag && dj > 0.0 {
+            dj
+        } else {
+            0.0
+        };
+        head[j * m + j] = dj;
+        d[j] = dj;
+        let rowj = &head[j * m..j * m + j];
+        let dk = &d[..j];
+        let fin = |s: f64| if dj != 0.0 { s / dj } else { 0.0 };
+        let mut rest = tail;
+        while rest.len() >= 4 * m {
+            let (four, more) = rest.split_at_mut(4 * m);
+            rest = more;
+            let (r0, x) = four.split_at_mut(m);
+            let (r1, x) = x.split_at_mut(m);
+            let (r2, r3) = x.split_at_mut(m);
+            let (mut s0, mut s1, mut s2, mut s3) = (r0[j], r1[j], r2[j], r3[j]);
+            let (r0j, r1j, r2j, r3j) = (&r0[..j], &r1[..j], &r2[..j], &r3[..j]);
+            for k in 0..j {
+                let (lk, dk) = (rowj[k], dk[k]);
+                s0 -= r0j[k] * lk * dk;
+                s1 -= r1j[k] * lk * dk;
+                s2 -= r2j[k] * lk * dk;
+                s3 -= r3j[k] * lk * dk;
+            }
+            r0[j] = fin(s0);
+            r1[j] = fin(s1);
+            r2[j] = fin(s2);
+            r3[j] = fin(s3);
+        }
+        for ri in rest.chunks_exact_mut(m) {
+            let mut s = ri[j];
+            for ((&x, &lk), &dk) in ri[..j].iter().zip(rowj).zip(dk) {
+                s -= x * lk * dk;
+            }
+            ri[j] = fin(s);
+        }
+    }
+}
