@@ -249,6 +249,8 @@ impl GroundContact {
         let ground = self.ground;
         let maxp = self.params.max_points_per_shape.max(1);
         let stepped = self.travel.begin();
+        // (c = 0: every margin is δ, the shapes' travel is not measured)
+        let measure = self.travel.measures();
         // (the shapes never change: held apart from `self`, which the search mutates)
         let shapes = std::sync::Arc::clone(&self.shapes);
         for (si, s) in shapes.iter().enumerate() {
@@ -266,11 +268,13 @@ impl GroundContact {
             // the speculative margin: max(δ, c·s), s how far down the shape
             // moved in the last step (docs/theory.md §"Speculative margin")
             let row = [r[(2, 0)], r[(2, 1)], r[(2, 2)]];
-            if stepped > 0.0 {
-                let down = travel::dropped(&self.anchor[si], z, row, s.bound);
-                self.travel.set(si, down * stepped);
+            if measure {
+                if stepped > 0.0 {
+                    let down = travel::dropped(&self.anchor[si], z, row, s.bound);
+                    self.travel.set(si, down * stepped);
+                }
+                self.anchor[si] = [z, row[0], row[1], row[2]];
             }
-            self.anchor[si] = [z, row[0], row[1], row[2]];
             let margin = self.travel.margin(si);
             if z - ground - s.bound > margin {
                 continue;
