@@ -465,7 +465,7 @@ impl PairContact {
                 continue;
             }
             let (ma, mb) = (&self.members[pair.a], &self.members[pair.b]);
-            let (wa, wb) = (self.poses[pair.a], self.poses[pair.b]);
+            let (wa, wb) = (&self.poses[pair.a], &self.poses[pair.b]);
             let margin = self.travel.pair_margin(pair.a, pair.b);
             self.queries += 1;
             self.raw.clear();
@@ -486,8 +486,8 @@ impl PairContact {
                         face_points(
                             &ma.shape,
                             &mb.shape,
-                            &wa,
-                            &wb,
+                            wa,
+                            wb,
                             hull_is_a,
                             margin,
                             self.max_points,
@@ -502,17 +502,17 @@ impl PairContact {
                 // the margin: no point, no parry query
                 let convex = ma.shape.convex && mb.shape.convex;
                 let apart = convex
-                    && (still_apart(pair.apart.as_ref(), ma, mb, &wa, &wb, margin) || {
-                        let gap = apart_along(&pair.axis, ma, mb, &wa, &wb);
-                        pair.apart = (gap > margin).then_some((gap, wa, wb));
+                    && (still_apart(pair.apart.as_ref(), ma, mb, wa, wb, margin) || {
+                        let gap = apart_along(&pair.axis, ma, mb, wa, wb);
+                        pair.apart = (gap > margin).then_some((gap, *wa, *wb));
                         gap > margin
                     });
                 if !plane && !apart {
                     parry_points(
                         &ma.shape,
                         &mb.shape,
-                        &wa,
-                        &wb,
+                        wa,
+                        wb,
                         margin,
                         &mut pair.manifolds,
                         &mut pair.workspace,
@@ -533,6 +533,11 @@ impl PairContact {
                         _ => Vector3::zeros(),
                     };
                 }
+            }
+            if self.raw.is_empty() {
+                // no point: every slot free (`assign_slots` of none)
+                keys.fill(NO_KEY);
+                continue;
             }
             let start = out.len();
             // the moving side first: a static a (an obstacle or a fixed
