@@ -14,10 +14,10 @@
 //! starts the solve), else a free one marked fresh (no warm start).
 
 use super::broad::{prefetch, PairTable, SweepAndPrune, LAZY_PAIR};
-use super::filter::{is_self_pair, may_touch, DroppedPair, START_OVERLAP};
+use super::filter::{is_self_pair, may_touch};
 use super::narrow::prim::{round_points_at, Round};
 use super::narrow::{face_kind, face_points, parry_points, reduce_pair, FaceScratch, Raw};
-use super::shapes::{from_pvec, pair_shape, to_pose, PairShape};
+use super::shapes::{from_pvec, pair_shape, PairShape};
 use super::travel::{moved_from, Travel};
 use super::{ContactError, ContactParams, ContactPoint};
 use crate::model::Model;
@@ -28,6 +28,7 @@ use std::path::PathBuf;
 
 pub(crate) mod apart;
 mod order;
+mod start;
 use apart::{apart_along, still_apart};
 use order::assign_slots;
 
@@ -561,50 +562,6 @@ impl PairContact {
             });
             assign_slots(pair.slot_base, keys, &mut out[start..]);
         }
-    }
-
-    /// Drops the self pairs that overlap by more than [`START_OVERLAP`] at the
-    /// body poses `o_m_i` (scene.md rule 4), after restoring every pair dropped
-    /// before; returns them, with their links, from `model`.
-    pub fn drop_start_overlaps(&mut self, model: &Model, o_m_i: &[Se3<f64>]) -> Vec<DroppedPair> {
-        let mut out = Vec::new();
-        self.dropped.fill(false);
-        for (pi, pair) in self.pairs.iter_mut().enumerate() {
-            if !pair.self_pair {
-                continue;
-            }
-            let (ma, mb) = (&self.members[pair.a], &self.members[pair.b]);
-            let (wa, wb) = (world(ma, o_m_i), world(mb, o_m_i));
-            let c = parry3d_f64::query::contact(
-                &to_pose(&wa),
-                &*ma.shape.shape,
-                &to_pose(&wb),
-                &*mb.shape.shape,
-                0.0,
-            );
-            if let Ok(Some(c)) = c {
-                if c.dist < -START_OVERLAP {
-                    self.dropped[pi] = true;
-                    pair.manifolds.clear();
-                    let maxp = self.max_points;
-                    if let Some(k) = self.keys.get_mut(pi * maxp..(pi + 1) * maxp) {
-                        k.fill(NO_KEY);
-                    }
-                    let link = |m: &Member| {
-                        model
-                            .collisions
-                            .get(m.geom)
-                            .map_or(String::new(), |g| g.link.clone())
-                    };
-                    out.push(DroppedPair {
-                        a: link(ma),
-                        b: link(mb),
-                        depth: -c.dist,
-                    });
-                }
-            }
-        }
-        out
     }
 
     /// The first slot of pair contact.
