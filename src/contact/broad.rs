@@ -121,6 +121,9 @@ pub struct SweepAndPrune {
     /// The sweep's pairs whose boxes overlap, in the sweep's order, before
     /// the table is read (then read a few ahead of use).
     cand: Vec<(u32, u32)>,
+    /// Scratch of the one sweep: the lower x of `order`'s shapes, in its
+    /// order (sorted with it, read by the sweep without a gather).
+    xs: Vec<f64>,
 }
 
 /// Shapes from which the floor is cut into strips.
@@ -142,6 +145,7 @@ impl SweepAndPrune {
             wide: Vec::with_capacity(n),
             merged: Vec::with_capacity(n),
             cand: Vec::new(),
+            xs: Vec::with_capacity(n),
         }
     }
 
@@ -199,27 +203,34 @@ impl SweepAndPrune {
     /// One sweep along x over every shape.
     fn sweep_x(&mut self, cand: &mut Vec<(u32, u32)>) {
         let n = self.order.len();
-        // insertion sort by lower x
-        for k in 1..n {
-            let mut m = k;
-            while m > 0
-                && self.lo[self.order[m - 1] as usize][0] > self.lo[self.order[m] as usize][0]
-            {
-                self.order.swap(m - 1, m);
-                m -= 1;
+        // the lower x in last step's order, then an insertion sort by it
+        // (the same comparisons, so the same order, as one on the boxes)
+        let mut buf = std::mem::take(&mut self.xs);
+        buf.clear();
+        buf.extend(self.order.iter().map(|&i| self.lo[i as usize][0]));
+        {
+            let order = &mut self.order[..n];
+            let xs = &mut buf[..n];
+            for k in 1..n {
+                let mut m = k;
+                while m > 0 && xs[m - 1] > xs[m] {
+                    xs.swap(m - 1, m);
+                    order.swap(m - 1, m);
+                    m -= 1;
+                }
             }
         }
         for k in 0..n {
             let i = self.order[k] as usize;
-            let hi = self.hi[i];
-            for &j in &self.order[k + 1..] {
-                let j = j as usize;
-                if self.lo[j][0] > hi[0] {
+            let hx = self.hi[i][0];
+            for (&x, &j) in buf[k + 1..n].iter().zip(&self.order[k + 1..]) {
+                if x > hx {
                     break;
                 }
-                self.report(i, j, cand);
+                self.report(i, j as usize, cand);
             }
         }
+        self.xs = buf;
     }
 
     /// Strips along y, each swept along x with the next (module docs).

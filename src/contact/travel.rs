@@ -66,6 +66,14 @@ impl Travel {
         }
     }
 
+    /// Whether the travel changes any margin: with the factor c = 0 (and
+    /// δ ≥ 0) max(δ, c·s) is δ whatever s is, so the travel need not be
+    /// measured (a URDF world's, a scene's: the margin is δ).
+    #[inline]
+    pub fn measures(&self) -> bool {
+        self.factor != 0.0 || !(self.delta >= 0.0)
+    }
+
     /// Shape `k` travelled `s` in the last step.
     #[inline]
     pub fn set(&mut self, k: usize, s: f64) {
@@ -111,6 +119,19 @@ pub(crate) fn margin(delta: f64, c: f64, s: f64) -> f64 {
 pub(crate) fn moved(w0: &Se3<f64>, w: &Se3<f64>, mid: &Vector3<f64>, radius: f64) -> f64 {
     (w.act_point(mid) - w0.act_point(mid)).norm()
         + (w.rot - w0.rot).norm() * std::f64::consts::FRAC_1_SQRT_2 * radius
+}
+
+/// [`moved`] of a shape whose point `mid` was at `c0` (pose `w0`) and is at
+/// `c` (pose `w`): the same value, from the points already placed.
+#[inline]
+pub(crate) fn moved_from(
+    c0: &Vector3<f64>,
+    c: &Vector3<f64>,
+    w0: &Se3<f64>,
+    w: &Se3<f64>,
+    radius: f64,
+) -> f64 {
+    (c - c0).norm() + (w.rot - w0.rot).norm() * std::f64::consts::FRAC_1_SQRT_2 * radius
 }
 
 /// The farthest any point within `radius` of a point p of a body moved down

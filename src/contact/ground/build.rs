@@ -252,6 +252,7 @@ impl GroundContact {
         let cap = shapes.iter().map(|s| s.nslots).max().unwrap_or(0);
         let nshapes = shapes.len();
         Ok(Some(Self {
+            cull: shapes.iter().map(super::Cull::of).collect(),
             shapes: shapes.into(),
             ground,
             params,

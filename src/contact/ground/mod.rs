@@ -78,6 +78,33 @@ pub struct GroundShape {
     low_box: Option<([f64; 3], [f64; 3])>,
 }
 
+/// What the detection's first tests read of a shape (its body, geometry
+/// origin, bounding sphere and box), apart from the shape: a few cache
+/// lines for all of a model's shapes, where each [`GroundShape`] fills a
+/// dozen (humanoid_CMU's 47 shapes did not fit the L1 cache, and most are
+/// culled from these alone).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Cull {
+    body: usize,
+    /// `placement.trans`.
+    origin: [f64; 3],
+    bound: f64,
+    /// `low_box`, when there is one.
+    low_box: Option<([f64; 3], [f64; 3])>,
+}
+
+impl Cull {
+    pub(super) fn of(s: &GroundShape) -> Self {
+        let t = &s.placement.trans;
+        Self {
+            body: s.body,
+            origin: [t.x, t.y, t.z],
+            bound: s.bound,
+            low_box: s.low_box,
+        }
+    }
+}
+
 /// The ground plane and every shape that can touch it.
 #[derive(Clone, Debug)]
 pub struct GroundContact {
@@ -85,6 +112,8 @@ pub struct GroundContact {
     /// Shared, not copied, by a clone (they never change after the build: a
     /// batch of simulations cloned from one holds its hulls once).
     pub shapes: std::sync::Arc<[GroundShape]>,
+    /// Each shape's [`Cull`] data, in the same order.
+    cull: std::sync::Arc<[Cull]>,
     /// Ground height (the plane z = ground, normal +z).
     pub ground: f64,
     /// The contact parameters it was built with.
@@ -249,33 +278,38 @@ impl GroundContact {
         let ground = self.ground;
         let maxp = self.params.max_points_per_shape.max(1);
         let stepped = self.travel.begin();
+        // (c = 0: every margin is δ, the shapes' travel is not measured)
+        let measure = self.travel.measures();
         // (the shapes never change: held apart from `self`, which the search mutates)
         let shapes = std::sync::Arc::clone(&self.shapes);
-        for (si, s) in shapes.iter().enumerate() {
-            let Some(o_m_b) = o_m_i.get(s.body) else {
+        let cull = std::sync::Arc::clone(&self.cull);
+        for (si, (s, cu)) in shapes.iter().zip(cull.iter()).enumerate() {
+            let Some(o_m_b) = o_m_i.get(cu.body) else {
                 continue;
             };
-            if asleep.get(s.body) == Some(&true) {
+            if asleep.get(cu.body) == Some(&true) {
                 continue;
             }
             // broad phase: the bounding sphere clear of the plane (the height of
             // the geometry origin alone, before the whole pose is composed)
             let r = &o_m_b.rot;
-            let pt = &s.placement.trans;
-            let z = r[(2, 0)] * pt.x + r[(2, 1)] * pt.y + r[(2, 2)] * pt.z + o_m_b.trans.z;
+            let pt = &cu.origin;
+            let z = r[(2, 0)] * pt[0] + r[(2, 1)] * pt[1] + r[(2, 2)] * pt[2] + o_m_b.trans.z;
             // the speculative margin: max(δ, c·s), s how far down the shape
             // moved in the last step (docs/theory.md §"Speculative margin")
             let row = [r[(2, 0)], r[(2, 1)], r[(2, 2)]];
-            if stepped > 0.0 {
-                let down = travel::dropped(&self.anchor[si], z, row, s.bound);
-                self.travel.set(si, down * stepped);
+            if measure {
+                if stepped > 0.0 {
+                    let down = travel::dropped(&self.anchor[si], z, row, cu.bound);
+                    self.travel.set(si, down * stepped);
+                }
+                self.anchor[si] = [z, row[0], row[1], row[2]];
             }
-            self.anchor[si] = [z, row[0], row[1], row[2]];
             let margin = self.travel.margin(si);
-            if z - ground - s.bound > margin {
+            if z - ground - cu.bound > margin {
                 continue;
             }
-            if let Some((c, e)) = &s.low_box {
+            if let Some((c, e)) = &cu.low_box {
                 let zc = row[0] * c[0] + row[1] * c[1] + row[2] * c[2] + o_m_b.trans.z;
                 let reach = row[0].abs() * e[0] + row[1].abs() * e[1] + row[2].abs() * e[2];
                 // (a nanometre of slack for the rounding of the two ways)

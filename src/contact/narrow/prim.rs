@@ -30,16 +30,20 @@ pub struct Round {
     pub p1: Vector3<f64>,
     /// The radius (m).
     pub r: f64,
+    /// The axis' length |p1 − p0| (0 for a sphere).
+    pub len: f64,
 }
 
 impl Round {
     /// The sphere or capsule `s` placed at `w`; None for another shape.
     pub(crate) fn of(s: &PairShape, w: &Se3<f64>) -> Option<Self> {
         let (p0, p1, r) = s.round?;
+        let (p0, p1) = (w.act_point(&p0), w.act_point(&p1));
         Some(Self {
-            p0: w.act_point(&p0),
-            p1: w.act_point(&p1),
+            p0,
+            p1,
             r,
+            len: (p1 - p0).norm_squared().sqrt(),
         })
     }
 }
@@ -58,15 +62,23 @@ pub(crate) fn round_points(
     let (Some(ra), Some(rb)) = (Round::of(a, wa), Round::of(b, wb)) else {
         return false;
     };
+    round_points_at(&ra, &rb, margin, raw);
+    true
+}
+
+/// The contact points of the spheres or capsules `ra` and `rb` (placed)
+/// within `margin` (`raw` cleared, then filled): [`round_points`] of shapes
+/// already placed (a pair's members placed once a detection, not once a pair).
+pub(crate) fn round_points_at(ra: &Round, rb: &Round, margin: f64, raw: &mut Vec<Raw>) {
     raw.clear();
+    // their bounding spheres (about the axes' middles) apart by more than
+    // the margin: no point (no division)
+    let reach = 0.5 * (ra.len + rb.len) + ra.r + rb.r + margin;
+    if (ra.p0 + ra.p1 - rb.p0 - rb.p1).norm_squared() > 4.0 * reach * reach {
+        return;
+    }
     let (da, db) = (ra.p1 - ra.p0, rb.p1 - rb.p0);
     let (aa, bb, ab) = (da.norm_squared(), db.norm_squared(), da.dot(&db));
-    // their bounding spheres (about the axes' middles) apart by more than
-    // the margin: no point (no division, no root)
-    let reach = 0.5 * (aa.sqrt() + bb.sqrt()) + ra.r + rb.r + margin;
-    if (ra.p0 + ra.p1 - rb.p0 - rb.p1).norm_squared() > 4.0 * reach * reach {
-        return true;
-    }
     let (pa, pb) = closest(&ra.p0, &da, aa, &rb.p0, &db, bb, ab);
     spheres(&pa, ra.r, &pb, rb.r, margin, PRIM_KEY, raw);
     let cross2 = aa * bb - ab * ab;
@@ -87,7 +99,6 @@ pub(crate) fn round_points(
             }
         }
     }
-    true
 }
 
 /// The point of segment p0 + s d (s in [0, 1], |d|² = `dd`) nearest `x`.

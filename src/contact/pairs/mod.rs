@@ -14,10 +14,11 @@
 //! starts the solve), else a free one marked fresh (no warm start).
 
 use super::broad::{prefetch, PairTable, SweepAndPrune, LAZY_PAIR};
-use super::filter::{is_self_pair, may_touch, DroppedPair, START_OVERLAP};
+use super::filter::{is_self_pair, may_touch};
+use super::narrow::prim::{round_points_at, Round};
 use super::narrow::{face_kind, face_points, parry_points, reduce_pair, FaceScratch, Raw};
-use super::shapes::{from_pvec, pair_shape, to_pose, PairShape};
-use super::travel::{moved, Travel};
+use super::shapes::{from_pvec, pair_shape, PairShape};
+use super::travel::{moved_from, Travel};
 use super::{ContactError, ContactParams, ContactPoint};
 use crate::model::Model;
 use crate::spatial::Se3;
@@ -27,6 +28,7 @@ use std::path::PathBuf;
 
 pub(crate) mod apart;
 mod order;
+mod start;
 use apart::{apart_along, still_apart};
 use order::assign_slots;
 
@@ -117,6 +119,13 @@ pub struct PairContact {
     visit: Vec<(u64, u32)>,
     /// Each member's world pose (parry's frame) at the last detection.
     poses: Vec<Se3<f64>>,
+    /// Each member's box centre (world) at the last detection, and the
+    /// radius of a sphere about it that holds the box (|half extents|).
+    centres: Vec<Vector3<f64>>,
+    radii: Vec<f64>,
+    /// A sphere or capsule member placed at the last detection (its closed
+    /// form's input, once a member, not once a pair).
+    rounds: Vec<Option<Round>>,
     scratch: FaceScratch,
     stamp: u32,
     raw: Vec<Raw>,
@@ -234,6 +243,9 @@ impl PairContact {
             live: Vec::new(),
             visit: Vec::new(),
             poses: Vec::with_capacity(n),
+            centres: Vec::with_capacity(n),
+            radii: Vec::with_capacity(n),
+            rounds: Vec::with_capacity(n),
             scratch: FaceScratch::default(),
             stamp: 0,
             raw: Vec::new(),
@@ -264,8 +276,12 @@ impl PairContact {
         made.travel = Travel::new(params, fixed);
         for (k, m) in made.members.iter().enumerate() {
             made.poses.push(m.placement);
+            let c = m.placement.act_point(&m.shape.mid);
+            made.centres.push(c);
+            made.radii.push(m.shape.half.norm());
+            made.rounds.push(Round::of(&m.shape, &m.placement));
             if m.body == 0 {
-                set_box(&mut made.sap, k, m, &m.placement, params.margin);
+                set_box(&mut made.sap, k, m, &m.placement, &c, params.margin);
             } else {
                 made.moving.push(k);
             }
@@ -362,18 +378,25 @@ impl PairContact {
     /// they held and are not queried.
     pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
         let stepped = self.travel.begin();
+        // (c = 0: every margin is δ, the members' travel is not measured)
+        let measure = self.travel.measures();
         self.keep_in_order();
         for &k in &self.moving {
             let m = &self.members[k];
             let w = world(m, o_m_i);
+            let c = w.act_point(&m.shape.mid);
             // the speculative margin: max(δ, c·s), s how far the member
             // moved in the last step (docs/theory.md §"Speculative margin")
-            if stepped > 0.0 {
-                let s = moved(&self.poses[k], &w, &m.shape.mid, m.shape.half.norm());
+            if stepped > 0.0 && measure {
+                let s = moved_from(&self.centres[k], &c, &self.poses[k], &w, self.radii[k]);
                 self.travel.set(k, s * stepped);
             }
-            set_box(&mut self.sap, k, m, &w, self.travel.margin(k));
+            set_box(&mut self.sap, k, m, &w, &c, self.travel.margin(k));
+            if m.shape.round.is_some() {
+                self.rounds[k] = Round::of(&m.shape, &w);
+            }
             self.poses[k] = w;
+            self.centres[k] = c;
         }
         self.overlapping.clear();
         self.fresh.clear();
@@ -443,64 +466,79 @@ impl PairContact {
                 continue;
             }
             let (ma, mb) = (&self.members[pair.a], &self.members[pair.b]);
-            let (wa, wb) = (self.poses[pair.a], self.poses[pair.b]);
+            let (wa, wb) = (&self.poses[pair.a], &self.poses[pair.b]);
             let margin = self.travel.pair_margin(pair.a, pair.b);
             self.queries += 1;
             self.raw.clear();
-            // a hull on a box's face or a flat height field: the plane
-            // contact where it is the exact one (`face`), else parry
-            let plane = match pair.face {
-                Some(hull_is_a) => {
-                    self.stamp = self.stamp.wrapping_add(1).max(1);
-                    face_points(
+            if let (Some(ra), Some(rb)) = (&self.rounds[pair.a], &self.rounds[pair.b]) {
+                // two spheres or capsules: their closed form (no manifold,
+                // never a separating axis: `parry_points`' first case)
+                round_points_at(ra, rb, margin, &mut self.raw);
+                pair.manifolds.clear();
+                pair.workspace = None;
+                pair.axis = Vector3::zeros();
+                pair.apart = None;
+            } else {
+                // a hull on a box's face or a flat height field: the plane
+                // contact where it is the exact one (`face`), else parry
+                let plane = match pair.face {
+                    Some(hull_is_a) => {
+                        self.stamp = self.stamp.wrapping_add(1).max(1);
+                        face_points(
+                            &ma.shape,
+                            &mb.shape,
+                            wa,
+                            wb,
+                            hull_is_a,
+                            margin,
+                            self.max_points,
+                            &mut self.scratch,
+                            &mut self.raw,
+                            self.stamp,
+                        )
+                    }
+                    None => false,
+                };
+                // two convex shapes apart along last step's axis by more than
+                // the margin: no point, no parry query
+                let convex = ma.shape.convex && mb.shape.convex;
+                let apart = convex
+                    && (still_apart(pair.apart.as_ref(), ma, mb, wa, wb, margin) || {
+                        let gap = apart_along(&pair.axis, ma, mb, wa, wb);
+                        pair.apart = (gap > margin).then_some((gap, *wa, *wb));
+                        gap > margin
+                    });
+                if !plane && !apart {
+                    parry_points(
                         &ma.shape,
                         &mb.shape,
-                        &wa,
-                        &wb,
-                        hull_is_a,
+                        wa,
+                        wb,
                         margin,
-                        self.max_points,
-                        &mut self.scratch,
+                        &mut pair.manifolds,
+                        &mut pair.workspace,
                         &mut self.raw,
-                        self.stamp,
-                    )
-                }
-                None => false,
-            };
-            // two convex shapes apart along last step's axis by more than
-            // the margin: no point, no parry query
-            let convex = ma.shape.convex && mb.shape.convex;
-            let apart = convex
-                && (still_apart(pair.apart.as_ref(), ma, mb, &wa, &wb, margin) || {
-                    let gap = apart_along(&pair.axis, ma, mb, &wa, &wb);
-                    pair.apart = (gap > margin).then_some((gap, wa, wb));
-                    gap > margin
-                });
-            if !plane && !apart {
-                parry_points(
-                    &ma.shape,
-                    &mb.shape,
-                    &wa,
-                    &wb,
-                    margin,
-                    &mut pair.manifolds,
-                    &mut pair.workspace,
-                    &mut self.raw,
-                );
-                // parry's last direction (a's frame, from a toward b): its
-                // separating axis when apart, else the contact normal
-                pair.axis = match pair.manifolds.first() {
-                    Some(m) if convex && pair.manifolds.len() == 1 => {
-                        let n = from_pvec(m.local_n1);
-                        let l = n.norm();
-                        if l > 0.5 && l.is_finite() {
-                            n / l
-                        } else {
-                            Vector3::zeros()
+                    );
+                    // parry's last direction (a's frame, from a toward b): its
+                    // separating axis when apart, else the contact normal
+                    pair.axis = match pair.manifolds.first() {
+                        Some(m) if convex && pair.manifolds.len() == 1 => {
+                            let n = from_pvec(m.local_n1);
+                            let l = n.norm();
+                            if l > 0.5 && l.is_finite() {
+                                n / l
+                            } else {
+                                Vector3::zeros()
+                            }
                         }
-                    }
-                    _ => Vector3::zeros(),
-                };
+                        _ => Vector3::zeros(),
+                    };
+                }
+            }
+            if self.raw.is_empty() {
+                // no point: every slot free (`assign_slots` of none)
+                keys.fill(NO_KEY);
+                continue;
             }
             let start = out.len();
             // the moving side first: a static a (an obstacle or a fixed
@@ -526,50 +564,6 @@ impl PairContact {
         }
     }
 
-    /// Drops the self pairs that overlap by more than [`START_OVERLAP`] at the
-    /// body poses `o_m_i` (scene.md rule 4), after restoring every pair dropped
-    /// before; returns them, with their links, from `model`.
-    pub fn drop_start_overlaps(&mut self, model: &Model, o_m_i: &[Se3<f64>]) -> Vec<DroppedPair> {
-        let mut out = Vec::new();
-        self.dropped.fill(false);
-        for (pi, pair) in self.pairs.iter_mut().enumerate() {
-            if !pair.self_pair {
-                continue;
-            }
-            let (ma, mb) = (&self.members[pair.a], &self.members[pair.b]);
-            let (wa, wb) = (world(ma, o_m_i), world(mb, o_m_i));
-            let c = parry3d_f64::query::contact(
-                &to_pose(&wa),
-                &*ma.shape.shape,
-                &to_pose(&wb),
-                &*mb.shape.shape,
-                0.0,
-            );
-            if let Ok(Some(c)) = c {
-                if c.dist < -START_OVERLAP {
-                    self.dropped[pi] = true;
-                    pair.manifolds.clear();
-                    let maxp = self.max_points;
-                    if let Some(k) = self.keys.get_mut(pi * maxp..(pi + 1) * maxp) {
-                        k.fill(NO_KEY);
-                    }
-                    let link = |m: &Member| {
-                        model
-                            .collisions
-                            .get(m.geom)
-                            .map_or(String::new(), |g| g.link.clone())
-                    };
-                    out.push(DroppedPair {
-                        a: link(ma),
-                        b: link(mb),
-                        depth: -c.dist,
-                    });
-                }
-            }
-        }
-        out
-    }
-
     /// The first slot of pair contact.
     pub fn slot_offset(&self) -> usize {
         self.slot_offset
@@ -582,11 +576,17 @@ impl PairContact {
 }
 
 /// Sets member `k`'s broad-phase box: its shape's box at the world pose `w`
-/// boxed along the world axes (centre R·c + t, half extents |R|·h), grown by
-/// `margin`.
+/// boxed along the world axes (centre `c` = R·c₀ + t, half extents |R|·h),
+/// grown by `margin`.
 #[inline]
-fn set_box(sap: &mut SweepAndPrune, k: usize, m: &Member, w: &Se3<f64>, margin: f64) {
-    let c = w.act_point(&m.shape.mid);
+fn set_box(
+    sap: &mut SweepAndPrune,
+    k: usize,
+    m: &Member,
+    w: &Se3<f64>,
+    c: &Vector3<f64>,
+    margin: f64,
+) {
     let h = &m.shape.half;
     let r = &w.rot;
     let e =
