@@ -2,8 +2,8 @@
 
 use crate::dynamics::rnea::act_force_ax;
 use crate::model::{dispatch_joint, Data, JointModel, Model};
-use crate::spatial::{Axis, CompositeInertia, Force, Motion, Scalar, Se3};
-use nalgebra::{DVector, Matrix3, Vector3};
+use crate::spatial::{Force, Motion, Scalar, Se3};
+use nalgebra::{DVector, Vector3};
 
 /// The joint-space inertia matrix H(q) by the CRBA (Featherstone, RBDA §6.2),
 /// written to `data.h` (the whole symmetric matrix; `data.li_m_i` is updated).
@@ -470,7 +470,7 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
                                 lin: ax.rot_mul(&li.rot, &f.lin),
                             };
                         }
-                        rotate_composite(&ici, &li.rot, &ax)
+                        ici.rotate_ax(&li.rot, &ax)
                     }
                     _ => {
                         for f in fsub.iter_mut() {
@@ -507,29 +507,4 @@ pub(crate) fn is_f64<T: Scalar>() -> bool {
 #[inline(always)]
 pub(crate) fn zero_trans<T: Scalar>(m: &Se3<T>) -> bool {
     m.trans.iter().all(|x| *x == T::zero())
-}
-
-/// [`CompositeInertia::act_ax`] for a rotation `r` about `ax` with a zero
-/// translation: `h' = R h`, `I_o' = R I_o Rᵀ` (the same products in the same
-/// order; the translation's terms, all zero, left out).
-#[inline(always)]
-fn rotate_composite<T: Scalar>(
-    c: &CompositeInertia<T>,
-    r: &Matrix3<T>,
-    ax: &Axis<T>,
-) -> CompositeInertia<T> {
-    let h = ax.rot_mul(r, &c.h);
-    let io = &c.io;
-    let m0 = ax.rot_mul(r, &io.column(0).into());
-    let m1 = ax.rot_mul(r, &io.column(1).into());
-    let m2 = ax.rot_mul(r, &io.column(2).into());
-    let e0 = ax.rot_mul(r, &Vector3::new(m0.x, m1.x, m2.x));
-    let e1 = ax.rot_mul(r, &Vector3::new(m0.y, m1.y, m2.y));
-    let e2 = ax.rot_mul(r, &Vector3::new(m0.z, m1.z, m2.z));
-    let (xx, yy, zz, xy, xz, yz) = (e0.x, e1.y, e2.z, e1.x, e2.x, e2.y);
-    CompositeInertia {
-        m: c.m,
-        h,
-        io: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
-    }
 }

@@ -78,10 +78,34 @@ impl<T: Scalar> CompositeInertia<T> {
         let Some(ax) = ax else {
             return self.act(x);
         };
-        let r = &x.rot;
-        let rh = ax.rot_mul(r, &self.h);
-        let t = x.trans;
+        let rot = self.rotate_ax(&x.rot, &ax);
+        let (rh, t) = (rot.h, x.trans);
         let h2 = axpy(&rh, &t, self.m);
+        let e = &rot.io;
+        let (xx, yy, zz, xy, xz, yz) = shift_entries(
+            e[(0, 0)],
+            e[(1, 1)],
+            e[(2, 2)],
+            e[(0, 1)],
+            e[(0, 2)],
+            e[(1, 2)],
+            &t,
+            &rh,
+            &h2,
+        );
+        Self {
+            m: self.m,
+            h: h2,
+            io: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
+        }
+    }
+
+    /// The inertia turned by `r`, a rotation about `ax`, with no translation:
+    /// `m' = m`, `h' = R h`, `I_o' = R I_o Rᵀ` (two rows and two columns mixed;
+    /// [`CompositeInertia::act_ax`] is this followed by the translation's shift).
+    #[inline(always)]
+    pub fn rotate_ax(&self, r: &Matrix3<T>, ax: &Axis<T>) -> Self {
+        let h = ax.rot_mul(r, &self.h);
         // M = R I_o by columns; R I_o Rᵀ = R Mᵀ (I_o symmetric), by columns.
         let io = &self.io;
         let m0 = ax.rot_mul(r, &io.column(0).into());
@@ -91,11 +115,10 @@ impl<T: Scalar> CompositeInertia<T> {
         let e1 = ax.rot_mul(r, &Vector3::new(m0.y, m1.y, m2.y));
         let e2 = ax.rot_mul(r, &Vector3::new(m0.z, m1.z, m2.z));
         // column j of R I_o Rᵀ is e_j; entry (i, j) = e_j[i]
-        let (xx, yy, zz, xy, xz, yz) =
-            shift_entries(e0.x, e1.y, e2.z, e1.x, e2.x, e2.y, &t, &rh, &h2);
+        let (xx, yy, zz, xy, xz, yz) = (e0.x, e1.y, e2.z, e1.x, e2.x, e2.y);
         Self {
             m: self.m,
-            h: h2,
+            h,
             io: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
         }
     }
