@@ -79,25 +79,16 @@ impl<T: Scalar> CompositeInertia<T> {
             return self.act(x);
         };
         let rot = self.rotate_ax(&x.rot, &ax);
-        let (rh, t) = (rot.h, x.trans);
-        let h2 = axpy(&rh, &t, self.m);
         let e = &rot.io;
-        let (xx, yy, zz, xy, xz, yz) = shift_entries(
+        let io = [
             e[(0, 0)],
             e[(1, 1)],
             e[(2, 2)],
             e[(0, 1)],
             e[(0, 2)],
             e[(1, 2)],
-            &t,
-            &rh,
-            &h2,
-        );
-        Self {
-            m: self.m,
-            h: h2,
-            io: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
-        }
+        ];
+        Self::shifted(self.m, rot.h, io, &x.trans)
     }
 
     /// The inertia turned by `r`, a rotation about `ax`, with no translation:
@@ -128,8 +119,6 @@ impl<T: Scalar> CompositeInertia<T> {
     pub fn act(&self, x: &Se3<T>) -> Self {
         let r = &x.rot;
         let rh = mat_vec(r, &self.h);
-        let t = x.trans;
-        let h2 = axpy(&rh, &t, self.m);
         // R I_o Rᵀ on the 6 distinct entries: M = R I_o, then rows of M · rows of R.
         let mm = mat_mat(r, &self.io);
         let e = |i: usize, j: usize| {
@@ -142,19 +131,21 @@ impl<T: Scalar> CompositeInertia<T> {
                 r[(j, 2)],
             )
         };
-        let (xx, yy, zz, xy, xz, yz) = shift_entries(
-            e(0, 0),
-            e(1, 1),
-            e(2, 2),
-            e(0, 1),
-            e(0, 2),
-            e(1, 2),
-            &t,
-            &rh,
-            &h2,
-        );
+        let io = [e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2)];
+        Self::shifted(self.m, rh, io, &x.trans)
+    }
+
+    /// The translation by `t` that [`CompositeInertia::act`] and
+    /// [`CompositeInertia::act_ax`] end with, from the rotated inertia's
+    /// `rh = R h` and `R I_o Rᵀ` entries `[xx, yy, zz, xy, xz, yz]`:
+    /// `h' = rh + m t`, `I_o'` as [`shift_entries`].
+    #[inline(always)]
+    fn shifted(m: T, rh: Vector3<T>, io: [T; 6], t: &Vector3<T>) -> Self {
+        let h2 = axpy(&rh, t, m);
+        let [xx, yy, zz, xy, xz, yz] = io;
+        let (xx, yy, zz, xy, xz, yz) = shift_entries(xx, yy, zz, xy, xz, yz, t, &rh, &h2);
         Self {
-            m: self.m,
+            m,
             h: h2,
             io: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
         }
