@@ -273,6 +273,23 @@ impl MassFactor {
         (path.get(s0)? == self.table.get(s)?).then(|| (s0, &self.anc[s..s + l - 1]))
     }
 
+    /// Tree: whether `path` is exactly the chain root … its last dof (a row on
+    /// one body's path, every contact's and joint row's in a robot): then the
+    /// ancestors of `path[t]` are `path[..t]` and their entries of L lie at
+    /// `anc[start[path[t]]..][..t]` (what [`Self::ancestors`] finds, without
+    /// its look-ups at every t). A path holds every ancestor of its last dof,
+    /// so one of the chain's length is the chain.
+    #[inline(always)]
+    fn is_chain(&self, path: &[usize]) -> bool {
+        match path.last() {
+            Some(&d) => {
+                self.len.get(d) == Some(&path.len())
+                    && self.start.get(d).and_then(|&s| self.table.get(s)) == path.first()
+            }
+            None => false,
+        }
+    }
+
     /// x ← H̃⁻¹ x.
     pub fn solve(&self, x: &mut DVector<f64>) {
         if self.tree {
@@ -343,6 +360,21 @@ impl MassFactor {
         let len = path.len().min(y.len());
         // Lᵀ g = j from the leaf in: along a path the tree is a chain, the
         // ancestors of path[t] are path[..t]
+        if self.is_chain(&path[..len]) {
+            for t in (0..len).rev() {
+                let yt = y[t];
+                if yt != 0.0 {
+                    let s = self.start[path[t]];
+                    for (ys, l) in y[..t].iter_mut().zip(&self.anc[s..s + t]) {
+                        *ys -= l * yt;
+                    }
+                }
+            }
+            for t in 0..len {
+                y[t] *= self.inv_sqrt_d[path[t]];
+            }
+            return;
+        }
         for t in (0..len).rev() {
             let yt = y[t];
             if yt != 0.0 {
@@ -376,6 +408,37 @@ impl MassFactor {
             return;
         }
         let len = path.len().min(y0.len()).min(y1.len()).min(y2.len());
+        if self.is_chain(&path[..len]) {
+            for t in (0..len).rev() {
+                let (a0, a1, a2) = (y0[t], y1[t], y2[t]);
+                let s = self.start[path[t]];
+                for (s, &l) in (0..t).zip(&self.anc[s..s + t]) {
+                    y0[s] -= l * a0;
+                    y1[s] -= l * a1;
+                    y2[s] -= l * a2;
+                }
+            }
+        } else {
+            self.row_transform3_general(path, len, y0, y1, y2);
+        }
+        for t in 0..len {
+            let d = self.inv_sqrt_d[path[t]];
+            y0[t] *= d;
+            y1[t] *= d;
+            y2[t] *= d;
+        }
+    }
+
+    /// [`Self::row_transform3`]'s elimination on any path (before the scaling).
+    #[inline]
+    fn row_transform3_general(
+        &self,
+        path: &[usize],
+        len: usize,
+        y0: &mut [f64],
+        y1: &mut [f64],
+        y2: &mut [f64],
+    ) {
         for t in (0..len).rev() {
             let (a0, a1, a2) = (y0[t], y1[t], y2[t]);
             match self.ancestors(path, t) {
@@ -395,12 +458,6 @@ impl MassFactor {
                     }
                 }
             }
-        }
-        for t in 0..len {
-            let d = self.inv_sqrt_d[path[t]];
-            y0[t] *= d;
-            y1[t] *= d;
-            y2[t] *= d;
         }
     }
 
@@ -428,8 +485,25 @@ impl MassFactor {
             0 => [0.0; 4],
             _ => y[len - 1],
         };
+        let chain = self.is_chain(&path[..len]);
         for t in (0..len).rev() {
             let a = next;
+            if chain {
+                // the ancestors are y[..t], L's entries at anc[start[path[t]]..]
+                if t > 0 {
+                    let s = self.start[path[t]];
+                    let anc = &self.anc[s..s + t];
+                    let (ys, last) = y[..t].split_at_mut(t - 1);
+                    for (ys, &l) in ys.iter_mut().zip(anc) {
+                        sub(ys, l, &a);
+                    }
+                    let mut v = last[0];
+                    sub(&mut v, anc[t - 1], &a);
+                    last[0] = v;
+                    next = v;
+                }
+                continue;
+            }
             match self.ancestors(path, t) {
                 Some((s0, anc)) if s0 < t => {
                     let (ys, last) = y[s0..t].split_at_mut(t - 1 - s0);

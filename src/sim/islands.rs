@@ -112,26 +112,38 @@ impl Islands {
         // a row on the same path as the row before it (a contact's tangents,
         // the points of one pair) joins the same trees: skipped
         let same = |r: usize| r > 0 && rows.path[r] == rows.path[r - 1];
-        for r in 0..n {
-            if same(r) {
-                continue;
+        if self.parent.len() == 1 {
+            // one tree (a single robot): every row on a dof joins tree 0, no
+            // union to find (the keys the general pass gives, without it)
+            for r in 0..n {
+                self.key[r] = if same(r) {
+                    self.key[r - 1]
+                } else {
+                    self.ends(rows, r).map_or(usize::MAX, |_| 0)
+                };
             }
-            if let Some((a, b)) = self.ends(rows, r) {
-                let (ra, rb) = (self.find(a), self.find(b));
-                if ra != rb {
-                    self.parent[ra.max(rb)] = ra.min(rb);
+        } else {
+            for r in 0..n {
+                if same(r) {
+                    continue;
+                }
+                if let Some((a, b)) = self.ends(rows, r) {
+                    let (ra, rb) = (self.find(a), self.find(b));
+                    if ra != rb {
+                        self.parent[ra.max(rb)] = ra.min(rb);
+                    }
                 }
             }
-        }
-        for r in 0..n {
-            self.key[r] = if same(r) {
-                self.key[r - 1]
-            } else {
-                match self.ends(rows, r) {
-                    Some((a, _)) => self.find(a),
-                    None => usize::MAX,
-                }
-            };
+            for r in 0..n {
+                self.key[r] = if same(r) {
+                    self.key[r - 1]
+                } else {
+                    match self.ends(rows, r) {
+                        Some((a, _)) => self.find(a),
+                        None => usize::MAX,
+                    }
+                };
+            }
         }
         // runs of consecutive rows with one key, then grouped by key (stable:
         // row order within an island)
