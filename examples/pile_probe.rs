@@ -9,6 +9,7 @@
 use urdyn::scene::Scene;
 use urdyn::sim::{SimOptions, Simulation};
 
+#[allow(clippy::needless_range_loop)]
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let file = args.get(1).ok_or("usage: pile_probe FILE [T1]")?;
