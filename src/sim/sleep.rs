@@ -45,6 +45,10 @@ pub(crate) struct Sleep {
     /// frame, radius); bodies without one use their centre of mass and 0.1 m.
     spheres: Vec<(usize, Vector3<f64>, f64)>,
     has_sphere: Vec<bool>,
+    /// Per tree: its spheres, a range of `spheres` (sorted by tree).
+    tree_spheres: Vec<(usize, usize)>,
+    /// The trees not asleep, ascending (the per-step loops run over these).
+    awake_trees: Vec<usize>,
     /// Per tree: how long it has been still (s).
     still: Vec<f64>,
     /// Per tree: asleep.
@@ -116,6 +120,23 @@ impl Sleep {
             }
         }
         let awake = has_dof.iter().filter(|&&d| d).count();
+        // spheres grouped by tree (a tree's bodies are one range), the world's
+        // (an obstacle's) last: they move nothing
+        let mut spheres = spheres;
+        let tree_key = |b: usize| tree_of_body.get(b).copied().unwrap_or(WORLD);
+        spheres.sort_by_key(|s| tree_key(s.0));
+        let mut tree_spheres = vec![(0, 0); nt];
+        let mut i = 0;
+        while i < spheres.len() {
+            let t = tree_key(spheres[i].0);
+            let s = i;
+            while i < spheres.len() && tree_key(spheres[i].0) == t {
+                i += 1;
+            }
+            if let Some(r) = tree_spheres.get_mut(t) {
+                *r = (s, i);
+            }
+        }
         Self {
             on,
             v_tol,
@@ -125,6 +146,8 @@ impl Sleep {
             has_dof,
             spheres,
             has_sphere,
+            tree_spheres,
+            awake_trees: (0..nt).collect(),
             still: vec![0.0; nt],
             asleep: vec![false; nt],
             body_asleep: vec![false; model.nbodies],
@@ -155,9 +178,23 @@ impl Sleep {
 
     /// The awake trees with dofs now.
     fn count_awake(&self) -> usize {
-        (0..self.asleep.len())
-            .filter(|&t| self.has_dof[t] && !self.asleep[t])
+        self.awake_trees
+            .iter()
+            .filter(|&&t| self.has_dof[t])
             .count()
+    }
+
+    /// The trees not asleep, listed anew after trees fell asleep or woke.
+    fn list_awake(&mut self) {
+        self.awake_trees.clear();
+        let asleep = &self.asleep;
+        self.awake_trees
+            .extend((0..asleep.len()).filter(|&t| !asleep[t]));
+    }
+
+    /// The trees not asleep, ascending.
+    pub fn awake_trees(&self) -> &[usize] {
+        &self.awake_trees
     }
 
     /// Wakes every sleeping tree; true when one woke.
@@ -173,6 +210,7 @@ impl Sleep {
         self.frozen_points.clear();
         self.frozen_forces.clear();
         self.any_asleep = false;
+        self.list_awake();
         self.awake = self.count_awake();
         woke
     }
@@ -212,6 +250,7 @@ impl Sleep {
             self.frozen_points.retain(|p| keep(p.body));
             self.frozen_forces.retain(|f| keep(f.point.body));
             self.any_asleep = self.asleep.iter().any(|&a| a);
+            self.list_awake();
             self.awake = self.count_awake();
         }
         woke
@@ -254,36 +293,30 @@ impl Sleep {
             self.awake_sum += self.awake as f64;
             return false;
         }
-        // each awake tree's largest point speed
-        self.speed.iter_mut().for_each(|s| *s = 0.0);
-        for &(b, c, r) in &self.spheres {
-            let t = self.tree(b);
-            if t == WORLD || self.asleep[t] {
-                continue;
+        // each awake tree's largest point speed (a max: the same whatever the
+        // order of the points), its still time, its own island
+        let awake_trees = std::mem::take(&mut self.awake_trees);
+        for &t in &awake_trees {
+            let mut speed = 0.0f64;
+            let (s0, s1) = self.tree_spheres[t];
+            for &(b, c, r) in &self.spheres[s0..s1] {
+                if let Some(m) = body_v.get(b) {
+                    let s = (m.lin + m.ang.cross(&c)).norm() + m.ang.norm() * r;
+                    speed = speed.max(s);
+                }
             }
-            if let Some(m) = body_v.get(b) {
-                let s = (m.lin + m.ang.cross(&c)).norm() + m.ang.norm() * r;
-                self.speed[t] = self.speed[t].max(s);
+            for b in model.trees[t].bodies.clone() {
+                if b == 0 || self.has_sphere[b] {
+                    continue;
+                }
+                if let Some(m) = body_v.get(b) {
+                    let c = model.inertias[b].com;
+                    let s = (m.lin + m.ang.cross(&c)).norm() + m.ang.norm() * 0.1;
+                    speed = speed.max(s);
+                }
             }
-        }
-        for (b, m) in body_v.iter().enumerate().skip(1) {
-            if self.has_sphere[b] {
-                continue;
-            }
-            let t = self.tree(b);
-            if t == WORLD || self.asleep[t] {
-                continue;
-            }
-            let c = model.inertias[b].com;
-            let s = (m.lin + m.ang.cross(&c)).norm() + m.ang.norm() * 0.1;
-            self.speed[t] = self.speed[t].max(s);
-        }
-        let nt = self.asleep.len();
-        for t in 0..nt {
-            if self.asleep[t] {
-                continue;
-            }
-            self.still[t] = if self.speed[t] < self.v_tol && !forced[t] {
+            self.speed[t] = speed;
+            self.still[t] = if speed < self.v_tol && !forced[t] {
                 self.still[t] + h
             } else {
                 0.0
@@ -305,23 +338,21 @@ impl Sleep {
             }
         }
         self.joins = joins;
-        // an island sleeps when every tree in it may: the root collects the
-        // verdict (true: may sleep)
+        // an island sleeps when every tree in it may: the root (an awake
+        // tree) collects the verdict (true: may sleep)
         let mut may = std::mem::take(&mut self.may);
-        may.clear();
-        may.resize(nt, true);
-        for t in 0..nt {
-            if self.asleep[t] {
-                continue;
-            }
+        for &t in &awake_trees {
+            may[t] = true;
+        }
+        for &t in &awake_trees {
             let r = self.find(t);
             if self.never[t] || forced[t] || self.still[t] < self.t_tol {
                 may[r] = false;
             }
         }
         let mut slept = false;
-        for t in 0..nt {
-            if self.asleep[t] || !self.has_dof[t] {
+        for &t in &awake_trees {
+            if !self.has_dof[t] {
                 continue;
             }
             let r = self.find(t);
@@ -340,11 +371,15 @@ impl Sleep {
             }
             for b in tree.bodies.clone() {
                 self.body_asleep[b] = true;
-                self.frozen_body[b] = body_forces.get(b).copied().unwrap_or(Force::zero());
+                let f = body_forces.get(b).copied().unwrap_or(Force::zero());
+                self.frozen_body[b] = f;
+                self.all_body[b] = f;
             }
         }
         self.may = may;
+        self.awake_trees = awake_trees;
         if slept {
+            self.list_awake();
             self.any_asleep = true;
             let asleep = &self.body_asleep;
             let sleeping = |b: usize| asleep.get(b) == Some(&true);
@@ -399,7 +434,7 @@ impl Sleep {
 
     /// The last solve's contact forces and body wrenches joined with the
     /// sleeping islands' frozen ones.
-    pub fn compose(&mut self, forces: &[ContactForce], body: &[Force]) {
+    pub fn compose(&mut self, model: &Model, forces: &[ContactForce], body: &[Force]) {
         if !self.any_asleep {
             return;
         }
@@ -411,13 +446,16 @@ impl Sleep {
         self.all_forces
             .extend(forces.iter().filter(|f| awake(f.point.body)));
         self.all_forces.extend_from_slice(&self.frozen_forces);
-        for (b, out) in self.all_body.iter_mut().enumerate() {
-            let f = body.get(b).copied().unwrap_or(Force::zero());
-            *out = if self.body_asleep[b] {
-                self.frozen_body[b]
-            } else {
-                f
-            };
+        // the sleeping bodies' entries are their frozen wrenches (set when
+        // they fell asleep): the awake bodies' (the world's too) are copied
+        let get = |b: usize| body.get(b).copied().unwrap_or(Force::zero());
+        if let Some(out) = self.all_body.get_mut(0) {
+            *out = get(0);
+        }
+        for &t in &self.awake_trees {
+            for b in model.trees[t].bodies.clone() {
+                self.all_body[b] = get(b);
+            }
         }
     }
     /// The contact forces to report: `awake` (the last solve's) joined with
@@ -507,15 +545,20 @@ impl super::Simulation {
         if let Some(w) = self.cons.push_velocity() {
             self.sleep.vw += w;
         }
+        // (the awake trees' bodies: a tree's bodies are one range after their
+        // parents, whose root hangs from the world; sleeping ones are not read)
         data.v[0] = crate::spatial::Motion::zero();
-        for i in 1..model.nbodies {
-            let mut vi = data.li_m_i[i].inv_act_motion(&data.v[model.parent[i]]);
-            model.joints[i].add_motion(&mut vi, &self.sleep.vw);
-            data.v[i] = vi;
+        for &t in self.sleep.awake_trees() {
+            for i in model.trees[t].bodies.clone() {
+                let mut vi = data.li_m_i[i].inv_act_motion(&data.v[model.parent[i]]);
+                model.joints[i].add_motion(&mut vi, &self.sleep.vw);
+                data.v[i] = vi;
+            }
         }
-        // trees driven now: a nonzero applied force, or a servo on one of its dofs
-        self.sleep_forced.iter_mut().for_each(|f| *f = false);
-        for (t, tree) in model.trees.iter().enumerate() {
+        // trees driven now: a nonzero applied force, or a servo on one of its
+        // dofs (read for the awake trees only)
+        for &t in self.sleep.awake_trees() {
+            let tree = &model.trees[t];
             self.sleep_forced[t] = tree.v.clone().any(|k| {
                 self.tau_applied[k] != 0.0
                     || (self.servo.active && (self.servo.kp[k] != 0.0 || self.servo.kd[k] != 0.0))
@@ -535,7 +578,10 @@ impl super::Simulation {
         if slept {
             self.energy_now = None;
         }
-        self.sleep
-            .compose(self.cons.contact_forces(), self.cons.body_forces());
+        self.sleep.compose(
+            &self.model,
+            self.cons.contact_forces(),
+            self.cons.body_forces(),
+        );
     }
 }
