@@ -2,7 +2,7 @@
 
 use crate::dynamics::rnea::act_force_ax;
 use crate::model::{dispatch_joint, Data, JointModel, Model};
-use crate::spatial::{Force, Motion, Scalar, Se3};
+use crate::spatial::{Force, Motion, Scalar};
 use nalgebra::{DVector, Vector3};
 
 /// The joint-space inertia matrix H(q) by the CRBA (Featherstone, RBDA §6.2),
@@ -417,6 +417,7 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
     let inertias = &model.inertias_origin[..nb];
     let parent = &model.parent[..nb];
     let ident = &model.placement_identity[..nb];
+    let zt = &model.placement_zero_trans[..nb];
     let sub_end = &model.topology.dof_subtree_end[..nv];
     let li_m_i = &mut data.li_m_i[..nb];
     let ic = &mut data.crba_ic[..nb];
@@ -463,7 +464,7 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
                 let moved = match ax {
                     // a joint frame at its parent's origin (a body's second and
                     // later joints in MJCF): the moves are rotations alone
-                    Some(ax) if exact && zero_trans(&li) => {
+                    Some(ax) if exact && zt[i] => {
                         for f in fsub.iter_mut() {
                             *f = Force {
                                 ang: ax.rot_mul(&li.rot, &f.ang),
@@ -499,12 +500,10 @@ pub(crate) fn is_f64<T: Scalar>() -> bool {
     std::any::TypeId::of::<T>() == std::any::TypeId::of::<f64>()
 }
 
-/// Whether `m`'s translation is exactly zero (either sign): moving a force or
-/// an inertia by `m` is then its rotation alone. Each term the translation
-/// enters (`t × f`, `m t`, the parallel-axis shift) is a product with a zero
-/// added to a value, so leaving them out gives the same numbers (at most a
-/// zero's sign differs: −0 + 0 is +0).
-#[inline(always)]
-pub(crate) fn zero_trans<T: Scalar>(m: &Se3<T>) -> bool {
-    m.trans.iter().all(|x| *x == T::zero())
-}
+// A revolute joint's `λ(i)Mi` keeps its placement's translation at every q
+// (`Se3::new(rot, xt.trans)`), so `Model::placement_zero_trans[i]` says at load
+// whether it is exactly zero (either sign): moving a force or an inertia by it
+// is then its rotation alone. Each term the translation enters (`t × f`, `m t`,
+// the parallel-axis shift) is a product with a zero added to a value, so
+// leaving them out gives the same numbers (at most a zero's sign differs:
+// −0 + 0 is +0).

@@ -1,4 +1,4 @@
-use super::crba::{is_f64, zero_trans};
+use super::crba::is_f64;
 use super::{check_sizes, DynamicsError};
 use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
 use crate::spatial::ops::add_cross;
@@ -129,6 +129,7 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
     let joints = &model.joints[..nb];
     let placements = &model.placements[..nb];
     let ident = &model.placement_identity[..nb];
+    let zt = &model.placement_zero_trans[..nb];
     let inertias = &model.inertias[..nb];
     let li_m_i = &mut data.li_m_i[..nb];
     let o_m_i = &mut data.o_m_i[..nb];
@@ -151,8 +152,8 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
             let li = if K { li_m_i[i] } else { jm.placement(&placements[i], q) };
             let ax = jm.rot_axis();
             // (the bias pass: a joint frame at its parent's origin moves
-            // motions by its rotation alone, crba::zero_trans)
-            let rot = K && exact && ax.is_some() && zero_trans(&li);
+            // motions by its rotation alone, `Model::placement_zero_trans`)
+            let rot = K && exact && ax.is_some() && zt[i];
             let mv = |x: &Motion<T>| match ax {
                 Some(ax) if rot => Motion {
                     ang: ax.rot_tr_mul(&li.rot, &x.ang),
@@ -225,7 +226,7 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
             // docs/theory.md §"Force recursion" (children part): f̂ₚ += ₚX̂ᵢ f̂ᵢ
             if p != 0 {
                 let x = match jm.rot_axis() {
-                    Some(ax) if K && exact && zero_trans(li) => Force {
+                    Some(ax) if K && exact && zt[i] => Force {
                         ang: ax.rot_mul(&li.rot, &fi.ang),
                         lin: ax.rot_mul(&li.rot, &fi.lin),
                     },

@@ -297,6 +297,7 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
         nbodies,
         parent,
         joints,
+        placement_zero_trans: crate::model::zero_translations(&placements),
         placement_identity: placements
             .iter()
             .map(|p| p.rot == Matrix3::identity())

@@ -277,6 +277,11 @@ pub struct Model<T: Scalar = f64> {
     /// hot loops then apply a revolute joint's rotation with 4 products a vector,
     /// see [`Joint::axis_rotation`]).
     pub placement_identity: Vec<bool>,
+    /// Whether `placements[i].trans` is exactly zero (either sign; decided at
+    /// load, [`zero_translations`]): a revolute joint's `λ(i)Mi` then has no
+    /// translation at any q, and the CRBA and the bias RNEA move forces,
+    /// motions and inertias across it by its rotation alone.
+    pub placement_zero_trans: Vec<bool>,
     /// Spatial inertia of each body in its own frame (links merged).
     pub inertias: Vec<Inertia<T>>,
     /// The same inertias in origin form (mass, first moment, rotational inertia
@@ -473,6 +478,7 @@ impl Model<f64> {
             joints: self.joints.iter().map(cj).collect(),
             placements: self.placements.iter().map(cs).collect(),
             placement_identity: self.placement_identity.clone(),
+            placement_zero_trans: self.placement_zero_trans.clone(),
             inertias: self
                 .inertias
                 .iter()
@@ -518,6 +524,15 @@ impl Model<f64> {
             equality_active: self.equality_active.clone(),
         }
     }
+}
+
+/// Per placement, whether its translation is exactly zero (either sign):
+/// [`Model::placement_zero_trans`], set by every constructor of a [`Model`].
+pub fn zero_translations<T: Scalar>(placements: &[Se3<T>]) -> Vec<bool> {
+    placements
+        .iter()
+        .map(|p| p.trans.iter().all(|x| *x == T::zero()))
+        .collect()
 }
 
 fn cast_axis<T: Scalar, U: Scalar>(a: Axis<T>, cv: &impl Fn(&Vector3<T>) -> Vector3<U>) -> Axis<U> {

@@ -54,6 +54,7 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
         joints: Vec::new(),
         placements: vec![Se3::identity()],
         placement_identity: vec![true],
+        placement_zero_trans: vec![true],
         inertias: Vec::new(),
         inertias_origin: Vec::new(),
         body_joint_names: vec!["universe".into()],
@@ -112,6 +113,8 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
             };
             m.placement_identity
                 .push(x.rot == nalgebra::Matrix3::identity());
+            m.placement_zero_trans
+                .extend(crate::model::zero_translations(std::slice::from_ref(&x)));
             m.placements.push(x);
             m.inertias.push(p.inertias[b]);
             m.inertias_origin.push(p.inertias_origin[b]);

@@ -414,6 +414,7 @@ pub(crate) fn lower(
         nbodies,
         parent,
         joints,
+        placement_zero_trans: crate::model::zero_translations(&placements),
         placement_identity: placements
             .iter()
             .map(|p| p.rot == nalgebra::Matrix3::identity())
