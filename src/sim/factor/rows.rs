@@ -1,0 +1,203 @@
+//! A constraint row through the mass factor, y ← R⁻ᵀ y (docs/theory.md
+//! §"Tree-sparse LTDL"): the rows of the solve held compactly over a dof path
+//! (one body's chain: every contact and joint row of a robot), one, three or
+//! four lanes at once.
+
+use super::super::factor_dense::dense_forward;
+use super::MassFactor;
+use crate::dynamics::linalg::by_size;
+
+impl MassFactor {
+    /// y ← R⁻ᵀ y for a row held compactly over `path` (`y[t]` is the entry of
+    /// dof `path[t]`; the row is zero off the path).
+    #[inline]
+    pub fn row_transform(&self, path: &[usize], y: &mut [f64]) {
+        let n = self.n;
+        let m = self.m.as_slice();
+        if !self.tree {
+            // R⁻ᵀ = L⁻¹ (the path is 0..n)
+            by_size!(n, N => dense_forward::<N, 1>(m, &self.inv_sqrt_d, n, [y]));
+            return;
+        }
+        let len = path.len().min(y.len());
+        // Lᵀ g = j from the leaf in: along a path the tree is a chain, the
+        // ancestors of path[t] are path[..t]
+        if self.is_chain(&path[..len]) {
+            for t in (0..len).rev() {
+                let yt = y[t];
+                if yt != 0.0 {
+                    let s = self.start[path[t]];
+                    for (ys, l) in y[..t].iter_mut().zip(&self.anc[s..s + t]) {
+                        *ys -= l * yt;
+                    }
+                }
+            }
+            for t in 0..len {
+                y[t] *= self.inv_sqrt_d[path[t]];
+            }
+            return;
+        }
+        for t in (0..len).rev() {
+            let yt = y[t];
+            if yt != 0.0 {
+                match self.ancestors(path, t) {
+                    Some((s0, anc)) => {
+                        for (ys, l) in y[s0..t].iter_mut().zip(anc) {
+                            *ys -= l * yt;
+                        }
+                    }
+                    None => {
+                        for s in 0..t {
+                            y[s] -= self.l_entry(path[t], path[s]) * yt;
+                        }
+                    }
+                }
+            }
+        }
+        for t in 0..len {
+            y[t] *= self.inv_sqrt_d[path[t]];
+        }
+    }
+
+    /// [`Self::row_transform`] of three rows on one path (a contact's normal
+    /// and tangents) in one pass over the factor.
+    #[inline]
+    pub fn row_transform3(&self, path: &[usize], y0: &mut [f64], y1: &mut [f64], y2: &mut [f64]) {
+        let n = self.n;
+        let m = self.m.as_slice();
+        if !self.tree {
+            by_size!(n, N => dense_forward::<N, 3>(m, &self.inv_sqrt_d, n, [y0, y1, y2]));
+            return;
+        }
+        let len = path.len().min(y0.len()).min(y1.len()).min(y2.len());
+        if self.is_chain(&path[..len]) {
+            for t in (0..len).rev() {
+                let (a0, a1, a2) = (y0[t], y1[t], y2[t]);
+                let s = self.start[path[t]];
+                for (s, &l) in (0..t).zip(&self.anc[s..s + t]) {
+                    y0[s] -= l * a0;
+                    y1[s] -= l * a1;
+                    y2[s] -= l * a2;
+                }
+            }
+        } else {
+            self.row_transform3_general(path, len, y0, y1, y2);
+        }
+        for t in 0..len {
+            let d = self.inv_sqrt_d[path[t]];
+            y0[t] *= d;
+            y1[t] *= d;
+            y2[t] *= d;
+        }
+    }
+
+    /// [`Self::row_transform3`]'s elimination on any path (before the scaling).
+    #[inline]
+    fn row_transform3_general(
+        &self,
+        path: &[usize],
+        len: usize,
+        y0: &mut [f64],
+        y1: &mut [f64],
+        y2: &mut [f64],
+    ) {
+        for t in (0..len).rev() {
+            let (a0, a1, a2) = (y0[t], y1[t], y2[t]);
+            match self.ancestors(path, t) {
+                Some((s0, anc)) => {
+                    for (s, &l) in (s0..t).zip(anc) {
+                        y0[s] -= l * a0;
+                        y1[s] -= l * a1;
+                        y2[s] -= l * a2;
+                    }
+                }
+                None => {
+                    for s in 0..t {
+                        let l = self.l_entry(path[t], path[s]);
+                        y0[s] -= l * a0;
+                        y1[s] -= l * a1;
+                        y2[s] -= l * a2;
+                    }
+                }
+            }
+        }
+    }
+
+    /// [`Self::row_transform3`] on rows held interleaved, `y[t] = [y₀ₜ, y₁ₜ,
+    /// y₂ₜ, pad]` (a contact's three rows, lane by lane): each lane takes
+    /// exactly the operations of [`Self::row_transform3`] in the same order (so
+    /// the same bits), four lanes at once. Tree factors only: returns false
+    /// (nothing done) on a dense one.
+    #[inline]
+    pub fn row_transform_lanes(&self, path: &[usize], y: &mut [[f64; 4]]) -> bool {
+        if !self.tree {
+            return false;
+        }
+        let len = path.len().min(y.len());
+        #[inline(always)]
+        fn sub(ys: &mut [f64; 4], l: f64, a: &[f64; 4]) {
+            for (x, &ai) in ys.iter_mut().zip(a) {
+                *x -= l * ai;
+            }
+        }
+        // `next` carries y[t − 1] as the step at t leaves it (held in a
+        // register, not read back from the store just made: the leaf-to-root
+        // chain is the form's latency)
+        let mut next = match len {
+            0 => [0.0; 4],
+            _ => y[len - 1],
+        };
+        let chain = self.is_chain(&path[..len]);
+        for t in (0..len).rev() {
+            let a = next;
+            if chain {
+                // the ancestors are y[..t], L's entries at anc[start[path[t]]..]
+                if t > 0 {
+                    let s = self.start[path[t]];
+                    let anc = &self.anc[s..s + t];
+                    let (ys, last) = y[..t].split_at_mut(t - 1);
+                    for (ys, &l) in ys.iter_mut().zip(anc) {
+                        sub(ys, l, &a);
+                    }
+                    let mut v = last[0];
+                    sub(&mut v, anc[t - 1], &a);
+                    last[0] = v;
+                    next = v;
+                }
+                continue;
+            }
+            match self.ancestors(path, t) {
+                Some((s0, anc)) if s0 < t => {
+                    let (ys, last) = y[s0..t].split_at_mut(t - 1 - s0);
+                    for (ys, &l) in ys.iter_mut().zip(anc) {
+                        sub(ys, l, &a);
+                    }
+                    let mut v = last[0];
+                    sub(&mut v, anc[t - 1 - s0], &a);
+                    last[0] = v;
+                    next = v;
+                }
+                Some(_) => {
+                    if t > 0 {
+                        next = y[t - 1];
+                    }
+                }
+                None => {
+                    for s in 0..t {
+                        sub(&mut y[s], self.l_entry(path[t], path[s]), &a);
+                    }
+                    if t > 0 {
+                        next = y[t - 1];
+                    }
+                }
+            }
+        }
+        for (yt, &k) in y[..len].iter_mut().zip(path) {
+            let d = self.inv_sqrt_d[k];
+            for x in yt.iter_mut() {
+                *x *= d;
+            }
+        }
+        true
+    }
+}
