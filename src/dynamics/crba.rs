@@ -464,6 +464,7 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
                 let moved = match ax {
                     // a joint frame at its parent's origin (a body's second and
                     // later joints in MJCF): the moves are rotations alone
+                    // (exact: `Model::placement_zero_trans`)
                     Some(ax) if exact && zt[i] => {
                         for f in fsub.iter_mut() {
                             *f = Force {
@@ -499,11 +500,3 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
 pub(crate) fn is_f64<T: Scalar>() -> bool {
     std::any::TypeId::of::<T>() == std::any::TypeId::of::<f64>()
 }
-
-// A revolute joint's `λ(i)Mi` keeps its placement's translation at every q
-// (`Se3::new(rot, xt.trans)`), so `Model::placement_zero_trans[i]` says at load
-// whether it is exactly zero (either sign): moving a force or an inertia by it
-// is then its rotation alone. Each term the translation enters (`t × f`, `m t`,
-// the parallel-axis shift) is a product with a zero added to a value, so
-// leaving them out gives the same numbers (at most a zero's sign differs:
-// −0 + 0 is +0).

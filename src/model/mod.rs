@@ -278,9 +278,13 @@ pub struct Model<T: Scalar = f64> {
     /// see [`Joint::axis_rotation`]).
     pub placement_identity: Vec<bool>,
     /// Whether `placements[i].trans` is exactly zero (either sign; decided at
-    /// load, [`zero_translations`]): a revolute joint's `λ(i)Mi` then has no
-    /// translation at any q, and the CRBA and the bias RNEA move forces,
-    /// motions and inertias across it by its rotation alone.
+    /// load, [`zero_translation`]): a revolute joint's `λ(i)Mi` keeps its
+    /// placement's translation at every q, so it then has none, and the CRBA
+    /// and the bias RNEA (f64) move forces, motions and inertias across it by
+    /// its rotation alone. Each term the translation enters (`t × f`, `m t`,
+    /// the parallel-axis shift) is a product with a zero added to a value, so
+    /// leaving them out gives the same numbers (at most a zero's sign differs:
+    /// −0 + 0 is +0).
     pub placement_zero_trans: Vec<bool>,
     /// Spatial inertia of each body in its own frame (links merged).
     pub inertias: Vec<Inertia<T>>,
@@ -526,13 +530,15 @@ impl Model<f64> {
     }
 }
 
-/// Per placement, whether its translation is exactly zero (either sign):
+/// Whether a placement's translation is exactly zero (either sign):
 /// [`Model::placement_zero_trans`], set by every constructor of a [`Model`].
+pub fn zero_translation<T: Scalar>(placement: &Se3<T>) -> bool {
+    placement.trans.iter().all(|x| *x == T::zero())
+}
+
+/// [`zero_translation`] of each placement.
 pub fn zero_translations<T: Scalar>(placements: &[Se3<T>]) -> Vec<bool> {
-    placements
-        .iter()
-        .map(|p| p.trans.iter().all(|x| *x == T::zero()))
-        .collect()
+    placements.iter().map(zero_translation).collect()
 }
 
 fn cast_axis<T: Scalar, U: Scalar>(a: Axis<T>, cv: &impl Fn(&Vector3<T>) -> Vector3<U>) -> Axis<U> {

@@ -114,7 +114,7 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
             m.placement_identity
                 .push(x.rot == nalgebra::Matrix3::identity());
             m.placement_zero_trans
-                .extend(crate::model::zero_translations(std::slice::from_ref(&x)));
+                .push(crate::model::zero_translation(&x));
             m.placements.push(x);
             m.inertias.push(p.inertias[b]);
             m.inertias_origin.push(p.inertias_origin[b]);

@@ -22,24 +22,18 @@ impl MassFactor {
         let len = path.len().min(y.len());
         // Lᵀ g = j from the leaf in: along a path the tree is a chain, the
         // ancestors of path[t] are path[..t]
-        if self.is_chain(&path[..len]) {
-            for t in (0..len).rev() {
-                let yt = y[t];
-                if yt != 0.0 {
-                    let s = self.start[path[t]];
-                    for (ys, l) in y[..t].iter_mut().zip(&self.anc[s..s + t]) {
-                        *ys -= l * yt;
-                    }
-                }
-            }
-            for t in 0..len {
-                y[t] *= self.inv_sqrt_d[path[t]];
-            }
-            return;
-        }
+        let chain = self.is_chain(&path[..len]);
         for t in (0..len).rev() {
             let yt = y[t];
-            if yt != 0.0 {
+            if yt == 0.0 {
+                continue;
+            }
+            if chain {
+                let s = self.start[path[t]];
+                for (ys, l) in y[..t].iter_mut().zip(&self.anc[s..s + t]) {
+                    *ys -= l * yt;
+                }
+            } else {
                 match self.ancestors(path, t) {
                     Some((s0, anc)) => {
                         for (ys, l) in y[s0..t].iter_mut().zip(anc) {
