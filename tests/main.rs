@@ -18,6 +18,7 @@ mod common;
 mod alloc;
 mod ant_rest;
 mod api;
+mod bad_cli;
 mod bad_inputs;
 mod cli_errors;
 mod constraint_dynamics;

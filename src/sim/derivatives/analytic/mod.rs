@@ -29,16 +29,18 @@
 mod rows;
 
 pub(super) use rows::solve_basic;
-use rows::{cq_row_dot, dot_rows, equality_row, lin, omega, spin_sliding, velocity_determined};
+use rows::{
+    cq_row_dot, dot_rows, equality_row, lin, omega, set, shape, spin_sliding, velocity_determined,
+    z0_product,
+};
 
 use super::position::PositionPass;
 use super::second_order::{add_second_order, loop_gamma_derivatives, loop_rows};
 use super::smooth::Tableau;
 use super::TransitionJacobians;
-use crate::contact::{ContactPoint, NO_GEOM};
+use crate::contact::ContactPoint;
 use crate::dynamics::linalg::{by_size, cholesky_fast, cholesky_solve_rows};
 use crate::dynamics::{rnea_derivatives, DynamicsError};
-use crate::model::Shape;
 use crate::sim::integrators::dop853_tableau::{A, B, N_STAGES};
 use crate::sim::integrators::explicit_limit;
 use crate::sim::solver::RowKind;
@@ -90,45 +92,6 @@ impl Default for Scratch {
             kk: m.clone(),
             z0: m,
         }
-    }
-}
-
-/// Column c of Z0 += K[k, c] · column k of H̃⁻¹ over the 2n columns of K
-/// (contiguous columns, K's structural zeros skipped); `N`: n when known at
-/// compile time, else 0.
-#[inline(always)]
-fn z0_product<const N: usize>(zs: &mut [f64], ms: &[f64], ks: &[f64], n: usize) {
-    let n = if N == 0 { n } else { N };
-    if zs.len() < 2 * n * n || ms.len() < n * n || ks.len() < 2 * n * n {
-        return;
-    }
-    for c in 0..2 * n {
-        let zc = &mut zs[c * n..(c + 1) * n];
-        for k in 0..n {
-            let x = ks[k + c * n];
-            if x != 0.0 {
-                for (z, &mi) in zc.iter_mut().zip(&ms[k * n..(k + 1) * n]) {
-                    *z += mi * x;
-                }
-            }
-        }
-    }
-}
-
-/// `dst` ← `src`, reallocating only on a change of length.
-fn set(dst: &mut DVector<f64>, src: &DVector<f64>) {
-    if dst.len() == src.len() {
-        dst.copy_from(src);
-    } else {
-        *dst = src.clone();
-    }
-}
-
-/// `m` of shape r × c, reallocated only on a change of shape (its entries
-/// are left as they were: the caller writes every one it reads, or zeroes).
-fn shape(m: &mut DMatrix<f64>, r: usize, c: usize) {
-    if m.shape() != (r, c) {
-        *m = DMatrix::zeros(r, c);
     }
 }
 
@@ -611,35 +574,5 @@ impl Simulation {
         // without the position pass δv_tot = δv⁺ (no copy)
         let dvtot = dvtot.as_ref().unwrap_or(dvplus);
         Ok(Some(self.output_map(vtot, vplus, dvtot, dvplus, h)))
-    }
-
-    /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces): the
-    /// analytic [`rnea_derivatives`] (docs/theory.md §"Derivatives"), which
-    /// leaves the simulation's kinematics at `q`.
-    pub(super) fn id_derivatives(
-        &mut self,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        a: &DVector<f64>,
-    ) -> Result<(DMatrix<f64>, DMatrix<f64>), SimError> {
-        rnea_derivatives(&self.model, &mut self.data, q, v, a, None)?;
-        Ok((self.data.dtau_dq.clone(), self.data.dtau_dv.clone()))
-    }
-
-    /// The radius of a contact shape that rolls (sphere, capsule): its contact
-    /// point is that far below the centre it moves with; 0 for vertices.
-    pub(super) fn rolling_radius(&self, pt: &ContactPoint) -> f64 {
-        if pt.other_geom != NO_GEOM {
-            // an obstacle's point: a sphere or capsule rolls on it too
-            return match self.model.collisions.get(pt.geom).map(|g| &g.shape) {
-                Some(Shape::Sphere { radius }) | Some(Shape::Capsule { radius, .. }) => *radius,
-                _ => 0.0,
-            };
-        }
-        self.contact
-            .as_ref()
-            .and_then(|c| c.ground.as_ref())
-            .and_then(|g| g.shapes.get(pt.shape))
-            .map_or(0.0, |s| s.rolling_radius())
     }
 }

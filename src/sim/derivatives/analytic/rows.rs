@@ -1,7 +1,12 @@
 //! The row algebra of the analytic step Jacobians (split from `analytic/mod.rs`):
 //! the basic solve of the active set, its equality and sliding rows, and small
-//! vector helpers.
+//! vector and matrix helpers, and the simulation's inverse-dynamics derivatives
+//! and rolling radii the step Jacobians read.
 
+use crate::contact::{ContactPoint, NO_GEOM};
+use crate::dynamics::rnea_derivatives;
+use crate::model::Shape;
+use crate::sim::{SimError, Simulation};
 use nalgebra::{DMatrix, DVector, Vector3};
 
 /// M X = R by Gaussian elimination with complete pivoting (M square), stopped
@@ -164,4 +169,75 @@ pub(super) fn velocity_determined(
         }
     }
     true
+}
+
+/// Column c of Z0 += K[k, c] · column k of H̃⁻¹ over the 2n columns of K
+/// (contiguous columns, K's structural zeros skipped); `N`: n when known at
+/// compile time, else 0.
+#[inline(always)]
+pub(super) fn z0_product<const N: usize>(zs: &mut [f64], ms: &[f64], ks: &[f64], n: usize) {
+    let n = if N == 0 { n } else { N };
+    if zs.len() < 2 * n * n || ms.len() < n * n || ks.len() < 2 * n * n {
+        return;
+    }
+    for c in 0..2 * n {
+        let zc = &mut zs[c * n..(c + 1) * n];
+        for k in 0..n {
+            let x = ks[k + c * n];
+            if x != 0.0 {
+                for (z, &mi) in zc.iter_mut().zip(&ms[k * n..(k + 1) * n]) {
+                    *z += mi * x;
+                }
+            }
+        }
+    }
+}
+
+/// `dst` ← `src`, reallocating only on a change of length.
+pub(super) fn set(dst: &mut DVector<f64>, src: &DVector<f64>) {
+    if dst.len() == src.len() {
+        dst.copy_from(src);
+    } else {
+        *dst = src.clone();
+    }
+}
+
+/// `m` of shape r × c, reallocated only on a change of shape (its entries
+/// are left as they were: the caller writes every one it reads, or zeroes).
+pub(super) fn shape(m: &mut DMatrix<f64>, r: usize, c: usize) {
+    if m.shape() != (r, c) {
+        *m = DMatrix::zeros(r, c);
+    }
+}
+
+impl Simulation {
+    /// ∂ID/∂q, ∂ID/∂v at (q, v, a) (tangent space; no external forces): the
+    /// analytic [`rnea_derivatives`] (docs/theory.md §"Derivatives"), which
+    /// leaves the simulation's kinematics at `q`.
+    pub(in crate::sim::derivatives) fn id_derivatives(
+        &mut self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        a: &DVector<f64>,
+    ) -> Result<(DMatrix<f64>, DMatrix<f64>), SimError> {
+        rnea_derivatives(&self.model, &mut self.data, q, v, a, None)?;
+        Ok((self.data.dtau_dq.clone(), self.data.dtau_dv.clone()))
+    }
+
+    /// The radius of a contact shape that rolls (sphere, capsule): its contact
+    /// point is that far below the centre it moves with; 0 for vertices.
+    pub(in crate::sim::derivatives) fn rolling_radius(&self, pt: &ContactPoint) -> f64 {
+        if pt.other_geom != NO_GEOM {
+            // an obstacle's point: a sphere or capsule rolls on it too
+            return match self.model.collisions.get(pt.geom).map(|g| &g.shape) {
+                Some(Shape::Sphere { radius }) | Some(Shape::Capsule { radius, .. }) => *radius,
+                _ => 0.0,
+            };
+        }
+        self.contact
+            .as_ref()
+            .and_then(|c| c.ground.as_ref())
+            .and_then(|g| g.shapes.get(pt.shape))
+            .map_or(0.0, |s| s.rolling_radius())
+    }
 }
