@@ -16,7 +16,7 @@ use crate::model::{
     JointLimits, LinkMass, Model, Shape, Topology, Tree, OBSTACLE,
 };
 use crate::spatial::{CompositeInertia, Inertia, Se3};
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{UnitQuaternion, Vector3};
 
 fn se3(p: &Vector3<f64>, q: &UnitQuaternion<f64>) -> Se3<f64> {
     Se3::new(q.to_rotation_matrix().into_inner(), *p)
@@ -298,10 +298,7 @@ pub(super) fn lower(world: &World) -> Result<Model, MjcfError> {
         parent,
         joints,
         placement_zero_trans: crate::model::zero_translations(&placements),
-        placement_identity: placements
-            .iter()
-            .map(|p| p.rot == Matrix3::identity())
-            .collect(),
+        placement_identity: crate::model::identity_rotations(&placements),
         placements,
         inertias_origin: inertias
             .iter()

@@ -541,6 +541,17 @@ pub fn zero_translations<T: Scalar>(placements: &[Se3<T>]) -> Vec<bool> {
     placements.iter().map(zero_translation).collect()
 }
 
+/// Whether a placement's rotation is exactly the identity:
+/// [`Model::placement_identity`], set by every constructor of a [`Model`].
+pub fn identity_rotation<T: Scalar>(placement: &Se3<T>) -> bool {
+    placement.rot == nalgebra::Matrix3::identity()
+}
+
+/// [`identity_rotation`] of each placement.
+pub fn identity_rotations<T: Scalar>(placements: &[Se3<T>]) -> Vec<bool> {
+    placements.iter().map(identity_rotation).collect()
+}
+
 fn cast_axis<T: Scalar, U: Scalar>(a: Axis<T>, cv: &impl Fn(&Vector3<T>) -> Vector3<U>) -> Axis<U> {
     match a {
         Axis::X => Axis::X,

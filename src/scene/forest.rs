@@ -112,7 +112,7 @@ pub fn forest(name: &str, parts: Vec<Part>, gravity: Vector3<f64>) -> Model {
                 p.placements[b]
             };
             m.placement_identity
-                .push(x.rot == nalgebra::Matrix3::identity());
+                .push(crate::model::identity_rotation(&x));
             m.placement_zero_trans
                 .push(crate::model::zero_translation(&x));
             m.placements.push(x);

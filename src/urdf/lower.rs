@@ -415,10 +415,7 @@ pub(crate) fn lower(
         parent,
         joints,
         placement_zero_trans: crate::model::zero_translations(&placements),
-        placement_identity: placements
-            .iter()
-            .map(|p| p.rot == nalgebra::Matrix3::identity())
-            .collect(),
+        placement_identity: crate::model::identity_rotations(&placements),
         placements,
         inertias_origin: inertias
             .iter()
