@@ -78,10 +78,11 @@ impl Servo {
     /// or inactive), c the step (0: the explicit stiffness tests).
     #[inline(always)]
     pub fn diag(&self, k: usize, c: f64) -> f64 {
-        if !self.active || self.saturated[k] != 0 {
+        if !self.active || self.saturated.get(k) != Some(&0) {
             return 0.0;
         }
-        c * self.kd[k] + c * c * self.kp[k]
+        let (kd, kp) = (self.kd.as_slice(), self.kp.as_slice());
+        c * kd[k] + c * c * kp[k]
     }
 
     /// τ_ff + the servo torque at (q, v) of v coordinate `k`, clamped to
@@ -107,7 +108,9 @@ impl Servo {
     /// The unclamped servo torque of v coordinate `iv` (q coordinate `iq`) at (q, v).
     #[inline(always)]
     pub fn torque(&self, iq: usize, iv: usize, q: f64, v: f64) -> f64 {
-        self.kp[iv] * (self.q_ref[iq] - q) + self.kd[iv] * (self.v_ref[iv] - v)
+        // (slices: one bounds test an entry, not a matrix index's)
+        let (kp, kd) = (self.kp.as_slice(), self.kd.as_slice());
+        kp[iv] * (self.q_ref.as_slice()[iq] - q) + kd[iv] * (self.v_ref.as_slice()[iv] - v)
     }
 }
 
@@ -246,13 +249,17 @@ impl Simulation {
             self.mass.vtot = c;
             return Err(e);
         }
+        // (the per-dof loops below read slices cut to nv: one bounds test an
+        // entry at most, where a DVector's index tests a matrix shape)
+        let s = &mut self.servo;
+        let (kp, kd) = (&s.kp.as_slice()[..nv], &s.kd.as_slice()[..nv]);
+        let (effort, tau_ff) = (&self.effort[..nv], &self.tau_applied.as_slice()[..nv]);
         // start with the joints whose servo has no gain and whose τ_ff passes
         // the limit saturated (the plain clamp), every servoed joint free
-        for k in 0..nv {
-            let e = self.effort[k];
-            let t = self.tau_applied[k];
-            let servoed = self.servo.kp[k] != 0.0 || self.servo.kd[k] != 0.0;
-            self.servo.saturated[k] = if !servoed && t.abs() > e {
+        for (k, sat) in s.saturated[..nv].iter_mut().enumerate() {
+            let (e, t) = (effort[k], tau_ff[k]);
+            let servoed = kp[k] != 0.0 || kd[k] != 0.0;
+            *sat = if !servoed && t.abs() > e {
                 t.signum() as i8
             } else {
                 0
@@ -262,12 +269,29 @@ impl Simulation {
         let mut result = Ok(());
         for _pass in 0..=nv.min(8) {
             // u − C − D v, u = τ_ff + e on free joints, ±effort on saturated ones
-            for k in 0..nv {
-                let u = match self.servo.saturated[k] {
-                    0 => self.tau_applied[k] + self.servo_explicit(k, h),
-                    s => f64::from(s) * self.effort[k],
-                };
-                tau[k] = u - c[k] - self.damping[k] * self.v[k];
+            {
+                let s = &self.servo;
+                let (q, v) = (self.q.as_slice(), &self.v.as_slice()[..nv]);
+                let (cs, damping) = (&c.as_slice()[..nv], &self.damping.as_slice()[..nv]);
+                let (effort, tau_ff) = (&self.effort[..nv], &self.tau_applied.as_slice()[..nv]);
+                let (sat, iqs) = (&s.saturated[..nv], &s.iq[..nv]);
+                let kp = &s.kp.as_slice()[..nv];
+                for (k, tk) in tau.as_mut_slice()[..nv].iter_mut().enumerate() {
+                    let u = match sat[k] {
+                        0 => {
+                            // τ_ff + e, e = kp (q_ref − q − h v) + kd (v_ref − v) (0 on base entries)
+                            let iq = iqs[k];
+                            let e = if iq == FREE {
+                                0.0
+                            } else {
+                                s.torque(iq, k, q[iq], v[k]) - h * kp[k] * v[k]
+                            };
+                            tau_ff[k] + e
+                        }
+                        sg => f64::from(sg) * effort[k],
+                    };
+                    *tk = u - cs[k] - damping[k] * v[k];
+                }
             }
             if let Err(e) = self.factor_mass(h) {
                 result = Err(e);
@@ -278,16 +302,19 @@ impl Simulation {
             self.mass.vfree.axpy(h, &tau, 1.0);
             // a free joint whose torque at v* passes its limit is saturated
             let mut grew = false;
+            let s = &mut self.servo;
+            let (q, vfree) = (self.q.as_slice(), &self.mass.vfree.as_slice()[..nv]);
+            let (effort, tau_ff) = (&self.effort[..nv], &self.tau_applied.as_slice()[..nv]);
             for k in 0..nv {
-                if self.servo.iq[k] == FREE
-                    || self.servo.saturated[k] != 0
-                    || !self.effort[k].is_finite()
-                {
+                let iq = s.iq[k];
+                if iq == FREE || s.saturated[k] != 0 || !effort[k].is_finite() {
                     continue;
                 }
-                let t = self.servo_torque_after(k, h);
-                if t.abs() > self.effort[k] {
-                    self.servo.saturated[k] = t.signum() as i8;
+                // τ_ff + the servo torque at q⁺ ≈ q + h v*, v⁺ = v*
+                let v1 = vfree[k];
+                let t = tau_ff[k] + s.torque(iq, k, q[iq] + h * v1, v1);
+                if t.abs() > effort[k] {
+                    s.saturated[k] = t.signum() as i8;
                     grew = true;
                 }
             }
@@ -295,36 +322,24 @@ impl Simulation {
                 break;
             }
         }
-        for k in 0..nv {
-            self.servo.applied[k] = match self.servo.saturated[k] {
-                0 if self.servo.iq[k] != FREE => self.servo_torque_after(k, h),
-                0 => self.tau_applied[k],
-                s => f64::from(s) * self.effort[k],
+        let mut applied = std::mem::replace(&mut self.servo.applied, DVector::zeros(0));
+        let s = &self.servo;
+        let (q, vfree) = (self.q.as_slice(), &self.mass.vfree.as_slice()[..nv]);
+        let (effort, tau_ff) = (&self.effort[..nv], &self.tau_applied.as_slice()[..nv]);
+        for (k, a) in applied.as_mut_slice()[..nv].iter_mut().enumerate() {
+            let iq = s.iq[k];
+            *a = match s.saturated[k] {
+                0 if iq != FREE => {
+                    let v1 = vfree[k];
+                    tau_ff[k] + s.torque(iq, k, q[iq] + h * v1, v1)
+                }
+                0 => tau_ff[k],
+                sg => f64::from(sg) * effort[k],
             };
         }
+        self.servo.applied = applied;
         self.mass.tau = tau;
         self.mass.vtot = c;
         result
-    }
-
-    /// The servo's explicit part e = kp (q_ref − q − h v) + kd (v_ref − v) of v
-    /// coordinate `k` (0 on base entries).
-    #[inline(always)]
-    fn servo_explicit(&self, k: usize, h: f64) -> f64 {
-        let iq = self.servo.iq[k];
-        if iq == FREE {
-            return 0.0;
-        }
-        let s = &self.servo;
-        s.torque(iq, k, self.q[iq], self.v[k]) - h * s.kp[k] * self.v[k]
-    }
-
-    /// τ_ff + the servo torque of joint coordinate `k` at the end of the step,
-    /// q⁺ ≈ q + h v*, v⁺ = v* (`mass.vfree`).
-    #[inline(always)]
-    fn servo_torque_after(&self, k: usize, h: f64) -> f64 {
-        let iq = self.servo.iq[k];
-        let v1 = self.mass.vfree[k];
-        self.tau_applied[k] + self.servo.torque(iq, k, self.q[iq] + h * v1, v1)
     }
 }

@@ -97,7 +97,9 @@ impl Simulation {
         self.mass
             .f
             .set_awake(&self.model, self.sleep.sleeping_trees());
-        let (arm, damp, servo) = (&self.armature, &self.damping, &self.servo);
+        // (slices: one bounds test an entry, not a DVector's matrix index)
+        let (arm, damp) = (self.armature.as_slice(), self.damping.as_slice());
+        let servo = &self.servo;
         let diag = |k: usize| arm[k] + c * damp[k] + servo.diag(k, c);
         if let Some(r) =
             self.mass

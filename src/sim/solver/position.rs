@@ -87,38 +87,61 @@ impl Rows {
             .sm
             .loops
             .prepare(&view, runs, &self.kind[..self.n], &self.w[..self.n]);
+        // SAFETY (unchecked reads of dw below): every path lies in `table`
+        // (checked here) and holds dof indices < nv (the factor's table and
+        // its unions, as the velocity sweeps rely on, pgs.rs)
+        let n = self.n;
+        if runs.iter().any(|&(_, s, e)| {
+                e > n
+                    || self.path[s..e]
+                        .iter()
+                        .any(|&(s, l)| s + l > table.len() || l > st)
+            })
+        {
+            return 0;
+        }
         let mut it = 0;
         while it < max_iter {
             it += 1;
             let mut change: f64 = 0.0;
-            for r in runs.iter().flat_map(|&(_, s, e)| s..e) {
-                let bilateral = self.kind[r] == RowKind::Bilateral;
-                if bilateral && block {
-                    continue;
-                }
-                if !bilateral && !matches!(self.kind[r], RowKind::Normal | RowKind::Unilateral) {
-                    continue;
-                }
-                let wrr = self.w[r];
-                if !(wrr > 1e-14) {
-                    continue;
-                }
-                let (ps, pl) = self.path[r];
-                let (Some(p), Some(yr)) = (table.get(ps..ps + pl), self.y.get(r * st..r * st + pl))
-                else {
-                    continue;
-                };
-                let u: f64 = yr.iter().zip(p).map(|(a, &k)| a * dw[k]).sum();
-                let old = self.mu[r];
-                let x = old - (u - self.bpos[r]) / wrr;
-                let new = if bilateral { x } else { x.max(0.0) };
-                let d = new - old;
-                if d != 0.0 {
-                    self.mu[r] = new;
-                    for (a, &k) in yr.iter().zip(p) {
-                        dw[k] += d * a;
+            for &(_, s, e) in runs {
+                for r in s..e {
+                    let kind = self.kind[r];
+                    let bilateral = kind == RowKind::Bilateral;
+                    if bilateral && block {
+                        continue;
                     }
-                    change = change.max((d * wrr).abs());
+                    if !bilateral && !matches!(kind, RowKind::Normal | RowKind::Unilateral) {
+                        continue;
+                    }
+                    let wrr = self.w[r];
+                    if !(wrr > 1e-14) {
+                        continue;
+                    }
+                    let (ps, pl) = self.path[r];
+                    let (Some(p), Some(yr)) =
+                        (table.get(ps..ps + pl), self.y.get(r * st..r * st + pl))
+                    else {
+                        continue;
+                    };
+                    // uᵣ = yᵣ·w' over the row's path
+                    let u: f64 = yr
+                        .iter()
+                        .zip(p)
+                        .map(|(a, &k)| a * unsafe { *dw.get_unchecked(k) })
+                        .sum();
+                    let old = self.mu[r];
+                    let x = old - (u - self.bpos[r]) / wrr;
+                    let new = if bilateral { x } else { x.max(0.0) };
+                    let d = new - old;
+                    if d != 0.0 {
+                        self.mu[r] = new;
+                        // w' += Δμ yᵣ
+                        for (a, &k) in yr.iter().zip(p) {
+                            unsafe { *dw.get_unchecked_mut(k) += d * a };
+                        }
+                        change = change.max((d * wrr).abs());
+                    }
                 }
             }
             if block {
