@@ -165,27 +165,13 @@ impl SweepAndPrune {
         out: &mut Vec<u32>,
         fresh: &mut Vec<(u32, u32)>,
     ) {
-        self.overlaps_among(table, &[], out, fresh);
-    }
-
-    /// [`Self::overlaps`] leaving out the pairs of two shapes flagged in
-    /// `settled` (indexed by shape; any other length: none), whose overlap
-    /// the caller knows from the last sweep (their boxes have not changed).
-    pub(crate) fn overlaps_among(
-        &mut self,
-        table: &PairTable,
-        settled: &[bool],
-        out: &mut Vec<u32>,
-        fresh: &mut Vec<(u32, u32)>,
-    ) {
         let n = self.lo.len();
         let mut cand = std::mem::take(&mut self.cand);
         cand.clear();
-        let settled = if settled.len() == n { settled } else { &[] };
         if n < STRIPS_FROM {
-            self.sweep_x(settled, &mut cand);
+            self.sweep_x(&mut cand);
         } else {
-            self.sweep_strips(settled, &mut cand);
+            self.sweep_strips(&mut cand);
         }
         // the table read in the sweep's order, eight pairs ahead fetched
         const AHEAD: usize = 8;
@@ -204,12 +190,9 @@ impl SweepAndPrune {
     }
 
     /// Shapes i and j (both boxes known to overlap in x) kept if their
-    /// boxes overlap in y and z and not both are `settled`.
+    /// boxes overlap in y and z.
     #[inline(always)]
-    fn report(&self, settled: &[bool], i: usize, j: usize, cand: &mut Vec<(u32, u32)>) {
-        if settled.get(i) == Some(&true) && settled.get(j) == Some(&true) {
-            return;
-        }
+    fn report(&self, i: usize, j: usize, cand: &mut Vec<(u32, u32)>) {
         let (li, hi, lj, hj) = (self.lo[i], self.hi[i], self.lo[j], self.hi[j]);
         if lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2] {
             return;
@@ -218,7 +201,7 @@ impl SweepAndPrune {
     }
 
     /// One sweep along x over every shape.
-    fn sweep_x(&mut self, settled: &[bool], cand: &mut Vec<(u32, u32)>) {
+    fn sweep_x(&mut self, cand: &mut Vec<(u32, u32)>) {
         let n = self.order.len();
         // the lower x in last step's order, then an insertion sort by it
         // (the same comparisons, so the same order, as one on the boxes)
@@ -244,14 +227,14 @@ impl SweepAndPrune {
                 if x > hx {
                     break;
                 }
-                self.report(settled, i, j as usize, cand);
+                self.report(i, j as usize, cand);
             }
         }
         self.xs = buf;
     }
 
     /// Strips along y, each swept along x with the next (module docs).
-    fn sweep_strips(&mut self, settled: &[bool], cand: &mut Vec<(u32, u32)>) {
+    fn sweep_strips(&mut self, cand: &mut Vec<(u32, u32)>) {
         let n = self.lo.len();
         // the strips' width: the widest ordinary y-extent
         self.ext.clear();
@@ -361,7 +344,7 @@ impl SweepAndPrune {
                         break;
                     }
                     if in_s || jn_s {
-                        self.report(settled, i, j, cand);
+                        self.report(i, j, cand);
                     }
                 }
             }
@@ -378,7 +361,7 @@ impl SweepAndPrune {
                 if self.lo[j][0] > self.hi[i][0] || self.lo[i][0] > self.hi[j][0] {
                     continue;
                 }
-                self.report(settled, i, j, cand);
+                self.report(i, j, cand);
             }
         }
     }

@@ -70,13 +70,9 @@ pub(crate) struct Sleep {
     pub frozen_forces: Vec<ContactForce>,
     /// The sleeping bodies' last contact wrenches (per body).
     frozen_body: Vec<Force>,
-    /// The last solve's contact forces on awake bodies (while anything sleeps).
-    awake_forces: Vec<ContactForce>,
-    /// Those joined with the frozen ones, made when first asked for after a
-    /// step (a step copies only the awake ones, never the frozen ones).
-    all_forces: std::sync::OnceLock<Vec<ContactForce>>,
-    /// The last solve's body wrenches with the frozen ones (in use while
-    /// anything sleeps).
+    /// The last solve's contact forces and wrenches with the frozen ones
+    /// (in use while anything sleeps).
+    all_forces: Vec<ContactForce>,
     all_body: Vec<Force>,
     /// v plus the position pass's pseudo-velocity (scratch: a point pushed out
     /// of a penetration is moving).
@@ -163,8 +159,7 @@ impl Sleep {
             frozen_points: Vec::new(),
             frozen_forces: Vec::new(),
             frozen_body: vec![Force::zero(); model.nbodies],
-            awake_forces: Vec::new(),
-            all_forces: std::sync::OnceLock::new(),
+            all_forces: Vec::new(),
             all_body: vec![Force::zero(); model.nbodies],
             vw: DVector::zeros(model.nv),
             awake,
@@ -214,7 +209,6 @@ impl Sleep {
         }
         self.frozen_points.clear();
         self.frozen_forces.clear();
-        self.all_forces.take();
         self.any_asleep = false;
         self.list_awake();
         self.awake = self.count_awake();
@@ -255,7 +249,6 @@ impl Sleep {
             let keep = |b: usize| asleep.get(b) == Some(&true);
             self.frozen_points.retain(|p| keep(p.body));
             self.frozen_forces.retain(|f| keep(f.point.body));
-            self.all_forces.take();
             self.any_asleep = self.asleep.iter().any(|&a| a);
             self.list_awake();
             self.awake = self.count_awake();
@@ -445,14 +438,14 @@ impl Sleep {
         if !self.any_asleep {
             return;
         }
+        self.all_forces.clear();
         // (the last solve's forces on islands that fell asleep after it are
-        // the frozen ones already); joined with those when asked for
+        // the frozen ones already)
         let asleep = &self.body_asleep;
         let awake = |b: usize| asleep.get(b) != Some(&true);
-        self.awake_forces.clear();
-        self.awake_forces
+        self.all_forces
             .extend(forces.iter().filter(|f| awake(f.point.body)));
-        self.all_forces.take();
+        self.all_forces.extend_from_slice(&self.frozen_forces);
         // the sleeping bodies' entries are their frozen wrenches (set when
         // they fell asleep): the awake bodies' (the world's too) are copied
         let get = |b: usize| body.get(b).copied().unwrap_or(Force::zero());
@@ -469,12 +462,7 @@ impl Sleep {
     /// the frozen ones while anything sleeps.
     pub fn forces<'a>(&'a self, awake: &'a [ContactForce]) -> &'a [ContactForce] {
         if self.any_asleep {
-            self.all_forces.get_or_init(|| {
-                let mut all = Vec::with_capacity(self.awake_forces.len() + self.frozen_forces.len());
-                all.extend_from_slice(&self.awake_forces);
-                all.extend_from_slice(&self.frozen_forces);
-                all
-            })
+            &self.all_forces
         } else {
             awake
         }

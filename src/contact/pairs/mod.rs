@@ -131,12 +131,6 @@ pub struct PairContact {
     raw: Vec<Raw>,
     /// Members that move (their boxes are refreshed each step).
     moving: Vec<usize>,
-    /// Per member: its box is last detection's and cannot change (static, or
-    /// asleep with the same box as at the last detection): a pair of two such
-    /// members overlaps now iff it did then, and is left out of the sweep.
-    settled: Vec<bool>,
-    /// A detection has run since the pipeline was built or forgot its history.
-    detected: bool,
     /// Slots in all.
     pub nslots: usize,
     /// Narrow-phase queries performed so far (one a pair whose boxes overlap).
@@ -256,8 +250,6 @@ impl PairContact {
             stamp: 0,
             raw: Vec::new(),
             moving: Vec::new(),
-            settled: Vec::new(),
-            detected: false,
             queries: 0,
             travel: Travel::new(params, Vec::new()),
             max_points: maxp,
@@ -282,7 +274,6 @@ impl PairContact {
         }
         let fixed = made.members.iter().map(|m| m.body == 0).collect();
         made.travel = Travel::new(params, fixed);
-        made.settled = vec![false; n];
         for (k, m) in made.members.iter().enumerate() {
             made.poses.push(m.placement);
             let c = m.placement.act_point(&m.shape.mid);
@@ -347,7 +338,6 @@ impl PairContact {
             pair.apart = None;
         }
         self.travel.forget();
-        self.detected = false;
     }
 
     /// The next detection follows a step ([`super::Collision::stepped`]).
@@ -391,11 +381,6 @@ impl PairContact {
         // (c = 0: every margin is δ, the members' travel is not measured)
         let measure = self.travel.measures();
         self.keep_in_order();
-        let detected = std::mem::replace(&mut self.detected, true);
-        for k in 0..self.members.len() {
-            // a static member's box was set once (at build)
-            self.settled[k] = detected && self.members[k].body == 0;
-        }
         for &k in &self.moving {
             let m = &self.members[k];
             let w = world(m, o_m_i);
@@ -406,12 +391,7 @@ impl PairContact {
                 let s = moved_from(&self.centres[k], &c, &self.poses[k], &w, self.radii[k]);
                 self.travel.set(k, s * stepped);
             }
-            let (lo, hi) = (self.sap.lo[k], self.sap.hi[k]);
             set_box(&mut self.sap, k, m, &w, &c, self.travel.margin(k));
-            self.settled[k] = detected
-                && asleep.get(m.body) == Some(&true)
-                && self.sap.lo[k] == lo
-                && self.sap.hi[k] == hi;
             if m.shape.round.is_some() {
                 self.rounds[k] = Round::of(&m.shape, &w);
             }
@@ -422,8 +402,7 @@ impl PairContact {
         self.fresh.clear();
         let mut ids = std::mem::take(&mut self.sap_ids);
         ids.clear();
-        self.sap
-            .overlaps_among(&self.table, &self.settled, &mut ids, &mut self.fresh);
+        self.sap.overlaps(&self.table, &mut ids, &mut self.fresh);
         for f in 0..self.fresh.len() {
             let (i, j) = self.fresh[f];
             ids.push(self.make_pair(i as usize, j as usize));
@@ -463,7 +442,7 @@ impl PairContact {
                     prefetch(k);
                 }
             }
-            let mut hit = next < self.overlapping.len() && self.overlapping[next].1 as usize == pi;
+            let hit = next < self.overlapping.len() && self.overlapping[next].1 as usize == pi;
             if hit {
                 next += 1;
             }
@@ -473,9 +452,6 @@ impl PairContact {
             ) else {
                 continue;
             };
-            // a pair of two settled members, left out of the sweep, is
-            // visited because it was live: it overlapped then and does now
-            hit = hit || (self.settled[pair.a] && self.settled[pair.b]);
             if !hit || self.dropped[pi] {
                 pair.apart = None;
                 if keys[0] != NO_KEY || !pair.manifolds.is_empty() {
