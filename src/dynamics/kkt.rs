@@ -5,6 +5,7 @@
 //! pseudo-inverse `K⁺ = V Λ⁺ Vᵀ`, which gives the least-norm λ of a consistent
 //! system. No allocation: every buffer is sized once.
 
+use super::linalg::by_size;
 use crate::spatial::ops::madd;
 use nalgebra::{DMatrix, DVector};
 
@@ -70,25 +71,8 @@ impl KktFactor {
     pub fn solve(&mut self, x: &mut [f64]) {
         let m = self.t.len();
         if self.full_rank {
-            // L (column-major): L[i, k] at i + k m
-            let l = self.f.as_slice();
-            let dinv = &self.dinv[..m];
-            let x = &mut x[..m];
-            for k in 0..m {
-                let xk = x[k] * dinv[k];
-                x[k] = xk;
-                for (xi, &lik) in x[k + 1..].iter_mut().zip(&l[k * m + k + 1..(k + 1) * m]) {
-                    *xi = madd(-lik, xk, *xi);
-                }
-            }
-            for i in (0..m).rev() {
-                let col = &l[i * m + i + 1..(i + 1) * m];
-                let mut s = x[i];
-                for (&a, &b) in col.iter().zip(&x[i + 1..]) {
-                    s = madd(-a, b, s);
-                }
-                x[i] = s * dinv[i];
-            }
+            let (l, dinv) = (self.f.as_slice(), &self.dinv[..]);
+            by_size!(m, N => cholesky_solve_n::<N>(l, dinv, x, m));
             return;
         }
         // V Λ⁺ Vᵀ x
@@ -167,7 +151,16 @@ impl KktFactor {
 /// below the diagonal less the earlier columns' contiguous axpys, then scaled
 /// by one reciprocal.
 fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>, dinv: &mut [f64]) -> bool {
-    let m = k.nrows();
+    // the size known at compile time for the common row counts (four 3-D feet,
+    // two 6-D soles: 12), so that the short columns' loops unroll; the same
+    // operations in the same order at every size
+    by_size!(k.nrows(), N => cholesky_n::<N>(k, l, dinv))
+}
+
+/// [`cholesky`] with `N` = K's size when known at compile time, else 0.
+#[inline(always)]
+fn cholesky_n<const N: usize>(k: &DMatrix<f64>, l: &mut DMatrix<f64>, dinv: &mut [f64]) -> bool {
+    let m = if N == 0 { k.nrows() } else { N };
     let ks = &k.as_slice()[..m * m];
     let ls = &mut l.as_mut_slice()[..m * m];
     for j in 0..m {
@@ -193,6 +186,31 @@ fn cholesky(k: &DMatrix<f64>, l: &mut DMatrix<f64>, dinv: &mut [f64]) -> bool {
         }
     }
     true
+}
+
+/// `x ← (L Lᵀ)⁻¹ x` from [`cholesky`]'s L (column-major, L[i, k] at i + k m)
+/// and the reciprocals of its diagonal; `N` = m when known at compile time, else 0.
+#[inline(always)]
+fn cholesky_solve_n<const N: usize>(l: &[f64], dinv: &[f64], x: &mut [f64], m: usize) {
+    let m = if N == 0 { m } else { N };
+    let (l, dinv, x) = (&l[..m * m], &dinv[..m], &mut x[..m]);
+    // L y = x
+    for k in 0..m {
+        let xk = x[k] * dinv[k];
+        x[k] = xk;
+        for (xi, &lik) in x[k + 1..].iter_mut().zip(&l[k * m + k + 1..(k + 1) * m]) {
+            *xi = madd(-lik, xk, *xi);
+        }
+    }
+    // Lᵀ x = y
+    for i in (0..m).rev() {
+        let col = &l[i * m + i + 1..(i + 1) * m];
+        let mut s = x[i];
+        for (&a, &b) in col.iter().zip(&x[i + 1..]) {
+            s = madd(-a, b, s);
+        }
+        x[i] = s * dinv[i];
+    }
 }
 
 /// The eigendecomposition of the symmetric `v` by cyclic Jacobi rotations: `v`

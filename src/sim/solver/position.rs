@@ -100,6 +100,7 @@ impl Rows {
         {
             return 0;
         }
+        debug_assert!(table.iter().all(|&k| k < nv), "a dof path beyond nv");
         let mut it = 0;
         while it < max_iter {
             it += 1;
