@@ -93,10 +93,11 @@ pub struct ConstraintData {
     pub(crate) span: Vec<(usize, usize)>,
     /// Scratch: one side's path of bodies.
     pub(crate) bodies: Vec<usize>,
-    /// The row blocks of K's block-diagonal part (`kkt_blocks`), found from
-    /// the spans in `blocks_span`; `blocked`: whether they are usable.
+    /// The row blocks of K's block-diagonal part (`kkt_blocks`).
     pub(crate) blocks: Vec<(usize, usize)>,
+    /// The spans `blocks` and `blocked` were found from.
     pub(crate) blocks_span: Vec<(usize, usize)>,
+    /// Whether the rows have that structure (K solved from its blocks).
     pub(crate) blocked: bool,
     /// Scratch (`MAX_SHARED` × m): the shared coordinates' rows of W.
     pub(crate) brows: Vec<f64>,
@@ -437,6 +438,10 @@ pub(crate) fn constraint_dynamics_with<'c>(
     let (n, m) = (model.nv, cd.rows);
     let lam = &model.dof_parent;
     let direct = data.deriv_direct;
+    // rows in disjoint blocks besides a few shared coordinates (a free base's
+    // six): those coordinates' rows are kept aside (B, D_B) and K's
+    // block-diagonal part alone is formed (`kkt_blocks`)
+    let blocked = !need_factor && kkt_blocks::blocked(cd, n);
     let w = &mut cd.y.as_mut_slice()[..n * m];
     w.copy_from_slice(&cd.jc.as_slice()[..n * m]);
     // K = Wᵀ D⁻¹ W = Σₖ D⁻¹ₖ W[k, :]ᵀ W[k, :]: by rank-1 updates of contiguous
@@ -448,16 +453,6 @@ pub(crate) fn constraint_dynamics_with<'c>(
     jq0.fill(0.0);
     let Data { h, chol, qdd, .. } = &mut *data;
     let dv = &mut cd.dinv[..n];
-    // rows in disjoint blocks besides a few shared coordinates (a free base's
-    // six): those coordinates' rows are kept aside (B, D_B) and K's
-    // block-diagonal part alone is formed (`kkt_blocks`)
-    // (the structure is the constraints' and the model's: found again only
-    // when the spans change)
-    if cd.blocks_span[..n] != cd.span[..n] {
-        cd.blocks_span[..n].copy_from_slice(&cd.span[..n]);
-        cd.blocked = kkt_blocks::structure(&cd.span[..n], m, &mut cd.blocks).is_some();
-    }
-    let blocked = !need_factor && cd.blocked;
     let (brows, bd) = (&mut cd.brows, &mut cd.bd);
     let mut g = 0;
     ltdl::ltdl_rows(
@@ -503,41 +498,7 @@ pub(crate) fn constraint_dynamics_with<'c>(
     .map_err(DynamicsError::Singular)?;
     // λ = K⁻¹ (−γ_c − J_c q̈₀) from K's blocks, where they are well inside
     // full rank (then K is: consistent rows)
-    let mut solved = false;
-    if blocked {
-        let r2 = cd.r2.as_mut_slice();
-        for ((x, &a), &c) in r2.iter_mut().zip(cd.r.as_slice()).zip(cd.gamma.as_slice()) {
-            *x = a - c;
-        }
-        solved = kkt_blocks::solve(
-            m,
-            &cd.k.as_slice()[..m * m],
-            &cd.blocks,
-            &cd.brows[..g * m],
-            &cd.bd[..g],
-            r2,
-            cd.lambda.as_mut_slice(),
-            &mut cd.lf,
-            &mut cd.ld,
-            &mut cd.z,
-        );
-        if !solved {
-            // K = A + Σ D⁻¹ₖ W[k, :]ᵀ W[k, :] over the rows kept aside
-            let k = &mut cd.k.as_mut_slice()[..m * m];
-            for (row, &d) in cd.brows[..g * m].chunks_exact(m).zip(&cd.bd[..g]) {
-                let dinv = 1.0 / d;
-                for (r, &xr) in row.iter().enumerate() {
-                    if xr == 0.0 {
-                        continue;
-                    }
-                    let a = xr * dinv;
-                    for (y, &x) in k[r * m..(r + 1) * m].iter_mut().zip(row) {
-                        *y = madd(a, x, *y);
-                    }
-                }
-            }
-        }
-    }
+    let solved = blocked && kkt_blocks::solve_or_form(cd, g);
     if !solved {
         let k = &mut cd.k.as_mut_slice()[..m * m];
         for r in 0..m {

@@ -14,6 +14,7 @@
 //! block is well inside full rank (then so is K); otherwise the caller forms
 //! K and takes the least-norm route (`kkt.rs`).
 
+use super::ConstraintData;
 use crate::spatial::ops::madd;
 
 /// At most this many shared coordinates (a free base and two more), and rows
@@ -68,30 +69,74 @@ pub(crate) fn structure(
     (end == m).then_some(shared)
 }
 
-/// `lambda = K⁻¹ r` with K = A + Bᵀ D_B⁻¹ B: `a` (m × m, column-major) holds A's
+/// Whether `cd`'s rows (their spans over the first `n` coordinates, `cd.span`)
+/// have the block structure of [`structure`], into `cd.blocks`; the structure
+/// is the constraints' and the model's, found again only when the spans change.
+pub(crate) fn blocked(cd: &mut ConstraintData, n: usize) -> bool {
+    if cd.blocks_span[..n] != cd.span[..n] {
+        cd.blocks_span[..n].copy_from_slice(&cd.span[..n]);
+        cd.blocked = structure(&cd.span[..n], cd.rows, &mut cd.blocks).is_some();
+    }
+    cd.blocked
+}
+
+/// With `cd.k` holding A's blocks, the g shared rows and pivots in `cd.brows`,
+/// `cd.bd`, `cd.r` = −J_c q̈₀ and `cd.gamma`: `cd.lambda` = K⁻¹ (−γ_c − J_c q̈₀)
+/// by [`solve`] (true), else (false) `cd.k`'s upper triangle completed to K
+/// (its g rank-1 updates, as the elimination would have added them) for the
+/// dense route.
+pub(crate) fn solve_or_form(cd: &mut ConstraintData, g: usize) -> bool {
+    let m = cd.rows;
+    let r2 = cd.r2.as_mut_slice();
+    for ((x, &a), &c) in r2.iter_mut().zip(cd.r.as_slice()).zip(cd.gamma.as_slice()) {
+        *x = a - c;
+    }
+    let args = (
+        m,
+        &cd.k.as_slice()[..m * m],
+        &cd.blocks[..],
+        &cd.brows[..g * m],
+        &cd.bd[..g],
+        &*r2,
+    );
+    if solve(
+        args,
+        cd.lambda.as_mut_slice(),
+        &mut cd.lf,
+        &mut cd.ld,
+        &mut cd.z,
+    ) {
+        return true;
+    }
+    // K = A + Σ D⁻¹ₖ W[k, :]ᵀ W[k, :] over the rows kept aside
+    let k = &mut cd.k.as_mut_slice()[..m * m];
+    for (row, &d) in cd.brows[..g * m].chunks_exact(m).zip(&cd.bd[..g]) {
+        let dinv = 1.0 / d;
+        for (r, &xr) in row.iter().enumerate() {
+            if xr == 0.0 {
+                continue;
+            }
+            let a = xr * dinv;
+            for (y, &x) in k[r * m..(r + 1) * m].iter_mut().zip(row) {
+                *y = madd(a, x, *y);
+            }
+        }
+    }
+    false
+}
+
+/// `lambda = K⁻¹ r` with K = A + Bᵀ D_B⁻¹ B; `args`: m, `a` (m × m, column-major) holding A's
 /// blocks (`blocks`, the entries outside them are not read), `brows` the g
 /// shared rows of W (row j at `j m`), `bd` their pivots D_B. Scratch: `lf`
 /// (m × [`MAX_SHARED`]: row i of a block's unit factor L, A = L D Lᵀ), `ld`
 /// (m: D⁻¹), `z` (m × [`MAX_SHARED`]: row i of Z = L⁻¹ Bᵀ). False, with
 /// `lambda` unset, when a block's pivot is at most [`BLOCK_TOL`] of its
 /// diagonal entry (or not finite).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn solve(
-    m: usize,
-    a: &[f64],
-    blocks: &[(usize, usize)],
-    brows: &[f64],
-    bd: &[f64],
-    r: &[f64],
-    lambda: &mut [f64],
-    lf: &mut [f64],
-    ld: &mut [f64],
-    z: &mut [f64],
-) -> bool {
+fn solve(args: Args, lambda: &mut [f64], lf: &mut [f64], ld: &mut [f64], z: &mut [f64]) -> bool {
     // the block size known at compile time when all are 3 (feet) or 6 (soles)
+    let blocks = args.2;
     let b0 = blocks[0].1 - blocks[0].0;
     let uniform = blocks.iter().all(|&(lo, hi)| hi - lo == b0);
-    let args = (m, a, blocks, brows, bd, r);
     match (uniform, b0) {
         (true, 3) => solve_n::<3>(args, lambda, lf, ld, z),
         (true, 6) => solve_n::<6>(args, lambda, lf, ld, z),
