@@ -84,4 +84,8 @@ for c in cases:
         p = d["pin"]
         ra = [x / y for x, y in zip(a, p)]; rb = [x / y for x, y in zip(b, p)]
         line += f" | pin {statistics.median(p):.0f} A/pin {statistics.median(ra):.3f} B/pin {statistics.median(rb):.3f} [{min(rb):.3f}-{max(rb):.3f}]"
+        # the ratio of the fastest runs over all rounds: on this machine a run lands in a
+        # fast or a ~1.4x slower mode (the whole run, either side, any core, ASLR or not:
+        # 1/3 of ur5's runs at load 0.3), so per-round ratios spread with the modes drawn
+        line += f" | min/min A/pin {min(a) / min(p):.3f} B/pin {min(b) / min(p):.3f}"
     print(line, flush=True)

@@ -198,3 +198,48 @@ fn constrained_hot_path_does_not_allocate() {
         );
     }
 }
+
+/// K solved from its blocks (src/dynamics/kkt_blocks.rs: four feet, two hands
+/// beside the shared base and torso) against K's dense factor (the
+/// derivatives' route, through H⁻¹): the same q̈ and λ to rounding.
+#[test]
+fn blocked_and_dense_routes_agree() {
+    for name in ["solo12_feet", "talos_hands"] {
+        let path = root().join(format!("tests/fixtures/constraints/{name}.json"));
+        let fix: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let floating_base = fix["floating_base"].as_bool().unwrap();
+        let model = urdyn::load_file(
+            root().join(fix["robot"].as_str().unwrap()),
+            LoadOptions { floating_base },
+        )
+        .unwrap();
+        let base = Constraints::from_value(&model, &fix["constraints"]).unwrap();
+        let mut data = Data::new(&model);
+        let mut cd = ConstraintData::new(&model, &base);
+        let mut worst = [0.0f64; 2];
+        for st in fix["states"].as_array().unwrap() {
+            let q = DVector::from_vec(vecf(&st["q"]));
+            let v = DVector::from_vec(vecf(&st["v"]));
+            let tau = DVector::from_vec(vecf(&st["tau"]));
+            let mut c = base.clone();
+            dynamics::forward_kinematics(&model, &mut data, &q).unwrap();
+            c.place_holds(&data);
+            let qdd =
+                dynamics::constraint_dynamics(&model, &mut data, &mut cd, &c, &q, &v, &tau, None)
+                    .unwrap()
+                    .clone();
+            let lambda = cd.lambda.clone();
+            dynamics::constraint_dynamics_derivatives(
+                &model, &mut data, &mut cd, &c, &q, &v, &tau, None,
+            )
+            .unwrap();
+            worst[0] = worst[0].max(rel(qdd.as_slice(), cd.qdd.as_slice()));
+            worst[1] = worst[1].max(rel(lambda.as_slice(), cd.lambda.as_slice()));
+        }
+        eprintln!(
+            "{name}: blocked vs dense, qdd {:e}, lambda {:e}",
+            worst[0], worst[1]
+        );
+        assert!(worst[0] < 1e-12 && worst[1] < 1e-12, "{name}: {worst:?}");
+    }
+}

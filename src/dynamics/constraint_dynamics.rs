@@ -13,6 +13,7 @@
 //! q̈ = q̈₀ + Y λ.
 
 use super::kkt::{mul_add, KktFactor};
+use super::kkt_blocks::{self, MAX_SHARED};
 use super::ltdl;
 use super::{check_massless, check_sizes, forward_dynamics_crba, linalg, DynamicsError};
 use crate::model::{
@@ -92,6 +93,22 @@ pub struct ConstraintData {
     pub(crate) span: Vec<(usize, usize)>,
     /// Scratch: one side's path of bodies.
     pub(crate) bodies: Vec<usize>,
+    /// The row blocks of K's block-diagonal part (`kkt_blocks`).
+    pub(crate) blocks: Vec<(usize, usize)>,
+    /// The spans `blocks` and `blocked` were found from.
+    pub(crate) blocks_span: Vec<(usize, usize)>,
+    /// Whether the rows have that structure (K solved from its blocks).
+    pub(crate) blocked: bool,
+    /// Scratch (`MAX_SHARED` × m): the shared coordinates' rows of W.
+    pub(crate) brows: Vec<f64>,
+    /// Scratch (`MAX_SHARED`): their pivots.
+    pub(crate) bd: Vec<f64>,
+    /// Scratch (m × `MAX_SHARED`): the blocks' factors.
+    pub(crate) lf: Vec<f64>,
+    /// Scratch (m): their diagonals' reciprocals.
+    pub(crate) ld: Vec<f64>,
+    /// Scratch (m × `MAX_SHARED`).
+    pub(crate) z: Vec<f64>,
 }
 
 impl ConstraintData {
@@ -121,6 +138,14 @@ impl ConstraintData {
             dinv: vec![0.0; nv],
             span: vec![(0, 0); nv],
             bodies: Vec::with_capacity(model.nbodies),
+            blocks: Vec::with_capacity(m),
+            blocks_span: vec![(usize::MAX, usize::MAX); nv],
+            blocked: false,
+            brows: vec![0.0; MAX_SHARED * m],
+            bd: vec![0.0; MAX_SHARED],
+            lf: vec![0.0; m * MAX_SHARED],
+            ld: vec![0.0; m],
+            z: vec![0.0; m * MAX_SHARED],
         }
     }
 }
@@ -335,6 +360,24 @@ pub fn constraint_dynamics<'c>(
     tau: &DVector<f64>,
     fext: Option<&[Force<f64>]>,
 ) -> Result<&'c DVector<f64>, ConstraintDynamicsError> {
+    constraint_dynamics_with(model, data, cd, constraints, q, v, tau, fext, false)
+}
+
+/// [`constraint_dynamics`]; `need_factor`: leave K's factor in `cd.kkt` (the
+/// derivatives read it), else K may be solved from its blocks
+/// (`kkt_blocks`) without a factor of its own.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn constraint_dynamics_with<'c>(
+    model: &Model,
+    data: &mut Data,
+    cd: &'c mut ConstraintData,
+    constraints: &Constraints,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+    tau: &DVector<f64>,
+    fext: Option<&[Force<f64>]>,
+    need_factor: bool,
+) -> Result<&'c DVector<f64>, ConstraintDynamicsError> {
     check_sizes(model, q, &[("v", v), ("tau", tau)], fext)?;
     check_massless(model)?;
     check_workspace(model, cd, constraints)?;
@@ -395,6 +438,10 @@ pub fn constraint_dynamics<'c>(
     let (n, m) = (model.nv, cd.rows);
     let lam = &model.dof_parent;
     let direct = data.deriv_direct;
+    // rows in disjoint blocks besides a few shared coordinates (a free base's
+    // six): those coordinates' rows are kept aside (B, D_B) and K's
+    // block-diagonal part alone is formed (`kkt_blocks`)
+    let blocked = !need_factor && kkt_blocks::blocked(cd, n);
     let w = &mut cd.y.as_mut_slice()[..n * m];
     w.copy_from_slice(&cd.jc.as_slice()[..n * m]);
     // K = Wᵀ D⁻¹ W = Σₖ D⁻¹ₖ W[k, :]ᵀ W[k, :]: by rank-1 updates of contiguous
@@ -406,6 +453,8 @@ pub fn constraint_dynamics<'c>(
     jq0.fill(0.0);
     let Data { h, chol, qdd, .. } = &mut *data;
     let dv = &mut cd.dinv[..n];
+    let (brows, bd) = (&mut cd.brows, &mut cd.bd);
+    let mut g = 0;
     ltdl::ltdl_rows(
         h,
         lam,
@@ -419,6 +468,18 @@ pub fn constraint_dynamics<'c>(
             let dinv = 1.0 / d;
             dv[c] = dinv;
             let s0 = bc * dinv;
+            if blocked && lo == 0 && xk.len() == m {
+                // a shared coordinate: its row and pivot kept aside
+                brows[g * m..(g + 1) * m].copy_from_slice(xk);
+                bd[g] = d;
+                g += 1;
+                for (r, &xr) in xk.iter().enumerate() {
+                    if xr != 0.0 {
+                        jq0[r] = madd(-xr, s0, jq0[r]);
+                    }
+                }
+                return;
+            }
             // xk: row c of W on its nonzero span lo..lo + len (zero elsewhere)
             for (r, &xr) in (lo..).zip(xk) {
                 if xr == 0.0 {
@@ -435,14 +496,20 @@ pub fn constraint_dynamics<'c>(
         },
     )
     .map_err(DynamicsError::Singular)?;
-    for r in 0..m {
-        for s2 in 0..r {
-            k[r + s2 * m] = k[s2 + r * m];
+    // λ = K⁻¹ (−γ_c − J_c q̈₀) from K's blocks, where they are well inside
+    // full rank (then K is: consistent rows)
+    let solved = blocked && kkt_blocks::solve_or_form(cd, g);
+    if !solved {
+        let k = &mut cd.k.as_mut_slice()[..m * m];
+        for r in 0..m {
+            for s2 in 0..r {
+                k[r + s2 * m] = k[s2 + r * m];
+            }
         }
+        solve_lambda_r(cd, constraints)?;
     }
     let (runs, run0) = (&data.deriv_anc_runs, &data.deriv_anc_run0);
     let u = data.chol.as_slice();
-    solve_lambda_r(cd, constraints)?;
     // t = D⁻¹ (w₀ + W λ), then q̈ = L⁻¹ t (root outwards)
     let w = &cd.y.as_slice()[..n * m];
     let lambda = cd.lambda.as_slice();

@@ -71,8 +71,18 @@ pub fn constraint_dynamics_derivatives(
     if model.has_mimic {
         // the reduced H through its factor (dense, or tree-sparse where the
         // followers keep the tree pattern)
-        let r =
-            super::constraint_dynamics(model, data, cd, constraints, q, v, tau, fbody).map(|_| ());
+        let r = super::constraint_dynamics::constraint_dynamics_with(
+            model,
+            data,
+            cd,
+            constraints,
+            q,
+            v,
+            tau,
+            fbody,
+            true,
+        )
+        .map(|_| ());
         data.deriv_fext = fb;
         r?;
         // H⁻¹ = solve(H, 1), all columns at once (symmetric: rows are columns)

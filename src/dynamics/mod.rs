@@ -21,6 +21,7 @@ mod jacobian_dot;
 mod joint_jacobians;
 mod kinematics;
 mod kkt;
+mod kkt_blocks;
 pub mod linalg;
 pub mod ltdl;
 mod minv;
