@@ -25,6 +25,25 @@ use nalgebra::{DMatrix, DVector};
 
 const NONE: usize = usize::MAX;
 
+/// `x[j]` for a dof `j` read from [`MassFactor::table`], without a bounds
+/// test: every entry of the table is a dof below `n` ([`MassFactor::new`]
+/// builds it so: each entry but `0..n`'s indexes `dof_parent`, of length
+/// `n`, when pushed), and the solves cut `x` to `n` first.
+#[inline(always)]
+fn at(x: &[f64], j: usize) -> f64 {
+    debug_assert!(j < x.len());
+    // SAFETY: j < n ≤ x.len() (the table's invariant above)
+    unsafe { *x.get_unchecked(j) }
+}
+
+/// [`at`], mutable.
+#[inline(always)]
+fn at_mut(x: &mut [f64], j: usize) -> &mut f64 {
+    debug_assert!(j < x.len());
+    // SAFETY: as [`at`]'s
+    unsafe { x.get_unchecked_mut(j) }
+}
+
 /// H̃ factored, with the dof paths rows live on.
 #[derive(Clone, Debug)]
 pub struct MassFactor {
@@ -62,7 +81,7 @@ pub struct MassFactor {
     /// Tree: D (the pivots), contiguous (the solve divides in vector lanes).
     dval: Vec<f64>,
     /// Tree: scratch of the elimination, a dof's multipliers L[k, ·] (and
-    /// its parent's beside them: 2 nv).
+    /// its parent's and grandparent's beside them: 3 nv).
     mult: Vec<f64>,
 }
 
@@ -121,7 +140,7 @@ impl MassFactor {
             len,
             x: DVector::zeros(n),
             dval: vec![1.0; if tree { n } else { 0 }],
-            mult: vec![0.0; if tree { 2 * n } else { 0 }],
+            mult: vec![0.0; if tree { 3 * n } else { 0 }],
         }
     }
 
@@ -311,17 +330,22 @@ impl MassFactor {
                         let xp = madd(-self.anc[s + l - 2], xi, x[i - 1]);
                         x[i - 1] = xp;
                         let sp = self.start[i - 1];
-                        for t in (0..l - 2).rev() {
-                            let j = self.table[s + t];
-                            let y = madd(-self.anc[s + t], xi, x[j]);
-                            x[j] = madd(-self.anc[sp + t], xp, y);
+                        let (a, ap) = (&self.anc[s..s + l - 2], &self.anc[sp..sp + l - 2]);
+                        for ((&a, &ap), &j) in a.iter().zip(ap).zip(&self.table[s..s + l - 2]).rev()
+                        {
+                            let xj = at_mut(x, j);
+                            *xj = madd(-ap, xp, madd(-a, xi, *xj));
                         }
                         i -= 1;
                         continue;
                     }
-                    for t in (0..l - 1).rev() {
-                        let j = self.table[s + t];
-                        x[j] = madd(-self.anc[s + t], xi, x[j]);
+                    for (&a, &j) in self.anc[s..s + l - 1]
+                        .iter()
+                        .zip(&self.table[s..s + l - 1])
+                        .rev()
+                    {
+                        let xj = at_mut(x, j);
+                        *xj = madd(-a, xi, *xj);
                     }
                 }
                 if let (Some(x), Some(d)) = (x.get_mut(k0..k1), self.dval.get(k0..k1)) {
@@ -332,8 +356,12 @@ impl MassFactor {
                 for i in k0..k1 {
                     let mut acc = x[i];
                     let (s, l) = (self.start[i], self.len[i]);
-                    for t in (0..l - 1).rev() {
-                        acc = madd(-self.anc[s + t], x[self.table[s + t]], acc);
+                    for (&a, &j) in self.anc[s..s + l - 1]
+                        .iter()
+                        .zip(&self.table[s..s + l - 1])
+                        .rev()
+                    {
+                        acc = madd(-a, at(x, j), acc);
                     }
                     x[i] = acc;
                 }
@@ -358,12 +386,17 @@ impl MassFactor {
         if z.len() < n {
             return;
         }
+        let z = &mut z[..n];
         for &(k0, k1) in self.ranges() {
             for i in k0..k1 {
                 let mut acc = z[i] * self.inv_sqrt_d[i];
                 let (s, l) = (self.start[i], self.len[i]);
-                for t in (0..l - 1).rev() {
-                    acc -= self.anc[s + t] * z[self.table[s + t]];
+                for (&a, &j) in self.anc[s..s + l - 1]
+                    .iter()
+                    .zip(&self.table[s..s + l - 1])
+                    .rev()
+                {
+                    acc -= a * at(z, j);
                 }
                 z[i] = acc;
             }
@@ -388,12 +421,17 @@ impl MassFactor {
         if v.len() < n || out.len() < n {
             return;
         }
+        let v = &v[..n];
         for &(k0, k1) in self.ranges() {
             for i in k0..k1 {
                 let mut acc = v[i];
                 let (s, l) = (self.start[i], self.len[i]);
-                for t in (0..l - 1).rev() {
-                    acc += self.anc[s + t] * v[self.table[s + t]];
+                for (&a, &j) in self.anc[s..s + l - 1]
+                    .iter()
+                    .zip(&self.table[s..s + l - 1])
+                    .rev()
+                {
+                    acc += a * at(v, j);
                 }
                 out[i] = self.sqrt_d[i] * acc;
             }

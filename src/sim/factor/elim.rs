@@ -1,6 +1,6 @@
 //! The tree-sparse LTDL elimination of [`MassFactor`] on one range of dofs
-//! (docs/theory.md §"Tree-sparse LTDL"), a dof and its parent at once where
-//! they form a chain.
+//! (docs/theory.md §"Tree-sparse LTDL"), a dof with its parent (and its
+//! grandparent) at once where they form a chain.
 
 use super::MassFactor;
 use crate::spatial::ops::madd;
@@ -14,7 +14,8 @@ impl MassFactor {
     /// rows applies k's update and k − 1's to each entry in turn — each
     /// entry gets the same two fused multiply-adds in the same order as one
     /// dof after the other (the same bits), with half the loads, stores and
-    /// loop set-ups.
+    /// loop set-ups. Where k − 2 is k − 1's parent as well (a robot's leg
+    /// of three, a floating base's six), the three go together the same way.
     pub(super) fn factor_range(&mut self, k0: usize, k1: usize, tiny: f64) -> Result<(), usize> {
         for k in k0..k1 {
             self.hdiag[k] = self.anc[self.start[k] + self.len[k] - 1];
@@ -69,13 +70,64 @@ impl MassFactor {
                     let (head, rest) = head.split_at_mut(sp);
                     let row_p = &mut rest[..m - 1];
                     // k − 1's multipliers L[k − 1, i] = H̃'[k − 1, i] / D[k − 1]
-                    // (`mult` holds 2 nv: k's and k − 1's side by side)
+                    // (`mult` holds 3 nv: k's, k − 1's and k − 2's side by side)
                     let (ml, mh) = mult_all.split_at_mut(m);
-                    let (mult, mult_p) = (&ml[..m], &mut mh[..m - 1]);
+                    let (mult, (mult_p, mult_g)) = (&ml[..m], mh.split_at_mut(m - 1));
                     for (a, &x) in mult_p.iter_mut().zip(row_p.iter()) {
                         *a = x / dp;
                     }
-                    for t in (0..m - 1).rev() {
+                    // k − 2 is k − 1's parent (and in the range): a triple. Its
+                    // row (t = m − 2) takes k's and k − 1's updates first, then
+                    // its multipliers, then one sweep over the three's common
+                    // ancestors' rows applies k's, k − 1's and k − 2's updates
+                    // to each entry in turn (the same fused multiply-adds in
+                    // the same order as the pairs and singles: the same bits)
+                    let mut t_pair = m - 1;
+                    if m >= 2 && k - 1 > k0 && table[sk + m - 2] == k - 2 {
+                        let sg = start[k - 2];
+                        let (head, rest) = head.split_at_mut(sg);
+                        let (Some(row_g), Some(row_k), Some(row_q)) =
+                            (rest.get_mut(..m - 1), row.get(..m - 1), row_p.get(..m - 1))
+                        else {
+                            return Err(k);
+                        };
+                        let (a, b) = (mult[m - 2], mult_p[m - 2]);
+                        for ((x, &hkj), &hqj) in row_g.iter_mut().zip(row_k).zip(row_q) {
+                            *x = madd(-b, hqj, madd(-a, hkj, *x));
+                        }
+                        t_pair = m - 2;
+                        let dg = row_g[m - 2];
+                        if pivot_ok(k - 2, dg) {
+                            let (row_g, mult_g) = (&mut row_g[..m - 2], &mut mult_g[..m - 2]);
+                            for (c, &x) in mult_g.iter_mut().zip(row_g.iter()) {
+                                *c = x / dg;
+                            }
+                            for t in (0..m - 2).rev() {
+                                let si = start[table[sk + t]];
+                                let (a, b, c) = (mult[t], mult_p[t], mult_g[t]);
+                                let (Some(row_i), Some(row_k), Some(row_q), Some(row_r)) = (
+                                    head.get_mut(si..si + t + 1),
+                                    row.get(..t + 1),
+                                    row_p.get(..t + 1),
+                                    row_g.get(..t + 1),
+                                ) else {
+                                    return Err(k);
+                                };
+                                for (((x, &hkj), &hqj), &hrj) in
+                                    row_i.iter_mut().zip(row_k).zip(row_q).zip(row_r)
+                                {
+                                    *x = madd(-c, hrj, madd(-b, hqj, madd(-a, hkj, *x)));
+                                }
+                            }
+                            row.copy_from_slice(mult);
+                            row_p.copy_from_slice(mult_p);
+                            row_g.copy_from_slice(mult_g);
+                            k -= 2;
+                            continue;
+                        }
+                        // (k − 2's pivot fails: found at its turn, as without triples)
+                    }
+                    for t in (0..t_pair).rev() {
                         let si = start[table[sk + t]];
                         let (a, b) = (mult[t], mult_p[t]);
                         let (Some(row_i), Some(row_k), Some(row_q)) = (
