@@ -8,7 +8,12 @@
 //! boxes' lower x (an insertion sort: nearly sorted from step to step, O(n));
 //! a sweep along x meets each shape only the shapes whose x-interval overlaps
 //! its own, and keeps the pairs that also overlap in y and z and that the
-//! pair filter allows (a table of pair indices).
+//! pair filter allows (a table of pair indices). Where the boxes spread
+//! wider along y or z (an arm hanging, a humanoid standing: its links all
+//! overlap in x), the sweep runs along that axis instead (its own sorted
+//! order, kept the same way): the same pairs, fewer shapes met; the pairs
+//! not made yet are still reported in the x-sweep's order (their indices,
+//! hence their slots, are the same whichever axis is swept).
 //!
 //! Many shapes: one sweep along x meets, for each shape, every shape of its
 //! x-slab, O(n^1.5) for shapes spread over a square floor (a pile in a bin).
@@ -89,15 +94,47 @@ impl PairTable {
 /// Asks the cache for the line holding `x` (no effect on any result).
 #[inline(always)]
 pub(crate) fn prefetch<T>(x: &T) {
+    prefetch_ptr((x as *const T).cast::<u8>());
+}
+
+/// Asks the cache for the line holding the byte at `p` (no effect on any
+/// result; never read, so any address will do).
+#[inline(always)]
+fn prefetch_ptr(p: *const u8) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
         // SAFETY: a prefetch is a hint (it reads nothing into the program
         // and cannot fault); SSE is part of x86_64.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast::<i8>()) };
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.cast::<i8>()) };
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
+    let _ = p;
+}
+
+/// Asks the cache for every line of `x` (no effect on any result).
+#[inline(always)]
+pub(crate) fn prefetch_all<T>(x: &T) {
+    let p = (x as *const T).cast::<u8>();
+    // (from the start of the first line to the end of the last)
+    let end = std::mem::size_of::<T>() + (p as usize) % 64;
+    let mut k = 0;
+    while k < end {
+        prefetch_ptr(p.wrapping_add(k).wrapping_sub((p as usize) % 64));
+        k += 64;
+    }
+}
+
+/// Asks the cache for every line of `xs`' elements (no effect on any result).
+#[inline(always)]
+pub(crate) fn prefetch_slice<T>(xs: &[T]) {
+    let p = xs.as_ptr().cast::<u8>();
+    let end = std::mem::size_of_val(xs) + (p as usize) % 64;
+    let mut k = 0;
+    while k < end {
+        prefetch_ptr(p.wrapping_add(k).wrapping_sub((p as usize) % 64));
+        k += 64;
+    }
 }
 
 /// The sweep's state.
@@ -124,6 +161,14 @@ pub struct SweepAndPrune {
     /// Scratch of the one sweep: the lower x of `order`'s shapes, in its
     /// order (sorted with it, read by the sweep without a gather).
     xs: Vec<f64>,
+    /// Few shapes: the axis swept (that of the boxes' widest spread, see
+    /// [`SweepAndPrune::sweep_axis`]), the shapes by their boxes' lower
+    /// corner along it, and those lower corners in that order.
+    axis: usize,
+    along: Vec<u32>,
+    ks: Vec<f64>,
+    /// Scratch: each shape's place in `order` (the sweep along x).
+    rank: Vec<u32>,
 }
 
 /// Shapes from which the floor is cut into strips.
@@ -146,6 +191,10 @@ impl SweepAndPrune {
             merged: Vec::with_capacity(n),
             cand: Vec::new(),
             xs: Vec::with_capacity(n),
+            axis: 0,
+            along: (0..n as u32).collect(),
+            ks: Vec::with_capacity(n),
+            rank: vec![0; n],
         }
     }
 
@@ -168,11 +217,14 @@ impl SweepAndPrune {
         let n = self.lo.len();
         let mut cand = std::mem::take(&mut self.cand);
         cand.clear();
+        let mut other_axis = false;
         if n < STRIPS_FROM {
             self.sweep_x(&mut cand);
+            other_axis = self.axis != 0;
         } else {
             self.sweep_strips(&mut cand);
         }
+        let fresh_from = fresh.len();
         // the table read in the sweep's order, eight pairs ahead fetched
         const AHEAD: usize = 8;
         for k in 0..cand.len() {
@@ -187,6 +239,54 @@ impl SweepAndPrune {
             }
         }
         self.cand = cand;
+        if other_axis && fresh.len() > fresh_from {
+            // the new pairs in the order of the sweep along x, as it met them
+            // (their pair indices, hence slots, follow it)
+            for (k, &i) in self.order.iter().enumerate() {
+                if let Some(r) = self.rank.get_mut(i as usize) {
+                    *r = k as u32;
+                }
+            }
+            let rank = &self.rank;
+            for f in fresh[fresh_from..].iter_mut() {
+                if rank[f.0 as usize] > rank[f.1 as usize] {
+                    *f = (f.1, f.0);
+                }
+            }
+            fresh[fresh_from..].sort_unstable_by_key(|f| (rank[f.0 as usize], rank[f.1 as usize]));
+        }
+    }
+
+    /// The axis of the boxes' widest spread (the variance of their centres,
+    /// finite boxes only), kept unless another's is twice as wide: sweeping
+    /// along it, a shape meets fewer shapes whose interval overlaps its own
+    /// (an arm or a humanoid standing: along z, not x).
+    fn sweep_axis(&self) -> usize {
+        let mut sum = [0.0f64; 3];
+        let mut sq = [0.0f64; 3];
+        let mut m = 0.0f64;
+        for (lo, hi) in self.lo.iter().zip(&self.hi) {
+            let c = [lo[0] + hi[0], lo[1] + hi[1], lo[2] + hi[2]];
+            if !(c[0].is_finite() && c[1].is_finite() && c[2].is_finite()) {
+                continue;
+            }
+            m += 1.0;
+            for a in 0..3 {
+                sum[a] += c[a];
+                sq[a] += c[a] * c[a];
+            }
+        }
+        if m < 2.0 {
+            return self.axis;
+        }
+        // m·Σc² − (Σc)²: m² times the variance (of 2c: the order is all that counts)
+        let var = |a: usize| m * sq[a] - sum[a] * sum[a];
+        let best = (0..3).fold(self.axis, |b, a| if var(a) > var(b) { a } else { b });
+        if var(best) > 2.0 * var(self.axis) {
+            best
+        } else {
+            self.axis
+        }
     }
 
     /// Shapes i and j (both boxes known to overlap in x) kept if their
@@ -220,17 +320,58 @@ impl SweepAndPrune {
                 }
             }
         }
-        for k in 0..n {
-            let i = self.order[k] as usize;
-            let hx = self.hi[i][0];
-            for (&x, &j) in buf[k + 1..n].iter().zip(&self.order[k + 1..]) {
-                if x > hx {
-                    break;
+        self.xs = buf;
+        self.axis = self.sweep_axis();
+        if self.axis == 0 {
+            for k in 0..n {
+                let i = self.order[k] as usize;
+                let hx = self.hi[i][0];
+                for (&x, &j) in self.xs[k + 1..n].iter().zip(&self.order[k + 1..]) {
+                    if x > hx {
+                        break;
+                    }
+                    self.report(i, j as usize, cand);
                 }
-                self.report(i, j as usize, cand);
+            }
+            return;
+        }
+        // along another axis: the same pairs (boxes overlapping on every
+        // axis, closed intervals), met in another order
+        let ax = self.axis;
+        let mut ks = std::mem::take(&mut self.ks);
+        ks.clear();
+        ks.extend(self.along.iter().map(|&i| self.lo[i as usize][ax]));
+        {
+            let along = &mut self.along[..n];
+            let ks = &mut ks[..n];
+            for k in 1..n {
+                let mut m = k;
+                while m > 0 && ks[m - 1] > ks[m] {
+                    ks.swap(m - 1, m);
+                    along.swap(m - 1, m);
+                    m -= 1;
+                }
             }
         }
-        self.xs = buf;
+        for k in 0..n {
+            let i = self.along[k] as usize;
+            let hk = self.hi[i][ax];
+            for (&x, &j) in ks[k + 1..n].iter().zip(&self.along[k + 1..]) {
+                if x > hk {
+                    break;
+                }
+                let j = j as usize;
+                let (li, hi, lj, hj) = (self.lo[i], self.hi[i], self.lo[j], self.hi[j]);
+                if lj[0] > hi[0] || li[0] > hj[0] {
+                    continue;
+                }
+                if lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2] {
+                    continue;
+                }
+                cand.push((i as u32, j as u32));
+            }
+        }
+        self.ks = ks;
     }
 
     /// Strips along y, each swept along x with the next (module docs).
