@@ -94,47 +94,15 @@ impl PairTable {
 /// Asks the cache for the line holding `x` (no effect on any result).
 #[inline(always)]
 pub(crate) fn prefetch<T>(x: &T) {
-    prefetch_ptr((x as *const T).cast::<u8>());
-}
-
-/// Asks the cache for the line holding the byte at `p` (no effect on any
-/// result; never read, so any address will do).
-#[inline(always)]
-fn prefetch_ptr(p: *const u8) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
         // SAFETY: a prefetch is a hint (it reads nothing into the program
         // and cannot fault); SSE is part of x86_64.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.cast::<i8>()) };
+        unsafe { _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast::<i8>()) };
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = p;
-}
-
-/// Asks the cache for every line of `x` (no effect on any result).
-#[inline(always)]
-pub(crate) fn prefetch_all<T>(x: &T) {
-    let p = (x as *const T).cast::<u8>();
-    // (from the start of the first line to the end of the last)
-    let end = std::mem::size_of::<T>() + (p as usize) % 64;
-    let mut k = 0;
-    while k < end {
-        prefetch_ptr(p.wrapping_add(k).wrapping_sub((p as usize) % 64));
-        k += 64;
-    }
-}
-
-/// Asks the cache for every line of `xs`' elements (no effect on any result).
-#[inline(always)]
-pub(crate) fn prefetch_slice<T>(xs: &[T]) {
-    let p = xs.as_ptr().cast::<u8>();
-    let end = std::mem::size_of_val(xs) + (p as usize) % 64;
-    let mut k = 0;
-    while k < end {
-        prefetch_ptr(p.wrapping_add(k).wrapping_sub((p as usize) % 64));
-        k += 64;
-    }
+    let _ = x;
 }
 
 /// The sweep's state.

@@ -13,7 +13,7 @@
 //! pair's slots: the slot of the same features last step (its impulse warm
 //! starts the solve), else a free one marked fresh (no warm start).
 
-use super::broad::{prefetch, prefetch_all, prefetch_slice, PairTable, SweepAndPrune, LAZY_PAIR};
+use super::broad::{prefetch, PairTable, SweepAndPrune, LAZY_PAIR};
 use super::filter::{is_self_pair, may_touch};
 use super::narrow::prim::{round_points_at, Round};
 use super::narrow::{face_kind, face_points, parry_points, reduce_pair, FaceScratch, Raw};
@@ -431,28 +431,16 @@ impl PairContact {
         for vi in 0..self.visit.len() {
             let (ord, pi) = self.visit[vi];
             let pi = pi as usize;
-            // the pair eight visits on fetched now, whole (a pile's pairs lie
-            // far apart in memory: a cache miss each), its manifold four on
-            // and that manifold's points two on (a chain of heap blocks),
-            // while this one is worked
-            if let Some(&(_, ahead)) = self.visit.get(vi + 8) {
+            // the pair four visits on fetched now (a pile's pairs lie far
+            // apart in memory: a cache miss each), while this one is worked
+            if let Some(&(_, ahead)) = self.visit.get(vi + 4) {
                 let ahead = ahead as usize;
                 if let Some(p) = self.pairs.get(ahead) {
-                    prefetch_all(p);
+                    prefetch(p);
                 }
                 if let Some(k) = self.keys.get(ahead * maxp) {
                     prefetch(k);
                 }
-            }
-            if let Some(&(_, ahead)) = self.visit.get(vi + 4)
-                && let Some(m) = self.pairs.get(ahead as usize).and_then(|p| p.manifolds.first())
-            {
-                prefetch_all(m);
-            }
-            if let Some(&(_, ahead)) = self.visit.get(vi + 2)
-                && let Some(m) = self.pairs.get(ahead as usize).and_then(|p| p.manifolds.first())
-            {
-                prefetch_slice(&m.points);
             }
             let hit = next < self.overlapping.len() && self.overlapping[next].1 as usize == pi;
             if hit {
