@@ -8,12 +8,7 @@
 //! boxes' lower x (an insertion sort: nearly sorted from step to step, O(n));
 //! a sweep along x meets each shape only the shapes whose x-interval overlaps
 //! its own, and keeps the pairs that also overlap in y and z and that the
-//! pair filter allows (a table of pair indices). Where the boxes spread
-//! wider along y or z (an arm hanging, a humanoid standing: its links all
-//! overlap in x), the sweep runs along that axis instead (its own sorted
-//! order, kept the same way): the same pairs, fewer shapes met; the pairs
-//! not made yet are still reported in the x-sweep's order (their indices,
-//! hence their slots, are the same whichever axis is swept).
+//! pair filter allows (a table of pair indices).
 //!
 //! Many shapes: one sweep along x meets, for each shape, every shape of its
 //! x-slab, O(n^1.5) for shapes spread over a square floor (a pile in a bin).
@@ -129,14 +124,6 @@ pub struct SweepAndPrune {
     /// Scratch of the one sweep: the lower x of `order`'s shapes, in its
     /// order (sorted with it, read by the sweep without a gather).
     xs: Vec<f64>,
-    /// Few shapes: the axis swept (that of the boxes' widest spread, see
-    /// [`SweepAndPrune::sweep_axis`]), the shapes by their boxes' lower
-    /// corner along it, and those lower corners in that order.
-    axis: usize,
-    along: Vec<u32>,
-    ks: Vec<f64>,
-    /// Scratch: each shape's place in `order` (the sweep along x).
-    rank: Vec<u32>,
 }
 
 /// Shapes from which the floor is cut into strips.
@@ -159,10 +146,6 @@ impl SweepAndPrune {
             merged: Vec::with_capacity(n),
             cand: Vec::new(),
             xs: Vec::with_capacity(n),
-            axis: 0,
-            along: (0..n as u32).collect(),
-            ks: Vec::with_capacity(n),
-            rank: vec![0; n],
         }
     }
 
@@ -185,14 +168,11 @@ impl SweepAndPrune {
         let n = self.lo.len();
         let mut cand = std::mem::take(&mut self.cand);
         cand.clear();
-        let mut other_axis = false;
         if n < STRIPS_FROM {
             self.sweep_x(&mut cand);
-            other_axis = self.axis != 0;
         } else {
             self.sweep_strips(&mut cand);
         }
-        let fresh_from = fresh.len();
         // the table read in the sweep's order, eight pairs ahead fetched
         const AHEAD: usize = 8;
         for k in 0..cand.len() {
@@ -207,54 +187,6 @@ impl SweepAndPrune {
             }
         }
         self.cand = cand;
-        if other_axis && fresh.len() > fresh_from {
-            // the new pairs in the order of the sweep along x, as it met them
-            // (their pair indices, hence slots, follow it)
-            for (k, &i) in self.order.iter().enumerate() {
-                if let Some(r) = self.rank.get_mut(i as usize) {
-                    *r = k as u32;
-                }
-            }
-            let rank = &self.rank;
-            for f in fresh[fresh_from..].iter_mut() {
-                if rank[f.0 as usize] > rank[f.1 as usize] {
-                    *f = (f.1, f.0);
-                }
-            }
-            fresh[fresh_from..].sort_unstable_by_key(|f| (rank[f.0 as usize], rank[f.1 as usize]));
-        }
-    }
-
-    /// The axis of the boxes' widest spread (the variance of their centres,
-    /// finite boxes only), kept unless another's is twice as wide: sweeping
-    /// along it, a shape meets fewer shapes whose interval overlaps its own
-    /// (an arm or a humanoid standing: along z, not x).
-    fn sweep_axis(&self) -> usize {
-        let mut sum = [0.0f64; 3];
-        let mut sq = [0.0f64; 3];
-        let mut m = 0.0f64;
-        for (lo, hi) in self.lo.iter().zip(&self.hi) {
-            let c = [lo[0] + hi[0], lo[1] + hi[1], lo[2] + hi[2]];
-            if !(c[0].is_finite() && c[1].is_finite() && c[2].is_finite()) {
-                continue;
-            }
-            m += 1.0;
-            for a in 0..3 {
-                sum[a] += c[a];
-                sq[a] += c[a] * c[a];
-            }
-        }
-        if m < 2.0 {
-            return self.axis;
-        }
-        // m·Σc² − (Σc)²: m² times the variance (of 2c: the order is all that counts)
-        let var = |a: usize| m * sq[a] - sum[a] * sum[a];
-        let best = (0..3).fold(self.axis, |b, a| if var(a) > var(b) { a } else { b });
-        if var(best) > 2.0 * var(self.axis) {
-            best
-        } else {
-            self.axis
-        }
     }
 
     /// Shapes i and j (both boxes known to overlap in x) kept if their
@@ -288,58 +220,17 @@ impl SweepAndPrune {
                 }
             }
         }
-        self.xs = buf;
-        self.axis = self.sweep_axis();
-        if self.axis == 0 {
-            for k in 0..n {
-                let i = self.order[k] as usize;
-                let hx = self.hi[i][0];
-                for (&x, &j) in self.xs[k + 1..n].iter().zip(&self.order[k + 1..]) {
-                    if x > hx {
-                        break;
-                    }
-                    self.report(i, j as usize, cand);
-                }
-            }
-            return;
-        }
-        // along another axis: the same pairs (boxes overlapping on every
-        // axis, closed intervals), met in another order
-        let ax = self.axis;
-        let mut ks = std::mem::take(&mut self.ks);
-        ks.clear();
-        ks.extend(self.along.iter().map(|&i| self.lo[i as usize][ax]));
-        {
-            let along = &mut self.along[..n];
-            let ks = &mut ks[..n];
-            for k in 1..n {
-                let mut m = k;
-                while m > 0 && ks[m - 1] > ks[m] {
-                    ks.swap(m - 1, m);
-                    along.swap(m - 1, m);
-                    m -= 1;
-                }
-            }
-        }
         for k in 0..n {
-            let i = self.along[k] as usize;
-            let hk = self.hi[i][ax];
-            for (&x, &j) in ks[k + 1..n].iter().zip(&self.along[k + 1..]) {
-                if x > hk {
+            let i = self.order[k] as usize;
+            let hx = self.hi[i][0];
+            for (&x, &j) in buf[k + 1..n].iter().zip(&self.order[k + 1..]) {
+                if x > hx {
                     break;
                 }
-                let j = j as usize;
-                let (li, hi, lj, hj) = (self.lo[i], self.hi[i], self.lo[j], self.hi[j]);
-                if lj[0] > hi[0] || li[0] > hj[0] {
-                    continue;
-                }
-                if lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2] {
-                    continue;
-                }
-                cand.push((i as u32, j as u32));
+                self.report(i, j as usize, cand);
             }
         }
-        self.ks = ks;
+        self.xs = buf;
     }
 
     /// Strips along y, each swept along x with the next (module docs).
