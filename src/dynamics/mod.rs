@@ -11,6 +11,7 @@ mod centroidal;
 mod com;
 pub(crate) mod constraint_dynamics;
 mod constraint_dynamics_derivatives;
+mod constraint_rows;
 mod crba;
 mod energy;
 mod external;
