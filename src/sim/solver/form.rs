@@ -51,6 +51,11 @@ impl Rows {
                 let (b, c) = rest.split_at_mut(st);
                 let (y0, y1, y2) = (&mut a[..pl], &mut b[..pl], &mut c[..pl]);
                 f.row_transform3(path, y0, y1, y2);
+                if let Some(yl) = self.ylanes.get_mut(r * st..r * st + pl) {
+                    for (t, l) in yl.iter_mut().enumerate() {
+                        *l = [y0[t], y1[t], y2[t], 0.0];
+                    }
+                }
                 let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
                 self.w[r] = dot(y0, y0);
                 self.w[r + 1] = dot(y1, y1);
@@ -110,6 +115,9 @@ impl Rows {
             y0[t] = b[0];
             y1[t] = b[1];
             y2[t] = b[2];
+        }
+        if let Some(yl) = self.ylanes.get_mut(r * st..r * st + pl) {
+            yl.copy_from_slice(buf);
         }
         self.c[r..r + 3].copy_from_slice(&c[..3]);
         self.w[r..r + 3].copy_from_slice(&d[..3]);

@@ -104,6 +104,10 @@ pub struct Rows {
     /// Scratch of [`Rows::form`]: a contact's three rows interleaved (one
     /// entry per path slot, `stride` of them).
     lanes: Vec<[f64; 4]>,
+    /// At a contact's normal row r: its three rows of Y interleaved (entry t
+    /// of the path at `ylanes[r·stride + t]`, lanes normal, t₁, t₂, unused),
+    /// a copy of `y` that the sweeps read with one vector product a dof.
+    ylanes: Vec<[f64; 4]>,
     /// Each row's velocity at its update in the last sweep.
     u_prev: Vec<f64>,
     /// Scratch of the subspace step ([`subspace_step`]).
@@ -157,6 +161,7 @@ impl Rows {
             w_block: vec![[0.0; 3]; cap],
             is_block: vec![false; cap],
             lanes: vec![[0.0; 4]; stride],
+            ylanes: vec![[0.0; 4]; cap * stride],
             u_prev: vec![0.0; cap],
             sm: Subspace::new(nv, cap),
             polished: false,

@@ -107,6 +107,7 @@ impl Rows {
             || dofs.is_some_and(|d| d.iter().any(|&k| k >= nv))
             || out.lambda.len() < n
             || out.u_prev.len() < n
+            || self.ylanes.len() < n * st
         {
             return (0, false);
         }
@@ -114,6 +115,7 @@ impl Rows {
         let (y, paths) = (&self.y[..], &self.path[..n]);
         let (kinds, c, b) = (&self.kind[..n], &self.c[..n], &self.b[..n]);
         let contact = &self.is_block[..n];
+        let ylanes = &self.ylanes[..n * st];
         // no factor of an earlier solve's W_FF is reused (subspace.rs)
         out.sm.0.forget();
         // the loop rows as one exact block, every other row seen through them
@@ -215,15 +217,9 @@ impl Rows {
                         // normal, then the tangent pair from the velocity the
                         // normal's change left (through the block's entries)
                         let p = path(r);
-                        let (mut dn, mut d1, mut d2) = (0.0, 0.0, 0.0);
-                        for (t, &k) in p.iter().enumerate() {
-                            let x = unsafe { *dv.get_unchecked(k) };
-                            unsafe {
-                                dn += y.get_unchecked(r * st + t) * x;
-                                d1 += y.get_unchecked((r + 1) * st + t) * x;
-                                d2 += y.get_unchecked((r + 2) * st + t) * x;
-                            }
-                        }
+                        // the three dots side by side over the interleaved
+                        // copy of their y (each a sum from 0 in path order)
+                        let [dn, d1, d2, _] = dot3(&ylanes[r * st..r * st + p.len()], p, dv);
                         let [wn1, wn2, w12] = w_block[r];
                         let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
                         let on = lambda[r];
@@ -383,6 +379,42 @@ impl Rows {
         }
         out.sm.0.loops = lb;
         (it, polished)
+    }
+}
+
+/// Σₜ lₜ x[pₜ] in each of the four lanes of `l` (a contact's three rows of
+/// y interleaved, `Rows::ylanes`), each lane a sum from 0 in path order; the
+/// indices of `p` must be < `x.len()` (a row's path: dof indices < nv).
+#[inline(always)]
+fn dot3(l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
+    debug_assert!(p.iter().all(|&k| k < x.len()));
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    {
+        use std::arch::x86_64::*;
+        let mut s = [0.0f64; 4];
+        // SAFETY: avx is enabled at compile time; every k < x.len() (the
+        // sweeps' check of the paths); `l`'s entries are 4 f64 each
+        unsafe {
+            let mut acc = _mm256_setzero_pd();
+            for (li, &k) in l.iter().zip(p) {
+                let xk = _mm256_broadcast_sd(x.get_unchecked(k));
+                acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_loadu_pd(li.as_ptr()), xk));
+            }
+            _mm256_storeu_pd(s.as_mut_ptr(), acc);
+        }
+        s
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+    {
+        let mut s = [0.0f64; 4];
+        for (li, &k) in l.iter().zip(p) {
+            // SAFETY: every k < x.len() (the sweeps' check of the paths)
+            let xk = unsafe { *x.get_unchecked(k) };
+            for (si, &v) in s.iter_mut().zip(li) {
+                *si += v * xk;
+            }
+        }
+        s
     }
 }
 
