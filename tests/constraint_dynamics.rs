@@ -42,7 +42,9 @@ fn rel(a: &[f64], b: &[f64]) -> f64 {
         / s
 }
 
-fn check(name: &str) {
+/// A fixture of tests/fixtures/constraints: its JSON, the robot it names
+/// (with its base) and its constraints.
+fn fixture(name: &str) -> (Value, urdyn::Model, Constraints) {
     let path = root().join(format!("tests/fixtures/constraints/{name}.json"));
     let fix: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     let floating_base = fix["floating_base"].as_bool().unwrap();
@@ -52,16 +54,33 @@ fn check(name: &str) {
     )
     .unwrap();
     let base = Constraints::from_value(&model, &fix["constraints"]).unwrap();
+    (fix, model, base)
+}
+
+/// A fixture state's q, v, τ and the constraints with their holds placed at
+/// that q (forward kinematics into `data`).
+fn state(
+    model: &urdyn::Model,
+    data: &mut Data,
+    base: &Constraints,
+    st: &Value,
+) -> (DVector<f64>, DVector<f64>, DVector<f64>, Constraints) {
+    let q = DVector::from_vec(vecf(&st["q"]));
+    let v = DVector::from_vec(vecf(&st["v"]));
+    let tau = DVector::from_vec(vecf(&st["tau"]));
+    let mut c = base.clone();
+    dynamics::forward_kinematics(model, data, &q).unwrap();
+    c.place_holds(data);
+    (q, v, tau, c)
+}
+
+fn check(name: &str) {
+    let (fix, model, base) = fixture(name);
     let mut data = Data::new(&model);
     let mut cd = ConstraintData::new(&model, &base);
     let mut worst = [0.0f64; 4];
     for (i, st) in fix["states"].as_array().unwrap().iter().enumerate() {
-        let q = DVector::from_vec(vecf(&st["q"]));
-        let v = DVector::from_vec(vecf(&st["v"]));
-        let tau = DVector::from_vec(vecf(&st["tau"]));
-        let mut c = base.clone();
-        dynamics::forward_kinematics(&model, &mut data, &q).unwrap();
-        c.place_holds(&data);
+        let (q, v, tau, c) = state(&model, &mut data, &base, st);
         let qdd = dynamics::constraint_dynamics(&model, &mut data, &mut cd, &c, &q, &v, &tau, None)
             .unwrap()
             .clone();
@@ -152,23 +171,10 @@ fn constrained_hot_path_does_not_allocate() {
     use crate::common::counting_alloc::{allocations, measure_this_thread};
     measure_this_thread();
     for name in ["solo12_feet", "four_bar_planar"] {
-        let path = root().join(format!("tests/fixtures/constraints/{name}.json"));
-        let fix: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-        let floating_base = fix["floating_base"].as_bool().unwrap();
-        let model = urdyn::load_file(
-            root().join(fix["robot"].as_str().unwrap()),
-            LoadOptions { floating_base },
-        )
-        .unwrap();
-        let mut c = Constraints::from_value(&model, &fix["constraints"]).unwrap();
+        let (fix, model, base) = fixture(name);
         let mut data = Data::new(&model);
-        let mut cd = ConstraintData::new(&model, &c);
-        let st = &fix["states"][1];
-        let q = DVector::from_vec(vecf(&st["q"]));
-        let v = DVector::from_vec(vecf(&st["v"]));
-        let tau = DVector::from_vec(vecf(&st["tau"]));
-        dynamics::forward_kinematics(&model, &mut data, &q).unwrap();
-        c.place_holds(&data);
+        let mut cd = ConstraintData::new(&model, &base);
+        let (q, v, tau, c) = state(&model, &mut data, &base, &fix["states"][1]);
         let mut jc = DMatrix::zeros(c.rows(), model.nv);
         let mut viol = vec![0.0; c.items.len()];
         // warm
@@ -205,25 +211,12 @@ fn constrained_hot_path_does_not_allocate() {
 #[test]
 fn blocked_and_dense_routes_agree() {
     for name in ["solo12_feet", "talos_hands"] {
-        let path = root().join(format!("tests/fixtures/constraints/{name}.json"));
-        let fix: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-        let floating_base = fix["floating_base"].as_bool().unwrap();
-        let model = urdyn::load_file(
-            root().join(fix["robot"].as_str().unwrap()),
-            LoadOptions { floating_base },
-        )
-        .unwrap();
-        let base = Constraints::from_value(&model, &fix["constraints"]).unwrap();
+        let (fix, model, base) = fixture(name);
         let mut data = Data::new(&model);
         let mut cd = ConstraintData::new(&model, &base);
         let mut worst = [0.0f64; 2];
         for st in fix["states"].as_array().unwrap() {
-            let q = DVector::from_vec(vecf(&st["q"]));
-            let v = DVector::from_vec(vecf(&st["v"]));
-            let tau = DVector::from_vec(vecf(&st["tau"]));
-            let mut c = base.clone();
-            dynamics::forward_kinematics(&model, &mut data, &q).unwrap();
-            c.place_holds(&data);
+            let (q, v, tau, c) = state(&model, &mut data, &base, st);
             let qdd =
                 dynamics::constraint_dynamics(&model, &mut data, &mut cd, &c, &q, &v, &tau, None)
                     .unwrap()
