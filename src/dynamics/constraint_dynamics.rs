@@ -14,7 +14,7 @@
 
 pub(crate) use super::constraint_rows::{bias_rows, jacobian_rows, side_point};
 pub use super::constraint_rows::{constraint_jacobian, constraint_violation};
-use super::kkt::{mul_add, KktFactor};
+use super::kkt::{add_rank1, mul_add, KktFactor};
 use super::kkt_blocks::{self, MAX_SHARED};
 use super::ltdl;
 use super::{check_massless, check_sizes, forward_dynamics_crba, linalg, DynamicsError};
@@ -349,30 +349,19 @@ pub(crate) fn constraint_dynamics_with<'c>(
             let dinv = 1.0 / d;
             dv[c] = dinv;
             let s0 = bc * dinv;
+            // xk: row c of W on its nonzero span lo..lo + len (zero elsewhere)
+            for (r, &xr) in (lo..).zip(xk) {
+                if xr != 0.0 {
+                    jq0[r] = madd(-xr, s0, jq0[r]);
+                }
+            }
             if blocked && lo == 0 && xk.len() == m {
                 // a shared coordinate: its row and pivot kept aside
                 brows[g * m..(g + 1) * m].copy_from_slice(xk);
                 bd[g] = d;
                 g += 1;
-                for (r, &xr) in xk.iter().enumerate() {
-                    if xr != 0.0 {
-                        jq0[r] = madd(-xr, s0, jq0[r]);
-                    }
-                }
-                return;
-            }
-            // xk: row c of W on its nonzero span lo..lo + len (zero elsewhere)
-            for (r, &xr) in (lo..).zip(xk) {
-                if xr == 0.0 {
-                    continue;
-                }
-                jq0[r] = madd(-xr, s0, jq0[r]);
-                // the span of the column (an axpy, vectorised): its entries below
-                // the diagonal are overwritten by the mirror that follows
-                let a = xr * dinv;
-                for (y, &x) in k[r * m + lo..r * m + lo + xk.len()].iter_mut().zip(xk) {
-                    *y = madd(a, x, *y);
-                }
+            } else {
+                add_rank1(k, m, lo, xk, dinv);
             }
         },
     )

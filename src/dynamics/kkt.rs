@@ -269,6 +269,23 @@ fn jacobi_eigen(v: &mut DMatrix<f64>, q: &mut DMatrix<f64>, ev: &mut DVector<f64
     }
 }
 
+/// K += D⁻¹ₖ xᵀ x over K's columns `lo..lo + x.len()` (K[s, r] at s + r m;
+/// `x` a row of W = L⁻ᵀ J_cᵀ on its span, zero elsewhere): one axpy a column
+/// (vectorised); the entries below the diagonal are overwritten when the
+/// callers mirror the upper triangle.
+#[inline(always)]
+pub(crate) fn add_rank1(k: &mut [f64], m: usize, lo: usize, x: &[f64], dinv: f64) {
+    for (r, &xr) in (lo..).zip(x) {
+        if xr == 0.0 {
+            continue;
+        }
+        let a = xr * dinv;
+        for (y, &xs) in k[r * m + lo..r * m + lo + x.len()].iter_mut().zip(x) {
+            *y = madd(a, xs, *y);
+        }
+    }
+}
+
 /// `c ← β c + α a b` for column-major matrices, allocation-free (nalgebra's
 /// `gemm` packs through the heap for larger sizes): register tiles of R × 4
 /// accumulators (R = 16, 8, 4, 2, 1 down the rows), each column of `a` read once

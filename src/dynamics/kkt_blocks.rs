@@ -14,6 +14,7 @@
 //! block is well inside full rank (then so is K); otherwise the caller forms
 //! K and takes the least-norm route (`kkt.rs`).
 
+use super::kkt::add_rank1;
 use super::ConstraintData;
 use crate::spatial::ops::madd;
 
@@ -111,16 +112,7 @@ pub(crate) fn solve_or_form(cd: &mut ConstraintData, g: usize) -> bool {
     // K = A + Σ D⁻¹ₖ W[k, :]ᵀ W[k, :] over the rows kept aside
     let k = &mut cd.k.as_mut_slice()[..m * m];
     for (row, &d) in cd.brows[..g * m].chunks_exact(m).zip(&cd.bd[..g]) {
-        let dinv = 1.0 / d;
-        for (r, &xr) in row.iter().enumerate() {
-            if xr == 0.0 {
-                continue;
-            }
-            let a = xr * dinv;
-            for (y, &x) in k[r * m..(r + 1) * m].iter_mut().zip(row) {
-                *y = madd(a, x, *y);
-            }
-        }
+        add_rank1(k, m, 0, row, 1.0 / d);
     }
     false
 }
