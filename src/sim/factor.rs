@@ -310,6 +310,21 @@ impl MassFactor {
         }
     }
 
+    /// Tree: row i's multipliers L[i, j] beside their dofs j (`table`'s
+    /// order, root first), without the last `drop` entries (the diagonal's
+    /// slot, and with 2 the parent's too).
+    #[inline(always)]
+    fn row_entries(
+        &self,
+        i: usize,
+        drop: usize,
+    ) -> std::iter::Zip<std::slice::Iter<'_, f64>, std::slice::Iter<'_, usize>> {
+        let (s, l) = (self.start[i], self.len[i]);
+        self.anc[s..s + l - drop]
+            .iter()
+            .zip(&self.table[s..s + l - drop])
+    }
+
     /// x ← H̃⁻¹ x.
     pub fn solve(&self, x: &mut DVector<f64>) {
         if self.tree {
@@ -330,8 +345,8 @@ impl MassFactor {
                         let xp = madd(-self.anc[s + l - 2], xi, x[i - 1]);
                         x[i - 1] = xp;
                         let sp = self.start[i - 1];
-                        let (a, ap) = (&self.anc[s..s + l - 2], &self.anc[sp..sp + l - 2]);
-                        for ((&a, &ap), &j) in a.iter().zip(ap).zip(&self.table[s..s + l - 2]).rev()
+                        for ((&a, &j), &ap) in
+                            self.row_entries(i, 2).zip(&self.anc[sp..sp + l - 2]).rev()
                         {
                             let xj = at_mut(x, j);
                             *xj = madd(-ap, xp, madd(-a, xi, *xj));
@@ -339,11 +354,7 @@ impl MassFactor {
                         i -= 1;
                         continue;
                     }
-                    for (&a, &j) in self.anc[s..s + l - 1]
-                        .iter()
-                        .zip(&self.table[s..s + l - 1])
-                        .rev()
-                    {
+                    for (&a, &j) in self.row_entries(i, 1).rev() {
                         let xj = at_mut(x, j);
                         *xj = madd(-a, xi, *xj);
                     }
@@ -355,12 +366,7 @@ impl MassFactor {
                 }
                 for i in k0..k1 {
                     let mut acc = x[i];
-                    let (s, l) = (self.start[i], self.len[i]);
-                    for (&a, &j) in self.anc[s..s + l - 1]
-                        .iter()
-                        .zip(&self.table[s..s + l - 1])
-                        .rev()
-                    {
+                    for (&a, &j) in self.row_entries(i, 1).rev() {
                         acc = madd(-a, at(x, j), acc);
                     }
                     x[i] = acc;
@@ -390,12 +396,7 @@ impl MassFactor {
         for &(k0, k1) in self.ranges() {
             for i in k0..k1 {
                 let mut acc = z[i] * self.inv_sqrt_d[i];
-                let (s, l) = (self.start[i], self.len[i]);
-                for (&a, &j) in self.anc[s..s + l - 1]
-                    .iter()
-                    .zip(&self.table[s..s + l - 1])
-                    .rev()
-                {
+                for (&a, &j) in self.row_entries(i, 1).rev() {
                     acc -= a * at(z, j);
                 }
                 z[i] = acc;
@@ -425,12 +426,7 @@ impl MassFactor {
         for &(k0, k1) in self.ranges() {
             for i in k0..k1 {
                 let mut acc = v[i];
-                let (s, l) = (self.start[i], self.len[i]);
-                for (&a, &j) in self.anc[s..s + l - 1]
-                    .iter()
-                    .zip(&self.table[s..s + l - 1])
-                    .rev()
-                {
+                for (&a, &j) in self.row_entries(i, 1).rev() {
                     acc += a * at(v, j);
                 }
                 out[i] = self.sqrt_d[i] * acc;
