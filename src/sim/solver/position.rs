@@ -92,12 +92,11 @@ impl Rows {
         // its unions, as the velocity sweeps rely on, pgs.rs)
         let n = self.n;
         if runs.iter().any(|&(_, s, e)| {
-                e > n
-                    || self.path[s..e]
-                        .iter()
-                        .any(|&(s, l)| s + l > table.len() || l > st)
-            })
-        {
+            e > n
+                || self.path[s..e]
+                    .iter()
+                    .any(|&(s, l)| s + l > table.len() || l > st)
+        }) {
             return 0;
         }
         debug_assert!(table.iter().all(|&k| k < nv), "a dof path beyond nv");
