@@ -11,7 +11,9 @@ default contact (self-collision included). The two are timed in --rounds interle
 round one call of each, the order alternating), so that a burst of other work on the
 machine hits both sides alike; each round prints steps/s of each (wall time, and the
 process's CPU time split into user and system) and the round's ratios, and the end the
-median and best round. Checks that one urdyn environment equals a Simulation with the
+median and best round, and each side's fastest round with their ratio (min/min: the
+fastest time over the fastest time, as benches/derivatives_ab.py --min; on a machine with
+fast and slow spells the fairest single figure beside the median of per-round ratios). Checks that one urdyn environment equals a Simulation with the
 same gains and targets stepped alone, bit for bit.
 
     /work/venv/bin/python benches/servo_rollout.py    # needs mujoco and urdyn installed
@@ -122,9 +124,13 @@ def main():
               f"| {B * N / w_ur:9,.0f} {B * N / c_ur:9,.0f} ({s_ur:.3f}s) "
               f"| {w_mj / w_ur:5.2f} {c_mj / c_ur:5.2f}")
     med = [statistics.median(x[k] for x in ratios) for k in range(4)]
+    # each side's fastest round (the machine's quietest moment for it) and their ratio
+    fast_mj, fast_ur = max(x[2] for x in ratios), max(x[3] for x in ratios)
     print(f"  median: mujoco.rollout {med[2]:,.0f} steps/s, urdyn.rollout {med[3]:,.0f} steps/s, "
           f"ratio wall {med[0]:.2f}, CPU {med[1]:.2f}; best round's wall ratio "
           f"{max(x[0] for x in ratios):.2f}, worst {min(x[0] for x in ratios):.2f}\n"
+          f"  fastest round: mujoco.rollout {fast_mj:,.0f} steps/s, urdyn.rollout "
+          f"{fast_ur:,.0f} steps/s, min/min wall ratio {fast_ur / fast_mj:.2f}\n"
           f"  urdyn environment 5 == a Simulation with the same gains and targets, bit for bit: {same}")
 
 

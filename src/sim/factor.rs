@@ -83,6 +83,10 @@ pub struct MassFactor {
     /// Tree: scratch of the elimination, a dof's multipliers L[k, ·] (and
     /// its parent's and grandparent's beside them: 3 nv).
     mult: Vec<f64>,
+    /// Tree: per dof, whether its path is a root's chain of consecutive dofs
+    /// (root, root + 1, …, the dof: a floating base's six), whose packed rows
+    /// then lie back to back as one triangle.
+    root_chain: Vec<bool>,
 }
 
 impl MassFactor {
@@ -115,6 +119,12 @@ impl MassFactor {
         start.push(table.len());
         len.push(n);
         table.extend(0..n);
+        let mut root_chain = vec![false; n];
+        for k in 0..n {
+            let p = model.dof_parent.get(k).copied();
+            root_chain[k] =
+                tree && (p == Some(NONE) || (k > 0 && p == Some(k - 1) && root_chain[k - 1]));
+        }
         Self {
             tree,
             n,
@@ -141,6 +151,7 @@ impl MassFactor {
             x: DVector::zeros(n),
             dval: vec![1.0; if tree { n } else { 0 }],
             mult: vec![0.0; if tree { 3 * n } else { 0 }],
+            root_chain,
         }
     }
 
@@ -325,6 +336,35 @@ impl MassFactor {
             .zip(&self.table[s..s + l - drop])
     }
 
+    /// Tree: `f(…f(f(init, a, j)…)` over row i's multipliers a = L[i, j]
+    /// beside their dofs j, from the nearest ancestor to the root (as
+    /// `row_entries(i, 1).rev()` one at a time: the same operations in the
+    /// same order); a row of up to 11 unrolled (constant bounds).
+    #[inline(always)]
+    fn fold_row(&self, i: usize, init: f64, f: impl Fn(f64, f64, usize) -> f64) -> f64 {
+        let (s, l) = (self.start[i], self.len[i]);
+        let (a, j) = (&self.anc[s..s + l - 1], &self.table[s..s + l - 1]);
+        match a.len() {
+            0 => init,
+            1 => fold_n::<1>(a, j, init, f),
+            2 => fold_n::<2>(a, j, init, f),
+            3 => fold_n::<3>(a, j, init, f),
+            4 => fold_n::<4>(a, j, init, f),
+            5 => fold_n::<5>(a, j, init, f),
+            6 => fold_n::<6>(a, j, init, f),
+            7 => fold_n::<7>(a, j, init, f),
+            8 => fold_n::<8>(a, j, init, f),
+            9 => fold_n::<9>(a, j, init, f),
+            10 => fold_n::<10>(a, j, init, f),
+            11 => fold_n::<11>(a, j, init, f),
+            _ => a
+                .iter()
+                .zip(j)
+                .rev()
+                .fold(init, |acc, (&a, &j)| f(acc, a, j)),
+        }
+    }
+
     /// x ← H̃⁻¹ x.
     pub fn solve(&self, x: &mut DVector<f64>) {
         if self.tree {
@@ -365,11 +405,7 @@ impl MassFactor {
                     }
                 }
                 for i in k0..k1 {
-                    let mut acc = x[i];
-                    for (&a, &j) in self.row_entries(i, 1).rev() {
-                        acc = madd(-a, at(x, j), acc);
-                    }
-                    x[i] = acc;
+                    x[i] = self.fold_row(i, x[i], |acc, a, j| madd(-a, at(x, j), acc));
                 }
             }
         } else {
@@ -395,11 +431,8 @@ impl MassFactor {
         let z = &mut z[..n];
         for &(k0, k1) in self.ranges() {
             for i in k0..k1 {
-                let mut acc = z[i] * self.inv_sqrt_d[i];
-                for (&a, &j) in self.row_entries(i, 1).rev() {
-                    acc -= a * at(z, j);
-                }
-                z[i] = acc;
+                let z0 = z[i] * self.inv_sqrt_d[i];
+                z[i] = self.fold_row(i, z0, |acc, a, j| acc - a * at(z, j));
             }
         }
     }
@@ -425,10 +458,7 @@ impl MassFactor {
         let v = &v[..n];
         for &(k0, k1) in self.ranges() {
             for i in k0..k1 {
-                let mut acc = v[i];
-                for (&a, &j) in self.row_entries(i, 1).rev() {
-                    acc += a * at(v, j);
-                }
+                let acc = self.fold_row(i, v[i], |acc, a, j| acc + a * at(v, j));
                 out[i] = self.sqrt_d[i] * acc;
             }
         }
@@ -448,4 +478,20 @@ impl MassFactor {
         self.x = x;
         r
     }
+}
+
+/// [`MassFactor::fold_row`] on `N` entries (`a[..N]`, `j[..N]`), the last first.
+#[inline(always)]
+fn fold_n<const N: usize>(
+    a: &[f64],
+    j: &[usize],
+    init: f64,
+    f: impl Fn(f64, f64, usize) -> f64,
+) -> f64 {
+    let (a, j) = (&a[..N], &j[..N]);
+    let mut acc = init;
+    for t in (0..N).rev() {
+        acc = f(acc, a[t], j[t]);
+    }
+    acc
 }

@@ -52,6 +52,37 @@ pub(crate) struct Servo {
 /// [`Servo::iq`] of a free joint's coordinate.
 pub(crate) const FREE: usize = usize::MAX;
 
+/// The servo's gains and targets as slices cut to nv (the per-dof loops of
+/// [`Simulation::servo_free_velocity`]: no bounds test on a v-indexed entry).
+struct Gains<'a> {
+    kp: &'a [f64],
+    kd: &'a [f64],
+    q_ref: &'a [f64],
+    v_ref: &'a [f64],
+}
+
+impl<'a> Gains<'a> {
+    fn of(
+        kp: &'a DVector<f64>,
+        kd: &'a DVector<f64>,
+        q_ref: &'a DVector<f64>,
+        v_ref: &'a DVector<f64>,
+        nv: usize,
+    ) -> Self {
+        Self {
+            kp: &kp.as_slice()[..nv],
+            kd: &kd.as_slice()[..nv],
+            q_ref: q_ref.as_slice(),
+            v_ref: &v_ref.as_slice()[..nv],
+        }
+    }
+    /// [`Servo::torque`] (the same operations).
+    #[inline(always)]
+    fn torque(&self, iq: usize, iv: usize, q: f64, v: f64) -> f64 {
+        self.kp[iv] * (self.q_ref[iq] - q) + self.kd[iv] * (self.v_ref[iv] - v)
+    }
+}
+
 impl Servo {
     /// No servo on `model`; `q_ref` starts at `q0`.
     pub fn new(model: &Model, q0: &DVector<f64>) -> Self {
@@ -275,7 +306,8 @@ impl Simulation {
                 let (cs, damping) = (&c.as_slice()[..nv], &self.damping.as_slice()[..nv]);
                 let (effort, tau_ff) = (&self.effort[..nv], &self.tau_applied.as_slice()[..nv]);
                 let (sat, iqs) = (&s.saturated[..nv], &s.iq[..nv]);
-                let kp = &s.kp.as_slice()[..nv];
+                let g = Gains::of(&s.kp, &s.kd, &s.q_ref, &s.v_ref, nv);
+                let kp = g.kp;
                 for (k, tk) in tau.as_mut_slice()[..nv].iter_mut().enumerate() {
                     let u = match sat[k] {
                         0 => {
@@ -284,7 +316,7 @@ impl Simulation {
                             let e = if iq == FREE {
                                 0.0
                             } else {
-                                s.torque(iq, k, q[iq], v[k]) - h * kp[k] * v[k]
+                                g.torque(iq, k, q[iq], v[k]) - h * kp[k] * v[k]
                             };
                             tau_ff[k] + e
                         }
@@ -303,18 +335,20 @@ impl Simulation {
             // a free joint whose torque at v* passes its limit is saturated
             let mut grew = false;
             let s = &mut self.servo;
+            let g = Gains::of(&s.kp, &s.kd, &s.q_ref, &s.v_ref, nv);
+            let (iqs, saturated) = (&s.iq[..nv], &mut s.saturated[..nv]);
             let (q, vfree) = (self.q.as_slice(), &self.mass.vfree.as_slice()[..nv]);
             let (effort, tau_ff) = (&self.effort[..nv], &self.tau_applied.as_slice()[..nv]);
             for k in 0..nv {
-                let iq = s.iq[k];
-                if iq == FREE || s.saturated[k] != 0 || !effort[k].is_finite() {
+                let iq = iqs[k];
+                if iq == FREE || saturated[k] != 0 || !effort[k].is_finite() {
                     continue;
                 }
                 // τ_ff + the servo torque at q⁺ ≈ q + h v*, v⁺ = v*
                 let v1 = vfree[k];
-                let t = tau_ff[k] + s.torque(iq, k, q[iq] + h * v1, v1);
+                let t = tau_ff[k] + g.torque(iq, k, q[iq] + h * v1, v1);
                 if t.abs() > effort[k] {
-                    s.saturated[k] = t.signum() as i8;
+                    saturated[k] = t.signum() as i8;
                     grew = true;
                 }
             }
@@ -324,14 +358,16 @@ impl Simulation {
         }
         let mut applied = std::mem::replace(&mut self.servo.applied, DVector::zeros(0));
         let s = &self.servo;
+        let g = Gains::of(&s.kp, &s.kd, &s.q_ref, &s.v_ref, nv);
+        let (iqs, saturated) = (&s.iq[..nv], &s.saturated[..nv]);
         let (q, vfree) = (self.q.as_slice(), &self.mass.vfree.as_slice()[..nv]);
         let (effort, tau_ff) = (&self.effort[..nv], &self.tau_applied.as_slice()[..nv]);
         for (k, a) in applied.as_mut_slice()[..nv].iter_mut().enumerate() {
-            let iq = s.iq[k];
-            *a = match s.saturated[k] {
+            let iq = iqs[k];
+            *a = match saturated[k] {
                 0 if iq != FREE => {
                     let v1 = vfree[k];
-                    tau_ff[k] + s.torque(iq, k, q[iq] + h * v1, v1)
+                    tau_ff[k] + g.torque(iq, k, q[iq] + h * v1, v1)
                 }
                 0 => tau_ff[k],
                 sg => f64::from(sg) * effort[k],

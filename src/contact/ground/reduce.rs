@@ -15,18 +15,42 @@ pub(super) fn band_best<const D: usize>(
     ground: f64,
     dir: &[(f64, f64); MAX_DIRS],
 ) -> [f64; MAX_DIRS + 1] {
-    // max(b, k) as `if k > b { k } else { b }`: one instruction (maxsd),
-    // a NaN k ignored as `reduce` does
-    let up = |b: f64, k: f64| if k > b { k } else { b };
     let nd = if D == 0 { MAX_DIRS } else { D };
     let mut best = [f64::NEG_INFINITY; MAX_DIRS + 1];
     let (xs, ys, zs) = (&pts.x[..n], &pts.y[..n], &pts.z[..n]);
-    for ((x, y), z) in xs.iter().zip(ys).zip(zs) {
-        best[0] = up(best[0], -(z - ground));
-        for q in 0..nd {
-            let (c, sn) = dir[q];
-            best[q + 1] = up(best[q + 1], c * x + sn * y);
+    best[0] = lane_max(zs, zs, |z, _| -(z - ground));
+    for q in 0..nd {
+        let (c, sn) = dir[q];
+        best[q + 1] = lane_max(xs, ys, |x, y| c * x + sn * y);
+    }
+    best
+}
+
+/// The maximum of `key(a[i], b[i])` over i (−∞ for none; a NaN key ignored):
+/// four running maxima, point i in lane i mod 4 (vector lanes), then the
+/// lanes' maximum. The same maximum of the same keys as one running maximum
+/// over the points in order, up to the sign of a zero, which the maxima's one
+/// use (`best − hold`, `best − 1e-6`: [`super::GroundContact::hull_patch`])
+/// does not see.
+#[inline(always)]
+fn lane_max(a: &[f64], b: &[f64], key: impl Fn(f64, f64) -> f64) -> f64 {
+    // max(m, k) as `if k > m { k } else { m }`: one instruction (maxpd),
+    // a NaN k ignored as `reduce` does
+    let up = |m: f64, k: f64| if k > m { k } else { m };
+    let mut acc = [f64::NEG_INFINITY; 4];
+    let (ac, bc) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ar, br) = (ac.remainder(), bc.remainder());
+    for (a4, b4) in ac.zip(bc) {
+        for l in 0..4 {
+            acc[l] = up(acc[l], key(a4[l], b4[l]));
         }
+    }
+    let mut best = f64::NEG_INFINITY;
+    for k in acc {
+        best = up(best, k);
+    }
+    for (&x, &y) in ar.iter().zip(br) {
+        best = up(best, key(x, y));
     }
     best
 }

@@ -21,6 +21,7 @@ impl MassFactor {
             self.hdiag[k] = self.anc[self.start[k] + self.len[k] - 1];
         }
         let (anc, table, start, len) = (&mut self.anc, &self.table, &self.start, &self.len);
+        let root_chain = &self.root_chain;
         let (hdiag, mult_all) = (&self.hdiag, &mut self.mult);
         // the pivot test of dof k, D[k] = d
         let pivot_ok = |k: usize, d: f64| d > tiny * hdiag[k].abs() && d.is_finite();
@@ -102,6 +103,27 @@ impl MassFactor {
                             for (c, &x) in mult_g.iter_mut().zip(row_g.iter()) {
                                 *c = x / dg;
                             }
+                            // the common ancestors a root's chain (a floating
+                            // base): their rows one packed triangle, swept by
+                            // the unrolled kernel (the same operations per entry)
+                            let na = m - 2;
+                            let tri = match table.get(sk).map(|&a0| start[a0]) {
+                                Some(s0) if na > 0 && root_chain[table[sk + na - 1]] => {
+                                    head.get_mut(s0..s0 + na * (na + 1) / 2)
+                                }
+                                _ => None,
+                            };
+                            let mr = (&mult[..na], &mult_p[..na], &mult_g[..na]);
+                            let rows = (&row[..na], &row_p[..na], &row_g[..na]);
+                            if let Some(tri) = tri {
+                                if sweep3_packed(tri, mr, rows) {
+                                    row.copy_from_slice(mult);
+                                    row_p.copy_from_slice(mult_p);
+                                    row_g.copy_from_slice(mult_g);
+                                    k -= 2;
+                                    continue;
+                                }
+                            }
                             for t in (0..m - 2).rev() {
                                 let si = start[table[sk + t]];
                                 let (a, b, c) = (mult[t], mult_p[t], mult_g[t]);
@@ -171,5 +193,50 @@ impl MassFactor {
             self.inv_sqrt_d[k] = 1.0 / self.sqrt_d[k];
         }
         Ok(())
+    }
+}
+
+/// The three-dof update of a root's chain of `na` ≤ 6 dofs (a floating base)
+/// whose packed rows lie back to back (`tri`, na(na + 1)/2 entries: row t's
+/// t + 1 entries from t(t + 1)/2): entry (t, j) ← x − a[t]·k[j] − b[t]·q[j] −
+/// c[t]·r[j], three fused multiply-adds in that order, as the general sweep.
+/// False (nothing done) for a longer chain.
+#[inline(always)]
+fn sweep3_packed(
+    tri: &mut [f64],
+    m: (&[f64], &[f64], &[f64]),
+    r: (&[f64], &[f64], &[f64]),
+) -> bool {
+    match m.0.len() {
+        1 => sweep3_n::<1>(tri, m, r),
+        2 => sweep3_n::<2>(tri, m, r),
+        3 => sweep3_n::<3>(tri, m, r),
+        4 => sweep3_n::<4>(tri, m, r),
+        5 => sweep3_n::<5>(tri, m, r),
+        6 => sweep3_n::<6>(tri, m, r),
+        _ => return false,
+    }
+    true
+}
+
+/// [`sweep3_packed`] for N dofs (constant bounds: unrolled, no bounds tests).
+#[inline(always)]
+fn sweep3_n<const N: usize>(
+    tri: &mut [f64],
+    (a, b, c): (&[f64], &[f64], &[f64]),
+    (rk, rq, rr): (&[f64], &[f64], &[f64]),
+) {
+    let (tri, a, b, c) = (&mut tri[..N * (N + 1) / 2], &a[..N], &b[..N], &c[..N]);
+    let (rk, rq, rr) = (&rk[..N], &rq[..N], &rr[..N]);
+    for t in (0..N).rev() {
+        let o = t * (t + 1) / 2;
+        for j in 0..=t {
+            // x − a k − b q − c r, one fused multiply-add each, in that order
+            tri[o + j] = madd(
+                -c[t],
+                rr[j],
+                madd(-b[t], rq[j], madd(-a[t], rk[j], tri[o + j])),
+            );
+        }
     }
 }

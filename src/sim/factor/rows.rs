@@ -117,6 +117,40 @@ impl MassFactor {
         }
     }
 
+    /// [`Self::row_transform_lanes`] on a chain path of `N` dofs (`path[..N]`,
+    /// `y[..N]`; false, nothing done, when either is shorter): the rows copied
+    /// into registers, every loop's bounds constant (unrolled, no bounds
+    /// tests); each lane's entry takes the same operations in the same order,
+    /// y[j] −= L[path[t], path[j]]·y[t] for t from the leaf in, then the scaling.
+    #[inline(always)]
+    fn lanes_chain<const N: usize>(&self, path: &[usize], y: &mut [[f64; 4]]) -> bool {
+        let (Some(path), Some(y)) = (path.get(..N), y.get_mut(..N)) else {
+            return false;
+        };
+        let mut w = [[0.0; 4]; N];
+        w.copy_from_slice(y);
+        for t in (1..N).rev() {
+            let a = w[t];
+            let s = self.start[path[t]];
+            let Some(anc) = self.anc.get(s..s + t) else {
+                return false;
+            };
+            for (wj, &l) in w.iter_mut().zip(anc) {
+                for (x, &ai) in wj.iter_mut().zip(&a) {
+                    *x -= l * ai;
+                }
+            }
+        }
+        for (wt, &k) in w.iter_mut().zip(path) {
+            let d = self.inv_sqrt_d[k];
+            for x in wt.iter_mut() {
+                *x *= d;
+            }
+        }
+        y.copy_from_slice(&w);
+        true
+    }
+
     /// [`Self::row_transform3`] on rows held interleaved, `y[t] = [y₀ₜ, y₁ₜ,
     /// y₂ₜ, pad]` (a contact's three rows, lane by lane): each lane takes
     /// exactly the operations of [`Self::row_transform3`] in the same order (so
@@ -142,6 +176,26 @@ impl MassFactor {
             _ => y[len - 1],
         };
         let chain = self.is_chain(&path[..len]);
+        if chain {
+            // a short chain (a robot's limb): unrolled, the rows in registers
+            let done = match len {
+                2 => self.lanes_chain::<2>(path, y),
+                3 => self.lanes_chain::<3>(path, y),
+                4 => self.lanes_chain::<4>(path, y),
+                5 => self.lanes_chain::<5>(path, y),
+                6 => self.lanes_chain::<6>(path, y),
+                7 => self.lanes_chain::<7>(path, y),
+                8 => self.lanes_chain::<8>(path, y),
+                9 => self.lanes_chain::<9>(path, y),
+                10 => self.lanes_chain::<10>(path, y),
+                11 => self.lanes_chain::<11>(path, y),
+                12 => self.lanes_chain::<12>(path, y),
+                _ => false,
+            };
+            if done {
+                return true;
+            }
+        }
         for t in (0..len).rev() {
             let a = next;
             if chain {
