@@ -14,9 +14,10 @@
 //! AABB at a pose is six such support values. The support face (the face
 //! whose normal is best aligned with d) is parry's, found among the few
 //! faces that can be best for a direction of d's cell in a finer cube map
-//! (`FACE_CELLS`), precomputed from the cells' cones (a climb over faces is
-//! not exact: the best normal is not always reached by improving
-//! neighbours). Point and ray queries are the wrapped `ConvexPolyhedron`'s.
+//! (`FACE_CELLS`), listed from the cell's cone on its first use (a climb
+//! over faces is not exact: the best normal is not always reached by
+//! improving neighbours). Point and ray queries are the wrapped
+//! `ConvexPolyhedron`'s.
 
 use parry3d_f64::bounding_volume::{Aabb, BoundingSphere};
 use parry3d_f64::mass_properties::MassProperties;
@@ -26,6 +27,7 @@ use parry3d_f64::shape::{
     ConvexPolyhedron, FeatureId, PackedFeatureId, PolygonalFeature, PolygonalFeatureMap, Shape,
     ShapeType, SupportMap, TypedShape,
 };
+use std::sync::OnceLock;
 
 /// Hulls with at most this many vertices are scanned whole (parry's own
 /// shape): a climb's start costs about as much.
@@ -88,50 +90,34 @@ fn angle(a: PVec, b: PVec) -> f64 {
     a.cross(b).length().atan2(a.dot(b))
 }
 
-/// Per cell of the faces' cube map, the faces that may be the best aligned
-/// with a direction in it, in index order (compressed rows: start, faces).
-/// A cell's directions lie within r of its centre c (r: the angle to its
-/// farthest corner); with θ_f = ∠(n_f, c) and θ₀ = min θ_f, a direction d
-/// of the cell has ∠(n_f, d) ≥ θ_f − r and ∠(n₀, d) ≤ θ₀ + r, so only faces
-/// with θ_f ≤ θ₀ + 2r can be best; a 10⁻⁶ rad slack keeps every face whose
-/// rounded n·d may tie the best (docs/theory.md §"Support face by cells").
-/// The angles are compared as cosines (one product a face and cell).
-fn face_candidates(normals: &[PVec]) -> (Vec<u32>, Vec<u32>) {
+/// The faces of cell `cell` of the faces' cube map that may be the best
+/// aligned with a direction in it, in index order (`normal` gives face f's
+/// unit normal). A cell's directions lie within r of its centre c (r: the
+/// angle to its farthest corner); with θ_f = ∠(n_f, c) and θ₀ = min θ_f, a
+/// direction d of the cell has ∠(n_f, d) ≥ θ_f − r and ∠(n₀, d) ≤ θ₀ + r, so
+/// only faces with θ_f ≤ θ₀ + 2r can be best; a 10⁻⁶ rad slack keeps every
+/// face whose rounded n·d may tie the best (docs/theory.md §"Support face by
+/// cells"). The angles are compared as cosines (one product a face).
+fn cell_faces(cell: usize, faces: usize, normal: impl Fn(usize) -> PVec) -> Box<[u32]> {
     const SLACK: f64 = 1e-6;
     let n = FACE_CELLS;
-    let mut start = Vec::with_capacity(6 * n * n + 1);
-    let mut list = Vec::new();
+    let (face, i, j) = (cell / (n * n), cell / n % n, cell % n);
     let w = |i: usize| 2.0 * i as f64 / n as f64 - 1.0;
-    let mut cosine = vec![0.0; normals.len()];
-    for face in 0..6 {
-        for i in 0..n {
-            for j in 0..n {
-                let (u0, u1, v0, v1) = (w(i), w(i + 1), w(j), w(j + 1));
-                let c = face_point(face, 0.5 * (u0 + u1), 0.5 * (v0 + v1)).normalize();
-                let r = [(u0, v0), (u0, v1), (u1, v0), (u1, v1)]
-                    .iter()
-                    .map(|&(u, v)| angle(face_point(face, u, v), c))
-                    .fold(0.0, f64::max);
-                let mut best = -1.0f64;
-                for (x, nf) in cosine.iter_mut().zip(normals) {
-                    *x = nf.dot(c);
-                    best = best.max(*x);
-                }
-                // cos(θ₀ + 2r + slack), θ₀ from the best cosine
-                let reach =
-                    (best.clamp(-1.0, 1.0).acos() + 2.0 * r + SLACK).min(std::f64::consts::PI);
-                let floor = reach.cos();
-                start.push(list.len() as u32);
-                list.extend(
-                    (0..normals.len())
-                        .filter(|&f| cosine[f] >= floor)
-                        .map(|f| f as u32),
-                );
-            }
-        }
-    }
-    start.push(list.len() as u32);
-    (start, list)
+    let (u0, u1, v0, v1) = (w(i), w(i + 1), w(j), w(j + 1));
+    let c = face_point(face, 0.5 * (u0 + u1), 0.5 * (v0 + v1)).normalize();
+    let r = [(u0, v0), (u0, v1), (u1, v0), (u1, v1)]
+        .iter()
+        .map(|&(u, v)| angle(face_point(face, u, v), c))
+        .fold(0.0, f64::max);
+    let cosine: Vec<f64> = (0..faces).map(|f| normal(f).dot(c)).collect();
+    let best = cosine.iter().copied().fold(-1.0f64, f64::max);
+    // cos(θ₀ + 2r + slack), θ₀ from the best cosine
+    let reach = (best.clamp(-1.0, 1.0).acos() + 2.0 * r + SLACK).min(std::f64::consts::PI);
+    let floor = reach.cos();
+    (0..faces)
+        .filter(|&f| cosine[f] >= floor)
+        .map(|f| f as u32)
+        .collect()
 }
 
 /// A convex hull with a graph-climbing support map (see the module doc).
@@ -150,10 +136,10 @@ pub(crate) struct ClimbHull {
     normal_x: Vec<f64>,
     normal_y: Vec<f64>,
     normal_z: Vec<f64>,
-    /// Per cell of the faces' cube map, its candidate faces (compressed
-    /// rows: those of cell c are `face_list[face_start[c]..face_start[c + 1]]`).
-    face_start: Vec<u32>,
-    face_list: Vec<u32>,
+    /// Per cell of the faces' cube map, its candidate faces ([`cell_faces`]),
+    /// found the first time a direction of the cell is asked (a robot's
+    /// pair asks few of the 384 cells).
+    cells: Box<[OnceLock<Box<[u32]>>]>,
     /// The mean of the vertices (a point inside the hull).
     centre: PVec,
     /// The box of the vertices in the hull's frame.
@@ -227,11 +213,10 @@ impl ClimbHull {
         }
         let normal = |c: usize| hull.faces().iter().map(|f| f.normal[c]).collect();
         let centre = pts.iter().fold(PVec::ZERO, |s, p| s + *p) / n as f64;
-        let normals: Vec<PVec> = hull.faces().iter().map(|f| f.normal).collect();
-        let (face_start, face_list) = face_candidates(&normals);
         Some(Ok(Self {
-            face_start,
-            face_list,
+            cells: (0..6 * FACE_CELLS * FACE_CELLS)
+                .map(|_| OnceLock::new())
+                .collect(),
             centre,
             local_box: hull.local_aabb(),
             normal_x: normal(0),
@@ -297,7 +282,7 @@ impl SupportMap for ClimbHull {
 impl ClimbHull {
     /// The face whose normal is best aligned with `dir` (the first of the
     /// best, as parry's scan): among the candidates of `dir`'s cell of the
-    /// faces' cube map (see [`face_candidates`]), which hold every face that
+    /// faces' cube map (see [`cell_faces`]), which hold every face that
     /// can reach the best value, in index order, so that the first of the
     /// best among them is the scan's (the same products, bit for bit); a
     /// direction with no cell (zero, tiny, not finite) is scanned whole.
@@ -310,10 +295,11 @@ impl ClimbHull {
             return self.scan_face(dir);
         }
         let c = cell_in(dir, FACE_CELLS);
-        let (a, b) = (self.face_start[c] as usize, self.face_start[c + 1] as usize);
+        let list = self.cells[c]
+            .get_or_init(|| cell_faces(c, nx.len(), |f| PVec::new(nx[f], ny[f], nz[f])));
         let mut best = f64::NEG_INFINITY;
         let mut face = 0;
-        for &k in &self.face_list[a..b] {
+        for &k in list.iter() {
             let v = dot(k as usize);
             if v > best {
                 best = v;
