@@ -12,8 +12,9 @@
 //! start is the hull's extreme vertex toward the centre of d's cell in a cube
 //! map of directions (`CELLS`), and a climb then takes a step or two. The
 //! AABB at a pose is six such support values. The support face (the face
-//! whose normal is best aligned with d) is parry's scan of every face, on
-//! the normals stored component by component so that it vectorises (a climb
+//! whose normal is best aligned with d) is parry's, found among the few
+//! faces that can be best for a direction of d's cell in a finer cube map
+//! (`FACE_CELLS`), listed from the cell's cone on its first use (a climb
 //! over faces is not exact: the best normal is not always reached by
 //! improving neighbours). Point and ray queries are the wrapped
 //! `ConvexPolyhedron`'s.
@@ -26,6 +27,7 @@ use parry3d_f64::shape::{
     ConvexPolyhedron, FeatureId, PackedFeatureId, PolygonalFeature, PolygonalFeatureMap, Shape,
     ShapeType, SupportMap, TypedShape,
 };
+use std::sync::OnceLock;
 
 /// Hulls with at most this many vertices are scanned whole (parry's own
 /// shape): a climb's start costs about as much.
@@ -40,6 +42,12 @@ const CELLS: usize = 4;
 /// The cube-map cell of direction d (any length, not zero).
 #[inline]
 fn cell(d: PVec) -> usize {
+    cell_in(d, CELLS)
+}
+
+/// The cell of direction d in a cube map of `cells`² cells a cube face.
+#[inline]
+fn cell_in(d: PVec, cells: usize) -> usize {
     let a = d.abs();
     // the dominant axis and the two others (u, v) in a fixed order
     let (axis, u, v, m) = if a.x >= a.y && a.x >= a.z {
@@ -52,21 +60,64 @@ fn cell(d: PVec) -> usize {
     let face = 2 * axis + usize::from(m < 0.0);
     let inv = 1.0 / m.abs();
     // (u/|m| + 1)/2 ∈ [0, 1] → a cell index (NaN → 0)
-    let idx = |w: f64| (((w * inv + 1.0) * 0.5 * CELLS as f64) as usize).min(CELLS - 1);
-    (face * CELLS + idx(u)) * CELLS + idx(v)
+    let idx = |w: f64| (((w * inv + 1.0) * 0.5 * cells as f64) as usize).min(cells - 1);
+    (face * cells + idx(u)) * cells + idx(v)
 }
 
-/// The centre direction of cube-map cell `c`.
-fn cell_centre(c: usize) -> PVec {
-    let (face, rest) = (c / (CELLS * CELLS), c % (CELLS * CELLS));
-    let w = |i: usize| 2.0 * (i as f64 + 0.5) / CELLS as f64 - 1.0;
-    let (u, v) = (w(rest / CELLS), w(rest % CELLS));
+/// The point (u, v) of cube face `face` (u, v ∈ [−1, 1]), as a direction.
+fn face_point(face: usize, u: f64, v: f64) -> PVec {
     let m = if face % 2 == 0 { 1.0 } else { -1.0 };
     match face / 2 {
         0 => PVec::new(m, u, v),
         1 => PVec::new(v, m, u),
         _ => PVec::new(u, v, m),
     }
+}
+
+/// The centre direction of cube-map cell `c`.
+fn cell_centre(c: usize) -> PVec {
+    let (face, rest) = (c / (CELLS * CELLS), c % (CELLS * CELLS));
+    let w = |i: usize| 2.0 * (i as f64 + 0.5) / CELLS as f64 - 1.0;
+    face_point(face, w(rest / CELLS), w(rest % CELLS))
+}
+
+/// The faces' cube map: `FACE_CELLS`² cells a cube face (their cones are
+/// narrower than the climb's seeds', so fewer faces are candidates of one).
+const FACE_CELLS: usize = 8;
+
+/// The angle (rad) between directions a and b (any length), accurate near 0.
+fn angle(a: PVec, b: PVec) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
+}
+
+/// The faces of cell `cell` of the faces' cube map that may be the best
+/// aligned with a direction in it, in index order (`normal` gives face f's
+/// unit normal). A cell's directions lie within r of its centre c (r: the
+/// angle to its farthest corner); with θ_f = ∠(n_f, c) and θ₀ = min θ_f, a
+/// direction d of the cell has ∠(n_f, d) ≥ θ_f − r and ∠(n₀, d) ≤ θ₀ + r, so
+/// only faces with θ_f ≤ θ₀ + 2r can be best; a 10⁻⁶ rad slack keeps every
+/// face whose rounded n·d may tie the best (docs/theory.md §"Support face by
+/// cells"). The angles are compared as cosines (one product a face).
+fn cell_faces(cell: usize, faces: usize, normal: impl Fn(usize) -> PVec) -> Box<[u32]> {
+    const SLACK: f64 = 1e-6;
+    let n = FACE_CELLS;
+    let (face, i, j) = (cell / (n * n), cell / n % n, cell % n);
+    let w = |i: usize| 2.0 * i as f64 / n as f64 - 1.0;
+    let (u0, u1, v0, v1) = (w(i), w(i + 1), w(j), w(j + 1));
+    let c = face_point(face, 0.5 * (u0 + u1), 0.5 * (v0 + v1)).normalize();
+    let r = [(u0, v0), (u0, v1), (u1, v0), (u1, v1)]
+        .iter()
+        .map(|&(u, v)| angle(face_point(face, u, v), c))
+        .fold(0.0, f64::max);
+    let cosine: Vec<f64> = (0..faces).map(|f| normal(f).dot(c)).collect();
+    let best = cosine.iter().copied().fold(-1.0f64, f64::max);
+    // cos(θ₀ + 2r + slack), θ₀ from the best cosine
+    let reach = (best.clamp(-1.0, 1.0).acos() + 2.0 * r + SLACK).min(std::f64::consts::PI);
+    let floor = reach.cos();
+    (0..faces)
+        .filter(|&f| cosine[f] >= floor)
+        .map(|f| f as u32)
+        .collect()
 }
 
 /// A convex hull with a graph-climbing support map (see the module doc).
@@ -85,6 +136,10 @@ pub(crate) struct ClimbHull {
     normal_x: Vec<f64>,
     normal_y: Vec<f64>,
     normal_z: Vec<f64>,
+    /// Per cell of the faces' cube map, its candidate faces ([`cell_faces`]),
+    /// found the first time a direction of the cell is asked (a robot's
+    /// pair asks few of the 384 cells).
+    cells: Box<[OnceLock<Box<[u32]>>]>,
     /// The mean of the vertices (a point inside the hull).
     centre: PVec,
     /// The box of the vertices in the hull's frame.
@@ -159,6 +214,9 @@ impl ClimbHull {
         let normal = |c: usize| hull.faces().iter().map(|f| f.normal[c]).collect();
         let centre = pts.iter().fold(PVec::ZERO, |s, p| s + *p) / n as f64;
         Some(Ok(Self {
+            cells: (0..6 * FACE_CELLS * FACE_CELLS)
+                .map(|_| OnceLock::new())
+                .collect(),
             centre,
             local_box: hull.local_aabb(),
             normal_x: normal(0),
@@ -223,11 +281,38 @@ impl SupportMap for ClimbHull {
 
 impl ClimbHull {
     /// The face whose normal is best aligned with `dir` (the first of the
-    /// best, as parry's scan): a scan of the face normals kept as three
-    /// arrays, the best value first (four lanes at a time), then its first
-    /// face (the same products, bit for bit).
+    /// best, as parry's scan): among the candidates of `dir`'s cell of the
+    /// faces' cube map (see [`cell_faces`]), which hold every face that
+    /// can reach the best value, in index order, so that the first of the
+    /// best among them is the scan's (the same products, bit for bit); a
+    /// direction with no cell (zero, tiny, not finite) is scanned whole.
     #[inline]
     fn best_face(&self, dir: PVec) -> usize {
+        let (nx, ny, nz) = (&self.normal_x, &self.normal_y, &self.normal_z);
+        let dot = |i: usize| nx[i] * dir.x + ny[i] * dir.y + nz[i] * dir.z;
+        let big = dir.abs().max_element();
+        if !(big > 1e-100 && big < 1e100) {
+            return self.scan_face(dir);
+        }
+        let c = cell_in(dir, FACE_CELLS);
+        let list = self.cells[c]
+            .get_or_init(|| cell_faces(c, nx.len(), |f| PVec::new(nx[f], ny[f], nz[f])));
+        let mut best = f64::NEG_INFINITY;
+        let mut face = 0;
+        for &k in list.iter() {
+            let v = dot(k as usize);
+            if v > best {
+                best = v;
+                face = k as usize;
+            }
+        }
+        face
+    }
+
+    /// [`Self::best_face`] by a scan of every face normal, kept as three
+    /// arrays: the best value first (four lanes at a time), then its first
+    /// face (the same products, bit for bit).
+    fn scan_face(&self, dir: PVec) -> usize {
         let (nx, ny, nz) = (&self.normal_x, &self.normal_y, &self.normal_z);
         let dot = |i: usize| nx[i] * dir.x + ny[i] * dir.y + nz[i] * dir.z;
         let n = nx.len();

@@ -88,7 +88,17 @@ fn support_face_is_the_scanned_best_face() {
                 2.0 * c - 1.0
             };
             let d = PVec::new(r(), r(), r()).normalize();
-            for d in [d, PVec::new(0.0, 0.0, d.z.signum())] {
+            // cube-map cell borders (equal components, ±1/4 steps), a long
+            // and a short copy, an axis
+            for d in [
+                d,
+                PVec::new(0.0, 0.0, d.z.signum()),
+                PVec::new(d.x, d.x, d.z),
+                PVec::new(d.x, -d.x, -d.x),
+                PVec::new(1.0, 0.25 * d.y.signum(), -0.75),
+                d * 1e3,
+                d * 1e-3,
+            ] {
                 h.support_feature(d, &mut f1);
                 h.hull().local_support_feature(d, &mut f2);
                 let n = |f: &PolygonalFeature| {
