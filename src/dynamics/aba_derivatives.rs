@@ -187,6 +187,22 @@ fn gemv2_add<T: Scalar, const K: usize>(
     cv: &[T; 12],
     neg: bool,
 ) {
+    gemv2::<T, K, false>(xq, xv, cols, cq, cv, neg, (&[], T::zero(), T::zero()));
+}
+
+/// [`gemv2_add`] with `OWN`: `(xq, xv)` start from `(h bq, h bv)` for
+/// `own = (h, bq, bv)` (each `madd(h, b, 0)`, as an axpy into zeros) instead of
+/// their contents, which are not read.
+#[inline(always)]
+fn gemv2<T: Scalar, const K: usize, const OWN: bool>(
+    xq: &mut [T],
+    xv: &mut [T],
+    cols: &[T],
+    cq: &[T; 12],
+    cv: &[T; 12],
+    neg: bool,
+    own: (&[T], T, T),
+) {
     let n = xq.len();
     // filled in a loop (`array::from_fn` was an out-of-line call)
     let mut c: [&[T]; K] = [&[]; K];
@@ -194,12 +210,72 @@ fn gemv2_add<T: Scalar, const K: usize>(
         *ck = &cols[k * n..(k + 1) * n];
     }
     let xv = &mut xv[..n];
+    let (h0, b0q, b0v) = own;
+    let h0 = if OWN { &h0[..n] } else { h0 };
     for i in 0..n {
-        let (mut sq, mut sv) = (xq[i], xv[i]);
+        let (mut sq, mut sv) = if OWN {
+            (madd(h0[i], b0q, T::zero()), madd(h0[i], b0v, T::zero()))
+        } else {
+            (xq[i], xv[i])
+        };
         for k in 0..K {
             let h = c[k][i];
             sq = madd(h, cq[k], sq);
             sv = madd(h, cv[k], sv);
+        }
+        if neg {
+            sq = -sq;
+            sv = -sv;
+        }
+        xq[i] = sq;
+        xv[i] = sv;
+    }
+}
+
+/// [`gemv2`] over columns that change in the same pass, for one-coordinate
+/// bodies of a chain (the low-rank products' S and P): entry i of column k,
+/// `cₖ[i]`, becomes `madd(g[i], gc[k], cₖ[i])` (the update of [`ger_add`]) —
+/// before the sums read it when `PRE` (P_i = P_λ + H⁻¹[:, λ] J_λᵀ, then
+/// P_i G_c), after when not (S_i β_c, then S += H⁻¹[:, i] αᵢᵀ). The same
+/// operations as [`ger_add`] and [`gemv2`] one after the other, in one pass.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn gemv2_ger<T: Scalar, const K: usize, const OWN: bool, const PRE: bool>(
+    xq: &mut [T],
+    xv: &mut [T],
+    cols: &mut [T],
+    cq: &[T; 12],
+    cv: &[T; 12],
+    neg: bool,
+    own: (&[T], T, T),
+    g: &[T],
+    gc: &[T; 12],
+) {
+    let n = xq.len();
+    let mut c: [&mut [T]; K] = std::array::from_fn(|_| Default::default());
+    let mut rest = &mut cols[..K * n];
+    for ck in c.iter_mut() {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(n);
+        *ck = head;
+        rest = tail;
+    }
+    let xv = &mut xv[..n];
+    let g = &g[..n];
+    let (h0, b0q, b0v) = own;
+    let h0 = if OWN { &h0[..n] } else { h0 };
+    for i in 0..n {
+        let (mut sq, mut sv) = if OWN {
+            (madd(h0[i], b0q, T::zero()), madd(h0[i], b0v, T::zero()))
+        } else {
+            (xq[i], xv[i])
+        };
+        let gi = g[i];
+        for k in 0..K {
+            let old = c[k][i];
+            let h = if PRE { madd(gi, gc[k], old) } else { old };
+            sq = madd(h, cq[k], sq);
+            sv = madd(h, cv[k], sv);
+            c[k][i] = if PRE { h } else { madd(gi, gc[k], old) };
         }
         if neg {
             sq = -sq;
@@ -286,6 +362,16 @@ fn neg_mul_low_rank<T: Scalar>(model: &Model<T>, data: &mut Data<T>, ext: bool) 
             let bq_c = coef12([&dadq[c].ang, &dadq[c].lin, &dvdq[c].ang, &jc[c].ang]);
             let bv_c = coef12([&dadv[c].ang, &dadv[c].lin, &jc[c].ang, &zero]);
             let (xqc, xvc) = (&mut xq[c * n..(c + 1) * n], &mut xv[c * n..(c + 1) * n]);
+            if ni == 1 && !ext {
+                // one coordinate: its H⁻¹ column times B[i, c] starts the sums
+                // (no pass over zeros), S += H⁻¹[:, i] αᵢᵀ in the same pass
+                let h = &a[c0 * n..(c0 + 1) * n];
+                let own = (h, bq[c0 + c * n], bv[c0 + c * n]);
+                let (s, al) = (&mut sbuf[si..si + sz], alpha(c0));
+                gemv2_ger::<T, 9, true, false>(xqc, xvc, s, &bq_c, &bv_c, false, own, h, &al);
+                continue;
+            }
+            let s = &sbuf[si..si + sz];
             for (xc, b) in [(&mut *xqc, bq), (&mut *xvc, bv)] {
                 xc.fill(T::zero());
                 for r in c0..c0 + ni {
@@ -295,7 +381,6 @@ fn neg_mul_low_rank<T: Scalar>(model: &Model<T>, data: &mut Data<T>, ext: bool) 
                     }
                 }
             }
-            let s = &sbuf[si..si + sz];
             if ext {
                 gemv2_add::<T, 12>(xqc, xvc, s, &bq_c, &bv_c, false);
             } else {
@@ -304,6 +389,10 @@ fn neg_mul_low_rank<T: Scalar>(model: &Model<T>, data: &mut Data<T>, ext: bool) 
         }
         let s = &mut sbuf[si..si + sz];
         for r in c0..c0 + ni {
+            if ni == 1 && !ext {
+                // done with the column's sums above
+                break;
+            }
             let al = alpha(r);
             let h = &a[r * n..(r + 1) * n];
             if ext {
@@ -345,6 +434,20 @@ fn neg_mul_low_rank<T: Scalar>(model: &Model<T>, data: &mut Data<T>, ext: bool) 
             }
             let dst = &mut pbuf[o..o + psz];
             let (cp, np) = (joints[p].iv, joints[p].nv());
+            if np == 1 && ni == 1 {
+                // one coordinate on each side: P's update and x[:, c] in one pass
+                let (c, g) = (c0, &a[cp * n..(cp + 1) * n]);
+                let jr = coef12([&jc[cp].ang, &jc[cp].lin, &zero, &zero]);
+                let (xqc, xvc) = (&mut xq[c * n..(c + 1) * n], &mut xv[c * n..(c + 1) * n]);
+                let (gq, gv) = (&dfdq[c], &dfdv[c]);
+                let (cq, cv) = (
+                    coef12([&gq.ang, &gq.lin, &zero, &zero]),
+                    coef12([&gv.ang, &gv.lin, &zero, &zero]),
+                );
+                let own = (&[][..], T::zero(), T::zero());
+                gemv2_ger::<T, 6, false, true>(xqc, xvc, dst, &cq, &cv, true, own, g, &jr);
+                continue;
+            }
             for r in cp..cp + np {
                 let jr = coef12([&jc[r].ang, &jc[r].lin, &zero, &zero]);
                 ger_add::<T, 6>(dst, &a[r * n..(r + 1) * n], &jr);

@@ -9,19 +9,18 @@ use crate::spatial::ops::madd;
 use crate::spatial::{CompositeInertia, Force, Motion, Scalar};
 use nalgebra::{DVector, Matrix6, Vector3, Vector6};
 
-/// `[I_o, h*; h*ᵀ, m 1]`, the 6x6 angular-first matrix of an origin-form inertia
+/// `m = [I_o, h*; h*ᵀ, m 1]`, the 6x6 angular-first matrix of an origin-form inertia
 /// (docs/theory.md §"Spatial inertia").
 #[inline(always)]
-fn matrix6<T: Scalar>(y: &CompositeInertia<T>) -> Matrix6<T> {
+fn matrix6<T: Scalar>(y: &CompositeInertia<T>, m: &mut Matrix6<T>) {
     let hx = crate::spatial::skew(&y.h);
-    let mut m = Matrix6::zeros();
+    m.fill(T::zero());
     m.fixed_view_mut::<3, 3>(0, 0).copy_from(&y.io);
     m.fixed_view_mut::<3, 3>(0, 3).copy_from(&hx);
     m.fixed_view_mut::<3, 3>(3, 0).copy_from(&hx.transpose());
     m[(3, 3)] = y.m;
     m[(4, 4)] = y.m;
     m[(5, 5)] = y.m;
-    m
 }
 
 #[inline(always)]
@@ -67,6 +66,25 @@ fn rows6_mut<T>(x: &mut [T], w: usize, lo: usize, hi: usize) -> [&mut [T]; 6] {
         &mut r3[lo..hi],
         &mut r4[lo..hi],
         &mut r5[lo..hi],
+    ]
+}
+
+/// [`rows6_mut`] for reading.
+#[inline(always)]
+fn rows6<T>(x: &[T], w: usize, lo: usize, hi: usize) -> [&[T]; 6] {
+    let (r0, x) = x.split_at(w);
+    let (r1, x) = x.split_at(w);
+    let (r2, x) = x.split_at(w);
+    let (r3, x) = x.split_at(w);
+    let (r4, x) = x.split_at(w);
+    let r5 = &x[..w];
+    [
+        &r0[lo..hi],
+        &r1[lo..hi],
+        &r2[lo..hi],
+        &r3[lo..hi],
+        &r4[lo..hi],
+        &r5[lo..hi],
     ]
 }
 
@@ -139,10 +157,10 @@ pub(crate) fn minv_pass<T: Scalar>(
     ov[0] = Motion::zero();
     for i in 1..nb {
         let p = parent[i];
-        let (op, ovp) = (o_m_i[p], ov[p]);
-        let ovi = dispatch_joint!(&joints[i], ident[i], jm => {
+        let ovp = ov[p];
+        let (ovi, om) = dispatch_joint!(&joints[i], ident[i], jm => {
             let li = jm.placement(&placements[i], q);
-            let om = jm.world_pose(&op, &li);
+            let om = jm.world_pose(&o_m_i[p], &li);
             li_m_i[i] = li;
             o_m_i[i] = om;
             let iv = jm.joint().iv;
@@ -153,14 +171,14 @@ pub(crate) fn minv_pass<T: Scalar>(
                 jcol[iv + c] = s;
                 motion_axpy(&mut vj, v[iv + c], &s);
             }
-            ovp + vj
+            (ovp + vj, om)
         });
         ov[i] = ovi;
         // cᵢ = ⁰v̂_λ × ⁰v̂ᵢ (= ⁰v̂ᵢ × J q̇)
         agf[i] = ovp.cross(&ovi);
         // Iᴬᵢ = Yᵢ = ⁰X̂*ᵢ Îᵢ ⁱX̂₀, pᴬᵢ = ⁰v̂ᵢ ×* Yᵢ ⁰v̂ᵢ − f̂ᵢˣ
-        let y = inertias[i].act(&o_m_i[i]);
-        ia[i] = matrix6(&y);
+        let y = inertias[i].act(&om);
+        matrix6(&y, &mut ia[i]);
         let hm = y.mul_motion(&ovi);
         // Yᵢ and ⁰v̂ᵢ's momentum left for the derivative sweep that follows
         // (`rnea_derivatives_pass_after_minv`)
@@ -184,7 +202,9 @@ pub(crate) fn minv_pass<T: Scalar>(
         let (c0, ni) = (jt.iv, jt.nv());
         let (ce, end) = (c0 + ni, sub_end[i]);
         let fi = of[i];
-        let mut iai = ia[i];
+        // Iᴬᵢ in place (not needed after), the parent's before it (p < i)
+        let (ia_lo, ia_hi) = ia.split_at_mut(i);
+        let iai = &mut ia_hi[0];
         // the columns after the subtree start at zero (sweep 3 subtracts from them)
         for r in c0..ce {
             m[r * nv + end..(r + 1) * nv].fill(T::zero());
@@ -193,7 +213,7 @@ pub(crate) fn minv_pass<T: Scalar>(
             let s = jcol[c0];
             let ui = tau[c0] - s.dot(&fi);
             uq[c0] = ui;
-            let uvec = iai * mv(&s);
+            let uvec = &*iai * mv(&s);
             let d = s.dot(&fv(&uvec));
             if d.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater) || !d.is_finite() {
                 return Err(DynamicsError::Singular(c0));
@@ -256,8 +276,8 @@ pub(crate) fn minv_pass<T: Scalar>(
                         iai[(r, cc)] = madd(-udvec[r], uvec[cc], iai[(r, cc)]);
                     }
                 }
-                let pa = fi + fv(&(iai * mv(&agf[i]) + udvec * ui));
-                add6(&mut ia[p], &iai);
+                let pa = fi + fv(&(&*iai * mv(&agf[i]) + udvec * ui));
+                add6(&mut ia_lo[p], iai);
                 of[p] += pa;
             }
         } else {
@@ -268,7 +288,7 @@ pub(crate) fn minv_pass<T: Scalar>(
                 jm.set_column(r, &mv(&jcol[c0 + r]));
                 uq[c0 + r] = tau[c0 + r] - jcol[c0 + r].dot(&fi);
             }
-            let u = iai * jm;
+            let u = &*iai * jm;
             let mut d = jm.transpose() * u;
             // fewer than 6 coordinates (spherical, planar): the unused block is 1
             for r in ni..6 {
@@ -317,9 +337,9 @@ pub(crate) fn minv_pass<T: Scalar>(
                     }
                 }
                 let uvec = Vector6::from_fn(|r, _| if r < ni { uq[c0 + r] } else { T::zero() });
-                iai -= ud * u.transpose();
-                let pa = fi + fv(&(iai * mv(&agf[i]) + ud * uvec));
-                add6(&mut ia[p], &iai);
+                *iai -= ud * u.transpose();
+                let pa = fi + fv(&(&*iai * mv(&agf[i]) + ud * uvec));
+                add6(&mut ia_lo[p], iai);
                 of[p] += pa;
             }
         }
@@ -369,9 +389,7 @@ pub(crate) fn minv_pass<T: Scalar>(
             (&[], &mut acol[acol_off[i]..acol_off[i] + sz])
         };
         let ap: [&[T]; 6] = if p != 0 {
-            // entry by entry (`array::from_fn` was an out-of-line call)
-            let row = |k: usize| &ap_buf[k * nv + c0..(k + 1) * nv];
-            [row(0), row(1), row(2), row(3), row(4), row(5)]
+            rows6(ap_buf, nv, c0, nv)
         } else {
             [&[]; 6]
         };

@@ -155,7 +155,8 @@ pub struct Data<T: Scalar = f64> {
     pub minv_udinv: Vec<Force<T>>,
     /// H⁻¹, per velocity coordinate: `u = τ − Jᵀ pᴬ`.
     pub minv_uq: Vec<T>,
-    /// H⁻¹: articulated inertia of each body (6x6, angular first, world).
+    /// H⁻¹: articulated inertia of each body (6x6, angular first, world); left
+    /// holding a non-root body's Iᵃ = Iᴬ − U D⁻¹ Uᵀ (scratch, updated in place).
     pub minv_ia: Vec<Matrix6<T>>,
     /// H⁻¹: world velocity of each body.
     pub minv_ov: Vec<Motion<T>>,
