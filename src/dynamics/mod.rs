@@ -7,6 +7,7 @@
 
 mod aba;
 mod aba_derivatives;
+mod aba_low_rank;
 mod centroidal;
 mod com;
 pub(crate) mod constraint_dynamics;
