@@ -76,11 +76,23 @@ impl<'a> Gains<'a> {
             v_ref: &v_ref.as_slice()[..nv],
         }
     }
-    /// [`Servo::torque`] (the same operations).
+    /// [`Servo::torque`] on the cut slices.
     #[inline(always)]
     fn torque(&self, iq: usize, iv: usize, q: f64, v: f64) -> f64 {
-        self.kp[iv] * (self.q_ref[iq] - q) + self.kd[iv] * (self.v_ref[iv] - v)
+        pd(
+            self.kp[iv],
+            self.kd[iv],
+            self.q_ref[iq] - q,
+            self.v_ref[iv] - v,
+        )
     }
+}
+
+/// The servo law of one coordinate, τ = kp e_q + kd e_v from its errors
+/// e_q = q_ref − q and e_v = v_ref − v.
+#[inline(always)]
+fn pd(kp: f64, kd: f64, e_q: f64, e_v: f64) -> f64 {
+    kp * e_q + kd * e_v
 }
 
 impl Servo {
@@ -141,7 +153,8 @@ impl Servo {
     pub fn torque(&self, iq: usize, iv: usize, q: f64, v: f64) -> f64 {
         // (slices: one bounds test an entry, not a matrix index's)
         let (kp, kd) = (self.kp.as_slice(), self.kd.as_slice());
-        kp[iv] * (self.q_ref.as_slice()[iq] - q) + kd[iv] * (self.v_ref.as_slice()[iv] - v)
+        let (q_ref, v_ref) = (self.q_ref.as_slice(), self.v_ref.as_slice());
+        pd(kp[iv], kd[iv], q_ref[iq] - q, v_ref[iv] - v)
     }
 }
 
