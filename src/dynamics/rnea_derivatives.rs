@@ -206,57 +206,65 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
         let p = parent[i];
         let (ovp, oap) = (ov[p], oa[p]);
         let c0 = col0[i];
-        let (ovi, oai) = dispatch_joint!(&joints[i], ident[i], jm => {
-            let iv = jm.joint().iv;
-            let om = if K {
-                o_m_i[i]
+        // ⁰v̂ᵢ = ⁰v̂ₚ + J q̇, ⁰âᵢ = ⁰âₚ + J q̈ + ⁰v̂ᵢ × J q̇, the world columns J
+        // (s, from c) first kept
+        macro_rules! joint_columns {
+            ($iv:expr, $n:expr, |$c:ident| $s:expr) => {{
+                let iv = $iv;
+                let mut vj = Motion::zero();
+                let mut aj = Motion::zero();
+                for $c in 0..$n {
+                    let s = $s;
+                    jcol[c0 + $c] = s;
+                    vj += s * v[iv + $c];
+                    aj += s * a[iv + $c];
+                }
+                let ovi = ovp + vj;
+                let oai = oap + aj + ovi.cross(&vj);
+                for c in 0..$n {
+                    let k = c0 + c;
+                    let s = jcol[k];
+                    // ∂v/∂q = v̂ₚ × J, ∂a/∂q = âₚ × J + v̂ₚ × ∂v/∂q, ∂a/∂v = v̂ᵢ × J + ∂v/∂q
+                    let dv = ovp.cross(&s);
+                    dvdq[k] = dv;
+                    dadq[k] = oap.cross(&s) + ovp.cross(&dv);
+                    dadv[k] = ovi.cross(&s) + dv;
+                }
+                (ovi, oai)
+            }};
+        }
+        let (ovi, oai) = if K {
+            // minv_pass's world columns (no joint dispatch); one column apart (a
+            // loop of one iteration: nothing hoisted out and spilled)
+            let jt = &joints[i];
+            let (iv, n) = (jt.iv, jt.nv());
+            if n == 1 {
+                joint_columns!(iv, 1, |c| minv_j[iv + c])
             } else {
+                joint_columns!(iv, n, |c| minv_j[iv + c])
+            }
+        } else {
+            dispatch_joint!(&joints[i], ident[i], jm => {
                 let li = jm.placement(&placements[i], q);
                 let om = jm.world_pose(&o_m_i[p], &li);
                 li_m_i[i] = li;
                 o_m_i[i] = om;
-                om
-            };
-            // ⁰v̂ᵢ = ⁰v̂ₚ + J q̇, ⁰âᵢ = ⁰âₚ + J q̈ + ⁰v̂ᵢ × J q̇
-            let mut vj = Motion::zero();
-            let mut aj = Motion::zero();
-            for c in 0..jm.nv() {
-                let s = if K {
-                    minv_j[iv + c]
-                } else {
-                    jm.subspace_in(c, &om)
-                };
-                jcol[c0 + c] = s;
-                vj += s * v[iv + c];
-                aj += s * a[iv + c];
-            }
-            let ovi = ovp + vj;
-            let oai = oap + aj + ovi.cross(&vj);
-            for c in 0..jm.nv() {
-                let k = c0 + c;
-                let s = jcol[k];
-                // ∂v/∂q = v̂ₚ × J, ∂a/∂q = âₚ × J + v̂ₚ × ∂v/∂q, ∂a/∂v = v̂ᵢ × J + ∂v/∂q
-                let dv = ovp.cross(&s);
-                dvdq[k] = dv;
-                dadq[k] = oap.cross(&s) + ovp.cross(&dv);
-                dadv[k] = ovi.cross(&s) + dv;
-            }
-            (ovi, oai)
-        });
+                joint_columns!(jm.joint().iv, jm.nv(), |c| jm.subspace_in(c, &om))
+            })
+        };
         ov[i] = ovi;
         oa[i] = oai;
-        // ⁰Yᵢ, the world force f = Y a + v ×* Y v and its variation Ẏ
-        let (y, hm) = if K {
-            (oy[i], hmom[i])
-        } else {
+        // ⁰Yᵢ, the world force f = Y a + v ×* Y v and its variation Ẏ (with K,
+        // the inertia and momentum minv_pass left, read in place)
+        if !K {
             let y = inertias[i].act(&o_m_i[i]);
             let hm = y.mul_motion(&ovi);
             hmom[i] = hm;
             oy[i] = y;
-            (y, hm)
-        };
-        of[i] = y.mul_motion(&oai) + ovi.cross_force(&hm);
-        doy[i] = variation_s(&y, &ovi);
+        }
+        let (y, hm) = (&oy[i], &hmom[i]);
+        of[i] = y.mul_motion(&oai) + ovi.cross_force(hm);
+        doy[i] = variation_s(y, &ovi);
         if F {
             fbody[i] = Force::zero();
             ext_t[i] = Vector3::zeros();
@@ -302,10 +310,13 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
     let (mq, mv, ma) = (&mut mq[..n * n], &mut mv[..n * n], &mut ma[..n * n]);
     for i in (1..nb).rev() {
         let p = parent[i];
-        let yi = oy[i];
-        let doyi = doy[i];
-        let hmi = hmom[i];
-        let fi = of[i];
+        // body i's composite Y, Ẏ, momentum and force read in place, its
+        // parent's (p < i) accumulated after
+        let (oy_lo, oy_hi) = oy.split_at_mut(i);
+        let (doy_lo, doy_hi) = doy.split_at_mut(i);
+        let (hm_lo, hm_hi) = hmom.split_at_mut(i);
+        let (of_lo, of_hi) = of.split_at_mut(i);
+        let (yi, doyi, hmi, fi) = (&oy_hi[0], &doy_hi[0], &hm_hi[0], &of_hi[0]);
         let c0 = col0[i];
         let nvi = joints[i].nv();
         let ce = c0 + nvi;
@@ -318,9 +329,9 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
             // angular-velocity columns of ∂τ/∂v (a root has nothing to pass on)
             for k in c0..ce {
                 let s = jcol[k];
-                tau[col_iv[k]] += s.dot(&fi);
+                tau[col_iv[k]] += s.dot(fi);
                 if k >= c0 + 3 {
-                    dfdv[k] = variation_mul(&doyi, &hmi, &s) + yi.mul_motion(&dadv[k]);
+                    dfdv[k] = variation_mul(doyi, hmi, &s) + yi.mul_motion(&dadv[k]);
                 }
             }
             for r in c0..ce {
@@ -342,72 +353,85 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
             }
             continue;
         }
-        for k in c0..ce {
-            let s = jcol[k];
-            // τ = Jᵀ F
-            tau[col_iv[k]] += s.dot(&fi);
-            // ∂F/∂a = Y J, ∂F/∂q = Ẏ ∂v/∂q + Y ∂a/∂q, ∂F/∂v = Ẏ J + Y ∂a/∂v, Ẏᵀ J
-            dfda[k] = yi.mul_motion(&s);
-            dfdq[k] = if root {
-                yi.mul_motion(&dadq[k])
-            } else {
-                variation_mul(&doyi, &hmi, &dvdq[k]) + yi.mul_motion(&dadq[k])
+        // the joint's columns against its subtree: written once for any
+        // number of columns and once for one (a loop of one iteration: its
+        // invariants are not hoisted out and spilled)
+        macro_rules! columns {
+            ($ce:ident) => {
+                for k in c0..$ce {
+                    let s = jcol[k];
+                    // τ = Jᵀ F
+                    tau[col_iv[k]] += s.dot(fi);
+                    // ∂F/∂a = Y J, ∂F/∂q = Ẏ ∂v/∂q + Y ∂a/∂q, ∂F/∂v = Ẏ J + Y ∂a/∂v, Ẏᵀ J
+                    dfda[k] = yi.mul_motion(&s);
+                    dfdq[k] = if root {
+                        yi.mul_motion(&dadq[k])
+                    } else {
+                        variation_mul(doyi, hmi, &dvdq[k]) + yi.mul_motion(&dadq[k])
+                    };
+                    dfdv[k] = variation_mul(doyi, hmi, &s) + yi.mul_motion(&dadv[k]);
+                    ytj[k] = variation_tr_mul(doyi, hmi, &s);
+                    if F {
+                        // the wrenches' world-fixed correction (docs/theory.md §"Derivatives"):
+                        // C = [ω × T + (tr P − Pᵀ) ω; ω × Σf], e = T × ω + (tr P − P) ω + Σf × v
+                        let (t, fs, pm) = (ext_t[i], ext_f[i], ext_p[i]);
+                        let tr = pm[(0, 0)] + pm[(1, 1)] + pm[(2, 2)];
+                        let w = s.ang;
+                        dfdq[k] += Force::new(cross(&w, &t) + w * tr - pm.transpose() * w, cross(&w, &fs));
+                        ext_e[k] = Force::new(
+                            cross(&t, &w) + w * tr - pm * w + cross(&fs, &s.lin),
+                            Vector3::zeros(),
+                        );
+                    }
+                }
+                for r in c0..$ce {
+                    let s = jcol[r];
+                    // rows of this joint, columns of its subtree: Jᵀ ∂F
+                    for c in c0..end {
+                        let at = r + c * n;
+                        if !K {
+                            ma[at] = s.dot(&dfda[c]);
+                        }
+                        mq[at] = s.dot(&dfdq[c]);
+                        mv[at] = s.dot(&dfdv[c]);
+                    }
+                    // rows of the strict subtree, columns of this joint
+                    let (aq, av, jr) = (dadq[r], dadv[r], s);
+                    let (dv, ang) = (dvdq[r], s.ang);
+                    for c in $ce..end {
+                        let at = c + r * n;
+                        let mut x = if root {
+                            aq.dot(&dfda[c])
+                        } else {
+                            aq.dot(&dfda[c]) + dv.dot(&ytj[c])
+                        };
+                        if F {
+                            x += crate::spatial::ops::dot(&ang, &ext_e[c].ang);
+                        }
+                        mq[at] = x;
+                        mv[at] = av.dot(&dfda[c]) + jr.dot(&ytj[c]);
+                        if !K {
+                            ma[at] = ma[r + c * n];
+                        }
+                    }
+                }
+                // the subtree moves rigidly with the joint: ∂F/∂q += J ×* F
+                for k in c0..$ce {
+                    dfdq[k] += jcol[k].cross_force(fi);
+                }
             };
-            dfdv[k] = variation_mul(&doyi, &hmi, &s) + yi.mul_motion(&dadv[k]);
-            ytj[k] = variation_tr_mul(&doyi, &hmi, &s);
-            if F {
-                // the wrenches' world-fixed correction (docs/theory.md §"Derivatives"):
-                // C = [ω × T + (tr P − Pᵀ) ω; ω × Σf], e = T × ω + (tr P − P) ω + Σf × v
-                let (t, fs, pm) = (ext_t[i], ext_f[i], ext_p[i]);
-                let tr = pm[(0, 0)] + pm[(1, 1)] + pm[(2, 2)];
-                let w = s.ang;
-                dfdq[k] += Force::new(cross(&w, &t) + w * tr - pm.transpose() * w, cross(&w, &fs));
-                ext_e[k] = Force::new(
-                    cross(&t, &w) + w * tr - pm * w + cross(&fs, &s.lin),
-                    Vector3::zeros(),
-                );
-            }
         }
-        for r in c0..ce {
-            let s = jcol[r];
-            // rows of this joint, columns of its subtree: Jᵀ ∂F
-            for c in c0..end {
-                let at = r + c * n;
-                if !K {
-                    ma[at] = s.dot(&dfda[c]);
-                }
-                mq[at] = s.dot(&dfdq[c]);
-                mv[at] = s.dot(&dfdv[c]);
-            }
-            // rows of the strict subtree, columns of this joint
-            let (aq, av, jr) = (dadq[r], dadv[r], s);
-            let (dv, ang) = (dvdq[r], s.ang);
-            for c in ce..end {
-                let at = c + r * n;
-                let mut x = if root {
-                    aq.dot(&dfda[c])
-                } else {
-                    aq.dot(&dfda[c]) + dv.dot(&ytj[c])
-                };
-                if F {
-                    x += crate::spatial::ops::dot(&ang, &ext_e[c].ang);
-                }
-                mq[at] = x;
-                mv[at] = av.dot(&dfda[c]) + jr.dot(&ytj[c]);
-                if !K {
-                    ma[at] = ma[r + c * n];
-                }
-            }
-        }
-        // the subtree moves rigidly with the joint: ∂F/∂q += J ×* F
-        for k in c0..ce {
-            dfdq[k] += jcol[k].cross_force(&fi);
+        if nvi == 1 {
+            let ce1 = c0 + 1;
+            columns!(ce1);
+        } else {
+            columns!(ce);
         }
         if p != 0 {
-            oy[p].add_assign(&yi);
-            doy[p] += doyi;
-            hmom[p] += hmi;
-            of[p] += fi;
+            oy_lo[p].add_assign(yi);
+            doy_lo[p] += *doyi;
+            hm_lo[p] += *hmi;
+            of_lo[p] += *fi;
             if F {
                 let (t, fs, pm) = (ext_t[i], ext_f[i], ext_p[i]);
                 ext_t[p] += t;
