@@ -230,21 +230,43 @@ impl GroundContact {
         let kept = &self.prev_list[pa..pb];
         let kept_all = &self.prev_list[pa..pc];
         let start = out.len();
+        // the kept picks still in the band (slot, place, world point), looked
+        // up once for every criterion (at most one pick a criterion: `dirs + 1`
+        // ≤ MAX_DIRS + 1 of them; beyond, looked up per criterion)
+        let mut kin = [(0usize, 0usize, Vector3::zeros()); MAX_DIRS + 1];
+        let mut nk = 0;
+        let cached = kept.len() <= kin.len();
+        if cached {
+            for &slot in kept {
+                if let Some(t) = at(slot) {
+                    kin[nk] = (slot, t, pts.get(t));
+                    nk += 1;
+                }
+            }
+        }
         for (q, &bq) in best.iter().enumerate().take(dirs + 1) {
             let hold = if q == 0 { HOLD_DEEPEST } else { HOLD_EXTREME };
-            let mut ch = usize::MAX;
-            for &slot in kept {
-                if slot < ch {
-                    if let Some(t) = at(slot) {
-                        if key(&pts.get(t), q) >= bq - hold {
-                            ch = slot;
+            let (mut ch, mut tch) = (usize::MAX, 0);
+            if cached {
+                for &(slot, t, p) in &kin[..nk] {
+                    if slot < ch && key(&p, q) >= bq - hold {
+                        (ch, tch) = (slot, t);
+                    }
+                }
+            } else {
+                for &slot in kept {
+                    if slot < ch {
+                        if let Some(t) = at(slot) {
+                            if key(&pts.get(t), q) >= bq - hold {
+                                (ch, tch) = (slot, t);
+                            }
                         }
                     }
                 }
             }
             // the choice's place in the band
             let t = if ch != usize::MAX {
-                at(ch).unwrap_or(0)
+                tch
             } else {
                 let (mut kmin, mut tmin) = (usize::MAX, 0);
                 for (t, &i) in cand.iter().enumerate() {

@@ -119,9 +119,7 @@ impl MassFactor {
 
     /// [`Self::row_transform_lanes`] on a chain path of `N` dofs (`path[..N]`,
     /// `y[..N]`; false, nothing done, when either is shorter): the rows copied
-    /// into registers, every loop's bounds constant (unrolled, no bounds
-    /// tests); each lane's entry takes the same operations in the same order,
-    /// y[j] −= L[path[t], path[j]]·y[t] for t from the leaf in, then the scaling.
+    /// into registers, transformed there ([`Self::chain_elim`]) and copied back.
     #[inline(always)]
     fn lanes_chain<const N: usize>(&self, path: &[usize], y: &mut [[f64; 4]]) -> bool {
         let (Some(path), Some(y)) = (path.get(..N), y.get_mut(..N)) else {
@@ -129,6 +127,35 @@ impl MassFactor {
         };
         let mut w = [[0.0; 4]; N];
         w.copy_from_slice(y);
+        if !self.chain_elim::<N>(path, &mut w) {
+            return false;
+        }
+        y.copy_from_slice(&w);
+        true
+    }
+
+    /// [`Self::row_transform_lanes`] of rows held in registers, `w[t] = [y₀ₜ,
+    /// y₁ₜ, y₂ₜ, pad]`, on a path of `N` dofs that is a tree factor's chain
+    /// root … leaf (a contact's three rows on one body's path): the same
+    /// operations in the same order (the same bits). False where the factor
+    /// is dense or `path` is not the chain; `w` is then not (or not wholly)
+    /// transformed, and the caller starts again from its rows.
+    #[inline(always)]
+    pub fn chain_lanes<const N: usize>(&self, path: &[usize], w: &mut [[f64; 4]; N]) -> bool {
+        self.tree && path.len() == N && self.is_chain(path) && self.chain_elim::<N>(path, w)
+    }
+
+    /// The elimination and scaling of [`Self::row_transform_lanes`] on a chain
+    /// path of `N` dofs (`path[..N]`), in registers: every loop's bounds
+    /// constant (unrolled, no bounds tests); each lane's entry takes the same
+    /// operations in the same order, y[j] −= L[path[t], path[j]]·y[t] for t
+    /// from the leaf in, then the scaling. False (w partly done) where L's
+    /// entries are not all there.
+    #[inline(always)]
+    fn chain_elim<const N: usize>(&self, path: &[usize], w: &mut [[f64; 4]; N]) -> bool {
+        let Some(path) = path.get(..N) else {
+            return false;
+        };
         for t in (1..N).rev() {
             let a = w[t];
             let s = self.start[path[t]];
@@ -147,7 +174,6 @@ impl MassFactor {
                 *x *= d;
             }
         }
-        y.copy_from_slice(&w);
         true
     }
 

@@ -84,6 +84,25 @@ impl Rows {
         if !f.is_tree() || pl > self.lanes.len() || self.j.len() < (r + 3) * st {
             return false;
         }
+        // a chain path (one body's: every contact of a robot on the ground)
+        // of up to 12 dofs: in registers, no scratch
+        let done = match pl {
+            2 => self.form_chain::<2>(f, r, path, vfree),
+            3 => self.form_chain::<3>(f, r, path, vfree),
+            4 => self.form_chain::<4>(f, r, path, vfree),
+            5 => self.form_chain::<5>(f, r, path, vfree),
+            6 => self.form_chain::<6>(f, r, path, vfree),
+            7 => self.form_chain::<7>(f, r, path, vfree),
+            8 => self.form_chain::<8>(f, r, path, vfree),
+            9 => self.form_chain::<9>(f, r, path, vfree),
+            10 => self.form_chain::<10>(f, r, path, vfree),
+            11 => self.form_chain::<11>(f, r, path, vfree),
+            12 => self.form_chain::<12>(f, r, path, vfree),
+            _ => false,
+        };
+        if done {
+            return true;
+        }
         let buf = &mut self.lanes[..pl];
         let j = &self.j[r * st..(r + 3) * st];
         let (j0, j1, j2) = (&j[..pl], &j[st..st + pl], &j[2 * st..2 * st + pl]);
@@ -118,6 +137,73 @@ impl Rows {
         }
         if let Some(yl) = self.ylanes.get_mut(r * st..r * st + pl) {
             yl.copy_from_slice(buf);
+        }
+        self.c[r..r + 3].copy_from_slice(&c[..3]);
+        self.w[r..r + 3].copy_from_slice(&d[..3]);
+        self.w_block[r] = [o[0], o[1], o[2]];
+        true
+    }
+
+    /// [`Rows::form_lanes`] on a chain path of `N` dofs
+    /// ([`MassFactor::chain_lanes`]): the three rows gathered straight into
+    /// registers, transformed there, and Y, its lanes, W and c written from
+    /// them (no scratch, no copies between): each value the same operations
+    /// in the same order, the same bits. False, nothing written, where the
+    /// path is not a chain of `N` (the caller's general way then).
+    #[inline(always)]
+    fn form_chain<const N: usize>(
+        &mut self,
+        f: &MassFactor,
+        r: usize,
+        path: &[usize],
+        vfree: &[f64],
+    ) -> bool {
+        let st = self.stride;
+        let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..(r + 3) * st)) else {
+            return false;
+        };
+        if N > st || path.iter().any(|&d| d >= vfree.len()) {
+            return false;
+        }
+        let (j0, j1, j2) = (&j[..N], &j[st..st + N], &j[2 * st..2 * st + N]);
+        // c = J v*, each row's sum from 0 in path order
+        let mut w = [[0.0f64; 4]; N];
+        let mut c = [0.0f64; 4];
+        for t in 0..N {
+            let b = [j0[t], j1[t], j2[t], 0.0];
+            w[t] = b;
+            let x = vfree[path[t]];
+            for (ci, &bi) in c.iter_mut().zip(b.iter()) {
+                *ci += bi * x;
+            }
+        }
+        if !f.chain_lanes::<N>(path, &mut w) {
+            return false;
+        }
+        // W's diagonal and the block's off-diagonal entries, each a sum in
+        // path order from −0 (as `Iterator::sum` of f64)
+        let (mut d, mut o) = ([-0.0f64; 4], [-0.0f64; 4]);
+        for b in w.iter() {
+            let p = [b[0] * b[0], b[1] * b[1], b[2] * b[2], 0.0];
+            let q = [b[0] * b[1], b[0] * b[2], b[1] * b[2], 0.0];
+            for i in 0..4 {
+                d[i] += p[i];
+                o[i] += q[i];
+            }
+        }
+        let y = &mut self.y[r * st..(r + 3) * st];
+        let (y0, rest) = y.split_at_mut(st);
+        let (y1, y2) = rest.split_at_mut(st);
+        let yl = self.ylanes.get_mut(r * st..r * st + N);
+        for (t, b) in w.iter().enumerate() {
+            y0[t] = b[0];
+            y1[t] = b[1];
+            y2[t] = b[2];
+        }
+        if let Some(yl) = yl {
+            for (l, b) in yl.iter_mut().zip(w.iter()) {
+                *l = *b;
+            }
         }
         self.c[r..r + 3].copy_from_slice(&c[..3]);
         self.w[r..r + 3].copy_from_slice(&d[..3]);
