@@ -216,10 +216,19 @@ impl Rows {
                         // a contact's three rows in one pass over its path: the
                         // normal, then the tangent pair from the velocity the
                         // normal's change left (through the block's entries)
-                        let p = path(r);
+                        // SAFETY: r is a row of `runs`, whose paths lie in
+                        // `table` and are at most `st` long (checked above), and
+                        // r < n, so r·st + len ≤ n·st = ylanes.len()
+                        let (p, lanes) = unsafe {
+                            let (s, l) = *paths.get_unchecked(r);
+                            (
+                                table.get_unchecked(s..s + l),
+                                ylanes.get_unchecked(r * st..r * st + l),
+                            )
+                        };
                         // the three dots side by side over the interleaved
                         // copy of their y (each a sum from 0 in path order)
-                        let [dn, d1, d2, _] = dot3(&ylanes[r * st..r * st + p.len()], p, dv);
+                        let [dn, d1, d2, _] = dot3(lanes, p, dv);
                         let [wn1, wn2, w12] = w_block[r];
                         let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
                         let on = lambda[r];
@@ -249,21 +258,26 @@ impl Rows {
                         lambda[r + 2] = t2;
                         let (dl1, dl2) = (t1 - o1, t2 - o2);
                         if dln != 0.0 || dl1 != 0.0 || dl2 != 0.0 {
-                            for (t, &k) in p.iter().enumerate() {
-                                unsafe {
-                                    *dv.get_unchecked_mut(k) += dln * y.get_unchecked(r * st + t)
-                                        + dl1 * y.get_unchecked((r + 1) * st + t)
-                                        + dl2 * y.get_unchecked((r + 2) * st + t);
-                                }
-                            }
+                            // Δv' += Δλₙ yₙ + Δλ₁ y₁ + Δλ₂ y₂ over the path
+                            let l = p.len();
+                            let yr = |q: usize| &y[q * st..q * st + l];
+                            axpy3([dln, dl1, dl2], [yr(r), yr(r + 1), yr(r + 2)], p, dv);
                             if block {
                                 lb.follow(&view, r, &[dln, dl1, dl2], lambda, dv);
                             }
                         }
-                        change = change
-                            .max(measure(first, (dln * wnn).abs(), un, &mut u_prev[r]))
-                            .max(measure(first, (dl1 * w11).abs(), u1, &mut u_prev[r + 1]))
-                            .max(measure(first, (dl2 * w22).abs(), u2, &mut u_prev[r + 2]));
+                        change = most(
+                            change,
+                            measure(first, (dln * wnn).abs(), un, &mut u_prev[r]),
+                        );
+                        change = most(
+                            change,
+                            measure(first, (dl1 * w11).abs(), u1, &mut u_prev[r + 1]),
+                        );
+                        change = most(
+                            change,
+                            measure(first, (dl2 * w22).abs(), u2, &mut u_prev[r + 2]),
+                        );
                         r += 3;
                         continue;
                     }
@@ -298,9 +312,12 @@ impl Rows {
                             if block {
                                 lb.follow(&view, r, &[d1, d2], lambda, dv);
                             }
-                            change = change
-                                .max(measure(first, (d1 * w11).abs(), u1, &mut u_prev[r]))
-                                .max(measure(first, (d2 * w22).abs(), u2, &mut u_prev[r + 1]));
+                            change =
+                                most(change, measure(first, (d1 * w11).abs(), u1, &mut u_prev[r]));
+                            change = most(
+                                change,
+                                measure(first, (d2 * w22).abs(), u2, &mut u_prev[r + 1]),
+                            );
                             r += 2;
                             continue;
                         }
@@ -333,13 +350,13 @@ impl Rows {
                             lb.follow(&view, r, &[d], lambda, dv);
                         }
                     }
-                    change = change.max(measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
+                    change = most(change, measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
                     r += 1;
                 }
             }
             if block {
                 // (rounding only: every update above kept the loop rows on target)
-                change = change.max(lb.solve(&view, Some(c), b, lambda, dv));
+                change = most(change, lb.solve(&view, Some(c), b, lambda, dv));
             }
             if finishing || (change <= tol && plain) {
                 converged = true;
@@ -415,6 +432,81 @@ fn dot3(l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
             }
         }
         s
+    }
+}
+
+/// The contact's update x[pₜ] += (a₀ y₀ₜ + a₁ y₁ₜ) + a₂ y₂ₜ over a contact's path
+/// `p` (its three rows of y, `ys`, each at least `p.len()` long), each entry
+/// the same operations in the same order as the scalar loop, four path slots
+/// at a time (gathered and scattered: a path's dofs are distinct);
+/// the indices of `p` must be < `x.len()` (a row's path: dof indices < nv).
+#[inline(always)]
+fn axpy3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
+    debug_assert!(p.iter().all(|&k| k < x.len()));
+    debug_assert!(p.iter().enumerate().all(|(i, k)| !p[..i].contains(k)));
+    let n = p.len().min(ys[0].len()).min(ys[1].len()).min(ys[2].len());
+    let [y0, y1, y2] = ys;
+    #[allow(unused_mut)]
+    let mut t = 0;
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    {
+        use std::arch::x86_64::*;
+        // SAFETY: avx is enabled at compile time; t + 3 < n ≤ every slice's
+        // length; every k < x.len() (the sweeps' check of the paths), and the
+        // four k of a group are distinct (a path lists a dof once)
+        unsafe {
+            let (a0, a1, a2) = (
+                _mm256_set1_pd(a[0]),
+                _mm256_set1_pd(a[1]),
+                _mm256_set1_pd(a[2]),
+            );
+            let xp = x.as_mut_ptr();
+            while t + 4 <= n {
+                let s = _mm256_add_pd(
+                    _mm256_add_pd(
+                        _mm256_mul_pd(a0, _mm256_loadu_pd(y0.as_ptr().add(t))),
+                        _mm256_mul_pd(a1, _mm256_loadu_pd(y1.as_ptr().add(t))),
+                    ),
+                    _mm256_mul_pd(a2, _mm256_loadu_pd(y2.as_ptr().add(t))),
+                );
+                let k = [
+                    *p.get_unchecked(t),
+                    *p.get_unchecked(t + 1),
+                    *p.get_unchecked(t + 2),
+                    *p.get_unchecked(t + 3),
+                ];
+                let lo = _mm_loadh_pd(_mm_load_sd(xp.add(k[0])), xp.add(k[1]));
+                let hi = _mm_loadh_pd(_mm_load_sd(xp.add(k[2])), xp.add(k[3]));
+                let v = _mm256_add_pd(_mm256_set_m128d(hi, lo), s);
+                let (vlo, vhi) = (_mm256_castpd256_pd128(v), _mm256_extractf128_pd::<1>(v));
+                _mm_storel_pd(xp.add(k[0]), vlo);
+                _mm_storeh_pd(xp.add(k[1]), vlo);
+                _mm_storel_pd(xp.add(k[2]), vhi);
+                _mm_storeh_pd(xp.add(k[3]), vhi);
+                t += 4;
+            }
+        }
+    }
+    while t < n {
+        // SAFETY: t < n ≤ every slice's length; p[t] < x.len() (as above)
+        unsafe {
+            let k = *p.get_unchecked(t);
+            *x.get_unchecked_mut(k) += a[0] * y0.get_unchecked(t)
+                + a[1] * y1.get_unchecked(t)
+                + a[2] * y2.get_unchecked(t);
+        }
+        t += 1;
+    }
+}
+
+/// The larger of a convergence measure `change` (never NaN) and `x`: as
+/// `change.max(x)` (a NaN `x` leaves `change`), one compare.
+#[inline(always)]
+fn most(change: f64, x: f64) -> f64 {
+    if x > change {
+        x
+    } else {
+        change
     }
 }
 

@@ -100,13 +100,19 @@ impl Rows {
             return 0;
         }
         debug_assert!(table.iter().all(|&k| k < nv), "a dof path beyond nv");
+        // the rows read-only and μ apart (no reload of the rows' fields after
+        // each write of μ)
+        let (kinds, w, paths) = (&self.kind[..n], &self.w[..n], &self.path[..n]);
+        let (y, bpos) = (&self.y[..], &self.bpos[..n]);
+        let mu = &mut self.mu[..n];
+        let loops = &mut self.sm.loops;
         let mut it = 0;
         while it < max_iter {
             it += 1;
             let mut change: f64 = 0.0;
             for &(_, s, e) in runs {
                 for r in s..e {
-                    let kind = self.kind[r];
+                    let kind = kinds[r];
                     let bilateral = kind == RowKind::Bilateral;
                     if bilateral && block {
                         continue;
@@ -114,13 +120,12 @@ impl Rows {
                     if !bilateral && !matches!(kind, RowKind::Normal | RowKind::Unilateral) {
                         continue;
                     }
-                    let wrr = self.w[r];
+                    let wrr = w[r];
                     if !(wrr > 1e-14) {
                         continue;
                     }
-                    let (ps, pl) = self.path[r];
-                    let (Some(p), Some(yr)) =
-                        (table.get(ps..ps + pl), self.y.get(r * st..r * st + pl))
+                    let (ps, pl) = paths[r];
+                    let (Some(p), Some(yr)) = (table.get(ps..ps + pl), y.get(r * st..r * st + pl))
                     else {
                         continue;
                     };
@@ -130,12 +135,12 @@ impl Rows {
                         .zip(p)
                         .map(|(a, &k)| a * unsafe { *dw.get_unchecked(k) })
                         .sum();
-                    let old = self.mu[r];
-                    let x = old - (u - self.bpos[r]) / wrr;
+                    let old = mu[r];
+                    let x = old - (u - bpos[r]) / wrr;
                     let new = if bilateral { x } else { x.max(0.0) };
                     let d = new - old;
                     if d != 0.0 {
-                        self.mu[r] = new;
+                        mu[r] = new;
                         // w' += Δμ yᵣ
                         for (a, &k) in yr.iter().zip(p) {
                             unsafe { *dw.get_unchecked_mut(k) += d * a };
@@ -147,15 +152,11 @@ impl Rows {
             if block {
                 let view = BlockRows {
                     st,
-                    y: &self.y,
-                    paths: &self.path[..self.n],
+                    y,
+                    paths,
                     table,
                 };
-                let n = self.n;
-                let moved =
-                    self.sm
-                        .loops
-                        .solve(&view, None, &self.bpos[..n], &mut self.mu[..n], dw);
+                let moved = loops.solve(&view, None, bpos, mu, dw);
                 change = change.max(moved);
             }
             if change <= tol {
