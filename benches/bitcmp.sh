@@ -9,6 +9,7 @@ set -u
 A=$1; B=$2; OUT=$3; DUR=${4:-1}
 REPO=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 ERD=$(${PYTHON:-python3} -c "import sysconfig,os;print(os.path.join(sysconfig.get_paths()['purelib'],'cmeel.prefix','share'))")
+[ -d "$ERD/example-robot-data/robots" ] || { echo "bitcmp: no example-robot-data below $ERD (set PYTHON to a python that has it)" >&2; exit 2; }
 mkdir -p "$OUT/a" "$OUT/b" "$OUT/scenes"
 python3 - "$REPO" "$ERD" "$OUT/scenes" <<'PY'
 import json, os, sys, glob
