@@ -347,12 +347,15 @@ impl Constraints {
             for pt in points {
                 for start in [pt.body, pt.other] {
                     let mut i = start;
-                    while i != 0 && i < model.nbodies && self.sw_done[i] != self.sw_stamp {
-                        self.sw_done[i] = self.sw_stamp;
-                        let j = &model.joints[i];
-                        let o = o_m_i[i];
-                        for c in 0..j.nv().min(6) {
-                            self.sw[i][c] = o.act_motion(&j.subspace_column(c));
+                    while i != 0
+                        && let Some(done) = self.sw_done.get_mut(i)
+                        && *done != self.sw_stamp
+                        && let (Some(j), Some(o), Some(sw)) =
+                            (model.joints.get(i), o_m_i.get(i), self.sw.get_mut(i))
+                    {
+                        *done = self.sw_stamp;
+                        for (c, s) in sw.iter_mut().enumerate().take(j.nv()) {
+                            *s = o.act_motion(&j.subspace_column(c));
                         }
                         i = model.parent[i];
                     }
@@ -365,7 +368,6 @@ impl Constraints {
                     true => [0.0; 3],
                     false => wc.get(pt.slot).copied().unwrap_or([0.0; 3]),
                 }));
-            let nv = rows.nv;
             let body_path = |b: usize| {
                 let jb = &model.joints[b];
                 f.path_of((jb.iv + jb.nv()).saturating_sub(1))
@@ -395,30 +397,29 @@ impl Constraints {
                     }
                 }
                 let slot = &self.slot;
-                let jrows = &mut jall[rn * st..(rn + 3) * st];
+                let (j0, rest) = jall[rn * st..(rn + 3) * st].split_at_mut(st);
+                let (j1, j2) = rest.split_at_mut(st);
                 let mut put = |col: usize, a: f64, b: f64, c: f64| {
                     if let Some(&t) = slot.get(col)
                         && on_path.get(t) == Some(&col)
-                        && t < st
+                        && let (Some(x0), Some(x1), Some(x2)) =
+                            (j0.get_mut(t), j1.get_mut(t), j2.get_mut(t))
                     {
-                        jrows[t] += a;
-                        jrows[st + t] += b;
-                        jrows[2 * st + t] += c;
+                        *x0 += a;
+                        *x1 += b;
+                        *x2 += c;
                     }
                 };
                 if pt.other == 0 && pt.normal == Vector3::z() {
                     // the ground: rows n = z, t₁ = x, t₂ = y: the point velocity
                     // v_c + ω_c × p of each ancestor's world-frame subspace column c
                     let mut b = pt.body;
-                    while b != 0 {
-                        let j = &model.joints[b];
-                        for c in 0..j.nv().min(6) {
-                            let s = &self.sw[b][c];
+                    while b != 0
+                        && let (Some(j), Some(sw)) = (model.joints.get(b), self.sw.get(b))
+                    {
+                        for (c, s) in sw.iter().enumerate().take(j.nv()) {
                             let vp = s.lin + s.ang.cross(&pt.point);
-                            let col = j.iv + c;
-                            if col < nv {
-                                put(col, vp.z, vp.x, vp.y);
-                            }
+                            put(j.iv + c, vp.z, vp.x, vp.y);
                         }
                         b = model.parent[b];
                     }
@@ -429,15 +430,12 @@ impl Constraints {
                     let (t1, t2) = tangents(&pt.normal);
                     for (start, sign) in [(pt.body, 1.0), (pt.other, -1.0)] {
                         let mut b = start;
-                        while b != 0 {
-                            let j = &model.joints[b];
-                            for c in 0..j.nv().min(6) {
-                                let s = &self.sw[b][c];
+                        while b != 0
+                            && let (Some(j), Some(sw)) = (model.joints.get(b), self.sw.get(b))
+                        {
+                            for (c, s) in sw.iter().enumerate().take(j.nv()) {
                                 let vp = (s.lin + s.ang.cross(&pt.point)) * sign;
-                                let col = j.iv + c;
-                                if col < nv {
-                                    put(col, pt.normal.dot(&vp), t1.dot(&vp), t2.dot(&vp));
-                                }
+                                put(j.iv + c, pt.normal.dot(&vp), t1.dot(&vp), t2.dot(&vp));
                             }
                             b = model.parent[b];
                         }
@@ -473,7 +471,7 @@ impl Constraints {
                 if info.kind.nv() != 1 {
                     continue;
                 }
-                let (iq, iv) = (model.dof_q(d), model.dof_v(d));
+                let (iq, iv) = (info.iq, info.iv);
                 if info.friction > 0.0 {
                     let kind = RowKind::Box {
                         limit: info.friction * h,
