@@ -103,44 +103,14 @@ impl Rows {
         if done {
             return true;
         }
-        let buf = &mut self.lanes[..pl];
         let j = &self.j[r * st..(r + 3) * st];
-        let (j0, j1, j2) = (&j[..pl], &j[st..st + pl], &j[2 * st..2 * st + pl]);
-        // c = J v*, each row's sum from 0 in path order
-        let mut c = [0.0f64; 4];
-        for (t, (b, &d)) in buf.iter_mut().zip(path).enumerate() {
-            *b = [j0[t], j1[t], j2[t], 0.0];
-            let x = vfree[d];
-            for (ci, &bi) in c.iter_mut().zip(b.iter()) {
-                *ci += bi * x;
-            }
-        }
-        f.row_transform_lanes(path, buf);
-        // W's diagonal and the block's off-diagonal entries, each a sum in
-        // path order from −0 (as `Iterator::sum` of f64)
-        let (mut d, mut o) = ([-0.0f64; 4], [-0.0f64; 4]);
-        for b in buf.iter() {
-            let p = [b[0] * b[0], b[1] * b[1], b[2] * b[2], 0.0];
-            let q = [b[0] * b[1], b[0] * b[2], b[1] * b[2], 0.0];
-            for i in 0..4 {
-                d[i] += p[i];
-                o[i] += q[i];
-            }
-        }
-        let y = &mut self.y[r * st..(r + 3) * st];
-        let (y0, rest) = y.split_at_mut(st);
-        let (y1, y2) = rest.split_at_mut(st);
-        for (t, b) in buf.iter().enumerate() {
-            y0[t] = b[0];
-            y1[t] = b[1];
-            y2[t] = b[2];
-        }
-        if let Some(yl) = self.ylanes.get_mut(r * st..r * st + pl) {
-            yl.copy_from_slice(buf);
-        }
-        self.c[r..r + 3].copy_from_slice(&c[..3]);
-        self.w[r..r + 3].copy_from_slice(&d[..3]);
-        self.w_block[r] = [o[0], o[1], o[2]];
+        let rows = [&j[..pl], &j[st..st + pl], &j[2 * st..2 * st + pl]];
+        let c = gather_rows(rows, path, vfree, &mut self.lanes[..pl]);
+        f.row_transform_lanes(path, &mut self.lanes[..pl]);
+        // (put back below: taking it moves no entry)
+        let lanes = std::mem::take(&mut self.lanes);
+        self.store_block(r, &lanes[..pl], c);
+        self.lanes = lanes;
         true
     }
 
@@ -165,27 +135,32 @@ impl Rows {
         if N > st || path.iter().any(|&d| d >= vfree.len()) {
             return false;
         }
-        let (j0, j1, j2) = (&j[..N], &j[st..st + N], &j[2 * st..2 * st + N]);
-        // c = J v*, each row's sum from 0 in path order
         let mut w = [[0.0f64; 4]; N];
-        let mut c = [0.0f64; 4];
-        for t in 0..N {
-            let b = [j0[t], j1[t], j2[t], 0.0];
-            w[t] = b;
-            let x = vfree[path[t]];
-            for (ci, &bi) in c.iter_mut().zip(b.iter()) {
-                *ci += bi * x;
-            }
-        }
+        let c = gather_rows(
+            [&j[..N], &j[st..st + N], &j[2 * st..2 * st + N]],
+            path,
+            vfree,
+            &mut w,
+        );
         if !f.chain_lanes::<N>(path, &mut w) {
             return false;
         }
+        self.store_block(r, &w, c);
+        true
+    }
+
+    /// Contact r's formed block from its transformed rows `b` (one
+    /// [y₀ₜ, y₁ₜ, y₂ₜ, 0] a path slot) and c = J v*: Y's three rows, their
+    /// lanes, c, W's diagonal and the block's off-diagonal entries.
+    #[inline(always)]
+    fn store_block(&mut self, r: usize, b: &[[f64; 4]], c: [f64; 4]) {
+        let st = self.stride;
         // W's diagonal and the block's off-diagonal entries, each a sum in
         // path order from −0 (as `Iterator::sum` of f64)
         let (mut d, mut o) = ([-0.0f64; 4], [-0.0f64; 4]);
-        for b in w.iter() {
-            let p = [b[0] * b[0], b[1] * b[1], b[2] * b[2], 0.0];
-            let q = [b[0] * b[1], b[0] * b[2], b[1] * b[2], 0.0];
+        for bt in b {
+            let p = [bt[0] * bt[0], bt[1] * bt[1], bt[2] * bt[2], 0.0];
+            let q = [bt[0] * bt[1], bt[0] * bt[2], bt[1] * bt[2], 0.0];
             for i in 0..4 {
                 d[i] += p[i];
                 o[i] += q[i];
@@ -194,21 +169,18 @@ impl Rows {
         let y = &mut self.y[r * st..(r + 3) * st];
         let (y0, rest) = y.split_at_mut(st);
         let (y1, y2) = rest.split_at_mut(st);
-        let yl = self.ylanes.get_mut(r * st..r * st + N);
-        for (t, b) in w.iter().enumerate() {
-            y0[t] = b[0];
-            y1[t] = b[1];
-            y2[t] = b[2];
+        for (((bt, a), b1), b2) in b.iter().zip(y0).zip(y1).zip(y2) {
+            (*a, *b1, *b2) = (bt[0], bt[1], bt[2]);
         }
-        if let Some(yl) = yl {
-            for (l, b) in yl.iter_mut().zip(w.iter()) {
-                *l = *b;
+        if let Some(yl) = self.ylanes.get_mut(r * st..r * st + b.len()) {
+            // entry by entry: inlined for a chain's N, where copy_from_slice calls memcpy
+            for (l, bt) in yl.iter_mut().zip(b) {
+                *l = *bt;
             }
         }
         self.c[r..r + 3].copy_from_slice(&c[..3]);
         self.w[r..r + 3].copy_from_slice(&d[..3]);
         self.w_block[r] = [o[0], o[1], o[2]];
-        true
     }
 
     /// Whether row r is a contact normal followed by its two tangent rows on
@@ -222,4 +194,22 @@ impl Rows {
             && self.path[r + 1] == self.path[r]
             && self.path[r + 2] == self.path[r]
     }
+}
+
+/// c = J v* over a contact's three rows `j` on `path` (each row's sum from 0
+/// in path order), the rows gathered into `out`, one [j₀ₜ, j₁ₜ, j₂ₜ, 0] a
+/// path slot.
+#[inline(always)]
+fn gather_rows(j: [&[f64]; 3], path: &[usize], vfree: &[f64], out: &mut [[f64; 4]]) -> [f64; 4] {
+    let mut c = [0.0f64; 4];
+    let rows = j[0].iter().zip(j[1]).zip(j[2]);
+    for ((o, &d), ((&j0, &j1), &j2)) in out.iter_mut().zip(path).zip(rows) {
+        let b = [j0, j1, j2, 0.0];
+        *o = b;
+        let x = vfree[d];
+        for (ci, &bi) in c.iter_mut().zip(b.iter()) {
+            *ci += bi * x;
+        }
+    }
+    c
 }
