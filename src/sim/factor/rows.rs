@@ -117,23 +117,6 @@ impl MassFactor {
         }
     }
 
-    /// [`Self::row_transform_lanes`] on a chain path of `N` dofs (`path[..N]`,
-    /// `y[..N]`; false, nothing done, when either is shorter): the rows copied
-    /// into registers, transformed there ([`Self::chain_elim`]) and copied back.
-    #[inline(always)]
-    fn lanes_chain<const N: usize>(&self, path: &[usize], y: &mut [[f64; 4]]) -> bool {
-        let (Some(path), Some(y)) = (path.get(..N), y.get_mut(..N)) else {
-            return false;
-        };
-        let mut w = [[0.0; 4]; N];
-        w.copy_from_slice(y);
-        if !self.chain_elim::<N>(path, &mut w) {
-            return false;
-        }
-        y.copy_from_slice(&w);
-        true
-    }
-
     /// [`Self::row_transform_lanes`] of rows held in registers, `w[t] = [y₀ₜ,
     /// y₁ₜ, y₂ₜ, pad]`, on a path of `N` dofs that is a tree factor's chain
     /// root … leaf (a contact's three rows on one body's path): the same
@@ -202,26 +185,6 @@ impl MassFactor {
             _ => y[len - 1],
         };
         let chain = self.is_chain(&path[..len]);
-        if chain {
-            // a short chain (a robot's limb): unrolled, the rows in registers
-            let done = match len {
-                2 => self.lanes_chain::<2>(path, y),
-                3 => self.lanes_chain::<3>(path, y),
-                4 => self.lanes_chain::<4>(path, y),
-                5 => self.lanes_chain::<5>(path, y),
-                6 => self.lanes_chain::<6>(path, y),
-                7 => self.lanes_chain::<7>(path, y),
-                8 => self.lanes_chain::<8>(path, y),
-                9 => self.lanes_chain::<9>(path, y),
-                10 => self.lanes_chain::<10>(path, y),
-                11 => self.lanes_chain::<11>(path, y),
-                12 => self.lanes_chain::<12>(path, y),
-                _ => false,
-            };
-            if done {
-                return true;
-            }
-        }
         for t in (0..len).rev() {
             let a = next;
             if chain {
