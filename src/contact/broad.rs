@@ -366,3 +366,111 @@ impl SweepAndPrune {
         }
     }
 }
+
+/// The broad phase of fewer than 64 shapes whose allowed pairs are all
+/// known (one robot's self pairs): for each shape l, the shapes h > l whose
+/// boxes overlap l's as the bits of a mask (a branch-free test of every h,
+/// which vectorises; under [`DENSE_FROM`] shapes, a test of each allowed
+/// pair), kept where the pair is allowed. A robot's link boxes
+/// meet along x for most pairs, so a sweep along x tests nearly every pair
+/// anyway, with a branch and a table look-up each. The pairs reported are
+/// the sweeps': exactly the allowed ones whose boxes overlap.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct PairMasks {
+    /// Per shape l, the allowed shapes h > l, as bits.
+    allowed: Vec<u64>,
+    /// Scratch: the boxes' lower and upper corners, axis by axis.
+    lo: [Vec<f64>; 3],
+    hi: [Vec<f64>; 3],
+}
+
+/// Shapes from which [`PairMasks`] tests every shape h > l at once (fewer:
+/// each allowed pair, as a scalar test).
+const DENSE_FROM: usize = 16;
+
+impl PairMasks {
+    /// The masks of `n` shapes with the allowed pairs `pairs` (`None`: more
+    /// than 64 shapes).
+    pub(crate) fn new(n: usize, pairs: impl Iterator<Item = (usize, usize)>) -> Option<Self> {
+        if n > 64 {
+            return None;
+        }
+        let mut allowed = vec![0u64; n];
+        for (i, j) in pairs {
+            let (l, h) = (i.min(j), i.max(j));
+            if h < n && l < h {
+                allowed[l] |= 1 << h;
+            }
+        }
+        let axes = || [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        Some(Self {
+            allowed,
+            lo: axes(),
+            hi: axes(),
+        })
+    }
+
+    /// Calls `found(l, h)` for each allowed pair l < h whose boxes in `sap`
+    /// overlap, by l, then h.
+    pub(crate) fn overlaps(&mut self, sap: &SweepAndPrune, mut found: impl FnMut(usize, usize)) {
+        let n = self.allowed.len().min(sap.lo.len()).min(sap.hi.len());
+        if n < DENSE_FROM {
+            // few shapes: each allowed pair tested (x first, one branch)
+            for (l, &allowed) in self.allowed.iter().enumerate().take(n) {
+                let (li, hi) = (&sap.lo[l], &sap.hi[l]);
+                let mut mask = allowed;
+                while mask != 0 {
+                    let h = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let (Some(lj), Some(hj)) = (sap.lo.get(h), sap.hi.get(h)) else {
+                        continue;
+                    };
+                    let apart = lj[0] > hi[0]
+                        || li[0] > hj[0]
+                        || lj[1] > hi[1]
+                        || li[1] > hj[1]
+                        || lj[2] > hi[2]
+                        || li[2] > hj[2];
+                    if !apart {
+                        found(l, h);
+                    }
+                }
+            }
+            return;
+        }
+        for k in 0..n {
+            for a in 0..3 {
+                self.lo[a][k] = sap.lo[k][a];
+                self.hi[a][k] = sap.hi[k][a];
+            }
+        }
+        let [lx, ly, lz] = &self.lo;
+        let [hx, hy, hz] = &self.hi;
+        let (lx, ly, lz, hx, hy, hz) = (&lx[..n], &ly[..n], &lz[..n], &hx[..n], &hy[..n], &hz[..n]);
+        for l in 0..n {
+            let allowed = self.allowed[l];
+            if allowed == 0 {
+                continue;
+            }
+            let (a0, a1, a2, b0, b1, b2) = (lx[l], ly[l], lz[l], hx[l], hy[l], hz[l]);
+            // bit h: boxes l and h overlap (apart: one's lower corner above
+            // the other's upper one along an axis)
+            let mut mask = 0u64;
+            for h in l + 1..n {
+                let apart = (lx[h] > b0)
+                    | (a0 > hx[h])
+                    | (ly[h] > b1)
+                    | (a1 > hy[h])
+                    | (lz[h] > b2)
+                    | (a2 > hz[h]);
+                mask |= u64::from(!apart) << h;
+            }
+            mask &= allowed;
+            while mask != 0 {
+                let h = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                found(l, h);
+            }
+        }
+    }
+}

@@ -5,7 +5,7 @@
 use super::super::shapes::{from_pvec, to_pvec};
 use super::Member;
 use crate::spatial::Se3;
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 /// The gap of convex members `a` at `wa` and `b` at `wb` along the unit
 /// axis `u` (a's frame, from a toward b; zero: not known, −∞): min over b
@@ -36,12 +36,40 @@ pub(crate) fn apart_along(
     low_b - top_a
 }
 
+/// A pair found apart by more than the margin: the gap g along the
+/// separating plane, and each member's box centre (world) and rotation then.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Apart {
+    pub(crate) gap: f64,
+    pub(crate) ca: Vector3<f64>,
+    pub(crate) ra: Matrix3<f64>,
+    pub(crate) cb: Vector3<f64>,
+    pub(crate) rb: Matrix3<f64>,
+}
+
+/// A member now: its box centre `c` (world; w·c₀ for its box's centre c₀ in
+/// its frame), its pose `w` and its box's |h| (half extents).
+pub(crate) type Now<'a> = (&'a Vector3<f64>, &'a Se3<f64>, f64);
+
 /// Whether two shapes separated by a plane with a gap g (> the margin) at
-/// the world poses `then` are still more than `margin` apart at `wa`, `wb`
+/// the poses of `then` are still more than `margin` apart now (`a`, `b`)
 /// without a support query: no point of a shape moved farther than D =
-/// |w·c − w₀·c| + ‖R − R₀‖_F |h| (c, h its box's centre and half extents in
-/// its frame: every point lies within |h| of c), so across that plane the
+/// |w·c₀ − w₀·c₀| + ‖R − R₀‖_F |h| (c₀, h its box's centre and half extents
+/// in its frame: every point lies within |h| of c₀), so across that plane the
 /// shapes are still g − D_a − D_b apart (conservative advancement).
+#[inline]
+pub(crate) fn still_apart_at(then: Option<&Apart>, a: Now, b: Now, margin: f64) -> bool {
+    let Some(t) = then else {
+        return false;
+    };
+    let moved = |(c, w, h): Now, c0: &Vector3<f64>, r0: &Matrix3<f64>| {
+        (c - c0).norm() + (w.rot - r0).norm() * h
+    };
+    t.gap - moved(a, &t.ca, &t.ra) - moved(b, &t.cb, &t.rb) > margin
+}
+
+/// [`still_apart_at`] of members `a`, `b` at the world poses `wa`, `wb`,
+/// apart by `then` = (g, their poses then) (its box centres computed here).
 pub(crate) fn still_apart(
     then: Option<&(f64, Se3<f64>, Se3<f64>)>,
     a: &Member,
@@ -50,12 +78,15 @@ pub(crate) fn still_apart(
     wb: &Se3<f64>,
     margin: f64,
 ) -> bool {
-    let Some((gap, wa0, wb0)) = then else {
-        return false;
-    };
-    let moved = |m: &Member, w0: &Se3<f64>, w: &Se3<f64>| {
-        (w.act_point(&m.shape.mid) - w0.act_point(&m.shape.mid)).norm()
-            + (w.rot - w0.rot).norm() * m.shape.half.norm()
-    };
-    gap - moved(a, wa0, wa) - moved(b, wb0, wb) > margin
+    let then = then.map(|(gap, wa0, wb0)| Apart {
+        gap: *gap,
+        ca: wa0.act_point(&a.shape.mid),
+        ra: wa0.rot,
+        cb: wb0.act_point(&b.shape.mid),
+        rb: wb0.rot,
+    });
+    let (ca, cb) = (wa.act_point(&a.shape.mid), wb.act_point(&b.shape.mid));
+    let now_a = (&ca, wa, a.shape.half.norm());
+    let now_b = (&cb, wb, b.shape.half.norm());
+    still_apart_at(then.as_ref(), now_a, now_b, margin)
 }

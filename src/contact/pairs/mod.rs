@@ -13,7 +13,7 @@
 //! pair's slots: the slot of the same features last step (its impulse warm
 //! starts the solve), else a free one marked fresh (no warm start).
 
-use super::broad::{prefetch, PairTable, SweepAndPrune, LAZY_PAIR};
+use super::broad::{prefetch, PairMasks, PairTable, SweepAndPrune, LAZY_PAIR, STRIPS_FROM};
 use super::filter::{is_self_pair, may_touch};
 use super::narrow::prim::{round_points_at, Round};
 use super::narrow::{face_kind, face_points, parry_points, reduce_pair, FaceScratch, Raw};
@@ -29,7 +29,7 @@ use std::path::PathBuf;
 pub(crate) mod apart;
 mod order;
 mod start;
-use apart::{apart_along, still_apart};
+use apart::{apart_along, still_apart_at, Apart};
 use order::assign_slots;
 
 /// One shape of pair contact.
@@ -62,9 +62,9 @@ struct Pair {
     /// shapes last time, or their contact normal (zero: none).
     axis: Vector3<f64>,
     /// The last time `axis` separated the shapes by more than the margin:
-    /// the gap along it and both shapes' world poses then (see
-    /// [`still_apart`]).
-    apart: Option<(f64, Se3<f64>, Se3<f64>)>,
+    /// the gap along it and both shapes' box centres and rotations then
+    /// (see [`still_apart_at`]).
+    apart: Option<Apart>,
     /// A hull and a box or height field (`Some(true)`: the hull is a): the
     /// face path ([`hull_on_face`]) is tried first.
     face: Option<bool>,
@@ -105,6 +105,11 @@ pub struct PairContact {
     /// Geometries in the model (the `ord` base).
     ngeoms: u64,
     sap: SweepAndPrune,
+    /// Once every allowed pair is made and the shapes are fewer than
+    /// [`STRIPS_FROM`] (one robot's self pairs), the broad phase by
+    /// [`PairMasks`] (the same pairs as the sweep's, and in visiting order:
+    /// no sort).
+    listed: Option<PairMasks>,
     /// The overlapping pairs of this detection as (ord, pair).
     overlapping: Vec<(u64, u32)>,
     /// Scratch: the broad phase's pair indices.
@@ -237,6 +242,7 @@ impl PairContact {
             model_of,
             ngeoms: g.len() as u64,
             sap: SweepAndPrune::new(n),
+            listed: None,
             overlapping: Vec::new(),
             sap_ids: Vec::new(),
             fresh: Vec::new(),
@@ -328,6 +334,20 @@ impl PairContact {
         p
     }
 
+    /// Sets up the broad phase by masks ([`Self::listed`]) once every
+    /// allowed pair is made among fewer than [`STRIPS_FROM`] shapes (after
+    /// that no pair is made: the allowed pairs stay those).
+    fn list_pairs(&mut self) {
+        if self.listed.is_some()
+            || self.pairs.len() != self.allowed
+            || self.members.len() >= STRIPS_FROM
+        {
+            return;
+        }
+        let pairs = self.pairs.iter().map(|p| (p.a, p.b));
+        self.listed = PairMasks::new(self.members.len(), pairs);
+    }
+
     /// Forgets every pair's manifolds and the features its slots held: the
     /// next detection finds what a newly built one would.
     pub fn forget_history(&mut self) {
@@ -399,21 +419,34 @@ impl PairContact {
             self.centres[k] = c;
         }
         self.overlapping.clear();
-        self.fresh.clear();
-        let mut ids = std::mem::take(&mut self.sap_ids);
-        ids.clear();
-        self.sap.overlaps(&self.table, &mut ids, &mut self.fresh);
-        for f in 0..self.fresh.len() {
-            let (i, j) = self.fresh[f];
-            ids.push(self.make_pair(i as usize, j as usize));
+        self.list_pairs();
+        if let Some(masks) = self.listed.as_mut() {
+            // every pair made: by l, then h, i.e. by `ord` (members are in
+            // geometry order)
+            let (table, ords, ov) = (&self.table, &self.ords, &mut self.overlapping);
+            masks.overlaps(&self.sap, |l, h| {
+                let p = table.get(l, h);
+                if let Some(&ord) = ords.get(p as usize) {
+                    ov.push((ord, p));
+                }
+            });
+        } else {
+            self.fresh.clear();
+            let mut ids = std::mem::take(&mut self.sap_ids);
+            ids.clear();
+            self.sap.overlaps(&self.table, &mut ids, &mut self.fresh);
+            for f in 0..self.fresh.len() {
+                let (i, j) = self.fresh[f];
+                ids.push(self.make_pair(i as usize, j as usize));
+            }
+            self.overlapping
+                .extend(ids.iter().map(|&p| (self.ords[p as usize], p)));
+            self.sap_ids = ids;
+            // the pairs not overlapping forget their points
+            // (sorted: the same order every step, whatever the sweep's or the
+            // order the pairs were made in)
+            self.overlapping.sort_unstable();
         }
-        self.overlapping
-            .extend(ids.iter().map(|&p| (self.ords[p as usize], p)));
-        self.sap_ids = ids;
-        // the pairs not overlapping forget their points
-        // (sorted: the same order every step, whatever the sweep's or the
-        // order the pairs were made in)
-        self.overlapping.sort_unstable();
         // visited: the overlapping pairs and those that held anything
         self.visit.clear();
         let (mut i, mut j) = (0, 0);
@@ -502,10 +535,19 @@ impl PairContact {
                 // two convex shapes apart along last step's axis by more than
                 // the margin: no point, no parry query
                 let convex = ma.shape.convex && mb.shape.convex;
+                let (ca, cb) = (&self.centres[pair.a], &self.centres[pair.b]);
+                let now_a = (ca, wa, self.radii[pair.a]);
+                let now_b = (cb, wb, self.radii[pair.b]);
                 let apart = convex
-                    && (still_apart(pair.apart.as_ref(), ma, mb, wa, wb, margin) || {
+                    && (still_apart_at(pair.apart.as_ref(), now_a, now_b, margin) || {
                         let gap = apart_along(&pair.axis, ma, mb, wa, wb);
-                        pair.apart = (gap > margin).then_some((gap, *wa, *wb));
+                        pair.apart = (gap > margin).then_some(Apart {
+                            gap,
+                            ca: *ca,
+                            ra: wa.rot,
+                            cb: *cb,
+                            rb: wb.rot,
+                        });
                         gap > margin
                     });
                 if !plane && !apart {
