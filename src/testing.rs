@@ -249,6 +249,20 @@ pub mod contact {
         s.set(i, c, h)
     }
 
+    /// `PairMasks::new` on `n` shapes and `pairs`, then `PairMasks::overlaps`
+    /// on the boxes of `s`: the pairs found, in the order found (`None`: more
+    /// than 64 shapes).
+    pub fn mask_pairs(
+        n: usize,
+        pairs: &[(usize, usize)],
+        s: &SweepAndPrune,
+    ) -> Option<Vec<(usize, usize)>> {
+        let mut m = crate::contact::broad::PairMasks::new(n, pairs.iter().copied())?;
+        let mut out = Vec::new();
+        m.overlaps(s, |l, h| out.push((l, h)));
+        Some(out)
+    }
+
     /// `SweepAndPrune::overlaps`.
     pub fn sap_overlaps(
         s: &mut SweepAndPrune,

@@ -2,7 +2,7 @@
 
 use crate::common::lcg::Lcg;
 use urdyn::testing::contact::{
-    sap_new, sap_overlaps, sap_set, table_allow, table_allowed, table_new, table_set,
+    mask_pairs, sap_new, sap_overlaps, sap_set, table_allow, table_allowed, table_new, table_set,
 };
 
 #[test]
@@ -108,4 +108,55 @@ fn strips_find_exactly_the_overlapping_pairs() {
         assert!(want.len() > 40, "{}", want.len());
         assert_eq!(got, want, "round {round}");
     }
+}
+
+#[test]
+fn masks_find_the_pairs_of_a_test_of_every_pair_in_order() {
+    // a robot's self pairs (PairMasks, fewer than 64 shapes, every allowed
+    // pair known): exactly the allowed pairs whose boxes overlap (touching
+    // counts, as in the sweep), by l then h, on both of its paths (under 16
+    // shapes a test of each allowed pair; from 16 every h at once)
+    let mut lcg = Lcg(777);
+    for n in [3usize, 15, 16, 17, 40, 64] {
+        let mut s = sap_new(n);
+        let mut pairs = Vec::new();
+        for i in 0..n {
+            for j in i + 1..n {
+                if (3 * i + j) % 5 != 0 {
+                    // both orders, as a model's pair list may give them
+                    pairs.push(if (i + j) % 2 == 0 { (i, j) } else { (j, i) });
+                }
+            }
+        }
+        for round in 0..4 {
+            for i in 0..n {
+                let c = [lcg.uniform(-0.5, 0.5), lcg.uniform(-0.3, 0.3), lcg.uniform(0.0, 1.0)];
+                let h = [lcg.uniform(0.05, 0.3), lcg.uniform(0.05, 0.3), lcg.uniform(0.05, 0.3)];
+                sap_set(&mut s, i, c, h);
+            }
+            if round == 3 && n > 2 {
+                // two boxes exactly touching along x: found
+                sap_set(&mut s, 0, [0.0, 0.0, 0.0], [0.1; 3]);
+                sap_set(&mut s, 2, [0.2, 0.0, 0.0], [0.1; 3]);
+            }
+            let got = mask_pairs(n, &pairs, &s).expect("n <= 64");
+            let mut want = Vec::new();
+            for i in 0..n {
+                for j in i + 1..n {
+                    let (a, b, c, d) = (s.lo[i], s.hi[i], s.lo[j], s.hi[j]);
+                    let over = (0..3).all(|k| c[k] <= b[k] && a[k] <= d[k]);
+                    if over && (3 * i + j) % 5 != 0 {
+                        want.push((i, j));
+                    }
+                }
+            }
+            assert!(n < 16 || want.len() > 5, "n {n}: {}", want.len());
+            if round == 3 && n > 2 {
+                assert!(want.contains(&(0, 2)), "n {n}");
+            }
+            assert_eq!(got, want, "n {n}, round {round}");
+        }
+    }
+    // more than 64 shapes: not for the masks
+    assert!(mask_pairs(65, &[(0, 1)], &sap_new(65)).is_none());
 }
