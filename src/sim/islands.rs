@@ -36,6 +36,10 @@ pub(crate) struct Islands {
     dofs: Vec<usize>,
     /// Scratch: a dof already listed.
     mark: Vec<bool>,
+    /// The rows' paths of the last grouping, when they were all the factor's
+    /// (no union path: `cached`): the islands are a function of them.
+    last: Vec<(usize, usize)>,
+    cached: bool,
 }
 
 /// One island of this step: its row runs and its dofs.
@@ -78,6 +82,8 @@ impl Islands {
             islands: Vec::with_capacity(rows.min(nt + 1)),
             dofs: Vec::with_capacity(model.nv),
             mark: vec![false; model.nv],
+            last: Vec::with_capacity(rows),
+            cached: false,
         }
     }
 
@@ -106,6 +112,17 @@ impl Islands {
     /// Groups the assembled rows into islands.
     pub fn group(&mut self, rows: &Rows) {
         let n = rows.n.min(self.key.len());
+        // the same rows' paths as the last grouping, each one of the factor's
+        // (fixed for the rows' life, [`Rows::set_table`]): the same islands
+        let fixed = rows.unions_empty();
+        if fixed && self.cached && rows.path[..n] == self.last[..] {
+            return;
+        }
+        self.cached = fixed && n <= self.last.capacity();
+        self.last.clear();
+        if self.cached {
+            self.last.extend_from_slice(&rows.path[..n]);
+        }
         for p in self.parent.iter_mut().enumerate() {
             *p.1 = p.0;
         }
@@ -166,6 +183,8 @@ impl Islands {
         while i < self.runs.len() {
             let k = self.runs[i].0;
             let (r0, d0) = (i, self.dofs.len());
+            // the dofs marked (listed, and their range)
+            let (mut lo, mut hi) = (usize::MAX, 0);
             while i < self.runs.len() && self.runs[i].0 == k {
                 let (_, s, e) = self.runs[i];
                 for q in s..e {
@@ -179,15 +198,31 @@ impl Islands {
                         {
                             *m = true;
                             self.dofs.push(d);
+                            lo = lo.min(d);
+                            hi = hi.max(d);
                         }
                     }
                 }
                 i += 1;
             }
+            // ascending: read off the marks where they are dense in their range
+            // (one robot: no sort), else sorted
             let dofs = &mut self.dofs[d0..];
-            dofs.sort_unstable();
-            for &d in dofs.iter() {
-                self.mark[d] = false;
+            if !dofs.is_empty() && hi - lo < 4 * dofs.len() + 32 {
+                let mut w = dofs.iter_mut();
+                for (d, m) in (lo..).zip(&mut self.mark[lo..=hi]) {
+                    if *m {
+                        *m = false;
+                        if let Some(x) = w.next() {
+                            *x = d;
+                        }
+                    }
+                }
+            } else {
+                dofs.sort_unstable();
+                for &d in dofs.iter() {
+                    self.mark[d] = false;
+                }
             }
             self.islands.push(((r0, i), (d0, self.dofs.len())));
         }
