@@ -36,6 +36,12 @@ pub(crate) struct Islands {
     dofs: Vec<usize>,
     /// Scratch: a dof already listed.
     mark: Vec<bool>,
+    /// Each dof's parent on its path to the root ([`Model::dof_parent`],
+    /// `usize::MAX` at a root).
+    dof_parent: Vec<usize>,
+    /// Each dof's path length to the root, itself included (`usize::MAX`:
+    /// unknown).
+    chain_len: Vec<usize>,
     /// The rows' paths of the last grouping, when they were all the factor's
     /// (no union path: `cached`): the islands are a function of them.
     last: Vec<(usize, usize)>,
@@ -62,6 +68,25 @@ impl Island<'_> {
     }
 }
 
+/// Each dof's path length to the root, itself included, along `parent`
+/// (`usize::MAX` where `parent` has no entry for it or does not reach a root
+/// in nv steps).
+fn chain_lengths(parent: &[usize], nv: usize) -> Vec<usize> {
+    (0..nv)
+        .map(|k| {
+            let mut x = k;
+            for len in 1..=nv {
+                match parent.get(x) {
+                    Some(&usize::MAX) => return len,
+                    Some(&p) if p < nv => x = p,
+                    _ => return usize::MAX,
+                }
+            }
+            usize::MAX
+        })
+        .collect()
+}
+
 impl Islands {
     /// Room for the islands of `model` with at most `rows` rows.
     pub fn new(model: &Model, rows: usize) -> Self {
@@ -82,6 +107,8 @@ impl Islands {
             islands: Vec::with_capacity(rows.min(nt + 1)),
             dofs: Vec::with_capacity(model.nv),
             mark: vec![false; model.nv],
+            dof_parent: model.dof_parent.clone(),
+            chain_len: chain_lengths(&model.dof_parent, model.nv),
             last: Vec::with_capacity(rows),
             cached: false,
         }
@@ -192,7 +219,27 @@ impl Islands {
                         continue;
                     }
                     let (ps, pl) = rows.path[q];
-                    for &d in table.get(ps..ps + pl).unwrap_or(&[]) {
+                    let p = table.get(ps..ps + pl).unwrap_or(&[]);
+                    // a path is closed under dof parents (a dof's path to the
+                    // root, a union of two, or every dof), and so are the
+                    // marks: a path as long as its last dof's chain is that
+                    // chain, marked from its end up to the first dof marked
+                    if let Some(&d) = p.last()
+                        && self.chain_len.get(d) == Some(&pl)
+                    {
+                        let mut x = d;
+                        while let Some(m) = self.mark.get_mut(x)
+                            && !*m
+                        {
+                            *m = true;
+                            self.dofs.push(x);
+                            lo = lo.min(x);
+                            hi = hi.max(x);
+                            x = self.dof_parent.get(x).copied().unwrap_or(usize::MAX);
+                        }
+                        continue;
+                    }
+                    for &d in p {
                         if let Some(m) = self.mark.get_mut(d)
                             && !*m
                         {

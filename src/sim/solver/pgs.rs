@@ -153,7 +153,11 @@ impl Rows {
             let moved = (u - *prev).abs();
             *prev = u;
             let moved = if first { f64::INFINITY } else { moved };
-            if moved < residual { moved } else { residual }
+            if moved < residual {
+                moved
+            } else {
+                residual
+            }
         }
         let lambda = &mut out.lambda[..n];
         // SAFETY (unchecked reads in rdot/raxpy): every path lies in `table`

@@ -253,8 +253,11 @@ fn dot3x3(l: &[[f64; 4]], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 4]; 3] {
         // SAFETY: avx is enabled at compile time; every k < x3.len() (a
         // path's dofs are < nv); `l`'s entries are 4 f64 each
         unsafe {
-            let (mut a0, mut a1, mut a2) =
-                (_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd());
+            let (mut a0, mut a1, mut a2) = (
+                _mm256_setzero_pd(),
+                _mm256_setzero_pd(),
+                _mm256_setzero_pd(),
+            );
             for (lt, &k) in l.iter().zip(p) {
                 let z = _mm256_loadu_pd(lt.as_ptr());
                 let xk = x3.get_unchecked(k);
