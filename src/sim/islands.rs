@@ -36,6 +36,16 @@ pub(crate) struct Islands {
     dofs: Vec<usize>,
     /// Scratch: a dof already listed.
     mark: Vec<bool>,
+    /// Each dof's parent on its path to the root ([`Model::dof_parent`],
+    /// `usize::MAX` at a root).
+    dof_parent: Vec<usize>,
+    /// Each dof's path length to the root, itself included (`usize::MAX`:
+    /// unknown).
+    chain_len: Vec<usize>,
+    /// The rows' paths of the last grouping, when they were all the factor's
+    /// (no union path: `cached`): the islands are a function of them.
+    last: Vec<(usize, usize)>,
+    cached: bool,
 }
 
 /// One island of this step: its row runs and its dofs.
@@ -58,6 +68,25 @@ impl Island<'_> {
     }
 }
 
+/// Each dof's path length to the root, itself included, along `parent`
+/// (`usize::MAX` where `parent` has no entry for it or does not reach a root
+/// in nv steps).
+fn chain_lengths(parent: &[usize], nv: usize) -> Vec<usize> {
+    (0..nv)
+        .map(|k| {
+            let mut x = k;
+            for len in 1..=nv {
+                match parent.get(x) {
+                    Some(&usize::MAX) => return len,
+                    Some(&p) if p < nv => x = p,
+                    _ => return usize::MAX,
+                }
+            }
+            usize::MAX
+        })
+        .collect()
+}
+
 impl Islands {
     /// Room for the islands of `model` with at most `rows` rows.
     pub fn new(model: &Model, rows: usize) -> Self {
@@ -78,6 +107,10 @@ impl Islands {
             islands: Vec::with_capacity(rows.min(nt + 1)),
             dofs: Vec::with_capacity(model.nv),
             mark: vec![false; model.nv],
+            dof_parent: model.dof_parent.clone(),
+            chain_len: chain_lengths(&model.dof_parent, model.nv),
+            last: Vec::with_capacity(rows),
+            cached: false,
         }
     }
 
@@ -106,6 +139,17 @@ impl Islands {
     /// Groups the assembled rows into islands.
     pub fn group(&mut self, rows: &Rows) {
         let n = rows.n.min(self.key.len());
+        // the same rows' paths as the last grouping, each one of the factor's
+        // (fixed for the rows' life, [`Rows::set_table`]): the same islands
+        let fixed = rows.unions_empty();
+        if fixed && self.cached && rows.path[..n] == self.last[..] {
+            return;
+        }
+        self.cached = fixed && n <= self.last.capacity();
+        self.last.clear();
+        if self.cached {
+            self.last.extend_from_slice(&rows.path[..n]);
+        }
         for p in self.parent.iter_mut().enumerate() {
             *p.1 = p.0;
         }
@@ -166,6 +210,8 @@ impl Islands {
         while i < self.runs.len() {
             let k = self.runs[i].0;
             let (r0, d0) = (i, self.dofs.len());
+            // the dofs marked (listed, and their range)
+            let (mut lo, mut hi) = (usize::MAX, 0);
             while i < self.runs.len() && self.runs[i].0 == k {
                 let (_, s, e) = self.runs[i];
                 for q in s..e {
@@ -173,21 +219,57 @@ impl Islands {
                         continue;
                     }
                     let (ps, pl) = rows.path[q];
-                    for &d in table.get(ps..ps + pl).unwrap_or(&[]) {
+                    let p = table.get(ps..ps + pl).unwrap_or(&[]);
+                    // a path is closed under dof parents (a dof's path to the
+                    // root, a union of two, or every dof), and so are the
+                    // marks: a path as long as its last dof's chain is that
+                    // chain, marked from its end up to the first dof marked
+                    if let Some(&d) = p.last()
+                        && self.chain_len.get(d) == Some(&pl)
+                    {
+                        let mut x = d;
+                        while let Some(m) = self.mark.get_mut(x)
+                            && !*m
+                        {
+                            *m = true;
+                            self.dofs.push(x);
+                            lo = lo.min(x);
+                            hi = hi.max(x);
+                            x = self.dof_parent.get(x).copied().unwrap_or(usize::MAX);
+                        }
+                        continue;
+                    }
+                    for &d in p {
                         if let Some(m) = self.mark.get_mut(d)
                             && !*m
                         {
                             *m = true;
                             self.dofs.push(d);
+                            lo = lo.min(d);
+                            hi = hi.max(d);
                         }
                     }
                 }
                 i += 1;
             }
+            // ascending: read off the marks where they are dense in their range
+            // (one robot: no sort), else sorted
             let dofs = &mut self.dofs[d0..];
-            dofs.sort_unstable();
-            for &d in dofs.iter() {
-                self.mark[d] = false;
+            if !dofs.is_empty() && hi - lo < 4 * dofs.len() + 32 {
+                let mut w = dofs.iter_mut();
+                for (d, m) in (lo..).zip(&mut self.mark[lo..=hi]) {
+                    if *m {
+                        *m = false;
+                        if let Some(x) = w.next() {
+                            *x = d;
+                        }
+                    }
+                }
+            } else {
+                dofs.sort_unstable();
+                for &d in dofs.iter() {
+                    self.mark[d] = false;
+                }
             }
             self.islands.push(((r0, i), (d0, self.dofs.len())));
         }

@@ -182,6 +182,11 @@ impl Rows {
         self.table.extend_from_slice(base);
         self.static_len = base.len();
     }
+    /// No union path was made this step: every row's path is one of the
+    /// factor's table ([`Rows::union_path`]).
+    pub(crate) fn unions_empty(&self) -> bool {
+        self.table.len() == self.static_len
+    }
     /// The dof paths rows index ([`Rows::path`]).
     pub fn table(&self) -> &[usize] {
         &self.table

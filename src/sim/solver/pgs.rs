@@ -145,14 +145,18 @@ impl Rows {
         // smaller, how much its velocity moved since the last sweep (redundant
         // contacts can trade impulse among themselves for many sweeps while no
         // velocity changes: that is converged)
+        // (on the first sweep the residual alone: `moved` taken as ∞; the
+        // smaller of the two by one compare, `minsd`: a NaN `moved` leaves the
+        // residual, as `f64::min` did)
         #[inline(always)]
         fn measure(first: bool, residual: f64, u: f64, prev: &mut f64) -> f64 {
             let moved = (u - *prev).abs();
             *prev = u;
-            if first {
-                residual
+            let moved = if first { f64::INFINITY } else { moved };
+            if moved < residual {
+                moved
             } else {
-                residual.min(moved)
+                residual
             }
         }
         let lambda = &mut out.lambda[..n];
@@ -183,10 +187,28 @@ impl Rows {
             None => dv.iter_mut().for_each(|x| *x = 0.0),
         }
         for &(_, s, e) in runs {
-            for (r, &l) in lambda.iter().enumerate().take(e).skip(s) {
+            let mut r = s;
+            while r < e {
+                let l = lambda[r];
+                if contact[r] && l != 0.0 && lambda[r + 1] != 0.0 && lambda[r + 2] != 0.0 {
+                    // a contact's three rows in one pass over their path: each
+                    // entry ((x + λₙyₙ) + λ₁y₁) + λ₂y₂, the row-by-row order
+                    // SAFETY: as the sweeps' contact update below
+                    let (p, lanes) = unsafe {
+                        let (s, l) = *paths.get_unchecked(r);
+                        (
+                            table.get_unchecked(s..s + l),
+                            ylanes.get_unchecked(r * st..r * st + l),
+                        )
+                    };
+                    warm3([l, lambda[r + 1], lambda[r + 2]], lanes, p, dv);
+                    r += 3;
+                    continue;
+                }
                 if l != 0.0 {
                     raxpy(l, y, r, st, path(r), dv);
                 }
+                r += 1;
             }
         }
         if block {
@@ -260,7 +282,9 @@ impl Rows {
                         if dln != 0.0 || dl1 != 0.0 || dl2 != 0.0 {
                             // Δv' += Δλₙ yₙ + Δλ₁ y₁ + Δλ₂ y₂ over the path
                             let l = p.len();
-                            let yr = |q: usize| &y[q * st..q * st + l];
+                            // SAFETY: r + 2 < n and l ≤ st (checked above), and
+                            // y holds n·st entries
+                            let yr = |q: usize| unsafe { y.get_unchecked(q * st..q * st + l) };
                             axpy3([dln, dl1, dl2], [yr(r), yr(r + 1), yr(r + 2)], p, dv);
                             if block {
                                 lb.follow(&view, r, &[dln, dl1, dl2], lambda, dv);
@@ -378,6 +402,7 @@ impl Rows {
                     table,
                     kinds,
                     contact,
+                    ylanes,
                     winv,
                     c,
                     b,
@@ -403,7 +428,7 @@ impl Rows {
 /// y interleaved, `Rows::ylanes`), each lane a sum from 0 in path order; the
 /// indices of `p` must be < `x.len()` (a row's path: dof indices < nv).
 #[inline(always)]
-fn dot3(l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
+pub(super) fn dot3(l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
     debug_assert!(p.iter().all(|&k| k < x.len()));
     #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
     {
@@ -432,6 +457,22 @@ fn dot3(l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
             }
         }
         s
+    }
+}
+
+/// The warm start of a contact's three rows: x[pₜ] = ((x[pₜ] + a₀ lₜ₀) + a₁ lₜ₁) +
+/// a₂ lₜ₂ over its path `p` (`l`: its rows of y interleaved, `Rows::ylanes`),
+/// each entry the same sum as three row-by-row updates (a path's dofs are
+/// distinct); the indices of `p` must be < `x.len()`.
+#[inline(always)]
+fn warm3(a: [f64; 3], l: &[[f64; 4]], p: &[usize], x: &mut [f64]) {
+    debug_assert!(p.iter().all(|&k| k < x.len()));
+    for (lt, &k) in l.iter().zip(p) {
+        // SAFETY: every k < x.len() (the sweeps' check of the paths)
+        unsafe {
+            let xk = x.get_unchecked_mut(k);
+            *xk = ((*xk + a[0] * lt[0]) + a[1] * lt[1]) + a[2] * lt[2];
+        }
     }
 }
 

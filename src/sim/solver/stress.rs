@@ -3,7 +3,7 @@
 //! (docs/theory.md §"Self-stress of a sticking stance").
 
 use super::dense::ldlt_dropping;
-use super::subspace::{Subspace, DEPENDENT};
+use super::subspace::{Lanes, Subspace, DEPENDENT};
 use super::{RowKind, Rows, SUBSPACE_MAX};
 use crate::dynamics::linalg::ldlt_dropping_solve;
 
@@ -124,7 +124,11 @@ impl Rows {
         }
         // W_FF's lower triangle (as the subspace step forms it)
         sm.forget();
-        sm.form_w_ff(&self.y, st, &self.path, table);
+        let lanes = Lanes {
+            contact: &self.is_block,
+            ylanes: &self.ylanes,
+        };
+        sm.form_w_ff(&self.y, st, &self.path, table, lanes);
         ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
         // null vectors n = L⁻ᵀ eⱼ of the dropped rows j (L unit lower, a
         // dropped row's column below zero: n lives on j and the kept rows

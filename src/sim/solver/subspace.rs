@@ -3,6 +3,7 @@
 
 use super::dense::ldlt_dropping;
 use super::loop_block::LoopBlock;
+use super::pgs::dot3;
 use super::{RowKind, SUBSPACE_MAX};
 use crate::dynamics::linalg::ldlt_dropping_solve;
 
@@ -66,13 +67,17 @@ impl Subspace {
     /// every partial sum as it was: the same bits as summing over the two
     /// paths' common dofs only, without the merge's branches (the cost follows
     /// the rows' paths, never nv). Rows `r` of `y` have room `st`; row r's
-    /// dofs are `table[paths[r]]`. `x` must hold nv entries, `w` m².
+    /// dofs are `table[paths[r]]`. `x` must hold nv entries, `w` m². A
+    /// contact's three rows q are read from their interleaved copy (`lanes`,
+    /// `Rows::ylanes`), the three sums side by side in vector lanes: each the
+    /// same sum in the same order.
     pub(super) fn form_w_ff(
         &mut self,
         y: &[f64],
         st: usize,
         paths: &[(usize, usize)],
         table: &[usize],
+        lanes: Lanes,
     ) {
         let m = self.rows.len();
         let path = |r: usize| {
@@ -112,18 +117,25 @@ impl Subspace {
                     let q = rows[bb];
                     let pq = path(q);
                     if three(bb, hi) {
-                        let (z0, z1, z2) = (
-                            yrow(q, pq.len()),
-                            yrow(q + 1, pq.len()),
-                            yrow(q + 2, pq.len()),
-                        );
                         let mut sum = [[0.0f64; 3]; 3];
-                        for (t, &k) in pq.iter().enumerate() {
-                            let xk = x3[k];
-                            let zt = [z0[t], z1[t], z2[t]];
-                            for (si, &xi) in sum.iter_mut().zip(&xk) {
-                                for (sij, &zj) in si.iter_mut().zip(&zt) {
-                                    *sij += zj * xi;
+                        if let Some(lq) = lanes.of(q, st, pq.len()) {
+                            let s4 = dot3x3(lq, pq, x3);
+                            for (si, s4i) in sum.iter_mut().zip(&s4) {
+                                si.copy_from_slice(&s4i[..3]);
+                            }
+                        } else {
+                            let (z0, z1, z2) = (
+                                yrow(q, pq.len()),
+                                yrow(q + 1, pq.len()),
+                                yrow(q + 2, pq.len()),
+                            );
+                            for (t, &k) in pq.iter().enumerate() {
+                                let xk = x3[k];
+                                let zt = [z0[t], z1[t], z2[t]];
+                                for (si, &xi) in sum.iter_mut().zip(&xk) {
+                                    for (sij, &zj) in si.iter_mut().zip(&zt) {
+                                        *sij += zj * xi;
+                                    }
                                 }
                             }
                         }
@@ -169,17 +181,21 @@ impl Subspace {
                 let q = rows[bb];
                 let pq = path(q);
                 if three(bb, a) {
-                    let (y0, y1, y2) = (
-                        yrow(q, pq.len()),
-                        yrow(q + 1, pq.len()),
-                        yrow(q + 2, pq.len()),
-                    );
                     let (mut s0, mut s1, mut s2) = (0.0, 0.0, 0.0);
-                    for (t, &k) in pq.iter().enumerate() {
-                        let xk = x[k];
-                        s0 += y0[t] * xk;
-                        s1 += y1[t] * xk;
-                        s2 += y2[t] * xk;
+                    if let Some(lq) = lanes.of(q, st, pq.len()) {
+                        [s0, s1, s2, _] = dot3(lq, pq, x);
+                    } else {
+                        let (y0, y1, y2) = (
+                            yrow(q, pq.len()),
+                            yrow(q + 1, pq.len()),
+                            yrow(q + 2, pq.len()),
+                        );
+                        for (t, &k) in pq.iter().enumerate() {
+                            let xk = x[k];
+                            s0 += y0[t] * xk;
+                            s1 += y1[t] * xk;
+                            s2 += y2[t] * xk;
+                        }
                     }
                     self.w[a * m + bb] = s0;
                     self.w[a * m + bb + 1] = s1;
@@ -199,6 +215,74 @@ impl Subspace {
             }
             a += 1;
         }
+    }
+}
+
+/// The contacts' rows of Y interleaved (`Rows::ylanes`) and which rows are a
+/// contact's normal (`Rows::is_block`), for [`Subspace::form_w_ff`].
+#[derive(Clone, Copy)]
+pub(super) struct Lanes<'a> {
+    pub(super) contact: &'a [bool],
+    pub(super) ylanes: &'a [[f64; 4]],
+}
+
+impl<'a> Lanes<'a> {
+    /// The interleaved rows of the contact whose normal is row `q` (its path
+    /// `len` long), or `None` (not a contact's normal, or out of range).
+    #[inline]
+    fn of(&self, q: usize, st: usize, len: usize) -> Option<&'a [[f64; 4]]> {
+        if *self.contact.get(q)? && len <= st {
+            self.ylanes.get(q * st..q * st + len)
+        } else {
+            None
+        }
+    }
+}
+
+/// The 3 × 3 block Σₜ x3[pₜ][i] lₜ[j] (i, j < 3; lane 3 unused) of two
+/// contacts' rows: `l` one contact's rows interleaved over its path `p`, `x3`
+/// the other's scattered to full width; each entry a sum from 0 in path order
+/// (the scalar loop's); the indices of `p` must be < `x3.len()`.
+#[inline(always)]
+fn dot3x3(l: &[[f64; 4]], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 4]; 3] {
+    debug_assert!(p.iter().all(|&k| k < x3.len()));
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    {
+        use std::arch::x86_64::*;
+        let mut s = [[0.0f64; 4]; 3];
+        // SAFETY: avx is enabled at compile time; every k < x3.len() (a
+        // path's dofs are < nv); `l`'s entries are 4 f64 each
+        unsafe {
+            let (mut a0, mut a1, mut a2) = (
+                _mm256_setzero_pd(),
+                _mm256_setzero_pd(),
+                _mm256_setzero_pd(),
+            );
+            for (lt, &k) in l.iter().zip(p) {
+                let z = _mm256_loadu_pd(lt.as_ptr());
+                let xk = x3.get_unchecked(k);
+                a0 = _mm256_add_pd(a0, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[0])));
+                a1 = _mm256_add_pd(a1, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[1])));
+                a2 = _mm256_add_pd(a2, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[2])));
+            }
+            _mm256_storeu_pd(s[0].as_mut_ptr(), a0);
+            _mm256_storeu_pd(s[1].as_mut_ptr(), a1);
+            _mm256_storeu_pd(s[2].as_mut_ptr(), a2);
+        }
+        s
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+    {
+        let mut s = [[0.0f64; 4]; 3];
+        for (lt, &k) in l.iter().zip(p) {
+            let xk = x3[k];
+            for (si, &xi) in s.iter_mut().zip(&xk) {
+                for (sij, &zj) in si.iter_mut().zip(lt) {
+                    *sij += zj * xi;
+                }
+            }
+        }
+        s
     }
 }
 
@@ -226,6 +310,8 @@ pub(super) struct Solved<'a> {
     pub(super) table: &'a [usize],
     pub(super) kinds: &'a [RowKind],
     pub(super) contact: &'a [bool],
+    /// The contacts' rows of Y interleaved (`Rows::ylanes`).
+    pub(super) ylanes: &'a [[f64; 4]],
     /// 1 / Wᵣᵣ (0: a row no impulse can move).
     pub(super) winv: &'a [f64],
     pub(super) c: &'a [f64],
@@ -261,6 +347,7 @@ pub(super) fn subspace_step(
         table,
         kinds,
         contact,
+        ylanes,
         winv,
         c,
         b,
@@ -288,6 +375,9 @@ pub(super) fn subspace_step(
                     if !sm.sliding[r + 1] && live(r + 1) && live(r + 2) {
                         sm.rows.push(r + 1);
                         sm.rows.push(r + 2);
+                    }
+                    if sm.rows.len() > SUBSPACE_MAX {
+                        return false;
                     }
                 }
                 r += 3;
@@ -336,7 +426,7 @@ pub(super) fn subspace_step(
         return false;
     }
     // the residuals b − u, then the lower triangle of W_FF = Y_F Y_Fᵀ
-    if sm.x.len() < nv {
+    if sm.x.len() < nv || dv.len() < nv {
         return false;
     }
     let target = |r: usize| match kinds[r] {
@@ -381,7 +471,7 @@ pub(super) fn subspace_step(
     // The rows' y are fixed within a solve: a step on the same free rows as
     // the last one of this solve reuses its factor (the same bits)
     if !(sm.factored && sm.factored_rows == sm.rows) {
-        sm.form_w_ff(y, st, paths, table);
+        sm.form_w_ff(y, st, paths, table, Lanes { contact, ylanes });
         ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
         sm.factored_rows.clone_from(&sm.rows);
         sm.factored = true;
@@ -399,13 +489,17 @@ pub(super) fn subspace_step(
     // normals and limits ≥ 0, friction in its box; then the tangent pairs, a
     // sticking pair into the cone of its new normal, a sliding one (held in
     // the solve) along its direction onto that cone's boundary, μλₙ
-    let add = |r: usize, d: f64, dv: &mut [f64]| {
+    // Δv' += d yᵣ over row r's path
+    #[inline(always)]
+    fn add(p: &[usize], yr: &[f64], d: f64, dv: &mut [f64]) {
         if d != 0.0 {
-            for (t, &k) in path(r).iter().enumerate() {
-                dv[k] += d * y[r * st + t];
+            for (&yt, &k) in yr.iter().zip(p) {
+                // SAFETY: a path's dofs are < nv ≤ dv.len() (the sweeps' check)
+                unsafe { *dv.get_unchecked_mut(k) += d * yt };
             }
         }
-    };
+    }
+    let yrow = |r: usize, l: usize| &y[r * st..r * st + l];
     for (a, &r) in sm.rows.iter().enumerate() {
         let x = match kinds[r] {
             RowKind::Normal | RowKind::Unilateral => sm.lam[a].max(0.0),
@@ -415,7 +509,8 @@ pub(super) fn subspace_step(
         };
         let d = x - lambda[r];
         lambda[r] = x;
-        add(r, d, dv);
+        let p = path(r);
+        add(p, yrow(r, p.len()), d, dv);
     }
     for r in runs.iter().flat_map(|&(_, s, e)| s..e) {
         if r + 1 >= n {
@@ -445,8 +540,23 @@ pub(super) fn subspace_step(
         let (d1, d2) = (n1 - lambda[r], n2 - lambda[r + 1]);
         lambda[r] = n1;
         lambda[r + 1] = n2;
-        add(r, d1, dv);
-        add(r + 1, d2, dv);
+        let p = path(r);
+        if d1 != 0.0 && d2 != 0.0 && paths[r + 1] == paths[r] {
+            // the pair on one path (a contact's) in one pass: each entry
+            // (x + d₁y₁) + d₂y₂, the row-by-row order
+            let (y1, y2) = (yrow(r, p.len()), yrow(r + 1, p.len()));
+            for ((&a, &b), &k) in y1.iter().zip(y2).zip(p) {
+                // SAFETY: a path's dofs are < nv ≤ dv.len() (the sweeps' check)
+                unsafe {
+                    let x = dv.get_unchecked_mut(k);
+                    *x = (*x + d1 * a) + d2 * b;
+                }
+            }
+        } else {
+            add(p, yrow(r, p.len()), d1, dv);
+            let p2 = path(r + 1);
+            add(p2, yrow(r + 1, p2.len()), d2, dv);
+        }
     }
     true
 }
