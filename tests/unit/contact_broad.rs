@@ -130,8 +130,16 @@ fn masks_find_the_pairs_of_a_test_of_every_pair_in_order() {
         }
         for round in 0..4 {
             for i in 0..n {
-                let c = [lcg.uniform(-0.5, 0.5), lcg.uniform(-0.3, 0.3), lcg.uniform(0.0, 1.0)];
-                let h = [lcg.uniform(0.05, 0.3), lcg.uniform(0.05, 0.3), lcg.uniform(0.05, 0.3)];
+                let c = [
+                    lcg.uniform(-0.5, 0.5),
+                    lcg.uniform(-0.3, 0.3),
+                    lcg.uniform(0.0, 1.0),
+                ];
+                let h = [
+                    lcg.uniform(0.05, 0.3),
+                    lcg.uniform(0.05, 0.3),
+                    lcg.uniform(0.05, 0.3),
+                ];
                 sap_set(&mut s, i, c, h);
             }
             if round == 3 && n > 2 {
