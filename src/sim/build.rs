@@ -301,6 +301,10 @@ impl Simulation {
                 vfree: DVector::zeros(nv),
                 tau: DVector::zeros(nv),
                 vtot: DVector::zeros(nv),
+                frame_dofs: (model.dofs.iter().enumerate())
+                    .filter(|(_, d)| matches!(d.kind, JointKind::Free | JointKind::Planar))
+                    .map(|(k, _)| k)
+                    .collect(),
             },
             smooth: SmoothWork {
                 data: Data::new(&model),
@@ -324,6 +328,10 @@ impl Simulation {
                 v_ref: DVector::zeros(nv),
                 recovering_until: None,
                 scale,
+                springs: model
+                    .dofs
+                    .iter()
+                    .any(|d| d.stiffness > 0.0 && d.stiffness.is_finite() && d.kind.nv() == 1),
             },
             steps: 0,
             rejected: 0,

@@ -269,7 +269,7 @@ impl Constraints {
     pub fn clear_forces(&mut self) {
         self.fext.iter_mut().for_each(|f| *f = Force::zero());
         self.contact_forces.clear();
-        self.tau_joint.fill(0.0);
+        self.tau_joint.as_mut_slice().fill(0.0);
     }
 
     /// Rows of the last assembly.
@@ -478,7 +478,7 @@ impl Constraints {
                     };
                     let path = f.path_of(iv);
                     if let Some(r) = rows.push(kind, 0.0, self.warm_joint[d][0], path) {
-                        rows.add_entry(r, iv, 1.0);
+                        add_joint_entry(rows, r, iv, 1.0);
                         self.joint_rows.push((d, 0));
                         counts.friction += 1;
                     }
@@ -502,7 +502,7 @@ impl Constraints {
                     let w = self.warm_joint[d][which as usize];
                     let path = f.path_of(iv);
                     if let Some(r) = rows.push(RowKind::Unilateral, speculative(gap), w, path) {
-                        rows.add_entry(r, iv, sign);
+                        add_joint_entry(rows, r, iv, sign);
                         rows.bpos[r] = pos_target(gap, p.limit_slop, p.limit_push_cap);
                         if rows.bpos[r] > 0.0 {
                             counts.violated += 1;
@@ -539,5 +539,18 @@ impl Constraints {
             }
         }
         self.counts
+    }
+}
+
+/// Adds `x` to J's entry of joint row `r` at its dof `iv`: the last of its
+/// path (`MassFactor::path_of(iv)` ends at `iv`), else where [`Rows::add_entry`]
+/// finds it.
+#[inline]
+fn add_joint_entry(rows: &mut Rows, r: usize, iv: usize, x: f64) {
+    let (ps, pl) = rows.path[r];
+    let last = (pl.checked_sub(1), rows.table().get(ps + pl.wrapping_sub(1)));
+    match last {
+        (Some(t), Some(&d)) if d == iv && t < rows.stride => rows.j[r * rows.stride + t] += x,
+        _ => rows.add_entry(r, iv, x),
     }
 }

@@ -341,22 +341,22 @@ impl MassFactor {
     /// `row_entries(i, 1).rev()` one at a time: the same operations in the
     /// same order); a row of up to 11 unrolled (constant bounds).
     #[inline(always)]
-    fn fold_row(&self, i: usize, init: f64, f: impl Fn(f64, f64, usize) -> f64) -> f64 {
+    fn fold_row<T>(&self, i: usize, init: T, f: impl Fn(T, f64, usize) -> T) -> T {
         let (s, l) = (self.start[i], self.len[i]);
         let (a, j) = (&self.anc[s..s + l - 1], &self.table[s..s + l - 1]);
         match a.len() {
             0 => init,
-            1 => fold_n::<1>(a, j, init, f),
-            2 => fold_n::<2>(a, j, init, f),
-            3 => fold_n::<3>(a, j, init, f),
-            4 => fold_n::<4>(a, j, init, f),
-            5 => fold_n::<5>(a, j, init, f),
-            6 => fold_n::<6>(a, j, init, f),
-            7 => fold_n::<7>(a, j, init, f),
-            8 => fold_n::<8>(a, j, init, f),
-            9 => fold_n::<9>(a, j, init, f),
-            10 => fold_n::<10>(a, j, init, f),
-            11 => fold_n::<11>(a, j, init, f),
+            1 => fold_n::<1, T>(a, j, init, f),
+            2 => fold_n::<2, T>(a, j, init, f),
+            3 => fold_n::<3, T>(a, j, init, f),
+            4 => fold_n::<4, T>(a, j, init, f),
+            5 => fold_n::<5, T>(a, j, init, f),
+            6 => fold_n::<6, T>(a, j, init, f),
+            7 => fold_n::<7, T>(a, j, init, f),
+            8 => fold_n::<8, T>(a, j, init, f),
+            9 => fold_n::<9, T>(a, j, init, f),
+            10 => fold_n::<10, T>(a, j, init, f),
+            11 => fold_n::<11, T>(a, j, init, f),
             _ => a
                 .iter()
                 .zip(j)
@@ -437,6 +437,31 @@ impl MassFactor {
         }
     }
 
+    /// z ← R⁻¹ z and w ← R⁻¹ w (full length) in one pass over the factor: each
+    /// vector's entries the operations of [`Self::half_solve`] in its order
+    /// (the same bits).
+    pub fn half_solve2(&self, z: &mut [f64], w: &mut [f64]) {
+        let n = self.n;
+        if !self.tree || z.len() < n || w.len() < n {
+            self.half_solve(z);
+            self.half_solve(w);
+            return;
+        }
+        // L x = D^-½ z, root outwards, both at once
+        let (z, w) = (&mut z[..n], &mut w[..n]);
+        for &(k0, k1) in self.ranges() {
+            for i in k0..k1 {
+                let s = self.inv_sqrt_d[i];
+                let init = (z[i] * s, w[i] * s);
+                let (zi, wi) = self.fold_row(i, init, |(az, aw), a, j| {
+                    (az - a * at(z, j), aw - a * at(w, j))
+                });
+                z[i] = zi;
+                w[i] = wi;
+            }
+        }
+    }
+
     /// out ← R v.
     pub fn apply_r(&self, v: &[f64], out: &mut [f64]) {
         let n = self.n;
@@ -482,12 +507,7 @@ impl MassFactor {
 
 /// [`MassFactor::fold_row`] on `N` entries (`a[..N]`, `j[..N]`), the last first.
 #[inline(always)]
-fn fold_n<const N: usize>(
-    a: &[f64],
-    j: &[usize],
-    init: f64,
-    f: impl Fn(f64, f64, usize) -> f64,
-) -> f64 {
+fn fold_n<const N: usize, T>(a: &[f64], j: &[usize], init: T, f: impl Fn(T, f64, usize) -> T) -> T {
     let (a, j) = (&a[..N], &j[..N]);
     let mut acc = init;
     for t in (0..N).rev() {

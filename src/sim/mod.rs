@@ -267,6 +267,9 @@ pub(crate) struct MassWork {
     vfree: DVector<f64>,
     tau: DVector<f64>,
     vtot: DVector<f64>,
+    /// The joints of `Model::dofs` that are free or planar (the semi-implicit
+    /// step's frame-rate terms: src/sim/integrators/euler.rs), in order.
+    frame_dofs: Vec<usize>,
 }
 
 /// Work of the smooth (higher-order) steps.
@@ -296,6 +299,8 @@ struct EnergyGuard {
     recovering_until: Option<f64>,
     /// M·|g|·1 m, the energy scale of the relative bound.
     scale: f64,
+    /// Some 1-DoF joint has a spring (`Simulation::spring_energy` is not 0).
+    springs: bool,
 }
 
 /// A simulation that a program steps itself.

@@ -146,6 +146,9 @@ impl Simulation {
     /// 0 without springs).
     pub(super) fn spring_energy(&self) -> f64 {
         let mut e = 0.0;
+        if !self.guard.springs {
+            return e;
+        }
         for d in &self.model.dofs {
             if d.stiffness > 0.0 && d.stiffness.is_finite() && d.kind.nv() == 1 {
                 let x = self.q[d.iq] - d.springref;
@@ -161,7 +164,7 @@ impl Simulation {
             return 0.0;
         }
         let mut e = 0.0;
-        for (a, v) in self.armature.iter().zip(self.v.iter()) {
+        for (a, v) in self.armature.as_slice().iter().zip(self.v.as_slice()) {
             e += 0.5 * a * v * v;
         }
         e

@@ -159,6 +159,11 @@ impl Simulation {
     }
 
     pub(super) fn check_finite(&self) -> Result<(), SimError> {
+        // the common case in one branch-free pass (vector compares) before the
+        // search for the first bad entry
+        if all_finite(self.q.as_slice()) && all_finite(self.v.as_slice()) {
+            return Ok(());
+        }
         let bad_q = self.q.iter().position(|x| !x.is_finite());
         let bad_v = self.v.iter().position(|x| !x.is_finite());
         if bad_q.is_none() && bad_v.is_none() {
@@ -181,7 +186,7 @@ impl Simulation {
         let Some(bound) = self.opts.max_energy_rise else {
             return Ok(());
         };
-        if self.servo.active || self.tau_applied.iter().any(|&x| x != 0.0) {
+        if self.servo.active || any_nonzero(self.tau_applied.as_slice()) {
             self.guard.reference = None;
             return Ok(());
         }
@@ -234,9 +239,21 @@ impl Simulation {
 
     /// Applied generalized force with joint torques clamped to effort limits.
     pub(super) fn clamped_tau(&self, out: &mut DVector<f64>) {
-        for (k, o) in out.iter_mut().enumerate() {
-            let e = self.effort[k];
-            *o = self.tau_applied[k].clamp(-e, e);
+        let (out, tau) = (out.as_mut_slice(), self.tau_applied.as_slice());
+        for ((o, &t), &e) in out.iter_mut().zip(tau).zip(&self.effort) {
+            *o = t.clamp(-e, e);
         }
     }
+}
+
+/// Every entry finite, without an early exit (the compares run in vector lanes).
+#[inline]
+fn all_finite(x: &[f64]) -> bool {
+    x.iter().fold(true, |ok, v| ok & v.is_finite())
+}
+
+/// Some entry non-zero (NaN counts), without an early exit.
+#[inline]
+fn any_nonzero(x: &[f64]) -> bool {
+    x.iter().fold(false, |any, &v| any | (v != 0.0))
 }

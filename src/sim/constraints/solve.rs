@@ -28,7 +28,7 @@ impl Constraints {
         solver: Solver,
     ) -> Impulses<'_> {
         self.clear_forces();
-        self.dv.fill(0.0);
+        self.dv.as_mut_slice().fill(0.0);
         // torsion and rolling rows (spin.rs) couple a point's rotation to its
         // normal: a step with them may take twice the sweeps before the cap
         let iterations = iterations * if self.counts.spin > 0 { 2 } else { 1 };
@@ -46,7 +46,6 @@ impl Constraints {
             // each island on its own (on several threads: docs/theory.md
             // §"Islands"), every island's result independent of the others'
             self.islands.group(rows);
-            f.apply_r(vfree.as_slice(), &mut self.a);
             let count = self.islands.len();
             if self.isl_sweeps.len() < count {
                 self.isl_sweeps.resize(count, 0);
@@ -54,25 +53,32 @@ impl Constraints {
             let written = rows.take_written();
             let (mut lam, mut up) = written;
             let dv = self.dv.as_mut_slice();
-            let args = (f, &self.a[..], iterations, tol, relaxation);
+            let args = (iterations, tol, relaxation);
             match self.pool.as_ref().filter(|_| count > 1) {
-                Some(pool) => par_islands(
-                    pool,
-                    rows,
-                    &self.islands,
-                    &mut self.scratch,
-                    &mut self.isl_sweeps[..count],
-                    (&mut lam, &mut up, dv),
-                    args,
-                ),
+                Some(pool) => {
+                    // a = R v* for the threads' energy-safe exits, before them
+                    f.apply_r(vfree.as_slice(), &mut self.a);
+                    par_islands(
+                        pool,
+                        rows,
+                        &self.islands,
+                        &mut self.scratch,
+                        &mut self.isl_sweeps[..count],
+                        (&mut lam, &mut up, dv),
+                        (&self.a[..], iterations, tol, relaxation),
+                    )
+                }
                 None => {
                     let mut out = IslandOut {
                         lambda: &mut lam,
                         u_prev: &mut up,
                         sm: &mut self.scratch[0],
                     };
+                    // a = R v* only if an island's energy-safe exit needs it
+                    let mut a = FreeR::Lazy(f, vfree.as_slice(), &mut self.a[..], false);
                     for (i, s) in self.isl_sweeps[..count].iter_mut().enumerate() {
-                        *s = solve_island(rows, &mut out, &self.islands.get(i), dv, args);
+                        let isl = self.islands.get(i);
+                        *s = solve_island(rows, &mut out, &isl, dv, &mut a, args);
                     }
                 }
             }
@@ -106,23 +112,32 @@ impl Constraints {
         fn dofs<'a>(pgs: bool, isl: &Island<'a>) -> Option<&'a [usize]> {
             pgs.then_some(isl.dofs)
         }
-        // Δv = R⁻¹ Δv'
-        f.half_solve(self.dv.as_mut_slice());
         // the position pass, only on the islands where something is violated
+        // (it reads neither Δv' nor Δv: Δv = R⁻¹ Δv' is taken after it,
+        // with w = R⁻¹ w' in the same pass over the factor)
         let pushing = self.counts.violated > 0;
         if pushing {
-            self.push.fill(0.0);
+            self.push.as_mut_slice().fill(0.0);
             rows.mu[..rows.n].fill(0.0);
             for i in 0..count {
                 let isl = if pgs { self.islands.get(i) } else { whole };
-                if pgs && !isl.each_row().any(|r| rows.bpos[r] != 0.0) {
+                let violated = |&(_, s, e): &(usize, usize, usize)| {
+                    rows.bpos[s..e]
+                        .iter()
+                        .fold(false, |any, &b| any | (b != 0.0))
+                };
+                if pgs && !isl.runs.iter().any(violated) {
                     continue;
                 }
                 let dw = self.push.as_mut_slice();
                 let s = rows.solve_position_runs(isl.runs, dofs(pgs, &isl), dw, iterations, tol);
                 self.work += (isl.rows() * s) as u64;
             }
-            f.half_solve(self.push.as_mut_slice());
+            // Δv = R⁻¹ Δv', w = R⁻¹ w'
+            f.half_solve2(self.dv.as_mut_slice(), self.push.as_mut_slice());
+        } else {
+            // Δv = R⁻¹ Δv'
+            f.half_solve(self.dv.as_mut_slice());
         }
         if let Some(l) = self.loops.as_mut() {
             l.read(rows);
@@ -136,7 +151,7 @@ impl Constraints {
             let lam = rows.lambda[r];
             self.warm_joint[d][which as usize] = lam;
             let iv = model.dof_v(d);
-            let jv = rows.entry(r, iv);
+            let jv = joint_entry(rows, r, iv);
             self.tau_joint[iv] += jv * lam / h;
         }
         // contact rows: warm starts by slot, forces
@@ -190,6 +205,18 @@ impl Constraints {
     }
 }
 
+/// J's entry of joint row `r` at its dof `iv`: the last of its path
+/// (`MassFactor::path_of(iv)` ends at `iv`), else found by [`Rows::entry`].
+#[inline]
+fn joint_entry(rows: &Rows, r: usize, iv: usize) -> f64 {
+    let (ps, pl) = rows.path[r];
+    let last = (pl.checked_sub(1), rows.table().get(ps + pl.wrapping_sub(1)));
+    match last {
+        (Some(t), Some(&d)) if d == iv && t < rows.stride => rows.j[r * rows.stride + t],
+        _ => rows.entry(r, iv),
+    }
+}
+
 /// (ΔKE of the impulse, the exact solution's bound Σ λᵣ max(bᵣ, 0), a·d, ‖d‖²)
 /// for the factored Δv' = `d` (a = R v*: the kinetic energy after the impulse
 /// is ½‖a + d‖² in the H̃-norm), the impulses `lambda`.
@@ -227,9 +254,33 @@ fn impulse_work(
     (ad + 0.5 * dd, allow, ad, dd)
 }
 
-/// What every island's solve reads besides the rows: the factor, a = R v*,
-/// the sweep cap, tolerance and over-relaxation.
-type IslandArgs<'a> = (&'a MassFactor, &'a [f64], usize, f64, f64);
+/// What every island's solve reads besides the rows: the sweep cap,
+/// tolerance and over-relaxation.
+type IslandArgs = (usize, f64, f64);
+
+/// a = R v* (the free velocity's kinetic energy is ½‖a‖²), read only by an
+/// energy-safe exit: computed before the solve (`Ready`), or at the first
+/// exit that needs it (`Lazy`: the factor, v*, the buffer, whether done).
+enum FreeR<'a> {
+    Ready(&'a [f64]),
+    Lazy(&'a MassFactor, &'a [f64], &'a mut [f64], bool),
+}
+
+impl FreeR<'_> {
+    /// a, computed here the first time for a `Lazy` one.
+    fn get(&mut self) -> &[f64] {
+        match self {
+            FreeR::Ready(a) => a,
+            FreeR::Lazy(f, v, a, done) => {
+                if !*done {
+                    f.apply_r(v, a);
+                    *done = true;
+                }
+                a
+            }
+        }
+    }
+}
 
 /// One island's velocity solve: warm-started PGS on its rows, written into
 /// `out` and `dv` (on its dofs only); a solve stopped by its cap, or one that
@@ -241,12 +292,13 @@ fn solve_island(
     out: &mut IslandOut<'_>,
     isl: &Island<'_>,
     dv: &mut [f64],
-    (_f, a, iterations, tol, relax): IslandArgs<'_>,
+    a: &mut FreeR<'_>,
+    (iterations, tol, relax): IslandArgs,
 ) -> usize {
     let dofs = Some(isl.dofs);
     let (mut s, polished) = rows.sweeps(out, isl.runs, dofs, dv, iterations, tol, relax);
     if s >= iterations || polished {
-        s += energy_safe_exit(rows, out, isl, dofs, a, dv, iterations, tol);
+        s += energy_safe_exit(rows, out, isl, dofs, a.get(), dv, iterations, tol);
     }
     s
 }
@@ -277,8 +329,9 @@ fn par_islands(
     scratch: &mut [Scratch],
     sweeps: &mut [usize],
     (lambda, u_prev, dv): (&mut [f64], &mut [f64], &mut [f64]),
-    args: IslandArgs<'_>,
+    (a, iterations, tol, relax): (&[f64], usize, f64, f64),
 ) {
+    let args = (iterations, tol, relax);
     let count = sweeps.len();
     let total: usize = (0..count).map(|i| islands.get(i).rows()).sum();
     let parts = scratch.len().max(1);
@@ -316,8 +369,9 @@ fn par_islands(
                     )
                 };
                 let mut out = IslandOut { lambda, u_prev, sm };
+                let mut a = FreeR::Ready(a);
                 for (j, s) in mine.iter_mut().enumerate() {
-                    *s = solve_island(rows, &mut out, &islands.get(start + j), dv, args);
+                    *s = solve_island(rows, &mut out, &islands.get(start + j), dv, &mut a, args);
                 }
             });
         }

@@ -117,6 +117,39 @@ impl MassFactor {
         }
     }
 
+    /// [`Self::row_transform`] of one row held in registers, on a path of `N`
+    /// dofs that is a tree factor's chain root … leaf (a joint row's, or a
+    /// contact's on one body): every loop's bounds constant, each entry the
+    /// same operations in the same order (a zero entry skipped, as there), so
+    /// the same bits. False where the factor is dense, `path` is not that
+    /// chain or L's entries are not all there; `y` is then not (or not wholly)
+    /// transformed, and the caller starts again from its row.
+    #[inline(always)]
+    pub fn chain_row<const N: usize>(&self, path: &[usize], y: &mut [f64; N]) -> bool {
+        if !(self.tree && path.len() == N && self.is_chain(path)) {
+            return false;
+        }
+        // Lᵀ g = j from the leaf in: y[s] −= L[path[t], path[s]]·y[t], s < t
+        for t in (1..N).rev() {
+            let yt = y[t];
+            if yt == 0.0 {
+                continue;
+            }
+            let s = self.start[path[t]];
+            let Some(anc) = self.anc.get(s..s + t) else {
+                return false;
+            };
+            for (ys, &l) in y.iter_mut().zip(anc) {
+                *ys -= l * yt;
+            }
+        }
+        // y ← D^-½ g
+        for (yt, &k) in y.iter_mut().zip(path) {
+            *yt *= self.inv_sqrt_d[k];
+        }
+        true
+    }
+
     /// [`Self::row_transform_lanes`] of rows held in registers, `w[t] = [y₀ₜ,
     /// y₁ₜ, y₂ₜ, pad]`, on a path of `N` dofs that is a tree factor's chain
     /// root … leaf (a contact's three rows on one body's path): the same

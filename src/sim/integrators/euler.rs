@@ -21,7 +21,10 @@ impl Simulation {
         for f in &self.model.free_joints {
             add_frame_rate(&mut self.mass.vfree, &self.v, h, f.iv);
         }
-        for d in &self.model.dofs {
+        for &k in &self.mass.frame_dofs {
+            let Some(d) = self.model.dofs.get(k) else {
+                continue;
+            };
             match d.kind {
                 crate::model::JointKind::Free => {
                     add_frame_rate(&mut self.mass.vfree, &self.v, h, d.iv)
@@ -78,8 +81,10 @@ impl Simulation {
         let mut tau = std::mem::replace(&mut self.mass.tau, DVector::zeros(0));
         self.clamped_tau(&mut tau);
         self.servo.applied.copy_from(&tau);
-        for k in 0..nv {
-            tau[k] -= self.damping[k] * self.v[k];
+        // τ − D v
+        let (d, v) = (self.damping.as_slice(), self.v.as_slice());
+        for ((t, &d), &v) in tau.as_mut_slice()[..nv].iter_mut().zip(d).zip(v) {
+            *t -= d * v;
         }
         let free = if dense {
             // C(q, v); when forward kinematics ran at this q (the last step's

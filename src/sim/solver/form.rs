@@ -36,6 +36,10 @@ impl Rows {
                 r += 3;
                 continue;
             }
+            if k == 1 && self.form_row(f, r, path, vfree) {
+                r += 1;
+                continue;
+            }
             for q in r..r + k {
                 let jr = &self.j[q * st..q * st + pl];
                 let yr = &mut self.y[q * st..q * st + pl];
@@ -111,6 +115,64 @@ impl Rows {
         let lanes = std::mem::take(&mut self.lanes);
         self.store_block(r, &lanes[..pl], c);
         self.lanes = lanes;
+        true
+    }
+
+    /// Row r (not a contact's) on a chain path of 2–12 dofs formed as
+    /// [`Rows::form`] does, in registers ([`Rows::form_row_chain`]). False
+    /// (nothing done) on any other path or a dense factor.
+    fn form_row(&mut self, f: &MassFactor, r: usize, path: &[usize], vfree: &[f64]) -> bool {
+        if !f.is_tree() {
+            return false;
+        }
+        match path.len() {
+            2 => self.form_row_chain::<2>(f, r, path, vfree),
+            3 => self.form_row_chain::<3>(f, r, path, vfree),
+            4 => self.form_row_chain::<4>(f, r, path, vfree),
+            5 => self.form_row_chain::<5>(f, r, path, vfree),
+            6 => self.form_row_chain::<6>(f, r, path, vfree),
+            7 => self.form_row_chain::<7>(f, r, path, vfree),
+            8 => self.form_row_chain::<8>(f, r, path, vfree),
+            9 => self.form_row_chain::<9>(f, r, path, vfree),
+            10 => self.form_row_chain::<10>(f, r, path, vfree),
+            11 => self.form_row_chain::<11>(f, r, path, vfree),
+            12 => self.form_row_chain::<12>(f, r, path, vfree),
+            _ => false,
+        }
+    }
+
+    /// [`Rows::form_row`] on a chain of `N` dofs ([`MassFactor::chain_row`]):
+    /// c = J v* (a sum from 0 in path order), y ← R⁻ᵀ j and Wᵣᵣ = ‖y‖² (a sum
+    /// from −0, as `Iterator::sum`), the same operations in the same order as
+    /// the general way: the same bits. False, nothing written, where the path
+    /// is not the chain.
+    #[inline(always)]
+    fn form_row_chain<const N: usize>(
+        &mut self,
+        f: &MassFactor,
+        r: usize,
+        path: &[usize],
+        vfree: &[f64],
+    ) -> bool {
+        let st = self.stride;
+        let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..r * st + N)) else {
+            return false;
+        };
+        if N > st || path.iter().any(|&d| d >= vfree.len()) {
+            return false;
+        }
+        let mut y = [0.0f64; N];
+        let mut cq = 0.0;
+        for ((yt, &d), &jk) in y.iter_mut().zip(path).zip(j) {
+            *yt = jk;
+            cq += jk * vfree[d];
+        }
+        if !f.chain_row::<N>(path, &mut y) {
+            return false;
+        }
+        self.c[r] = cq;
+        self.y[r * st..r * st + N].copy_from_slice(&y);
+        self.w[r] = y.iter().map(|x| x * x).sum();
         true
     }
 
