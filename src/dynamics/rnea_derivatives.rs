@@ -5,7 +5,7 @@
 
 use super::{check_sizes, DynamicsError};
 use crate::model::{dispatch_joint, Data, FrameId, JointModel, Model, NameError};
-use crate::spatial::ops::cross;
+use crate::spatial::ops::{cross, madd};
 use crate::spatial::{skew, CompositeInertia, Force, Motion, Scalar};
 use nalgebra::{DVector, Matrix3, Vector3};
 
@@ -70,9 +70,14 @@ pub(crate) fn rnea_derivatives_pass<T: Scalar>(
     a: &DVector<T>,
     fext: Option<&[LinkWrench<T>]>,
 ) {
+    let c = by_cols(data);
     match fext {
-        Some(w) if !w.is_empty() => pass::<T, true, false>(model, data, q, v, a, w, false),
-        _ => pass::<T, false, false>(model, data, q, v, a, &[], false),
+        Some(w) if !w.is_empty() && c => {
+            pass::<T, true, false, true>(model, data, q, v, a, w, false)
+        }
+        Some(w) if !w.is_empty() => pass::<T, true, false, false>(model, data, q, v, a, w, false),
+        _ if c => pass::<T, false, false, true>(model, data, q, v, a, &[], false),
+        _ => pass::<T, false, false, false>(model, data, q, v, a, &[], false),
     }
 }
 
@@ -95,10 +100,21 @@ pub(crate) fn rnea_derivatives_pass_after_minv<T: Scalar>(
     free_root: bool,
 ) {
     debug_assert!(data.deriv_direct);
+    let c = by_cols(data);
     match fext {
-        Some(w) if !w.is_empty() => pass::<T, true, true>(model, data, q, v, a, w, false),
-        _ => pass::<T, false, true>(model, data, q, v, a, &[], free_root),
+        Some(w) if !w.is_empty() && c => {
+            pass::<T, true, true, true>(model, data, q, v, a, w, false)
+        }
+        Some(w) if !w.is_empty() => pass::<T, true, true, false>(model, data, q, v, a, w, false),
+        _ if c => pass::<T, false, true, true>(model, data, q, v, a, &[], free_root),
+        _ => pass::<T, false, true, false>(model, data, q, v, a, &[], free_root),
     }
+}
+
+/// Whether the sweep forms ∂τ/∂x by loops over rows (`Data::deriv_by_cols`,
+/// with the columns' components' buffer in place).
+fn by_cols<T: Scalar>(data: &Data<T>) -> bool {
+    data.deriv_by_cols && data.deriv_cols.len() >= 18 * data.deriv_col_iv.len()
 }
 
 /// The 3x3 part `S = ω×I_o − I_o ω× − h vᵀ − v hᵀ + 2 (v·h) 1` of the variation
@@ -141,11 +157,128 @@ fn variation_tr_mul<T: Scalar>(s: &Matrix3<T>, hm: &Force<T>, x: &Motion<T>) -> 
     )
 }
 
+/// `x = mᵀ f` for the 6-vectors `m` (angular first) and the force `f`, as
+/// [`Motion::dot`] takes it (the same operations in the same order).
+#[inline(always)]
+fn dot6<T: Scalar>(m: &[T; 6], f: [T; 6]) -> T {
+    madd(
+        m[5],
+        f[5],
+        madd(
+            m[4],
+            f[4],
+            madd(m[3], f[3], madd(m[2], f[2], madd(m[1], f[1], m[0] * f[0]))),
+        ),
+    )
+}
+
+/// A motion's 6 components, angular first.
+#[inline(always)]
+fn m6<T: Scalar>(m: &Motion<T>) -> [T; 6] {
+    [m.ang.x, m.ang.y, m.ang.z, m.lin.x, m.lin.y, m.lin.z]
+}
+
+/// A force's 6 components, angular first.
+#[inline(always)]
+fn f6<T: Scalar>(f: &Force<T>) -> [T; 6] {
+    [f.ang.x, f.ang.y, f.ang.z, f.lin.x, f.lin.y, f.lin.z]
+}
+
+/// Rows `k0..k0 + R` of the columns' components (`Data::deriv_cols`, stride
+/// `nc`), each cut to `[lo, lo + len)`.
+#[inline(always)]
+fn comps<T, const R: usize>(cs: &[T], nc: usize, k0: usize, lo: usize, len: usize) -> [&[T]; R] {
+    let mut out: [&[T]; R] = [&[]; R];
+    for (k, o) in out.iter_mut().enumerate() {
+        let at = (k0 + k) * nc + lo;
+        *o = &cs[at..at + len];
+    }
+    out
+}
+
+/// One column of this joint (at `col` in the column-major results `x`) against
+/// a run `[lo, hi)` of its strict ancestors' rows r: `x_q[r] = Jᵣᵀ ∂F/∂q`,
+/// `x_v[r] = Jᵣᵀ ∂F/∂v` and without `K` `x_a[r] = Jᵣᵀ Y J` (`f`: the column's
+/// ∂F/∂q, ∂F/∂v, ∂F/∂a), Jᵣ read by components from `cols.0`
+/// (`Data::deriv_cols`, stride `cols.1`): a loop over rows that vectorises, each
+/// entry the operations of `Jᵣ.dot(f)`.
+#[inline(always)]
+fn ancestor_rows<T: Scalar, const K: bool>(
+    f: [&Force<T>; 3],
+    cols: (&[T], usize),
+    x: &mut [&mut [T]; 3],
+    col: usize,
+    (lo, hi): (usize, usize),
+) {
+    let [xq, xv, xa] = x;
+    let len = hi - lo;
+    let xq = &mut xq[col + lo..col + hi];
+    let (xv, xa) = (&mut xv[col + lo..col + hi], &mut xa[col + lo..col + hi]);
+    let j: [&[T]; 6] = comps(cols.0, cols.1, 0, lo, len);
+    let (fq, fv, fa) = (f6(f[0]), f6(f[1]), f6(f[2]));
+    for r in 0..len {
+        let m = [j[0][r], j[1][r], j[2][r], j[3][r], j[4][r], j[5][r]];
+        xq[r] = dot6(&m, fq);
+        xv[r] = dot6(&m, fv);
+        if !K {
+            xa[r] = dot6(&m, fa);
+        }
+    }
+}
+
+/// One column r of this joint against its strict subtree's rows c (from `rows.2`
+/// on): `x_q[c] = ∂aᵣᵀ/∂q Y J_c + ∂vᵣ/∂qᵀ (Ẏᵀ J)_c` (no second term at a `ROOT`;
+/// with `F`, `+ ωᵣ · e_c`), `x_v[c] = ∂aᵣ/∂vᵀ Y J_c + Jᵣᵀ (Ẏᵀ J)_c` and without
+/// `K` `x_a[c] = Jᵣᵀ Y J_c` (`m`: row r's ∂a/∂q, ∂v/∂q, ∂a/∂v, J), the columns c
+/// read by components from `rows.0` (`Data::deriv_cols`): a loop over rows that
+/// vectorises, each entry the operations of the `Motion::dot`s it replaces
+/// (`(Ẏᵀ J).lin` = 0 and e.lin = 0 included as such).
+#[inline(always)]
+fn subtree_rows<T: Scalar, const F: bool, const K: bool, const ROOT: bool>(
+    m: [&Motion<T>; 4],
+    rows: (&[T], usize, usize),
+    x: [&mut [T]; 3],
+) {
+    let [xq, xv, xa] = x;
+    let len = xq.len();
+    let (xv, xa) = (&mut xv[..len], &mut xa[..len]);
+    let (cs, nc, lo) = rows;
+    let y: [&[T]; 6] = comps(cs, nc, 6, lo, len);
+    let t: [&[T]; 3] = comps(cs, nc, 12, lo, len);
+    let e: [&[T]; 3] = if F {
+        comps(cs, nc, 15, lo, len)
+    } else {
+        [&[]; 3]
+    };
+    let (aq, dv, av, jr) = (m6(m[0]), m6(m[1]), m6(m[2]), m6(m[3]));
+    let z = T::zero();
+    for c in 0..len {
+        let yc = [y[0][c], y[1][c], y[2][c], y[3][c], y[4][c], y[5][c]];
+        let tc = [t[0][c], t[1][c], t[2][c], z, z, z];
+        let mut q = if ROOT {
+            dot6(&aq, yc)
+        } else {
+            dot6(&aq, yc) + dot6(&dv, tc)
+        };
+        if F {
+            // ωᵣ · e_c
+            q += madd(jr[2], e[2][c], madd(jr[1], e[1][c], jr[0] * e[0][c]));
+        }
+        xq[c] = q;
+        xv[c] = dot6(&av, yc) + dot6(&jr, tc);
+        if !K {
+            xa[c] = dot6(&jr, yc);
+        }
+    }
+}
+
 /// The two sweeps; `F`: external wrenches present; `K`: the poses, world
 /// columns, world inertias and momenta are those `minv_pass` left (direct columns
-/// only), and H is not written; `free_root`: body 1's columns as
+/// only), and H is not written; `C`: ∂τ/∂x's entries by loops over rows
+/// (`Data::deriv_by_cols`, long patterns: each column's strict ancestors' rows at
+/// its body, the strict subtree's rows of each column at the column's body); `free_root`: body 1's columns as
 /// [`rnea_derivatives_pass_after_minv`] says.
-fn pass<T: Scalar, const F: bool, const K: bool>(
+fn pass<T: Scalar, const F: bool, const K: bool, const C: bool>(
     model: &Model<T>,
     data: &mut Data<T>,
     q: &DVector<T>,
@@ -192,10 +325,15 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
         deriv_ytj: ytj,
         deriv_ext_e: ext_e,
         deriv_full: full,
+        deriv_cols: cs,
+        deriv_anc_runs: runs,
+        deriv_anc_run0: run0,
         minv_j,
         ..
     } = data;
-    let direct = *direct;
+    // the stride of the columns' components (`deriv_cols`)
+    let nc = col_iv.len();
+    let (direct, by_cols) = (*direct, C);
 
     // Sweep 1, root outwards (docs/theory.md §"Derivatives"): world velocity and
     // acceleration, J = ⁰X̂ᵢ S and the columns' ∂v/∂q, ∂a/∂q, ∂a/∂v.
@@ -216,6 +354,12 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
                 for $c in 0..$n {
                     let s = $s;
                     jcol[c0 + $c] = s;
+                    if by_cols {
+                        for r in 0..3 {
+                            cs[r * nc + c0 + $c] = s.ang[r];
+                            cs[(3 + r) * nc + c0 + $c] = s.lin[r];
+                        }
+                    }
                     vj += s * v[iv + $c];
                     aj += s * a[iv + $c];
                 }
@@ -339,6 +483,10 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
                 for c in c0 + 3..ce {
                     mv[r + c * n] = s.dot(&dfdv[c]);
                 }
+                if by_cols {
+                    // (by columns: at the later columns' bodies)
+                    continue;
+                }
                 for c in ce..end {
                     let at = r + c * n;
                     mq[at] = s.dot(&dfdq[c]);
@@ -383,11 +531,22 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
                             Vector3::zeros(),
                         );
                     }
+                    // Y J, (Ẏᵀ J).ang and e.ang by components, for the loops below
+                    let (ya, yt) = (&dfda[k], &ytj[k]);
+                    for r in 0..if by_cols { 3 } else { 0 } {
+                        cs[(6 + r) * nc + k] = ya.ang[r];
+                        cs[(9 + r) * nc + k] = ya.lin[r];
+                        cs[(12 + r) * nc + k] = yt.ang[r];
+                        if F {
+                            cs[(15 + r) * nc + k] = ext_e[k].ang[r];
+                        }
+                    }
                 }
                 for r in c0..$ce {
                     let s = jcol[r];
-                    // rows of this joint, columns of its subtree: Jᵀ ∂F
-                    for c in c0..end {
+                    // rows of this joint, columns of its subtree (by columns: of
+                    // this joint, the others at their bodies): Jᵀ ∂F
+                    for c in c0..if by_cols { $ce } else { end } {
                         let at = r + c * n;
                         if !K {
                             ma[at] = s.dot(&dfda[c]);
@@ -396,28 +555,62 @@ fn pass<T: Scalar, const F: bool, const K: bool>(
                         mv[at] = s.dot(&dfdv[c]);
                     }
                     // rows of the strict subtree, columns of this joint
-                    let (aq, av, jr) = (dadq[r], dadv[r], s);
-                    let (dv, ang) = (dvdq[r], s.ang);
-                    for c in $ce..end {
-                        let at = c + r * n;
-                        let mut x = if root {
-                            aq.dot(&dfda[c])
-                        } else {
-                            aq.dot(&dfda[c]) + dv.dot(&ytj[c])
-                        };
-                        if F {
-                            x += crate::spatial::ops::dot(&ang, &ext_e[c].ang);
+                    if !by_cols {
+                        let (aq, av, jr) = (dadq[r], dadv[r], s);
+                        let (dv, ang) = (dvdq[r], s.ang);
+                        for c in $ce..end {
+                            let at = c + r * n;
+                            let mut x = if root {
+                                aq.dot(&dfda[c])
+                            } else {
+                                aq.dot(&dfda[c]) + dv.dot(&ytj[c])
+                            };
+                            if F {
+                                x += crate::spatial::ops::dot(&ang, &ext_e[c].ang);
+                            }
+                            mq[at] = x;
+                            mv[at] = av.dot(&dfda[c]) + jr.dot(&ytj[c]);
+                            if !K {
+                                ma[at] = ma[r + c * n];
+                            }
                         }
-                        mq[at] = x;
-                        mv[at] = av.dot(&dfda[c]) + jr.dot(&ytj[c]);
-                        if !K {
-                            ma[at] = ma[r + c * n];
+                    } else if $ce < end {
+                        let (col, lo, hi) = (r * n, $ce, end);
+                        let (xq, xv, xa) = (
+                            &mut mq[col + lo..col + hi],
+                            &mut mv[col + lo..col + hi],
+                            &mut ma[col + lo..col + hi],
+                        );
+                        let (m, rows) = ([&dadq[r], &dvdq[r], &dadv[r], &s], (&cs[..], nc, lo));
+                        if root {
+                            subtree_rows::<T, F, K, true>(m, rows, [xq, xv, xa]);
+                        } else {
+                            subtree_rows::<T, F, K, false>(m, rows, [xq, xv, xa]);
                         }
                     }
                 }
-                // the subtree moves rigidly with the joint: ∂F/∂q += J ×* F
                 for k in c0..$ce {
+                    // the subtree moves rigidly with the joint: ∂F/∂q += J ×* F
                     dfdq[k] += jcol[k].cross_force(fi);
+                    if !by_cols {
+                        continue;
+                    }
+                    // rows of the strict ancestors, columns of this joint: Jᵀ ∂F
+                    // (∂F whole now)
+                    let f = [&dfdq[k], &dfdv[k], &dfda[k]];
+                    let mut x = [&mut *mq, &mut *mv, &mut *ma];
+                    if direct {
+                        for &run in &runs[run0[c0]..run0[c0 + 1]] {
+                            ancestor_rows::<T, K>(f, (&cs[..], nc), &mut x, k * n, run);
+                        }
+                    } else {
+                        let mut b = p;
+                        while b != 0 {
+                            let run = (col0[b], col0[b] + joints[b].nv());
+                            ancestor_rows::<T, K>(f, (&cs[..], nc), &mut x, k * n, run);
+                            b = parent[b];
+                        }
+                    }
                 }
             };
         }

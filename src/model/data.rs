@@ -129,6 +129,15 @@ pub struct Data<T: Scalar = f64> {
     pub deriv_ytj: Vec<Force<T>>,
     /// Derivatives, per column: the external-force term `[e; 0]` of the lower block.
     pub deriv_ext_e: Vec<Force<T>>,
+    /// Derivatives, per column, by components (the sweep's loops over columns
+    /// vectorise): J (rows 0–5), `Yᶜ J` (6–11), the angular part of `(Ẏᶜ)ᵀ J`
+    /// (12–14) and of e (15–17); component k of column c at `k ncol + c`.
+    pub deriv_cols: Vec<T>,
+    /// Derivatives: whether the sweep forms ∂τ/∂x's entries by loops over rows
+    /// that read the columns by components (`deriv_cols`: long patterns, ≥ 32
+    /// rows a column on average) rather than column by column (the short loops
+    /// of branched trees, where the loops' set-up outweighs them).
+    pub deriv_by_cols: bool,
     /// Derivatives with mimic joints: ∂τ/∂q, ∂τ/∂v, ∂τ/∂a over the column space
     /// (then reduced by G); empty without mimic joints.
     pub deriv_full: [DMatrix<T>; 3],
@@ -233,6 +242,7 @@ impl<T: Scalar> Data<T> {
         let mut s_off = vec![0; nb];
         let mut s_len = 0;
         let mut low_rank = false;
+        let mut by_cols = false;
         if direct && nv > 0 {
             let rows: usize = (0..nv)
                 .map(|c| {
@@ -244,6 +254,7 @@ impl<T: Scalar> Data<T> {
                 })
                 .sum();
             low_rank = 94 * nv * nv < 2 * nv * rows;
+            by_cols = rows >= 32 * nv;
         }
         if direct {
             let mut nchild = vec![0usize; nb];
@@ -312,6 +323,8 @@ impl<T: Scalar> Data<T> {
             deriv_dfda: vec![Force::zero(); ncol],
             deriv_ytj: vec![Force::zero(); ncol],
             deriv_ext_e: vec![Force::zero(); ncol],
+            deriv_cols: vec![T::zero(); if by_cols { 18 * ncol } else { 0 }],
+            deriv_by_cols: by_cols,
             deriv_full: std::array::from_fn(|_| lazy_zeros(nfull, nfull)),
             deriv_scratch: lazy_zeros(nv, nv),
             deriv_tmp: DVector::zeros(nv),
