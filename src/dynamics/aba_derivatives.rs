@@ -5,7 +5,8 @@
 //! H"; the products over ∂ID/∂x's tree pattern, "The products").
 
 use super::rnea_derivatives::{
-    check_wrenches, rnea_derivatives_pass, rnea_derivatives_pass_after_minv, LinkWrench,
+    check_wrenches, rnea_derivatives_pass, rnea_derivatives_pass_after_minv,
+    rnea_derivatives_pass_diagonal, LinkWrench,
 };
 use super::{check_massless, check_sizes, minv, DynamicsError};
 use crate::model::{Data, JointKind, Model};
@@ -28,8 +29,11 @@ use nalgebra::{DMatrix, DVector, Vector3};
 /// root without wrenches: its columns of ∂q̈/∂q and linear-velocity columns of
 /// ∂q̈/∂v in closed form (docs/theory.md §"Derivatives: a free root's columns").
 /// Also leaves `data.dtau_dq`, `data.dtau_dv` (at a = q̈; with a free root and no
-/// wrenches, except those nine columns, left as they were); `data.h` only with
-/// mimic joints. No allocation.
+/// wrenches, except those nine columns, left as they were) — but on the low-rank
+/// route (`data.deriv_low_rank`) only their blocks of each joint's own rows and
+/// columns, the other entries left as they were (call
+/// [`super::rnea_derivatives`] for ∂τ/∂x whole); `data.h` only with mimic
+/// joints. No allocation.
 pub fn aba_derivatives<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,
@@ -61,10 +65,15 @@ pub fn aba_derivatives<T: Scalar>(
         // ∂q̈/∂q and its linear-velocity columns of ∂q̈/∂v are known in closed form
         // (`free_root_columns`); ∂τ/∂x's are not formed for them.
         let free_root = fext.is_none() && !data.deriv_low_rank && free_root(model);
-        // ∂τ/∂q, ∂τ/∂v at a = q̈
+        // ∂τ/∂q, ∂τ/∂v at a = q̈ (for the low-rank products only each joint's
+        // own block, and the per-column vectors)
         let mut a = std::mem::replace(&mut data.deriv_tmp, DVector::zeros(0));
         a.copy_from(&data.qdd);
-        rnea_derivatives_pass_after_minv(model, data, q, v, &a, fext, free_root);
+        if data.deriv_low_rank {
+            rnea_derivatives_pass_diagonal(model, data, q, v, &a, fext);
+        } else {
+            rnea_derivatives_pass_after_minv(model, data, q, v, &a, fext, free_root);
+        }
         data.deriv_tmp = a;
         if data.deriv_low_rank {
             // ∂q̈/∂x = −H⁻¹ ∂τ/∂x from ∂τ/∂x's low-rank parts (long chains)

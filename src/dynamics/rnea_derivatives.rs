@@ -73,11 +73,13 @@ pub(crate) fn rnea_derivatives_pass<T: Scalar>(
     let c = by_cols(data);
     match fext {
         Some(w) if !w.is_empty() && c => {
-            pass::<T, true, false, true>(model, data, q, v, a, w, false)
+            pass::<T, true, false, true, false>(model, data, q, v, a, w, false)
         }
-        Some(w) if !w.is_empty() => pass::<T, true, false, false>(model, data, q, v, a, w, false),
-        _ if c => pass::<T, false, false, true>(model, data, q, v, a, &[], false),
-        _ => pass::<T, false, false, false>(model, data, q, v, a, &[], false),
+        Some(w) if !w.is_empty() => {
+            pass::<T, true, false, false, false>(model, data, q, v, a, w, false)
+        }
+        _ if c => pass::<T, false, false, true, false>(model, data, q, v, a, &[], false),
+        _ => pass::<T, false, false, false, false>(model, data, q, v, a, &[], false),
     }
 }
 
@@ -103,11 +105,39 @@ pub(crate) fn rnea_derivatives_pass_after_minv<T: Scalar>(
     let c = by_cols(data);
     match fext {
         Some(w) if !w.is_empty() && c => {
-            pass::<T, true, true, true>(model, data, q, v, a, w, false)
+            pass::<T, true, true, true, false>(model, data, q, v, a, w, false)
         }
-        Some(w) if !w.is_empty() => pass::<T, true, true, false>(model, data, q, v, a, w, false),
-        _ if c => pass::<T, false, true, true>(model, data, q, v, a, &[], free_root),
-        _ => pass::<T, false, true, false>(model, data, q, v, a, &[], free_root),
+        Some(w) if !w.is_empty() => {
+            pass::<T, true, true, false, false>(model, data, q, v, a, w, false)
+        }
+        _ if c => pass::<T, false, true, true, false>(model, data, q, v, a, &[], free_root),
+        _ => pass::<T, false, true, false, false>(model, data, q, v, a, &[], free_root),
+    }
+}
+
+/// [`rnea_derivatives_pass_after_minv`] without a free root's shortcut, for the
+/// low-rank products of `aba_derivatives` (`Data::deriv_low_rank`, long chains),
+/// which read of ∂τ/∂q, ∂τ/∂v only the blocks of each joint's rows and columns:
+/// the other entries are not formed (they keep what they held); every per-column
+/// vector the products read (∂F/∂x, Y J, Ẏᵀ J, e, J, ∂v/∂q, ∂a/∂x) is.
+pub(crate) fn rnea_derivatives_pass_diagonal<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+    a: &DVector<T>,
+    fext: Option<&[LinkWrench<T>]>,
+) {
+    debug_assert!(data.deriv_direct);
+    if !by_cols(data) {
+        // (not the case on the low-rank route: long patterns are by columns)
+        return rnea_derivatives_pass_after_minv(model, data, q, v, a, fext, false);
+    }
+    match fext {
+        Some(w) if !w.is_empty() => {
+            pass::<T, true, true, true, true>(model, data, q, v, a, w, false)
+        }
+        _ => pass::<T, false, true, true, true>(model, data, q, v, a, &[], false),
     }
 }
 
@@ -276,9 +306,11 @@ fn subtree_rows<T: Scalar, const F: bool, const K: bool, const ROOT: bool>(
 /// columns, world inertias and momenta are those `minv_pass` left (direct columns
 /// only), and H is not written; `C`: ∂τ/∂x's entries by loops over rows
 /// (`Data::deriv_by_cols`, long patterns: each column's strict ancestors' rows at
-/// its body, the strict subtree's rows of each column at the column's body); `free_root`: body 1's columns as
+/// its body, the strict subtree's rows of each column at the column's body); `D`
+/// (with `C`): only each joint's own block (rows and columns of the joint), as
+/// [`rnea_derivatives_pass_diagonal`] says; `free_root`: body 1's columns as
 /// [`rnea_derivatives_pass_after_minv`] says.
-fn pass<T: Scalar, const F: bool, const K: bool, const C: bool>(
+fn pass<T: Scalar, const F: bool, const K: bool, const C: bool, const D: bool>(
     model: &Model<T>,
     data: &mut Data<T>,
     q: &DVector<T>,
@@ -334,6 +366,8 @@ fn pass<T: Scalar, const F: bool, const K: bool, const C: bool>(
     // the stride of the columns' components (`deriv_cols`)
     let nc = col_iv.len();
     let (direct, by_cols) = (*direct, C);
+    // the columns' components (`deriv_cols`), read only by the off-diagonal loops
+    let comps_kept = C && !D;
 
     // Sweep 1, root outwards (docs/theory.md §"Derivatives"): world velocity and
     // acceleration, J = ⁰X̂ᵢ S and the columns' ∂v/∂q, ∂a/∂q, ∂a/∂v.
@@ -354,7 +388,7 @@ fn pass<T: Scalar, const F: bool, const K: bool, const C: bool>(
                 for $c in 0..$n {
                     let s = $s;
                     jcol[c0 + $c] = s;
-                    if by_cols {
+                    if comps_kept {
                         for r in 0..3 {
                             cs[r * nc + c0 + $c] = s.ang[r];
                             cs[(3 + r) * nc + c0 + $c] = s.lin[r];
@@ -533,7 +567,7 @@ fn pass<T: Scalar, const F: bool, const K: bool, const C: bool>(
                     }
                     // Y J, (Ẏᵀ J).ang and e.ang by components, for the loops below
                     let (ya, yt) = (&dfda[k], &ytj[k]);
-                    for r in 0..if by_cols { 3 } else { 0 } {
+                    for r in 0..if comps_kept { 3 } else { 0 } {
                         cs[(6 + r) * nc + k] = ya.ang[r];
                         cs[(9 + r) * nc + k] = ya.lin[r];
                         cs[(12 + r) * nc + k] = yt.ang[r];
@@ -574,7 +608,7 @@ fn pass<T: Scalar, const F: bool, const K: bool, const C: bool>(
                                 ma[at] = ma[r + c * n];
                             }
                         }
-                    } else if $ce < end {
+                    } else if !D && $ce < end {
                         let (col, lo, hi) = (r * n, $ce, end);
                         let (xq, xv, xa) = (
                             &mut mq[col + lo..col + hi],
@@ -592,7 +626,7 @@ fn pass<T: Scalar, const F: bool, const K: bool, const C: bool>(
                 for k in c0..$ce {
                     // the subtree moves rigidly with the joint: ∂F/∂q += J ×* F
                     dfdq[k] += jcol[k].cross_force(fi);
-                    if !by_cols {
+                    if !by_cols || D {
                         continue;
                     }
                     // rows of the strict ancestors, columns of this joint: Jᵀ ∂F

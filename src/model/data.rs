@@ -66,9 +66,11 @@ pub struct Data<T: Scalar = f64> {
     pub jacobians: DMatrix<T>,
 
     // Derivatives (docs/theory.md §"Derivatives"). Results first.
-    /// ∂τ/∂q (nv × nv, tangent space) from `rnea_derivatives`.
+    /// ∂τ/∂q (nv × nv, tangent space) from `rnea_derivatives` (`aba_derivatives`
+    /// leaves it at a = q̈, on its low-rank route only each joint's own block).
     pub dtau_dq: DMatrix<T>,
-    /// ∂τ/∂v (nv × nv) from `rnea_derivatives`.
+    /// ∂τ/∂v (nv × nv) from `rnea_derivatives` (as `dtau_dq` after
+    /// `aba_derivatives`).
     pub dtau_dv: DMatrix<T>,
     /// ∂q̈/∂q (nv × nv, tangent space) from `aba_derivatives`.
     pub dqdd_dq: DMatrix<T>,
