@@ -161,6 +161,35 @@ impl MassFactor {
         self.tree && path.len() == N && self.is_chain(path) && self.chain_elim::<N>(path, w)
     }
 
+    /// [`Self::row_transform_lanes`] of rows held in registers on a path of
+    /// `A + B` dofs that is two trees' chains, root … leaf each (a contact's
+    /// three rows between two free bodies: every contact of a pile): L is zero
+    /// between the trees, so each chain is eliminated on its own, each lane's
+    /// entry taking the same operations in the same order (the same bits).
+    /// False where the factor is dense or `path` is not two such chains.
+    #[inline(always)]
+    pub fn two_chain_lanes<const A: usize, const B: usize>(
+        &self,
+        path: &[usize],
+        w: &mut [[f64; 4]],
+    ) -> bool {
+        if !(self.tree && path.len() == A + B && w.len() == A + B) {
+            return false;
+        }
+        let (pa, pb) = path.split_at(A);
+        if !(self.is_chain(pa) && self.is_chain(pb)) {
+            return false;
+        }
+        let (wa, wb) = w.split_at_mut(A);
+        match (
+            <&mut [[f64; 4]; A]>::try_from(wa),
+            <&mut [[f64; 4]; B]>::try_from(wb),
+        ) {
+            (Ok(wa), Ok(wb)) => self.chain_elim::<B>(pb, wb) && self.chain_elim::<A>(pa, wa),
+            _ => false,
+        }
+    }
+
     /// The elimination and scaling of [`Self::row_transform_lanes`] on a chain
     /// path of `N` dofs (`path[..N]`), in registers: every loop's bounds
     /// constant (unrolled, no bounds tests); each lane's entry takes the same

@@ -104,7 +104,8 @@ impl Rows {
             12 => self.form_chain::<12>(f, r, path, vfree),
             _ => false,
         };
-        if done {
+        // two free bodies' chains (6 + 6: a pile's contacts between bodies)
+        if done || (pl == 12 && self.form_two::<6, 6, 12>(f, r, path, vfree)) {
             return true;
         }
         let j = &self.j[r * st..(r + 3) * st];
@@ -205,6 +206,39 @@ impl Rows {
             &mut w,
         );
         if !f.chain_lanes::<N>(path, &mut w) {
+            return false;
+        }
+        self.store_block(r, &w, c);
+        true
+    }
+
+    /// [`Rows::form_chain`] on a path of `N = A + B` dofs that is two trees'
+    /// chains ([`MassFactor::two_chain_lanes`]): the same operations in the
+    /// same order as the general way, the same bits. False, nothing written,
+    /// where the path is not two such chains.
+    #[inline(always)]
+    fn form_two<const A: usize, const B: usize, const N: usize>(
+        &mut self,
+        f: &MassFactor,
+        r: usize,
+        path: &[usize],
+        vfree: &[f64],
+    ) -> bool {
+        let st = self.stride;
+        let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..(r + 3) * st)) else {
+            return false;
+        };
+        if N != A + B || N > st || path.iter().any(|&d| d >= vfree.len()) {
+            return false;
+        }
+        let mut w = [[0.0f64; 4]; N];
+        let c = gather_rows(
+            [&j[..N], &j[st..st + N], &j[2 * st..2 * st + N]],
+            path,
+            vfree,
+            &mut w,
+        );
+        if !f.two_chain_lanes::<A, B>(path, &mut w) {
             return false;
         }
         self.store_block(r, &w, c);
