@@ -29,6 +29,7 @@ pub mod ltdl;
 mod minv;
 mod rnea;
 mod rnea_derivatives;
+mod rnea_derivatives_rows;
 
 pub use crate::spatial::CompositeInertia;
 pub use aba::aba;
