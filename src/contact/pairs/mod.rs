@@ -13,10 +13,10 @@
 //! pair's slots: the slot of the same features last step (its impulse warm
 //! starts the solve), else a free one marked fresh (no warm start).
 
-use super::broad::{prefetch, PairMasks, PairTable, SweepAndPrune, LAZY_PAIR, STRIPS_FROM};
+use super::broad::{prefetch, PairMasks, PairTable, SweepAndPrune, LAZY_PAIR};
 use super::filter::{is_self_pair, may_touch};
 use super::narrow::prim::{round_points_at, Round};
-use super::narrow::{face_kind, face_points, parry_points, reduce_pair, FaceScratch, Raw};
+use super::narrow::{face_points, parry_points, reduce_pair, FaceScratch, Raw};
 use super::shapes::{from_pvec, pair_shape, PairShape};
 use super::travel::{moved_from, Travel};
 use super::{ContactError, ContactParams, ContactPoint};
@@ -27,6 +27,7 @@ use parry3d_f64::query::{ContactManifold, ContactManifoldsWorkspace};
 use std::path::PathBuf;
 
 pub(crate) mod apart;
+mod make;
 mod order;
 mod start;
 use apart::{apart_along, still_apart_at, Apart};
@@ -293,59 +294,6 @@ impl PairContact {
             }
         }
         Ok(Some(made))
-    }
-
-    /// Makes the pair of members `i` and `j` (allowed, not made yet): its
-    /// state, its slots (the next `max_points`), its place in the table.
-    fn make_pair(&mut self, i: usize, j: usize) -> u32 {
-        // members are in geometry order: the lower one first, as the filter
-        // enumerated them (the sweep meets them in either order)
-        let (i, j) = (i.min(j), i.max(j));
-        let (mi, mj) = (&self.members[i], &self.members[j]);
-        // a non-convex shape (a mesh obstacle, a height field) is never shape
-        // a: parry is given it second
-        let (a, b) = if mi.shape.convex || !mj.shape.convex {
-            (i, j)
-        } else {
-            (j, i)
-        };
-        let (ga, gb) = (self.members[a].geom as u64, self.members[b].geom as u64);
-        let p = self.pairs.len() as u32;
-        self.table.set(a, b, p);
-        let maxp = self.max_points;
-        let self_pair = self.model_of[a].is_some() && self.model_of[a] == self.model_of[b];
-        let ord = ga.min(gb) * self.ngeoms + ga.max(gb);
-        self.ords.push(ord);
-        self.keys.extend(std::iter::repeat_n(NO_KEY, maxp));
-        self.dropped.push(false);
-        self.made_since_sort += 1;
-        self.pairs.push(Pair {
-            a,
-            b,
-            slot_base: self.slot_offset + p as usize * maxp,
-            manifolds: Vec::new(),
-            workspace: None,
-            self_pair,
-            axis: Vector3::zeros(),
-            apart: None,
-            face: face_kind(&self.members[a].shape, &self.members[b].shape),
-            friction: self.friction[a].max(self.friction[b]),
-        });
-        p
-    }
-
-    /// Sets up the broad phase by masks ([`Self::listed`]) once every
-    /// allowed pair is made among fewer than [`STRIPS_FROM`] shapes (after
-    /// that no pair is made: the allowed pairs stay those).
-    fn list_pairs(&mut self) {
-        if self.listed.is_some()
-            || self.pairs.len() != self.allowed
-            || self.members.len() >= STRIPS_FROM
-        {
-            return;
-        }
-        let pairs = self.pairs.iter().map(|p| (p.a, p.b));
-        self.listed = PairMasks::new(self.members.len(), pairs);
     }
 
     /// Forgets every pair's manifolds and the features its slots held: the
