@@ -19,8 +19,9 @@ mod rows;
 use super::factor_dense::{dense_backward, dense_forward};
 use crate::dynamics::crba_packed;
 use crate::dynamics::linalg::{by_size, cholesky_fast};
-use crate::model::{Data, Model};
+use crate::model::{Data, JointKind, Model};
 use crate::spatial::ops::madd;
+use crate::spatial::CompositeInertia;
 use nalgebra::{DMatrix, DVector};
 
 const NONE: usize = usize::MAX;
@@ -87,6 +88,18 @@ pub struct MassFactor {
     /// (root, root + 1, …, the dof: a floating base's six), whose packed rows
     /// then lie back to back as one triangle.
     root_chain: Vec<bool>,
+    /// Tree: every body a lone free body on the world (each tree one body).
+    /// H is then each body's spatial inertia in its body frame (the free
+    /// joint's S = 1, docs/theory.md §"Floating base"), the same numbers at
+    /// every q: H̃ and its factor change only with the diagonal A + h D and
+    /// the inertias.
+    lone_free: bool,
+    /// The factor in place is [`Self::factor_at`]'s of every tree of such a
+    /// model with `held_diag` added to H's diagonal and the bodies' inertias
+    /// `held_inertia` (false: not known to be).
+    held: bool,
+    held_diag: Vec<f64>,
+    held_inertia: Vec<CompositeInertia<f64>>,
 }
 
 impl MassFactor {
@@ -125,9 +138,19 @@ impl MassFactor {
             root_chain[k] =
                 tree && (p == Some(NONE) || (k > 0 && p == Some(k - 1) && root_chain[k - 1]));
         }
+        let nb = model.nbodies;
+        let lone_free = tree
+            && nb > 1
+            && model.parent.len() == nb
+            && model.joints.len() == nb
+            && (1..nb).all(|i| model.parent[i] == 0 && model.joints[i].kind == JointKind::Free);
         Self {
             tree,
             n,
+            lone_free,
+            held: false,
+            held_diag: vec![0.0; if lone_free { n } else { 0 }],
+            held_inertia: Vec::with_capacity(if lone_free { nb } else { 0 }),
             m: if tree {
                 DMatrix::zeros(0, 0)
             } else {
@@ -180,6 +203,7 @@ impl MassFactor {
     /// not positive.
     pub fn factor(&mut self, h: &DMatrix<f64>) -> Result<(), usize> {
         self.partial = false;
+        self.held = false;
         if self.tree {
             for k in 0..self.n {
                 let (s, l) = (self.start[k], self.len[k]);
@@ -211,6 +235,13 @@ impl MassFactor {
         placed: bool,
         diag: impl Fn(usize) -> f64,
     ) -> Option<Result<(), usize>> {
+        // lone free bodies: H̃ at this q is H̃ at the last one; with the same
+        // diagonal and inertias the factor in place is the one this would
+        // compute, bit for bit (`placed`: nor are the placements to be stored)
+        if placed && self.held && self.holds(model, &diag) {
+            return Some(Ok(()));
+        }
+        self.held = false;
         let bodies = self.partial.then_some(&self.body_ranges[..]);
         let (anc, start, len) = (&mut self.anc, &self.start, &self.len);
         if !self.tree || !crba_packed(model, data, q, placed, anc, start, len, bodies) {
@@ -225,7 +256,38 @@ impl MassFactor {
                 }
             }
         }
-        Some(self.factor_packed())
+        let r = self.factor_packed();
+        // every tree factored (none asleep): the factor may be held
+        let covered: usize = self.ranges().iter().map(|&(k0, k1)| k1 - k0).sum();
+        if r.is_ok() && self.lone_free && covered == self.n {
+            self.hold(model, &diag);
+        }
+        Some(r)
+    }
+
+    /// Whether H̃'s diagonal additions and the bodies' inertias are, bit for
+    /// bit, those of the held factor.
+    fn holds(&self, model: &Model, diag: &impl Fn(usize) -> f64) -> bool {
+        let same = |a: &CompositeInertia<f64>, b: &CompositeInertia<f64>| {
+            a.m.to_bits() == b.m.to_bits()
+                && a.h.iter().zip(b.h.iter()).all(|(x, y)| x.to_bits() == y.to_bits())
+                && a.io.iter().zip(b.io.iter()).all(|(x, y)| x.to_bits() == y.to_bits())
+        };
+        let inertias = &model.inertias_origin;
+        self.held_diag.len() == self.n
+            && (0..self.n).all(|k| diag(k).to_bits() == self.held_diag[k].to_bits())
+            && inertias.len() == self.held_inertia.len()
+            && inertias.iter().zip(&self.held_inertia).all(|(a, b)| same(a, b))
+    }
+
+    /// Records the diagonal additions and inertias of the factor just made.
+    fn hold(&mut self, model: &Model, diag: &impl Fn(usize) -> f64) {
+        for (k, x) in self.held_diag.iter_mut().enumerate() {
+            *x = diag(k);
+        }
+        self.held_inertia.clear();
+        self.held_inertia.extend_from_slice(&model.inertias_origin);
+        self.held = self.held_diag.len() == self.n;
     }
 
     /// The next [`Self::factor_at`] (and the solves until the next factor)
