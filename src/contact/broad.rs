@@ -379,9 +379,10 @@ impl SweepAndPrune {
 pub(crate) struct PairMasks {
     /// Per shape l, the allowed shapes h > l, as bits.
     allowed: Vec<u64>,
-    /// Scratch: the boxes' lower and upper corners, axis by axis.
-    lo: [Vec<f64>; 3],
-    hi: [Vec<f64>; 3],
+    /// Scratch: the boxes' lower and upper corners (x, y, z, then x, y, z)
+    /// of shapes 4b to 4b + 3 in block b, a lane a shape (the last block
+    /// padded: never allowed).
+    quads: Vec<[[f64; 4]; 6]>,
 }
 
 /// Shapes from which [`PairMasks`] tests every shape h > l at once (fewer:
@@ -402,11 +403,9 @@ impl PairMasks {
                 allowed[l] |= 1 << h;
             }
         }
-        let axes = || [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
         Some(Self {
             allowed,
-            lo: axes(),
-            hi: axes(),
+            quads: vec![[[0.0; 4]; 6]; n.div_ceil(4)],
         })
     }
 
@@ -439,31 +438,25 @@ impl PairMasks {
             return;
         }
         for k in 0..n {
+            let q = &mut self.quads[k / 4];
             for a in 0..3 {
-                self.lo[a][k] = sap.lo[k][a];
-                self.hi[a][k] = sap.hi[k][a];
+                q[a][k % 4] = sap.lo[k][a];
+                q[a + 3][k % 4] = sap.hi[k][a];
             }
         }
-        let [lx, ly, lz] = &self.lo;
-        let [hx, hy, hz] = &self.hi;
-        let (lx, ly, lz, hx, hy, hz) = (&lx[..n], &ly[..n], &lz[..n], &hx[..n], &hy[..n], &hz[..n]);
         for l in 0..n {
             let allowed = self.allowed[l];
             if allowed == 0 {
                 continue;
             }
-            let (a0, a1, a2, b0, b1, b2) = (lx[l], ly[l], lz[l], hx[l], hy[l], hz[l]);
+            let q = &self.quads[l / 4][..];
+            let lbox = [0, 1, 2, 3, 4, 5].map(|a| q[a][l % 4]);
             // bit h: boxes l and h overlap (apart: one's lower corner above
-            // the other's upper one along an axis)
+            // the other's upper one along an axis), 4 shapes h at a time
             let mut mask = 0u64;
-            for h in l + 1..n {
-                let apart = (lx[h] > b0)
-                    | (a0 > hx[h])
-                    | (ly[h] > b1)
-                    | (a1 > hy[h])
-                    | (lz[h] > b2)
-                    | (a2 > hz[h]);
-                mask |= u64::from(!apart) << h;
+            let first = (l + 1) / 4;
+            for (b, hbox) in self.quads.iter().enumerate().skip(first) {
+                mask |= overlap4(&lbox, hbox) << (4 * b);
             }
             mask &= allowed;
             while mask != 0 {
@@ -472,5 +465,46 @@ impl PairMasks {
                 found(l, h);
             }
         }
+    }
+}
+
+/// The bits (0–3) of the 4 boxes `h` (lower x, y, z, upper x, y, z, a lane
+/// each) that overlap box `l` (lower x, y, z, upper x, y, z): none apart
+/// along an axis (the same comparisons whatever the path: exact).
+#[inline]
+fn overlap4(l: &[f64; 6], h: &[[f64; 4]; 6]) -> u64 {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    {
+        use std::arch::x86_64::{
+            _mm256_broadcast_sd, _mm256_cmp_pd, _mm256_loadu_pd, _mm256_movemask_pd,
+            _mm256_or_pd, _CMP_GT_OQ,
+        };
+        // SAFETY: AVX is enabled for this build (the cfg); the loads read
+        // the 4 lanes of arrays of 4 f64 and the broadcasts one f64.
+        unsafe {
+            let gt = |a, b| _mm256_cmp_pd::<_CMP_GT_OQ>(a, b);
+            let lane = |k: usize| _mm256_loadu_pd(h[k].as_ptr());
+            let one = |k: usize| _mm256_broadcast_sd(&l[k]);
+            // lo_h > hi_l or lo_l > hi_h, along x, y, z
+            let x = _mm256_or_pd(gt(lane(0), one(3)), gt(one(0), lane(3)));
+            let y = _mm256_or_pd(gt(lane(1), one(4)), gt(one(1), lane(4)));
+            let z = _mm256_or_pd(gt(lane(2), one(5)), gt(one(2), lane(5)));
+            let apart = _mm256_movemask_pd(_mm256_or_pd(x, _mm256_or_pd(y, z)));
+            u64::from(!(apart as u32) & 0xF)
+        }
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+    {
+        let mut bits = 0u64;
+        for i in 0..4 {
+            let apart = (h[0][i] > l[3])
+                | (l[0] > h[3][i])
+                | (h[1][i] > l[4])
+                | (l[1] > h[4][i])
+                | (h[2][i] > l[5])
+                | (l[2] > h[5][i]);
+            bits |= u64::from(!apart) << i;
+        }
+        bits
     }
 }
