@@ -110,6 +110,9 @@ pub struct Rows {
     ylanes: Vec<[f64; 4]>,
     /// Each row's velocity at its update in the last sweep.
     u_prev: Vec<f64>,
+    /// Scratch of the position pass: the rows it updates, in sweep order
+    /// (position.rs).
+    pos_rows: Vec<PosRow>,
     /// Scratch of the subspace step ([`subspace_step`]).
     sm: Subspace,
     /// The last solve took a subspace step.
@@ -131,6 +134,17 @@ pub struct Rows {
     solves: u64,
     /// This solve sheds the self-stress of its jointed islands.
     shed_now: bool,
+}
+
+/// A row the position pass updates (position.rs): its index, its path's
+/// start and length in the table (checked to lie there), and whether it is
+/// a loop row (bilateral: μ free).
+#[derive(Clone, Copy, Debug)]
+struct PosRow {
+    r: usize,
+    ps: usize,
+    pl: usize,
+    bilateral: bool,
 }
 
 /// Every how many steps a jointed island's self-stress is shed (stress.rs).
@@ -163,6 +177,7 @@ impl Rows {
             lanes: vec![[0.0; 4]; stride],
             ylanes: vec![[0.0; 4]; cap * stride],
             u_prev: vec![0.0; cap],
+            pos_rows: Vec::with_capacity(cap),
             sm: Subspace::new(nv, cap),
             polished: false,
             cap,

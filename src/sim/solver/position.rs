@@ -1,7 +1,7 @@
 //! The position pass (split impulse) on the solve's rows.
 
 use super::loop_block::BlockRows;
-use super::{MassFactor, RowKind, Rows};
+use super::{MassFactor, PosRow, RowKind, Rows};
 
 impl Rows {
     /// The position pass (split impulse): projected Gauss–Seidel on the same
@@ -104,49 +104,76 @@ impl Rows {
         // each write of μ)
         let (kinds, w, paths) = (&self.kind[..n], &self.w[..n], &self.path[..n]);
         let (y, bpos) = (&self.y[..], &self.bpos[..n]);
+        // the rows a sweep updates, listed once in sweep order: the contact
+        // normals and joint limits (and the loop rows when not one block)
+        // with a diagonal W above 1e-14 and their path and y in range (the
+        // rows every sweep skipped are left out of the sweeps)
+        let mut list = std::mem::take(&mut self.pos_rows);
+        list.clear();
+        for &(_, s, e) in runs {
+            for r in s..e {
+                let kind = kinds[r];
+                let bilateral = kind == RowKind::Bilateral;
+                if bilateral && block {
+                    continue;
+                }
+                if !bilateral && !matches!(kind, RowKind::Normal | RowKind::Unilateral) {
+                    continue;
+                }
+                if !(w[r] > 1e-14) {
+                    continue;
+                }
+                let (ps, pl) = paths[r];
+                if table.get(ps..ps + pl).is_none() || y.get(r * st..r * st + pl).is_none() {
+                    continue;
+                }
+                list.push(PosRow {
+                    r,
+                    ps,
+                    pl,
+                    bilateral,
+                });
+            }
+        }
         let mu = &mut self.mu[..n];
         let loops = &mut self.sm.loops;
         let mut it = 0;
         while it < max_iter {
             it += 1;
             let mut change: f64 = 0.0;
-            for &(_, s, e) in runs {
-                for r in s..e {
-                    let kind = kinds[r];
-                    let bilateral = kind == RowKind::Bilateral;
-                    if bilateral && block {
-                        continue;
+            for &PosRow {
+                r,
+                ps,
+                pl,
+                bilateral,
+            } in &list
+            {
+                let wrr = w[r];
+                // SAFETY: the row's path and y were checked to lie in
+                // `table` and `y` when listed (neither changes in the pass)
+                let (p, yr) = unsafe {
+                    (
+                        table.get_unchecked(ps..ps + pl),
+                        y.get_unchecked(r * st..r * st + pl),
+                    )
+                };
+                // uᵣ = yᵣ·w' over the row's path
+                let u: f64 = yr
+                    .iter()
+                    .zip(p)
+                    .map(|(a, &k)| a * unsafe { *dw.get_unchecked(k) })
+                    .sum();
+                let old = mu[r];
+                let x = old - (u - bpos[r]) / wrr;
+                let new = if bilateral { x } else { x.max(0.0) };
+                let d = new - old;
+                if d != 0.0 {
+                    mu[r] = new;
+                    // w' += Δμ yᵣ
+                    for (a, &k) in yr.iter().zip(p) {
+                        unsafe { *dw.get_unchecked_mut(k) += d * a };
                     }
-                    if !bilateral && !matches!(kind, RowKind::Normal | RowKind::Unilateral) {
-                        continue;
-                    }
-                    let wrr = w[r];
-                    if !(wrr > 1e-14) {
-                        continue;
-                    }
-                    let (ps, pl) = paths[r];
-                    let (Some(p), Some(yr)) = (table.get(ps..ps + pl), y.get(r * st..r * st + pl))
-                    else {
-                        continue;
-                    };
-                    // uᵣ = yᵣ·w' over the row's path
-                    let u: f64 = yr
-                        .iter()
-                        .zip(p)
-                        .map(|(a, &k)| a * unsafe { *dw.get_unchecked(k) })
-                        .sum();
-                    let old = mu[r];
-                    let x = old - (u - bpos[r]) / wrr;
-                    let new = if bilateral { x } else { x.max(0.0) };
-                    let d = new - old;
-                    if d != 0.0 {
-                        mu[r] = new;
-                        // w' += Δμ yᵣ
-                        for (a, &k) in yr.iter().zip(p) {
-                            unsafe { *dw.get_unchecked_mut(k) += d * a };
-                        }
-                        change = change.max((d * wrr).abs());
-                    }
+                    change = change.max((d * wrr).abs());
                 }
             }
             if block {
@@ -163,6 +190,7 @@ impl Rows {
                 break;
             }
         }
+        self.pos_rows = list;
         it
     }
 }
