@@ -99,9 +99,16 @@ pub(crate) fn bias_at_placements_ahead<'d>(
     q: &DVector<f64>,
     v: &DVector<f64>,
 ) -> &'d DVector<f64> {
-    let ahead = data.step_bias_ok
-        && data.step_bias_q.as_slice() == q.as_slice()
-        && data.step_bias_v.as_slice() == v.as_slice();
+    // bit for bit (`==` would take −0 for +0)
+    // (over slices, no early exit: one vectorised pass)
+    let same = |a: &DVector<f64>, b: &DVector<f64>| {
+        let (a, b) = (a.as_slice(), b.as_slice());
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .fold(true, |s, (x, y)| s & (x.to_bits() == y.to_bits()))
+    };
+    let ahead = data.step_bias_ok && same(&data.step_bias_q, q) && same(&data.step_bias_v, v);
     if ahead {
         std::mem::swap(&mut data.bias, &mut data.step_bias);
     } else {
