@@ -38,6 +38,34 @@ pub fn kinetic_energy_from_placements<T: Scalar>(
     Ok(ke)
 }
 
+/// [`kinetic_energy_from_placements`] for the simulation's energy guard at
+/// (q, v) (sizes the simulation's own): when a step asked for the bias at
+/// placements since the last call (`data.step_bias_wanted`), the bias pass runs
+/// here instead, its C kept in `data.step_bias` for the next step
+/// (`rnea::bias_at_placements_ahead`), and T = ½ Σ v̂ᵢᵀ Îᵢ v̂ᵢ is summed there
+/// over its body velocities and their products Îᵢ v̂ᵢ (docs/theory.md
+/// §"Velocity recursion": the same velocities as the velocity pass, its
+/// rotations about joint axes skipping only products with exact zeros and
+/// ones).
+pub(crate) fn kinetic_energy_step_ahead(
+    model: &Model<f64>,
+    data: &mut Data<f64>,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+) -> f64 {
+    if !data.step_bias_wanted || q.len() != model.nq || v.len() != model.nv {
+        data.step_bias_ok = false;
+        return kinetic_energy_from_placements(model, data, v).unwrap_or(f64::NAN);
+    }
+    let ke = super::rnea::bias_at_placements_energy(model, data, v);
+    data.step_bias.copy_from(&data.bias);
+    data.step_bias_q.copy_from(q);
+    data.step_bias_v.copy_from(v);
+    data.step_bias_ok = true;
+    data.step_bias_wanted = false;
+    ke
+}
+
 /// Gravitational potential energy `−Σ mᵢ gᵀ cᵢ` over the bodies' world centres of
 /// mass (zero at the world origin), from `data.o_m_i` (call forward kinematics first).
 pub fn potential_energy<T: Scalar>(model: &Model<T>, data: &Data<T>) -> T {

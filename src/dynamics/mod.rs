@@ -49,13 +49,14 @@ pub use jacobian_dot::frame_jacobian_time_variation;
 pub use joint_jacobians::joint_jacobians;
 pub use rnea_derivatives::{rnea_derivatives, LinkWrench};
 
+pub(crate) use energy::kinetic_energy_step_ahead;
 pub use energy::{energies, kinetic_energy, kinetic_energy_from_placements, potential_energy};
 pub use forward_rnea::{forward_dynamics_rnea, mass_matrix_rnea};
 pub use jacobian::{frame_jacobian, Reference};
 pub(crate) use kinematics::forward_kinematics_pass;
 pub use kinematics::{forward_kinematics, frame_placement, update_frames};
-pub(crate) use rnea::bias_at_placements;
 pub use rnea::{bias, rnea};
+pub(crate) use rnea::{bias_at_placements, bias_at_placements_ahead};
 
 /// Why forward dynamics has no answer.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

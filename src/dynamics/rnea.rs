@@ -54,8 +54,69 @@ pub(crate) fn bias_pass<T: Scalar>(
 /// joint placements `data.li_m_i` already hold (forward kinematics ran at it):
 /// the pass reads them instead of recomputing each joint's transform.
 pub(crate) fn bias_at_placements<T: Scalar>(model: &Model<T>, data: &mut Data<T>, v: &DVector<T>) {
-    rnea_pass::<T, true, false, false, true>(model, data, &[], v.as_slice(), &[], true, None);
+    rnea_pass::<T, true, false, false, true, false>(
+        model,
+        data,
+        &[],
+        v.as_slice(),
+        &[],
+        true,
+        None,
+    );
     data.bias.copy_from(&data.tau);
+}
+
+/// [`bias_at_placements`] that also returns the kinetic energy
+/// `T = ½ Σ v̂ᵢᵀ Îᵢ v̂ᵢ` summed over the pass's body velocities, from the
+/// products `Îᵢ v̂ᵢ` the pass forms anyway (in body order, as
+/// [`super::kinetic_energy_from_placements`]; a massless body adds nothing).
+pub(crate) fn bias_at_placements_energy<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    v: &DVector<T>,
+) -> T {
+    let ke = rnea_pass::<T, true, false, false, true, true>(
+        model,
+        data,
+        &[],
+        v.as_slice(),
+        &[],
+        true,
+        None,
+    );
+    data.bias.copy_from(&data.tau);
+    ke
+}
+
+/// [`bias_at_placements`] for the simulation step at (q, v), into `data.bias`:
+/// taken from `data.step_bias` when the energy guard computed it ahead at this
+/// very state (`data.step_bias_q`, `data.step_bias_v` equal to q and v bit for
+/// bit; the same pass from the same placements, so the same numbers), else
+/// computed. Marks that the step wants it, so the guard computes it ahead.
+pub(crate) fn bias_at_placements_ahead<'d>(
+    model: &Model<f64>,
+    data: &'d mut Data<f64>,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+) -> &'d DVector<f64> {
+    // bit for bit (`==` would take −0 for +0)
+    // (over slices, no early exit: one vectorised pass)
+    let same = |a: &DVector<f64>, b: &DVector<f64>| {
+        let (a, b) = (a.as_slice(), b.as_slice());
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .fold(true, |s, (x, y)| s & (x.to_bits() == y.to_bits()))
+    };
+    let ahead = data.step_bias_ok && same(&data.step_bias_q, q) && same(&data.step_bias_v, v);
+    if ahead {
+        std::mem::swap(&mut data.bias, &mut data.step_bias);
+    } else {
+        bias_at_placements(model, data, v);
+    }
+    data.step_bias_ok = false;
+    data.step_bias_wanted = true;
+    &data.bias
 }
 
 /// The one RNEA pass behind every entry point. `v = None` means q̇ = 0, `a = None`
@@ -96,26 +157,34 @@ fn rnea_variant<T: Scalar, const F: bool>(
     // Monomorphised on which of q̇, q̈ are present (no per-body test).
     match (v, a) {
         (Some(v), Some(a)) => {
-            rnea_pass::<T, true, true, F, false>(model, data, q, v, a, gravity, fext)
+            rnea_pass::<T, true, true, F, false, false>(model, data, q, v, a, gravity, fext);
         }
         (Some(v), None) => {
-            rnea_pass::<T, true, false, F, false>(model, data, q, v, &[], gravity, fext)
+            rnea_pass::<T, true, false, F, false, false>(model, data, q, v, &[], gravity, fext);
         }
         (None, Some(a)) => {
-            rnea_pass::<T, false, true, F, false>(model, data, q, &[], a, gravity, fext)
+            rnea_pass::<T, false, true, F, false, false>(model, data, q, &[], a, gravity, fext);
         }
         (None, None) => {
-            rnea_pass::<T, false, false, F, false>(model, data, q, &[], &[], gravity, fext)
+            rnea_pass::<T, false, false, F, false, false>(model, data, q, &[], &[], gravity, fext);
         }
     }
 }
 
 /// [`rnea_impl`] with q̇ present iff `V`, q̈ present iff `A` and external forces
-/// read iff `F`. The joint kind of
+/// read iff `F`; with `E` (the bias pass, `K`) the kinetic energy of the body
+/// velocities is summed and returned (zero otherwise). The joint kind of
 /// each body is matched once per sweep ([`dispatch_joint!`]); the body step is then
 /// compiled per joint model, with the axis and transform shape known.
 #[inline(always)]
-fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bool>(
+fn rnea_pass<
+    T: Scalar,
+    const V: bool,
+    const A: bool,
+    const F: bool,
+    const K: bool,
+    const E: bool,
+>(
     model: &Model<T>,
     data: &mut Data<T>,
     q: &[T],
@@ -123,7 +192,8 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
     a: &[T],
     gravity: bool,
     fext: Option<&[Force<T>]>,
-) {
+) -> T {
+    let mut ke = T::zero();
     let nb = model.nbodies;
     let parent = &model.parent[..nb];
     let joints = &model.joints[..nb];
@@ -189,7 +259,12 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
         if !(K && exact && massless(inertia)) {
             fi = inertia.mul_motion(&ai);
             if V {
-                fi += vi.cross_force(&inertia.mul_motion(&vi));
+                let hi = inertia.mul_motion(&vi);
+                fi += vi.cross_force(&hi);
+                // (E) T += ½ v̂ᵢᵀ Îᵢ v̂ᵢ (`Inertia::kinetic_energy`'s products)
+                if E {
+                    ke += vi.dot(&hi) * crate::spatial::lit(0.5);
+                }
             }
         }
         if let (true, Some(fext)) = (F, fext) {
@@ -240,6 +315,7 @@ fn rnea_pass<T: Scalar, const V: bool, const A: bool, const F: bool, const K: bo
             }
         });
     }
+    ke
 }
 
 /// `m.inv_act_motion(x)`, with `m`'s rotation applied as a rotation about `ax`

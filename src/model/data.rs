@@ -28,6 +28,22 @@ pub struct Data<T: Scalar = f64> {
     pub tau: DVector<T>,
     /// C(q, v) (docs/theory.md §"Bias forces").
     pub bias: DVector<T>,
+    /// C(q, v) computed ahead by the simulation's energy guard at the state
+    /// (`step_bias_q`, `step_bias_v`) from the joint placements of forward
+    /// kinematics there, for the next step's free velocity
+    /// (`rnea::bias_at_placements_ahead`): the pass the step would run, so
+    /// the same numbers, with the guard's kinetic energy read from its body
+    /// velocities (one velocity pass at a state, not two).
+    pub(crate) step_bias: DVector<T>,
+    /// The configuration of `step_bias`.
+    pub(crate) step_bias_q: DVector<T>,
+    /// The velocity of `step_bias`.
+    pub(crate) step_bias_v: DVector<T>,
+    /// `step_bias` holds C at (`step_bias_q`, `step_bias_v`), not yet used.
+    pub(crate) step_bias_ok: bool,
+    /// A step's free velocity asked for C at placements since the guard last
+    /// ran: the guard computes it ahead.
+    pub(crate) step_bias_wanted: bool,
     /// Generalized accelerations from forward dynamics.
     pub qdd: DVector<T>,
     /// The joint-space inertia matrix H(q) (full, symmetric).
@@ -284,6 +300,11 @@ impl<T: Scalar> Data<T> {
             f: vec![Force::zero(); nb],
             tau: DVector::zeros(nv),
             bias: DVector::zeros(nv),
+            step_bias: DVector::zeros(nv),
+            step_bias_q: DVector::zeros(model.nq),
+            step_bias_v: DVector::zeros(nv),
+            step_bias_ok: false,
+            step_bias_wanted: false,
             qdd: DVector::zeros(nv),
             h: lazy_zeros(nv, nv),
             chol: lazy_zeros(nv, nv),

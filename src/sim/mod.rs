@@ -87,7 +87,7 @@ pub use integrators::Integrator;
 use crate::contact::{Collision, ContactError, ContactParams, ContactPoint};
 use crate::dynamics::DynamicsError;
 use crate::dynamics::{
-    forward_kinematics_pass as forward_kinematics, kinetic_energy_from_placements, potential_energy,
+    forward_kinematics_pass as forward_kinematics, kinetic_energy_step_ahead, potential_energy,
 };
 use crate::model::configuration::normalize_quats;
 use crate::model::{Data, JointKind, Model};

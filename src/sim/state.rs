@@ -183,8 +183,7 @@ impl Simulation {
             self.fk_valid = true;
         }
         // v has nv entries (the simulation's own state): no size error
-        let e = kinetic_energy_from_placements(&self.model, &mut self.data, &self.v)
-            .unwrap_or(f64::NAN)
+        let e = kinetic_energy_step_ahead(&self.model, &mut self.data, &self.q, &self.v)
             + potential_energy(&self.model, &self.data)
             + self.armature_energy()
             + self.spring_energy();

@@ -6,7 +6,7 @@
 //! (λ the impulses, w the position pass's pseudo-velocity: [`super::super::constraints`]).
 
 use super::solve_rows;
-use crate::dynamics::{bias, bias_at_placements, forward_dynamics};
+use crate::dynamics::{bias, bias_at_placements_ahead, forward_dynamics};
 use crate::model::configuration::{integrate_config, rotate_base_velocity};
 use crate::sim::{SimError, Simulation};
 use nalgebra::{DVector, Vector3};
@@ -88,10 +88,15 @@ impl Simulation {
         }
         let free = if dense {
             // C(q, v); when forward kinematics ran at this q (the last step's
-            // contact refresh), its joint placements are reused
+            // contact refresh), its joint placements are reused (and the energy
+            // guard's pass at this state, when it ran one)
             let c = if self.fk_valid && self.v.len() == nv {
-                bias_at_placements(&self.model, &mut self.data, &self.v);
-                Ok(&self.data.bias)
+                Ok(bias_at_placements_ahead(
+                    &self.model,
+                    &mut self.data,
+                    &self.q,
+                    &self.v,
+                ))
             } else {
                 bias(&self.model, &mut self.data, &self.q, &self.v, None)
             };
