@@ -426,11 +426,14 @@ impl Constraints {
                 } else {
                     // two bodies: J = J_a − J_b, the relative velocity of the
                     // point on a and on b along (n, t₁, t₂), n from b toward a
-                    // (a common ancestor's columns cancel)
+                    // (a common ancestor's columns cancel: x + (−x) = +0, the
+                    // entry as zeroed, so each walk stops at the first of them)
                     let (t1, t2) = tangents(&pt.normal);
+                    let lca = common_ancestor(&model.parent, pt.body, pt.other);
                     for (start, sign) in [(pt.body, 1.0), (pt.other, -1.0)] {
                         let mut b = start;
-                        while b != 0
+                        while b != lca
+                            && b != 0
                             && let (Some(j), Some(sw)) = (model.joints.get(b), self.sw.get(b))
                         {
                             for (c, s) in sw.iter().enumerate().take(j.nv()) {
@@ -540,6 +543,21 @@ impl Constraints {
         }
         self.counts
     }
+}
+
+/// The nearest common ancestor-or-self of bodies `a` and `b` (`parent[i] <
+/// i`: the greater steps up until they meet), 0 (the world) for two trees or
+/// where `parent` does not reach them.
+#[inline]
+fn common_ancestor(parent: &[usize], mut a: usize, mut b: usize) -> usize {
+    while a != b {
+        let x = if a > b { &mut a } else { &mut b };
+        match parent.get(*x) {
+            Some(&p) if p < *x => *x = p,
+            _ => return 0,
+        }
+    }
+    a
 }
 
 /// Adds `x` to J's entry of joint row `r` at its dof `iv`: the last of its

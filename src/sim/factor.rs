@@ -270,14 +270,23 @@ impl MassFactor {
     fn holds(&self, model: &Model, diag: &impl Fn(usize) -> f64) -> bool {
         let same = |a: &CompositeInertia<f64>, b: &CompositeInertia<f64>| {
             a.m.to_bits() == b.m.to_bits()
-                && a.h.iter().zip(b.h.iter()).all(|(x, y)| x.to_bits() == y.to_bits())
-                && a.io.iter().zip(b.io.iter()).all(|(x, y)| x.to_bits() == y.to_bits())
+                && a.h
+                    .iter()
+                    .zip(b.h.iter())
+                    .all(|(x, y)| x.to_bits() == y.to_bits())
+                && a.io
+                    .iter()
+                    .zip(b.io.iter())
+                    .all(|(x, y)| x.to_bits() == y.to_bits())
         };
         let inertias = &model.inertias_origin;
         self.held_diag.len() == self.n
             && (0..self.n).all(|k| diag(k).to_bits() == self.held_diag[k].to_bits())
             && inertias.len() == self.held_inertia.len()
-            && inertias.iter().zip(&self.held_inertia).all(|(a, b)| same(a, b))
+            && inertias
+                .iter()
+                .zip(&self.held_inertia)
+                .all(|(a, b)| same(a, b))
     }
 
     /// Records the diagonal additions and inertias of the factor just made.
@@ -336,18 +345,6 @@ impl MassFactor {
             self.factor_range(k0, k1, tiny)?;
         }
         Ok(())
-    }
-
-    /// Tree: L[k, j] for j an ancestor of k (0 otherwise).
-    #[inline(always)]
-    fn l_entry(&self, k: usize, j: usize) -> f64 {
-        let (s, l) = (self.start[k], self.len[k]);
-        let dj = self.len[j] - 1;
-        if dj + 1 < l && self.table[s + dj] == j {
-            self.anc[s + dj]
-        } else {
-            0.0
-        }
     }
 
     /// Tree: where the ancestors of `path[t]` lie on `path` when they are

@@ -40,11 +40,7 @@ impl MassFactor {
                             *ys -= l * yt;
                         }
                     }
-                    None => {
-                        for s in 0..t {
-                            y[s] -= self.l_entry(path[t], path[s]) * yt;
-                        }
-                    }
+                    None => self.for_ancestors(path, t, |s, l| y[s] -= l * yt),
                 }
             }
         }
@@ -105,14 +101,11 @@ impl MassFactor {
                         y2[s] -= l * a2;
                     }
                 }
-                None => {
-                    for s in 0..t {
-                        let l = self.l_entry(path[t], path[s]);
-                        y0[s] -= l * a0;
-                        y1[s] -= l * a1;
-                        y2[s] -= l * a2;
-                    }
-                }
+                None => self.for_ancestors(path, t, |s, l| {
+                    y0[s] -= l * a0;
+                    y1[s] -= l * a1;
+                    y2[s] -= l * a2;
+                }),
             }
         }
     }
@@ -148,6 +141,49 @@ impl MassFactor {
             *yt *= self.inv_sqrt_d[k];
         }
         true
+    }
+
+    /// Tree: `f(s, L[path[t], path[s]])` for each ancestor `path[s]` of
+    /// `path[t]` on the path, root first (a row on two branches of one tree
+    /// interleaved: [`Self::ancestors`]'s `None`). The path and each dof's
+    /// ancestors (`table`, root first) both ascend, so one merge finds them;
+    /// L is zero at the path's other entries, whose `y[s] −= 0·a` is skipped.
+    #[inline(always)]
+    fn for_ancestors(&self, path: &[usize], t: usize, mut f: impl FnMut(usize, f64)) {
+        let Some(&d) = path.get(t) else {
+            return;
+        };
+        let (s, l) = (self.start[d], self.len[d]);
+        let (anc, dofs) = (&self.anc[s..s + l - 1], &self.table[s..s + l - 1]);
+        let mut p = 0;
+        for (&a, &j) in anc.iter().zip(dofs) {
+            while p < t && path[p] < j {
+                p += 1;
+            }
+            if p < t && path[p] == j {
+                f(p, a);
+                p += 1;
+            }
+        }
+    }
+
+    /// Tree: where the ancestors of `path[t]` lie on `path` when they are two
+    /// runs, `path[..k]` and `path[p..t]` (a row on two branches of one tree:
+    /// the branches' common ancestors, then `path[t]`'s own branch after the
+    /// other's), with L's entries at them (`k` then `t − p`); `None` otherwise.
+    #[inline(always)]
+    fn ancestor_runs(&self, path: &[usize], t: usize) -> Option<(usize, usize, &[f64])> {
+        let d = *path.get(t)?;
+        let (s, l) = (*self.start.get(d)?, *self.len.get(d)?);
+        let na = l.checked_sub(1)?;
+        let dofs = self.table.get(s..s + na)?;
+        // the own branch: the ancestors from the nearest back, on path[..t]'s end
+        let (mut k, mut p) = (na, t);
+        while k > 0 && p > 0 && dofs[k - 1] == path[p - 1] {
+            k -= 1;
+            p -= 1;
+        }
+        (k <= p && path.get(..k)? == &dofs[..k]).then(|| (k, p, &self.anc[s..s + na]))
     }
 
     /// [`Self::row_transform_lanes`] of rows held in registers, `w[t] = [y₀ₜ,
@@ -282,8 +318,20 @@ impl MassFactor {
                     }
                 }
                 None => {
-                    for s in 0..t {
-                        sub(&mut y[s], self.l_entry(path[t], path[s]), &a);
+                    match self.ancestor_runs(path, t) {
+                        // two runs: the branches' common ancestors path[..k]
+                        // and path[t]'s own branch path[p..t]
+                        Some((k, p, anc)) => {
+                            let (ya, yb) = y[..t].split_at_mut(p);
+                            let (la, lb) = anc.split_at(k);
+                            for (ys, &l) in ya[..k].iter_mut().zip(la) {
+                                sub(ys, l, &a);
+                            }
+                            for (ys, &l) in yb.iter_mut().zip(lb) {
+                                sub(ys, l, &a);
+                            }
+                        }
+                        None => self.for_ancestors(path, t, |s, l| sub(&mut y[s], l, &a)),
                     }
                     if t > 0 {
                         next = y[t - 1];
