@@ -258,13 +258,25 @@ impl Rows {
                         let nn = (on - relax * (un - b[r]) * winv[r]).max(0.0) * live(r);
                         let dln = nn - on;
                         lambda[r] = nn;
+                        let (o1, o2) = (lambda[r + 1], lambda[r + 2]);
+                        let u1 = c[r + 1] + d1 + dln * wn1;
+                        let u2 = c[r + 2] + d2 + dln * wn2;
+                        if on == 0.0 && nn == 0.0 && o1 == 0.0 && o2 == 0.0 {
+                            // an inactive contact that stays so (λₙ = 0, uₙ ≥ bₙ):
+                            // μλₙ = 0 pins both tangents at 0, nothing moves, and
+                            // each row's measure is its residual 0; only the
+                            // velocities are kept for the next sweep's measure
+                            // (the tangents may keep a zero of the other sign)
+                            u_prev[r] = un;
+                            u_prev[r + 1] = u1;
+                            u_prev[r + 2] = u2;
+                            r += 3;
+                            continue;
+                        }
                         let mu = match kinds[r + 1] {
                             RowKind::Tangent { mu, .. } => mu,
                             _ => 0.0,
                         };
-                        let (o1, o2) = (lambda[r + 1], lambda[r + 2]);
-                        let u1 = c[r + 1] + d1 + dln * wn1;
-                        let u2 = c[r + 2] + d2 + dln * wn2;
                         let mut t1 = (o1 - u1 * winv[r + 1]) * live(r + 1);
                         let mut t2 = (o2 - u2 * winv[r + 2]) * live(r + 2);
                         let lim = mu * nn;
