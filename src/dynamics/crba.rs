@@ -332,12 +332,17 @@ pub(crate) fn crba_packed<T: Scalar>(
     }
     // (fits: both hold nv entries; sliced so that an index below nv needs no test)
     let (start, len) = (&start[..nv], &len[..nv]);
-    let write = |row: usize, c: usize, val: T| {
-        // the upper triangle (row an ancestor-or-self of c, so row ≤ c): the
-        // entry the factor reads; the lower one is its mirror
-        if row <= c {
-            if let Some(x) = out.get_mut(start[c] + len[row] - 1) {
-                *x = val;
+    let write = |k0: usize, c: usize, vals: &[T]| {
+        // column c's entries start at start[c] (c < nv: checked once per column)
+        let Some(&s) = start.get(c) else { return };
+        for (r, &val) in vals.iter().enumerate() {
+            let row = k0 + r;
+            // the upper triangle (row an ancestor-or-self of c, so row ≤ c): the
+            // entry the factor reads; the lower one is its mirror
+            if row <= c {
+                if let Some(x) = len.get(row).and_then(|&l| out.get_mut(s + l - 1)) {
+                    *x = val;
+                }
             }
         }
     };
@@ -377,18 +382,21 @@ fn crba_local_pass<T: Scalar, const PLACED: bool, const FACTOR: bool>(
     assert!(!FACTOR || us.len() >= nv * nv, "the factor is nv x nv");
     let up = us.as_mut_ptr();
     let all = [(1, model.nbodies)];
-    local_pass::<T, PLACED, _>(model, data, q, &all, move |row, c, val| {
-        // SAFETY: row < nv and c < nv (local_pass asserts it before every
-        // write), so both row + c nv and c + row nv are < nv² ≤ the length
-        // of `hs` (asserted above), and of `us` with FACTOR (asserted above);
-        // both outlive the pass.
-        unsafe {
-            *hp.add(row + c * nv) = val;
-            *hp.add(c + row * nv) = val;
-            if FACTOR {
-                // row is a coordinate of an ancestor-or-self of c's joint:
-                // row ≤ c, the upper triangle
-                *up.add(row + c * nv) = val;
+    local_pass::<T, PLACED, _>(model, data, q, &all, move |k0, c, vals| {
+        for (r, &val) in vals.iter().enumerate() {
+            let row = k0 + r;
+            // SAFETY: row < nv and c < nv (local_pass asserts it before every
+            // write: k0 + vals.len() ≤ nv), so both row + c nv and c + row nv
+            // are < nv² ≤ the length of `hs` (asserted above), and of `us` with
+            // FACTOR (asserted above); both outlive the pass.
+            unsafe {
+                *hp.add(row + c * nv) = val;
+                *hp.add(c + row * nv) = val;
+                if FACTOR {
+                    // row is a coordinate of an ancestor-or-self of c's joint:
+                    // row ≤ c, the upper triangle
+                    *up.add(row + c * nv) = val;
+                }
             }
         }
     });
@@ -400,10 +408,12 @@ fn crba_local_pass<T: Scalar, const PLACED: bool, const FACTOR: bool>(
 
 /// The local-frame pass: every entry `H[row, c]` on the tree pattern (row a
 /// coordinate of a joint, c one of its subtree's; row < nv, c < nv) given to
-/// `write` (the entries off the pattern are zero and never given), over the
+/// `write`, a joint's rows of column c at once (`write(k0, c, vals)`: `H[k0 + r,
+/// c] = vals[r]`, k0 + vals.len() ≤ nv; the entries off the pattern are zero
+/// and never given), over the
 /// bodies of `bodies` (ranges `[b0, b1)` in 1..nb, each whole subtrees of the
 /// world: every tree's bodies, or some trees' of a forest).
-fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
+fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, &[T])>(
     model: &Model<T>,
     data: &mut Data<T>,
     q: &[T],
@@ -451,11 +461,13 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, T)>(
             // H[k0 + r, c] = S_rᵀ F_c for every coordinate c of the subtree
             // (docs/theory.md §"Joint-force projection") and its mirror H[c, k0 + r].
             assert!(k0 + jm.nv() <= end && end <= nv, "subtree coordinates out of range");
+            let nr = jm.nv();
             for (dc, f) in fsub.iter().enumerate() {
-                let c = k0 + dc;
-                for r in 0..jm.nv() {
-                    write(k0 + r, c, jm.project_column(r, f));
+                let mut vals = [T::zero(); 6];
+                for (r, x) in vals[..nr].iter_mut().enumerate() {
+                    *x = jm.project_column(r, f);
                 }
+                write(k0, k0 + dc, &vals[..nr]);
             }
             if p != 0 {
                 // The subtree's forces to the parent frame: ᵖX̂ᵢ* F
