@@ -54,16 +54,7 @@ pub(crate) fn bias_pass<T: Scalar>(
 /// joint placements `data.li_m_i` already hold (forward kinematics ran at it):
 /// the pass reads them instead of recomputing each joint's transform.
 pub(crate) fn bias_at_placements<T: Scalar>(model: &Model<T>, data: &mut Data<T>, v: &DVector<T>) {
-    rnea_pass::<T, true, false, false, true, false>(
-        model,
-        data,
-        &[],
-        v.as_slice(),
-        &[],
-        true,
-        None,
-    );
-    data.bias.copy_from(&data.tau);
+    bias_pass_at_placements::<T, false>(model, data, v);
 }
 
 /// [`bias_at_placements`] that also returns the kinetic energy
@@ -75,7 +66,18 @@ pub(crate) fn bias_at_placements_energy<T: Scalar>(
     data: &mut Data<T>,
     v: &DVector<T>,
 ) -> T {
-    let ke = rnea_pass::<T, true, false, false, true, true>(
+    bias_pass_at_placements::<T, true>(model, data, v)
+}
+
+/// C(q, v) at the placements into `data.bias`, and with `E` the kinetic
+/// energy of the pass's body velocities (zero without).
+#[inline(always)]
+fn bias_pass_at_placements<T: Scalar, const E: bool>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    v: &DVector<T>,
+) -> T {
+    let ke = rnea_pass::<T, true, false, false, true, E>(
         model,
         data,
         &[],
