@@ -476,8 +476,8 @@ fn overlap4(l: &[f64; 6], h: &[[f64; 4]; 6]) -> u64 {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
     {
         use std::arch::x86_64::{
-            _mm256_broadcast_sd, _mm256_cmp_pd, _mm256_loadu_pd, _mm256_movemask_pd,
-            _mm256_or_pd, _CMP_GT_OQ,
+            _mm256_broadcast_sd, _mm256_cmp_pd, _mm256_loadu_pd, _mm256_movemask_pd, _mm256_or_pd,
+            _CMP_GT_OQ,
         };
         // SAFETY: AVX is enabled for this build (the cfg); the loads read
         // the 4 lanes of arrays of 4 f64 and the broadcasts one f64.

@@ -71,17 +71,7 @@ pub(crate) fn rnea_derivatives_pass<T: Scalar>(
     a: &DVector<T>,
     fext: Option<&[LinkWrench<T>]>,
 ) {
-    let c = by_cols(data);
-    match fext {
-        Some(w) if !w.is_empty() && c => {
-            pass::<T, true, false, true, false>(model, data, q, v, a, w, false)
-        }
-        Some(w) if !w.is_empty() => {
-            pass::<T, true, false, false, false>(model, data, q, v, a, w, false)
-        }
-        _ if c => pass::<T, false, false, true, false>(model, data, q, v, a, &[], false),
-        _ => pass::<T, false, false, false, false>(model, data, q, v, a, &[], false),
-    }
+    dispatch::<T, false>(model, data, q, v, a, fext, false);
 }
 
 /// [`rnea_derivatives_pass`] right after [`super::minv::minv_pass`] at the same
@@ -103,16 +93,33 @@ pub(crate) fn rnea_derivatives_pass_after_minv<T: Scalar>(
     free_root: bool,
 ) {
     debug_assert!(data.deriv_direct);
+    dispatch::<T, true>(model, data, q, v, a, fext, free_root);
+}
+
+/// The full sweep (`pass` without `D`), monomorphised on whether wrenches
+/// are read and whether ∂τ/∂x is formed by columns; `K`: after `minv_pass`
+/// (its poses and world quantities reused). `free_root` applies without
+/// wrenches only.
+#[inline(always)]
+fn dispatch<T: Scalar, const K: bool>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+    v: &DVector<T>,
+    a: &DVector<T>,
+    fext: Option<&[LinkWrench<T>]>,
+    free_root: bool,
+) {
     let c = by_cols(data);
     match fext {
         Some(w) if !w.is_empty() && c => {
-            pass::<T, true, true, true, false>(model, data, q, v, a, w, false)
+            pass::<T, true, K, true, false>(model, data, q, v, a, w, false)
         }
         Some(w) if !w.is_empty() => {
-            pass::<T, true, true, false, false>(model, data, q, v, a, w, false)
+            pass::<T, true, K, false, false>(model, data, q, v, a, w, false)
         }
-        _ if c => pass::<T, false, true, true, false>(model, data, q, v, a, &[], free_root),
-        _ => pass::<T, false, true, false, false>(model, data, q, v, a, &[], free_root),
+        _ if c => pass::<T, false, K, true, false>(model, data, q, v, a, &[], free_root),
+        _ => pass::<T, false, K, false, false>(model, data, q, v, a, &[], free_root),
     }
 }
 
