@@ -27,6 +27,7 @@ use super::solver::{RowKind, Rows, Scratch};
 use super::{ContactForce, Solver};
 use crate::contact::{tangents, ContactPoint};
 use crate::model::{JointKind, Model};
+use crate::spatial::ops::{add_cross, mat_vec};
 use crate::spatial::{Force, Motion, Se3};
 use nalgebra::{DVector, Vector3};
 
@@ -102,6 +103,8 @@ pub(crate) struct Constraints {
     rows: Rows,
     /// (dof, which): which = 0 friction, 1 lower limit, 2 upper limit, per joint row.
     joint_rows: Vec<(usize, u8)>,
+    /// The 1-DoF joints that may have rows (friction, or a limit), in dof order.
+    jrows: Vec<JointRowSource>,
     /// The first joint row (contact triples come first).
     first_joint_row: usize,
     /// The contact point (index into the step's points) of each contact triple.
@@ -118,6 +121,9 @@ pub(crate) struct Constraints {
     /// step where `sw_done` holds `sw_stamp`.
     sw: Vec<[Motion; 6]>,
     sw_done: Vec<u64>,
+    /// Each body's joint's motion subspace columns in the body frame (the
+    /// joint's constants: kind, axis, `mult`), the world-frame ones' source.
+    cols: Vec<BodyColumns>,
     sw_stamp: u64,
     /// Where each dof lies on the current point's row path (scratch; valid
     /// where the path holds that dof there).
@@ -200,6 +206,7 @@ impl Constraints {
         Self {
             rows,
             joint_rows: Vec::with_capacity(3 * ndof),
+            jrows: JointRowSource::of(model),
             first_joint_row: 0,
             row_point: Vec::with_capacity(max_points),
             warm_contact: vec![[0.0; 3]; nslots],
@@ -208,6 +215,9 @@ impl Constraints {
             warm_points: Vec::with_capacity(max_points),
             sw: vec![[Motion::zero(); 6]; model.nbodies],
             sw_done: vec![0; model.nbodies],
+            cols: (0..model.nbodies)
+                .map(|i| BodyColumns::of(model, i))
+                .collect(),
             sw_stamp: 0,
             slot: vec![0; nv],
             counts: RowCounts::default(),
@@ -344,18 +354,20 @@ impl Constraints {
             // world-frame motion subspace columns of the bodies the points'
             // rows reach (each point's two bodies and their ancestors), once
             self.sw_stamp = self.sw_stamp.wrapping_add(1).max(1);
+            // (the columns in the body frame are the joint's constants, kept
+            // from the start: `cols`)
             for pt in points {
                 for start in [pt.body, pt.other] {
                     let mut i = start;
                     while i != 0
                         && let Some(done) = self.sw_done.get_mut(i)
                         && *done != self.sw_stamp
-                        && let (Some(j), Some(o), Some(sw)) =
-                            (model.joints.get(i), o_m_i.get(i), self.sw.get_mut(i))
+                        && let (Some(cols), Some(o), Some(sw)) =
+                            (self.cols.get(i), o_m_i.get(i), self.sw.get_mut(i))
                     {
                         *done = self.sw_stamp;
-                        for (c, s) in sw.iter_mut().enumerate().take(j.nv()) {
-                            *s = o.act_motion(&j.subspace_column(c));
+                        for (s, c) in sw.iter_mut().zip(&cols.s).take(cols.nv) {
+                            *s = act_column(o, c);
                         }
                         i = model.parent[i];
                     }
@@ -368,9 +380,10 @@ impl Constraints {
                     true => [0.0; 3],
                     false => wc.get(pt.slot).copied().unwrap_or([0.0; 3]),
                 }));
+            let cols = &self.cols;
             let body_path = |b: usize| {
-                let jb = &model.joints[b];
-                f.path_of((jb.iv + jb.nv()).saturating_sub(1))
+                let (iv, nv) = cols.get(b).map_or((0, 0), |c| (c.iv, c.nv));
+                f.path_of((iv + nv).saturating_sub(1))
             };
             for (pi, (pt, &warm)) in points.iter().zip(&self.warm_points).enumerate() {
                 // the body's path to the root: its joint's last dof and every
@@ -415,11 +428,11 @@ impl Constraints {
                     // v_c + ω_c × p of each ancestor's world-frame subspace column c
                     let mut b = pt.body;
                     while b != 0
-                        && let (Some(j), Some(sw)) = (model.joints.get(b), self.sw.get(b))
+                        && let (Some(bc), Some(sw)) = (self.cols.get(b), self.sw.get(b))
                     {
-                        for (c, s) in sw.iter().enumerate().take(j.nv()) {
+                        for (c, s) in sw.iter().enumerate().take(bc.nv) {
                             let vp = s.lin + s.ang.cross(&pt.point);
-                            put(j.iv + c, vp.z, vp.x, vp.y);
+                            put(bc.iv + c, vp.z, vp.x, vp.y);
                         }
                         b = model.parent[b];
                     }
@@ -434,11 +447,11 @@ impl Constraints {
                         let mut b = start;
                         while b != lca
                             && b != 0
-                            && let (Some(j), Some(sw)) = (model.joints.get(b), self.sw.get(b))
+                            && let (Some(bc), Some(sw)) = (self.cols.get(b), self.sw.get(b))
                         {
-                            for (c, s) in sw.iter().enumerate().take(j.nv()) {
+                            for (c, s) in sw.iter().enumerate().take(bc.nv) {
                                 let vp = (s.lin + s.ang.cross(&pt.point)) * sign;
-                                put(j.iv + c, pt.normal.dot(&vp), t1.dot(&vp), t2.dot(&vp));
+                                put(bc.iv + c, pt.normal.dot(&vp), t1.dot(&vp), t2.dot(&vp));
                             }
                             b = model.parent[b];
                         }
@@ -469,32 +482,26 @@ impl Constraints {
         self.first_joint_row = rows.n;
         // joint rows: friction (|λ| ≤ F h), limits (λ ≥ 0)
         if p.joint_dynamics {
-            for (d, info) in model.dofs.iter().enumerate() {
-                // friction and limits of 1-DoF joints only
-                if info.kind.nv() != 1 {
-                    continue;
-                }
-                let (iq, iv) = (info.iq, info.iv);
-                if info.friction > 0.0 {
+            // (the 1-DoF joints with friction or a limit, in dof order: `jrows`)
+            for js in &self.jrows {
+                let (d, iq, iv) = (js.d, js.iq, js.iv);
+                let path = f.path_of(iv);
+                if js.friction > 0.0 {
                     let kind = RowKind::Box {
-                        limit: info.friction * h,
+                        limit: js.friction * h,
                     };
-                    let path = f.path_of(iv);
                     if let Some(r) = rows.push(kind, 0.0, self.warm_joint[d][0], path) {
                         add_joint_entry(rows, r, iv, 1.0);
                         self.joint_rows.push((d, 0));
                         counts.friction += 1;
                     }
                 }
-                if info.continuous {
+                if js.continuous {
                     continue;
                 }
                 let (qd, vd) = (q[iq], v[iv]);
                 let margin = 1e-3 + 2.0 * vd.abs() * h;
-                let sides = [
-                    (info.limits.lower, 1.0, 1u8),
-                    (info.limits.upper, -1.0, 2u8),
-                ];
+                let sides = [(js.lower, 1.0, 1u8), (js.upper, -1.0, 2u8)];
                 for (limit, sign, which) in sides {
                     let Some(l) = limit else { continue };
                     // φ = q − lower, or upper − q
@@ -503,7 +510,6 @@ impl Constraints {
                         continue;
                     }
                     let w = self.warm_joint[d][which as usize];
-                    let path = f.path_of(iv);
                     if let Some(r) = rows.push(RowKind::Unilateral, speculative(gap), w, path) {
                         add_joint_entry(rows, r, iv, sign);
                         rows.bpos[r] = pos_target(gap, p.limit_slop, p.limit_push_cap);
@@ -542,6 +548,119 @@ impl Constraints {
             }
         }
         self.counts
+    }
+}
+
+/// What a 1-DoF joint's rows are built from (its [`crate::model::DofInfo`]'s
+/// fields, copied once: the row loop reads these few, not every dof's whole entry).
+#[derive(Clone, Copy, Debug)]
+struct JointRowSource {
+    /// The dof's index in `model.dofs`.
+    d: usize,
+    iq: usize,
+    iv: usize,
+    friction: f64,
+    continuous: bool,
+    lower: Option<f64>,
+    upper: Option<f64>,
+}
+
+impl JointRowSource {
+    /// The model's 1-DoF joints with friction or a position limit (the others
+    /// never have a row), in dof order.
+    fn of(model: &Model) -> Vec<Self> {
+        let mut out = Vec::new();
+        for (d, info) in model.dofs.iter().enumerate() {
+            if info.kind.nv() != 1 {
+                continue;
+            }
+            let js = Self {
+                d,
+                iq: info.iq,
+                iv: info.iv,
+                friction: info.friction,
+                continuous: info.continuous,
+                lower: info.limits.lower,
+                upper: info.limits.upper,
+            };
+            let limited = !js.continuous && (js.lower.is_some() || js.upper.is_some());
+            if js.friction > 0.0 || limited {
+                out.push(js);
+            }
+        }
+        out
+    }
+}
+
+/// A body's joint's motion subspace columns in the body frame
+/// ([`crate::model::Joint::subspace_column`]), `nv` of them (none for the world).
+#[derive(Clone, Copy, Debug)]
+struct BodyColumns {
+    s: [Column; 6],
+    nv: usize,
+    /// The joint's first velocity coordinate.
+    iv: usize,
+}
+
+/// One subspace column and which of its parts are zero.
+#[derive(Clone, Copy, Debug)]
+struct Column {
+    s: Motion,
+    ang_zero: bool,
+    lin_zero: bool,
+}
+
+impl BodyColumns {
+    fn of(model: &Model, i: usize) -> Self {
+        let zero = Column {
+            s: Motion::zero(),
+            ang_zero: true,
+            lin_zero: true,
+        };
+        let mut cols = Self {
+            s: [zero; 6],
+            nv: 0,
+            iv: 0,
+        };
+        if let Some(j) = model.joints.get(i) {
+            cols.iv = j.iv;
+            cols.nv = if i == 0 { 0 } else { j.nv().min(6) };
+            for (k, c) in cols.s.iter_mut().enumerate().take(cols.nv) {
+                let s = j.subspace_column(k);
+                *c = Column {
+                    s,
+                    ang_zero: s.ang == Vector3::zeros(),
+                    lin_zero: s.lin == Vector3::zeros(),
+                };
+            }
+        }
+        cols
+    }
+}
+
+/// `o.act_motion(&c.s)` (ω' = R ω, v' = R v + t × ω'), a zero part's
+/// products left out: the same values but for the sign of a zero, which no
+/// row keeps (J's entries are sums onto the +0 that [`Rows::clear`] left;
+/// the spin rows' sums start from 0 too).
+#[inline(always)]
+fn act_column(o: &Se3<f64>, c: &Column) -> Motion {
+    let ang = if c.ang_zero {
+        Vector3::zeros()
+    } else {
+        mat_vec(&o.rot, &c.s.ang)
+    };
+    let lin = if c.lin_zero {
+        Vector3::zeros()
+    } else {
+        mat_vec(&o.rot, &c.s.lin)
+    };
+    Motion {
+        lin: if c.ang_zero {
+            lin
+        } else {
+            add_cross(&lin, &o.trans, &ang)
+        },
+        ang,
     }
 }
 

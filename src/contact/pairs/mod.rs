@@ -74,6 +74,10 @@ struct Pair {
 
 const NO_KEY: u64 = u64::MAX;
 
+/// Raw points a query's scratch holds from the start (parry's manifolds of
+/// one pair, the closed forms' two or three).
+const RAW_ROOM: usize = 64;
+
 /// Contact between pairs of shapes.
 #[derive(Clone)]
 pub struct PairContact {
@@ -279,6 +283,15 @@ impl PairContact {
         if allowed == 0 {
             return Ok(None);
         }
+        // a detection's lists sized here, not grown in a step: every allowed
+        // pair (a model's own pairs, all made above), at most 8 a member for
+        // a scene's (a pile's count is the square of its bodies'), and a
+        // query's raw points
+        let room = allowed.min(8 * n);
+        made.overlapping.reserve(room);
+        made.live.reserve(room);
+        made.visit.reserve(2 * room);
+        made.raw.reserve(RAW_ROOM);
         let fixed = made.members.iter().map(|m| m.body == 0).collect();
         made.travel = Travel::new(params, fixed);
         for (k, m) in made.members.iter().enumerate() {
