@@ -200,14 +200,21 @@ fn sweep_common<const R: usize>(
             4 => sweep_n::<4, R>(tri, m, r),
             5 => sweep_n::<5, R>(tri, m, r),
             6 => sweep_n::<6, R>(tri, m, r),
+            7 => sweep_n::<7, R>(tri, m, r),
+            8 => sweep_n::<8, R>(tri, m, r),
+            9 => sweep_n::<9, R>(tri, m, r),
+            10 => sweep_n::<10, R>(tri, m, r),
+            11 => sweep_n::<11, R>(tri, m, r),
+            12 => sweep_n::<12, R>(tri, m, r),
             _ => sweep_rt::<R>(tri, p, m, r),
         }
     }
     Some(())
 }
 
-/// [`sweep_common`]'s triangle of N ≤ 6 rows (constant bounds: unrolled, no
-/// bounds tests).
+/// [`sweep_common`]'s triangle of N ≤ 12 rows (a floating base's six, a
+/// humanoid's trunk and hip after them; constant bounds: unrolled, no bounds
+/// tests).
 #[inline(always)]
 fn sweep_n<const N: usize, const R: usize>(tri: &mut [f64], m: [&[f64]; R], r: [&[f64]; R]) {
     let tri = &mut tri[..N * (N + 1) / 2];
