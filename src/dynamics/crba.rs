@@ -333,17 +333,23 @@ pub(crate) fn crba_packed<T: Scalar>(
     // (fits: both hold nv entries; sliced so that an index below nv needs no test)
     let (start, len) = (&start[..nv], &len[..nv]);
     let write = |k0: usize, c: usize, vals: &[T]| {
-        // column c's entries start at start[c] (c < nv: checked once per column)
-        let Some(&s) = start.get(c) else { return };
-        for (r, &val) in vals.iter().enumerate() {
-            let row = k0 + r;
-            // the upper triangle (row an ancestor-or-self of c, so row ≤ c): the
-            // entry the factor reads; the lower one is its mirror
-            if row <= c {
-                if let Some(x) = len.get(row).and_then(|&l| out.get_mut(s + l - 1)) {
-                    *x = val;
-                }
-            }
+        // column c's entries start at start[c]; row k0 + r (an ancestor-or-self
+        // of c, a joint's coordinates one chain: depth len[k0] − 1 + r) sits at
+        // start[c] + len[k0] − 1 + r. The upper triangle (row ≤ c) only: the
+        // entries the factor reads, the lower ones their mirror
+        let (Some(&s), Some(&l0)) = (start.get(c), len.get(k0)) else {
+            return;
+        };
+        let n = vals.len().min((c + 1).saturating_sub(k0));
+        debug_assert!((0..n).all(|r| len[k0 + r] == l0 + r));
+        let Some(x) = out.get_mut(s + l0 - 1..s + l0 - 1 + n) else {
+            return;
+        };
+        // (the common lengths with constant bounds: no call to memcpy)
+        match (x, &vals[..n]) {
+            ([x], [v]) => *x = *v,
+            (x @ [_, _, _, _, _, _], v @ [_, _, _, _, _, _]) => x.copy_from_slice(v),
+            (x, v) => x.copy_from_slice(v),
         }
     };
     let all = [(1, model.nbodies)];

@@ -380,24 +380,8 @@ impl MassFactor {
         }
     }
 
-    /// Tree: row i's multipliers L[i, j] beside their dofs j (`table`'s
-    /// order, root first), without the last `drop` entries (the diagonal's
-    /// slot, and with 2 the parent's too).
-    #[inline(always)]
-    fn row_entries(
-        &self,
-        i: usize,
-        drop: usize,
-    ) -> std::iter::Zip<std::slice::Iter<'_, f64>, std::slice::Iter<'_, usize>> {
-        let (s, l) = (self.start[i], self.len[i]);
-        self.anc[s..s + l - drop]
-            .iter()
-            .zip(&self.table[s..s + l - drop])
-    }
-
     /// Tree: `f(…f(f(init, a, j)…)` over row i's multipliers a = L[i, j]
-    /// beside their dofs j, from the nearest ancestor to the root (as
-    /// `row_entries(i, 1).rev()` one at a time: the same operations in the
+    /// beside their dofs j, from the nearest ancestor to the root (one at a time: the same operations in the
     /// same order); a row of up to 11 unrolled (constant bounds).
     #[inline(always)]
     fn fold_row<T>(&self, i: usize, init: T, f: impl Fn(T, f64, usize) -> T) -> T {
@@ -444,19 +428,19 @@ impl MassFactor {
                         let xp = madd(-self.anc[s + l - 2], xi, x[i - 1]);
                         x[i - 1] = xp;
                         let sp = self.start[i - 1];
-                        for ((&a, &j), &ap) in
-                            self.row_entries(i, 2).zip(&self.anc[sp..sp + l - 2]).rev()
-                        {
-                            let xj = at_mut(x, j);
-                            *xj = madd(-ap, xp, madd(-a, xi, *xj));
-                        }
+                        let (a, ap, js) = (
+                            &self.anc[s..s + l - 2],
+                            &self.anc[sp..sp + l - 2],
+                            &self.table[s..s + l - 2],
+                        );
+                        scatter_row(a, js, |t, xj| {
+                            *at_mut(x, xj) = madd(-ap[t], xp, madd(-a[t], xi, at(x, xj)))
+                        });
                         i -= 1;
                         continue;
                     }
-                    for (&a, &j) in self.row_entries(i, 1).rev() {
-                        let xj = at_mut(x, j);
-                        *xj = madd(-a, xi, *xj);
-                    }
+                    let (a, js) = (&self.anc[s..s + l - 1], &self.table[s..s + l - 1]);
+                    scatter_row(a, js, |t, xj| *at_mut(x, xj) = madd(-a[t], xi, at(x, xj)));
                 }
                 if let (Some(x), Some(d)) = (x.get_mut(k0..k1), self.dval.get(k0..k1)) {
                     for (x, &d) in x.iter_mut().zip(d) {
@@ -562,6 +546,32 @@ impl MassFactor {
         self.x = x;
         r
     }
+}
+
+/// `f(t, j[t])` for t from the last entry of `a` to the first (`a`, `j` of
+/// equal length: a row's multipliers beside their dofs, from the nearest ancestor to the root): each entry's own update, in the same order; a
+/// row of up to 11 unrolled (constant bounds), as [`MassFactor::fold_row`].
+#[inline(always)]
+fn scatter_row(a: &[f64], j: &[usize], mut f: impl FnMut(usize, usize)) {
+    let n = a.len().min(j.len());
+    macro_rules! unrolled {
+        ($($n:literal)*) => {
+            match n {
+                $($n => {
+                    let j = &j[..$n];
+                    for t in (0..$n).rev() {
+                        f(t, j[t]);
+                    }
+                })*
+                _ => {
+                    for t in (0..n).rev() {
+                        f(t, j[t]);
+                    }
+                }
+            }
+        };
+    }
+    unrolled!(0 1 2 3 4 5 6 7 8 9 10 11);
 }
 
 /// [`MassFactor::fold_row`] on `N` entries (`a[..N]`, `j[..N]`), the last first.

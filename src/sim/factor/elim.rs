@@ -103,43 +103,13 @@ impl MassFactor {
                             for (c, &x) in mult_g.iter_mut().zip(row_g.iter()) {
                                 *c = x / dg;
                             }
-                            // the common ancestors a root's chain (a floating
-                            // base): their rows one packed triangle, swept by
-                            // the unrolled kernel (the same operations per entry)
+                            // the three's updates of their common ancestors' rows
                             let na = m - 2;
-                            let tri = match table.get(sk).map(|&a0| start[a0]) {
-                                Some(s0) if na > 0 && root_chain[table[sk + na - 1]] => {
-                                    head.get_mut(s0..s0 + na * (na + 1) / 2)
-                                }
-                                _ => None,
-                            };
-                            let mr = (&mult[..na], &mult_p[..na], &mult_g[..na]);
-                            let rows = (&row[..na], &row_p[..na], &row_g[..na]);
-                            if let Some(tri) = tri {
-                                if sweep3_packed(tri, mr, rows) {
-                                    row.copy_from_slice(mult);
-                                    row_p.copy_from_slice(mult_p);
-                                    row_g.copy_from_slice(mult_g);
-                                    k -= 2;
-                                    continue;
-                                }
-                            }
-                            for t in (0..m - 2).rev() {
-                                let si = start[table[sk + t]];
-                                let (a, b, c) = (mult[t], mult_p[t], mult_g[t]);
-                                let (Some(row_i), Some(row_k), Some(row_q), Some(row_r)) = (
-                                    head.get_mut(si..si + t + 1),
-                                    row.get(..t + 1),
-                                    row_p.get(..t + 1),
-                                    row_g.get(..t + 1),
-                                ) else {
-                                    return Err(k);
-                                };
-                                for (((x, &hkj), &hqj), &hrj) in
-                                    row_i.iter_mut().zip(row_k).zip(row_q).zip(row_r)
-                                {
-                                    *x = madd(-c, hrj, madd(-b, hqj, madd(-a, hkj, *x)));
-                                }
+                            let mr = [&mult[..na], &mult_p[..na], &mult_g[..na]];
+                            let rows = [&row[..na], &row_p[..na], &row_g[..na]];
+                            if sweep_common(head, table, start, root_chain, sk, mr, rows).is_none()
+                            {
+                                return Err(k);
                             }
                             row.copy_from_slice(mult);
                             row_p.copy_from_slice(mult_p);
@@ -149,19 +119,14 @@ impl MassFactor {
                         }
                         // (k − 2's pivot fails: found at its turn, as without triples)
                     }
-                    for t in (0..t_pair).rev() {
-                        let si = start[table[sk + t]];
-                        let (a, b) = (mult[t], mult_p[t]);
-                        let (Some(row_i), Some(row_k), Some(row_q)) = (
-                            head.get_mut(si..si + t + 1),
-                            row.get(..t + 1),
-                            row_p.get(..t + 1),
-                        ) else {
-                            return Err(k);
-                        };
-                        for ((x, &hkj), &hqj) in row_i.iter_mut().zip(row_k).zip(row_q) {
-                            *x = madd(-b, hqj, madd(-a, hkj, *x));
-                        }
+                    // the pair's updates of their common ancestors' rows
+                    let na = t_pair;
+                    let (Some(rk), Some(rq)) = (row.get(..na), row_p.get(..na)) else {
+                        return Err(k);
+                    };
+                    let mr = [&mult[..na], &mult_p[..na]];
+                    if sweep_common(head, table, start, root_chain, sk, mr, [rk, rq]).is_none() {
+                        return Err(k);
                     }
                     row.copy_from_slice(mult);
                     row_p.copy_from_slice(mult_p);
@@ -169,16 +134,12 @@ impl MassFactor {
                     continue;
                 }
             }
-            for t in (0..t_end).rev() {
-                let si = start[table[sk + t]];
-                let a = mult[t];
-                let (Some(row_i), Some(row_k)) = (head.get_mut(si..si + t + 1), row.get(..t + 1))
-                else {
-                    return Err(k);
-                };
-                for (x, &hkj) in row_i.iter_mut().zip(row_k) {
-                    *x = madd(-a, hkj, *x);
-                }
+            // k's update of its ancestors' rows
+            let (Some(rk), Some(mk)) = (row.get(..t_end), mult.get(..t_end)) else {
+                return Err(k);
+            };
+            if sweep_common(head, table, start, root_chain, sk, [mk], [rk]).is_none() {
+                return Err(k);
             }
             row.copy_from_slice(mult);
             if pair {
@@ -196,47 +157,116 @@ impl MassFactor {
     }
 }
 
-/// The three-dof update of a root's chain of `na` ≤ 6 dofs (a floating base)
-/// whose packed rows lie back to back (`tri`, na(na + 1)/2 entries: row t's
-/// t + 1 entries from t(t + 1)/2): entry (t, j) ← x − a[t]·k[j] − b[t]·q[j] −
-/// c[t]·r[j], three fused multiply-adds in that order, as the general sweep.
-/// False (nothing done) for a longer chain.
+/// The update of R eliminated dofs (k, k − 1, k − 2: `m[0]`, `m[1]`, `m[2]`,
+/// their multipliers L[·, i], and `r`, their rows H̃'[·, j] before the
+/// multipliers replaced them) on the rows of their `na` common ancestors
+/// i = path_k[t], t < na (`table[sk..sk + na]`, root first; na = the length of
+/// every slice): entry (t, j ≤ t) of row i ← x − m[0][t] r[0][j] − m[1][t]
+/// r[1][j] − …, one fused multiply-add each in that order. The entries are
+/// independent, so any order of rows gives the same bits. The ancestors
+/// that are a root's chain (a floating base's six, a trunk's joints after
+/// them: [`MassFactor`]'s `root_chain`, a prefix of the path) have their packed
+/// rows back to back, one triangle swept without look-ups; the rest row by
+/// row. `None`: a row out of `anc`'s range (not on a factor's own tables).
 #[inline(always)]
-fn sweep3_packed(
-    tri: &mut [f64],
-    m: (&[f64], &[f64], &[f64]),
-    r: (&[f64], &[f64], &[f64]),
-) -> bool {
-    match m.0.len() {
-        1 => sweep3_n::<1>(tri, m, r),
-        2 => sweep3_n::<2>(tri, m, r),
-        3 => sweep3_n::<3>(tri, m, r),
-        4 => sweep3_n::<4>(tri, m, r),
-        5 => sweep3_n::<5>(tri, m, r),
-        6 => sweep3_n::<6>(tri, m, r),
-        _ => return false,
+fn sweep_common<const R: usize>(
+    head: &mut [f64],
+    table: &[usize],
+    start: &[usize],
+    root_chain: &[bool],
+    sk: usize,
+    m: [&[f64]; R],
+    r: [&[f64]; R],
+) -> Option<()> {
+    let na = m[0].len();
+    // the root's-chain prefix: path_k[..p] (a prefix: a dof's path is its
+    // ancestors' paths extended)
+    let mut p = na;
+    while p > 0 && !root_chain.get(*table.get(sk + p - 1)?).copied()? {
+        p -= 1;
     }
-    true
+    for t in (p..na).rev() {
+        let si = *start.get(*table.get(sk + t)?)?;
+        let row_i = head.get_mut(si..si + t + 1)?;
+        row_update(row_i, t, m, r);
+    }
+    if p > 0 {
+        let s0 = *start.get(*table.get(sk)?)?;
+        let tri = head.get_mut(s0..s0 + p * (p + 1) / 2)?;
+        match p {
+            1 => sweep_n::<1, R>(tri, m, r),
+            2 => sweep_n::<2, R>(tri, m, r),
+            3 => sweep_n::<3, R>(tri, m, r),
+            4 => sweep_n::<4, R>(tri, m, r),
+            5 => sweep_n::<5, R>(tri, m, r),
+            6 => sweep_n::<6, R>(tri, m, r),
+            7 => sweep_n::<7, R>(tri, m, r),
+            8 => sweep_n::<8, R>(tri, m, r),
+            9 => sweep_n::<9, R>(tri, m, r),
+            10 => sweep_n::<10, R>(tri, m, r),
+            11 => sweep_n::<11, R>(tri, m, r),
+            12 => sweep_n::<12, R>(tri, m, r),
+            _ => sweep_rt::<R>(tri, p, m, r),
+        }
+    }
+    Some(())
 }
 
-/// [`sweep3_packed`] for N dofs (constant bounds: unrolled, no bounds tests).
+/// [`sweep_common`]'s triangle of N ≤ 12 rows (a floating base's six, a
+/// humanoid's trunk and hip after them; constant bounds: unrolled, no bounds
+/// tests).
 #[inline(always)]
-fn sweep3_n<const N: usize>(
-    tri: &mut [f64],
-    (a, b, c): (&[f64], &[f64], &[f64]),
-    (rk, rq, rr): (&[f64], &[f64], &[f64]),
-) {
-    let (tri, a, b, c) = (&mut tri[..N * (N + 1) / 2], &a[..N], &b[..N], &c[..N]);
-    let (rk, rq, rr) = (&rk[..N], &rq[..N], &rr[..N]);
+fn sweep_n<const N: usize, const R: usize>(tri: &mut [f64], m: [&[f64]; R], r: [&[f64]; R]) {
+    let tri = &mut tri[..N * (N + 1) / 2];
+    for q in 0..R {
+        assert!(m[q].len() >= N && r[q].len() >= N);
+    }
     for t in (0..N).rev() {
         let o = t * (t + 1) / 2;
         for j in 0..=t {
-            // x − a k − b q − c r, one fused multiply-add each, in that order
-            tri[o + j] = madd(
-                -c[t],
-                rr[j],
-                madd(-b[t], rq[j], madd(-a[t], rk[j], tri[o + j])),
-            );
+            let mut y = tri[o + j];
+            for q in 0..R {
+                y = madd(-m[q][t], r[q][j], y);
+            }
+            tri[o + j] = y;
+        }
+    }
+}
+
+/// [`sweep_common`]'s triangle of `p` rows (any number), row by row.
+#[inline(always)]
+fn sweep_rt<const R: usize>(tri: &mut [f64], p: usize, m: [&[f64]; R], r: [&[f64]; R]) {
+    for q in 0..R {
+        assert!(m[q].len() >= p && r[q].len() >= p);
+    }
+    let mut rest = tri;
+    for t in 0..p {
+        let (row_i, tail) = std::mem::take(&mut rest).split_at_mut(t + 1);
+        rest = tail;
+        row_update(row_i, t, m, r);
+    }
+}
+
+/// One row of [`sweep_common`]: `row_i[j] ← x − m[0][t] r[0][j] − …` for j
+/// < row_i.len() (R ≤ 3; zipped slices: vector lanes, no bounds tests).
+#[inline(always)]
+fn row_update<const R: usize>(row_i: &mut [f64], t: usize, m: [&[f64]; R], r: [&[f64]; R]) {
+    let n = row_i.len();
+    if R == 1 {
+        let (a, ra) = (m[0][t], &r[0][..n]);
+        for (x, &u) in row_i.iter_mut().zip(ra) {
+            *x = madd(-a, u, *x);
+        }
+    } else if R == 2 {
+        let (a, b, ra, rb) = (m[0][t], m[1][t], &r[0][..n], &r[1][..n]);
+        for ((x, &u), &w) in row_i.iter_mut().zip(ra).zip(rb) {
+            *x = madd(-b, w, madd(-a, u, *x));
+        }
+    } else {
+        let (a, b, c) = (m[0][t], m[1][t], m[2][t]);
+        let (ra, rb, rc) = (&r[0][..n], &r[1][..n], &r[2][..n]);
+        for (((x, &u), &w), &y) in row_i.iter_mut().zip(ra).zip(rb).zip(rc) {
+            *x = madd(-c, y, madd(-b, w, madd(-a, u, *x)));
         }
     }
 }
