@@ -4,7 +4,7 @@
 
 use super::loop_block::BlockRows;
 use super::subspace::{subspace_step, Solved, Subspace};
-use super::{MassFactor, RowKind, Rows};
+use super::{MassFactor, RowKind, Rows, SUBSPACE_MAX};
 
 impl Rows {
     /// Projected Gauss–Seidel on W = Y Yᵀ, kept implicit: Δv' = Yᵀλ is carried
@@ -224,6 +224,8 @@ impl Rows {
         let mut attempts = 0;
         let mut polished = false;
         let mut converged = false;
+        // every row of the island fits one subspace step
+        let small = runs.iter().map(|&(_, s, e)| e - s).sum::<usize>() <= SUBSPACE_MAX;
         while it < max_iter {
             it += 1;
             let plain = it <= PLAIN || finishing || polished || 2 * it > max_iter || relax == 1.0;
@@ -400,9 +402,16 @@ impl Rows {
             }
             if change <= tol {
                 finishing = true;
-            } else if it >= SUBSPACE_AFTER && attempts < SUBSPACE_TRIES && it + 1 < max_iter {
+            } else if it >= SUBSPACE_AFTER
+                && attempts < SUBSPACE_TRIES
+                && (attempts + 1 < SUBSPACE_TRIES || !small || it >= SUBSPACE_LAST)
+                && it + 1 < max_iter
+            {
                 // slow linear convergence (coupled rows): solve the rows
                 // the sweeps left free exactly, then let plain sweeps check
+                // (on an island whose rows all fit one step, the last try
+                // waits until the sweeps have settled which pairs stick and
+                // which slide)
                 attempts += 1;
                 let rows = Solved {
                     n,
@@ -582,6 +591,14 @@ pub(crate) struct Scratch(pub(super) Subspace);
 /// Sweeps before the first subspace step, and the most a solve takes.
 const SUBSPACE_AFTER: usize = 2;
 const SUBSPACE_TRIES: usize = 3;
+/// The sweep from which a solve's last subspace step may be taken on an
+/// island of at most [`SUBSPACE_MAX`] rows (the others follow sweeps 2 and 3;
+/// larger islands try again at sweep 4). A free set picked that early often
+/// has a pair the next sweeps move between sticking and sliding; on
+/// Gymnasium's ant landing on four feet with its ankles on their limits (16
+/// rows), a last step at sweep 4 left 10–20 sweeps of slow convergence a step,
+/// one at sweep 7 finishes the solve (docs/theory.md §"Constraint solve").
+const SUBSPACE_LAST: usize = 7;
 
 /// A tangent pair's update when its Gauss–Seidel step leaves the cone (the
 /// point slides): one isotropic step, λₜ − uₜ/w̄ with `wbar` = w̄ at least the
