@@ -266,6 +266,8 @@ impl Rows {
     /// operations in the same order, the same bits. False, nothing written,
     /// where `path` (contact r + 3's too: the caller's test) is not two such
     /// chains.
+    // (kept out of `form`: inlined there, it costs every other path's rows)
+    #[inline(never)]
     fn form_pair(&mut self, f: &MassFactor, r: usize, path: &[usize], vfree: &[f64]) -> bool {
         const N: usize = 12;
         let st = self.stride;
