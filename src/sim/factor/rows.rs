@@ -226,6 +226,78 @@ impl MassFactor {
         }
     }
 
+    /// [`Self::two_chain_lanes`] of two contacts' rows on the same path (two
+    /// contacts between the same two free bodies), `w` and `v`: one walk of L
+    /// for both, each lane's entry taking the same operations in the same
+    /// order as [`Self::two_chain_lanes`] alone (the same bits). False where
+    /// the factor is dense or `path` is not two such chains.
+    #[inline(always)]
+    pub fn two_chain_lanes2<const A: usize, const B: usize>(
+        &self,
+        path: &[usize],
+        w: &mut [[f64; 4]],
+        v: &mut [[f64; 4]],
+    ) -> bool {
+        if !(self.tree && path.len() == A + B && w.len() == A + B && v.len() == A + B) {
+            return false;
+        }
+        let (pa, pb) = path.split_at(A);
+        if !(self.is_chain(pa) && self.is_chain(pb)) {
+            return false;
+        }
+        let (wa, wb) = w.split_at_mut(A);
+        let (va, vb) = v.split_at_mut(A);
+        match (
+            <&mut [[f64; 4]; A]>::try_from(wa),
+            <&mut [[f64; 4]; B]>::try_from(wb),
+            <&mut [[f64; 4]; A]>::try_from(va),
+            <&mut [[f64; 4]; B]>::try_from(vb),
+        ) {
+            (Ok(wa), Ok(wb), Ok(va), Ok(vb)) => {
+                self.chain_elim2::<B>(pb, wb, vb) && self.chain_elim2::<A>(pa, wa, va)
+            }
+            _ => false,
+        }
+    }
+
+    /// [`Self::chain_elim`] of two right-hand sides `w`, `v` on one chain path:
+    /// each L entry loaded once for both, each lane's entry the same operations
+    /// in the same order as [`Self::chain_elim`] (the same bits).
+    #[inline(always)]
+    fn chain_elim2<const N: usize>(
+        &self,
+        path: &[usize],
+        w: &mut [[f64; 4]; N],
+        v: &mut [[f64; 4]; N],
+    ) -> bool {
+        let Some(path) = path.get(..N) else {
+            return false;
+        };
+        // y[j] −= L[path[t], path[j]]·y[t] for t from the leaf in, both sides
+        for t in (1..N).rev() {
+            let (a, b) = (w[t], v[t]);
+            let s = self.start[path[t]];
+            let Some(anc) = self.anc.get(s..s + t) else {
+                return false;
+            };
+            for ((wj, vj), &l) in w.iter_mut().zip(v.iter_mut()).zip(anc) {
+                for i in 0..4 {
+                    wj[i] -= l * a[i];
+                    vj[i] -= l * b[i];
+                }
+            }
+        }
+        // y[t] ← y[t]/√D[path[t]]
+        for ((wt, vt), &k) in w.iter_mut().zip(v.iter_mut()).zip(path) {
+            let d = self.inv_sqrt_d[k];
+            for i in 0..4 {
+                wt[i] *= d;
+                vt[i] *= d;
+            }
+        }
+        true
+    }
+
     /// The elimination and scaling of [`Self::row_transform_lanes`] on a chain
     /// path of `N` dofs (`path[..N]`), in registers: every loop's bounds
     /// constant (unrolled, no bounds tests); each lane's entry takes the same

@@ -32,6 +32,21 @@ impl Rows {
             for q in r..(r + k).min(self.is_block.len()) {
                 self.is_block[q] = block && q == r;
             }
+            // two contacts between the same two free bodies (6 + 6 dofs, the
+            // same path): formed together, one walk of L for both
+            let same = |(qs, ql): (usize, usize)| table.get(qs..qs + ql) == Some(path);
+            if block
+                && pl == 12
+                && self.is_contact(r + 3)
+                && same(self.path[r + 3])
+                && self.form_pair(f, r, path, vfree)
+            {
+                for q in r + 3..r + 6 {
+                    self.is_block[q] = q == r + 3;
+                }
+                r += 6;
+                continue;
+            }
             if k == 3 && self.form_lanes(f, r, path, vfree) {
                 r += 3;
                 continue;
@@ -242,6 +257,45 @@ impl Rows {
             return false;
         }
         self.store_block(r, &w, c);
+        true
+    }
+
+    /// Contacts r and r + 3 on the same path of two free bodies' chains
+    /// (6 + 6 dofs) formed as [`Rows::form_two`] forms each
+    /// ([`MassFactor::two_chain_lanes2`]: one walk of L for both): the same
+    /// operations in the same order, the same bits. False, nothing written,
+    /// where `path` (contact r + 3's too: the caller's test) is not two such
+    /// chains.
+    // (kept out of `form`: inlined there, it costs every other path's rows)
+    #[inline(never)]
+    fn form_pair(&mut self, f: &MassFactor, r: usize, path: &[usize], vfree: &[f64]) -> bool {
+        const N: usize = 12;
+        let st = self.stride;
+        let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..(r + 6) * st)) else {
+            return false;
+        };
+        if N > st || path.iter().any(|&d| d >= vfree.len()) {
+            return false;
+        }
+        let (mut w, mut v) = ([[0.0f64; 4]; N], [[0.0f64; 4]; N]);
+        let c = gather_rows(
+            [&j[..N], &j[st..st + N], &j[2 * st..2 * st + N]],
+            path,
+            vfree,
+            &mut w,
+        );
+        let j = &j[3 * st..];
+        let e = gather_rows(
+            [&j[..N], &j[st..st + N], &j[2 * st..2 * st + N]],
+            path,
+            vfree,
+            &mut v,
+        );
+        if !f.two_chain_lanes2::<6, 6>(path, &mut w, &mut v) {
+            return false;
+        }
+        self.store_block(r, &w, c);
+        self.store_block(r + 3, &v, e);
         true
     }
 
