@@ -18,6 +18,7 @@
 
 mod solve;
 mod spin;
+mod tables;
 
 use super::factor::MassFactor;
 use super::islands::Islands;
@@ -27,9 +28,9 @@ use super::solver::{RowKind, Rows, Scratch};
 use super::{ContactForce, Solver};
 use crate::contact::{tangents, ContactPoint};
 use crate::model::{JointKind, Model};
-use crate::spatial::ops::{add_cross, mat_vec};
 use crate::spatial::{Force, Motion, Se3};
 use nalgebra::{DVector, Vector3};
+use tables::{act_column, BodyColumns, JointRowSource};
 
 /// What the rows are built from, besides the state.
 #[derive(Clone, Copy, Debug)]
@@ -548,119 +549,6 @@ impl Constraints {
             }
         }
         self.counts
-    }
-}
-
-/// What a 1-DoF joint's rows are built from (its [`crate::model::DofInfo`]'s
-/// fields, copied once: the row loop reads these few, not every dof's whole entry).
-#[derive(Clone, Copy, Debug)]
-struct JointRowSource {
-    /// The dof's index in `model.dofs`.
-    d: usize,
-    iq: usize,
-    iv: usize,
-    friction: f64,
-    continuous: bool,
-    lower: Option<f64>,
-    upper: Option<f64>,
-}
-
-impl JointRowSource {
-    /// The model's 1-DoF joints with friction or a position limit (the others
-    /// never have a row), in dof order.
-    fn of(model: &Model) -> Vec<Self> {
-        let mut out = Vec::new();
-        for (d, info) in model.dofs.iter().enumerate() {
-            if info.kind.nv() != 1 {
-                continue;
-            }
-            let js = Self {
-                d,
-                iq: info.iq,
-                iv: info.iv,
-                friction: info.friction,
-                continuous: info.continuous,
-                lower: info.limits.lower,
-                upper: info.limits.upper,
-            };
-            let limited = !js.continuous && (js.lower.is_some() || js.upper.is_some());
-            if js.friction > 0.0 || limited {
-                out.push(js);
-            }
-        }
-        out
-    }
-}
-
-/// A body's joint's motion subspace columns in the body frame
-/// ([`crate::model::Joint::subspace_column`]), `nv` of them (none for the world).
-#[derive(Clone, Copy, Debug)]
-struct BodyColumns {
-    s: [Column; 6],
-    nv: usize,
-    /// The joint's first velocity coordinate.
-    iv: usize,
-}
-
-/// One subspace column and which of its parts are zero.
-#[derive(Clone, Copy, Debug)]
-struct Column {
-    s: Motion,
-    ang_zero: bool,
-    lin_zero: bool,
-}
-
-impl BodyColumns {
-    fn of(model: &Model, i: usize) -> Self {
-        let zero = Column {
-            s: Motion::zero(),
-            ang_zero: true,
-            lin_zero: true,
-        };
-        let mut cols = Self {
-            s: [zero; 6],
-            nv: 0,
-            iv: 0,
-        };
-        if let Some(j) = model.joints.get(i) {
-            cols.iv = j.iv;
-            cols.nv = if i == 0 { 0 } else { j.nv().min(6) };
-            for (k, c) in cols.s.iter_mut().enumerate().take(cols.nv) {
-                let s = j.subspace_column(k);
-                *c = Column {
-                    s,
-                    ang_zero: s.ang == Vector3::zeros(),
-                    lin_zero: s.lin == Vector3::zeros(),
-                };
-            }
-        }
-        cols
-    }
-}
-
-/// `o.act_motion(&c.s)` (ω' = R ω, v' = R v + t × ω'), a zero part's
-/// products left out: the same values but for the sign of a zero, which no
-/// row keeps (J's entries are sums onto the +0 that [`Rows::clear`] left;
-/// the spin rows' sums start from 0 too).
-#[inline(always)]
-fn act_column(o: &Se3<f64>, c: &Column) -> Motion {
-    let ang = if c.ang_zero {
-        Vector3::zeros()
-    } else {
-        mat_vec(&o.rot, &c.s.ang)
-    };
-    let lin = if c.lin_zero {
-        Vector3::zeros()
-    } else {
-        mat_vec(&o.rot, &c.s.lin)
-    };
-    Motion {
-        lin: if c.ang_zero {
-            lin
-        } else {
-            add_cross(&lin, &o.trans, &ang)
-        },
-        ang,
     }
 }
 

@@ -1,0 +1,121 @@
+//! The constants `assemble` reads each step, made once at construction: the
+//! 1-DoF joints that may have rows, and each body's joint subspace columns in
+//! its body frame with which of their parts are zero.
+
+use crate::model::Model;
+use crate::spatial::ops::{add_cross, mat_vec};
+use crate::spatial::{Motion, Se3};
+use nalgebra::Vector3;
+
+/// What a 1-DoF joint's rows are built from (its [`crate::model::DofInfo`]'s
+/// fields, copied once: the row loop reads these few, not every dof's whole entry).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct JointRowSource {
+    /// The dof's index in `model.dofs`.
+    pub(super) d: usize,
+    pub(super) iq: usize,
+    pub(super) iv: usize,
+    pub(super) friction: f64,
+    pub(super) continuous: bool,
+    pub(super) lower: Option<f64>,
+    pub(super) upper: Option<f64>,
+}
+
+impl JointRowSource {
+    /// The model's 1-DoF joints with friction or a position limit (the others
+    /// never have a row), in dof order.
+    pub(super) fn of(model: &Model) -> Vec<Self> {
+        let mut out = Vec::new();
+        for (d, info) in model.dofs.iter().enumerate() {
+            if info.kind.nv() != 1 {
+                continue;
+            }
+            let js = Self {
+                d,
+                iq: info.iq,
+                iv: info.iv,
+                friction: info.friction,
+                continuous: info.continuous,
+                lower: info.limits.lower,
+                upper: info.limits.upper,
+            };
+            let limited = !js.continuous && (js.lower.is_some() || js.upper.is_some());
+            if js.friction > 0.0 || limited {
+                out.push(js);
+            }
+        }
+        out
+    }
+}
+
+/// A body's joint's motion subspace columns in the body frame
+/// ([`crate::model::Joint::subspace_column`]), `nv` of them (none for the world).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BodyColumns {
+    pub(super) s: [Column; 6],
+    pub(super) nv: usize,
+    /// The joint's first velocity coordinate.
+    pub(super) iv: usize,
+}
+
+/// One subspace column and which of its parts are zero.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Column {
+    pub(super) s: Motion,
+    pub(super) ang_zero: bool,
+    pub(super) lin_zero: bool,
+}
+
+impl BodyColumns {
+    pub(super) fn of(model: &Model, i: usize) -> Self {
+        let zero = Column {
+            s: Motion::zero(),
+            ang_zero: true,
+            lin_zero: true,
+        };
+        let mut cols = Self {
+            s: [zero; 6],
+            nv: 0,
+            iv: 0,
+        };
+        if let Some(j) = model.joints.get(i) {
+            cols.iv = j.iv;
+            cols.nv = if i == 0 { 0 } else { j.nv().min(6) };
+            for (k, c) in cols.s.iter_mut().enumerate().take(cols.nv) {
+                let s = j.subspace_column(k);
+                *c = Column {
+                    s,
+                    ang_zero: s.ang == Vector3::zeros(),
+                    lin_zero: s.lin == Vector3::zeros(),
+                };
+            }
+        }
+        cols
+    }
+}
+
+/// `o.act_motion(&c.s)` (ω' = R ω, v' = R v + t × ω'), a zero part's
+/// products left out: the same values but for the sign of a zero, which no
+/// row keeps (J's entries are sums onto the +0 that [`Rows::clear`] left;
+/// the spin rows' sums start from 0 too).
+#[inline(always)]
+pub(super) fn act_column(o: &Se3<f64>, c: &Column) -> Motion {
+    let ang = if c.ang_zero {
+        Vector3::zeros()
+    } else {
+        mat_vec(&o.rot, &c.s.ang)
+    };
+    let lin = if c.lin_zero {
+        Vector3::zeros()
+    } else {
+        mat_vec(&o.rot, &c.s.lin)
+    };
+    Motion {
+        lin: if c.ang_zero {
+            lin
+        } else {
+            add_cross(&lin, &o.trans, &ang)
+        },
+        ang,
+    }
+}
