@@ -21,6 +21,7 @@
 
 mod dense;
 mod form;
+mod kernels;
 mod loop_block;
 mod pgs;
 mod position;

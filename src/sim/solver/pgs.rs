@@ -2,6 +2,7 @@
 //! contact's three rows taken in one pass and the exact Coulomb slide onto
 //! the friction disc.
 
+use super::kernels::{axpy3, dot3, warm3};
 use super::loop_block::BlockRows;
 use super::subspace::{subspace_step, Solved, Subspace};
 use super::{MassFactor, RowKind, Rows, SUBSPACE_MAX};
@@ -442,122 +443,6 @@ impl Rows {
         }
         out.sm.0.loops = lb;
         (it, polished)
-    }
-}
-
-/// Σₜ lₜ x[pₜ] in each of the four lanes of `l` (a contact's three rows of
-/// y interleaved, `Rows::ylanes`), each lane a sum from 0 in path order; the
-/// indices of `p` must be < `x.len()` (a row's path: dof indices < nv).
-#[inline(always)]
-pub(super) fn dot3(l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
-    debug_assert!(p.iter().all(|&k| k < x.len()));
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-    {
-        use std::arch::x86_64::*;
-        let mut s = [0.0f64; 4];
-        // SAFETY: avx is enabled at compile time; every k < x.len() (the
-        // sweeps' check of the paths); `l`'s entries are 4 f64 each
-        unsafe {
-            let mut acc = _mm256_setzero_pd();
-            for (li, &k) in l.iter().zip(p) {
-                let xk = _mm256_broadcast_sd(x.get_unchecked(k));
-                acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_loadu_pd(li.as_ptr()), xk));
-            }
-            _mm256_storeu_pd(s.as_mut_ptr(), acc);
-        }
-        s
-    }
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
-    {
-        let mut s = [0.0f64; 4];
-        for (li, &k) in l.iter().zip(p) {
-            // SAFETY: every k < x.len() (the sweeps' check of the paths)
-            let xk = unsafe { *x.get_unchecked(k) };
-            for (si, &v) in s.iter_mut().zip(li) {
-                *si += v * xk;
-            }
-        }
-        s
-    }
-}
-
-/// The warm start of a contact's three rows: x[pₜ] = ((x[pₜ] + a₀ lₜ₀) + a₁ lₜ₁) +
-/// a₂ lₜ₂ over its path `p` (`l`: its rows of y interleaved, `Rows::ylanes`),
-/// each entry the same sum as three row-by-row updates (a path's dofs are
-/// distinct); the indices of `p` must be < `x.len()`.
-#[inline(always)]
-fn warm3(a: [f64; 3], l: &[[f64; 4]], p: &[usize], x: &mut [f64]) {
-    debug_assert!(p.iter().all(|&k| k < x.len()));
-    for (lt, &k) in l.iter().zip(p) {
-        // SAFETY: every k < x.len() (the sweeps' check of the paths)
-        unsafe {
-            let xk = x.get_unchecked_mut(k);
-            *xk = ((*xk + a[0] * lt[0]) + a[1] * lt[1]) + a[2] * lt[2];
-        }
-    }
-}
-
-/// The contact's update x[pₜ] += (a₀ y₀ₜ + a₁ y₁ₜ) + a₂ y₂ₜ over a contact's path
-/// `p` (its three rows of y, `ys`, each at least `p.len()` long), each entry
-/// the same operations in the same order as the scalar loop, four path slots
-/// at a time (gathered and scattered: a path's dofs are distinct);
-/// the indices of `p` must be < `x.len()` (a row's path: dof indices < nv).
-#[inline(always)]
-fn axpy3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
-    debug_assert!(p.iter().all(|&k| k < x.len()));
-    debug_assert!(p.iter().enumerate().all(|(i, k)| !p[..i].contains(k)));
-    let n = p.len().min(ys[0].len()).min(ys[1].len()).min(ys[2].len());
-    let [y0, y1, y2] = ys;
-    #[allow(unused_mut)]
-    let mut t = 0;
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-    {
-        use std::arch::x86_64::*;
-        // SAFETY: avx is enabled at compile time; t + 3 < n ≤ every slice's
-        // length; every k < x.len() (the sweeps' check of the paths), and the
-        // four k of a group are distinct (a path lists a dof once)
-        unsafe {
-            let (a0, a1, a2) = (
-                _mm256_set1_pd(a[0]),
-                _mm256_set1_pd(a[1]),
-                _mm256_set1_pd(a[2]),
-            );
-            let xp = x.as_mut_ptr();
-            while t + 4 <= n {
-                let s = _mm256_add_pd(
-                    _mm256_add_pd(
-                        _mm256_mul_pd(a0, _mm256_loadu_pd(y0.as_ptr().add(t))),
-                        _mm256_mul_pd(a1, _mm256_loadu_pd(y1.as_ptr().add(t))),
-                    ),
-                    _mm256_mul_pd(a2, _mm256_loadu_pd(y2.as_ptr().add(t))),
-                );
-                let k = [
-                    *p.get_unchecked(t),
-                    *p.get_unchecked(t + 1),
-                    *p.get_unchecked(t + 2),
-                    *p.get_unchecked(t + 3),
-                ];
-                let lo = _mm_loadh_pd(_mm_load_sd(xp.add(k[0])), xp.add(k[1]));
-                let hi = _mm_loadh_pd(_mm_load_sd(xp.add(k[2])), xp.add(k[3]));
-                let v = _mm256_add_pd(_mm256_set_m128d(hi, lo), s);
-                let (vlo, vhi) = (_mm256_castpd256_pd128(v), _mm256_extractf128_pd::<1>(v));
-                _mm_storel_pd(xp.add(k[0]), vlo);
-                _mm_storeh_pd(xp.add(k[1]), vlo);
-                _mm_storel_pd(xp.add(k[2]), vhi);
-                _mm_storeh_pd(xp.add(k[3]), vhi);
-                t += 4;
-            }
-        }
-    }
-    while t < n {
-        // SAFETY: t < n ≤ every slice's length; p[t] < x.len() (as above)
-        unsafe {
-            let k = *p.get_unchecked(t);
-            *x.get_unchecked_mut(k) += a[0] * y0.get_unchecked(t)
-                + a[1] * y1.get_unchecked(t)
-                + a[2] * y2.get_unchecked(t);
-        }
-        t += 1;
     }
 }
 

@@ -2,8 +2,8 @@
 //! free rows solved exactly by a dense LDLᵀ.
 
 use super::dense::ldlt_dropping;
+use super::kernels::dot3;
 use super::loop_block::LoopBlock;
-use super::pgs::dot3;
 use super::{RowKind, SUBSPACE_MAX};
 use crate::dynamics::linalg::ldlt_dropping_solve;
 
