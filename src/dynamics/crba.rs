@@ -1,7 +1,8 @@
 //! The composite-rigid-body algorithm (CRBA) for the joint-space inertia matrix H(q).
 
 use crate::dynamics::rnea::act_force_ax;
-use crate::model::{dispatch_joint, Data, JointModel, Model};
+use crate::model::joint::dispatch_of;
+use crate::model::{dispatch_joint, dispatch_keyed, Data, JointModel, Model};
 use crate::spatial::{Force, Motion, Scalar};
 use nalgebra::{DVector, Vector3};
 
@@ -435,6 +436,8 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, &[T])>(
     let ident = &model.placement_identity[..nb];
     let zt = &model.placement_zero_trans[..nb];
     let sub_end = &model.topology.dof_subtree_end[..nv];
+    // (PLACED: each joint's dispatch as `data` holds it for the model)
+    let keys = if PLACED { &data.dispatch[..nb] } else { &[] };
     let li_m_i = &mut data.li_m_i[..nb];
     let ic = &mut data.crba_ic[..nb];
     ic.copy_from_slice(inertias);
@@ -455,7 +458,12 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, &[T])>(
             tail[0] = ici;
         }
         carry_to = 0;
-        let li = dispatch_joint!(&joints[i], ident[i], jm => {
+        let key = if PLACED {
+            keys[i]
+        } else {
+            dispatch_of(&joints[i])
+        };
+        let li = dispatch_keyed!(&joints[i], key, ident[i], jm => {
             let li = if PLACED { li_m_i[i] } else { jm.placement(&placements[i], q) };
             let k0 = jm.joint().iv;
             let end = sub_end[k0];

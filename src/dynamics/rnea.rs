@@ -1,6 +1,7 @@
 use super::crba::is_f64;
 use super::{check_sizes, DynamicsError};
-use crate::model::{dispatch_joint, Axis, Data, JointModel, Model};
+use crate::model::joint::dispatch_of;
+use crate::model::{dispatch_keyed, Axis, Data, JointModel, Model};
 use crate::spatial::ops::add_cross;
 use crate::spatial::{Force, Inertia, Motion, Scalar, Se3};
 use nalgebra::DVector;
@@ -203,6 +204,8 @@ fn rnea_pass<
     let ident = &model.placement_identity[..nb];
     let zt = &model.placement_zero_trans[..nb];
     let inertias = &model.inertias[..nb];
+    // (K: each joint's dispatch as `data` holds it for the model, made once)
+    let keys = if K { &data.dispatch[..nb] } else { &[] };
     let li_m_i = &mut data.li_m_i[..nb];
     let o_m_i = &mut data.o_m_i[..nb];
     let vel = &mut data.v[..nb];
@@ -219,28 +222,22 @@ fn rnea_pass<
     for i in 1..nb {
         let p = parent[i];
         let (vp, ap) = (vel[p], acc[p]);
-        let (li, vi, ai) = dispatch_joint!(&joints[i], ident[i], jm => {
+        let key = if K { keys[i] } else { dispatch_of(&joints[i]) };
+        let (li, vi, ai) = dispatch_keyed!(&joints[i], key, ident[i], jm => {
             // ᵢXₚ at q, or (K) as forward kinematics left it at this q
             let li = if K { li_m_i[i] } else { jm.placement(&placements[i], q) };
             let ax = jm.rot_axis();
             // (the bias pass: a joint frame at its parent's origin moves
             // motions by its rotation alone, `Model::placement_zero_trans`)
             let rot = K && exact && ax.is_some() && zt[i];
-            let mv = |x: &Motion<T>| match ax {
-                Some(ax) if rot => Motion {
-                    ang: ax.rot_tr_mul(&li.rot, &x.ang),
-                    lin: ax.rot_tr_mul(&li.rot, &x.lin),
-                },
-                _ => inv_act_motion_ax(&li, ax, x),
-            };
             // docs/theory.md §"Velocity recursion": v̂ᵢ = ᵢX̂ₚ v̂ₚ + ŝᵢ q̇ᵢ
             let mut vi = Motion::zero();
             if V {
-                vi = mv(&vp);
+                vi = move_motion(&li, ax, rot, &vp);
                 jm.add_motion(&mut vi, v);
             }
             // docs/theory.md §"Acceleration recursion": âᵢ = ᵢX̂ₚ âₚ + v̂ᵢ × ŝᵢ q̇ᵢ + ŝᵢ q̈ᵢ
-            let mut ai = mv(&ap);
+            let mut ai = move_motion(&li, ax, rot, &ap);
             if V {
                 jm.add_cross_motion(&mut ai, &vi, v);
             }
@@ -296,7 +293,8 @@ fn rnea_pass<
             tail[0] = fi;
         }
         let li = &li_m_i[i];
-        dispatch_joint!(&joints[i], ident[i], jm => {
+        let key = if K { keys[i] } else { dispatch_of(&joints[i]) };
+        dispatch_keyed!(&joints[i], key, ident[i], jm => {
             // docs/theory.md §"Joint-force projection": Qᵢ = ŝᵢᵀ f̂ᵢ (a mimic joint adds
             // to its leader's coordinate)
             jm.project_add(&fi, tau);
@@ -318,6 +316,20 @@ fn rnea_pass<
         });
     }
     ke
+}
+
+/// `ᵢX̂ₚ x` given `li` = λ(i)Mi: by its rotation alone when `rot` (a joint
+/// frame at its parent's origin, `ax` given), else [`inv_act_motion_ax`]
+/// (a function, not a closure: inlined into the pass, no call per body).
+#[inline(always)]
+fn move_motion<T: Scalar>(li: &Se3<T>, ax: Option<Axis<T>>, rot: bool, x: &Motion<T>) -> Motion<T> {
+    match ax {
+        Some(ax) if rot => Motion {
+            ang: ax.rot_tr_mul(&li.rot, &x.ang),
+            lin: ax.rot_tr_mul(&li.rot, &x.lin),
+        },
+        _ => inv_act_motion_ax(li, ax, x),
+    }
 }
 
 /// `m.inv_act_motion(x)`, with `m`'s rotation applied as a rotation about `ax`
@@ -357,7 +369,10 @@ pub(crate) fn act_force_ax<T: Scalar>(m: &Se3<T>, ax: Option<Axis<T>>, f: &Force
 /// term a product with a zero; at most a zero's sign differs).
 #[inline(always)]
 fn massless<T: Scalar>(i: &Inertia<T>) -> bool {
-    i.mass == T::zero()
-        && i.com.iter().all(|x| *x == T::zero())
-        && i.inertia_c.iter().all(|x| *x == T::zero())
+    // (the mass first; then the twelve others' tests folded without early
+    // exit: compared side by side, no branch an entry)
+    let z = T::zero();
+    i.mass == z
+        && i.com.iter().fold(true, |all, x| all & (*x == z))
+            & i.inertia_c.iter().fold(true, |all, x| all & (*x == z))
 }

@@ -13,6 +13,11 @@ pub struct Data<T: Scalar = f64> {
     pub li_m_i: Vec<Se3<T>>,
     /// `oMi`: body i's frame in the world.
     pub o_m_i: Vec<Se3<T>>,
+    /// Each body's joint as the hot passes run it (`joint::dispatch_of` of
+    /// the model this workspace was made for, entry 0 unused): the passes at
+    /// forward kinematics' placements (the simulation's bias and CRBA) read
+    /// it instead of re-deriving it per body and pass.
+    pub(crate) dispatch: Vec<(super::joint::Dispatch<T>, T, T)>,
     /// `oMf`: every URDF link frame in the world.
     pub o_m_f: Vec<Se3<T>>,
     /// Spatial velocity of each body (body frame).
@@ -294,6 +299,10 @@ impl<T: Scalar> Data<T> {
         Self {
             li_m_i: vec![Se3::identity(); nb],
             o_m_i: vec![Se3::identity(); nb],
+            dispatch: model.joints[..nb]
+                .iter()
+                .map(super::joint::dispatch_of)
+                .collect(),
             o_m_f: vec![Se3::identity(); model.frames.len()],
             v: vec![Motion::zero(); nb],
             a: vec![Motion::zero(); nb],

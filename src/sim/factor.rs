@@ -100,6 +100,10 @@ pub struct MassFactor {
     held: bool,
     held_diag: Vec<f64>,
     held_inertia: Vec<CompositeInertia<f64>>,
+    /// The caller's scratch for H̃'s diagonal additions (n entries), filled
+    /// in one pass over slices before [`Self::factor_at`] reads it
+    /// (`Simulation::factor_mass`).
+    pub(crate) diag_buf: Vec<f64>,
 }
 
 impl MassFactor {
@@ -151,6 +155,7 @@ impl MassFactor {
             held: false,
             held_diag: vec![0.0; if lone_free { n } else { 0 }],
             held_inertia: Vec::with_capacity(if lone_free { nb } else { 0 }),
+            diag_buf: vec![0.0; n],
             m: if tree {
                 DMatrix::zeros(0, 0)
             } else {

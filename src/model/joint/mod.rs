@@ -242,7 +242,7 @@ pub(super) fn dot6<T: Scalar>(x: &Vector6<T>, off: usize, ax: Axis<T>, mult: T) 
 /// How [`dispatch_joint!`] runs a joint: its kind and axis, a negative
 /// coordinate axis `−eₖ` (MJCF's `axis="0 -1 0"`, a URDF's `<axis xyz="0 -1
 /// 0"/>`) folded onto `+eₖ`.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 pub(crate) enum Dispatch<T: Scalar> {
     RevX,
     RevY,
@@ -313,13 +313,28 @@ pub(crate) fn dispatch_of<T: Scalar>(j: &Joint<T>) -> (Dispatch<T>, T, T) {
 /// kind is matched here, once, and `$body` is compiled once per joint model.
 macro_rules! dispatch_joint {
     ($joint:expr, $ident:expr, $jm:ident => $body:expr) => {{
+        // the kind matched once (a negative coordinate axis folded onto the
+        // positive one, `dispatch_of`)
+        let jd__ = $joint;
+        $crate::model::joint::dispatch_keyed!(
+            jd__,
+            $crate::model::joint::dispatch_of(jd__),
+            $ident,
+            $jm => $body
+        )
+    }};
+}
+pub(crate) use dispatch_joint;
+
+/// [`dispatch_joint!`] with the joint's `dispatch_of` already known (`$key`,
+/// e.g. [`crate::model::Data`]'s per-body copy made once for its model).
+macro_rules! dispatch_keyed {
+    ($joint:expr, $key:expr, $ident:expr, $jm:ident => $body:expr) => {{
         use $crate::model::joint::{
             AxU, AxX, AxY, AxZ, Dispatch, FreeJ, PlanarJ, PrismaticJ, RevoluteJ, SphericalJ,
         };
-        // the kind matched once (a negative coordinate axis folded onto the
-        // positive one, `dispatch_of`)
         let j__ = $joint;
-        let (key__, mult__, off__) = $crate::model::joint::dispatch_of(j__);
+        let (key__, mult__, off__) = $key;
         match (key__, $ident) {
             (Dispatch::RevX, true) => {
                 let $jm = RevoluteJ::<_, _, true> {
@@ -435,4 +450,4 @@ macro_rules! dispatch_joint {
         }
     }};
 }
-pub(crate) use dispatch_joint;
+pub(crate) use dispatch_keyed;

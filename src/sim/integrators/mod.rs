@@ -99,13 +99,27 @@ impl Simulation {
             .set_awake(&self.model, self.sleep.sleeping_trees());
         // (slices: one bounds test an entry, not a DVector's matrix index)
         let (arm, damp) = (self.armature.as_slice(), self.damping.as_slice());
+        // H̃'s diagonal additions A + c D + c kd + c² kp, all at once (one
+        // pass over slices, the same sums entry by entry as `Servo::diag`)
+        let mut buf = std::mem::take(&mut self.mass.f.diag_buf);
+        let filled = fill_diag(&mut buf, arm, damp, &self.servo, c);
         let servo = &self.servo;
-        let diag = |k: usize| arm[k] + c * damp[k] + servo.diag(k, c);
-        if let Some(r) =
+        let at = if filled {
+            self.mass.f.factor_at(
+                &self.model,
+                &mut self.data,
+                self.q.as_slice(),
+                placed,
+                |k| buf[k],
+            )
+        } else {
+            let diag = |k: usize| arm[k] + c * damp[k] + servo.diag(k, c);
             self.mass
                 .f
                 .factor_at(&self.model, &mut self.data, self.q.as_slice(), placed, diag)
-        {
+        };
+        self.mass.f.diag_buf = buf;
+        if let Some(r) = at {
             return r.map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)));
         }
         // the joint placements of the last forward kinematics at this q are
@@ -129,6 +143,47 @@ impl Simulation {
             .factor(&self.data.h)
             .map_err(|p| SimError::Dynamics(DynamicsError::Singular(p)))
     }
+}
+
+/// `buf[k] = arm[k] + c damp[k] + servo.diag(k, c)` for every k < nv (the
+/// same operations in the same order as [`super::servo::Servo::diag`]'s
+/// callers, over slices: no per-entry branch on the servo's state nor bounds
+/// test). False, nothing written, where a slice is shorter than `buf`.
+fn fill_diag(
+    buf: &mut [f64],
+    arm: &[f64],
+    damp: &[f64],
+    servo: &super::servo::Servo,
+    c: f64,
+) -> bool {
+    let n = buf.len();
+    let (Some(arm), Some(damp)) = (arm.get(..n), damp.get(..n)) else {
+        return false;
+    };
+    if !servo.active {
+        // (`Servo::diag` is 0 when inactive: the + 0 kept, −0 becomes +0)
+        for ((b, &a), &d) in buf.iter_mut().zip(arm).zip(damp) {
+            *b = a + c * d + 0.0;
+        }
+        return true;
+    }
+    let (Some(kd), Some(kp), Some(sat)) = (
+        servo.kd.as_slice().get(..n),
+        servo.kp.as_slice().get(..n),
+        servo.saturated.get(..n),
+    ) else {
+        return false;
+    };
+    for k in 0..n {
+        // c kd + c² kp on a free servo, 0 on a saturated one
+        let s = if sat[k] == 0 {
+            c * kd[k] + c * c * kp[k]
+        } else {
+            0.0
+        };
+        buf[k] = arm[k] + c * damp[k] + s;
+    }
+    true
 }
 
 /// The assembled rows' impulses at the free velocity `mass.vfree` with the
