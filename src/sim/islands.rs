@@ -26,8 +26,13 @@ pub(crate) struct Islands {
     tree_of_dof: Vec<usize>,
     /// Union-find parents over the trees (scratch).
     parent: Vec<usize>,
-    /// Each row's island root tree (`usize::MAX`: a row on no dof).
-    key: Vec<usize>,
+    /// The rows' groups: maximal runs of consecutive rows on one path (a
+    /// contact's three rows, the points of one pair), as (first row, end),
+    /// and each group's island root tree (`usize::MAX`: a row on no dof).
+    groups: Vec<(usize, usize)>,
+    gkey: Vec<usize>,
+    /// The group starting at each row (read at runs' first rows only).
+    group_at: Vec<usize>,
     /// Runs of consecutive rows of one island: (island key, first row, end).
     runs: Vec<(usize, usize, usize)>,
     /// Per island: its runs, a range of `runs`, and its dofs, a range of `dofs`.
@@ -102,7 +107,9 @@ impl Islands {
         Self {
             tree_of_dof,
             parent: (0..nt).collect(),
-            key: vec![0; rows],
+            groups: Vec::with_capacity(rows),
+            gkey: Vec::with_capacity(rows),
+            group_at: vec![0; rows],
             runs: Vec::with_capacity(rows),
             islands: Vec::with_capacity(rows.min(nt + 1)),
             dofs: Vec::with_capacity(model.nv),
@@ -138,7 +145,7 @@ impl Islands {
 
     /// Groups the assembled rows into islands.
     pub fn group(&mut self, rows: &Rows) {
-        let n = rows.n.min(self.key.len());
+        let n = rows.n.min(self.group_at.len());
         // the same rows' paths as the last grouping, each one of the factor's
         // (fixed for the rows' life, [`Rows::set_table`]): the same islands
         let fixed = rows.unions_empty();
@@ -153,53 +160,56 @@ impl Islands {
         for p in self.parent.iter_mut().enumerate() {
             *p.1 = p.0;
         }
-        // a row on the same path as the row before it (a contact's tangents,
-        // the points of one pair) joins the same trees: skipped
-        let same = |r: usize| r > 0 && rows.path[r] == rows.path[r - 1];
+        // rows on the same path as the row before them (a contact's tangents,
+        // the points of one pair) join the same trees: one group, looked at once
+        self.groups.clear();
+        let path = &rows.path[..n];
+        let mut r = 0;
+        while r < n {
+            let s = r;
+            r += 1;
+            while r < n && path[r] == path[s] {
+                r += 1;
+            }
+            self.group_at[s] = self.groups.len();
+            self.groups.push((s, r));
+        }
+        self.gkey.clear();
         if self.parent.len() == 1 {
             // one tree (a single robot): every row on a dof joins tree 0, no
             // union to find (the keys the general pass gives, without it)
-            for r in 0..n {
-                self.key[r] = if same(r) {
-                    self.key[r - 1]
-                } else {
-                    self.ends(rows, r).map_or(usize::MAX, |_| 0)
-                };
+            for g in 0..self.groups.len() {
+                let k = self.ends(rows, self.groups[g].0).map_or(usize::MAX, |_| 0);
+                self.gkey.push(k);
             }
         } else {
-            for r in 0..n {
-                if same(r) {
-                    continue;
-                }
-                if let Some((a, b)) = self.ends(rows, r) {
+            for g in 0..self.groups.len() {
+                if let Some((a, b)) = self.ends(rows, self.groups[g].0) {
                     let (ra, rb) = (self.find(a), self.find(b));
                     if ra != rb {
                         self.parent[ra.max(rb)] = ra.min(rb);
                     }
                 }
             }
-            for r in 0..n {
-                self.key[r] = if same(r) {
-                    self.key[r - 1]
-                } else {
-                    match self.ends(rows, r) {
-                        Some((a, _)) => self.find(a),
-                        None => usize::MAX,
-                    }
+            for g in 0..self.groups.len() {
+                let k = match self.ends(rows, self.groups[g].0) {
+                    Some((a, _)) => self.find(a),
+                    None => usize::MAX,
                 };
+                self.gkey.push(k);
             }
         }
-        // runs of consecutive rows with one key, then grouped by key (stable:
-        // row order within an island)
+        // runs of consecutive rows with one key (whole groups), then grouped
+        // by key (stable: row order within an island)
         self.runs.clear();
-        let mut r = 0;
-        while r < n {
-            let k = self.key[r];
-            let s = r;
-            while r < n && self.key[r] == k {
-                r += 1;
+        let mut g = 0;
+        while g < self.groups.len() {
+            let k = self.gkey[g];
+            let s = self.groups[g].0;
+            while g < self.groups.len() && self.gkey[g] == k {
+                g += 1;
             }
-            self.runs.push((k, s, r));
+            self.runs.push((k, s, self.groups[g - 1].1));
         }
         self.runs.sort_unstable_by_key(|&(k, s, _)| (k, s));
         // each island's runs and dofs
@@ -214,11 +224,13 @@ impl Islands {
             let (mut lo, mut hi) = (usize::MAX, 0);
             while i < self.runs.len() && self.runs[i].0 == k {
                 let (_, s, e) = self.runs[i];
-                for q in s..e {
-                    if q > s && rows.path[q] == rows.path[q - 1] {
-                        continue;
-                    }
-                    let (ps, pl) = rows.path[q];
+                // the run's groups (a run starts a group), one path each
+                let mut g = self.group_at[s];
+                while let Some(&(q, _)) = self.groups.get(g)
+                    && q < e
+                {
+                    g += 1;
+                    let (ps, pl) = path[q];
                     let p = table.get(ps..ps + pl).unwrap_or(&[]);
                     // a path is closed under dof parents (a dof's path to the
                     // root, a union of two, or every dof), and so are the
