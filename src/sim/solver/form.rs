@@ -104,7 +104,7 @@ impl Rows {
             return false;
         }
         // a chain path (one body's: every contact of a robot on the ground)
-        // of up to 12 dofs: in registers, no scratch
+        // of up to 13 dofs (a humanoid's foot): in registers, no scratch
         let done = match pl {
             2 => self.form_chain::<2>(f, r, path, vfree),
             3 => self.form_chain::<3>(f, r, path, vfree),
@@ -117,6 +117,7 @@ impl Rows {
             10 => self.form_chain::<10>(f, r, path, vfree),
             11 => self.form_chain::<11>(f, r, path, vfree),
             12 => self.form_chain::<12>(f, r, path, vfree),
+            13 => self.form_chain::<13>(f, r, path, vfree),
             _ => false,
         };
         // two free bodies' chains (6 + 6: a pile's contacts between bodies)
