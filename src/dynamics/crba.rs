@@ -327,7 +327,10 @@ pub(crate) fn crba_packed<T: Scalar>(
     let nv = model.nv;
     let fits = start.len() >= nv
         && len.len() >= nv
-        && (0..nv).all(|k| len[k] >= 1 && start[k] + len[k] <= out.len());
+        && start[..nv]
+            .iter()
+            .zip(&len[..nv])
+            .fold(true, |ok, (&s, &l)| ok & (l >= 1) & (s + l <= out.len()));
     if model.has_mimic || !model.topology.crba_local || !fits || (!placed && q.len() != model.nq) {
         return false;
     }
@@ -341,6 +344,14 @@ pub(crate) fn crba_packed<T: Scalar>(
         let (Some(&s), Some(&l0)) = (start.get(c), len.get(k0)) else {
             return;
         };
+        // a 1-dof joint's row (vals' length known where the pass is
+        // compiled per joint model): its one entry, no run to cut
+        if let [v] = vals {
+            if let (true, Some(x)) = (c >= k0, out.get_mut(s + l0 - 1)) {
+                *x = *v;
+            }
+            return;
+        }
         let n = vals.len().min((c + 1).saturating_sub(k0));
         debug_assert!((0..n).all(|r| len[k0 + r] == l0 + r));
         let Some(x) = out.get_mut(s + l0 - 1..s + l0 - 1 + n) else {
@@ -472,27 +483,36 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, &[T])>(
                 fc[k0 + c] = jm.mul_subspace(&ici, c);
             }
             let fsub = &mut fc[k0..end];
-            // H[k0 + r, c] = S_rᵀ F_c for every coordinate c of the subtree
-            // (docs/theory.md §"Joint-force projection") and its mirror H[c, k0 + r].
             assert!(k0 + jm.nv() <= end && end <= nv, "subtree coordinates out of range");
             let nr = jm.nv();
-            for (dc, f) in fsub.iter().enumerate() {
-                let mut vals = [T::zero(); 6];
-                for (r, x) in vals[..nr].iter_mut().enumerate() {
-                    *x = jm.project_column(r, f);
-                }
-                write(k0, k0 + dc, &vals[..nr]);
+            // H[k0 + r, c] = S_rᵀ F_c for every coordinate c of the subtree
+            // (docs/theory.md §"Joint-force projection"; its mirror H[c, k0 + r])
+            // (a macro, not a closure: inlined at each of its three sweeps)
+            macro_rules! project {
+                ($dc:expr, $f:expr) => {{
+                    let mut vals = [T::zero(); 6];
+                    for (r, x) in vals[..nr].iter_mut().enumerate() {
+                        *x = jm.project_column(r, $f);
+                    }
+                    write(k0, k0 + $dc, &vals[..nr]);
+                }};
             }
-            if p != 0 {
-                // The subtree's forces to the parent frame: ᵖX̂ᵢ* F
-                let ax = jm.rot_axis();
+            // each force projected, then (p ≠ 0) moved to the parent frame,
+            // ᵖX̂ᵢ* F, in the same sweep (each force's arithmetic as before)
+            let ax = jm.rot_axis();
+            if p == 0 {
+                for (dc, f) in fsub.iter().enumerate() {
+                    project!(dc, f);
+                }
+            } else {
                 // I^c_p += ₚX̂ᵢ* I^c_i ⁱX̂ₚ
                 let moved = match ax {
                     // a joint frame at its parent's origin (a body's second and
                     // later joints in MJCF): the moves are rotations alone
                     // (exact: `Model::placement_zero_trans`)
                     Some(ax) if exact && zt[i] => {
-                        for f in fsub.iter_mut() {
+                        for (dc, f) in fsub.iter_mut().enumerate() {
+                            project!(dc, f);
                             *f = Force {
                                 ang: ax.rot_mul(&li.rot, &f.ang),
                                 lin: ax.rot_mul(&li.rot, &f.lin),
@@ -501,7 +521,8 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, &[T])>(
                         ici.rotate_ax(&li.rot, &ax)
                     }
                     _ => {
-                        for f in fsub.iter_mut() {
+                        for (dc, f) in fsub.iter_mut().enumerate() {
+                            project!(dc, f);
                             *f = act_force_ax(&li, ax, f);
                         }
                         ici.act_ax(&li, ax)
@@ -515,7 +536,10 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, &[T])>(
             }
             li
         });
-        li_m_i[i] = li;
+        // (PLACED: read from there, nothing to store)
+        if !PLACED {
+            li_m_i[i] = li;
+        }
     }
 }
 

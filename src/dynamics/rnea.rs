@@ -246,7 +246,10 @@ fn rnea_pass<
             }
             (li, vi, ai)
         });
-        li_m_i[i] = li;
+        // (K: read from there, nothing to store)
+        if !K {
+            li_m_i[i] = li;
+        }
         vel[i] = vi;
         acc[i] = ai;
         // docs/theory.md §"Force recursion" (own part):
