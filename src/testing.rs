@@ -164,6 +164,18 @@ pub mod contact {
         crate::contact::narrow::parry_points(a, b, wa, wb, margin, manifolds, workspace, raw)
     }
 
+    /// `contact::narrow::boxes::box_box`: the closed-form manifold of boxes
+    /// of half extents `ha`, `hb`, b at `a_m_b` in a's frame.
+    pub fn box_box(
+        ha: &Vector3<f64>,
+        hb: &Vector3<f64>,
+        a_m_b: &Se3<f64>,
+        margin: f64,
+        man: &mut ContactManifold<(), ()>,
+    ) -> bool {
+        crate::contact::narrow::boxes::box_box(ha, hb, &a_m_b.rot, &a_m_b.trans, margin, man)
+    }
+
     /// `Round::of`.
     pub fn round_of(s: &PairShape, w: &Se3<f64>) -> Option<Round> {
         Round::of(s, w)

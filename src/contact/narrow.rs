@@ -1,6 +1,7 @@
 //! The narrow phase of one pair of shapes: a hull on a flat face by the face
 //! path ([`super::face`]), two spheres or capsules in closed form
-//! ([`prim`]), everything else by parry's contact manifolds, and
+//! ([`prim`]), two boxes by parry's box–box manifold redone without parry
+//! ([`boxes`]), everything else by parry's contact manifolds, and
 //! the reduction of the points found to a persistent patch of at most
 //! `max_points_per_shape`.
 
@@ -16,6 +17,7 @@ use parry3d_f64::query::{
 };
 use parry3d_f64::shape::ShapeType;
 
+pub(crate) mod boxes;
 pub(crate) mod prim;
 
 /// The key bit of a face-path point (its vertex index below it): never a key
@@ -75,6 +77,27 @@ pub(crate) fn parry_points(
     if prim::round_points(a, b, wa, wb, margin, raw) {
         manifolds.clear();
         *workspace = None;
+        return;
+    }
+    // two boxes: the closed form (`boxes`), parry's manifold without parry
+    if let (Some(ha), Some(hb)) = (&a.cuboid, &b.cuboid) {
+        // b in a's frame: (R, t) = wa⁻¹ wb
+        let a_m_b = wa.inverse().compose(wb);
+        let (r, t) = (&a_m_b.rot, &a_m_b.trans);
+        raw.clear();
+        if manifolds.len() != 1 {
+            manifolds.clear();
+            manifolds.push(ContactManifold::new());
+            *workspace = None;
+        }
+        let man = &mut manifolds[0];
+        // a resting pair keeps its points (as parry's reuse below), else
+        // the separating axes and the faces' clip
+        if boxes::reuse(man, r, t, REUSE_COS, REUSE_SLIDE * REUSE_SLIDE)
+            || boxes::box_box(ha, hb, r, t, margin, man)
+        {
+            push_points(&manifolds[..], wa, wb, margin, f64::INFINITY, raw);
+        }
         return;
     }
     let dispatcher = DefaultQueryDispatcher;

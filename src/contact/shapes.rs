@@ -39,6 +39,9 @@ pub struct PairShape {
     /// A sphere's or capsule's axis ends in parry's frame of it (equal for a
     /// sphere) and radius: the closed-form pairs' (`narrow::prim`).
     pub round: Option<(Vector3<f64>, Vector3<f64>, f64)>,
+    /// A box's half extents in parry's frame of it (the closed-form
+    /// box–box pairs', `narrow::boxes`).
+    pub cuboid: Option<Vector3<f64>>,
 }
 
 impl PairShape {
@@ -53,8 +56,10 @@ impl PairShape {
                 .as_capsule()
                 .map(|c| (from_pvec(c.segment.a), from_pvec(c.segment.b), c.radius))
         };
+        let cuboid = shape.as_cuboid().map(|c| from_pvec(c.half_extents));
         Self {
             round,
+            cuboid,
             mid: from_pvec(b.center()),
             half: from_pvec(b.half_extents()),
             shape,
