@@ -306,21 +306,30 @@ impl MassFactor {
     /// entries are not all there.
     #[inline(always)]
     fn chain_elim<const N: usize>(&self, path: &[usize], w: &mut [[f64; 4]; N]) -> bool {
-        let Some(path) = path.get(..N) else {
+        let Some(path) = path.get(..N).filter(|_| N <= 16) else {
             return false;
         };
-        for t in (1..N).rev() {
-            let a = w[t];
-            let s = self.start[path[t]];
-            let Some(anc) = self.anc.get(s..s + t) else {
-                return false;
-            };
-            for (wj, &l) in w.iter_mut().zip(anc) {
-                for (x, &ai) in wj.iter_mut().zip(&a) {
-                    *x -= l * ai;
+        // the step at each t from the leaf in, t a constant (the loop written
+        // out: each step's loop over y[..t] unrolled, no loop over t)
+        macro_rules! steps {
+            ($($t:literal)*) => {$(
+                if $t < N {
+                    let (Some(&a), Some(&d)) = (w.get($t), path.get($t)) else {
+                        return false;
+                    };
+                    let s = self.start[d];
+                    let Some(anc) = self.anc.get(s..s + $t) else {
+                        return false;
+                    };
+                    for (wj, &l) in w.iter_mut().zip(anc) {
+                        for (x, &ai) in wj.iter_mut().zip(&a) {
+                            *x -= l * ai;
+                        }
+                    }
                 }
-            }
+            )*};
         }
+        steps!(15 14 13 12 11 10 9 8 7 6 5 4 3 2 1);
         for (wt, &k) in w.iter_mut().zip(path) {
             let d = self.inv_sqrt_d[k];
             for x in wt.iter_mut() {
