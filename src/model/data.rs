@@ -18,6 +18,11 @@ pub struct Data<T: Scalar = f64> {
     /// forward kinematics' placements (the simulation's bias and CRBA) read
     /// it instead of re-deriving it per body and pass.
     pub(crate) dispatch: Vec<(super::joint::Dispatch<T>, T, T)>,
+    /// `k k` for `k = u*` of each body whose joint is revolute about an
+    /// oblique unit axis `u` (`Dispatch::RevU`; zero for the others): the
+    /// square in Rodrigues' `1 + k s + k² (1 − c)` made once, for forward
+    /// kinematics on this model's own workspace (`forward_kinematics_pass`).
+    pub(crate) axis_k2: Vec<Matrix3<T>>,
     /// `oMf`: every URDF link frame in the world.
     pub o_m_f: Vec<Se3<T>>,
     /// Spatial velocity of each body (body frame).
@@ -302,6 +307,16 @@ impl<T: Scalar> Data<T> {
             dispatch: model.joints[..nb]
                 .iter()
                 .map(super::joint::dispatch_of)
+                .collect(),
+            axis_k2: model.joints[..nb]
+                .iter()
+                .map(|j| match super::joint::dispatch_of(j).0 {
+                    super::joint::Dispatch::RevU(u) => {
+                        let k = crate::spatial::skew(&u);
+                        k * k
+                    }
+                    _ => Matrix3::zeros(),
+                })
                 .collect(),
             o_m_f: vec![Se3::identity(); model.frames.len()],
             v: vec![Motion::zero(); nb],
