@@ -23,6 +23,10 @@ pub struct Data<T: Scalar = f64> {
     /// square in Rodrigues' `1 + k s + k² (1 − c)` made once, for forward
     /// kinematics on this model's own workspace (`forward_kinematics_pass`).
     pub(crate) axis_k2: Vec<Matrix3<T>>,
+    /// Whether each body's inertia is exactly zero ([`crate::spatial::Inertia::is_zero`]
+    /// of the model this workspace was made for): the simulation's bias pass
+    /// leaves such a body's own force out.
+    pub(crate) massless: Vec<bool>,
     /// `oMf`: every URDF link frame in the world.
     pub o_m_f: Vec<Se3<T>>,
     /// Spatial velocity of each body (body frame).
@@ -318,6 +322,7 @@ impl<T: Scalar> Data<T> {
                     _ => Matrix3::zeros(),
                 })
                 .collect(),
+            massless: model.inertias[..nb].iter().map(|i| i.is_zero()).collect(),
             o_m_f: vec![Se3::identity(); model.frames.len()],
             v: vec![Motion::zero(); nb],
             a: vec![Motion::zero(); nb],
