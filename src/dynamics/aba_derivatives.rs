@@ -49,7 +49,7 @@ pub fn aba_derivatives<T: Scalar>(
     // the wrenches onto their bodies at this q (forward kinematics first)
     let mut fb = std::mem::take(&mut data.deriv_fext);
     if let Some(ws) = fext {
-        super::forward_kinematics_pass(model, data, q);
+        super::forward_kinematics_unkeyed(model, data, q);
         fb.fill(Force::zero());
         for w in ws {
             super::add_link_wrench(model, data, w.frame, &w.force, &w.torque, &mut fb)?;

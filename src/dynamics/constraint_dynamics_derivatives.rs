@@ -56,7 +56,7 @@ pub fn constraint_dynamics_derivatives(
     let fext = fext.filter(|w| !w.is_empty());
     let mut fb = std::mem::take(&mut data.deriv_fext);
     if let Some(ws) = fext {
-        super::forward_kinematics_pass(model, data, q);
+        super::forward_kinematics_unkeyed(model, data, q);
         fb.fill(Force::zero());
         for w in ws {
             if let Err(e) =

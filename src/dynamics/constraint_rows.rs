@@ -144,7 +144,7 @@ pub fn constraint_jacobian(
     check_sizes(model, q, &[], None)?;
     DimensionError::check("constraint jacobian rows", constraints.rows(), out.nrows())?;
     DimensionError::check("constraint jacobian columns", model.nv, out.ncols())?;
-    super::forward_kinematics_pass(model, data, q);
+    super::forward_kinematics_unkeyed(model, data, q);
     jacobian_rows(model, data, constraints, out);
     Ok(())
 }
@@ -160,7 +160,7 @@ pub fn constraint_violation(
 ) -> Result<(), DynamicsError> {
     check_sizes(model, q, &[], None)?;
     DimensionError::check("violation entries", constraints.items.len(), out.len())?;
-    super::forward_kinematics_pass(model, data, q);
+    super::forward_kinematics_unkeyed(model, data, q);
     constraints.violation(data, q.as_slice(), out);
     Ok(())
 }

@@ -336,25 +336,81 @@ pub(crate) fn crba_packed<T: Scalar>(
     }
     // (fits: both hold nv entries; sliced so that an index below nv needs no test)
     let (start, len) = (&start[..nv], &len[..nv]);
-    let write = |k0: usize, c: usize, vals: &[T]| {
-        // column c's entries start at start[c]; row k0 + r (an ancestor-or-self
-        // of c, a joint's coordinates one chain: depth len[k0] − 1 + r) sits at
-        // start[c] + len[k0] − 1 + r. The upper triangle (row ≤ c) only: the
-        // entries the factor reads, the lower ones their mirror
-        let (Some(&s), Some(&l0)) = (start.get(c), len.get(k0)) else {
+    let sink = PackedSink {
+        out,
+        start,
+        len,
+        l0: 1,
+        starts: &[],
+    };
+    let all = [(1, model.nbodies)];
+    let bodies = bodies.unwrap_or(&all);
+    if bodies.iter().any(|&(b0, b1)| b0 < 1 || b1 > model.nbodies) {
+        return false;
+    }
+    if placed {
+        local_pass::<T, true, _>(model, data, &[], bodies, sink);
+    } else {
+        local_pass::<T, false, _>(model, data, q, bodies, sink);
+    }
+    true
+}
+
+/// Where the local-frame pass puts H's entries: per body, [`RowSink::begin`]
+/// with its joint's first coordinate and the number of its subtree's
+/// coordinates (the per-body lookups done once there: the joint's depth, its
+/// columns' starts), then [`RowSink::put`] per column.
+trait RowSink<T> {
+    /// The joint of first coordinate `k0` whose subtree's coordinates are
+    /// `k0..k0 + n` (the caller's promise: `k0 + n ≤ nv`).
+    fn begin(&mut self, k0: usize, n: usize);
+    /// `H[k0 + r, k0 + dc] = vals[r]` (dc < n, `vals` the joint's rows: k0 +
+    /// vals.len() ≤ k0 + n).
+    fn put(&mut self, dc: usize, vals: &[T]);
+}
+
+/// [`crba_packed`]'s storage: `H[i, k]` for i an ancestor-or-self of k at
+/// `out[start[k] + len[i] − 1]`, the upper triangle only (row ≤ column: the
+/// entries the factor reads, the lower ones their mirror).
+struct PackedSink<'a, T> {
+    out: &'a mut [T],
+    start: &'a [usize],
+    len: &'a [usize],
+    /// The current joint's depth, len[k0] (≥ 1: `fits`).
+    l0: usize,
+    /// The current joint's columns' starts, start[k0..k0 + n].
+    starts: &'a [usize],
+}
+
+impl<'a, T: Scalar> RowSink<T> for PackedSink<'a, T> {
+    #[inline(always)]
+    fn begin(&mut self, k0: usize, n: usize) {
+        // (out of range: no column, every put a no-op)
+        let (len, start): (&'a [usize], &'a [usize]) = (self.len, self.start);
+        (self.l0, self.starts) = match (len.get(k0), start.get(k0..k0 + n)) {
+            (Some(&l0), Some(starts)) => (l0, starts),
+            _ => (1, &[][..]),
+        };
+    }
+    #[inline(always)]
+    fn put(&mut self, dc: usize, vals: &[T]) {
+        // column c = k0 + dc's entries start at start[c]; row k0 + r (an
+        // ancestor-or-self of c, a joint's coordinates one chain: depth
+        // len[k0] − 1 + r) sits at start[c] + len[k0] − 1 + r
+        let (Some(&s), l0) = (self.starts.get(dc), self.l0) else {
             return;
         };
         // a 1-dof joint's row (vals' length known where the pass is
         // compiled per joint model): its one entry, no run to cut
         if let [v] = vals {
-            if let (true, Some(x)) = (c >= k0, out.get_mut(s + l0 - 1)) {
+            if let Some(x) = self.out.get_mut(s + l0 - 1) {
                 *x = *v;
             }
             return;
         }
-        let n = vals.len().min((c + 1).saturating_sub(k0));
-        debug_assert!((0..n).all(|r| len[k0 + r] == l0 + r));
-        let Some(x) = out.get_mut(s + l0 - 1..s + l0 - 1 + n) else {
+        // rows k0 + r ≤ c only
+        let n = vals.len().min(dc + 1);
+        let Some(x) = self.out.get_mut(s + l0 - 1..s + l0 - 1 + n) else {
             return;
         };
         // (the common lengths with constant bounds: no call to memcpy)
@@ -363,18 +419,49 @@ pub(crate) fn crba_packed<T: Scalar>(
             (x @ [_, _, _, _, _, _], v @ [_, _, _, _, _, _]) => x.copy_from_slice(v),
             (x, v) => x.copy_from_slice(v),
         }
-    };
-    let all = [(1, model.nbodies)];
-    let bodies = bodies.unwrap_or(&all);
-    if bodies.iter().any(|&(b0, b1)| b0 < 1 || b1 > model.nbodies) {
-        return false;
     }
-    if placed {
-        local_pass::<T, true, _>(model, data, &[], bodies, write);
-    } else {
-        local_pass::<T, false, _>(model, data, q, bodies, write);
+}
+
+/// [`crba_local_pass`]'s storage: both triangles of the nv x nv `H` (and with
+/// `FACTOR` the upper one of the factor's matrix), by raw pointers.
+struct DenseSink<T, const FACTOR: bool> {
+    hp: *mut T,
+    up: *mut T,
+    nv: usize,
+    /// The current joint's first coordinate and subtree size.
+    k0: usize,
+    n: usize,
+}
+
+impl<T: Scalar, const FACTOR: bool> RowSink<T> for DenseSink<T, FACTOR> {
+    #[inline(always)]
+    fn begin(&mut self, k0: usize, n: usize) {
+        assert!(k0 + n <= self.nv, "subtree coordinates out of range");
+        (self.k0, self.n) = (k0, n);
     }
-    true
+    #[inline(always)]
+    fn put(&mut self, dc: usize, vals: &[T]) {
+        let (hp, up, nv, k0) = (self.hp, self.up, self.nv, self.k0);
+        assert!(dc < self.n && vals.len() <= self.n, "rows out of range");
+        let c = k0 + dc;
+        for (r, &val) in vals.iter().enumerate() {
+            let row = k0 + r;
+            // SAFETY: row < nv and c < nv (asserted here and in begin: dc <
+            // n, vals.len() ≤ n, k0 + n ≤ nv), so both row + c nv and c + row
+            // nv are < nv² ≤ the length of H's storage (asserted by
+            // crba_local_pass), and of the factor's with FACTOR (asserted
+            // there); both outlive the pass.
+            unsafe {
+                *hp.add(row + c * nv) = val;
+                *hp.add(c + row * nv) = val;
+                if FACTOR {
+                    // row is a coordinate of an ancestor-or-self of c's
+                    // joint: row ≤ c, the upper triangle
+                    *up.add(row + c * nv) = val;
+                }
+            }
+        }
+    }
 }
 
 /// The local-frame pass into `data.h` (both triangles); `PLACED`:
@@ -400,24 +487,14 @@ fn crba_local_pass<T: Scalar, const PLACED: bool, const FACTOR: bool>(
     assert!(!FACTOR || us.len() >= nv * nv, "the factor is nv x nv");
     let up = us.as_mut_ptr();
     let all = [(1, model.nbodies)];
-    local_pass::<T, PLACED, _>(model, data, q, &all, move |k0, c, vals| {
-        for (r, &val) in vals.iter().enumerate() {
-            let row = k0 + r;
-            // SAFETY: row < nv and c < nv (local_pass asserts it before every
-            // write: k0 + vals.len() ≤ nv), so both row + c nv and c + row nv
-            // are < nv² ≤ the length of `hs` (asserted above), and of `us` with
-            // FACTOR (asserted above); both outlive the pass.
-            unsafe {
-                *hp.add(row + c * nv) = val;
-                *hp.add(c + row * nv) = val;
-                if FACTOR {
-                    // row is a coordinate of an ancestor-or-self of c's joint:
-                    // row ≤ c, the upper triangle
-                    *up.add(row + c * nv) = val;
-                }
-            }
-        }
-    });
+    let sink = DenseSink::<T, FACTOR> {
+        hp,
+        up,
+        nv,
+        k0: 0,
+        n: 0,
+    };
+    local_pass::<T, PLACED, _>(model, data, q, &all, sink);
     data.h = h;
     if FACTOR {
         data.chol = u;
@@ -426,17 +503,17 @@ fn crba_local_pass<T: Scalar, const PLACED: bool, const FACTOR: bool>(
 
 /// The local-frame pass: every entry `H[row, c]` on the tree pattern (row a
 /// coordinate of a joint, c one of its subtree's; row < nv, c < nv) given to
-/// `write`, a joint's rows of column c at once (`write(k0, c, vals)`: `H[k0 + r,
-/// c] = vals[r]`, k0 + vals.len() ≤ nv; the entries off the pattern are zero
-/// and never given), over the
-/// bodies of `bodies` (ranges `[b0, b1)` in 1..nb, each whole subtrees of the
-/// world: every tree's bodies, or some trees' of a forest).
-fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, &[T])>(
+/// `sink`, a joint's rows of one column at once ([`RowSink::put`], after
+/// [`RowSink::begin`] for the body; the entries off the pattern are zero and
+/// never given),
+/// over the bodies of `bodies` (ranges `[b0, b1)` in 1..nb, each whole
+/// subtrees of the world: every tree's bodies, or some trees' of a forest).
+fn local_pass<T: Scalar, const PLACED: bool, W: RowSink<T>>(
     model: &Model<T>,
     data: &mut Data<T>,
     q: &[T],
     bodies: &[(usize, usize)],
-    mut write: W,
+    mut sink: W,
 ) {
     let nb = model.nbodies;
     let nv = model.nv;
@@ -466,7 +543,11 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, &[T])>(
         let mut ici = tail[0];
         if carry_to == i {
             ici.add_assign(&carry);
-            tail[0] = ici;
+            // (PLACED, the simulation's: body i's composite inertia is read
+            // nowhere after this, not stored back)
+            if !PLACED {
+                tail[0] = ici;
+            }
         }
         carry_to = 0;
         let key = if PLACED {
@@ -487,6 +568,7 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, &[T])>(
             let nr = jm.nv();
             // H[k0 + r, c] = S_rᵀ F_c for every coordinate c of the subtree
             // (docs/theory.md §"Joint-force projection"; its mirror H[c, k0 + r])
+            sink.begin(k0, end - k0);
             // (a macro, not a closure: inlined at each of its three sweeps)
             macro_rules! project {
                 ($dc:expr, $f:expr) => {{
@@ -494,7 +576,7 @@ fn local_pass<T: Scalar, const PLACED: bool, W: FnMut(usize, usize, &[T])>(
                     for (r, x) in vals[..nr].iter_mut().enumerate() {
                         *x = jm.project_column(r, $f);
                     }
-                    write(k0, k0 + $dc, &vals[..nr]);
+                    sink.put($dc, &vals[..nr]);
                 }};
             }
             // each force projected, then (p ≠ 0) moved to the parent frame,

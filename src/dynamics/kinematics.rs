@@ -1,5 +1,7 @@
-use crate::model::{dispatch_joint, Data, FrameId, JointModel, Model, NameError};
-use crate::spatial::{Scalar, Se3};
+use crate::model::joint::{dispatch_of, Dispatch};
+use crate::model::{dispatch_keyed, Data, FrameId, JointModel, Model, NameError};
+use crate::spatial::ops::mat_mat;
+use crate::spatial::{rodrigues, sin_cos, skew, Scalar, Se3};
 use nalgebra::DVector;
 
 /// Forward kinematics of every body: `liMi = X_tree,i · X_J(q_i)` and
@@ -11,33 +13,78 @@ pub fn forward_kinematics<T: Scalar>(
     q: &DVector<T>,
 ) -> Result<(), super::DynamicsError> {
     super::check_sizes(model, q, &[], None)?;
-    forward_kinematics_pass(model, data, q);
+    forward_kinematics_unkeyed(model, data, q);
     Ok(())
 }
 
 /// [`forward_kinematics`] for callers whose `q` has nq entries by construction
-/// (the simulation's own state).
+/// and whose `data` was made by [`Data::new`] for this very model (the
+/// simulation's own state and workspace): each joint's dispatch and an oblique
+/// revolute axis's `k k` are read from `data` ([`Data::axis_k2`]) instead of
+/// re-derived per body.
 pub(crate) fn forward_kinematics_pass<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,
     q: &DVector<T>,
 ) {
+    fk_pass::<T, true>(model, data, q);
+}
+
+/// [`forward_kinematics`] for callers whose `q` has nq entries by construction
+/// and whose `data` may have been made for another model of the same size
+/// (the public entry points': each joint's dispatch derived from the model).
+pub(crate) fn forward_kinematics_unkeyed<T: Scalar>(
+    model: &Model<T>,
+    data: &mut Data<T>,
+    q: &DVector<T>,
+) {
+    fk_pass::<T, false>(model, data, q);
+}
+
+/// Forward kinematics; `KEYED`: the joints' dispatch and `k k` from `data`.
+#[inline(always)]
+fn fk_pass<T: Scalar, const KEYED: bool>(model: &Model<T>, data: &mut Data<T>, q: &DVector<T>) {
     let nb = model.nbodies;
     let q = q.as_slice();
     let joints = &model.joints[..nb];
     let parent = &model.parent[..nb];
     let placements = &model.placements[..nb];
     let ident = &model.placement_identity[..nb];
+    let keys = if KEYED { &data.dispatch[..nb] } else { &[] };
+    let k2s = if KEYED { &data.axis_k2[..nb] } else { &[] };
     let li_m_i = &mut data.li_m_i[..nb];
     let o_m_i = &mut data.o_m_i[..nb];
     for i in 1..nb {
         let op = o_m_i[parent[i]];
-        // The joint kind matched once per body (dispatch_joint!).
-        let (li, om) = dispatch_joint!(&joints[i], ident[i], jm => {
-            let li = jm.placement(&placements[i], q);
-            let om = jm.world_pose(&op, &li);
-            (li, om)
-        });
+        let key = if KEYED {
+            keys[i]
+        } else {
+            dispatch_of(&joints[i])
+        };
+        // The joint kind matched once per body (dispatch_keyed!).
+        let (li, om) = match key {
+            // a revolute joint about an oblique axis u: `λ(i)Mi`'s rotation
+            // `X_tree.rot · R`, R = 1 + k s + k² (1 − c) (`Axis::rotate_right`,
+            // `k k` made once). With an identity placement rotation the product
+            // is R itself, bit for bit: its entry (r, c) is R[r][c] plus two
+            // products of an exact zero with finite entries of R (or NaN with
+            // NaN ones), which changes R[r][c] only if R[r][c] is −0; and no
+            // entry of R is −0: each is 1 or +0 plus k s, then plus k² (1 − c),
+            // and a sum whose first term is not −0 is not −0.
+            (Dispatch::RevU(u), mult, off) if KEYED => {
+                let (s, c) = sin_cos(mult * q[joints[i].iq] + off);
+                let r = rodrigues(&skew(&u), &k2s[i], s, c);
+                let xt = &placements[i];
+                let rot = if ident[i] { r } else { mat_mat(&xt.rot, &r) };
+                let li = Se3::new(rot, xt.trans);
+                (li, op.compose(&li))
+            }
+            key => dispatch_keyed!(&joints[i], key, ident[i], jm => {
+                let li = jm.placement(&placements[i], q);
+                let om = jm.world_pose(&op, &li);
+                (li, om)
+            }),
+        };
         li_m_i[i] = li;
         o_m_i[i] = om;
     }

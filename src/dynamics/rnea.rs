@@ -3,7 +3,7 @@ use super::{check_sizes, DynamicsError};
 use crate::model::joint::dispatch_of;
 use crate::model::{dispatch_keyed, Axis, Data, JointModel, Model};
 use crate::spatial::ops::add_cross;
-use crate::spatial::{Force, Inertia, Motion, Scalar, Se3};
+use crate::spatial::{Force, Motion, Scalar, Se3};
 use nalgebra::DVector;
 
 /// Recursive Newton–Euler inverse dynamics (docs/theory.md §"Recursive Newton–Euler"):
@@ -204,8 +204,10 @@ fn rnea_pass<
     let ident = &model.placement_identity[..nb];
     let zt = &model.placement_zero_trans[..nb];
     let inertias = &model.inertias[..nb];
-    // (K: each joint's dispatch as `data` holds it for the model, made once)
+    // (K: each joint's dispatch as `data` holds it for the model, made once;
+    // likewise whether each body is massless)
     let keys = if K { &data.dispatch[..nb] } else { &[] };
+    let massless = if K { &data.massless[..nb] } else { &[] };
     let li_m_i = &mut data.li_m_i[..nb];
     let o_m_i = &mut data.o_m_i[..nb];
     let vel = &mut data.v[..nb];
@@ -258,7 +260,7 @@ fn rnea_pass<
         // (the bias pass: a massless body's own force is zero, its products
         // with the zero inertia left out)
         let mut fi = Force::zero();
-        if !(K && exact && massless(inertia)) {
+        if !(K && exact && massless[i]) {
             fi = inertia.mul_motion(&ai);
             if V {
                 let hi = inertia.mul_motion(&vi);
@@ -365,17 +367,4 @@ pub(crate) fn act_force_ax<T: Scalar>(m: &Se3<T>, ax: Option<Axis<T>>, f: &Force
             }
         }
     }
-}
-
-/// Whether a body's inertia is exactly zero (mass, centre of mass and
-/// rotational inertia): its own force `Î a + v ×* Î v` is then zero (each
-/// term a product with a zero; at most a zero's sign differs).
-#[inline(always)]
-fn massless<T: Scalar>(i: &Inertia<T>) -> bool {
-    // (the mass first; then the twelve others' tests folded without early
-    // exit: compared side by side, no branch an entry)
-    let z = T::zero();
-    i.mass == z
-        && i.com.iter().fold(true, |all, x| all & (*x == z))
-            & i.inertia_c.iter().fold(true, |all, x| all & (*x == z))
 }

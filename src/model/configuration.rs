@@ -32,8 +32,15 @@ fn coordinate_joints(model: &Model) -> impl Iterator<Item = (JointKind, usize, u
 /// quaternion likewise; a planar joint's (x, y) += h R(θ) (vx, vy), θ += h ω;
 /// 1-DoF joints += h v.
 pub fn integrate_config(model: &Model, q: &mut DVector<f64>, v: &DVector<f64>, h: f64) {
-    for (kind, iq, iv) in coordinate_joints(model) {
-        match kind {
+    // (the joints of `coordinate_joints` in its order, each kind matched by
+    // reference and a 1-DoF joint's entry through slices: no copy of a kind,
+    // no matrix index an entry)
+    for f in &model.free_joints {
+        integrate_free(q, v, h, f.iq, f.iv);
+    }
+    for d in &model.dofs {
+        let (iq, iv) = (d.iq, d.iv);
+        match &d.kind {
             JointKind::Free => integrate_free(q, v, h, iq, iv),
             JointKind::Spherical => integrate_quat(q, v, h, iq, iv),
             JointKind::Planar => {
@@ -43,7 +50,7 @@ pub fn integrate_config(model: &Model, q: &mut DVector<f64>, v: &DVector<f64>, h
                 q[iq + 1] += h * (s * vx + c * vy);
                 q[iq + 2] += h * v[iv + 2];
             }
-            _ => q[iq] += h * v[iv],
+            _ => q.as_mut_slice()[iq] += h * v.as_slice()[iv],
         }
     }
 }
@@ -83,11 +90,19 @@ fn integrate_quat(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize, iv:
 /// [`integrate_config`] this makes a semi-implicit step rotate the velocity
 /// exactly (no energy from the frame's own rotation).
 pub fn rotate_base_velocity(model: &Model, v: &mut DVector<f64>, w: &DVector<f64>, h: f64) {
-    for (kind, _, iv) in coordinate_joints(model) {
-        let (wv, n) = match kind {
-            JointKind::Free => (Vector3::new(w[iv + 3], w[iv + 4], w[iv + 5]) * h, 3),
-            JointKind::Planar => (Vector3::new(0.0, 0.0, w[iv + 2] * h), 2),
-            _ => continue,
+    // (the joints of `coordinate_joints` in its order, the kinds matched by
+    // reference: no copy of a 1-DoF joint's kind to skip it)
+    let frees = model.free_joints.iter().map(|f| (true, f.iv));
+    let others = model.dofs.iter().filter_map(|d| match &d.kind {
+        JointKind::Free => Some((true, d.iv)),
+        JointKind::Planar => Some((false, d.iv)),
+        _ => None,
+    });
+    for (free, iv) in frees.chain(others) {
+        let (wv, n) = if free {
+            (Vector3::new(w[iv + 3], w[iv + 4], w[iv + 5]) * h, 3)
+        } else {
+            (Vector3::new(0.0, 0.0, w[iv + 2] * h), 2)
         };
         let th = wv.norm();
         if th > 0.0 {

@@ -18,6 +18,15 @@ pub struct Data<T: Scalar = f64> {
     /// forward kinematics' placements (the simulation's bias and CRBA) read
     /// it instead of re-deriving it per body and pass.
     pub(crate) dispatch: Vec<(super::joint::Dispatch<T>, T, T)>,
+    /// `k k` for `k = u*` of each body whose joint is revolute about an
+    /// oblique unit axis `u` (`Dispatch::RevU`; zero for the others): the
+    /// square in Rodrigues' `1 + k s + k² (1 − c)` made once, for forward
+    /// kinematics on this model's own workspace (`forward_kinematics_pass`).
+    pub(crate) axis_k2: Vec<Matrix3<T>>,
+    /// Whether each body's inertia is exactly zero ([`crate::spatial::Inertia::is_zero`]
+    /// of the model this workspace was made for): the simulation's bias pass
+    /// leaves such a body's own force out.
+    pub(crate) massless: Vec<bool>,
     /// `oMf`: every URDF link frame in the world.
     pub o_m_f: Vec<Se3<T>>,
     /// Spatial velocity of each body (body frame).
@@ -303,6 +312,17 @@ impl<T: Scalar> Data<T> {
                 .iter()
                 .map(super::joint::dispatch_of)
                 .collect(),
+            axis_k2: model.joints[..nb]
+                .iter()
+                .map(|j| match super::joint::dispatch_of(j).0 {
+                    super::joint::Dispatch::RevU(u) => {
+                        let k = crate::spatial::skew(&u);
+                        k * k
+                    }
+                    _ => Matrix3::zeros(),
+                })
+                .collect(),
+            massless: model.inertias[..nb].iter().map(|i| i.is_zero()).collect(),
             o_m_f: vec![Se3::identity(); model.frames.len()],
             v: vec![Motion::zero(); nb],
             a: vec![Motion::zero(); nb],

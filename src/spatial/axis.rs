@@ -79,7 +79,7 @@ impl<T: Scalar> Axis<T> {
             Axis::Z => Matrix3::from_columns(&[mix(c0, c, c1, s), mix(c1, c, c0, -s), c2.into()]),
             Axis::Unit(u) => {
                 let k = super::skew(u);
-                mat_mat(m, &(Matrix3::identity() + k * s + k * k * (T::one() - c)))
+                mat_mat(m, &rodrigues(&k, &(k * k), s, c))
             }
         }
     }
@@ -203,6 +203,15 @@ impl<T: Scalar> Axis<T> {
             Axis::Unit(u) => mat_vec(m, u),
         }
     }
+}
+
+/// The rotation by `atan2(s, c)` about a unit axis `u` (Rodrigues, as
+/// [`super::axis_angle`]): `1 + k s + k² (1 − c)` for `k = u*` and `k2 = k k`
+/// (a joint's `k k` may be made once, `Data::axis_k2`: the same product, the
+/// same bits).
+#[inline(always)]
+pub(crate) fn rodrigues<T: Scalar>(k: &Matrix3<T>, k2: &Matrix3<T>, s: T, c: T) -> Matrix3<T> {
+    Matrix3::identity() + k * s + k2 * (T::one() - c)
 }
 
 /// `a x + b y` for two columns of a 3x3 matrix (an axis rotation mixing them).

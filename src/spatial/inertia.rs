@@ -52,6 +52,18 @@ impl<T: Scalar> Inertia<T> {
             lin,
         }
     }
+    /// Whether the inertia is exactly zero (mass, centre of mass and
+    /// rotational inertia): a body's own force `Î a + v ×* Î v` is then zero
+    /// (each term a product with a zero; at most a zero's sign differs).
+    #[inline(always)]
+    pub fn is_zero(&self) -> bool {
+        // (the mass first; then the twelve others' tests folded without early
+        // exit: compared side by side, no branch an entry)
+        let z = T::zero();
+        self.mass == z
+            && self.com.iter().fold(true, |all, x| all & (*x == z))
+                & self.inertia_c.iter().fold(true, |all, x| all & (*x == z))
+    }
     /// Kinetic energy `½ vᵀ Î v`.
     #[inline]
     pub fn kinetic_energy(&self, v: &Motion<T>) -> T {

@@ -20,7 +20,7 @@ pub mod ops;
 mod se3;
 
 pub use axis::Axis;
-pub(crate) use axis::{AxU, AxX, AxY, AxZ, AxisOf};
+pub(crate) use axis::{rodrigues, AxU, AxX, AxY, AxZ, AxisOf};
 pub use composite::CompositeInertia;
 pub use force::Force;
 pub use inertia::Inertia;
