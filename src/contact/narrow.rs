@@ -18,6 +18,7 @@ use parry3d_f64::query::{
 use parry3d_f64::shape::ShapeType;
 
 pub(crate) mod boxes;
+pub(crate) mod cylinder;
 pub(crate) mod prim;
 
 /// The key bit of a face-path point (its vertex index below it): never a key
@@ -99,6 +100,28 @@ pub(crate) fn parry_points(
             push_points(&manifolds[..], wa, wb, margin, f64::INFINITY, raw);
         }
         return;
+    }
+    // a cylinder on a box's face: the closed form where the face's normal
+    // is the exact one (`cylinder`), else parry below
+    let cyl_box = match (a.cylinder, &b.cuboid, &a.cuboid, b.cylinder) {
+        (Some(cy), Some(e), _, _) => Some((cy, e, true)),
+        (_, _, Some(e), Some(cy)) => Some((cy, e, false)),
+        _ => None,
+    };
+    if let Some((cy, e, cyl_is_a)) = cyl_box {
+        raw.clear();
+        if let Some(axis) = cylinder::cylinder_box_points(cy, e, cyl_is_a, wa, wb, margin, raw) {
+            // one manifold without points: its normal is the pair's axis
+            if manifolds.len() != 1 {
+                manifolds.clear();
+                manifolds.push(ContactManifold::new());
+                *workspace = None;
+            }
+            manifolds[0].points.clear();
+            manifolds[0].local_n1 = super::shapes::to_pvec(&axis);
+            return;
+        }
+        raw.clear();
     }
     let dispatcher = DefaultQueryDispatcher;
     let pos12 = to_pose(&wa.inverse().compose(wb));
