@@ -197,6 +197,27 @@ pub mod contact {
         }
     }
 
+    /// `contact::narrow::cylinder::cylinder_on_cylinder`: cylinders (half
+    /// height, radius) a and b, b at `a_m_b` in a's frame: None where the
+    /// closed form declines, else whether the cap is a's, the normal and the
+    /// points in that cylinder's frame (as [`cylinder_on_box`]), none when
+    /// apart.
+    #[allow(clippy::type_complexity)]
+    pub fn cylinder_on_cylinder(
+        ca: (f64, f64),
+        cb: (f64, f64),
+        a_m_b: &Se3<f64>,
+        margin: f64,
+    ) -> Option<(bool, Vector3<f64>, bool, Vec<(Vector3<f64>, f64, u64)>)> {
+        use crate::contact::narrow::cylinder::{cylinder_on_cylinder, CylBox, Pts, MAX_PTS};
+        let mut pts: Pts = ([(Vector3::zeros(), 0.0, 0); MAX_PTS], 0);
+        match cylinder_on_cylinder(ca, cb, a_m_b, margin, &mut pts) {
+            (CylBox::Other, _) => None,
+            (CylBox::Apart(n), on_a) => Some((on_a, n, true, Vec::new())),
+            (CylBox::Plane(n), on_a) => Some((on_a, n, false, pts.0[..pts.1].to_vec())),
+        }
+    }
+
     /// `Round::of`.
     pub fn round_of(s: &PairShape, w: &Se3<f64>) -> Option<Round> {
         Round::of(s, w)

@@ -101,28 +101,35 @@ pub(crate) fn parry_points(
         }
         return;
     }
-    // a cylinder on a box's face: the closed form where the face's normal
-    // is the exact one (`cylinder`), else parry below
-    let cyl_box = match (a.cylinder, &b.cuboid, &a.cuboid, b.cylinder) {
-        (Some(cy), Some(e), _, _) => Some((cy, e, true)),
-        (_, _, Some(e), Some(cy)) => Some((cy, e, false)),
+    // a cylinder on a box's face or on a cylinder's cap: the closed form
+    // where that plane is the exact contact (`cylinder`), else parry below
+    let closed = match (a.cylinder, &a.cuboid, b.cylinder, &b.cuboid) {
+        (Some(cy), _, _, Some(e)) => {
+            raw.clear();
+            cylinder::cylinder_box_points(cy, e, true, wa, wb, margin, raw)
+        }
+        (_, Some(e), Some(cy), _) => {
+            raw.clear();
+            cylinder::cylinder_box_points(cy, e, false, wa, wb, margin, raw)
+        }
+        (Some(ca), _, Some(cb), _) => {
+            raw.clear();
+            cylinder::cylinder_cylinder_points(ca, cb, wa, wb, margin, raw)
+        }
         _ => None,
     };
-    if let Some((cy, e, cyl_is_a)) = cyl_box {
-        raw.clear();
-        if let Some(axis) = cylinder::cylinder_box_points(cy, e, cyl_is_a, wa, wb, margin, raw) {
-            // one manifold without points: its normal is the pair's axis
-            if manifolds.len() != 1 {
-                manifolds.clear();
-                manifolds.push(ContactManifold::new());
-                *workspace = None;
-            }
-            manifolds[0].points.clear();
-            manifolds[0].local_n1 = super::shapes::to_pvec(&axis);
-            return;
+    if let Some(axis) = closed {
+        // one manifold without points: its normal is the pair's axis
+        if manifolds.len() != 1 {
+            manifolds.clear();
+            manifolds.push(ContactManifold::new());
+            *workspace = None;
         }
-        raw.clear();
+        manifolds[0].points.clear();
+        manifolds[0].local_n1 = super::shapes::to_pvec(&axis);
+        return;
     }
+    raw.clear();
     let dispatcher = DefaultQueryDispatcher;
     let pos12 = to_pose(&wa.inverse().compose(wb));
     let query = |manifolds: &mut Vec<ContactManifold<(), ()>>,

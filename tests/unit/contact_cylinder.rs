@@ -5,7 +5,8 @@
 //! and deepest gap (to EPA's tolerance), and, where parry's features are
 //! fixed by the pose (a side, a cap tilted off level; a level cap's square
 //! turns with GJK's point), the same points; apart, parry finds no point
-//! within the margin.
+//! within the margin. The same for a cylinder on another's cap (parry's
+//! cap is its square, turned to GJK's point).
 
 use crate::common::lcg::Lcg;
 use parry3d_f64::math::Vector as PVec;
@@ -14,7 +15,7 @@ use parry3d_f64::query::ContactManifold;
 use parry3d_f64::shape::{Cuboid, Cylinder, PackedFeatureId};
 use urdyn::nalgebra::{Rotation3, Unit, Vector3};
 use urdyn::spatial::Se3;
-use urdyn::testing::contact::{cylinder_on_box, to_pose, to_v};
+use urdyn::testing::contact::{cylinder_on_box, cylinder_on_cylinder, to_pose, to_v};
 
 fn unit(g: &mut Lcg) -> Unit<Vector3<f64>> {
     Unit::new_normalize(Vector3::new(
@@ -61,7 +62,7 @@ struct Seen {
     dg: f64,
 }
 
-/// Whether `p` has a match (position within `tol`, gap within 1e-6) in `qs`
+/// Whether `p` has a match (position within `tol`, gap within 1e-5) in `qs`
 /// (a crossing of two edges at a shallow angle moves along them by the
 /// normal's error over the angle: 4e-5 m seen for EPA's).
 fn matched(p: &(Vector3<f64>, f64), qs: &[(Vector3<f64>, f64)], tol: f64, seen: &mut Seen) -> bool {
@@ -69,7 +70,7 @@ fn matched(p: &(Vector3<f64>, f64), qs: &[(Vector3<f64>, f64)], tol: f64, seen: 
         .iter()
         .min_by(|a, b| (a.0 - p.0).norm().total_cmp(&(b.0 - p.0).norm()));
     match best {
-        Some(q) if (q.0 - p.0).norm() < tol && (q.1 - p.1).abs() < 1e-6 => {
+        Some(q) if (q.0 - p.0).norm() < tol && (q.1 - p.1).abs() < 1e-5 => {
             seen.dp = seen.dp.max((q.0 - p.0).norm());
             seen.dg = seen.dg.max((q.1 - p.1).abs());
             true
@@ -239,4 +240,146 @@ fn resting_cylinders_on_boxes_match_parrys_deepest() {
         compare(case, (0.05, 0.05), &e, &b_m_c, &mut seen);
     }
     assert!(seen.touching >= 5 && seen.declined <= 1, "{seen:?}");
+}
+
+/// Compares cylinders `ca`, `cb` (half height, radius), b at `a_m_b`.
+fn compare_pair(case: usize, ca: (f64, f64), cb: (f64, f64), a_m_b: &Se3<f64>, seen: &mut Seen) {
+    let margin = 0.005;
+    let ours = cylinder_on_cylinder(ca, cb, a_m_b, margin);
+    let (cya, cyb) = (Cylinder::new(ca.0, ca.1), Cylinder::new(cb.0, cb.1));
+    let mut man: ContactManifold<(), ()> = ContactManifold::new();
+    contact_manifold_pfm_pfm(
+        &to_pose(a_m_b),
+        &cya,
+        0.0,
+        None,
+        &cyb,
+        0.0,
+        None,
+        margin,
+        &mut man,
+    );
+    let near: Vec<_> = man.points.iter().filter(|p| p.dist <= margin).collect();
+    let theirs_min = near.iter().map(|p| p.dist).fold(f64::INFINITY, f64::min);
+    let Some((on_a, n, apart, pts)) = ours else {
+        seen.declined += 1;
+        return;
+    };
+    if apart {
+        seen.apart += 1;
+        assert!(
+            theirs_min > margin - 1e-7,
+            "case {case}: apart, parry {theirs_min}"
+        );
+        return;
+    }
+    seen.plane += 1;
+    let deepest = pts.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+    if near.is_empty() {
+        assert!(
+            deepest > margin - 1e-7,
+            "case {case}: parry none, ours {deepest}"
+        );
+        return;
+    }
+    seen.touching += 1;
+    // ours in the cap's cylinder's frame (p), out of it; parry's in a's, a
+    // toward b; the other cylinder's (q's) points in p's frame
+    let b_m_a = a_m_b.inverse();
+    let (p_m_q, m) = if on_a {
+        (*a_m_b, to_v(man.local_n1))
+    } else {
+        (b_m_a, -(b_m_a.rot * to_v(man.local_n1)))
+    };
+    let point = |t: &parry3d_f64::query::TrackedContact<()>| {
+        let q = if on_a {
+            a_m_b.act_point(&to_v(t.local_p2))
+        } else {
+            b_m_a.act_point(&to_v(t.local_p1))
+        };
+        (q, t.dist)
+    };
+    assert!(
+        (m - n).norm() < 1e-6,
+        "case {case}: normal {n:?} vs parry's {m:?}"
+    );
+    assert!(
+        (theirs_min - deepest).abs() < 1e-7,
+        "case {case}: deepest {deepest} vs parry's {theirs_min}"
+    );
+    seen.dn = seen.dn.max((m - n).norm());
+    seen.dd = seen.dd.max((theirs_min - deepest).abs());
+    // the features are the pose's own: q's side or tilted cap, p's square
+    // turned to a point off its axis
+    // (a level side's GJK point, and so p's square, lies anywhere along it)
+    let (hq, r) = if on_a { cb } else { ca };
+    let u: Vector3<f64> = p_m_q.rot.column(1).into();
+    let un = n.dot(&u).abs();
+    let tilted =
+        (un < 0.45 && 2.0 * hq * un > 1e-3) || (un > 0.55 && r * (1.0 - un * un).sqrt() > 1e-3);
+    let deep = pts.iter().min_by(|a, b| a.1.total_cmp(&b.1)).map(|p| p.0);
+    let off_axis = deep.is_some_and(|d| d.x.hypot(d.z) > 1e-3);
+    if !tilted || !off_axis {
+        return;
+    }
+    seen.sets += 1;
+    let gjk = |t: &&parry3d_f64::query::TrackedContact<()>| t.fid1 == PackedFeatureId::UNKNOWN;
+    let theirs: Vec<_> = near.iter().filter(|t| !gjk(t)).map(|t| point(t)).collect();
+    let all: Vec<_> = near.iter().map(|t| point(t)).collect();
+    let ours: Vec<_> = pts
+        .iter()
+        .filter(|p| p.2 & 31 != 7)
+        .map(|p| (p.0, p.1))
+        .collect();
+    for p in theirs.iter().filter(|p| p.1 < margin - 1e-6) {
+        assert!(
+            matched(p, &ours, 2e-4, seen),
+            "case {case}: parry's {p:?} not in ours {ours:?}"
+        );
+    }
+    for p in ours.iter().filter(|p| p.1 < margin - 1e-6) {
+        assert!(
+            matched(p, &all, 2e-4, seen),
+            "case {case}: our {p:?} not in parry's {all:?}"
+        );
+    }
+}
+
+#[test]
+fn random_cylinders_on_cylinders_match_parrys_manifold() {
+    let mut g = Lcg(13);
+    let mut seen = Seen::default();
+    for case in 0..20000 {
+        // a third the pile's cylinders, else random
+        let (ca, cb) = if case % 3 == 0 {
+            ((0.05, 0.05), (0.05, 0.05))
+        } else {
+            (
+                (g.uniform(0.02, 0.1), g.uniform(0.02, 0.1)),
+                (g.uniform(0.02, 0.1), g.uniform(0.02, 0.1)),
+            )
+        };
+        // q on p's cap (p = a, or b every other case)
+        let (p, q) = if case % 2 == 0 { (ca, cb) } else { (cb, ca) };
+        let tilt = [0.0, 1e-3, 0.05, 0.5][(case / 2) % 4];
+        let rot = rotation(&mut g, 1, tilt);
+        let u: Vector3<f64> = rot.matrix().column(1).into();
+        let s = if g.uniform(0.0, 1.0) < 0.5 { 1.0 } else { -1.0 };
+        let reach = p.1 + 0.5 * (q.0 + q.1);
+        let mut c = Vector3::new(g.uniform(-reach, reach), 0.0, g.uniform(-reach, reach));
+        let rp = q.1 * (1.0 - u.y * u.y).max(0.0).sqrt();
+        c.y = s * (p.0 + q.0 * u.y.abs() + rp + g.uniform(-0.004, 0.008));
+        let p_m_q = Se3::new(*rot.matrix(), c);
+        let a_m_b = if case % 2 == 0 {
+            p_m_q
+        } else {
+            p_m_q.inverse()
+        };
+        compare_pair(case, ca, cb, &a_m_b, &mut seen);
+    }
+    eprintln!("{seen:?}");
+    assert!(
+        seen.plane > 4000 && seen.touching > 4000 && seen.sets > 1500 && seen.apart > 500,
+        "{seen:?}"
+    );
 }
