@@ -181,6 +181,7 @@ pub mod contact {
     /// extents `e`: None where the closed form declines, else the face's
     /// normal (box frame) and the points (the cylinder's point in the box's
     /// frame, its gap, key), none when apart (`apart` true).
+    #[allow(clippy::type_complexity)]
     pub fn cylinder_on_box(
         h: f64,
         r: f64,
