@@ -176,6 +176,49 @@ pub mod contact {
         crate::contact::narrow::boxes::box_box(ha, hb, &a_m_b.rot, &a_m_b.trans, margin, man)
     }
 
+    /// `contact::narrow::cylinder::cylinder_on_box`: a cylinder (parry's,
+    /// half height `h`, radius `r`) at `b_m_c` in the frame of a box of half
+    /// extents `e`: None where the closed form declines, else the face's
+    /// normal (box frame) and the points (the cylinder's point in the box's
+    /// frame, its gap, key), none when apart (`apart` true).
+    #[allow(clippy::type_complexity)]
+    pub fn cylinder_on_box(
+        h: f64,
+        r: f64,
+        e: &Vector3<f64>,
+        b_m_c: &Se3<f64>,
+        margin: f64,
+    ) -> Option<(Vector3<f64>, bool, Vec<(Vector3<f64>, f64, u64)>)> {
+        use crate::contact::narrow::cylinder::{cylinder_on_box, CylBox, Pts, MAX_PTS};
+        let mut pts: Pts = ([(Vector3::zeros(), 0.0, 0); MAX_PTS], 0);
+        match cylinder_on_box(h, r, e, b_m_c, margin, &mut pts) {
+            CylBox::Other => None,
+            CylBox::Apart(n) => Some((n, true, Vec::new())),
+            CylBox::Plane(n) => Some((n, false, pts.0[..pts.1].to_vec())),
+        }
+    }
+
+    /// `contact::narrow::cylinder::cylinder_on_cylinder`: cylinders (half
+    /// height, radius) a and b, b at `a_m_b` in a's frame: None where the
+    /// closed form declines, else whether the cap is a's, the normal and the
+    /// points in that cylinder's frame (as [`cylinder_on_box`]), none when
+    /// apart.
+    #[allow(clippy::type_complexity)]
+    pub fn cylinder_on_cylinder(
+        ca: (f64, f64),
+        cb: (f64, f64),
+        a_m_b: &Se3<f64>,
+        margin: f64,
+    ) -> Option<(bool, Vector3<f64>, bool, Vec<(Vector3<f64>, f64, u64)>)> {
+        use crate::contact::narrow::cylinder::{cylinder_on_cylinder, CylBox, Pts, MAX_PTS};
+        let mut pts: Pts = ([(Vector3::zeros(), 0.0, 0); MAX_PTS], 0);
+        match cylinder_on_cylinder(ca, cb, a_m_b, margin, &mut pts) {
+            (CylBox::Other, _) => None,
+            (CylBox::Apart(n), on_a) => Some((on_a, n, true, Vec::new())),
+            (CylBox::Plane(n), on_a) => Some((on_a, n, false, pts.0[..pts.1].to_vec())),
+        }
+    }
+
     /// `Round::of`.
     pub fn round_of(s: &PairShape, w: &Se3<f64>) -> Option<Round> {
         Round::of(s, w)

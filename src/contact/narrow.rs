@@ -18,6 +18,7 @@ use parry3d_f64::query::{
 use parry3d_f64::shape::ShapeType;
 
 pub(crate) mod boxes;
+pub(crate) mod cylinder;
 pub(crate) mod prim;
 
 /// The key bit of a face-path point (its vertex index below it): never a key
@@ -100,6 +101,35 @@ pub(crate) fn parry_points(
         }
         return;
     }
+    // a cylinder on a box's face or on a cylinder's cap: the closed form
+    // where that plane is the exact contact (`cylinder`), else parry below
+    let closed = match (a.cylinder, &a.cuboid, b.cylinder, &b.cuboid) {
+        (Some(cy), _, _, Some(e)) => {
+            raw.clear();
+            cylinder::cylinder_box_points(cy, e, true, wa, wb, margin, raw)
+        }
+        (_, Some(e), Some(cy), _) => {
+            raw.clear();
+            cylinder::cylinder_box_points(cy, e, false, wa, wb, margin, raw)
+        }
+        (Some(ca), _, Some(cb), _) => {
+            raw.clear();
+            cylinder::cylinder_cylinder_points(ca, cb, wa, wb, margin, raw)
+        }
+        _ => None,
+    };
+    if let Some(axis) = closed {
+        // one manifold without points: its normal is the pair's axis
+        if manifolds.len() != 1 {
+            manifolds.clear();
+            manifolds.push(ContactManifold::new());
+            *workspace = None;
+        }
+        manifolds[0].points.clear();
+        manifolds[0].local_n1 = super::shapes::to_pvec(&axis);
+        return;
+    }
+    raw.clear();
     let dispatcher = DefaultQueryDispatcher;
     let pos12 = to_pose(&wa.inverse().compose(wb));
     let query = |manifolds: &mut Vec<ContactManifold<(), ()>>,

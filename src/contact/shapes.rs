@@ -42,6 +42,9 @@ pub struct PairShape {
     /// A box's half extents in parry's frame of it (the closed-form
     /// box–box pairs', `narrow::boxes`).
     pub cuboid: Option<Vector3<f64>>,
+    /// A cylinder's half height and radius (parry's: axis y; the
+    /// closed-form cylinder–box pairs', `narrow::cylinder`).
+    pub cylinder: Option<(f64, f64)>,
 }
 
 impl PairShape {
@@ -57,7 +60,9 @@ impl PairShape {
                 .map(|c| (from_pvec(c.segment.a), from_pvec(c.segment.b), c.radius))
         };
         let cuboid = shape.as_cuboid().map(|c| from_pvec(c.half_extents));
+        let cylinder = shape.as_cylinder().map(|c| (c.half_height, c.radius));
         Self {
+            cylinder,
             round,
             cuboid,
             mid: from_pvec(b.center()),
