@@ -75,3 +75,41 @@ pub(super) fn ldlt_dropping(a: &mut [f64], m: usize, drop: f64) {
         }
     }
 }
+
+/// [`linalg::ldlt_dropping_solve`] (L D Lᵀ x = b in place, the factor of
+/// [`ldlt_dropping`] in the lower triangle of the row-major m × m `a`, a
+/// dropped pivot's x set to 0), the same operations in the same order on
+/// each entry, without the index checks of the library's loops.
+pub(super) fn ldlt_dropping_solve(a: &[f64], m: usize, x: &mut [f64]) {
+    if a.len() < m * m || x.len() < m {
+        return;
+    }
+    let (a, x) = (&a[..m * m], &mut x[..m]);
+    // L z = b: row i's sum over k < i in order
+    for i in 1..m {
+        let (done, rest) = x.split_at_mut(i);
+        let mut s = rest[0];
+        for (&l, &z) in a[i * m..i * m + i].iter().zip(done.iter()) {
+            s -= l * z;
+        }
+        rest[0] = s;
+    }
+    // z /= D
+    for (i, xi) in x.iter_mut().enumerate() {
+        let d = a[i * m + i];
+        *xi = if d != 0.0 { *xi / d } else { 0.0 };
+    }
+    // Lᵀ x = z: entry i's sum over k > i in order, down column i of L
+    for i in (0..m).rev() {
+        if a[i * m + i] == 0.0 {
+            x[i] = 0.0;
+            continue;
+        }
+        let (head, done) = x.split_at_mut(i + 1);
+        let mut s = head[i];
+        for (&l, &xk) in a[i * m + i..].iter().step_by(m).skip(1).zip(done.iter()) {
+            s -= l * xk;
+        }
+        head[i] = s;
+    }
+}

@@ -2,10 +2,9 @@
 //! that moves nothing, chosen least-norm
 //! (docs/theory.md §"Self-stress of a sticking stance").
 
-use super::dense::ldlt_dropping;
+use super::dense::{ldlt_dropping, ldlt_dropping_solve};
 use super::subspace::{Lanes, Subspace, DEPENDENT};
 use super::{RowKind, Rows, SUBSPACE_MAX};
-use crate::dynamics::linalg::ldlt_dropping_solve;
 
 impl Rows {
     /// Whether this step's solve of the island on `dofs` (`None`: every dof)

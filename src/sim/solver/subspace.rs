@@ -1,11 +1,10 @@
 //! The subspace-minimisation step of projected Gauss–Seidel (PGS-SM): the
 //! free rows solved exactly by a dense LDLᵀ.
 
-use super::dense::ldlt_dropping;
-use super::kernels::dot3;
+use super::dense::{ldlt_dropping, ldlt_dropping_solve};
+use super::kernels::{dot3, dot3_from};
 use super::loop_block::LoopBlock;
 use super::{RowKind, SUBSPACE_MAX};
-use crate::dynamics::linalg::ldlt_dropping_solve;
 
 /// Preallocated scratch of [`subspace_step`]: the free rows, their dense
 /// Delassus block and right-hand side, their Y rows scattered to full width.
@@ -433,6 +432,7 @@ pub(super) fn subspace_step(
         RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
         _ => b[r],
     };
+    let lanes = Lanes { contact, ylanes };
     let mut a = 0;
     while a < m {
         let r = sm.rows[a];
@@ -445,13 +445,17 @@ pub(super) fn subspace_step(
             && paths[r + 2] == paths[r]
         {
             // a contact's three rows in one pass, each sum in its order
-            let (y0, y1, y2) = (yr(0), yr(1), yr(2));
             let (mut u0, mut u1, mut u2) = (c[r], c[r + 1], c[r + 2]);
-            for (t, &k) in pa.iter().enumerate() {
-                let x = dv[k];
-                u0 += y0[t] * x;
-                u1 += y1[t] * x;
-                u2 += y2[t] * x;
+            if let Some(l) = lanes.of(r, st, pa.len()) {
+                [u0, u1, u2, _] = dot3_from([u0, u1, u2, 0.0], l, pa, dv);
+            } else {
+                let (y0, y1, y2) = (yr(0), yr(1), yr(2));
+                for (t, &k) in pa.iter().enumerate() {
+                    let x = dv[k];
+                    u0 += y0[t] * x;
+                    u1 += y1[t] * x;
+                    u2 += y2[t] * x;
+                }
             }
             sm.rhs[a] = target(r) - u0;
             sm.rhs[a + 1] = target(r + 1) - u1;
@@ -461,7 +465,8 @@ pub(super) fn subspace_step(
         }
         let mut u = c[r];
         for (&yt, &k) in yr(0).iter().zip(pa) {
-            u += yt * dv[k];
+            // SAFETY: a path's dofs are < nv ≤ dv.len() (checked above)
+            u += yt * unsafe { *dv.get_unchecked(k) };
         }
         sm.rhs[a] = target(r) - u;
         a += 1;
@@ -471,7 +476,7 @@ pub(super) fn subspace_step(
     // The rows' y are fixed within a solve: a step on the same free rows as
     // the last one of this solve reuses its factor (the same bits)
     if !(sm.factored && sm.factored_rows == sm.rows) {
-        sm.form_w_ff(y, st, paths, table, Lanes { contact, ylanes });
+        sm.form_w_ff(y, st, paths, table, lanes);
         ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
         sm.factored_rows.clone_from(&sm.rows);
         sm.factored = true;
@@ -512,15 +517,24 @@ pub(super) fn subspace_step(
         let p = path(r);
         add(p, yrow(r, p.len()), d, dv);
     }
+    // the free rows are a subsequence of this walk's rows (the scan above
+    // took them in this order, each once): a cursor finds a row's place
+    let mut next = 0;
     for r in runs.iter().flat_map(|&(_, s, e)| s..e) {
         if r + 1 >= n {
             break;
         }
+        let at = if sm.rows.get(next) == Some(&r) {
+            next += 1;
+            Some(next - 1)
+        } else {
+            None
+        };
         let RowKind::Tangent { normal, mu } = kinds[r] else {
             continue;
         };
         let lim = mu * lambda.get(normal).copied().unwrap_or(0.0).max(0.0);
-        let free = sm.rows.iter().position(|&q| q == r);
+        let free = at;
         let (t1, t2) = match free {
             Some(a) if winv[r + 1] == 0.0 => (sm.lam[a], 0.0),
             Some(a) if a + 1 < m => (sm.lam[a], sm.lam[a + 1]),
