@@ -12,46 +12,64 @@
 
 use crate::dynamics::linalg;
 
-/// Most rows taken here (more: the library's loop).
+/// Most rows taken here (more: the library's loop, `ld` = m and `from` = 0
+/// only).
 const CAP: usize = 64;
+const _: () = assert!(super::SUBSPACE_MAX <= CAP);
 
-/// [`linalg::ldlt_dropping`] (the lower triangle of the row-major m × m `a`
-/// factored as L D Lᵀ, a pivot below `drop` of its diagonal dropped), the
-/// same bits.
-pub(super) fn ldlt_dropping(a: &mut [f64], m: usize, drop: f64) {
-    if m > CAP || a.len() < m * m {
-        linalg::ldlt_dropping(a, m, drop);
+/// [`linalg::ldlt_dropping`] (the lower triangle of the m × m `a`, row i at
+/// `a[i * ld..]`, factored as L D Lᵀ, a pivot below `drop` of its diagonal
+/// dropped), the same bits, its rows before `from` taken as factored already.
+///
+/// Row i of the factor (its L entries and pivot) depends on the rows ≤ i of
+/// the matrix only, and each entry is the same sum in the same order whatever
+/// follows: the factor of a leading block is the leading block of the factor.
+/// So rows appended to a factored block (`from` its size) are factored here
+/// to the bits a factor from scratch gives them (docs/theory.md §"Constraint
+/// solve": the subspace step's free rows kept across a solve's tries).
+pub(super) fn ldlt_dropping(a: &mut [f64], ld: usize, m: usize, from: usize, drop: f64) {
+    let from = from.min(m);
+    if m > CAP || ld < m || a.len() < m * ld {
+        if ld == m && from == 0 {
+            linalg::ldlt_dropping(a, m, drop);
+        }
         return;
     }
-    let a = &mut a[..m * m];
+    let a = &mut a[..m * ld];
     let mut d = [0.0f64; CAP];
     for j in 0..m {
-        let (head, tail) = a.split_at_mut((j + 1) * m);
-        let (rowj, diag) = {
-            let r = &head[j * m..j * m + j + 1];
-            (&r[..j], r[j])
-        };
-        let mut dj = diag;
-        for (&l, &dk) in rowj.iter().zip(&d[..j]) {
-            dj -= l * l * dk;
-        }
-        let dj = if dj > drop * diag && dj > 0.0 {
-            dj
+        let (head, tail) = a.split_at_mut((j + 1) * ld);
+        let dj = if j < from {
+            head[j * ld + j]
         } else {
-            0.0
+            let (rowj, diag) = {
+                let r = &head[j * ld..j * ld + j + 1];
+                (&r[..j], r[j])
+            };
+            let mut dj = diag;
+            for (&l, &dk) in rowj.iter().zip(&d[..j]) {
+                dj -= l * l * dk;
+            }
+            let dj = if dj > drop * diag && dj > 0.0 {
+                dj
+            } else {
+                0.0
+            };
+            head[j * ld + j] = dj;
+            dj
         };
-        head[j * m + j] = dj;
         d[j] = dj;
-        let rowj = &head[j * m..j * m + j];
+        let rowj = &head[j * ld..j * ld + j];
         let dk = &d[..j];
         let fin = |s: f64| if dj != 0.0 { s / dj } else { 0.0 };
-        let mut rest = tail;
-        while rest.len() >= 4 * m {
-            let (four, more) = rest.split_at_mut(4 * m);
+        // the rows below j not factored yet: from `from` on
+        let mut rest = &mut tail[from.saturating_sub(j + 1) * ld..];
+        while rest.len() >= 4 * ld {
+            let (four, more) = rest.split_at_mut(4 * ld);
             rest = more;
-            let (r0, x) = four.split_at_mut(m);
-            let (r1, x) = x.split_at_mut(m);
-            let (r2, r3) = x.split_at_mut(m);
+            let (r0, x) = four.split_at_mut(ld);
+            let (r1, x) = x.split_at_mut(ld);
+            let (r2, r3) = x.split_at_mut(ld);
             let (mut s0, mut s1, mut s2, mut s3) = (r0[j], r1[j], r2[j], r3[j]);
             let (r0j, r1j, r2j, r3j) = (&r0[..j], &r1[..j], &r2[..j], &r3[..j]);
             for k in 0..j {
@@ -66,7 +84,7 @@ pub(super) fn ldlt_dropping(a: &mut [f64], m: usize, drop: f64) {
             r2[j] = fin(s2);
             r3[j] = fin(s3);
         }
-        for ri in rest.chunks_exact_mut(m) {
+        for ri in rest.chunks_exact_mut(ld) {
             let mut s = ri[j];
             for ((&x, &lk), &dk) in ri[..j].iter().zip(rowj).zip(dk) {
                 s -= x * lk * dk;
@@ -77,37 +95,37 @@ pub(super) fn ldlt_dropping(a: &mut [f64], m: usize, drop: f64) {
 }
 
 /// [`linalg::ldlt_dropping_solve`] (L D Lᵀ x = b in place, the factor of
-/// [`ldlt_dropping`] in the lower triangle of the row-major m × m `a`, a
-/// dropped pivot's x set to 0), the same operations in the same order on
-/// each entry, without the index checks of the library's loops.
-pub(super) fn ldlt_dropping_solve(a: &[f64], m: usize, x: &mut [f64]) {
-    if a.len() < m * m || x.len() < m {
+/// [`ldlt_dropping`] in the lower triangle of the m × m `a`, row i at
+/// `a[i * ld..]`, a dropped pivot's x set to 0), the same operations in the
+/// same order on each entry, without the index checks of the library's loops.
+pub(super) fn ldlt_dropping_solve(a: &[f64], ld: usize, m: usize, x: &mut [f64]) {
+    if m == 0 || ld < m || a.len() < (m - 1) * ld + m || x.len() < m {
         return;
     }
-    let (a, x) = (&a[..m * m], &mut x[..m]);
+    let (a, x) = (&a[..(m - 1) * ld + m], &mut x[..m]);
     // L z = b: row i's sum over k < i in order
     for i in 1..m {
         let (done, rest) = x.split_at_mut(i);
         let mut s = rest[0];
-        for (&l, &z) in a[i * m..i * m + i].iter().zip(done.iter()) {
+        for (&l, &z) in a[i * ld..i * ld + i].iter().zip(done.iter()) {
             s -= l * z;
         }
         rest[0] = s;
     }
     // z /= D
     for (i, xi) in x.iter_mut().enumerate() {
-        let d = a[i * m + i];
+        let d = a[i * ld + i];
         *xi = if d != 0.0 { *xi / d } else { 0.0 };
     }
     // Lᵀ x = z: entry i's sum over k > i in order, down column i of L
     for i in (0..m).rev() {
-        if a[i * m + i] == 0.0 {
+        if a[i * ld + i] == 0.0 {
             x[i] = 0.0;
             continue;
         }
         let (head, done) = x.split_at_mut(i + 1);
         let mut s = head[i];
-        for (&l, &xk) in a[i * m + i..].iter().step_by(m).skip(1).zip(done.iter()) {
+        for (&l, &xk) in a[i * ld + i..].iter().step_by(ld).skip(1).zip(done.iter()) {
             s -= l * xk;
         }
         head[i] = s;

@@ -11,7 +11,14 @@ use super::{RowKind, SUBSPACE_MAX};
 #[derive(Clone, Debug)]
 pub(super) struct Subspace {
     pub(super) rows: Vec<usize>,
+    /// At a free row: a contact's three rows start there ([`Subspace::group`];
+    /// the others false).
+    pub(super) three: Vec<bool>,
+    /// W_FF (lower triangle) or its factor, row a at `w[a * ld..]`: the
+    /// stride fixed (the most rows a step takes), so that a factor's leading
+    /// rows stay in place when rows are appended.
     pub(super) w: Vec<f64>,
+    pub(super) ld: usize,
     pub(super) rhs: Vec<f64>,
     pub(super) lam: Vec<f64>,
     /// A row scattered to full width (nv entries, zero between uses).
@@ -39,7 +46,9 @@ impl Subspace {
         let m = cap.min(SUBSPACE_MAX);
         Self {
             rows: Vec::with_capacity(m),
+            three: Vec::with_capacity(m),
             w: vec![0.0; m * m],
+            ld: m,
             rhs: vec![0.0; m],
             lam: vec![0.0; m],
             x: vec![0.0; nv],
@@ -59,17 +68,59 @@ impl Subspace {
         self.factored = false;
     }
 
+    /// Marks where a contact's three rows start in `self.rows` (`three`): rows
+    /// r, r + 1, r + 2 in a row on one path, taken from the first row on (the
+    /// groups the residuals and W_FF are summed by).
+    pub(super) fn group(&mut self, paths: &[(usize, usize)]) {
+        let (rows, m) = (&self.rows[..], self.rows.len());
+        self.three.clear();
+        let mut a = 0;
+        while a < m {
+            let r = rows[a];
+            let t = a + 2 < m
+                && rows[a + 1] == r + 1
+                && rows[a + 2] == r + 2
+                && paths[r + 1] == paths[r]
+                && paths[r + 2] == paths[r];
+            self.three.push(t);
+            if t {
+                self.three.extend([false, false]);
+                a += 3;
+            } else {
+                a += 1;
+            }
+        }
+    }
+
+    /// The start of the group ([`Subspace::group`]) that holds free row `p`
+    /// (`p` itself at or past the end).
+    fn group_start(&self, p: usize) -> usize {
+        let mut a = 0;
+        while a < p.min(self.three.len()) {
+            let next = if self.three[a] { a + 3 } else { a + 1 };
+            if next > p {
+                return a;
+            }
+            a = next;
+        }
+        p
+    }
+
     /// The lower triangle of W_FF = Y_F Y_Fᵀ over `self.rows` (m of them) into
-    /// `self.w` (m × m, row-major): row r scattered onto its path's dofs in `x`
-    /// (zeros elsewhere, put back after), each entry then a sum over the other
-    /// row's path in its order. A dof off r's path adds y·0 = ±0, which leaves
-    /// every partial sum as it was: the same bits as summing over the two
-    /// paths' common dofs only, without the merge's branches (the cost follows
-    /// the rows' paths, never nv). Rows `r` of `y` have room `st`; row r's
-    /// dofs are `table[paths[r]]`. `x` must hold nv entries, `w` m². A
-    /// contact's three rows q are read from their interleaved copy (`lanes`,
-    /// `Rows::ylanes`), the three sums side by side in vector lanes: each the
-    /// same sum in the same order.
+    /// `self.w` (row a at `w[a * ld..]`), its rows from `from` on (a group's
+    /// start, [`Subspace::group`], which must have been run on these rows):
+    /// row r scattered onto its path's dofs in `x` (zeros elsewhere, put back
+    /// after), each entry then a sum over the other row's path in its order.
+    /// A dof off r's path adds y·0 = ±0, which leaves every partial sum as it
+    /// was: the same bits as summing over the two paths' common dofs only,
+    /// without the merge's branches (the cost follows the rows' paths, never
+    /// nv). Rows `r` of `y` have room `st`; row r's dofs are
+    /// `table[paths[r]]`, each < nv (the sweeps' check). `x` must hold nv
+    /// entries, `w` m · ld. A contact's three rows q are read from their
+    /// interleaved copy (`lanes`, `Rows::ylanes`), the three sums side by side
+    /// in vector lanes: each the same sum in the same order. Returns whether
+    /// it was formed (false: the scratch does not fit these rows).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn form_w_ff(
         &mut self,
         y: &[f64],
@@ -77,28 +128,37 @@ impl Subspace {
         paths: &[(usize, usize)],
         table: &[usize],
         lanes: Lanes,
-    ) {
-        let m = self.rows.len();
+        nv: usize,
+        from: usize,
+    ) -> bool {
+        let (m, ld) = (self.rows.len(), self.ld);
+        if m > ld
+            || self.w.len() < m * ld
+            || self.three.len() != m
+            || self.x.len() < nv
+            || self.x3.len() < nv
+        {
+            return false;
+        }
         let path = |r: usize| {
             let (s, l) = paths[r];
             &table[s..s + l]
         };
         let rows = &self.rows[..];
-        // rows a.., q.. on one path from a: a contact's three rows
-        let three = |a: usize, hi: usize| {
-            let r = rows[a];
-            a + 2 <= hi
-                && rows[a + 1] == r + 1
-                && rows[a + 2] == r + 2
-                && paths[r + 1] == paths[r]
-                && paths[r + 2] == paths[r]
-        };
+        let three = &self.three[..];
+        let w = &mut self.w[..m * ld];
         let yrow = |q: usize, len: usize| &y[q * st..q * st + len];
+        // SAFETY (the writes below): every (i, j) written has i < m, j ≤ i
+        let mut put = |i: usize, j: usize, v: f64| unsafe { *w.get_unchecked_mut(i * ld + j) = v };
         let mut a = 0;
         while a < m {
             let r = rows[a];
             let pa = path(r);
-            if a + 2 < m && three(a, m - 1) {
+            if three[a] {
+                if a < from {
+                    a += 3;
+                    continue;
+                }
                 // a contact's three rows at once: every entry (a + i, bb + j),
                 // bb + j ≤ a + i, the same sum in the same order as below
                 let (y0, y1, y2) = (
@@ -110,12 +170,11 @@ impl Subspace {
                     self.x3[k] = [y0[t], y1[t], y2[t]];
                 }
                 let x3 = &self.x3[..];
-                let hi = a + 2;
                 let mut bb = 0;
-                while bb <= hi {
+                while bb <= a {
                     let q = rows[bb];
                     let pq = path(q);
-                    if three(bb, hi) {
+                    if three[bb] {
                         let mut sum = [[0.0f64; 3]; 3];
                         if let Some(lq) = lanes.of(q, st, pq.len()) {
                             let s4 = dot3x3(lq, pq, x3);
@@ -129,7 +188,8 @@ impl Subspace {
                                 yrow(q + 2, pq.len()),
                             );
                             for (t, &k) in pq.iter().enumerate() {
-                                let xk = x3[k];
+                                // SAFETY: k < nv ≤ x3.len() (the sweeps' check)
+                                let xk = unsafe { *x3.get_unchecked(k) };
                                 let zt = [z0[t], z1[t], z2[t]];
                                 for (si, &xi) in sum.iter_mut().zip(&xk) {
                                     for (sij, &zj) in si.iter_mut().zip(&zt) {
@@ -138,10 +198,16 @@ impl Subspace {
                                 }
                             }
                         }
-                        for (i, si) in sum.iter().enumerate() {
-                            for (j, &sij) in si.iter().enumerate() {
-                                if bb + j <= a + i {
-                                    self.w[(a + i) * m + bb + j] = sij;
+                        if bb < a {
+                            for (i, si) in sum.iter().enumerate() {
+                                for (j, &sij) in si.iter().enumerate() {
+                                    put(a + i, bb + j, sij);
+                                }
+                            }
+                        } else {
+                            for (i, si) in sum.iter().enumerate() {
+                                for (j, &sij) in si.iter().enumerate().take(i + 1) {
+                                    put(a + i, bb + j, sij);
                                 }
                             }
                         }
@@ -150,15 +216,14 @@ impl Subspace {
                     }
                     let mut sum = [0.0f64; 3];
                     for (&yt, &k) in yrow(q, pq.len()).iter().zip(pq) {
-                        let xk = x3[k];
+                        // SAFETY: k < nv ≤ x3.len() (the sweeps' check)
+                        let xk = unsafe { *x3.get_unchecked(k) };
                         for (si, &xi) in sum.iter_mut().zip(&xk) {
                             *si += yt * xi;
                         }
                     }
                     for (i, &si) in sum.iter().enumerate() {
-                        if bb <= a + i {
-                            self.w[(a + i) * m + bb] = si;
-                        }
+                        put(a + i, bb, si);
                     }
                     bb += 1;
                 }
@@ -166,6 +231,10 @@ impl Subspace {
                     self.x3[k] = [0.0; 3];
                 }
                 a += 3;
+                continue;
+            }
+            if a < from {
+                a += 1;
                 continue;
             }
             let yr = yrow(r, pa.len());
@@ -179,7 +248,7 @@ impl Subspace {
             while bb <= a {
                 let q = rows[bb];
                 let pq = path(q);
-                if three(bb, a) {
+                if three[bb] {
                     let (mut s0, mut s1, mut s2) = (0.0, 0.0, 0.0);
                     if let Some(lq) = lanes.of(q, st, pq.len()) {
                         [s0, s1, s2, _] = dot3(lq, pq, x);
@@ -190,23 +259,25 @@ impl Subspace {
                             yrow(q + 2, pq.len()),
                         );
                         for (t, &k) in pq.iter().enumerate() {
-                            let xk = x[k];
+                            // SAFETY: k < nv ≤ x.len() (the sweeps' check)
+                            let xk = unsafe { *x.get_unchecked(k) };
                             s0 += y0[t] * xk;
                             s1 += y1[t] * xk;
                             s2 += y2[t] * xk;
                         }
                     }
-                    self.w[a * m + bb] = s0;
-                    self.w[a * m + bb + 1] = s1;
-                    self.w[a * m + bb + 2] = s2;
+                    put(a, bb, s0);
+                    put(a, bb + 1, s1);
+                    put(a, bb + 2, s2);
                     bb += 3;
                     continue;
                 }
                 let mut s = 0.0;
                 for (&yt, &k) in yrow(q, pq.len()).iter().zip(pq) {
-                    s += yt * x[k];
+                    // SAFETY: k < nv ≤ x.len() (the sweeps' check)
+                    s += yt * unsafe { *x.get_unchecked(k) };
                 }
-                self.w[a * m + bb] = s;
+                put(a, bb, s);
                 bb += 1;
             }
             for &k in pa {
@@ -214,6 +285,7 @@ impl Subspace {
             }
             a += 1;
         }
+        true
     }
 }
 
@@ -433,17 +505,13 @@ pub(super) fn subspace_step(
         _ => b[r],
     };
     let lanes = Lanes { contact, ylanes };
+    sm.group(paths);
     let mut a = 0;
     while a < m {
         let r = sm.rows[a];
         let pa = path(r);
         let yr = |i: usize| &y[(r + i) * st..(r + i) * st + pa.len()];
-        if a + 2 < m
-            && sm.rows[a + 1] == r + 1
-            && sm.rows[a + 2] == r + 2
-            && paths[r + 1] == paths[r]
-            && paths[r + 2] == paths[r]
-        {
+        if sm.three[a] {
             // a contact's three rows in one pass, each sum in its order
             let (mut u0, mut u1, mut u2) = (c[r], c[r + 1], c[r + 2]);
             if let Some(l) = lanes.of(r, st, pa.len()) {
@@ -473,15 +541,26 @@ pub(super) fn subspace_step(
     }
     // W_FF = L D Lᵀ; a pivot that lost all but `DEPENDENT` of its diagonal
     // is a row dependent on earlier ones (redundant contacts): dropped (δ = 0).
-    // The rows' y are fixed within a solve: a step on the same free rows as
-    // the last one of this solve reuses its factor (the same bits)
-    if !(sm.factored && sm.factored_rows == sm.rows) {
-        sm.form_w_ff(y, st, paths, table, lanes);
-        ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
-        sm.factored_rows.clone_from(&sm.rows);
-        sm.factored = true;
+    // The rows' y are fixed within a solve: a step whose free rows begin
+    // with those of this solve's last factor keeps the factor's rows there
+    // (a leading block's factor, the same bits, dense.rs) and forms and
+    // factors the rows after them only (all of them on the same free rows)
+    let kept = if sm.factored {
+        let same = sm.factored_rows.iter().zip(&sm.rows).take_while(|(p, q)| p == q);
+        sm.group_start(same.count())
+    } else {
+        0
+    };
+    if kept < m {
+        if !sm.form_w_ff(y, st, paths, table, lanes, nv, kept) {
+            sm.forget();
+            return false;
+        }
+        ldlt_dropping(&mut sm.w, sm.ld, m, kept, DEPENDENT);
     }
-    ldlt_dropping_solve(&sm.w[..m * m], m, &mut sm.rhs[..m]);
+    sm.factored_rows.clone_from(&sm.rows);
+    sm.factored = true;
+    ldlt_dropping_solve(&sm.w, sm.ld, m, &mut sm.rhs[..m]);
     // the new impulses (none taken if one is not finite)
     for (a, &r) in sm.rows.iter().enumerate() {
         let x = lambda[r] + sm.rhs[a];
