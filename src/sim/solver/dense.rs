@@ -102,32 +102,35 @@ pub(super) fn ldlt_dropping_solve(a: &[f64], ld: usize, m: usize, x: &mut [f64])
     if m == 0 || ld < m || a.len() < (m - 1) * ld + m || x.len() < m {
         return;
     }
-    let (a, x) = (&a[..(m - 1) * ld + m], &mut x[..m]);
-    // L z = b: row i's sum over k < i in order
-    for i in 1..m {
-        let (done, rest) = x.split_at_mut(i);
-        let mut s = rest[0];
-        for (&l, &z) in a[i * ld..i * ld + i].iter().zip(done.iter()) {
-            s -= l * z;
+    // SAFETY: every index read or written below is i·ld + k (i, k < m) in `a`,
+    // at most (m − 1)·ld + m − 1 < a.len(), and i < m ≤ x.len() in `x`
+    let (a, x) = (a.as_ptr(), x.as_mut_ptr());
+    unsafe {
+        // L z = b: row i's sum over k < i in order
+        for i in 1..m {
+            let row = a.add(i * ld);
+            let mut s = *x.add(i);
+            for k in 0..i {
+                s -= *row.add(k) * *x.add(k);
+            }
+            *x.add(i) = s;
         }
-        rest[0] = s;
-    }
-    // z /= D
-    for (i, xi) in x.iter_mut().enumerate() {
-        let d = a[i * ld + i];
-        *xi = if d != 0.0 { *xi / d } else { 0.0 };
-    }
-    // Lᵀ x = z: entry i's sum over k > i in order, down column i of L
-    for i in (0..m).rev() {
-        if a[i * ld + i] == 0.0 {
-            x[i] = 0.0;
-            continue;
+        // z /= D
+        for i in 0..m {
+            let d = *a.add(i * ld + i);
+            *x.add(i) = if d != 0.0 { *x.add(i) / d } else { 0.0 };
         }
-        let (head, done) = x.split_at_mut(i + 1);
-        let mut s = head[i];
-        for (&l, &xk) in a[i * ld + i..].iter().step_by(ld).skip(1).zip(done.iter()) {
-            s -= l * xk;
+        // Lᵀ x = z: entry i's sum over k > i in order, down column i of L
+        for i in (0..m).rev() {
+            if *a.add(i * ld + i) == 0.0 {
+                *x.add(i) = 0.0;
+                continue;
+            }
+            let mut s = *x.add(i);
+            for k in i + 1..m {
+                s -= *a.add(k * ld + i) * *x.add(k);
+            }
+            *x.add(i) = s;
         }
-        head[i] = s;
     }
 }

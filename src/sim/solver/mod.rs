@@ -27,6 +27,7 @@ mod pgs;
 mod position;
 mod stress;
 mod subspace;
+mod wff;
 
 pub(crate) use pgs::{IslandOut, Scratch};
 

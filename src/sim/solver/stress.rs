@@ -3,7 +3,8 @@
 //! (docs/theory.md §"Self-stress of a sticking stance").
 
 use super::dense::{ldlt_dropping, ldlt_dropping_solve};
-use super::subspace::{Lanes, Subspace, DEPENDENT};
+use super::subspace::{Subspace, DEPENDENT};
+use super::wff::Lanes;
 use super::{RowKind, Rows, SUBSPACE_MAX};
 
 impl Rows {
@@ -129,7 +130,7 @@ impl Rows {
             ylanes: &self.ylanes,
         };
         sm.group(&self.path);
-        if !sm.form_w_ff(&self.y, st, &self.path, table, lanes, self.nv, 0) {
+        if !sm.form_w_ff(&self.y, st, &self.path, table, lanes, self.nv, 0, false) {
             return false;
         }
         ldlt_dropping(&mut sm.w, ld, m, 0, DEPENDENT);

@@ -2,8 +2,9 @@
 //! free rows solved exactly by a dense LDLᵀ.
 
 use super::dense::{ldlt_dropping, ldlt_dropping_solve};
-use super::kernels::{dot3, dot3_from};
+use super::kernels::dot3_from;
 use super::loop_block::LoopBlock;
+use super::wff::Lanes;
 use super::{RowKind, SUBSPACE_MAX};
 
 /// Preallocated scratch of [`subspace_step`]: the free rows, their dense
@@ -36,9 +37,13 @@ pub(super) struct Subspace {
     /// Their Gram matrix in the W-diagonal metric (stress.rs).
     pub(super) gram: Vec<f64>,
     /// `w` holds the LDLᵀ of W_FF over `factored_rows`, made in this solve
-    /// of an island's rows (cleared when one starts, [`Subspace::forget`]).
+    /// of an island's rows (cleared when one starts, [`Subspace::forget`]),
+    /// and `wf` that W_FF itself (lower triangle, row a at `wf[a * ld..]`).
     pub(super) factored: bool,
     pub(super) factored_rows: Vec<usize>,
+    pub(super) wf: Vec<f64>,
+    /// At a free row: its place in `factored_rows` (`usize::MAX`: not there).
+    pub(super) old: Vec<usize>,
 }
 
 impl Subspace {
@@ -59,6 +64,8 @@ impl Subspace {
             gram: vec![0.0; m * m],
             factored: false,
             factored_rows: Vec::with_capacity(m),
+            wf: vec![0.0; m * m],
+            old: Vec::with_capacity(m),
         }
     }
 
@@ -66,294 +73,6 @@ impl Subspace {
     #[inline]
     pub(super) fn forget(&mut self) {
         self.factored = false;
-    }
-
-    /// Marks where a contact's three rows start in `self.rows` (`three`): rows
-    /// r, r + 1, r + 2 in a row on one path, taken from the first row on (the
-    /// groups the residuals and W_FF are summed by).
-    pub(super) fn group(&mut self, paths: &[(usize, usize)]) {
-        let (rows, m) = (&self.rows[..], self.rows.len());
-        self.three.clear();
-        let mut a = 0;
-        while a < m {
-            let r = rows[a];
-            let t = a + 2 < m
-                && rows[a + 1] == r + 1
-                && rows[a + 2] == r + 2
-                && paths[r + 1] == paths[r]
-                && paths[r + 2] == paths[r];
-            self.three.push(t);
-            if t {
-                self.three.extend([false, false]);
-                a += 3;
-            } else {
-                a += 1;
-            }
-        }
-    }
-
-    /// The start of the group ([`Subspace::group`]) that holds free row `p`
-    /// (`p` itself at or past the end).
-    fn group_start(&self, p: usize) -> usize {
-        let mut a = 0;
-        while a < p.min(self.three.len()) {
-            let next = if self.three[a] { a + 3 } else { a + 1 };
-            if next > p {
-                return a;
-            }
-            a = next;
-        }
-        p
-    }
-
-    /// The lower triangle of W_FF = Y_F Y_Fᵀ over `self.rows` (m of them) into
-    /// `self.w` (row a at `w[a * ld..]`), its rows from `from` on (a group's
-    /// start, [`Subspace::group`], which must have been run on these rows):
-    /// row r scattered onto its path's dofs in `x` (zeros elsewhere, put back
-    /// after), each entry then a sum over the other row's path in its order.
-    /// A dof off r's path adds y·0 = ±0, which leaves every partial sum as it
-    /// was: the same bits as summing over the two paths' common dofs only,
-    /// without the merge's branches (the cost follows the rows' paths, never
-    /// nv). Rows `r` of `y` have room `st`; row r's dofs are
-    /// `table[paths[r]]`, each < nv (the sweeps' check). `x` must hold nv
-    /// entries, `w` m · ld. A contact's three rows q are read from their
-    /// interleaved copy (`lanes`, `Rows::ylanes`), the three sums side by side
-    /// in vector lanes: each the same sum in the same order. Returns whether
-    /// it was formed (false: the scratch does not fit these rows).
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn form_w_ff(
-        &mut self,
-        y: &[f64],
-        st: usize,
-        paths: &[(usize, usize)],
-        table: &[usize],
-        lanes: Lanes,
-        nv: usize,
-        from: usize,
-    ) -> bool {
-        let (m, ld) = (self.rows.len(), self.ld);
-        if m > ld
-            || self.w.len() < m * ld
-            || self.three.len() != m
-            || self.x.len() < nv
-            || self.x3.len() < nv
-        {
-            return false;
-        }
-        let path = |r: usize| {
-            let (s, l) = paths[r];
-            &table[s..s + l]
-        };
-        let rows = &self.rows[..];
-        let three = &self.three[..];
-        let w = &mut self.w[..m * ld];
-        let yrow = |q: usize, len: usize| &y[q * st..q * st + len];
-        // SAFETY (the writes below): every (i, j) written has i < m, j ≤ i
-        let mut put = |i: usize, j: usize, v: f64| unsafe { *w.get_unchecked_mut(i * ld + j) = v };
-        let mut a = 0;
-        while a < m {
-            let r = rows[a];
-            let pa = path(r);
-            if three[a] {
-                if a < from {
-                    a += 3;
-                    continue;
-                }
-                // a contact's three rows at once: every entry (a + i, bb + j),
-                // bb + j ≤ a + i, the same sum in the same order as below
-                let (y0, y1, y2) = (
-                    yrow(r, pa.len()),
-                    yrow(r + 1, pa.len()),
-                    yrow(r + 2, pa.len()),
-                );
-                for (t, &k) in pa.iter().enumerate() {
-                    self.x3[k] = [y0[t], y1[t], y2[t]];
-                }
-                let x3 = &self.x3[..];
-                let mut bb = 0;
-                while bb <= a {
-                    let q = rows[bb];
-                    let pq = path(q);
-                    if three[bb] {
-                        let mut sum = [[0.0f64; 3]; 3];
-                        if let Some(lq) = lanes.of(q, st, pq.len()) {
-                            let s4 = dot3x3(lq, pq, x3);
-                            for (si, s4i) in sum.iter_mut().zip(&s4) {
-                                si.copy_from_slice(&s4i[..3]);
-                            }
-                        } else {
-                            let (z0, z1, z2) = (
-                                yrow(q, pq.len()),
-                                yrow(q + 1, pq.len()),
-                                yrow(q + 2, pq.len()),
-                            );
-                            for (t, &k) in pq.iter().enumerate() {
-                                // SAFETY: k < nv ≤ x3.len() (the sweeps' check)
-                                let xk = unsafe { *x3.get_unchecked(k) };
-                                let zt = [z0[t], z1[t], z2[t]];
-                                for (si, &xi) in sum.iter_mut().zip(&xk) {
-                                    for (sij, &zj) in si.iter_mut().zip(&zt) {
-                                        *sij += zj * xi;
-                                    }
-                                }
-                            }
-                        }
-                        if bb < a {
-                            for (i, si) in sum.iter().enumerate() {
-                                for (j, &sij) in si.iter().enumerate() {
-                                    put(a + i, bb + j, sij);
-                                }
-                            }
-                        } else {
-                            for (i, si) in sum.iter().enumerate() {
-                                for (j, &sij) in si.iter().enumerate().take(i + 1) {
-                                    put(a + i, bb + j, sij);
-                                }
-                            }
-                        }
-                        bb += 3;
-                        continue;
-                    }
-                    let mut sum = [0.0f64; 3];
-                    for (&yt, &k) in yrow(q, pq.len()).iter().zip(pq) {
-                        // SAFETY: k < nv ≤ x3.len() (the sweeps' check)
-                        let xk = unsafe { *x3.get_unchecked(k) };
-                        for (si, &xi) in sum.iter_mut().zip(&xk) {
-                            *si += yt * xi;
-                        }
-                    }
-                    for (i, &si) in sum.iter().enumerate() {
-                        put(a + i, bb, si);
-                    }
-                    bb += 1;
-                }
-                for &k in pa {
-                    self.x3[k] = [0.0; 3];
-                }
-                a += 3;
-                continue;
-            }
-            if a < from {
-                a += 1;
-                continue;
-            }
-            let yr = yrow(r, pa.len());
-            for (&yt, &k) in yr.iter().zip(pa) {
-                self.x[k] = yt;
-            }
-            // rows q on one path (a contact's three) summed side by side:
-            // each entry the same sum in the same order
-            let x = &self.x[..];
-            let mut bb = 0;
-            while bb <= a {
-                let q = rows[bb];
-                let pq = path(q);
-                if three[bb] {
-                    let (mut s0, mut s1, mut s2) = (0.0, 0.0, 0.0);
-                    if let Some(lq) = lanes.of(q, st, pq.len()) {
-                        [s0, s1, s2, _] = dot3(lq, pq, x);
-                    } else {
-                        let (y0, y1, y2) = (
-                            yrow(q, pq.len()),
-                            yrow(q + 1, pq.len()),
-                            yrow(q + 2, pq.len()),
-                        );
-                        for (t, &k) in pq.iter().enumerate() {
-                            // SAFETY: k < nv ≤ x.len() (the sweeps' check)
-                            let xk = unsafe { *x.get_unchecked(k) };
-                            s0 += y0[t] * xk;
-                            s1 += y1[t] * xk;
-                            s2 += y2[t] * xk;
-                        }
-                    }
-                    put(a, bb, s0);
-                    put(a, bb + 1, s1);
-                    put(a, bb + 2, s2);
-                    bb += 3;
-                    continue;
-                }
-                let mut s = 0.0;
-                for (&yt, &k) in yrow(q, pq.len()).iter().zip(pq) {
-                    // SAFETY: k < nv ≤ x.len() (the sweeps' check)
-                    s += yt * unsafe { *x.get_unchecked(k) };
-                }
-                put(a, bb, s);
-                bb += 1;
-            }
-            for &k in pa {
-                self.x[k] = 0.0;
-            }
-            a += 1;
-        }
-        true
-    }
-}
-
-/// The contacts' rows of Y interleaved (`Rows::ylanes`) and which rows are a
-/// contact's normal (`Rows::is_block`), for [`Subspace::form_w_ff`].
-#[derive(Clone, Copy)]
-pub(super) struct Lanes<'a> {
-    pub(super) contact: &'a [bool],
-    pub(super) ylanes: &'a [[f64; 4]],
-}
-
-impl<'a> Lanes<'a> {
-    /// The interleaved rows of the contact whose normal is row `q` (its path
-    /// `len` long), or `None` (not a contact's normal, or out of range).
-    #[inline]
-    fn of(&self, q: usize, st: usize, len: usize) -> Option<&'a [[f64; 4]]> {
-        if *self.contact.get(q)? && len <= st {
-            self.ylanes.get(q * st..q * st + len)
-        } else {
-            None
-        }
-    }
-}
-
-/// The 3 × 3 block Σₜ x3[pₜ][i] lₜ[j] (i, j < 3; lane 3 unused) of two
-/// contacts' rows: `l` one contact's rows interleaved over its path `p`, `x3`
-/// the other's scattered to full width; each entry a sum from 0 in path order
-/// (the scalar loop's); the indices of `p` must be < `x3.len()`.
-#[inline(always)]
-fn dot3x3(l: &[[f64; 4]], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 4]; 3] {
-    debug_assert!(p.iter().all(|&k| k < x3.len()));
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-    {
-        use std::arch::x86_64::*;
-        let mut s = [[0.0f64; 4]; 3];
-        // SAFETY: avx is enabled at compile time; every k < x3.len() (a
-        // path's dofs are < nv); `l`'s entries are 4 f64 each
-        unsafe {
-            let (mut a0, mut a1, mut a2) = (
-                _mm256_setzero_pd(),
-                _mm256_setzero_pd(),
-                _mm256_setzero_pd(),
-            );
-            for (lt, &k) in l.iter().zip(p) {
-                let z = _mm256_loadu_pd(lt.as_ptr());
-                let xk = x3.get_unchecked(k);
-                a0 = _mm256_add_pd(a0, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[0])));
-                a1 = _mm256_add_pd(a1, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[1])));
-                a2 = _mm256_add_pd(a2, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[2])));
-            }
-            _mm256_storeu_pd(s[0].as_mut_ptr(), a0);
-            _mm256_storeu_pd(s[1].as_mut_ptr(), a1);
-            _mm256_storeu_pd(s[2].as_mut_ptr(), a2);
-        }
-        s
-    }
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
-    {
-        let mut s = [[0.0f64; 4]; 3];
-        for (lt, &k) in l.iter().zip(p) {
-            let xk = x3[k];
-            for (si, &xi) in s.iter_mut().zip(&xk) {
-                for (sij, &zj) in si.iter_mut().zip(lt) {
-                    *sij += zj * xi;
-                }
-            }
-        }
-        s
     }
 }
 
@@ -543,19 +262,28 @@ pub(super) fn subspace_step(
     // is a row dependent on earlier ones (redundant contacts): dropped (δ = 0).
     // The rows' y are fixed within a solve: a step whose free rows begin
     // with those of this solve's last factor keeps the factor's rows there
-    // (a leading block's factor, the same bits, dense.rs) and forms and
-    // factors the rows after them only (all of them on the same free rows)
+    // (a leading block's factor, the same bits, dense.rs)
+    // and forms and factors the rows after them only (all of them on the same
+    // free rows), their entries with rows of that W_FF copied from it
     let kept = if sm.factored {
-        let same = sm.factored_rows.iter().zip(&sm.rows).take_while(|(p, q)| p == q);
+        let same = sm
+            .factored_rows
+            .iter()
+            .zip(&sm.rows)
+            .take_while(|(p, q)| p == q);
         sm.group_start(same.count())
     } else {
         0
     };
     if kept < m {
-        if !sm.form_w_ff(y, st, paths, table, lanes, nv, kept) {
+        if sm.factored {
+            sm.map_old();
+        }
+        if !sm.form_w_ff(y, st, paths, table, lanes, nv, kept, sm.factored) {
             sm.forget();
             return false;
         }
+        sm.keep_w_ff(kept);
         ldlt_dropping(&mut sm.w, sm.ld, m, kept, DEPENDENT);
     }
     sm.factored_rows.clone_from(&sm.rows);
