@@ -327,56 +327,58 @@ pub(super) fn subspace_step(
     // the free rows are a subsequence of this walk's rows (the scan above
     // took them in this order, each once): a cursor finds a row's place
     let mut next = 0;
-    for r in runs.iter().flat_map(|&(_, s, e)| s..e) {
-        if r + 1 >= n {
-            break;
-        }
-        let at = if sm.rows.get(next) == Some(&r) {
-            next += 1;
-            Some(next - 1)
-        } else {
-            None
-        };
-        let RowKind::Tangent { normal, mu } = kinds[r] else {
-            continue;
-        };
-        let lim = mu * lambda.get(normal).copied().unwrap_or(0.0).max(0.0);
-        let free = at;
-        let (t1, t2) = match free {
-            Some(a) if winv[r + 1] == 0.0 => (sm.lam[a], 0.0),
-            Some(a) if a + 1 < m => (sm.lam[a], sm.lam[a + 1]),
-            _ => (lambda[r], lambda[r + 1]),
-        };
-        let norm = (t1 * t1 + t2 * t2).sqrt();
-        let s = if norm > lim || (free.is_none() && sm.sliding[r]) {
-            if norm > 0.0 {
-                lim / norm
+    'walk: for &(_, s, e) in runs {
+        for r in s..e {
+            if r + 1 >= n {
+                break 'walk;
+            }
+            let at = if sm.rows.get(next) == Some(&r) {
+                next += 1;
+                Some(next - 1)
             } else {
-                0.0
-            }
-        } else {
-            1.0
-        };
-        let (n1, n2) = (t1 * s, t2 * s);
-        let (d1, d2) = (n1 - lambda[r], n2 - lambda[r + 1]);
-        lambda[r] = n1;
-        lambda[r + 1] = n2;
-        let p = path(r);
-        if d1 != 0.0 && d2 != 0.0 && paths[r + 1] == paths[r] {
-            // the pair on one path (a contact's) in one pass: each entry
-            // (x + d₁y₁) + d₂y₂, the row-by-row order
-            let (y1, y2) = (yrow(r, p.len()), yrow(r + 1, p.len()));
-            for ((&a, &b), &k) in y1.iter().zip(y2).zip(p) {
-                // SAFETY: a path's dofs are < nv ≤ dv.len() (the sweeps' check)
-                unsafe {
-                    let x = dv.get_unchecked_mut(k);
-                    *x = (*x + d1 * a) + d2 * b;
+                None
+            };
+            let RowKind::Tangent { normal, mu } = kinds[r] else {
+                continue;
+            };
+            let lim = mu * lambda.get(normal).copied().unwrap_or(0.0).max(0.0);
+            let free = at;
+            let (t1, t2) = match free {
+                Some(a) if winv[r + 1] == 0.0 => (sm.lam[a], 0.0),
+                Some(a) if a + 1 < m => (sm.lam[a], sm.lam[a + 1]),
+                _ => (lambda[r], lambda[r + 1]),
+            };
+            let norm = (t1 * t1 + t2 * t2).sqrt();
+            let s = if norm > lim || (free.is_none() && sm.sliding[r]) {
+                if norm > 0.0 {
+                    lim / norm
+                } else {
+                    0.0
                 }
+            } else {
+                1.0
+            };
+            let (n1, n2) = (t1 * s, t2 * s);
+            let (d1, d2) = (n1 - lambda[r], n2 - lambda[r + 1]);
+            lambda[r] = n1;
+            lambda[r + 1] = n2;
+            let p = path(r);
+            if d1 != 0.0 && d2 != 0.0 && paths[r + 1] == paths[r] {
+                // the pair on one path (a contact's) in one pass: each entry
+                // (x + d₁y₁) + d₂y₂, the row-by-row order
+                let (y1, y2) = (yrow(r, p.len()), yrow(r + 1, p.len()));
+                for ((&a, &b), &k) in y1.iter().zip(y2).zip(p) {
+                    // SAFETY: a path's dofs are < nv ≤ dv.len() (the sweeps' check)
+                    unsafe {
+                        let x = dv.get_unchecked_mut(k);
+                        *x = (*x + d1 * a) + d2 * b;
+                    }
+                }
+            } else {
+                add(p, yrow(r, p.len()), d1, dv);
+                let p2 = path(r + 1);
+                add(p2, yrow(r + 1, p2.len()), d2, dv);
             }
-        } else {
-            add(p, yrow(r, p.len()), d1, dv);
-            let p2 = path(r + 1);
-            add(p2, yrow(r + 1, p2.len()), d2, dv);
         }
     }
     true
