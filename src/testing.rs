@@ -365,3 +365,17 @@ pub mod view {
         crate::cli::view::visuals::read(text)
     }
 }
+
+/// The subspace step's dense LDLᵀ of W_FF (sim/solver/dense.rs).
+pub mod solver {
+    /// `sim::solver::dense::ldlt_dropping` (row i at `a[i * ld..]`, rows
+    /// before `from` factored already).
+    pub fn ldlt_dropping(a: &mut [f64], ld: usize, m: usize, from: usize, drop: f64) {
+        crate::sim::solver::dense::ldlt_dropping(a, ld, m, from, drop)
+    }
+
+    /// `sim::solver::dense::ldlt_dropping_solve`.
+    pub fn ldlt_dropping_solve(a: &[f64], ld: usize, m: usize, x: &mut [f64]) {
+        crate::sim::solver::dense::ldlt_dropping_solve(a, ld, m, x)
+    }
+}

@@ -19,6 +19,7 @@ mod mesh_dae;
 mod mesh_inertia;
 mod scene_srdf;
 mod sim_build;
+mod sim_dense;
 mod sim_factor;
 mod spatial;
 mod view_geometry;

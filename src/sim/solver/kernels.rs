@@ -39,6 +39,42 @@ pub(super) fn dot3(l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
     }
 }
 
+/// `s0` + Σₜ lₜ x[pₜ] in each of the four lanes (as [`dot3`], each lane's
+/// sum started from its `s0` instead of 0: ((s0 + l₀x) + l₁x) + …, the
+/// scalar loop `u += y x` from `u = s0`).
+#[inline(always)]
+pub(super) fn dot3_from(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
+    debug_assert!(p.iter().all(|&k| k < x.len()));
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    {
+        use std::arch::x86_64::*;
+        let mut s = s0;
+        // SAFETY: avx is enabled at compile time; every k < x.len() (the
+        // sweeps' check of the paths); `l`'s entries are 4 f64 each
+        unsafe {
+            let mut acc = _mm256_loadu_pd(s.as_ptr());
+            for (li, &k) in l.iter().zip(p) {
+                let xk = _mm256_broadcast_sd(x.get_unchecked(k));
+                acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_loadu_pd(li.as_ptr()), xk));
+            }
+            _mm256_storeu_pd(s.as_mut_ptr(), acc);
+        }
+        s
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+    {
+        let mut s = s0;
+        for (li, &k) in l.iter().zip(p) {
+            // SAFETY: every k < x.len() (the sweeps' check of the paths)
+            let xk = unsafe { *x.get_unchecked(k) };
+            for (si, &v) in s.iter_mut().zip(li) {
+                *si += v * xk;
+            }
+        }
+        s
+    }
+}
+
 /// The warm start of a contact's three rows: x[pₜ] = ((x[pₜ] + a₀ lₜ₀) + a₁ lₜ₁) +
 /// a₂ lₜ₂ over its path `p` (`l`: its rows of y interleaved, `Rows::ylanes`),
 /// each entry the same sum as three row-by-row updates (a path's dofs are

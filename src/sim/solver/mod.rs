@@ -19,7 +19,7 @@
 //! 0 ≤ μ ⊥ J w − b_pos ≥ 0 on the unilateral rows, b_pos = min(βφ⁻/Δt, cap),
 //! moves q but never enters v.
 
-mod dense;
+pub(crate) mod dense;
 mod form;
 mod kernels;
 mod loop_block;
@@ -27,6 +27,7 @@ mod pgs;
 mod position;
 mod stress;
 mod subspace;
+mod wff;
 
 pub(crate) use pgs::{IslandOut, Scratch};
 

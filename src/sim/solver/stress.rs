@@ -2,10 +2,10 @@
 //! that moves nothing, chosen least-norm
 //! (docs/theory.md §"Self-stress of a sticking stance").
 
-use super::dense::ldlt_dropping;
-use super::subspace::{Lanes, Subspace, DEPENDENT};
+use super::dense::{ldlt_dropping, ldlt_dropping_solve};
+use super::subspace::{Subspace, DEPENDENT};
+use super::wff::Lanes;
 use super::{RowKind, Rows, SUBSPACE_MAX};
-use crate::dynamics::linalg::ldlt_dropping_solve;
 
 impl Rows {
     /// Whether this step's solve of the island on `dofs` (`None`: every dof)
@@ -119,7 +119,8 @@ impl Rows {
             }
         }
         let m = sm.rows.len();
-        if m < 2 || m > SUBSPACE_MAX || sm.w.len() < m * m || sm.null.len() < m * m {
+        let ld = sm.ld;
+        if m < 2 || m > SUBSPACE_MAX || m > ld || sm.null.len() < m * m {
             return false;
         }
         // W_FF's lower triangle (as the subspace step forms it)
@@ -128,14 +129,17 @@ impl Rows {
             contact: &self.is_block,
             ylanes: &self.ylanes,
         };
-        sm.form_w_ff(&self.y, st, &self.path, table, lanes);
-        ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
+        sm.group(&self.path);
+        if !sm.form_w_ff(&self.y, st, &self.path, table, lanes, self.nv, 0, false) {
+            return false;
+        }
+        ldlt_dropping(&mut sm.w, ld, m, 0, DEPENDENT);
         // null vectors n = L⁻ᵀ eⱼ of the dropped rows j (L unit lower, a
         // dropped row's column below zero: n lives on j and the kept rows
         // before it)
         let mut d = 0;
         for j in 0..m {
-            if sm.w[j * m + j] != 0.0 {
+            if sm.w[j * ld + j] != 0.0 {
                 continue;
             }
             let col = &mut sm.null[d * m..(d + 1) * m];
@@ -144,7 +148,7 @@ impl Rows {
             for i in (0..j).rev() {
                 let mut s = 0.0;
                 for k in i + 1..=j {
-                    s -= sm.w[k * m + i] * col[k];
+                    s -= sm.w[k * ld + i] * col[k];
                 }
                 col[i] = s;
             }
@@ -170,8 +174,8 @@ impl Rows {
                 sm.gram[a * d + b] = s;
             }
         }
-        ldlt_dropping(&mut sm.gram[..d * d], d, 1e-12);
-        ldlt_dropping_solve(&sm.gram[..d * d], d, &mut sm.lam[..d]);
+        ldlt_dropping(&mut sm.gram[..d * d], d, d, 0, 1e-12);
+        ldlt_dropping_solve(&sm.gram[..d * d], d, d, &mut sm.lam[..d]);
         // the step N z (into rhs), the old impulses kept in x's first m
         // entries would clash with its use as a dof scratch: kept in `w`
         // (W_FF's factor is done with)

@@ -1,18 +1,25 @@
 //! The subspace-minimisation step of projected Gauss–Seidel (PGS-SM): the
 //! free rows solved exactly by a dense LDLᵀ.
 
-use super::dense::ldlt_dropping;
-use super::kernels::dot3;
+use super::dense::{ldlt_dropping, ldlt_dropping_solve};
+use super::kernels::dot3_from;
 use super::loop_block::LoopBlock;
+use super::wff::Lanes;
 use super::{RowKind, SUBSPACE_MAX};
-use crate::dynamics::linalg::ldlt_dropping_solve;
 
 /// Preallocated scratch of [`subspace_step`]: the free rows, their dense
 /// Delassus block and right-hand side, their Y rows scattered to full width.
 #[derive(Clone, Debug)]
 pub(super) struct Subspace {
     pub(super) rows: Vec<usize>,
+    /// At a free row: a contact's three rows start there ([`Subspace::group`];
+    /// the others false).
+    pub(super) three: Vec<bool>,
+    /// W_FF (lower triangle) or its factor, row a at `w[a * ld..]`: the
+    /// stride fixed (the most rows a step takes), so that a factor's leading
+    /// rows stay in place when rows are appended.
     pub(super) w: Vec<f64>,
+    pub(super) ld: usize,
     pub(super) rhs: Vec<f64>,
     pub(super) lam: Vec<f64>,
     /// A row scattered to full width (nv entries, zero between uses).
@@ -30,9 +37,13 @@ pub(super) struct Subspace {
     /// Their Gram matrix in the W-diagonal metric (stress.rs).
     pub(super) gram: Vec<f64>,
     /// `w` holds the LDLᵀ of W_FF over `factored_rows`, made in this solve
-    /// of an island's rows (cleared when one starts, [`Subspace::forget`]).
+    /// of an island's rows (cleared when one starts, [`Subspace::forget`]),
+    /// and `wf` that W_FF itself (lower triangle, row a at `wf[a * ld..]`).
     pub(super) factored: bool,
     pub(super) factored_rows: Vec<usize>,
+    pub(super) wf: Vec<f64>,
+    /// At a free row: its place in `factored_rows` (`usize::MAX`: not there).
+    pub(super) old: Vec<usize>,
 }
 
 impl Subspace {
@@ -40,7 +51,9 @@ impl Subspace {
         let m = cap.min(SUBSPACE_MAX);
         Self {
             rows: Vec::with_capacity(m),
+            three: Vec::with_capacity(m),
             w: vec![0.0; m * m],
+            ld: m,
             rhs: vec![0.0; m],
             lam: vec![0.0; m],
             x: vec![0.0; nv],
@@ -51,6 +64,8 @@ impl Subspace {
             gram: vec![0.0; m * m],
             factored: false,
             factored_rows: Vec::with_capacity(m),
+            wf: vec![0.0; m * m],
+            old: Vec::with_capacity(m),
         }
     }
 
@@ -58,231 +73,6 @@ impl Subspace {
     #[inline]
     pub(super) fn forget(&mut self) {
         self.factored = false;
-    }
-
-    /// The lower triangle of W_FF = Y_F Y_Fᵀ over `self.rows` (m of them) into
-    /// `self.w` (m × m, row-major): row r scattered onto its path's dofs in `x`
-    /// (zeros elsewhere, put back after), each entry then a sum over the other
-    /// row's path in its order. A dof off r's path adds y·0 = ±0, which leaves
-    /// every partial sum as it was: the same bits as summing over the two
-    /// paths' common dofs only, without the merge's branches (the cost follows
-    /// the rows' paths, never nv). Rows `r` of `y` have room `st`; row r's
-    /// dofs are `table[paths[r]]`. `x` must hold nv entries, `w` m². A
-    /// contact's three rows q are read from their interleaved copy (`lanes`,
-    /// `Rows::ylanes`), the three sums side by side in vector lanes: each the
-    /// same sum in the same order.
-    pub(super) fn form_w_ff(
-        &mut self,
-        y: &[f64],
-        st: usize,
-        paths: &[(usize, usize)],
-        table: &[usize],
-        lanes: Lanes,
-    ) {
-        let m = self.rows.len();
-        let path = |r: usize| {
-            let (s, l) = paths[r];
-            &table[s..s + l]
-        };
-        let rows = &self.rows[..];
-        // rows a.., q.. on one path from a: a contact's three rows
-        let three = |a: usize, hi: usize| {
-            let r = rows[a];
-            a + 2 <= hi
-                && rows[a + 1] == r + 1
-                && rows[a + 2] == r + 2
-                && paths[r + 1] == paths[r]
-                && paths[r + 2] == paths[r]
-        };
-        let yrow = |q: usize, len: usize| &y[q * st..q * st + len];
-        let mut a = 0;
-        while a < m {
-            let r = rows[a];
-            let pa = path(r);
-            if a + 2 < m && three(a, m - 1) {
-                // a contact's three rows at once: every entry (a + i, bb + j),
-                // bb + j ≤ a + i, the same sum in the same order as below
-                let (y0, y1, y2) = (
-                    yrow(r, pa.len()),
-                    yrow(r + 1, pa.len()),
-                    yrow(r + 2, pa.len()),
-                );
-                for (t, &k) in pa.iter().enumerate() {
-                    self.x3[k] = [y0[t], y1[t], y2[t]];
-                }
-                let x3 = &self.x3[..];
-                let hi = a + 2;
-                let mut bb = 0;
-                while bb <= hi {
-                    let q = rows[bb];
-                    let pq = path(q);
-                    if three(bb, hi) {
-                        let mut sum = [[0.0f64; 3]; 3];
-                        if let Some(lq) = lanes.of(q, st, pq.len()) {
-                            let s4 = dot3x3(lq, pq, x3);
-                            for (si, s4i) in sum.iter_mut().zip(&s4) {
-                                si.copy_from_slice(&s4i[..3]);
-                            }
-                        } else {
-                            let (z0, z1, z2) = (
-                                yrow(q, pq.len()),
-                                yrow(q + 1, pq.len()),
-                                yrow(q + 2, pq.len()),
-                            );
-                            for (t, &k) in pq.iter().enumerate() {
-                                let xk = x3[k];
-                                let zt = [z0[t], z1[t], z2[t]];
-                                for (si, &xi) in sum.iter_mut().zip(&xk) {
-                                    for (sij, &zj) in si.iter_mut().zip(&zt) {
-                                        *sij += zj * xi;
-                                    }
-                                }
-                            }
-                        }
-                        for (i, si) in sum.iter().enumerate() {
-                            for (j, &sij) in si.iter().enumerate() {
-                                if bb + j <= a + i {
-                                    self.w[(a + i) * m + bb + j] = sij;
-                                }
-                            }
-                        }
-                        bb += 3;
-                        continue;
-                    }
-                    let mut sum = [0.0f64; 3];
-                    for (&yt, &k) in yrow(q, pq.len()).iter().zip(pq) {
-                        let xk = x3[k];
-                        for (si, &xi) in sum.iter_mut().zip(&xk) {
-                            *si += yt * xi;
-                        }
-                    }
-                    for (i, &si) in sum.iter().enumerate() {
-                        if bb <= a + i {
-                            self.w[(a + i) * m + bb] = si;
-                        }
-                    }
-                    bb += 1;
-                }
-                for &k in pa {
-                    self.x3[k] = [0.0; 3];
-                }
-                a += 3;
-                continue;
-            }
-            let yr = yrow(r, pa.len());
-            for (&yt, &k) in yr.iter().zip(pa) {
-                self.x[k] = yt;
-            }
-            // rows q on one path (a contact's three) summed side by side:
-            // each entry the same sum in the same order
-            let x = &self.x[..];
-            let mut bb = 0;
-            while bb <= a {
-                let q = rows[bb];
-                let pq = path(q);
-                if three(bb, a) {
-                    let (mut s0, mut s1, mut s2) = (0.0, 0.0, 0.0);
-                    if let Some(lq) = lanes.of(q, st, pq.len()) {
-                        [s0, s1, s2, _] = dot3(lq, pq, x);
-                    } else {
-                        let (y0, y1, y2) = (
-                            yrow(q, pq.len()),
-                            yrow(q + 1, pq.len()),
-                            yrow(q + 2, pq.len()),
-                        );
-                        for (t, &k) in pq.iter().enumerate() {
-                            let xk = x[k];
-                            s0 += y0[t] * xk;
-                            s1 += y1[t] * xk;
-                            s2 += y2[t] * xk;
-                        }
-                    }
-                    self.w[a * m + bb] = s0;
-                    self.w[a * m + bb + 1] = s1;
-                    self.w[a * m + bb + 2] = s2;
-                    bb += 3;
-                    continue;
-                }
-                let mut s = 0.0;
-                for (&yt, &k) in yrow(q, pq.len()).iter().zip(pq) {
-                    s += yt * x[k];
-                }
-                self.w[a * m + bb] = s;
-                bb += 1;
-            }
-            for &k in pa {
-                self.x[k] = 0.0;
-            }
-            a += 1;
-        }
-    }
-}
-
-/// The contacts' rows of Y interleaved (`Rows::ylanes`) and which rows are a
-/// contact's normal (`Rows::is_block`), for [`Subspace::form_w_ff`].
-#[derive(Clone, Copy)]
-pub(super) struct Lanes<'a> {
-    pub(super) contact: &'a [bool],
-    pub(super) ylanes: &'a [[f64; 4]],
-}
-
-impl<'a> Lanes<'a> {
-    /// The interleaved rows of the contact whose normal is row `q` (its path
-    /// `len` long), or `None` (not a contact's normal, or out of range).
-    #[inline]
-    fn of(&self, q: usize, st: usize, len: usize) -> Option<&'a [[f64; 4]]> {
-        if *self.contact.get(q)? && len <= st {
-            self.ylanes.get(q * st..q * st + len)
-        } else {
-            None
-        }
-    }
-}
-
-/// The 3 × 3 block Σₜ x3[pₜ][i] lₜ[j] (i, j < 3; lane 3 unused) of two
-/// contacts' rows: `l` one contact's rows interleaved over its path `p`, `x3`
-/// the other's scattered to full width; each entry a sum from 0 in path order
-/// (the scalar loop's); the indices of `p` must be < `x3.len()`.
-#[inline(always)]
-fn dot3x3(l: &[[f64; 4]], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 4]; 3] {
-    debug_assert!(p.iter().all(|&k| k < x3.len()));
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-    {
-        use std::arch::x86_64::*;
-        let mut s = [[0.0f64; 4]; 3];
-        // SAFETY: avx is enabled at compile time; every k < x3.len() (a
-        // path's dofs are < nv); `l`'s entries are 4 f64 each
-        unsafe {
-            let (mut a0, mut a1, mut a2) = (
-                _mm256_setzero_pd(),
-                _mm256_setzero_pd(),
-                _mm256_setzero_pd(),
-            );
-            for (lt, &k) in l.iter().zip(p) {
-                let z = _mm256_loadu_pd(lt.as_ptr());
-                let xk = x3.get_unchecked(k);
-                a0 = _mm256_add_pd(a0, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[0])));
-                a1 = _mm256_add_pd(a1, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[1])));
-                a2 = _mm256_add_pd(a2, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[2])));
-            }
-            _mm256_storeu_pd(s[0].as_mut_ptr(), a0);
-            _mm256_storeu_pd(s[1].as_mut_ptr(), a1);
-            _mm256_storeu_pd(s[2].as_mut_ptr(), a2);
-        }
-        s
-    }
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
-    {
-        let mut s = [[0.0f64; 4]; 3];
-        for (lt, &k) in l.iter().zip(p) {
-            let xk = x3[k];
-            for (si, &xi) in s.iter_mut().zip(&xk) {
-                for (sij, &zj) in si.iter_mut().zip(lt) {
-                    *sij += zj * xi;
-                }
-            }
-        }
-        s
     }
 }
 
@@ -433,25 +223,26 @@ pub(super) fn subspace_step(
         RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
         _ => b[r],
     };
+    let lanes = Lanes { contact, ylanes };
+    sm.group(paths);
     let mut a = 0;
     while a < m {
         let r = sm.rows[a];
         let pa = path(r);
         let yr = |i: usize| &y[(r + i) * st..(r + i) * st + pa.len()];
-        if a + 2 < m
-            && sm.rows[a + 1] == r + 1
-            && sm.rows[a + 2] == r + 2
-            && paths[r + 1] == paths[r]
-            && paths[r + 2] == paths[r]
-        {
+        if sm.three[a] {
             // a contact's three rows in one pass, each sum in its order
-            let (y0, y1, y2) = (yr(0), yr(1), yr(2));
             let (mut u0, mut u1, mut u2) = (c[r], c[r + 1], c[r + 2]);
-            for (t, &k) in pa.iter().enumerate() {
-                let x = dv[k];
-                u0 += y0[t] * x;
-                u1 += y1[t] * x;
-                u2 += y2[t] * x;
+            if let Some(l) = lanes.of(r, st, pa.len()) {
+                [u0, u1, u2, _] = dot3_from([u0, u1, u2, 0.0], l, pa, dv);
+            } else {
+                let (y0, y1, y2) = (yr(0), yr(1), yr(2));
+                for (t, &k) in pa.iter().enumerate() {
+                    let x = dv[k];
+                    u0 += y0[t] * x;
+                    u1 += y1[t] * x;
+                    u2 += y2[t] * x;
+                }
             }
             sm.rhs[a] = target(r) - u0;
             sm.rhs[a + 1] = target(r + 1) - u1;
@@ -461,22 +252,43 @@ pub(super) fn subspace_step(
         }
         let mut u = c[r];
         for (&yt, &k) in yr(0).iter().zip(pa) {
-            u += yt * dv[k];
+            // SAFETY: a path's dofs are < nv ≤ dv.len() (checked above)
+            u += yt * unsafe { *dv.get_unchecked(k) };
         }
         sm.rhs[a] = target(r) - u;
         a += 1;
     }
     // W_FF = L D Lᵀ; a pivot that lost all but `DEPENDENT` of its diagonal
     // is a row dependent on earlier ones (redundant contacts): dropped (δ = 0).
-    // The rows' y are fixed within a solve: a step on the same free rows as
-    // the last one of this solve reuses its factor (the same bits)
-    if !(sm.factored && sm.factored_rows == sm.rows) {
-        sm.form_w_ff(y, st, paths, table, Lanes { contact, ylanes });
-        ldlt_dropping(&mut sm.w[..m * m], m, DEPENDENT);
-        sm.factored_rows.clone_from(&sm.rows);
-        sm.factored = true;
+    // The rows' y are fixed within a solve: a step whose free rows begin
+    // with those of this solve's last factor keeps the factor's rows there
+    // (a leading block's factor, the same bits, dense.rs)
+    // and forms and factors the rows after them only (all of them on the same
+    // free rows), their entries with rows of that W_FF copied from it
+    let kept = if sm.factored {
+        let same = sm
+            .factored_rows
+            .iter()
+            .zip(&sm.rows)
+            .take_while(|(p, q)| p == q);
+        sm.group_start(same.count())
+    } else {
+        0
+    };
+    if kept < m {
+        if sm.factored {
+            sm.map_old();
+        }
+        if !sm.form_w_ff(y, st, paths, table, lanes, nv, kept, sm.factored) {
+            sm.forget();
+            return false;
+        }
+        sm.keep_w_ff(kept);
+        ldlt_dropping(&mut sm.w, sm.ld, m, kept, DEPENDENT);
     }
-    ldlt_dropping_solve(&sm.w[..m * m], m, &mut sm.rhs[..m]);
+    sm.factored_rows.clone_from(&sm.rows);
+    sm.factored = true;
+    ldlt_dropping_solve(&sm.w, sm.ld, m, &mut sm.rhs[..m]);
     // the new impulses (none taken if one is not finite)
     for (a, &r) in sm.rows.iter().enumerate() {
         let x = lambda[r] + sm.rhs[a];
@@ -512,50 +324,61 @@ pub(super) fn subspace_step(
         let p = path(r);
         add(p, yrow(r, p.len()), d, dv);
     }
-    for r in runs.iter().flat_map(|&(_, s, e)| s..e) {
-        if r + 1 >= n {
-            break;
-        }
-        let RowKind::Tangent { normal, mu } = kinds[r] else {
-            continue;
-        };
-        let lim = mu * lambda.get(normal).copied().unwrap_or(0.0).max(0.0);
-        let free = sm.rows.iter().position(|&q| q == r);
-        let (t1, t2) = match free {
-            Some(a) if winv[r + 1] == 0.0 => (sm.lam[a], 0.0),
-            Some(a) if a + 1 < m => (sm.lam[a], sm.lam[a + 1]),
-            _ => (lambda[r], lambda[r + 1]),
-        };
-        let norm = (t1 * t1 + t2 * t2).sqrt();
-        let s = if norm > lim || (free.is_none() && sm.sliding[r]) {
-            if norm > 0.0 {
-                lim / norm
+    // the free rows are a subsequence of this walk's rows (the scan above
+    // took them in this order, each once): a cursor finds a row's place
+    let mut next = 0;
+    'walk: for &(_, s, e) in runs {
+        for r in s..e {
+            if r + 1 >= n {
+                break 'walk;
+            }
+            let at = if sm.rows.get(next) == Some(&r) {
+                next += 1;
+                Some(next - 1)
             } else {
-                0.0
-            }
-        } else {
-            1.0
-        };
-        let (n1, n2) = (t1 * s, t2 * s);
-        let (d1, d2) = (n1 - lambda[r], n2 - lambda[r + 1]);
-        lambda[r] = n1;
-        lambda[r + 1] = n2;
-        let p = path(r);
-        if d1 != 0.0 && d2 != 0.0 && paths[r + 1] == paths[r] {
-            // the pair on one path (a contact's) in one pass: each entry
-            // (x + d₁y₁) + d₂y₂, the row-by-row order
-            let (y1, y2) = (yrow(r, p.len()), yrow(r + 1, p.len()));
-            for ((&a, &b), &k) in y1.iter().zip(y2).zip(p) {
-                // SAFETY: a path's dofs are < nv ≤ dv.len() (the sweeps' check)
-                unsafe {
-                    let x = dv.get_unchecked_mut(k);
-                    *x = (*x + d1 * a) + d2 * b;
+                None
+            };
+            let RowKind::Tangent { normal, mu } = kinds[r] else {
+                continue;
+            };
+            let lim = mu * lambda.get(normal).copied().unwrap_or(0.0).max(0.0);
+            let free = at;
+            let (t1, t2) = match free {
+                Some(a) if winv[r + 1] == 0.0 => (sm.lam[a], 0.0),
+                Some(a) if a + 1 < m => (sm.lam[a], sm.lam[a + 1]),
+                _ => (lambda[r], lambda[r + 1]),
+            };
+            let norm = (t1 * t1 + t2 * t2).sqrt();
+            let s = if norm > lim || (free.is_none() && sm.sliding[r]) {
+                if norm > 0.0 {
+                    lim / norm
+                } else {
+                    0.0
                 }
+            } else {
+                1.0
+            };
+            let (n1, n2) = (t1 * s, t2 * s);
+            let (d1, d2) = (n1 - lambda[r], n2 - lambda[r + 1]);
+            lambda[r] = n1;
+            lambda[r + 1] = n2;
+            let p = path(r);
+            if d1 != 0.0 && d2 != 0.0 && paths[r + 1] == paths[r] {
+                // the pair on one path (a contact's) in one pass: each entry
+                // (x + d₁y₁) + d₂y₂, the row-by-row order
+                let (y1, y2) = (yrow(r, p.len()), yrow(r + 1, p.len()));
+                for ((&a, &b), &k) in y1.iter().zip(y2).zip(p) {
+                    // SAFETY: a path's dofs are < nv ≤ dv.len() (the sweeps' check)
+                    unsafe {
+                        let x = dv.get_unchecked_mut(k);
+                        *x = (*x + d1 * a) + d2 * b;
+                    }
+                }
+            } else {
+                add(p, yrow(r, p.len()), d1, dv);
+                let p2 = path(r + 1);
+                add(p2, yrow(r + 1, p2.len()), d2, dv);
             }
-        } else {
-            add(p, yrow(r, p.len()), d1, dv);
-            let p2 = path(r + 1);
-            add(p2, yrow(r + 1, p2.len()), d2, dv);
         }
     }
     true

@@ -1,0 +1,351 @@
+//! W_FF = Y_F Y_Fᵀ of the subspace step's free rows (subspace.rs, stress.rs):
+//! its lower triangle formed a pair of row groups at a time (a contact's
+//! three rows side by side), entries kept from the solve's last W_FF copied.
+
+use super::kernels::dot3;
+use super::subspace::Subspace;
+
+impl Subspace {
+    /// Marks where a contact's three rows start in `self.rows` (`three`): rows
+    /// r, r + 1, r + 2 in a row on one path, taken from the first row on (the
+    /// groups the residuals and W_FF are summed by).
+    pub(super) fn group(&mut self, paths: &[(usize, usize)]) {
+        let (rows, m) = (&self.rows[..], self.rows.len());
+        self.three.clear();
+        let mut a = 0;
+        while a < m {
+            let r = rows[a];
+            let t = a + 2 < m
+                && rows[a + 1] == r + 1
+                && rows[a + 2] == r + 2
+                && paths[r + 1] == paths[r]
+                && paths[r + 2] == paths[r];
+            self.three.push(t);
+            if t {
+                self.three.extend([false, false]);
+                a += 3;
+            } else {
+                a += 1;
+            }
+        }
+    }
+
+    /// The start of the group ([`Subspace::group`]) that holds free row `p`
+    /// (`p` itself at or past the end).
+    pub(super) fn group_start(&self, p: usize) -> usize {
+        let mut a = 0;
+        while a < p.min(self.three.len()) {
+            let next = if self.three[a] { a + 3 } else { a + 1 };
+            if next > p {
+                return a;
+            }
+            a = next;
+        }
+        p
+    }
+
+    /// Where each free row was in the last factor's rows (`old`, [`NEW`]
+    /// where it was not): both lists are in row order, so one merge.
+    pub(super) fn map_old(&mut self) {
+        self.old.clear();
+        let mut o = 0;
+        for &r in &self.rows {
+            while o < self.factored_rows.len() && self.factored_rows[o] < r {
+                o += 1;
+            }
+            if self.factored_rows.get(o) == Some(&r) {
+                self.old.push(o);
+                o += 1;
+            } else {
+                self.old.push(NEW);
+            }
+        }
+    }
+
+    /// The lower triangle of W_FF = Y_F Y_Fᵀ over `self.rows` (m of them) into
+    /// `self.w` (row a at `w[a * ld..]`), its rows from `from` on (a group's
+    /// start, [`Subspace::group`], which must have been run on these rows):
+    /// row r scattered onto its path's dofs in `x` (zeros elsewhere, put back
+    /// after), each entry then a sum over the other row's path in its order.
+    /// A dof off r's path adds y·0 = ±0, which leaves every partial sum as it
+    /// was: the same bits as summing over the two paths' common dofs only,
+    /// without the merge's branches (the cost follows the rows' paths, never
+    /// nv). Rows `r` of `y` have room `st`; row r's dofs are
+    /// `table[paths[r]]`, each < nv (the sweeps' check). `x` must hold nv
+    /// entries, `w` m · ld. A contact's three rows q are read from their
+    /// interleaved copy (`lanes`, `Rows::ylanes`), the three sums side by side
+    /// in vector lanes: each the same sum in the same order. With `reuse`
+    /// (`old` mapped, [`Subspace::map_old`]), an entry between two groups of
+    /// rows all in the last W_FF (`wf`) is copied from there: the same sum,
+    /// whichever group it was summed in. Returns whether it was formed
+    /// (false: the scratch does not fit these rows).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn form_w_ff(
+        &mut self,
+        y: &[f64],
+        st: usize,
+        paths: &[(usize, usize)],
+        table: &[usize],
+        lanes: Lanes,
+        nv: usize,
+        from: usize,
+        reuse: bool,
+    ) -> bool {
+        let (m, ld) = (self.rows.len(), self.ld);
+        if m > ld
+            || self.w.len() < m * ld
+            || self.three.len() != m
+            || self.x.len() < nv
+            || self.x3.len() < nv
+            || (reuse && (self.old.len() != m || self.wf.len() < m * ld))
+        {
+            return false;
+        }
+        let Self {
+            rows,
+            three,
+            w,
+            wf,
+            old,
+            x,
+            x3,
+            ..
+        } = self;
+        let (rows, three, wf, old) = (&rows[..], &three[..], &wf[..], &old[..]);
+        let path = |r: usize| {
+            let (s, l) = paths[r];
+            &table[s..s + l]
+        };
+        let w = &mut w[..m * ld];
+        let yrow = |q: usize, len: usize| &y[q * st..q * st + len];
+        // SAFETY (the writes below): every (i, j) written has i < m, j ≤ i
+        let mut put = |i: usize, j: usize, v: f64| unsafe { *w.get_unchecked_mut(i * ld + j) = v };
+        let known = |a: usize, s: usize| reuse && old[a..a + s].iter().all(|&o| o != NEW);
+        let mut a = 0;
+        while a < m {
+            let sa = if three[a] { 3 } else { 1 };
+            if a < from {
+                a += sa;
+                continue;
+            }
+            let r = rows[a];
+            let pa = path(r);
+            let a_known = known(a, sa);
+            let mut scattered = false;
+            let mut bb = 0;
+            while bb <= a {
+                let sb = if three[bb] { 3 } else { 1 };
+                if a_known && known(bb, sb) {
+                    // both in the last W_FF: its entries (old places keep
+                    // the order, so (a + i, bb + j) stays in its lower triangle)
+                    for i in 0..sa {
+                        for j in 0..sb {
+                            if bb + j <= a + i {
+                                put(a + i, bb + j, wf[old[a + i] * ld + old[bb + j]]);
+                            }
+                        }
+                    }
+                    bb += sb;
+                    continue;
+                }
+                if !scattered {
+                    scattered = true;
+                    if sa == 3 {
+                        let (y0, y1, y2) = (
+                            yrow(r, pa.len()),
+                            yrow(r + 1, pa.len()),
+                            yrow(r + 2, pa.len()),
+                        );
+                        for (t, &k) in pa.iter().enumerate() {
+                            x3[k] = [y0[t], y1[t], y2[t]];
+                        }
+                    } else {
+                        for (&yt, &k) in yrow(r, pa.len()).iter().zip(pa) {
+                            x[k] = yt;
+                        }
+                    }
+                }
+                let q = rows[bb];
+                let pq = path(q);
+                match (sa, sb) {
+                    (3, 3) => {
+                        // a contact's three rows against another's: every
+                        // entry (a + i, bb + j), bb + j ≤ a + i, the same sum
+                        // in the same order as the single rows' below
+                        let mut sum = [[0.0f64; 3]; 3];
+                        if let Some(lq) = lanes.of(q, st, pq.len()) {
+                            let s4 = dot3x3(lq, pq, x3);
+                            for (si, s4i) in sum.iter_mut().zip(&s4) {
+                                si.copy_from_slice(&s4i[..3]);
+                            }
+                        } else {
+                            let (z0, z1, z2) = (
+                                yrow(q, pq.len()),
+                                yrow(q + 1, pq.len()),
+                                yrow(q + 2, pq.len()),
+                            );
+                            for (t, &k) in pq.iter().enumerate() {
+                                // SAFETY: k < nv ≤ x3.len() (the sweeps' check)
+                                let xk = unsafe { *x3.get_unchecked(k) };
+                                let zt = [z0[t], z1[t], z2[t]];
+                                for (si, &xi) in sum.iter_mut().zip(&xk) {
+                                    for (sij, &zj) in si.iter_mut().zip(&zt) {
+                                        *sij += zj * xi;
+                                    }
+                                }
+                            }
+                        }
+                        for (i, si) in sum.iter().enumerate() {
+                            for (j, &sij) in si.iter().enumerate() {
+                                if bb + j <= a + i {
+                                    put(a + i, bb + j, sij);
+                                }
+                            }
+                        }
+                    }
+                    (3, _) => {
+                        let mut sum = [0.0f64; 3];
+                        for (&yt, &k) in yrow(q, pq.len()).iter().zip(pq) {
+                            // SAFETY: k < nv ≤ x3.len() (the sweeps' check)
+                            let xk = unsafe { *x3.get_unchecked(k) };
+                            for (si, &xi) in sum.iter_mut().zip(&xk) {
+                                *si += yt * xi;
+                            }
+                        }
+                        for (i, &si) in sum.iter().enumerate() {
+                            put(a + i, bb, si);
+                        }
+                    }
+                    (_, 3) => {
+                        // rows q on one path (a contact's three) summed side
+                        // by side: each entry the same sum in the same order
+                        let (mut s0, mut s1, mut s2) = (0.0, 0.0, 0.0);
+                        if let Some(lq) = lanes.of(q, st, pq.len()) {
+                            [s0, s1, s2, _] = dot3(lq, pq, x);
+                        } else {
+                            let (y0, y1, y2) = (
+                                yrow(q, pq.len()),
+                                yrow(q + 1, pq.len()),
+                                yrow(q + 2, pq.len()),
+                            );
+                            for (t, &k) in pq.iter().enumerate() {
+                                // SAFETY: k < nv ≤ x.len() (the sweeps' check)
+                                let xk = unsafe { *x.get_unchecked(k) };
+                                s0 += y0[t] * xk;
+                                s1 += y1[t] * xk;
+                                s2 += y2[t] * xk;
+                            }
+                        }
+                        put(a, bb, s0);
+                        put(a, bb + 1, s1);
+                        put(a, bb + 2, s2);
+                    }
+                    _ => {
+                        let mut s = 0.0;
+                        for (&yt, &k) in yrow(q, pq.len()).iter().zip(pq) {
+                            // SAFETY: k < nv ≤ x.len() (the sweeps' check)
+                            s += yt * unsafe { *x.get_unchecked(k) };
+                        }
+                        put(a, bb, s);
+                    }
+                }
+                bb += sb;
+            }
+            if scattered {
+                if sa == 3 {
+                    for &k in pa {
+                        x3[k] = [0.0; 3];
+                    }
+                } else {
+                    for &k in pa {
+                        x[k] = 0.0;
+                    }
+                }
+            }
+            a += sa;
+        }
+        true
+    }
+
+    /// Keeps W_FF's rows `from..` (in `w`, about to be factored) in `wf`.
+    pub(super) fn keep_w_ff(&mut self, from: usize) {
+        let (m, ld) = (self.rows.len(), self.ld);
+        for a in from..m.min(ld) {
+            let i = a * ld;
+            if let (Some(d), Some(s)) = (self.wf.get_mut(i..=i + a), self.w.get(i..=i + a)) {
+                d.copy_from_slice(s);
+            }
+        }
+    }
+}
+
+/// A free row not in the last factor ([`Subspace::map_old`]).
+const NEW: usize = usize::MAX;
+
+/// The contacts' rows of Y interleaved (`Rows::ylanes`) and which rows are a
+/// contact's normal (`Rows::is_block`), for [`Subspace::form_w_ff`].
+#[derive(Clone, Copy)]
+pub(super) struct Lanes<'a> {
+    pub(super) contact: &'a [bool],
+    pub(super) ylanes: &'a [[f64; 4]],
+}
+
+impl<'a> Lanes<'a> {
+    /// The interleaved rows of the contact whose normal is row `q` (its path
+    /// `len` long), or `None` (not a contact's normal, or out of range).
+    #[inline]
+    pub(super) fn of(&self, q: usize, st: usize, len: usize) -> Option<&'a [[f64; 4]]> {
+        if *self.contact.get(q)? && len <= st {
+            self.ylanes.get(q * st..q * st + len)
+        } else {
+            None
+        }
+    }
+}
+
+/// The 3 × 3 block Σₜ x3[pₜ][i] lₜ[j] (i, j < 3; lane 3 unused) of two
+/// contacts' rows: `l` one contact's rows interleaved over its path `p`, `x3`
+/// the other's scattered to full width; each entry a sum from 0 in path order
+/// (the scalar loop's); the indices of `p` must be < `x3.len()`.
+#[inline(always)]
+fn dot3x3(l: &[[f64; 4]], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 4]; 3] {
+    debug_assert!(p.iter().all(|&k| k < x3.len()));
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    {
+        use std::arch::x86_64::*;
+        let mut s = [[0.0f64; 4]; 3];
+        // SAFETY: avx is enabled at compile time; every k < x3.len() (a
+        // path's dofs are < nv); `l`'s entries are 4 f64 each
+        unsafe {
+            let (mut a0, mut a1, mut a2) = (
+                _mm256_setzero_pd(),
+                _mm256_setzero_pd(),
+                _mm256_setzero_pd(),
+            );
+            for (lt, &k) in l.iter().zip(p) {
+                let z = _mm256_loadu_pd(lt.as_ptr());
+                let xk = x3.get_unchecked(k);
+                a0 = _mm256_add_pd(a0, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[0])));
+                a1 = _mm256_add_pd(a1, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[1])));
+                a2 = _mm256_add_pd(a2, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[2])));
+            }
+            _mm256_storeu_pd(s[0].as_mut_ptr(), a0);
+            _mm256_storeu_pd(s[1].as_mut_ptr(), a1);
+            _mm256_storeu_pd(s[2].as_mut_ptr(), a2);
+        }
+        s
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+    {
+        let mut s = [[0.0f64; 4]; 3];
+        for (lt, &k) in l.iter().zip(p) {
+            let xk = x3[k];
+            for (si, &xi) in s.iter_mut().zip(&xk) {
+                for (sij, &zj) in si.iter_mut().zip(lt) {
+                    *sij += zj * xi;
+                }
+            }
+        }
+        s
+    }
+}
