@@ -7,6 +7,40 @@ use super::super::factor_dense::dense_forward;
 use super::MassFactor;
 use crate::dynamics::linalg::by_size;
 
+/// `pub fn NAME<const A: usize, const B: usize>(&self, path, w, …)`: rows on
+/// a path of two trees' chains (`A` dofs then `B`), one or more right-hand
+/// sides `w` (each with the names of its two halves), each chain eliminated
+/// on its own by `ELIM` (one body for one and two sides).
+macro_rules! two_chain_lanes {
+    ($(#[$m:meta])* $name:ident, $elim:ident, $($w:ident / $wa:ident / $wb:ident),+) => {
+        $(#[$m])*
+        #[inline(always)]
+        pub fn $name<const A: usize, const B: usize>(
+            &self,
+            path: &[usize],
+            $($w: &mut [[f64; 4]]),+
+        ) -> bool {
+            if !(self.tree && path.len() == A + B $(&& $w.len() == A + B)+) {
+                return false;
+            }
+            let (pa, pb) = path.split_at(A);
+            if !(self.is_chain(pa) && self.is_chain(pb)) {
+                return false;
+            }
+            $(let ($wa, $wb) = $w.split_at_mut(A);)+
+            match (
+                ($(<&mut [[f64; 4]; A]>::try_from($wa),)+),
+                ($(<&mut [[f64; 4]; B]>::try_from($wb),)+),
+            ) {
+                (($(Ok($wa),)+), ($(Ok($wb),)+)) => {
+                    self.$elim::<B>(pb, $($wb),+) && self.$elim::<A>(pa, $($wa),+)
+                }
+                _ => false,
+            }
+        }
+    };
+}
+
 impl MassFactor {
     /// y ← R⁻ᵀ y for a row held compactly over `path` (`y[t]` is the entry of
     /// dof `path[t]`; the row is zero off the path).
@@ -197,67 +231,25 @@ impl MassFactor {
         self.tree && path.len() == N && self.is_chain(path) && self.chain_elim::<N>(path, w)
     }
 
-    /// [`Self::row_transform_lanes`] of rows held in registers on a path of
-    /// `A + B` dofs that is two trees' chains, root … leaf each (a contact's
-    /// three rows between two free bodies: every contact of a pile): L is zero
-    /// between the trees, so each chain is eliminated on its own, each lane's
-    /// entry taking the same operations in the same order (the same bits).
-    /// False where the factor is dense or `path` is not two such chains.
-    #[inline(always)]
-    pub fn two_chain_lanes<const A: usize, const B: usize>(
-        &self,
-        path: &[usize],
-        w: &mut [[f64; 4]],
-    ) -> bool {
-        if !(self.tree && path.len() == A + B && w.len() == A + B) {
-            return false;
-        }
-        let (pa, pb) = path.split_at(A);
-        if !(self.is_chain(pa) && self.is_chain(pb)) {
-            return false;
-        }
-        let (wa, wb) = w.split_at_mut(A);
-        match (
-            <&mut [[f64; 4]; A]>::try_from(wa),
-            <&mut [[f64; 4]; B]>::try_from(wb),
-        ) {
-            (Ok(wa), Ok(wb)) => self.chain_elim::<B>(pb, wb) && self.chain_elim::<A>(pa, wa),
-            _ => false,
-        }
+    two_chain_lanes! {
+        /// [`Self::row_transform_lanes`] of rows held in registers on a path
+        /// of `A + B` dofs that is two trees' chains, root … leaf each (a
+        /// contact's three rows between two free bodies: every contact of a
+        /// pile): L is zero between the trees, so each chain is eliminated on
+        /// its own, each lane's entry taking the same operations in the same
+        /// order (the same bits). False where the factor is dense or `path` is
+        /// not two such chains.
+        two_chain_lanes, chain_elim, w / wa / wb
     }
 
-    /// [`Self::two_chain_lanes`] of two contacts' rows on the same path (two
-    /// contacts between the same two free bodies), `w` and `v`: one walk of L
-    /// for both, each lane's entry taking the same operations in the same
-    /// order as [`Self::two_chain_lanes`] alone (the same bits). False where
-    /// the factor is dense or `path` is not two such chains.
-    #[inline(always)]
-    pub fn two_chain_lanes2<const A: usize, const B: usize>(
-        &self,
-        path: &[usize],
-        w: &mut [[f64; 4]],
-        v: &mut [[f64; 4]],
-    ) -> bool {
-        if !(self.tree && path.len() == A + B && w.len() == A + B && v.len() == A + B) {
-            return false;
-        }
-        let (pa, pb) = path.split_at(A);
-        if !(self.is_chain(pa) && self.is_chain(pb)) {
-            return false;
-        }
-        let (wa, wb) = w.split_at_mut(A);
-        let (va, vb) = v.split_at_mut(A);
-        match (
-            <&mut [[f64; 4]; A]>::try_from(wa),
-            <&mut [[f64; 4]; B]>::try_from(wb),
-            <&mut [[f64; 4]; A]>::try_from(va),
-            <&mut [[f64; 4]; B]>::try_from(vb),
-        ) {
-            (Ok(wa), Ok(wb), Ok(va), Ok(vb)) => {
-                self.chain_elim2::<B>(pb, wb, vb) && self.chain_elim2::<A>(pa, wa, va)
-            }
-            _ => false,
-        }
+    two_chain_lanes! {
+        /// [`Self::two_chain_lanes`] of two contacts' rows on the same path
+        /// (two contacts between the same two free bodies), `w` and `v`: one
+        /// walk of L for both, each lane's entry taking the same operations
+        /// in the same order as [`Self::two_chain_lanes`] alone (the same
+        /// bits). False where the factor is dense or `path` is not two such
+        /// chains.
+        two_chain_lanes2, chain_elim2, w / wa / wb, v / va / vb
     }
 
     /// [`Self::chain_elim`] of two right-hand sides `w`, `v` on one chain path:
