@@ -20,13 +20,10 @@ macro_rules! two_chain_lanes {
             path: &[usize],
             $($w: &mut [[f64; 4]]),+
         ) -> bool {
-            if !(self.tree && path.len() == A + B $(&& $w.len() == A + B)+) {
+            if !(self.two_chains::<A, B>(path) $(&& $w.len() == A + B)+) {
                 return false;
             }
             let (pa, pb) = path.split_at(A);
-            if !(self.is_chain(pa) && self.is_chain(pb)) {
-                return false;
-            }
             $(let ($wa, $wb) = $w.split_at_mut(A);)+
             match (
                 ($(<&mut [[f64; 4]; A]>::try_from($wa),)+),
@@ -229,6 +226,16 @@ impl MassFactor {
     #[inline(always)]
     pub fn chain_lanes<const N: usize>(&self, path: &[usize], w: &mut [[f64; 4]; N]) -> bool {
         self.tree && path.len() == N && self.is_chain(path) && self.chain_elim::<N>(path, w)
+    }
+
+    /// Whether `path` is two trees' chains, root … leaf each, of `A` dofs
+    /// then `B` (a tree factor's; what [`Self::two_chain_lanes`] takes).
+    #[inline(always)]
+    pub fn two_chains<const A: usize, const B: usize>(&self, path: &[usize]) -> bool {
+        self.tree && path.len() == A + B && {
+            let (pa, pb) = path.split_at(A);
+            self.is_chain(pa) && self.is_chain(pb)
+        }
     }
 
     two_chain_lanes! {

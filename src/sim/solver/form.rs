@@ -247,7 +247,9 @@ impl Rows {
         let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..(r + 6) * st)) else {
             return false;
         };
-        if N > st || path.iter().any(|&d| d >= vfree.len()) {
+        // (the shape first: a robot's foot, one 12-dof chain, is not two
+        // chains, and its rows are not gathered twice)
+        if N > st || !f.two_chains::<6, 6>(path) || path.iter().any(|&d| d >= vfree.len()) {
             return false;
         }
         let (mut w, mut v) = ([[0.0f64; 4]; N], [[0.0f64; 4]; N]);
