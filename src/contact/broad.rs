@@ -449,8 +449,8 @@ impl PairMasks {
             if allowed == 0 {
                 continue;
             }
-            let q = &self.quads[l / 4][..];
-            let lbox = [0, 1, 2, 3, 4, 5].map(|a| q[a][l % 4]);
+            let (q, i) = (&self.quads[l / 4], l % 4);
+            let lbox = [q[0][i], q[1][i], q[2][i], q[3][i], q[4][i], q[5][i]];
             // bit h: boxes l and h overlap (apart: one's lower corner above
             // the other's upper one along an axis), 4 shapes h at a time
             let mut mask = 0u64;

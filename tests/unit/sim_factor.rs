@@ -92,3 +92,69 @@ fn a_failed_pivot_names_its_dof_inside_a_pair_and_alone() {
         assert_eq!(r, Some(Err(bad)), "dof {bad}");
     }
 }
+
+/// A contact's three rows through the factor held as lanes
+/// (`row_transform_lanes`: a chain, or two branches of one tree found once
+/// for the path) take the bits of the three rows taken apart
+/// (`row_transform3`, which looks up each dof's ancestors): on every chain of
+/// humanoid_CMU and on every pair of its dofs on two branches (the union of
+/// their paths, as a self-collision contact's).
+#[test]
+fn rows_as_lanes_take_the_bits_of_rows_apart_on_chains_and_two_branches() {
+    let m = mjcf("dm_control/humanoid_CMU.xml");
+    let q = pose(&m);
+    let mut f = MassFactor::new(&m);
+    let mut data = Data::new(&m);
+    let diag = |k: usize| 0.01 + 0.001 * k as f64;
+    assert_eq!(
+        f.factor_at(&m, &mut data, q.as_slice(), false, diag),
+        Some(Ok(()))
+    );
+    let nv = m.nv;
+    // dof d and its ancestors, ascending
+    let chain = |d: usize| {
+        let mut p = vec![d];
+        while let Some(&a) = p.last().and_then(|&k| m.dof_parent.get(k)) {
+            if a == usize::MAX {
+                break;
+            }
+            p.push(a);
+        }
+        p.reverse();
+        p
+    };
+    let mut paths = Vec::new();
+    let mut branches = 0;
+    for a in 0..nv {
+        paths.push(chain(a));
+        for b in a + 1..nv {
+            let (pa, pb) = (chain(a), chain(b));
+            if pb.contains(&a) {
+                continue;
+            }
+            let mut u: Vec<usize> = pa.iter().chain(&pb).copied().collect();
+            u.sort_unstable();
+            u.dedup();
+            branches += 1;
+            paths.push(u);
+        }
+    }
+    assert!(branches > 100, "{branches} pairs on two branches");
+    for (i, path) in paths.iter().enumerate() {
+        let n = path.len();
+        let row = |r: usize| -> Vec<f64> {
+            (0..n)
+                .map(|t| ((1 + i + 7 * r + 3 * t) as f64 * 0.37).sin())
+                .collect()
+        };
+        let (mut y0, mut y1, mut y2) = (row(0), row(1), row(2));
+        let mut lanes: Vec<[f64; 4]> = (0..n).map(|t| [y0[t], y1[t], y2[t], 0.0]).collect();
+        f.row_transform3(path, &mut y0, &mut y1, &mut y2);
+        assert!(f.row_transform_lanes(path, &mut lanes), "path {path:?}");
+        for t in 0..n {
+            let want = [y0[t], y1[t], y2[t]].map(f64::to_bits);
+            let got = [lanes[t][0], lanes[t][1], lanes[t][2]].map(f64::to_bits);
+            assert_eq!(got, want, "path {path:?}, entry {t}");
+        }
+    }
+}

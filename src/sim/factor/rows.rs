@@ -7,6 +7,37 @@ use super::super::factor_dense::dense_forward;
 use super::MassFactor;
 use crate::dynamics::linalg::by_size;
 
+/// `pub fn NAME<const A: usize, const B: usize>(&self, path, w, …)`: rows on
+/// a path of two trees' chains (`A` dofs then `B`), one or more right-hand
+/// sides `w` (each with the names of its two halves), each chain eliminated
+/// on its own by `ELIM` (one body for one and two sides).
+macro_rules! two_chain_lanes {
+    ($(#[$m:meta])* $name:ident, $elim:ident, $($w:ident / $wa:ident / $wb:ident),+) => {
+        $(#[$m])*
+        #[inline(always)]
+        pub fn $name<const A: usize, const B: usize>(
+            &self,
+            path: &[usize],
+            $($w: &mut [[f64; 4]]),+
+        ) -> bool {
+            if !(self.two_chains::<A, B>(path) $(&& $w.len() == A + B)+) {
+                return false;
+            }
+            let (pa, pb) = path.split_at(A);
+            $(let ($wa, $wb) = $w.split_at_mut(A);)+
+            match (
+                ($(<&mut [[f64; 4]; A]>::try_from($wa),)+),
+                ($(<&mut [[f64; 4]; B]>::try_from($wb),)+),
+            ) {
+                (($(Ok($wa),)+), ($(Ok($wb),)+)) => {
+                    self.$elim::<B>(pb, $($wb),+) && self.$elim::<A>(pa, $($wa),+)
+                }
+                _ => false,
+            }
+        }
+    };
+}
+
 impl MassFactor {
     /// y ← R⁻ᵀ y for a row held compactly over `path` (`y[t]` is the entry of
     /// dof `path[t]`; the row is zero off the path).
@@ -197,67 +228,35 @@ impl MassFactor {
         self.tree && path.len() == N && self.is_chain(path) && self.chain_elim::<N>(path, w)
     }
 
-    /// [`Self::row_transform_lanes`] of rows held in registers on a path of
-    /// `A + B` dofs that is two trees' chains, root … leaf each (a contact's
-    /// three rows between two free bodies: every contact of a pile): L is zero
-    /// between the trees, so each chain is eliminated on its own, each lane's
-    /// entry taking the same operations in the same order (the same bits).
-    /// False where the factor is dense or `path` is not two such chains.
+    /// Whether `path` is two trees' chains, root … leaf each, of `A` dofs
+    /// then `B` (a tree factor's; what [`Self::two_chain_lanes`] takes).
     #[inline(always)]
-    pub fn two_chain_lanes<const A: usize, const B: usize>(
-        &self,
-        path: &[usize],
-        w: &mut [[f64; 4]],
-    ) -> bool {
-        if !(self.tree && path.len() == A + B && w.len() == A + B) {
-            return false;
-        }
-        let (pa, pb) = path.split_at(A);
-        if !(self.is_chain(pa) && self.is_chain(pb)) {
-            return false;
-        }
-        let (wa, wb) = w.split_at_mut(A);
-        match (
-            <&mut [[f64; 4]; A]>::try_from(wa),
-            <&mut [[f64; 4]; B]>::try_from(wb),
-        ) {
-            (Ok(wa), Ok(wb)) => self.chain_elim::<B>(pb, wb) && self.chain_elim::<A>(pa, wa),
-            _ => false,
+    pub fn two_chains<const A: usize, const B: usize>(&self, path: &[usize]) -> bool {
+        self.tree && path.len() == A + B && {
+            let (pa, pb) = path.split_at(A);
+            self.is_chain(pa) && self.is_chain(pb)
         }
     }
 
-    /// [`Self::two_chain_lanes`] of two contacts' rows on the same path (two
-    /// contacts between the same two free bodies), `w` and `v`: one walk of L
-    /// for both, each lane's entry taking the same operations in the same
-    /// order as [`Self::two_chain_lanes`] alone (the same bits). False where
-    /// the factor is dense or `path` is not two such chains.
-    #[inline(always)]
-    pub fn two_chain_lanes2<const A: usize, const B: usize>(
-        &self,
-        path: &[usize],
-        w: &mut [[f64; 4]],
-        v: &mut [[f64; 4]],
-    ) -> bool {
-        if !(self.tree && path.len() == A + B && w.len() == A + B && v.len() == A + B) {
-            return false;
-        }
-        let (pa, pb) = path.split_at(A);
-        if !(self.is_chain(pa) && self.is_chain(pb)) {
-            return false;
-        }
-        let (wa, wb) = w.split_at_mut(A);
-        let (va, vb) = v.split_at_mut(A);
-        match (
-            <&mut [[f64; 4]; A]>::try_from(wa),
-            <&mut [[f64; 4]; B]>::try_from(wb),
-            <&mut [[f64; 4]; A]>::try_from(va),
-            <&mut [[f64; 4]; B]>::try_from(vb),
-        ) {
-            (Ok(wa), Ok(wb), Ok(va), Ok(vb)) => {
-                self.chain_elim2::<B>(pb, wb, vb) && self.chain_elim2::<A>(pa, wa, va)
-            }
-            _ => false,
-        }
+    two_chain_lanes! {
+        /// [`Self::row_transform_lanes`] of rows held in registers on a path
+        /// of `A + B` dofs that is two trees' chains, root … leaf each (a
+        /// contact's three rows between two free bodies: every contact of a
+        /// pile): L is zero between the trees, so each chain is eliminated on
+        /// its own, each lane's entry taking the same operations in the same
+        /// order (the same bits). False where the factor is dense or `path` is
+        /// not two such chains.
+        two_chain_lanes, chain_elim, w / wa / wb
+    }
+
+    two_chain_lanes! {
+        /// [`Self::two_chain_lanes`] of two contacts' rows on the same path
+        /// (two contacts between the same two free bodies), `w` and `v`: one
+        /// walk of L for both, each lane's entry taking the same operations
+        /// in the same order as [`Self::two_chain_lanes`] alone (the same
+        /// bits). False where the factor is dense or `path` is not two such
+        /// chains.
+        two_chain_lanes2, chain_elim2, w / wa / wb, v / va / vb
     }
 
     /// [`Self::chain_elim`] of two right-hand sides `w`, `v` on one chain path:
@@ -350,82 +349,137 @@ impl MassFactor {
             return false;
         }
         let len = path.len().min(y.len());
-        #[inline(always)]
-        fn sub(ys: &mut [f64; 4], l: f64, a: &[f64; 4]) {
-            for (x, &ai) in ys.iter_mut().zip(a) {
-                *x -= l * ai;
-            }
-        }
-        // `next` carries y[t − 1] as the step at t leaves it (held in a
-        // register, not read back from the store just made: the leaf-to-root
-        // chain is the form's latency)
-        let mut next = match len {
-            0 => [0.0; 4],
-            _ => y[len - 1],
+        let (path, y) = (&path[..len], &mut y[..len]);
+        // the path's shape, found once: a chain root … leaf (p = len), or two
+        // branches of one tree, path[..p] a chain and the last dof's ancestors
+        // path[..k] and path[p..] (a contact between two links of one robot)
+        let runs = if self.is_chain(path) {
+            Some((0, len))
+        } else {
+            self.two_branches(path)
         };
-        let chain = self.is_chain(&path[..len]);
-        for t in (0..len).rev() {
-            let a = next;
-            if chain {
-                // the ancestors are y[..t], L's entries at anc[start[path[t]]..]
-                if t > 0 {
-                    let s = self.start[path[t]];
-                    let anc = &self.anc[s..s + t];
-                    let (ys, last) = y[..t].split_at_mut(t - 1);
-                    for (ys, &l) in ys.iter_mut().zip(anc) {
-                        sub(ys, l, &a);
-                    }
-                    let mut v = last[0];
-                    sub(&mut v, anc[t - 1], &a);
-                    last[0] = v;
-                    next = v;
-                }
-                continue;
-            }
-            match self.ancestors(path, t) {
-                Some((s0, anc)) if s0 < t => {
-                    let (ys, last) = y[s0..t].split_at_mut(t - 1 - s0);
-                    for (ys, &l) in ys.iter_mut().zip(anc) {
-                        sub(ys, l, &a);
-                    }
-                    let mut v = last[0];
-                    sub(&mut v, anc[t - 1 - s0], &a);
-                    last[0] = v;
-                    next = v;
-                }
-                Some(_) => {
-                    if t > 0 {
-                        next = y[t - 1];
-                    }
-                }
-                None => {
-                    match self.ancestor_runs(path, t) {
-                        // two runs: the branches' common ancestors path[..k]
-                        // and path[t]'s own branch path[p..t]
-                        Some((k, p, anc)) => {
-                            let (ya, yb) = y[..t].split_at_mut(p);
-                            let (la, lb) = anc.split_at(k);
-                            for (ys, &l) in ya[..k].iter_mut().zip(la) {
-                                sub(ys, l, &a);
-                            }
-                            for (ys, &l) in yb.iter_mut().zip(lb) {
-                                sub(ys, l, &a);
-                            }
-                        }
-                        None => self.for_ancestors(path, t, |s, l| sub(&mut y[s], l, &a)),
-                    }
-                    if t > 0 {
-                        next = y[t - 1];
-                    }
-                }
+        let Some((k, p)) = runs else {
+            self.lanes_general(path, y);
+            return true;
+        };
+        // the second branch from its leaf in: path[t]'s ancestors are path[..k]
+        // and path[p..t], L's entries at anc[start[path[t]]..], in that order
+        // (each y[j] gets the general way's updates in the same order: t
+        // descending, one a step)
+        for t in (p..len).rev() {
+            let a = y[t];
+            let s = self.start[path[t]];
+            let (la, lb) = self.anc[s..s + k + t - p].split_at(k);
+            let (ya, yb) = y[..t].split_at_mut(p);
+            sub_lanes(&mut ya[..k], la, a);
+            sub_lanes(yb, lb, a);
+        }
+        // the chain path[..p]: the ancestors of path[t] are path[..t]; `next`
+        // carries y[t − 1] as the step at t leaves it (held in a register, not
+        // read back from the store just made: the leaf-to-root chain is the
+        // form's latency)
+        if p > 0 {
+            let mut next = y[p - 1];
+            for t in (1..p).rev() {
+                let a = next;
+                let s = self.start[path[t]];
+                let anc = &self.anc[s..s + t];
+                let (ys, last) = y[..t].split_at_mut(t - 1);
+                sub_lanes(ys, anc, a);
+                let mut v = last[0];
+                sub_lanes(std::slice::from_mut(&mut v), &anc[t - 1..], a);
+                last[0] = v;
+                next = v;
             }
         }
-        for (yt, &k) in y[..len].iter_mut().zip(path) {
+        for (yt, &k) in y.iter_mut().zip(path) {
             let d = self.inv_sqrt_d[k];
             for x in yt.iter_mut() {
                 *x *= d;
             }
         }
         true
+    }
+
+    /// Tree: `(k, p)` where `path` is two branches of one tree, `path[..p]`
+    /// a chain root … `path[p − 1]` and the last dof's ancestors `path[..k]`
+    /// (the branches' common ones) then `path[p..]` (its own branch, p > k);
+    /// `None` for any other path.
+    #[inline]
+    fn two_branches(&self, path: &[usize]) -> Option<(usize, usize)> {
+        let (k, p, _) = self.ancestor_runs(path, path.len().checked_sub(1)?)?;
+        (k < p && self.is_chain(&path[..p])).then_some((k, p))
+    }
+
+    /// [`Self::row_transform_lanes`]'s elimination (before the scaling) on a
+    /// path that is neither a chain nor two branches: each dof's ancestors
+    /// found on the path at each step.
+    fn lanes_general(&self, path: &[usize], y: &mut [[f64; 4]]) {
+        for t in (0..path.len().min(y.len())).rev() {
+            let a = y[t];
+            match self.ancestors(path, t) {
+                Some((s0, anc)) => sub_lanes(&mut y[s0..t], anc, a),
+                None => match self.ancestor_runs(path, t) {
+                    // two runs: the branches' common ancestors path[..k]
+                    // and path[t]'s own branch path[p..t]
+                    Some((k, p, anc)) => {
+                        let (ya, yb) = y[..t].split_at_mut(p);
+                        let (la, lb) = anc.split_at(k);
+                        sub_lanes(&mut ya[..k], la, a);
+                        sub_lanes(yb, lb, a);
+                    }
+                    None => self.for_ancestors(path, t, |s, l| {
+                        sub_lanes(std::slice::from_mut(&mut y[s]), &[l], a)
+                    }),
+                },
+            }
+        }
+    }
+}
+
+/// y[j] −= l[j]·a, lane by lane, for each j: each lane one product and one
+/// difference, each rounded (the scalar operations' bits), the four lanes
+/// as one vector (written out: left to itself the compiler vectorises over
+/// j, two entries at a time, with shuffles that cost more than they save).
+#[inline(always)]
+fn sub_lanes(ys: &mut [[f64; 4]], ls: &[f64], a: [f64; 4]) {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    {
+        use std::arch::x86_64::{
+            _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_storeu_pd, _mm256_sub_pd,
+        };
+        // SAFETY: AVX is enabled for this build (the cfg); each load and
+        // store is of one [f64; 4]
+        unsafe {
+            let av = _mm256_loadu_pd(a.as_ptr());
+            for (yj, &l) in ys.iter_mut().zip(ls) {
+                let y = _mm256_loadu_pd(yj.as_ptr());
+                let p = _mm256_mul_pd(_mm256_set1_pd(l), av);
+                _mm256_storeu_pd(yj.as_mut_ptr(), _mm256_sub_pd(y, p));
+            }
+        }
+    }
+    #[cfg(all(target_arch = "x86_64", not(target_feature = "avx")))]
+    {
+        use std::arch::x86_64::{_mm_loadu_pd, _mm_mul_pd, _mm_set1_pd, _mm_storeu_pd, _mm_sub_pd};
+        // SAFETY: SSE2 is every x86_64's; each load and store is of two f64
+        // of one [f64; 4]
+        unsafe {
+            let (a0, a1) = (_mm_loadu_pd(a.as_ptr()), _mm_loadu_pd(a[2..].as_ptr()));
+            for (yj, &l) in ys.iter_mut().zip(ls) {
+                let lv = _mm_set1_pd(l);
+                let (lo, hi) = yj.split_at_mut(2);
+                let y0 = _mm_sub_pd(_mm_loadu_pd(lo.as_ptr()), _mm_mul_pd(lv, a0));
+                let y1 = _mm_sub_pd(_mm_loadu_pd(hi.as_ptr()), _mm_mul_pd(lv, a1));
+                _mm_storeu_pd(lo.as_mut_ptr(), y0);
+                _mm_storeu_pd(hi.as_mut_ptr(), y1);
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    for (yj, &l) in ys.iter_mut().zip(ls) {
+        for (x, &ai) in yj.iter_mut().zip(&a) {
+            *x -= l * ai;
+        }
     }
 }

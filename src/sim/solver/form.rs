@@ -106,22 +106,22 @@ impl Rows {
         // a chain path (one body's: every contact of a robot on the ground)
         // of up to 13 dofs (a humanoid's foot): in registers, no scratch
         let done = match pl {
-            2 => self.form_chain::<2>(f, r, path, vfree),
-            3 => self.form_chain::<3>(f, r, path, vfree),
-            4 => self.form_chain::<4>(f, r, path, vfree),
-            5 => self.form_chain::<5>(f, r, path, vfree),
-            6 => self.form_chain::<6>(f, r, path, vfree),
-            7 => self.form_chain::<7>(f, r, path, vfree),
-            8 => self.form_chain::<8>(f, r, path, vfree),
-            9 => self.form_chain::<9>(f, r, path, vfree),
-            10 => self.form_chain::<10>(f, r, path, vfree),
-            11 => self.form_chain::<11>(f, r, path, vfree),
-            12 => self.form_chain::<12>(f, r, path, vfree),
-            13 => self.form_chain::<13>(f, r, path, vfree),
+            2 => self.form_chain::<2, 0, 2>(f, r, path, vfree),
+            3 => self.form_chain::<3, 0, 3>(f, r, path, vfree),
+            4 => self.form_chain::<4, 0, 4>(f, r, path, vfree),
+            5 => self.form_chain::<5, 0, 5>(f, r, path, vfree),
+            6 => self.form_chain::<6, 0, 6>(f, r, path, vfree),
+            7 => self.form_chain::<7, 0, 7>(f, r, path, vfree),
+            8 => self.form_chain::<8, 0, 8>(f, r, path, vfree),
+            9 => self.form_chain::<9, 0, 9>(f, r, path, vfree),
+            10 => self.form_chain::<10, 0, 10>(f, r, path, vfree),
+            11 => self.form_chain::<11, 0, 11>(f, r, path, vfree),
+            12 => self.form_chain::<12, 0, 12>(f, r, path, vfree),
+            13 => self.form_chain::<13, 0, 13>(f, r, path, vfree),
             _ => false,
         };
         // two free bodies' chains (6 + 6: a pile's contacts between bodies)
-        if done || (pl == 12 && self.form_two::<6, 6, 12>(f, r, path, vfree)) {
+        if done || (pl == 12 && self.form_chain::<6, 6, 12>(f, r, path, vfree)) {
             return true;
         }
         let j = &self.j[r * st..(r + 3) * st];
@@ -193,47 +193,15 @@ impl Rows {
         true
     }
 
-    /// [`Rows::form_lanes`] on a chain path of `N` dofs
-    /// ([`MassFactor::chain_lanes`]): the three rows gathered straight into
-    /// registers, transformed there, and Y, its lanes, W and c written from
-    /// them (no scratch, no copies between): each value the same operations
-    /// in the same order, the same bits. False, nothing written, where the
-    /// path is not a chain of `N` (the caller's general way then).
+    /// [`Rows::form_lanes`] on a path of `N = A + B` dofs that is a chain
+    /// (`B = 0`: [`MassFactor::chain_lanes`]) or two trees' chains
+    /// ([`MassFactor::two_chain_lanes`]): the three rows gathered straight
+    /// into registers, transformed there, and Y, its lanes, W and c written
+    /// from them (no scratch, no copies between): each value the same
+    /// operations in the same order, the same bits. False, nothing written,
+    /// where the path is not such chains (the caller's general way then).
     #[inline(always)]
-    fn form_chain<const N: usize>(
-        &mut self,
-        f: &MassFactor,
-        r: usize,
-        path: &[usize],
-        vfree: &[f64],
-    ) -> bool {
-        let st = self.stride;
-        let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..(r + 3) * st)) else {
-            return false;
-        };
-        if N > st || path.iter().any(|&d| d >= vfree.len()) {
-            return false;
-        }
-        let mut w = [[0.0f64; 4]; N];
-        let c = gather_rows(
-            [&j[..N], &j[st..st + N], &j[2 * st..2 * st + N]],
-            path,
-            vfree,
-            &mut w,
-        );
-        if !f.chain_lanes::<N>(path, &mut w) {
-            return false;
-        }
-        self.store_block(r, &w, c);
-        true
-    }
-
-    /// [`Rows::form_chain`] on a path of `N = A + B` dofs that is two trees'
-    /// chains ([`MassFactor::two_chain_lanes`]): the same operations in the
-    /// same order as the general way, the same bits. False, nothing written,
-    /// where the path is not two such chains.
-    #[inline(always)]
-    fn form_two<const A: usize, const B: usize, const N: usize>(
+    fn form_chain<const A: usize, const B: usize, const N: usize>(
         &mut self,
         f: &MassFactor,
         r: usize,
@@ -254,7 +222,11 @@ impl Rows {
             vfree,
             &mut w,
         );
-        if !f.two_chain_lanes::<A, B>(path, &mut w) {
+        let done = match B {
+            0 => f.chain_lanes::<N>(path, &mut w),
+            _ => f.two_chain_lanes::<A, B>(path, &mut w),
+        };
+        if !done {
             return false;
         }
         self.store_block(r, &w, c);
@@ -262,7 +234,7 @@ impl Rows {
     }
 
     /// Contacts r and r + 3 on the same path of two free bodies' chains
-    /// (6 + 6 dofs) formed as [`Rows::form_two`] forms each
+    /// (6 + 6 dofs) formed as [`Rows::form_chain`] forms each
     /// ([`MassFactor::two_chain_lanes2`]: one walk of L for both): the same
     /// operations in the same order, the same bits. False, nothing written,
     /// where `path` (contact r + 3's too: the caller's test) is not two such
@@ -275,7 +247,9 @@ impl Rows {
         let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..(r + 6) * st)) else {
             return false;
         };
-        if N > st || path.iter().any(|&d| d >= vfree.len()) {
+        // (the shape first: a robot's foot, one 12-dof chain, is not two
+        // chains, and its rows are not gathered twice)
+        if N > st || !f.two_chains::<6, 6>(path) || path.iter().any(|&d| d >= vfree.len()) {
             return false;
         }
         let (mut w, mut v) = ([[0.0f64; 4]; N], [[0.0f64; 4]; N]);
