@@ -76,6 +76,10 @@ pub mod contact {
         pub fn support_index(&self, d: PVec) -> (usize, f64) {
             self.0.support_index(d)
         }
+        /// `ClimbHull::support_index_by_index` (the climb's reference).
+        pub fn support_index_by_index(&self, d: PVec) -> (usize, f64) {
+            self.0.support_index_by_index(d)
+        }
         /// `ClimbHull::points`.
         pub fn points(&self) -> &[PVec] {
             self.0.points()

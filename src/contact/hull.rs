@@ -129,6 +129,9 @@ pub(crate) struct ClimbHull {
     /// vertex k are `adj[adj_start[k]..adj_start[k + 1]]`.
     adj_start: Vec<u32>,
     adj: Vec<u32>,
+    /// The neighbours' points, `adj`'s entries' vertices copied in the same
+    /// order (the climb reads them contiguously, with no index to follow).
+    adj_pts: Vec<PVec>,
     /// Per cube-map cell, the extreme vertex toward its centre (one with
     /// neighbours).
     seeds: Vec<u32>,
@@ -211,6 +214,7 @@ impl ClimbHull {
             }
             seeds.push(best as u32);
         }
+        let adj_pts = adj.iter().map(|&j| pts[j as usize]).collect();
         let normal = |c: usize| hull.faces().iter().map(|f| f.normal[c]).collect();
         let centre = pts.iter().fold(PVec::ZERO, |s, p| s + *p) / n as f64;
         Some(Ok(Self {
@@ -225,6 +229,7 @@ impl ClimbHull {
             hull,
             adj_start,
             adj,
+            adj_pts,
             seeds,
         }))
     }
@@ -245,17 +250,41 @@ impl ClimbHull {
         &self.adj[self.adj_start[k] as usize..self.adj_start[k + 1] as usize]
     }
 
-    /// The index of a vertex maximising d·v, and d·v there.
+    /// The index of a vertex maximising d·v, and d·v there: a steepest
+    /// ascent from d's cell's seed, to the first best neighbour while it is
+    /// better (the neighbours' points read from `adj_pts`, the same products).
     #[inline]
     pub fn support_index(&self, d: PVec) -> (usize, f64) {
         let pts = self.hull.points();
         let mut k = self.seeds[cell(d)] as usize;
         let mut best = pts[k].dot(d);
-        // steepest ascent: the best neighbour while it is better
         loop {
             let (a, b) = (self.adj_start[k] as usize, self.adj_start[k + 1] as usize);
+            let mut next = usize::MAX;
+            for (i, p) in self.adj_pts[a..b].iter().enumerate() {
+                let v = p.dot(d);
+                if v > best {
+                    best = v;
+                    next = i;
+                }
+            }
+            if next == usize::MAX {
+                return (k, best);
+            }
+            k = self.adj[a + next] as usize;
+        }
+    }
+
+    /// The climb as it was before `adj_pts` (each neighbour's point read
+    /// through its index), kept as the reference [`Self::support_index`]
+    /// must match index for index (tests/unit/contact_hull.rs).
+    pub(crate) fn support_index_by_index(&self, d: PVec) -> (usize, f64) {
+        let pts = self.hull.points();
+        let mut k = self.seeds[cell(d)] as usize;
+        let mut best = pts[k].dot(d);
+        loop {
             let mut next = k;
-            for &j in &self.adj[a..b] {
+            for &j in self.neighbours(k) {
                 let v = pts[j as usize].dot(d);
                 if v > best {
                     best = v;
@@ -448,3 +477,4 @@ impl Shape for ClimbHull {
         Some((self as &dyn PolygonalFeatureMap, 0.0))
     }
 }
+

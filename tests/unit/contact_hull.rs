@@ -73,6 +73,37 @@ fn climbed_support_is_the_scanned_maximum() {
     }
 }
 
+/// The climb reading its neighbours' points contiguously ends at the same
+/// vertex, with the same value bit for bit, as the climb by index, for
+/// random directions, axes and their mixes (ties on flat faces).
+#[test]
+fn climb_is_the_climb_by_index() {
+    for pts in clouds() {
+        let Some(Ok(h)) = TestHull::of_points(&pts) else {
+            panic!("a hull of many vertices");
+        };
+        let mut c = 0.271_f64;
+        for _ in 0..5000 {
+            let mut r = || {
+                c = (c * 9.17 + 0.377).fract();
+                2.0 * c - 1.0
+            };
+            let d = PVec::new(r(), r(), r());
+            for d in [
+                d,
+                PVec::new(d.x.signum(), 0.0, 0.0),
+                PVec::new(0.0, d.y.signum(), d.z.signum()),
+                PVec::new(0.0, d.y, d.z),
+                PVec::new(d.x, 0.0, 0.0),
+            ] {
+                let (k, v) = h.support_index(d);
+                let (k0, v0) = h.support_index_by_index(d);
+                assert_eq!((k, v.to_bits()), (k0, v0.to_bits()), "{d:?}");
+            }
+        }
+    }
+}
+
 #[test]
 fn support_face_is_the_scanned_best_face() {
     for pts in clouds() {
