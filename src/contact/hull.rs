@@ -477,4 +477,3 @@ impl Shape for ClimbHull {
         Some((self as &dyn PolygonalFeatureMap, 0.0))
     }
 }
-

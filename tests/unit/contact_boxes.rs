@@ -19,7 +19,12 @@ fn random_rotation(g: &mut Lcg) -> Rotation3<f64> {
 }
 
 /// parry's manifold of the same pair (from scratch).
-fn parry(ha: &Vector3<f64>, hb: &Vector3<f64>, a_m_b: &Se3<f64>, margin: f64) -> ContactManifold<(), ()> {
+fn parry(
+    ha: &Vector3<f64>,
+    hb: &Vector3<f64>,
+    a_m_b: &Se3<f64>,
+    margin: f64,
+) -> ContactManifold<(), ()> {
     let (ca, cb) = (
         Cuboid::new(parry3d_f64::math::Vector::new(ha.x, ha.y, ha.z)),
         Cuboid::new(parry3d_f64::math::Vector::new(hb.x, hb.y, hb.z)),
@@ -31,20 +36,44 @@ fn parry(ha: &Vector3<f64>, hb: &Vector3<f64>, a_m_b: &Se3<f64>, margin: f64) ->
 
 /// Compares the two manifolds of one pose: the same points (features, gaps,
 /// positions) and normals.
-fn same(ours: &ContactManifold<(), ()>, theirs: &ContactManifold<(), ()>, found: bool, case: usize) {
-    assert_eq!(ours.points.len(), theirs.points.len(), "case {case}: points");
+fn same(
+    ours: &ContactManifold<(), ()>,
+    theirs: &ContactManifold<(), ()>,
+    found: bool,
+    case: usize,
+) {
+    assert_eq!(
+        ours.points.len(),
+        theirs.points.len(),
+        "case {case}: points"
+    );
     if !found || theirs.points.is_empty() {
         return;
     }
     let (n, m) = (to_v(ours.local_n1), to_v(theirs.local_n1));
     assert!((n - m).norm() < 1e-9, "case {case}: normal {n:?} vs {m:?}");
     assert!((to_v(ours.local_n2) - to_v(theirs.local_n2)).norm() < 1e-9);
-    assert_eq!(ours.points.len(), theirs.points.len(), "case {case}: points");
+    assert_eq!(
+        ours.points.len(),
+        theirs.points.len(),
+        "case {case}: points"
+    );
     for (p, q) in ours.points.iter().zip(&theirs.points) {
         assert_eq!((p.fid1, p.fid2), (q.fid1, q.fid2), "case {case}: features");
-        assert!((p.dist - q.dist).abs() < 1e-9, "case {case}: gap {} vs {}", p.dist, q.dist);
-        assert!((to_v(p.local_p1) - to_v(q.local_p1)).norm() < 1e-9, "case {case}: p1");
-        assert!((to_v(p.local_p2) - to_v(q.local_p2)).norm() < 1e-9, "case {case}: p2");
+        assert!(
+            (p.dist - q.dist).abs() < 1e-9,
+            "case {case}: gap {} vs {}",
+            p.dist,
+            q.dist
+        );
+        assert!(
+            (to_v(p.local_p1) - to_v(q.local_p1)).norm() < 1e-9,
+            "case {case}: p1"
+        );
+        assert!(
+            (to_v(p.local_p2) - to_v(q.local_p2)).norm() < 1e-9,
+            "case {case}: p2"
+        );
     }
 }
 
@@ -54,8 +83,16 @@ fn random_box_pairs_match_parrys_manifold() {
     let margin = 0.005;
     let (mut touching, mut compared) = (0, 0);
     for case in 0..20000 {
-        let ha = Vector3::new(g.uniform(0.02, 0.3), g.uniform(0.02, 0.3), g.uniform(0.02, 0.3));
-        let hb = Vector3::new(g.uniform(0.02, 0.3), g.uniform(0.02, 0.3), g.uniform(0.02, 0.3));
+        let ha = Vector3::new(
+            g.uniform(0.02, 0.3),
+            g.uniform(0.02, 0.3),
+            g.uniform(0.02, 0.3),
+        );
+        let hb = Vector3::new(
+            g.uniform(0.02, 0.3),
+            g.uniform(0.02, 0.3),
+            g.uniform(0.02, 0.3),
+        );
         let r = random_rotation(&mut g);
         // b's centre about the sum of the boxes' sizes away: near contact
         let dir = Unit::new_normalize(Vector3::new(
