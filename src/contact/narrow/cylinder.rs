@@ -379,18 +379,7 @@ pub(crate) fn cylinder_cylinder_points(
     };
     // the cap's normal points out of its cylinder toward the other
     let wp = if on_a { wa } else { wb };
-    let nw = wp.rot * n;
-    let normal = if on_a { -nw } else { nw };
-    for &(v, gap, key) in &pts.0[..pts.1] {
-        let p = v - n * (0.5 * gap);
-        raw.push(Raw {
-            point: wp.act_point(&p),
-            normal,
-            gap,
-            key,
-        });
-    }
-    Some(wa.rot.transpose() * -normal)
+    Some(push_plane_points(&pts, &n, wp, !on_a, wa, raw))
 }
 
 /// The contact points of `a` at `wa` and `b` at `wb` when one is a cylinder
@@ -416,18 +405,32 @@ pub(crate) fn cylinder_box_points(
         CylBox::Apart(n) | CylBox::Plane(n) => n,
     };
     // the face's normal points from the box toward the cylinder
-    let nw = wx.rot * n;
-    let normal = if cyl_is_a { nw } else { -nw };
+    Some(push_plane_points(&pts, &n, wx, cyl_is_a, wa, raw))
+}
+
+/// The points `pts` found on a plane of normal `n` (the frame `wp` of the
+/// plane's shape, out of it) appended to `raw` with the normal from b toward
+/// a (`n` in the world if the plane's shape is b, else its opposite), each at
+/// the midpoint of its vertex and the vertex's foot on the plane; returned:
+/// the pair's axis, a's frame, from a toward b.
+fn push_plane_points(
+    pts: &Pts,
+    n: &Vector3<f64>,
+    wp: &Se3<f64>,
+    plane_is_b: bool,
+    wa: &Se3<f64>,
+    raw: &mut Vec<Raw>,
+) -> Vector3<f64> {
+    let nw = wp.rot * n;
+    let normal = if plane_is_b { nw } else { -nw };
     for &(v, gap, key) in &pts.0[..pts.1] {
-        // the midpoint of the cylinder's point and its foot on the plane
         let p = v - n * (0.5 * gap);
         raw.push(Raw {
-            point: wx.act_point(&p),
+            point: wp.act_point(&p),
             normal,
             gap,
             key,
         });
     }
-    // a's frame, from a toward b
-    Some(wa.rot.transpose() * -normal)
+    wa.rot.transpose() * -normal
 }
