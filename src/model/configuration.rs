@@ -55,20 +55,40 @@ pub fn integrate_config(model: &Model, q: &mut DVector<f64>, v: &DVector<f64>, h
     }
 }
 
-/// One free joint's q ⊕ h v, its q at `iq..iq + 7`, its v at `iv..iv + 6`.
+/// One free joint's q ⊕ h v, its q at `iq..iq + 7`, its v at `iv..iv + 6`
+/// (out of range: left as is).
 fn integrate_free(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize, iv: usize) {
-    let r = quat_to_matrix(q[iq + 3], q[iq + 4], q[iq + 5], q[iq + 6]);
-    let dp = r * Vector3::new(v[iv], v[iv + 1], v[iv + 2]) * h;
-    q[iq] += dp.x;
-    q[iq + 1] += dp.y;
-    q[iq + 2] += dp.z;
-    integrate_quat(q, v, h, iq + 3, iv + 3);
+    // (through the joint's slices: one bounds test each, not one an entry)
+    let (Some(qs), Some(&[vx, vy, vz, wx, wy, wz])) = (
+        q.as_mut_slice().get_mut(iq..iq + 7),
+        v.as_slice().get(iv..iv + 6),
+    ) else {
+        return;
+    };
+    let (p, quat) = qs.split_at_mut(3);
+    let r = quat_to_matrix(quat[0], quat[1], quat[2], quat[3]);
+    let dp = r * Vector3::new(vx, vy, vz) * h;
+    p[0] += dp.x;
+    p[1] += dp.y;
+    p[2] += dp.z;
+    quat_step(quat, [wx, wy, wz], h);
 }
 
 /// The quaternion `q[iq..iq + 4]` ← itself ⊗ exp(h ω / 2), ω = `v[iv..iv + 3]`
-/// (renormalised).
+/// (renormalised; out of range: left as is).
 fn integrate_quat(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize, iv: usize) {
-    let w = Vector3::new(v[iv], v[iv + 1], v[iv + 2]) * h;
+    if let (Some(quat), Some(&[wx, wy, wz])) = (
+        q.as_mut_slice().get_mut(iq..iq + 4),
+        v.as_slice().get(iv..iv + 3),
+    ) {
+        quat_step(quat, [wx, wy, wz], h);
+    }
+}
+
+/// `quat` (x, y, z, w; four entries) ← itself ⊗ exp(h ω / 2), renormalised.
+#[inline]
+fn quat_step(quat: &mut [f64], omega: [f64; 3], h: f64) {
+    let w = Vector3::new(omega[0], omega[1], omega[2]) * h;
     let th = w.norm();
     let (s, c) = if th > 1e-12 {
         let (s, c) = sin_cos(th / 2.0);
@@ -77,12 +97,14 @@ fn integrate_quat(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize, iv:
         (0.5 - th * th / 48.0, 1.0 - th * th / 8.0)
     };
     let (dx, dy, dz, dw) = (w.x * s, w.y * s, w.z * s, c);
-    let (x, y, z, ww) = (q[iq], q[iq + 1], q[iq + 2], q[iq + 3]);
-    q[iq] = ww * dx + x * dw + y * dz - z * dy;
-    q[iq + 1] = ww * dy - x * dz + y * dw + z * dx;
-    q[iq + 2] = ww * dz + x * dy - y * dx + z * dw;
-    q[iq + 3] = ww * dw - x * dx - y * dy - z * dz;
-    normalize_quat_at(q, iq);
+    let [x, y, z, ww, ..] = *quat else {
+        return;
+    };
+    quat[0] = ww * dx + x * dw + y * dz - z * dy;
+    quat[1] = ww * dy - x * dz + y * dw + z * dx;
+    quat[2] = ww * dz + x * dy - y * dx + z * dw;
+    quat[3] = ww * dw - x * dx - y * dy - z * dz;
+    normalize4(quat);
 }
 
 /// Re-expresses a free or planar joint's child-frame linear velocity after its
@@ -183,12 +205,24 @@ pub fn normalize_quats(model: &Model, q: &mut DVector<f64>) {
 }
 
 /// Normalises the quaternion `q[at..at + 4]` (a zero or non-finite one is left as is).
+#[inline]
 fn normalize_quat_at(q: &mut DVector<f64>, at: usize) {
-    let n = (q[at] * q[at] + q[at + 1] * q[at + 1] + q[at + 2] * q[at + 2] + q[at + 3] * q[at + 3])
-        .sqrt();
+    if let Some(quat) = q.as_mut_slice().get_mut(at..at + 4) {
+        normalize4(quat);
+    }
+}
+
+/// Normalises the quaternion of four entries `quat` (a zero or non-finite
+/// one, or fewer entries, left as is).
+#[inline]
+fn normalize4(quat: &mut [f64]) {
+    let Some(quat) = quat.get_mut(..4) else {
+        return;
+    };
+    let n = (quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]).sqrt();
     if n > 0.0 && n.is_finite() {
-        for k in at..at + 4 {
-            q[k] /= n;
+        for x in quat {
+            *x /= n;
         }
     }
 }

@@ -183,20 +183,26 @@ impl Islands {
                 self.gkey.push(k);
             }
         } else {
-            for g in 0..self.groups.len() {
-                if let Some((a, b)) = self.ends(rows, self.groups[g].0) {
-                    let (ra, rb) = (self.find(a), self.find(b));
-                    if ra != rb {
-                        self.parent[ra.max(rb)] = ra.min(rb);
-                    }
-                }
-            }
+            // (each group's first tree kept in `gkey` meanwhile: its ends
+            // looked up once)
             for g in 0..self.groups.len() {
                 let k = match self.ends(rows, self.groups[g].0) {
-                    Some((a, _)) => self.find(a),
+                    Some((a, b)) => {
+                        let (ra, rb) = (self.find(a), self.find(b));
+                        if ra != rb {
+                            self.parent[ra.max(rb)] = ra.min(rb);
+                        }
+                        a
+                    }
                     None => usize::MAX,
                 };
                 self.gkey.push(k);
+            }
+            for g in 0..self.gkey.len() {
+                let a = self.gkey[g];
+                if a != usize::MAX {
+                    self.gkey[g] = self.find(a);
+                }
             }
         }
         // runs of consecutive rows with one key (whole groups), then grouped

@@ -124,16 +124,24 @@ impl Simulation {
 /// rotation); it is rotated into the new frame after the position update. Done
 /// this way the rotation of the body-frame velocity is exact and adds no energy.
 /// `iv`: the free joint's first velocity coordinate.
+#[inline]
 pub(in crate::sim) fn add_frame_rate(
     v_new: &mut DVector<f64>,
     v_old: &DVector<f64>,
     h: f64,
     iv: usize,
 ) {
-    let w = Vector3::new(v_old[iv + 3], v_old[iv + 4], v_old[iv + 5]);
-    let vl = Vector3::new(v_old[iv], v_old[iv + 1], v_old[iv + 2]);
+    // (through slices of the joint's six entries: one bounds test, not nine)
+    let (Some(&[x, y, z, wx, wy, wz]), Some([nx, ny, nz])) = (
+        v_old.as_slice().get(iv..iv + 6),
+        v_new.as_mut_slice().get_mut(iv..iv + 3),
+    ) else {
+        return;
+    };
+    let w = Vector3::new(wx, wy, wz);
+    let vl = Vector3::new(x, y, z);
     let d = w.cross(&vl) * h;
-    v_new[iv] += d.x;
-    v_new[iv + 1] += d.y;
-    v_new[iv + 2] += d.z;
+    *nx += d.x;
+    *ny += d.y;
+    *nz += d.z;
 }
