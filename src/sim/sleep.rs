@@ -71,8 +71,11 @@ pub(crate) struct Sleep {
     /// The sleeping bodies' last contact wrenches (per body).
     frozen_body: Vec<Force>,
     /// The last solve's contact forces and wrenches with the frozen ones
-    /// (in use while anything sleeps).
-    all_forces: Vec<ContactForce>,
+    /// (in use while anything sleeps). The forces' list is made when first
+    /// read after a step ([`Sleep::forces`]), not at every step: a sleeping
+    /// pile's frozen forces copied every step cost more than the rest of its
+    /// bookkeeping (a lock: `Simulation` is `Sync`).
+    all_forces: std::sync::OnceLock<Vec<ContactForce>>,
     all_body: Vec<Force>,
     /// v plus the position pass's pseudo-velocity (scratch: a point pushed out
     /// of a penetration is moving).
@@ -159,7 +162,7 @@ impl Sleep {
             frozen_points: Vec::new(),
             frozen_forces: Vec::new(),
             frozen_body: vec![Force::zero(); model.nbodies],
-            all_forces: Vec::new(),
+            all_forces: std::sync::OnceLock::new(),
             all_body: vec![Force::zero(); model.nbodies],
             vw: DVector::zeros(model.nv),
             awake,
@@ -432,20 +435,15 @@ impl Sleep {
         self.awake_sum += self.awake as f64;
     }
 
-    /// The last solve's contact forces and body wrenches joined with the
-    /// sleeping islands' frozen ones.
-    pub fn compose(&mut self, model: &Model, forces: &[ContactForce], body: &[Force]) {
+    /// The last solve's body wrenches joined with the sleeping islands'
+    /// frozen ones; its contact forces joined with theirs are left to be
+    /// made at their first read ([`Sleep::forces`]: nothing they are made of
+    /// changes before the next step's solve and its `compose`).
+    pub fn compose(&mut self, model: &Model, body: &[Force]) {
         if !self.any_asleep {
             return;
         }
-        self.all_forces.clear();
-        // (the last solve's forces on islands that fell asleep after it are
-        // the frozen ones already)
-        let asleep = &self.body_asleep;
-        let awake = |b: usize| asleep.get(b) != Some(&true);
-        self.all_forces
-            .extend(forces.iter().filter(|f| awake(f.point.body)));
-        self.all_forces.extend_from_slice(&self.frozen_forces);
+        self.all_forces.take();
         // the sleeping bodies' entries are their frozen wrenches (set when
         // they fell asleep): the awake bodies' (the world's too) are copied
         let get = |b: usize| body.get(b).copied().unwrap_or(Force::zero());
@@ -460,9 +458,19 @@ impl Sleep {
     }
     /// The contact forces to report: `awake` (the last solve's) joined with
     /// the frozen ones while anything sleeps.
+    /// (`awake`: the last solve's, those [`Sleep::compose`] was given.)
     pub fn forces<'a>(&'a self, awake: &'a [ContactForce]) -> &'a [ContactForce] {
         if self.any_asleep {
-            &self.all_forces
+            self.all_forces.get_or_init(|| {
+                // (the last solve's forces on islands that fell asleep after
+                // it are the frozen ones already)
+                let asleep = &self.body_asleep;
+                let awake_body = |b: usize| asleep.get(b) != Some(&true);
+                let mut all = Vec::with_capacity(awake.len() + self.frozen_forces.len());
+                all.extend(awake.iter().filter(|f| awake_body(f.point.body)));
+                all.extend_from_slice(&self.frozen_forces);
+                all
+            })
         } else {
             awake
         }
@@ -578,10 +586,6 @@ impl super::Simulation {
         if slept {
             self.energy_now = None;
         }
-        self.sleep.compose(
-            &self.model,
-            self.cons.contact_forces(),
-            self.cons.body_forces(),
-        );
+        self.sleep.compose(&self.model, self.cons.body_forces());
     }
 }
