@@ -35,6 +35,10 @@ pub(crate) struct Islands {
     group_at: Vec<usize>,
     /// Runs of consecutive rows of one island: (island key, first row, end).
     runs: Vec<(usize, usize, usize)>,
+    /// Scratch of the runs' sort by key: the runs, and each key's count,
+    /// then its place.
+    sorted: Vec<(usize, usize, usize)>,
+    count: Vec<usize>,
     /// Per island: its runs, a range of `runs`, and its dofs, a range of `dofs`.
     islands: Vec<((usize, usize), (usize, usize))>,
     /// The islands' dofs, island after island (ascending within one).
@@ -111,6 +115,8 @@ impl Islands {
             gkey: Vec::with_capacity(rows),
             group_at: vec![0; rows],
             runs: Vec::with_capacity(rows),
+            sorted: Vec::with_capacity(rows),
+            count: Vec::with_capacity(nt + 2),
             islands: Vec::with_capacity(rows.min(nt + 1)),
             dofs: Vec::with_capacity(model.nv),
             mark: vec![false; model.nv],
@@ -217,7 +223,27 @@ impl Islands {
             }
             self.runs.push((k, s, self.groups[g - 1].1));
         }
-        self.runs.sort_unstable_by_key(|&(k, s, _)| (k, s));
+        // (a counting sort over the keys: the runs are in row order, so each
+        // key's stay in it; the trees' keys, then rows on no dof, as a sort by
+        // (key, first row) puts them)
+        let nk = self.parent.len() + 1;
+        let bucket = |k: usize| k.min(nk - 1);
+        self.count.clear();
+        self.count.resize(nk + 1, 0);
+        for &(k, _, _) in &self.runs {
+            self.count[bucket(k) + 1] += 1;
+        }
+        for b in 0..nk {
+            self.count[b + 1] += self.count[b];
+        }
+        self.sorted.clear();
+        self.sorted.resize(self.runs.len(), (0, 0, 0));
+        for &run in &self.runs {
+            let at = &mut self.count[bucket(run.0)];
+            self.sorted[*at] = run;
+            *at += 1;
+        }
+        std::mem::swap(&mut self.runs, &mut self.sorted);
         // each island's runs and dofs
         self.islands.clear();
         self.dofs.clear();
