@@ -47,17 +47,23 @@ pub fn kinetic_energy_from_placements<T: Scalar>(
 /// §"Velocity recursion": the same velocities as the velocity pass, its
 /// rotations about joint axes skipping only products with exact zeros and
 /// ones).
+///
+/// `skip`: bodies of sleeping trees (at v = 0, held), left out of the bias
+/// pass ([`super::rnea::bias_at_placements_energy`]: T the same, their C
+/// entries zero); the caller drops the C computed ahead when one of them
+/// wakes before the step (`data.step_bias_ok = false`).
 pub(crate) fn kinetic_energy_step_ahead(
     model: &Model<f64>,
     data: &mut Data<f64>,
     q: &DVector<f64>,
     v: &DVector<f64>,
+    skip: &[bool],
 ) -> f64 {
     if !data.step_bias_wanted || q.len() != model.nq || v.len() != model.nv {
         data.step_bias_ok = false;
         return kinetic_energy_from_placements(model, data, v).unwrap_or(f64::NAN);
     }
-    let ke = super::rnea::bias_at_placements_energy(model, data, v);
+    let ke = super::rnea::bias_at_placements_energy(model, data, v, skip);
     data.step_bias.copy_from(&data.bias);
     data.step_bias_q.copy_from(q);
     data.step_bias_v.copy_from(v);

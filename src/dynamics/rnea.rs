@@ -55,19 +55,24 @@ pub(crate) fn bias_pass<T: Scalar>(
 /// joint placements `data.li_m_i` already hold (forward kinematics ran at it):
 /// the pass reads them instead of recomputing each joint's transform.
 pub(crate) fn bias_at_placements<T: Scalar>(model: &Model<T>, data: &mut Data<T>, v: &DVector<T>) {
-    bias_pass_at_placements::<T, false>(model, data, v);
+    bias_pass_at_placements::<T, false>(model, data, v, &[]);
 }
 
 /// [`bias_at_placements`] that also returns the kinetic energy
 /// `T = ½ Σ v̂ᵢᵀ Îᵢ v̂ᵢ` summed over the pass's body velocities, from the
 /// products `Îᵢ v̂ᵢ` the pass forms anyway (in body order, as
 /// [`super::kinetic_energy_from_placements`]; a massless body adds nothing).
+/// The bodies flagged in `skip` (a sleeping tree's: all of a tree, at zero
+/// velocity) are left out: their C entries zero, their body velocity,
+/// acceleration and force zero; a body at rest adds ±0 to T, which leaves it
+/// as it was (a sum from +0 is never −0).
 pub(crate) fn bias_at_placements_energy<T: Scalar>(
     model: &Model<T>,
     data: &mut Data<T>,
     v: &DVector<T>,
+    skip: &[bool],
 ) -> T {
-    bias_pass_at_placements::<T, true>(model, data, v)
+    bias_pass_at_placements::<T, true>(model, data, v, skip)
 }
 
 /// C(q, v) at the placements into `data.bias`, and with `E` the kinetic
@@ -77,16 +82,32 @@ fn bias_pass_at_placements<T: Scalar, const E: bool>(
     model: &Model<T>,
     data: &mut Data<T>,
     v: &DVector<T>,
+    skip: &[bool],
 ) -> T {
-    let ke = rnea_pass::<T, true, false, false, true, E>(
-        model,
-        data,
-        &[],
-        v.as_slice(),
-        &[],
-        true,
-        None,
-    );
+    // (a pass of its own with bodies to skip: the one without tests none)
+    let ke = if E && !skip.is_empty() {
+        rnea_pass::<T, true, false, false, true, E, true>(
+            model,
+            data,
+            &[],
+            v.as_slice(),
+            &[],
+            true,
+            None,
+            skip,
+        )
+    } else {
+        rnea_pass::<T, true, false, false, true, E, false>(
+            model,
+            data,
+            &[],
+            v.as_slice(),
+            &[],
+            true,
+            None,
+            &[],
+        )
+    };
     data.bias.copy_from(&data.tau);
     ke
 }
@@ -160,23 +181,60 @@ fn rnea_variant<T: Scalar, const F: bool>(
     // Monomorphised on which of q̇, q̈ are present (no per-body test).
     match (v, a) {
         (Some(v), Some(a)) => {
-            rnea_pass::<T, true, true, F, false, false>(model, data, q, v, a, gravity, fext);
+            rnea_pass::<T, true, true, F, false, false, false>(
+                model,
+                data,
+                q,
+                v,
+                a,
+                gravity,
+                fext,
+                &[],
+            );
         }
         (Some(v), None) => {
-            rnea_pass::<T, true, false, F, false, false>(model, data, q, v, &[], gravity, fext);
+            rnea_pass::<T, true, false, F, false, false, false>(
+                model,
+                data,
+                q,
+                v,
+                &[],
+                gravity,
+                fext,
+                &[],
+            );
         }
         (None, Some(a)) => {
-            rnea_pass::<T, false, true, F, false, false>(model, data, q, &[], a, gravity, fext);
+            rnea_pass::<T, false, true, F, false, false, false>(
+                model,
+                data,
+                q,
+                &[],
+                a,
+                gravity,
+                fext,
+                &[],
+            );
         }
         (None, None) => {
-            rnea_pass::<T, false, false, F, false, false>(model, data, q, &[], &[], gravity, fext);
+            rnea_pass::<T, false, false, F, false, false, false>(
+                model,
+                data,
+                q,
+                &[],
+                &[],
+                gravity,
+                fext,
+                &[],
+            );
         }
     }
 }
 
 /// [`rnea_impl`] with q̇ present iff `V`, q̈ present iff `A` and external forces
 /// read iff `F`; with `E` (the bias pass, `K`) the kinetic energy of the body
-/// velocities is summed and returned (zero otherwise). The joint kind of
+/// velocities is summed and returned (zero otherwise), and with `S` the bodies
+/// flagged in `skip` left out (`bias_at_placements_energy`). The joint kind of
 /// each body is matched once per sweep ([`dispatch_joint!`]); the body step is then
 /// compiled per joint model, with the axis and transform shape known.
 #[inline(always)]
@@ -187,6 +245,7 @@ fn rnea_pass<
     const F: bool,
     const K: bool,
     const E: bool,
+    const S: bool,
 >(
     model: &Model<T>,
     data: &mut Data<T>,
@@ -195,6 +254,7 @@ fn rnea_pass<
     a: &[T],
     gravity: bool,
     fext: Option<&[Force<T>]>,
+    skip: &[bool],
 ) -> T {
     let mut ke = T::zero();
     let nb = model.nbodies;
@@ -221,7 +281,15 @@ fn rnea_pass<
     } else {
         Motion::zero()
     };
+    // (S, with E: the bodies flagged in `skip`, a whole tree each, left out)
+    let skipped = |i: usize| S && E && skip.get(i) == Some(&true);
     for i in 1..nb {
+        if skipped(i) {
+            vel[i] = Motion::zero();
+            acc[i] = Motion::zero();
+            frc[i] = Force::zero();
+            continue;
+        }
         let p = parent[i];
         let (vp, ap) = (vel[p], acc[p]);
         let key = if K { keys[i] } else { dispatch_of(&joints[i]) };
@@ -290,6 +358,10 @@ fn rnea_pass<
     let mut carry = Force::zero();
     let mut carry_to = 0;
     for i in (1..nb).rev() {
+        // (a skipped body's tree is skipped whole: no force to or from it)
+        if skipped(i) {
+            continue;
+        }
         let p = parent[i];
         let (head, tail) = frc.split_at_mut(i);
         let mut fi = tail[0];

@@ -484,6 +484,15 @@ impl Sleep {
         }
     }
 
+    /// Per body: asleep, when any tree sleeps (empty: every body is awake).
+    pub fn bodies_asleep(&self) -> &[bool] {
+        if self.on && self.any_asleep {
+            &self.body_asleep
+        } else {
+            &[]
+        }
+    }
+
     /// Whether tree `t` sleeps.
     pub fn tree_asleep(&self, t: usize) -> bool {
         self.asleep.get(t).copied().unwrap_or(false)
@@ -517,6 +526,9 @@ impl super::Simulation {
     /// Wakes every sleeping island now (their contacts are found anew).
     pub fn wake(&mut self) {
         if self.sleep.wake_all(&self.model) {
+            // (the energy guard's C computed ahead left the sleeping trees
+            // out, `Sleep::bodies_asleep`: not the step's)
+            self.data.step_bias_ok = false;
             self.refresh_contacts();
         }
     }
