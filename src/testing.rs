@@ -202,6 +202,27 @@ pub mod contact {
         }
     }
 
+    /// `contact::narrow::cylinder::box_on_cap`: a box of half extents `e` at
+    /// `c_m_b` in the frame of a cylinder (parry's, half height `h`, radius
+    /// `r`): None where the closed form declines, else the cap's normal and
+    /// the points in the cylinder's frame (as [`cylinder_on_box`]).
+    #[allow(clippy::type_complexity)]
+    pub fn box_on_cap(
+        h: f64,
+        r: f64,
+        e: &Vector3<f64>,
+        c_m_b: &Se3<f64>,
+        margin: f64,
+    ) -> Option<(Vector3<f64>, bool, Vec<(Vector3<f64>, f64, u64)>)> {
+        use crate::contact::narrow::cylinder::{box_on_cap, CylBox, Pts, MAX_PTS};
+        let mut pts: Pts = ([(Vector3::zeros(), 0.0, 0); MAX_PTS], 0);
+        match box_on_cap(h, r, e, c_m_b, margin, &mut pts) {
+            CylBox::Other => None,
+            CylBox::Apart(n) => Some((n, true, Vec::new())),
+            CylBox::Plane(n) => Some((n, false, pts.0[..pts.1].to_vec())),
+        }
+    }
+
     /// `contact::narrow::cylinder::cylinder_on_cylinder`: cylinders (half
     /// height, radius) a and b, b at `a_m_b` in a's frame: None where the
     /// closed form declines, else whether the cap is a's, the normal and the

@@ -1,5 +1,6 @@
-//! A cylinder on a box's face or on another cylinder's cap in closed form,
-//! where the face's normal is the exact contact normal: parry's GJK + EPA
+//! A cylinder on a box's face or on another cylinder's cap, and a box on a
+//! cylinder's cap ([`boxed`]), in closed form, where the face's normal is
+//! the exact contact normal: parry's GJK + EPA
 //! and its polygonal features' clipping (`contact_manifold_pfm_pfm`) give
 //! the same plane and points (up to EPA's tolerance) at ~40 k instructions
 //! a pair.
@@ -39,6 +40,10 @@
 use super::Raw;
 use crate::spatial::Se3;
 use nalgebra::Vector3;
+
+mod boxed;
+use boxed::box_feature;
+pub(crate) use boxed::box_on_cap;
 
 /// The key bit of a cylinder-on-face point (face index and feature code
 /// below it): neither parry's features (bits 0–59), the closed-form round
@@ -100,38 +105,54 @@ fn inside(poly: &[(f64, f64); 4], p: (f64, f64)) -> bool {
     sides.iter().all(|&x| x >= 0.0) || sides.iter().all(|&x| x <= 0.0)
 }
 
-/// The contact of a cylinder (parry's: axis y, half height `h`, radius `r`)
-/// at `q_m_c` (its frame in the face's shape's) with `face`, its separation
-/// from the face's plane `sep` (≤ margin): whether the plane contact is the
-/// exact one (module doc); if so its points are written to `out`.
-fn on_face(
-    h: f64,
-    r: f64,
-    q_m_c: &Se3<f64>,
-    face: Face,
-    sep: f64,
-    margin: f64,
-    out: &mut Pts,
-) -> bool {
-    let Face {
-        i,
-        s,
-        off,
-        region,
-        f,
-    } = face;
-    let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-    let mut n = Vector3::zeros();
-    n[i] = s;
-    let depth = (-sep).max(0.0);
-    if depth > off {
-        return false;
+/// The shape set on a [`Face`]: a cylinder (parry's: axis y, half height,
+/// radius) or a box (half extents).
+#[derive(Clone, Copy, Debug)]
+enum Other {
+    Cyl(f64, f64),
+    Box(Vector3<f64>),
+}
+
+/// The other shape's support feature along −n (in the face's frame): its
+/// deepest point `p0`, the point that stands for the contact, the feature's
+/// vertices (`m` of them), its plane (normal, a point; for a polygon) and its
+/// key code (bits 5–7).
+struct Feature {
+    p0: Vector3<f64>,
+    stand: Vector3<f64>,
+    vs: [Vector3<f64>; 4],
+    m: usize,
+    plane: (Vector3<f64>, Vector3<f64>),
+    code: u64,
+}
+
+impl Face {
+    /// Whether `p` lies over the region at least `depth` from its edges.
+    fn over(&self, p: &Vector3<f64>, depth: f64) -> bool {
+        let (j, k) = ((self.i + 1) % 3, (self.i + 2) % 3);
+        match self.region {
+            Region::Rect(ej, ek) => p[j].abs() + depth <= ej && p[k].abs() + depth <= ek,
+            Region::Disc(rad) => p[j].hypot(p[k]) + depth <= rad,
+        }
     }
+}
+
+/// A cylinder's [`Feature`] on `face` (outward normal `n`): the lower end of
+/// the axis and the rim's lowest direction across it, −(n − (n·u)u) (a level
+/// cap: the cylinder's x axis); the deepest point, else (a level side or
+/// cap) its point nearest the face's centre line; parry's square on the
+/// lower cap or the side's segment. None when no point stands for it.
+fn cylinder_feature(
+    (h, r): (f64, f64),
+    q_m_c: &Se3<f64>,
+    face: &Face,
+    n: &Vector3<f64>,
+    depth: f64,
+) -> Option<Feature> {
+    let (j, k) = ((face.i + 1) % 3, (face.i + 2) % 3);
     let c = q_m_c.trans;
     let u: Vector3<f64> = q_m_c.rot.column(1).into();
-    let un = s * u[i];
-    // the lower end of the axis and the rim's lowest direction across it,
-    // −(n − (n·u)u) (a level cap: the cylinder's x axis)
+    let un = u.dot(n);
     let t0 = if un > 0.0 { -h } else { h };
     let w = u * un - n;
     let wl = w.norm();
@@ -140,14 +161,8 @@ fn on_face(
     } else {
         q_m_c.rot.column(0).into()
     };
-    let over = |p: &Vector3<f64>| match region {
-        Region::Rect(ej, ek) => p[j].abs() + depth <= ej && p[k].abs() + depth <= ek,
-        Region::Disc(rad) => p[j].hypot(p[k]) + depth <= rad,
-    };
-    // the deepest point, else (a level side or cap) its point nearest the
-    // face's centre line: the point that stands for the contact
     let p0 = c + u * t0 + w0 * r;
-    let stand = if over(&p0) {
+    let stand = if face.over(&p0, depth) {
         p0
     } else if 2.0 * h * un.abs() <= LEVEL {
         // a level side's lowest line
@@ -169,22 +184,77 @@ fn on_face(
         let vl = v.norm();
         cc + if vl > r { v * (r / vl) } else { v }
     } else {
-        return false;
+        return None;
     };
-    if !over(&stand) {
-        return false;
-    }
-    // the feature: parry's square on the lower cap, or the side's segment
-    let (vs, m, top) = if un.abs() >= 0.5 {
-        let cc = c + u * t0;
+    let cc = c + u * t0;
+    if un.abs() >= 0.5 {
         let w1 = w0.cross(&u);
-        let vs = [cc + w0 * r, cc + w1 * r, cc - w0 * r, cc - w1 * r];
-        (vs, 4, t0 > 0.0)
+        Some(Feature {
+            p0,
+            stand,
+            vs: [cc + w0 * r, cc + w1 * r, cc - w0 * r, cc - w1 * r],
+            m: 4,
+            plane: (u, cc),
+            code: u64::from(t0 > 0.0),
+        })
     } else {
         let foot = c + w0 * r;
         let z = Vector3::zeros();
-        ([foot - u * h, foot + u * h, z, z], 2, false)
+        Some(Feature {
+            p0,
+            stand,
+            vs: [foot - u * h, foot + u * h, z, z],
+            m: 2,
+            plane: (u, cc),
+            code: 0,
+        })
+    }
+}
+
+/// The contact of `other` at `q_m_c` (its frame in the face's shape's) with
+/// `face`, its separation from the face's plane `sep` (≤ margin): whether
+/// the plane contact is the exact one (module doc); if so its points are
+/// written to `out`.
+fn on_face(
+    other: Other,
+    q_m_c: &Se3<f64>,
+    face: Face,
+    sep: f64,
+    margin: f64,
+    out: &mut Pts,
+) -> bool {
+    let Face {
+        i,
+        s,
+        off,
+        region,
+        f,
+    } = face;
+    let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+    let mut n = Vector3::zeros();
+    n[i] = s;
+    let depth = (-sep).max(0.0);
+    if depth > off {
+        return false;
+    }
+    let feature = match other {
+        Other::Cyl(h, r) => cylinder_feature((h, r), q_m_c, &face, &n, depth),
+        Other::Box(e) => box_feature(&e, q_m_c, &face, &n, depth),
     };
+    let Some(Feature {
+        p0,
+        stand,
+        vs,
+        m,
+        plane: (pn, pc),
+        code,
+    }) = feature
+    else {
+        return false;
+    };
+    if !face.over(&stand, depth) {
+        return false;
+    }
     // the face's polygon in (j, k): the box's rectangle, or parry's square
     // on the cap, its first vertex at GJK's point's azimuth (the stand-in's
     // foot; on the axis, the x axis: (j, k) = (z, x) of a cylinder's frame)
@@ -201,7 +271,7 @@ fn on_face(
             [(dj, dk), (dk, -dj), (-dj, -dk), (-dk, dj)]
         }
     };
-    let key0 = CYL_KEY | f << 8 | u64::from(top) << 5;
+    let key0 = CYL_KEY | f << 8 | code << 5;
     let mut push = |v: Vector3<f64>, code: u64| {
         let gap = s * v[i] - off;
         if gap <= margin && out.1 < MAX_PTS {
@@ -215,8 +285,8 @@ fn on_face(
             push(*v, a as u64);
         }
     }
-    // the face's corners under the square, at the cap's plane:
-    // u·(corner + g n − centre) = 0
+    // the face's corners under the feature's polygon, at its plane:
+    // pn·(corner + g n − pc) = 0
     if m == 4 {
         let sq = [
             (vs[0][j], vs[0][k]),
@@ -224,14 +294,14 @@ fn on_face(
             (vs[2][j], vs[2][k]),
             (vs[3][j], vs[3][k]),
         ];
-        let cc = c + u * t0;
+        let pnn = pn.dot(&n);
         for (ci, &p) in poly.iter().enumerate() {
             if inside(&sq, p) {
                 let mut q = Vector3::zeros();
                 q[i] = s * off;
                 q[j] = p.0;
                 q[k] = p.1;
-                let g = u.dot(&(cc - q)) / un;
+                let g = pn.dot(&(pc - q)) / pnn;
                 push(q + n * g, 8 + ci as u64);
             }
         }
@@ -304,7 +374,7 @@ pub(crate) fn cylinder_on_box(
         region: Region::Rect(e[j], e[k]),
         f: f as u64,
     };
-    if on_face(h, r, b_m_c, face, sep, margin, out) {
+    if on_face(Other::Cyl(h, r), b_m_c, face, sep, margin, out) {
         CylBox::Plane(n)
     } else {
         CylBox::Other
@@ -351,7 +421,7 @@ pub(crate) fn cylinder_on_cylinder(
         region: Region::Disc(p.1),
         f: 6 + 2 * u64::from(!on_a) + u64::from(s < 0.0),
     };
-    if on_face(q.0, q.1, m, face, sep, margin, out) {
+    if on_face(Other::Cyl(q.0, q.1), m, face, sep, margin, out) {
         (CylBox::Plane(n), on_a)
     } else {
         (CylBox::Other, on_a)
@@ -401,7 +471,15 @@ pub(crate) fn cylinder_box_points(
     let x_m_c = wx.inverse().compose(wc);
     let mut pts: Pts = ([(Vector3::zeros(), 0.0, 0); MAX_PTS], 0);
     let n = match cylinder_on_box(cyl.0, cyl.1, e, &x_m_c, margin, &mut pts) {
-        CylBox::Other => return None,
+        CylBox::Other => {
+            // the box on the cylinder's cap: the cap's normal points from
+            // the cylinder toward the box
+            let n = match box_on_cap(cyl.0, cyl.1, e, &x_m_c.inverse(), margin, &mut pts) {
+                CylBox::Other => return None,
+                CylBox::Apart(n) | CylBox::Plane(n) => n,
+            };
+            return Some(push_plane_points(&pts, &n, wc, !cyl_is_a, wa, raw));
+        }
         CylBox::Apart(n) | CylBox::Plane(n) => n,
     };
     // the face's normal points from the box toward the cylinder
