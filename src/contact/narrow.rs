@@ -147,23 +147,7 @@ pub(crate) fn parry_points(
             man.points.clear();
         }
         if let (Some(ha), Some(hb)) = climbs {
-            // two climbing hulls: the dispatcher's generator for them (one
-            // manifold, parry's polyhedral one, no border, no normal
-            // constraint) called with their own type, its supports inlined
-            if manifolds.is_empty() {
-                manifolds.push(ContactManifold::new());
-            }
-            contact_manifold_pfm_pfm(
-                &pos12,
-                ha,
-                0.0,
-                None,
-                hb,
-                0.0,
-                None,
-                margin,
-                &mut manifolds[0],
-            );
+            climb_manifolds(&pos12, ha, hb, margin, manifolds);
             return Ok(());
         }
         dispatcher.contact_manifolds(&pos12, &*a.shape, &*b.shape, margin, manifolds, workspace)
@@ -202,6 +186,34 @@ pub(crate) fn parry_points(
     if ok.is_ok() {
         push_points(&manifolds[..], wa, wb, margin, bound, raw);
     }
+}
+
+/// The dispatcher's generator for two climbing hulls (one manifold, parry's
+/// polyhedral one, no border, no normal constraint) called with their own
+/// type: GJK's supports inlined, not called through `dyn`. Out of line: in
+/// [`parry_points`] it grew the pair visit past what the inliner keeps whole.
+#[inline(never)]
+fn climb_manifolds(
+    pos12: &Pose,
+    ha: &ClimbHull,
+    hb: &ClimbHull,
+    margin: f64,
+    manifolds: &mut Vec<ContactManifold<(), ()>>,
+) {
+    if manifolds.is_empty() {
+        manifolds.push(ContactManifold::new());
+    }
+    contact_manifold_pfm_pfm(
+        pos12,
+        ha,
+        0.0,
+        None,
+        hb,
+        0.0,
+        None,
+        margin,
+        &mut manifolds[0],
+    );
 }
 
 /// How far (m) a kept point may slide along the contact plane, and how far
