@@ -411,6 +411,7 @@ impl PairMasks {
 
     /// Calls `found(l, h)` for each allowed pair l < h whose boxes in `sap`
     /// overlap, by l, then h.
+    #[inline]
     pub(crate) fn overlaps(&mut self, sap: &SweepAndPrune, mut found: impl FnMut(usize, usize)) {
         let n = self.allowed.len().min(sap.lo.len()).min(sap.hi.len());
         if n < DENSE_FROM {

@@ -83,7 +83,7 @@ fn cell_centre(c: usize) -> PVec {
 
 /// The faces' cube map: `FACE_CELLS`² cells a cube face (their cones are
 /// narrower than the climb's seeds', so fewer faces are candidates of one).
-const FACE_CELLS: usize = 8;
+const FACE_CELLS: usize = 16;
 
 /// The angle (rad) between directions a and b (any length), accurate near 0.
 fn angle(a: PVec, b: PVec) -> f64 {
@@ -141,7 +141,7 @@ pub(crate) struct ClimbHull {
     normal_z: Vec<f64>,
     /// Per cell of the faces' cube map, its candidate faces ([`cell_faces`]),
     /// found the first time a direction of the cell is asked (a robot's
-    /// pair asks few of the 384 cells).
+    /// pair asks few of the 1,536 cells).
     cells: Box<[OnceLock<Box<[u32]>>]>,
     /// The mean of the vertices (a point inside the hull).
     centre: PVec,

@@ -7,11 +7,13 @@
 
 use super::face::{hull_on_face, FaceContact, FacePoint, FaceShape, HullRef};
 use super::frame::tangents;
+use super::hull::ClimbHull;
 use super::shapes::{from_pvec, to_pose, PairShape};
 use super::ContactPoint;
 use crate::spatial::Se3;
 use nalgebra::Vector3;
 use parry3d_f64::math::Pose;
+use parry3d_f64::query::details::contact_manifold_pfm_pfm;
 use parry3d_f64::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
@@ -132,6 +134,10 @@ pub(crate) fn parry_points(
     raw.clear();
     let dispatcher = DefaultQueryDispatcher;
     let pos12 = to_pose(&wa.inverse().compose(wb));
+    let climbs = (
+        a.shape.as_shape::<ClimbHull>(),
+        b.shape.as_shape::<ClimbHull>(),
+    );
     let query = |manifolds: &mut Vec<ContactManifold<(), ()>>,
                  workspace: &mut Option<ContactManifoldsWorkspace>| {
         // the points are found anew (a generator that finds the shapes
@@ -139,6 +145,10 @@ pub(crate) fn parry_points(
         // contact data, carry the warm starts)
         for man in manifolds.iter_mut() {
             man.points.clear();
+        }
+        if let (Some(ha), Some(hb)) = climbs {
+            climb_manifolds(&pos12, ha, hb, margin, manifolds);
+            return Ok(());
         }
         dispatcher.contact_manifolds(&pos12, &*a.shape, &*b.shape, margin, manifolds, workspace)
     };
@@ -176,6 +186,34 @@ pub(crate) fn parry_points(
     if ok.is_ok() {
         push_points(&manifolds[..], wa, wb, margin, bound, raw);
     }
+}
+
+/// The dispatcher's generator for two climbing hulls (one manifold, parry's
+/// polyhedral one, no border, no normal constraint) called with their own
+/// type: GJK's supports inlined, not called through `dyn`. Out of line: in
+/// [`parry_points`] it grew the pair visit past what the inliner keeps whole.
+#[inline(never)]
+fn climb_manifolds(
+    pos12: &Pose,
+    ha: &ClimbHull,
+    hb: &ClimbHull,
+    margin: f64,
+    manifolds: &mut Vec<ContactManifold<(), ()>>,
+) {
+    if manifolds.is_empty() {
+        manifolds.push(ContactManifold::new());
+    }
+    contact_manifold_pfm_pfm(
+        pos12,
+        ha,
+        0.0,
+        None,
+        hb,
+        0.0,
+        None,
+        margin,
+        &mut manifolds[0],
+    );
 }
 
 /// How far (m) a kept point may slide along the contact plane, and how far
