@@ -161,6 +161,13 @@ impl Rows {
             }
         }
         let lambda = &mut out.lambda[..n];
+        // rows pinned at a bound skipped while provably still pinned
+        // ([`pinned_until`]): `drift` bounds ‖Δv'‖ since the first was
+        // (every entry of `until` is −∞ between solves)
+        let mut until = std::mem::take(&mut out.sm.0.until);
+        let skip = !block && until.len() >= n;
+        // (only once some row is pinned: `armed`)
+        let (mut drift, mut armed) = (0.0, false);
         // SAFETY (unchecked reads in rdot/raxpy): every path lies in `table`
         // (checked above) and holds dof indices < nv; y holds n·stride entries and
         // a path is at most stride long.
@@ -238,6 +245,16 @@ impl Rows {
                 while r < e {
                     let kind = kinds[r];
                     if contact[r] {
+                        if armed && drift < until[r] {
+                            // an inactive contact that provably stays so:
+                            // nothing moves, no measure (its velocity unknown:
+                            // the next measure, if it wakes, is its residual)
+                            u_prev[r] = f64::NAN;
+                            u_prev[r + 1] = f64::NAN;
+                            u_prev[r + 2] = f64::NAN;
+                            r += 3;
+                            continue;
+                        }
                         // a contact's three rows in one pass over its path: the
                         // normal, then the tangent pair from the velocity the
                         // normal's change left (through the block's entries)
@@ -273,6 +290,10 @@ impl Rows {
                             u_prev[r] = un;
                             u_prev[r + 1] = u1;
                             u_prev[r + 2] = u2;
+                            if skip {
+                                until[r] = pinned_until(drift, un - b[r], un, wnn);
+                                armed |= until[r] > f64::NEG_INFINITY;
+                            }
                             r += 3;
                             continue;
                         }
@@ -301,6 +322,11 @@ impl Rows {
                             // y holds n·st entries
                             let yr = |q: usize| unsafe { y.get_unchecked(q * st..q * st + l) };
                             axpy3([dln, dl1, dl2], [yr(r), yr(r + 1), yr(r + 2)], p, dv);
+                            if armed {
+                                drift += dln.abs() * wnn.sqrt()
+                                    + dl1.abs() * w11.sqrt()
+                                    + dl2.abs() * w22.sqrt();
+                            }
                             if block {
                                 lb.follow(&view, r, &[dln, dl1, dl2], lambda, dv);
                             }
@@ -344,9 +370,11 @@ impl Rows {
                             let (d1, d2) = (t1 - o1, t2 - o2);
                             if d1 != 0.0 {
                                 raxpy(d1, y, r, st, p1, dv);
+                                drift += if armed { d1.abs() * w11.sqrt() } else { 0.0 };
                             }
                             if d2 != 0.0 {
                                 raxpy(d2, y, r + 1, st, p2, dv);
+                                drift += if armed { d2.abs() * w22.sqrt() } else { 0.0 };
                             }
                             if block {
                                 lb.follow(&view, r, &[d1, d2], lambda, dv);
@@ -365,6 +393,12 @@ impl Rows {
                             continue;
                         }
                         _ => {}
+                    }
+                    if armed && drift < until[r] {
+                        // pinned at its bound, provably still (as a contact's)
+                        u_prev[r] = f64::NAN;
+                        r += 1;
+                        continue;
                     }
                     let wrr = w[r];
                     let old = lambda[r];
@@ -385,9 +419,22 @@ impl Rows {
                     let d = new - old;
                     if d != 0.0 {
                         raxpy(d, y, r, st, p, dv);
+                        if armed {
+                            drift += d.abs() * wrr.sqrt();
+                        }
                         if block && lb.couples(r) {
                             lb.follow(&view, r, &[d], lambda, dv);
                         }
+                    } else if skip && winv[r] != 0.0 {
+                        // held at a bound by its velocity: the margin it has
+                        let slack = match kind {
+                            RowKind::Box { limit } if limit > 0.0 && old == limit => b[r] - u,
+                            RowKind::Box { limit } if limit > 0.0 && old == -limit => u - b[r],
+                            RowKind::Unilateral | RowKind::Normal if old.to_bits() == 0 => u - b[r],
+                            _ => f64::NAN,
+                        };
+                        until[r] = pinned_until(drift, slack, u, wrr);
+                        armed |= until[r] > f64::NEG_INFINITY;
                     }
                     change = most(change, measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
                     r += 1;
@@ -431,6 +478,13 @@ impl Rows {
                 };
                 if subspace_step(&mut out.sm.0, &rows, lambda, dv) {
                     polished = true;
+                    // Δv' moved outside `drift`: every row looked at again
+                    if armed {
+                        for &(_, s, e) in runs {
+                            until[s..e].fill(f64::NEG_INFINITY);
+                        }
+                        (drift, armed) = (0.0, false);
+                    }
                     if block {
                         lb.solve(&view, Some(c), b, lambda, dv);
                     }
@@ -442,7 +496,38 @@ impl Rows {
             self.shed_self_stress(&mut out.sm.0, runs, lambda, dv, tol);
         }
         out.sm.0.loops = lb;
+        if armed {
+            for &(_, s, e) in runs {
+                until[s..e].fill(f64::NEG_INFINITY);
+            }
+        }
+        out.sm.0.until = until;
         (it, polished)
+    }
+}
+
+/// Below how much of its slack a pinned row is taken to be held, relative
+/// to 1 + |u|: room for the rounding of u and of Δv' (about 1e-15 of them).
+const PIN_MARGIN: f64 = 1e-9;
+
+/// Up to which `drift` a row held at a bound by its velocity stays held: a
+/// row at its bound with `slack` = how far its velocity `u` lies on the
+/// holding side of its target (uᵣ − bᵣ for an inactive normal or limit at
+/// λ = 0; bᵣ − uᵣ at a joint friction's +limit, uᵣ − bᵣ at its −limit) keeps
+/// its impulse, and moves nothing, while u stays on that side. Every update
+/// since adds |Δλ_q| ‖y_q‖ = |Δλ_q| √W_qq to `drift`, a bound on ‖Δv'‖ by the
+/// triangle inequality, and Cauchy–Schwarz bounds |Δuᵣ| = |yᵣ·Δv'| by
+/// √Wᵣᵣ ‖Δv'‖: so while `drift` − (its value now) < slack/√Wᵣᵣ (less a
+/// margin for rounding) the row's update is provably the one that leaves it
+/// pinned, and the sweeps skip it (the same λ and Δv' bit for bit).
+/// `NEG_INFINITY` (never skipped) when the slack is not positive.
+#[inline(always)]
+fn pinned_until(drift: f64, slack: f64, u: f64, w: f64) -> f64 {
+    let s = slack - PIN_MARGIN * (1.0 + u.abs());
+    if s > 0.0 && w > 0.0 {
+        drift + s / w.sqrt()
+    } else {
+        f64::NEG_INFINITY
     }
 }
 
