@@ -2,7 +2,7 @@
 //! contact's three rows taken in one pass and the exact Coulomb slide onto
 //! the friction disc.
 
-use super::kernels::{axpy3, dot3, warm3};
+use super::kernels::{axpy3, dot3, pinned_until, warm3};
 use super::loop_block::BlockRows;
 use super::subspace::{subspace_step, Solved, Subspace};
 use super::{MassFactor, RowKind, Rows, SUBSPACE_MAX};
@@ -165,7 +165,12 @@ impl Rows {
         // ([`pinned_until`]): `drift` bounds ‖Δv'‖ since the first was
         // (every entry of `until` is −∞ between solves)
         let mut until = std::mem::take(&mut out.sm.0.until);
-        let skip = !block && until.len() >= n;
+        // (on islands of a robot's joints, where joint friction sits at its
+        // bound and self-collision pairs wait apart; on free bodies' islands
+        // no row is armed: their contacts are nearly all active, and the
+        // bookkeeping would cost more than it skips)
+        let jointed = |d: &[usize]| d.iter().any(|&k| self.jointed.get(k) == Some(&true));
+        let skip = !block && until.len() >= n && self.any_jointed && dofs.is_none_or(jointed);
         // (only once some row is pinned: `armed`)
         let (mut drift, mut armed) = (0.0, false);
         // SAFETY (unchecked reads in rdot/raxpy): every path lies in `table`
@@ -503,31 +508,6 @@ impl Rows {
         }
         out.sm.0.until = until;
         (it, polished)
-    }
-}
-
-/// Below how much of its slack a pinned row is taken to be held, relative
-/// to 1 + |u|: room for the rounding of u and of Δv' (about 1e-15 of them).
-const PIN_MARGIN: f64 = 1e-9;
-
-/// Up to which `drift` a row held at a bound by its velocity stays held: a
-/// row at its bound with `slack` = how far its velocity `u` lies on the
-/// holding side of its target (uᵣ − bᵣ for an inactive normal or limit at
-/// λ = 0; bᵣ − uᵣ at a joint friction's +limit, uᵣ − bᵣ at its −limit) keeps
-/// its impulse, and moves nothing, while u stays on that side. Every update
-/// since adds |Δλ_q| ‖y_q‖ = |Δλ_q| √W_qq to `drift`, a bound on ‖Δv'‖ by the
-/// triangle inequality, and Cauchy–Schwarz bounds |Δuᵣ| = |yᵣ·Δv'| by
-/// √Wᵣᵣ ‖Δv'‖: so while `drift` − (its value now) < slack/√Wᵣᵣ (less a
-/// margin for rounding) the row's update is provably the one that leaves it
-/// pinned, and the sweeps skip it (the same λ and Δv' bit for bit).
-/// `NEG_INFINITY` (never skipped) when the slack is not positive.
-#[inline(always)]
-fn pinned_until(drift: f64, slack: f64, u: f64, w: f64) -> f64 {
-    let s = slack - PIN_MARGIN * (1.0 + u.abs());
-    if s > 0.0 && w > 0.0 {
-        drift + s / w.sqrt()
-    } else {
-        f64::NEG_INFINITY
     }
 }
 
