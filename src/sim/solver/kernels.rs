@@ -154,3 +154,28 @@ pub(super) fn axpy3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
         t += 1;
     }
 }
+
+/// Below how much of its slack a pinned row is taken to be held, relative
+/// to 1 + |u|: room for the rounding of u and of Δv' (about 1e-15 of them).
+const PIN_MARGIN: f64 = 1e-9;
+
+/// Up to which `drift` a row held at a bound by its velocity stays held: a
+/// row at its bound with `slack` = how far its velocity `u` lies on the
+/// holding side of its target (uᵣ − bᵣ for an inactive normal or limit at
+/// λ = 0; bᵣ − uᵣ at a joint friction's +limit, uᵣ − bᵣ at its −limit) keeps
+/// its impulse, and moves nothing, while u stays on that side. Every update
+/// since adds |Δλ_q| ‖y_q‖ = |Δλ_q| √W_qq to `drift`, a bound on ‖Δv'‖ by the
+/// triangle inequality, and Cauchy–Schwarz bounds |Δuᵣ| = |yᵣ·Δv'| by
+/// √Wᵣᵣ ‖Δv'‖: so while `drift` − (its value now) < slack/√Wᵣᵣ (less a
+/// margin for rounding) the row's update is provably the one that leaves it
+/// pinned, and the sweeps skip it (the same λ and Δv' bit for bit).
+/// `NEG_INFINITY` (never skipped) when the slack is not positive.
+#[inline(always)]
+pub(super) fn pinned_until(drift: f64, slack: f64, u: f64, w: f64) -> f64 {
+    let s = slack - PIN_MARGIN * (1.0 + u.abs());
+    if s > 0.0 && w > 0.0 {
+        drift + s / w.sqrt()
+    } else {
+        f64::NEG_INFINITY
+    }
+}

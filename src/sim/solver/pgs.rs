@@ -2,7 +2,7 @@
 //! contact's three rows taken in one pass and the exact Coulomb slide onto
 //! the friction disc.
 
-use super::kernels::{axpy3, dot3, warm3};
+use super::kernels::{axpy3, dot3, pinned_until, warm3};
 use super::loop_block::BlockRows;
 use super::subspace::{subspace_step, Solved, Subspace};
 use super::{MassFactor, RowKind, Rows, SUBSPACE_MAX};
@@ -161,6 +161,18 @@ impl Rows {
             }
         }
         let lambda = &mut out.lambda[..n];
+        // rows pinned at a bound skipped while provably still pinned
+        // ([`pinned_until`]): `drift` bounds ‖Δv'‖ since the first was
+        // (every entry of `until` is −∞ between solves)
+        let mut until = std::mem::take(&mut out.sm.0.until);
+        // (on islands of a robot's joints, where joint friction sits at its
+        // bound and self-collision pairs wait apart; on free bodies' islands
+        // no row is armed: their contacts are nearly all active, and the
+        // bookkeeping would cost more than it skips)
+        let jointed = |d: &[usize]| d.iter().any(|&k| self.jointed.get(k) == Some(&true));
+        let skip = !block && until.len() >= n && self.any_jointed && dofs.is_none_or(jointed);
+        // (only once some row is pinned: `armed`)
+        let (mut drift, mut armed) = (0.0, false);
         // SAFETY (unchecked reads in rdot/raxpy): every path lies in `table`
         // (checked above) and holds dof indices < nv; y holds n·stride entries and
         // a path is at most stride long.
@@ -238,6 +250,16 @@ impl Rows {
                 while r < e {
                     let kind = kinds[r];
                     if contact[r] {
+                        if armed && drift < until[r] {
+                            // an inactive contact that provably stays so:
+                            // nothing moves, no measure (its velocity unknown:
+                            // the next measure, if it wakes, is its residual)
+                            u_prev[r] = f64::NAN;
+                            u_prev[r + 1] = f64::NAN;
+                            u_prev[r + 2] = f64::NAN;
+                            r += 3;
+                            continue;
+                        }
                         // a contact's three rows in one pass over its path: the
                         // normal, then the tangent pair from the velocity the
                         // normal's change left (through the block's entries)
@@ -273,6 +295,10 @@ impl Rows {
                             u_prev[r] = un;
                             u_prev[r + 1] = u1;
                             u_prev[r + 2] = u2;
+                            if skip {
+                                until[r] = pinned_until(drift, un - b[r], un, wnn);
+                                armed |= until[r] > f64::NEG_INFINITY;
+                            }
                             r += 3;
                             continue;
                         }
@@ -301,6 +327,11 @@ impl Rows {
                             // y holds n·st entries
                             let yr = |q: usize| unsafe { y.get_unchecked(q * st..q * st + l) };
                             axpy3([dln, dl1, dl2], [yr(r), yr(r + 1), yr(r + 2)], p, dv);
+                            if armed {
+                                drift += dln.abs() * wnn.sqrt()
+                                    + dl1.abs() * w11.sqrt()
+                                    + dl2.abs() * w22.sqrt();
+                            }
                             if block {
                                 lb.follow(&view, r, &[dln, dl1, dl2], lambda, dv);
                             }
@@ -344,9 +375,11 @@ impl Rows {
                             let (d1, d2) = (t1 - o1, t2 - o2);
                             if d1 != 0.0 {
                                 raxpy(d1, y, r, st, p1, dv);
+                                drift += if armed { d1.abs() * w11.sqrt() } else { 0.0 };
                             }
                             if d2 != 0.0 {
                                 raxpy(d2, y, r + 1, st, p2, dv);
+                                drift += if armed { d2.abs() * w22.sqrt() } else { 0.0 };
                             }
                             if block {
                                 lb.follow(&view, r, &[d1, d2], lambda, dv);
@@ -365,6 +398,12 @@ impl Rows {
                             continue;
                         }
                         _ => {}
+                    }
+                    if armed && drift < until[r] {
+                        // pinned at its bound, provably still (as a contact's)
+                        u_prev[r] = f64::NAN;
+                        r += 1;
+                        continue;
                     }
                     let wrr = w[r];
                     let old = lambda[r];
@@ -385,9 +424,22 @@ impl Rows {
                     let d = new - old;
                     if d != 0.0 {
                         raxpy(d, y, r, st, p, dv);
+                        if armed {
+                            drift += d.abs() * wrr.sqrt();
+                        }
                         if block && lb.couples(r) {
                             lb.follow(&view, r, &[d], lambda, dv);
                         }
+                    } else if skip && winv[r] != 0.0 {
+                        // held at a bound by its velocity: the margin it has
+                        let slack = match kind {
+                            RowKind::Box { limit } if limit > 0.0 && old == limit => b[r] - u,
+                            RowKind::Box { limit } if limit > 0.0 && old == -limit => u - b[r],
+                            RowKind::Unilateral | RowKind::Normal if old.to_bits() == 0 => u - b[r],
+                            _ => f64::NAN,
+                        };
+                        until[r] = pinned_until(drift, slack, u, wrr);
+                        armed |= until[r] > f64::NEG_INFINITY;
                     }
                     change = most(change, measure(first, (d * wrr).abs(), u, &mut u_prev[r]));
                     r += 1;
@@ -431,6 +483,13 @@ impl Rows {
                 };
                 if subspace_step(&mut out.sm.0, &rows, lambda, dv) {
                     polished = true;
+                    // Δv' moved outside `drift`: every row looked at again
+                    if armed {
+                        for &(_, s, e) in runs {
+                            until[s..e].fill(f64::NEG_INFINITY);
+                        }
+                        (drift, armed) = (0.0, false);
+                    }
                     if block {
                         lb.solve(&view, Some(c), b, lambda, dv);
                     }
@@ -442,6 +501,12 @@ impl Rows {
             self.shed_self_stress(&mut out.sm.0, runs, lambda, dv, tol);
         }
         out.sm.0.loops = lb;
+        if armed {
+            for &(_, s, e) in runs {
+                until[s..e].fill(f64::NEG_INFINITY);
+            }
+        }
+        out.sm.0.until = until;
         (it, polished)
     }
 }

@@ -44,6 +44,9 @@ pub(super) struct Subspace {
     pub(super) wf: Vec<f64>,
     /// At a free row: its place in `factored_rows` (`usize::MAX`: not there).
     pub(super) old: Vec<usize>,
+    /// Each row: the sweeps' `drift` up to which it is pinned at its bound
+    /// (pgs.rs, `pinned_until`).
+    pub(super) until: Vec<f64>,
 }
 
 impl Subspace {
@@ -66,6 +69,7 @@ impl Subspace {
             factored_rows: Vec::with_capacity(m),
             wf: vec![0.0; m * m],
             old: Vec::with_capacity(m),
+            until: vec![f64::NEG_INFINITY; cap],
         }
     }
 
