@@ -30,6 +30,7 @@ use crate::contact::{tangents, ContactPoint};
 use crate::model::{JointKind, Model};
 use crate::spatial::{Force, Motion, Se3};
 use nalgebra::{DVector, Vector3};
+pub(crate) use tables::add_body_rows;
 use tables::{act_column, add_body, BodyColumns, JointRowSource};
 
 /// What the rows are built from, besides the state.

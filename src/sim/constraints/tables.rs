@@ -70,6 +70,46 @@ pub(super) fn add_body(
     t0
 }
 
+/// [`add_body`] for a body of the world columns `cols` (≤ 6: their own
+/// body-frame ones) from dof `iv`, onto three zeroed rows as long as `path`
+/// (the tests' hook, `urdyn::testing::constraints`).
+pub(crate) fn add_body_rows(
+    path: &[usize],
+    hi: usize,
+    iv: usize,
+    cols: &[Motion],
+    p: &Vector3<f64>,
+    row: &dyn Fn(Vector3<f64>) -> [f64; 3],
+) -> ([Vec<f64>; 3], usize) {
+    let zero = Column {
+        s: Motion::zero(),
+        ang_zero: true,
+        lin_zero: true,
+    };
+    let mut bc = BodyColumns {
+        s: [zero; 6],
+        nv: cols.len().min(6),
+        iv,
+    };
+    let mut sw = [Motion::zero(); 6];
+    for ((c, w), &s) in bc.s.iter_mut().zip(&mut sw).zip(cols) {
+        *c = Column {
+            s,
+            ang_zero: s.ang == Vector3::zeros(),
+            lin_zero: s.lin == Vector3::zeros(),
+        };
+        *w = s;
+    }
+    let mut j = [
+        vec![0.0; path.len()],
+        vec![0.0; path.len()],
+        vec![0.0; path.len()],
+    ];
+    let [a, b, c] = &mut j;
+    let t0 = add_body([a, b, c], path, hi, &bc, &sw, p, row);
+    (j, t0)
+}
+
 /// The point velocity `s.lin + s.ang × p` of world column `s`: a column
 /// with no angular part (`ang_zero`: [`act_column`] left it +0) is `s.lin`,
 /// the same values for a finite p but for the sign of a zero, which no row
