@@ -391,6 +391,27 @@ pub mod view {
     }
 }
 
+/// Row forming (sim/constraints.rs, constraints/tables.rs).
+pub mod constraints {
+    use crate::spatial::Motion;
+    use nalgebra::Vector3;
+
+    /// `sim::constraints::tables::add_body` for a body of world columns `cols`
+    /// from dof `iv` on the row path `path` (from `hi`): the three rows (each
+    /// `row(vp)` where the path holds the column's dof, else 0) and where the
+    /// body's first dof lies.
+    pub fn add_body_rows(
+        path: &[usize],
+        hi: usize,
+        iv: usize,
+        cols: &[Motion],
+        p: &Vector3<f64>,
+        row: &dyn Fn(Vector3<f64>) -> [f64; 3],
+    ) -> ([Vec<f64>; 3], usize) {
+        crate::sim::constraints::add_body_rows(path, hi, iv, cols, p, row)
+    }
+}
+
 /// The subspace step's dense LDLᵀ of W_FF (sim/solver/dense.rs).
 pub mod solver {
     /// `sim::solver::dense::ldlt_dropping` (row i at `a[i * ld..]`, rows

@@ -30,7 +30,8 @@ use crate::contact::{tangents, ContactPoint};
 use crate::model::{JointKind, Model};
 use crate::spatial::{Force, Motion, Se3};
 use nalgebra::{DVector, Vector3};
-use tables::{act_column, BodyColumns, JointRowSource};
+pub(crate) use tables::add_body_rows;
+use tables::{act_column, add_body, BodyColumns, JointRowSource};
 
 /// What the rows are built from, besides the state.
 #[derive(Clone, Copy, Debug)]
@@ -126,9 +127,6 @@ pub(crate) struct Constraints {
     /// joint's constants: kind, axis, `mult`), the world-frame ones' source.
     cols: Vec<BodyColumns>,
     sw_stamp: u64,
-    /// Where each dof lies on the current point's row path (scratch; valid
-    /// where the path holds that dof there).
-    slot: Vec<usize>,
     counts: RowCounts,
     dv: DVector<f64>,
     push: DVector<f64>,
@@ -220,7 +218,6 @@ impl Constraints {
                 .map(|i| BodyColumns::of(model, i))
                 .collect(),
             sw_stamp: 0,
-            slot: vec![0; nv],
             counts: RowCounts::default(),
             dv: DVector::zeros(nv),
             push: DVector::zeros(nv),
@@ -400,60 +397,50 @@ impl Constraints {
                 self.row_point.push(pi);
                 counts.contacts += 1;
                 // J's entries are added straight onto the rows' paths (zeroed
-                // by `clear`): entry t of a row is dof path[t]
+                // by `clear`): entry t of a row is dof path[t] (a path is
+                // ascending: `add_body` finds a dof by bisection)
                 let st = rows.stride;
                 let (ps, pl) = path;
                 let (tab, jall) = rows.table_and_j();
                 let on_path = tab.get(ps..ps + pl).unwrap_or(&[]);
-                for (t, &d) in on_path.iter().enumerate() {
-                    if let Some(x) = self.slot.get_mut(d) {
-                        *x = t;
-                    }
-                }
-                let slot = &self.slot;
                 let (j0, rest) = jall[rn * st..(rn + 3) * st].split_at_mut(st);
                 let (j1, j2) = rest.split_at_mut(st);
-                let mut put = |col: usize, a: f64, b: f64, c: f64| {
-                    if let Some(&t) = slot.get(col)
-                        && on_path.get(t) == Some(&col)
-                        && let (Some(x0), Some(x1), Some(x2)) =
-                            (j0.get_mut(t), j1.get_mut(t), j2.get_mut(t))
-                    {
-                        *x0 += a;
-                        *x1 += b;
-                        *x2 += c;
-                    }
-                };
+                let at = &pt.point;
                 if pt.other == 0 && pt.normal == Vector3::z() {
                     // the ground: rows n = z, t₁ = x, t₂ = y: the point velocity
                     // v_c + ω_c × p of each ancestor's world-frame subspace column c
-                    let mut b = pt.body;
+                    let (mut b, mut hi) = (pt.body, on_path.len());
                     while b != 0
                         && let (Some(bc), Some(sw)) = (self.cols.get(b), self.sw.get(b))
                     {
-                        for (c, s) in sw.iter().enumerate().take(bc.nv) {
-                            let vp = s.lin + s.ang.cross(&pt.point);
-                            put(bc.iv + c, vp.z, vp.x, vp.y);
-                        }
+                        let j = [&mut *j0, &mut *j1, &mut *j2];
+                        hi = add_body(j, on_path, hi, bc, sw, at, |vp| [vp.z, vp.x, vp.y]);
                         b = model.parent[b];
                     }
                 } else {
                     // two bodies: J = J_a − J_b, the relative velocity of the
                     // point on a and on b along (n, t₁, t₂), n from b toward a
                     // (a common ancestor's columns cancel: x + (−x) = +0, the
-                    // entry as zeroed, so each walk stops at the first of them)
-                    let (t1, t2) = tangents(&pt.normal);
+                    // entry as zeroed, so each walk stops at the first of them);
+                    // b's entries are −(n·vp), the values of n·(−vp) but for
+                    // the sign of a zero, which the sum onto +0 drops
+                    let (n, (t1, t2)) = (pt.normal, tangents(&pt.normal));
                     let lca = common_ancestor(&model.parent, pt.body, pt.other);
-                    for (start, sign) in [(pt.body, 1.0), (pt.other, -1.0)] {
-                        let mut b = start;
+                    for (start, neg) in [(pt.body, false), (pt.other, true)] {
+                        let (mut b, mut hi) = (start, on_path.len());
                         while b != lca
                             && b != 0
                             && let (Some(bc), Some(sw)) = (self.cols.get(b), self.sw.get(b))
                         {
-                            for (c, s) in sw.iter().enumerate().take(bc.nv) {
-                                let vp = (s.lin + s.ang.cross(&pt.point)) * sign;
-                                put(bc.iv + c, pt.normal.dot(&vp), t1.dot(&vp), t2.dot(&vp));
-                            }
+                            let j = [&mut *j0, &mut *j1, &mut *j2];
+                            hi = add_body(j, on_path, hi, bc, sw, at, |vp| {
+                                let r = [n.dot(&vp), t1.dot(&vp), t2.dot(&vp)];
+                                if neg {
+                                    r.map(|x| -x)
+                                } else {
+                                    r
+                                }
+                            });
                             b = model.parent[b];
                         }
                     }

@@ -18,6 +18,7 @@ mod mesh_cache;
 mod mesh_dae;
 mod mesh_inertia;
 mod scene_srdf;
+mod sim_add_body;
 mod sim_build;
 mod sim_dense;
 mod sim_factor;

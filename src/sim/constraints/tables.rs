@@ -7,6 +7,122 @@ use crate::spatial::ops::{add_cross, mat_vec};
 use crate::spatial::{Motion, Se3};
 use nalgebra::Vector3;
 
+/// Adds one body's entries to a contact's three rows `j` (the path's
+/// entries, `on_path` its dofs, ascending as every row path is, see
+/// `Rows::union_path`): `row(vp)` for the point velocity vp at `p` of each of
+/// the body's world columns `sw` (`bc`: the body-frame ones, which have no
+/// angular part). `hi`: where the dofs of the body walked before, a
+/// descendant, begin (the path's length for the first): the body's lie
+/// before, back to back at its end on a body's own path to the root (tried
+/// first; else found by bisection). Returns where the body's first dof lies
+/// (its ancestors' lie before). Back to back (checked at both ends: the path
+/// ascends), the entries are written in place, one bounds test a row; else
+/// each is looked up.
+#[inline(always)]
+pub(super) fn add_body(
+    j: [&mut [f64]; 3],
+    on_path: &[usize],
+    hi: usize,
+    bc: &BodyColumns,
+    sw: &[Motion; 6],
+    p: &Vector3<f64>,
+    row: impl Fn(Vector3<f64>) -> [f64; 3],
+) -> usize {
+    let (iv, nv) = (bc.iv, bc.nv.min(6));
+    let Some(last) = nv.checked_sub(1) else {
+        return hi;
+    };
+    let guess = hi.wrapping_sub(nv);
+    let t0 = match on_path.get(guess) {
+        Some(&d) if d == iv => guess,
+        _ => on_path.partition_point(|&d| d < iv),
+    };
+    let cols = bc.s.iter().zip(sw).take(nv);
+    let [j0, j1, j2] = j;
+    if on_path.get(t0 + last) == Some(&(iv + last))
+        && on_path.get(t0) == Some(&iv)
+        && let (Some(r0), Some(r1), Some(r2)) = (
+            j0.get_mut(t0..t0 + nv),
+            j1.get_mut(t0..t0 + nv),
+            j2.get_mut(t0..t0 + nv),
+        )
+    {
+        for ((((c, s), x0), x1), x2) in cols.zip(r0).zip(r1).zip(r2) {
+            let [a, b, e] = row(point_velocity(s, c.ang_zero, p));
+            *x0 += a;
+            *x1 += b;
+            *x2 += e;
+        }
+        return t0;
+    }
+    for (k, (c, s)) in cols.enumerate() {
+        let col = iv + k;
+        let t = on_path.partition_point(|&d| d < col);
+        if on_path.get(t) == Some(&col)
+            && let (Some(x0), Some(x1), Some(x2)) = (j0.get_mut(t), j1.get_mut(t), j2.get_mut(t))
+        {
+            let [a, b, e] = row(point_velocity(s, c.ang_zero, p));
+            *x0 += a;
+            *x1 += b;
+            *x2 += e;
+        }
+    }
+    t0
+}
+
+/// [`add_body`] for a body of the world columns `cols` (≤ 6: their own
+/// body-frame ones) from dof `iv`, onto three zeroed rows as long as `path`
+/// (the tests' hook, `urdyn::testing::constraints`).
+pub(crate) fn add_body_rows(
+    path: &[usize],
+    hi: usize,
+    iv: usize,
+    cols: &[Motion],
+    p: &Vector3<f64>,
+    row: &dyn Fn(Vector3<f64>) -> [f64; 3],
+) -> ([Vec<f64>; 3], usize) {
+    let zero = Column {
+        s: Motion::zero(),
+        ang_zero: true,
+        lin_zero: true,
+    };
+    let mut bc = BodyColumns {
+        s: [zero; 6],
+        nv: cols.len().min(6),
+        iv,
+    };
+    let mut sw = [Motion::zero(); 6];
+    for ((c, w), &s) in bc.s.iter_mut().zip(&mut sw).zip(cols) {
+        *c = Column {
+            s,
+            ang_zero: s.ang == Vector3::zeros(),
+            lin_zero: s.lin == Vector3::zeros(),
+        };
+        *w = s;
+    }
+    let mut j = [
+        vec![0.0; path.len()],
+        vec![0.0; path.len()],
+        vec![0.0; path.len()],
+    ];
+    let [a, b, c] = &mut j;
+    let t0 = add_body([a, b, c], path, hi, &bc, &sw, p, row);
+    (j, t0)
+}
+
+/// The point velocity `s.lin + s.ang × p` of world column `s`: a column
+/// with no angular part (`ang_zero`: [`act_column`] left it +0) is `s.lin`,
+/// the same values for a finite p but for the sign of a zero, which no row
+/// keeps (J's entries are sums onto the +0 that `Rows::clear` left).
+#[inline(always)]
+fn point_velocity(s: &Motion, ang_zero: bool, p: &Vector3<f64>) -> Vector3<f64> {
+    if ang_zero {
+        s.lin
+    } else {
+        s.lin + s.ang.cross(p)
+    }
+}
+
 /// What a 1-DoF joint's rows are built from (its [`crate::model::DofInfo`]'s
 /// fields, copied once: the row loop reads these few, not every dof's whole entry).
 #[derive(Clone, Copy, Debug)]
