@@ -192,7 +192,12 @@ impl Rows {
         // rows pinned at a bound skipped while provably still pinned
         // ([`pinned_until`]): `drift` bounds ‖Δv'‖ since the first was
         // (every entry of `until` is −∞ between solves)
-        let mut until = std::mem::take(&mut out.sm.0.until);
+        // (without `SKIP` not even taken: nothing of it live in the loop)
+        let mut until = if SKIP {
+            std::mem::take(&mut out.sm.0.until)
+        } else {
+            Vec::new()
+        };
         let skip = SKIP && !block && until.len() >= n;
         // (only once some row is pinned: `armed`; never without `SKIP`)
         let (mut drift, mut armed) = (0.0, false);
@@ -537,7 +542,9 @@ impl Rows {
                 until[s..e].fill(f64::NEG_INFINITY);
             }
         }
-        out.sm.0.until = until;
+        if SKIP {
+            out.sm.0.until = until;
+        }
         (it, polished)
     }
 }
