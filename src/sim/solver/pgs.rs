@@ -94,6 +94,34 @@ impl Rows {
         tol: f64,
         relax: f64,
     ) -> (usize, bool) {
+        // rows pinned at a bound skipped while provably still pinned
+        // ([`pinned_until`]) on islands of a robot's joints, where joint
+        // friction sits at its bound and self-collision pairs wait apart; on
+        // free bodies' islands no row is armed: their contacts are nearly all
+        // active, and the bookkeeping would cost more than it skips. Those
+        // islands run the sweeps compiled without it (`SKIP` false: not one
+        // test of it in their loop)
+        let jointed = |d: &[usize]| d.iter().any(|&k| self.jointed.get(k) == Some(&true));
+        if out.sm.0.until.len() >= self.n && self.any_jointed && dofs.is_none_or(jointed) {
+            self.sweeps_as::<true>(out, runs, dofs, dv, max_iter, tol, relax)
+        } else {
+            self.sweeps_as::<false>(out, runs, dofs, dv, max_iter, tol, relax)
+        }
+    }
+
+    /// [`Rows::sweeps`], pinned rows skipped if `SKIP` (and no loop block).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    fn sweeps_as<const SKIP: bool>(
+        &self,
+        out: &mut IslandOut<'_>,
+        runs: &[(usize, usize, usize)],
+        dofs: Option<&[usize]>,
+        dv: &mut [f64],
+        max_iter: usize,
+        tol: f64,
+        relax: f64,
+    ) -> (usize, bool) {
         let table = &self.table[..];
         let (nv, n, st) = (self.nv, self.n, self.stride);
         if dv.len() < nv
@@ -164,14 +192,14 @@ impl Rows {
         // rows pinned at a bound skipped while provably still pinned
         // ([`pinned_until`]): `drift` bounds ‖Δv'‖ since the first was
         // (every entry of `until` is −∞ between solves)
-        let mut until = std::mem::take(&mut out.sm.0.until);
-        // (on islands of a robot's joints, where joint friction sits at its
-        // bound and self-collision pairs wait apart; on free bodies' islands
-        // no row is armed: their contacts are nearly all active, and the
-        // bookkeeping would cost more than it skips)
-        let jointed = |d: &[usize]| d.iter().any(|&k| self.jointed.get(k) == Some(&true));
-        let skip = !block && until.len() >= n && self.any_jointed && dofs.is_none_or(jointed);
-        // (only once some row is pinned: `armed`)
+        // (without `SKIP` not even taken: nothing of it live in the loop)
+        let mut until = if SKIP {
+            std::mem::take(&mut out.sm.0.until)
+        } else {
+            Vec::new()
+        };
+        let skip = SKIP && !block && until.len() >= n;
+        // (only once some row is pinned: `armed`; never without `SKIP`)
         let (mut drift, mut armed) = (0.0, false);
         // SAFETY (unchecked reads in rdot/raxpy): every path lies in `table`
         // (checked above) and holds dof indices < nv; y holds n·stride entries and
@@ -250,7 +278,7 @@ impl Rows {
                 while r < e {
                     let kind = kinds[r];
                     if contact[r] {
-                        if armed && drift < until[r] {
+                        if SKIP && armed && drift < until[r] {
                             // an inactive contact that provably stays so:
                             // nothing moves, no measure (its velocity unknown:
                             // the next measure, if it wakes, is its residual)
@@ -327,7 +355,7 @@ impl Rows {
                             // y holds n·st entries
                             let yr = |q: usize| unsafe { y.get_unchecked(q * st..q * st + l) };
                             axpy3([dln, dl1, dl2], [yr(r), yr(r + 1), yr(r + 2)], p, dv);
-                            if armed {
+                            if SKIP && armed {
                                 drift += dln.abs() * wnn.sqrt()
                                     + dl1.abs() * w11.sqrt()
                                     + dl2.abs() * w22.sqrt();
@@ -375,11 +403,19 @@ impl Rows {
                             let (d1, d2) = (t1 - o1, t2 - o2);
                             if d1 != 0.0 {
                                 raxpy(d1, y, r, st, p1, dv);
-                                drift += if armed { d1.abs() * w11.sqrt() } else { 0.0 };
+                                drift += if SKIP && armed {
+                                    d1.abs() * w11.sqrt()
+                                } else {
+                                    0.0
+                                };
                             }
                             if d2 != 0.0 {
                                 raxpy(d2, y, r + 1, st, p2, dv);
-                                drift += if armed { d2.abs() * w22.sqrt() } else { 0.0 };
+                                drift += if SKIP && armed {
+                                    d2.abs() * w22.sqrt()
+                                } else {
+                                    0.0
+                                };
                             }
                             if block {
                                 lb.follow(&view, r, &[d1, d2], lambda, dv);
@@ -399,7 +435,7 @@ impl Rows {
                         }
                         _ => {}
                     }
-                    if armed && drift < until[r] {
+                    if SKIP && armed && drift < until[r] {
                         // pinned at its bound, provably still (as a contact's)
                         u_prev[r] = f64::NAN;
                         r += 1;
@@ -424,7 +460,7 @@ impl Rows {
                     let d = new - old;
                     if d != 0.0 {
                         raxpy(d, y, r, st, p, dv);
-                        if armed {
+                        if SKIP && armed {
                             drift += d.abs() * wrr.sqrt();
                         }
                         if block && lb.couples(r) {
@@ -484,7 +520,7 @@ impl Rows {
                 if subspace_step(&mut out.sm.0, &rows, lambda, dv) {
                     polished = true;
                     // Δv' moved outside `drift`: every row looked at again
-                    if armed {
+                    if SKIP && armed {
                         for &(_, s, e) in runs {
                             until[s..e].fill(f64::NEG_INFINITY);
                         }
@@ -501,12 +537,14 @@ impl Rows {
             self.shed_self_stress(&mut out.sm.0, runs, lambda, dv, tol);
         }
         out.sm.0.loops = lb;
-        if armed {
+        if SKIP && armed {
             for &(_, s, e) in runs {
                 until[s..e].fill(f64::NEG_INFINITY);
             }
         }
-        out.sm.0.until = until;
+        if SKIP {
+            out.sm.0.until = until;
+        }
         (it, polished)
     }
 }
