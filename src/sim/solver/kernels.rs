@@ -179,3 +179,33 @@ pub(super) fn pinned_until(drift: f64, slack: f64, u: f64, w: f64) -> f64 {
         f64::NEG_INFINITY
     }
 }
+
+/// A tangent pair's update when its Gauss–Seidel step leaves the cone (the
+/// point slides): one isotropic step, λₜ − uₜ/w̄ with `wbar` = w̄ at least the
+/// largest eigenvalue of the pair's 2 × 2 Delassus block, projected onto the disc
+/// of radius `lim`. A fixed point of it is the exact Coulomb law: λₜ = s (λₜ − uₜ/w̄)
+/// with s < 1 makes λₜ anti-parallel to the slip uₜ, ‖λₜ‖ = μλₙ (maximal
+/// dissipation; the per-row diagonal step would leave λₜ anti-parallel to
+/// D⁻¹uₜ instead, off by the block's anisotropy: docs/theory.md §"Constraint
+/// solve"). Inside the cone (sticking) the diagonal step is kept.
+#[inline]
+pub(super) fn slide_onto_cone(
+    o1: f64,
+    o2: f64,
+    u1: f64,
+    u2: f64,
+    wbar: f64,
+    lim: f64,
+) -> (f64, f64) {
+    if !(wbar > 1e-14) {
+        return (0.0, 0.0);
+    }
+    let (t1, t2) = (o1 - u1 / wbar, o2 - u2 / wbar);
+    let m = (t1 * t1 + t2 * t2).sqrt();
+    if m > lim {
+        let s = if m > 0.0 { lim / m } else { 0.0 };
+        (t1 * s, t2 * s)
+    } else {
+        (t1, t2)
+    }
+}
