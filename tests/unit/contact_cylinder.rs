@@ -82,6 +82,37 @@ fn matched(p: &(Vector3<f64>, f64), qs: &[(Vector3<f64>, f64)], tol: f64, seen: 
     }
 }
 
+/// Away from the margin's edge, each of parry's points (`theirs`: its GJK
+/// stand-ins left out; `all`: every one) is one of ours and each of ours
+/// (`pts`, without our level feature's stand-in for GJK's point, code 7) one
+/// of parry's, by [`matched`] within 2e-4 m (`case` names the pose).
+fn points_match(
+    case: usize,
+    theirs: &[(Vector3<f64>, f64)],
+    all: &[(Vector3<f64>, f64)],
+    pts: &[(Vector3<f64>, f64, u64)],
+    margin: f64,
+    seen: &mut Seen,
+) {
+    let ours: Vec<_> = pts
+        .iter()
+        .filter(|p| p.2 & 31 != 7)
+        .map(|p| (p.0, p.1))
+        .collect();
+    for p in theirs.iter().filter(|p| p.1 < margin - 1e-6) {
+        assert!(
+            matched(p, &ours, 2e-4, seen),
+            "case {case}: parry's {p:?} not in ours {ours:?}"
+        );
+    }
+    for p in ours.iter().filter(|p| p.1 < margin - 1e-6) {
+        assert!(
+            matched(p, &all, 2e-4, seen),
+            "case {case}: our {p:?} not in parry's {all:?}"
+        );
+    }
+}
+
 /// Compares one pose (`case` names it in failures).
 fn compare(case: usize, (h, r): (f64, f64), e: &Vector3<f64>, b_m_c: &Se3<f64>, seen: &mut Seen) {
     let margin = 0.005;
@@ -151,26 +182,8 @@ fn compare(case: usize, (h, r): (f64, f64), e: &Vector3<f64>, b_m_c: &Se3<f64>, 
         return;
     }
     seen.sets += 1;
-    // away from the margin's edge, each point of one is a point of the other
-    // (not our level feature's stand-in for GJK's point, code 7)
-    let ours: Vec<_> = pts
-        .iter()
-        .filter(|p| p.2 & 31 != 7)
-        .map(|p| (p.0, p.1))
-        .collect();
     let all: Vec<_> = near.iter().map(|p| point(p)).collect();
-    for p in theirs.iter().filter(|p| p.1 < margin - 1e-6) {
-        assert!(
-            matched(p, &ours, 2e-4, seen),
-            "case {case}: parry's {p:?} not in ours {ours:?}"
-        );
-    }
-    for p in ours.iter().filter(|p| p.1 < margin - 1e-6) {
-        assert!(
-            matched(p, &all, 2e-4, seen),
-            "case {case}: our {p:?} not in parry's {all:?}"
-        );
-    }
+    points_match(case, &theirs, &all, &pts, margin, seen);
 }
 
 #[test]
@@ -329,23 +342,7 @@ fn compare_pair(case: usize, ca: (f64, f64), cb: (f64, f64), a_m_b: &Se3<f64>, s
     let gjk = |t: &&parry3d_f64::query::TrackedContact<()>| t.fid1 == PackedFeatureId::UNKNOWN;
     let theirs: Vec<_> = near.iter().filter(|t| !gjk(t)).map(|t| point(t)).collect();
     let all: Vec<_> = near.iter().map(|t| point(t)).collect();
-    let ours: Vec<_> = pts
-        .iter()
-        .filter(|p| p.2 & 31 != 7)
-        .map(|p| (p.0, p.1))
-        .collect();
-    for p in theirs.iter().filter(|p| p.1 < margin - 1e-6) {
-        assert!(
-            matched(p, &ours, 2e-4, seen),
-            "case {case}: parry's {p:?} not in ours {ours:?}"
-        );
-    }
-    for p in ours.iter().filter(|p| p.1 < margin - 1e-6) {
-        assert!(
-            matched(p, &all, 2e-4, seen),
-            "case {case}: our {p:?} not in parry's {all:?}"
-        );
-    }
+    points_match(case, &theirs, &all, &pts, margin, seen);
 }
 
 #[test]
@@ -480,23 +477,7 @@ fn compare_cap(
     seen.sets += 1;
     let theirs: Vec<_> = near.iter().filter(|p| !gjk(p)).map(|p| point(p)).collect();
     let all: Vec<_> = near.iter().map(|p| point(p)).collect();
-    let ours: Vec<_> = pts
-        .iter()
-        .filter(|p| p.2 & 31 != 7)
-        .map(|p| (p.0, p.1))
-        .collect();
-    for p in theirs.iter().filter(|p| p.1 < margin - 1e-6) {
-        assert!(
-            matched(p, &ours, 2e-4, seen),
-            "case {case}: parry's {p:?} not in ours {ours:?}"
-        );
-    }
-    for p in ours.iter().filter(|p| p.1 < margin - 1e-6) {
-        assert!(
-            matched(p, &all, 2e-4, seen),
-            "case {case}: our {p:?} not in parry's {all:?}"
-        );
-    }
+    points_match(case, &theirs, &all, &pts, margin, seen);
 }
 
 #[test]
