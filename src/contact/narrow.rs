@@ -13,13 +13,13 @@ use super::ContactPoint;
 use crate::spatial::Se3;
 use nalgebra::Vector3;
 use parry3d_f64::math::Pose;
-use parry3d_f64::query::details::contact_manifold_pfm_pfm;
 use parry3d_f64::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
 use parry3d_f64::shape::ShapeType;
 
 pub(crate) mod boxes;
+pub(crate) mod climb;
 pub(crate) mod cylinder;
 pub(crate) mod prim;
 
@@ -147,7 +147,7 @@ pub(crate) fn parry_points(
             man.points.clear();
         }
         if let (Some(ha), Some(hb)) = climbs {
-            climb_manifolds(&pos12, ha, hb, margin, manifolds);
+            climb_manifolds(&pos12, ha, hb, margin, manifolds, workspace);
             return Ok(());
         }
         dispatcher.contact_manifolds(&pos12, &*a.shape, &*b.shape, margin, manifolds, workspace)
@@ -189,8 +189,9 @@ pub(crate) fn parry_points(
 }
 
 /// The dispatcher's generator for two climbing hulls (one manifold, parry's
-/// polyhedral one, no border, no normal constraint) called with their own
-/// type: GJK's supports inlined, not called through `dyn`. Out of line: in
+/// polyhedral one, no border, no normal constraint) with their own type:
+/// GJK's supports inlined, not called through `dyn`, and GJK started from
+/// the pair's last simplex ([`climb::climb_manifold`]). Out of line: in
 /// [`parry_points`] it grew the pair visit past what the inliner keeps whole.
 #[inline(never)]
 fn climb_manifolds(
@@ -199,21 +200,14 @@ fn climb_manifolds(
     hb: &ClimbHull,
     margin: f64,
     manifolds: &mut Vec<ContactManifold<(), ()>>,
+    workspace: &mut Option<ContactManifoldsWorkspace>,
 ) {
+    // a pair with a manifold has a history (every reset clears them)
+    let warm = !manifolds.is_empty();
     if manifolds.is_empty() {
         manifolds.push(ContactManifold::new());
     }
-    contact_manifold_pfm_pfm(
-        pos12,
-        ha,
-        0.0,
-        None,
-        hb,
-        0.0,
-        None,
-        margin,
-        &mut manifolds[0],
-    );
+    climb::climb_manifold(pos12, ha, hb, margin, &mut manifolds[0], warm, workspace);
 }
 
 /// How far (m) a kept point may slide along the contact plane, and how far

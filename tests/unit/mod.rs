@@ -8,6 +8,7 @@ mod cli_output;
 mod contact_apart;
 mod contact_boxes;
 mod contact_broad;
+mod contact_climb_step;
 mod contact_cylinder;
 mod contact_face;
 mod contact_hull;
