@@ -156,7 +156,7 @@ impl Rows {
             paths,
             table,
         };
-        let block = lb.prepare(&view, runs, kinds, &self.w[..n]);
+        let block = self.bilateral && lb.prepare(&view, runs, kinds, &self.w[..n]);
         if block {
             let (w, wb, wi) = (&self.w[..n], &self.w_block[..n], &self.winv[..n]);
             lb.reduce(&view, runs, kinds, contact, w, wb, wi);
