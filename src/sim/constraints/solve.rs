@@ -402,18 +402,22 @@ fn energy_safe_exit(
     }
     let budget = 4 * iterations;
     let mut extra = 0;
+    // (the work of the impulses as they stand: computed again only after
+    // sweeps moved them)
+    let mut now = impulse_work(rows, out.lambda, isl, dofs, a, d);
     loop {
-        let (work, allow, _, _) = impulse_work(rows, out.lambda, isl, dofs, a, d);
+        let (work, allow, _, _) = now;
         if work <= allow || extra >= budget {
             break;
         }
         let (it, _) = rows.sweeps(out, isl.runs, dofs, d, 10, tol, 1.0);
         extra += it;
+        now = impulse_work(rows, out.lambda, isl, dofs, a, d);
         if it < 10 {
             break;
         }
     }
-    let (work, allow, ad, dd) = impulse_work(rows, out.lambda, isl, dofs, a, d);
+    let (work, allow, ad, dd) = now;
     if work <= allow || dd <= 0.0 {
         return extra;
     }

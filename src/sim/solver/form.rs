@@ -310,7 +310,7 @@ impl Rows {
 
     /// Whether row r is a contact normal followed by its two tangent rows on
     /// the same path (as `sim::constraints` pushes them).
-    #[inline]
+    #[inline(always)]
     pub(super) fn is_contact(&self, r: usize) -> bool {
         r + 2 < self.n
             && self.kind[r] == RowKind::Normal

@@ -3,7 +3,7 @@
 //! the friction disc.
 
 use super::kernels::{axpy3, dot3, pinned_until, slide_onto_cone, warm3};
-use super::loop_block::BlockRows;
+use super::loop_block::{BlockRows, LoopBlock};
 use super::subspace::{subspace_step, Solved, Subspace};
 use super::{MassFactor, RowKind, Rows, SUBSPACE_MAX};
 
@@ -149,14 +149,19 @@ impl Rows {
         out.sm.0.forget();
         // the loop rows as one exact block, every other row seen through them
         // (the reduced W', loop_block.rs): taken out for the solve
-        let mut lb = std::mem::take(&mut out.sm.0.loops);
+        // (without a bilateral row not even taken: nothing to move)
+        let mut lb = if self.bilateral {
+            std::mem::take(&mut out.sm.0.loops)
+        } else {
+            LoopBlock::default()
+        };
         let view = BlockRows {
             st,
             y,
             paths,
             table,
         };
-        let block = lb.prepare(&view, runs, kinds, &self.w[..n]);
+        let block = self.bilateral && lb.prepare(&view, runs, kinds, &self.w[..n]);
         if block {
             let (w, wb, wi) = (&self.w[..n], &self.w_block[..n], &self.winv[..n]);
             lb.reduce(&view, runs, kinds, contact, w, wb, wi);
@@ -536,7 +541,9 @@ impl Rows {
         if converged && !block && self.sheds(dofs) {
             self.shed_self_stress(&mut out.sm.0, runs, lambda, dv, tol);
         }
-        out.sm.0.loops = lb;
+        if self.bilateral {
+            out.sm.0.loops = lb;
+        }
         if SKIP && armed {
             for &(_, s, e) in runs {
                 until[s..e].fill(f64::NEG_INFINITY);
