@@ -510,6 +510,9 @@ impl MassFactor {
         }
         // L x = D^-½ z, root outwards, both at once
         let (z, w) = (&mut z[..n], &mut w[..n]);
+        if self.lone_half_solve(z) && self.lone_half_solve(w) {
+            return;
+        }
         for &(k0, k1) in self.ranges() {
             for i in k0..k1 {
                 let s = self.inv_sqrt_d[i];

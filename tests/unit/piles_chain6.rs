@@ -68,6 +68,11 @@ fn lone_free_solves_take_the_general_loops_bits() {
     let (mut zl, mut zm) = (b(18), b(19));
     fl.half_solve(zl.as_mut_slice());
     fm.half_solve(zm.as_mut_slice());
+    // half_solve2 (two vectors at once: each the bits of half_solve)
+    let (mut zl2, mut wl2) = (b(18), b(18).map(|x| 2.0 * x - 0.3));
+    let (mut zm2, mut wm2) = (b(19), b(19).map(|x| 2.0 * x - 0.3));
+    fl.half_solve2(zl2.as_mut_slice(), wl2.as_mut_slice());
+    fm.half_solve2(zm2.as_mut_slice(), wm2.as_mut_slice());
     // apply_r
     let (mut rl, mut rm) = (vec![0.0; 18], vec![0.0; 19]);
     fl.apply_r(b(18).as_slice(), &mut rl);
@@ -76,6 +81,9 @@ fn lone_free_solves_take_the_general_loops_bits() {
         assert_eq!(xl[k].to_bits(), xm[k].to_bits(), "solve, dof {k}");
         assert_eq!(zl[k].to_bits(), zm[k].to_bits(), "half_solve, dof {k}");
         assert_eq!(rl[k].to_bits(), rm[k].to_bits(), "apply_r, dof {k}");
+        assert_eq!(zl2[k].to_bits(), zm2[k].to_bits(), "half_solve2 z, dof {k}");
+        assert_eq!(wl2[k].to_bits(), wm2[k].to_bits(), "half_solve2 w, dof {k}");
+        assert_eq!(zl2[k].to_bits(), zl[k].to_bits(), "half_solve2 z = half_solve, dof {k}");
     }
 }
 
