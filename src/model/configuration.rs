@@ -32,11 +32,27 @@ fn coordinate_joints(model: &Model) -> impl Iterator<Item = (JointKind, usize, u
 /// quaternion likewise; a planar joint's (x, y) += h R(θ) (vx, vy), θ += h ω;
 /// 1-DoF joints += h v.
 pub fn integrate_config(model: &Model, q: &mut DVector<f64>, v: &DVector<f64>, h: f64) {
+    integrate_config_held(model, q, v, h, &[]);
+}
+
+/// [`integrate_config`] but for the free joints of the bodies flagged in
+/// `held` (a sleeping tree's: the step puts its q back, `Sleep::hold`, so
+/// its q ⊕ h v would be thrown away; `&[]`: none).
+#[inline]
+pub fn integrate_config_held(
+    model: &Model,
+    q: &mut DVector<f64>,
+    v: &DVector<f64>,
+    h: f64,
+    held: &[bool],
+) {
     // (the joints of `coordinate_joints` in its order, each kind matched by
     // reference and a 1-DoF joint's entry through slices: no copy of a kind,
     // no matrix index an entry)
     for f in &model.free_joints {
-        integrate_free(q, v, h, f.iq, f.iv);
+        if held.get(f.body) != Some(&true) {
+            integrate_free(q, v, h, f.iq, f.iv);
+        }
     }
     for d in &model.dofs {
         let (iq, iv) = (d.iq, d.iv);
@@ -112,9 +128,27 @@ fn quat_step(quat: &mut [f64], omega: [f64; 3], h: f64) {
 /// [`integrate_config`] this makes a semi-implicit step rotate the velocity
 /// exactly (no energy from the frame's own rotation).
 pub fn rotate_base_velocity(model: &Model, v: &mut DVector<f64>, w: &DVector<f64>, h: f64) {
+    rotate_base_velocity_held(model, v, w, h, &[]);
+}
+
+/// [`rotate_base_velocity`] but for the free joints of the bodies flagged in
+/// `held` (a sleeping tree's: the step sets its v back to 0, `Sleep::hold`;
+/// `&[]`: none).
+#[inline]
+pub fn rotate_base_velocity_held(
+    model: &Model,
+    v: &mut DVector<f64>,
+    w: &DVector<f64>,
+    h: f64,
+    held: &[bool],
+) {
     // (the joints of `coordinate_joints` in its order, the kinds matched by
     // reference: no copy of a 1-DoF joint's kind to skip it)
-    let frees = model.free_joints.iter().map(|f| (true, f.iv));
+    let frees = model
+        .free_joints
+        .iter()
+        .filter(|f| held.get(f.body) != Some(&true))
+        .map(|f| (true, f.iv));
     let others = model.dofs.iter().filter_map(|d| match &d.kind {
         JointKind::Free => Some((true, d.iv)),
         JointKind::Planar => Some((false, d.iv)),

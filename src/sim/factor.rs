@@ -13,6 +13,7 @@
 //! tree-sparse `mj_factorI` / `mj_solveM` idea). With mimic joints H̃ is not
 //! tree-shaped: a dense Cholesky H̃ = L Lᵀ (R = Lᵀ) and full-length rows.
 
+mod chain6;
 mod elim;
 mod rows;
 
@@ -73,6 +74,9 @@ pub struct MassFactor {
     dof_ranges: Vec<(usize, usize)>,
     body_ranges: Vec<(usize, usize)>,
     partial: bool,
+    /// Tree, lone free bodies: every tree's dof range (the solves' ranges
+    /// when none sleeps, `chain6`); else empty.
+    lone_ranges: Vec<(usize, usize)>,
     all: (usize, usize),
     /// Every dof's path (root … dof, ascending) back to back, then `0..n`.
     table: Vec<usize>,
@@ -148,7 +152,7 @@ impl MassFactor {
             && model.parent.len() == nb
             && model.joints.len() == nb
             && (1..nb).all(|i| model.parent[i] == 0 && model.joints[i].kind == JointKind::Free);
-        Self {
+        let mut f = Self {
             tree,
             n,
             lone_free,
@@ -172,6 +176,7 @@ impl MassFactor {
             dof_ranges: Vec::with_capacity(model.trees.len()),
             body_ranges: Vec::with_capacity(model.trees.len()),
             partial: false,
+            lone_ranges: chain6::lone_ranges(model, n, lone_free),
             all: (0, n),
             table,
             start,
@@ -180,7 +185,9 @@ impl MassFactor {
             dval: vec![1.0; if tree { n } else { 0 }],
             mult: vec![0.0; if tree { 3 * n } else { 0 }],
             root_chain,
-        }
+        };
+        f.check_lone_ranges();
+        f
     }
 
     /// The path of a row acting on dofs up to `dof` (its body's last dof, or a
@@ -419,6 +426,9 @@ impl MassFactor {
             // Lᵀ y = b (leaves inwards), z = D⁻¹ y, L x = z (root outwards):
             // [`crate::dynamics::ltdl::ltdl_solve`] on the packed factor
             let x = &mut x.as_mut_slice()[..self.n];
+            if self.lone_solve(x) {
+                return;
+            }
             for &(k0, k1) in self.ranges() {
                 let mut i = k1;
                 while i > k0 {
@@ -477,6 +487,9 @@ impl MassFactor {
             return;
         }
         let z = &mut z[..n];
+        if self.lone_half_solve(z) {
+            return;
+        }
         for &(k0, k1) in self.ranges() {
             for i in k0..k1 {
                 let z0 = z[i] * self.inv_sqrt_d[i];
@@ -497,6 +510,9 @@ impl MassFactor {
         }
         // L x = D^-½ z, root outwards, both at once
         let (z, w) = (&mut z[..n], &mut w[..n]);
+        if self.lone_half_solve(z) && self.lone_half_solve(w) {
+            return;
+        }
         for &(k0, k1) in self.ranges() {
             for i in k0..k1 {
                 let s = self.inv_sqrt_d[i];
@@ -529,6 +545,9 @@ impl MassFactor {
             return;
         }
         let v = &v[..n];
+        if self.lone_apply_r(v, out) {
+            return;
+        }
         for &(k0, k1) in self.ranges() {
             for i in k0..k1 {
                 let acc = self.fold_row(i, v[i], |acc, a, j| acc + a * at(v, j));

@@ -18,6 +18,7 @@ mod contact_travel;
 mod mesh_cache;
 mod mesh_dae;
 mod mesh_inertia;
+mod piles_chain6;
 mod scene_srdf;
 mod sim_add_body;
 mod sim_build;

@@ -7,7 +7,7 @@
 
 use super::solve_rows;
 use crate::dynamics::{bias, bias_at_placements_ahead, forward_dynamics};
-use crate::model::configuration::{integrate_config, rotate_base_velocity};
+use crate::model::configuration::{integrate_config_held, rotate_base_velocity_held};
 use crate::sim::{SimError, Simulation};
 use nalgebra::{DVector, Vector3};
 
@@ -62,10 +62,16 @@ impl Simulation {
             self.v.copy_from(&self.mass.vfree);
             self.mass.vtot.copy_from(&self.v);
         }
-        integrate_config(&self.model, &mut self.q, &self.mass.vtot, h);
+        // (a sleeping tree's free joints left out: `Sleep::hold` puts their q
+        // and v back after the step)
+        let held = match self.sleep.sleeping_trees() {
+            Some(_) => &self.sleep.body_asleep[..],
+            None => &[],
+        };
+        integrate_config_held(&self.model, &mut self.q, &self.mass.vtot, h, held);
         // the base's linear velocity, found in the start frame R, expressed in
         // the new frame R⁺ = R exp(h ω_total)
-        rotate_base_velocity(&self.model, &mut self.v, &self.mass.vtot, h);
+        rotate_base_velocity_held(&self.model, &mut self.v, &self.mass.vtot, h, held);
         Ok(())
     }
 
