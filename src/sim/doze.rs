@@ -332,6 +332,31 @@ impl Sleep {
 }
 
 impl super::Simulation {
+    /// The awake models with degrees of freedom now (cli.md's `awake`).
+    pub fn awake(&self) -> usize {
+        self.sleep.awake
+    }
+    /// The mean of [`Simulation::awake`] over the steps taken.
+    pub fn mean_awake(&self) -> f64 {
+        self.sleep.mean_awake()
+    }
+    /// Whether the scene model `name` sleeps (`None`: no such model; a lone
+    /// URDF's one model is named "").
+    pub fn sleeping(&self, name: &str) -> Option<bool> {
+        let t = self.model.trees.iter().position(|t| t.name == name)?;
+        Some(self.sleep.tree_asleep(t))
+    }
+    /// Wakes every sleeping island now, and every dozing one takes a full
+    /// step (their contacts are found anew).
+    pub fn wake(&mut self) {
+        if self.sleep.wake_all(&self.model) {
+            // (the energy guard's C computed ahead left the sleeping trees
+            // out, `Sleep::bodies_asleep`: not the step's)
+            self.data.step_bias_ok = false;
+            self.refresh_contacts();
+        }
+    }
+
     /// Turns the multirate step of quiet islands on or off (on by default
     /// with sleep; off, a run is the one without it: the A/B of issue #30).
     /// Dozing trees take a full step now.

@@ -532,30 +532,6 @@ impl Sleep {
 }
 
 impl super::Simulation {
-    /// The awake models with degrees of freedom now (cli.md's `awake`).
-    pub fn awake(&self) -> usize {
-        self.sleep.awake
-    }
-    /// The mean of [`Simulation::awake`] over the steps taken.
-    pub fn mean_awake(&self) -> f64 {
-        self.sleep.mean_awake()
-    }
-    /// Whether the scene model `name` sleeps (`None`: no such model; a lone
-    /// URDF's one model is named "").
-    pub fn sleeping(&self, name: &str) -> Option<bool> {
-        let t = self.model.trees.iter().position(|t| t.name == name)?;
-        Some(self.sleep.tree_asleep(t))
-    }
-    /// Wakes every sleeping island now (their contacts are found anew).
-    pub fn wake(&mut self) {
-        if self.sleep.wake_all(&self.model) {
-            // (the energy guard's C computed ahead left the sleeping trees
-            // out, `Sleep::bodies_asleep`: not the step's)
-            self.data.step_bias_ok = false;
-            self.refresh_contacts();
-        }
-    }
-
     /// Sleep's work at the end of a step of `h`: islands that an awake body
     /// touches woken (their contacts found), then the still islands put to sleep.
     pub(super) fn update_sleep(&mut self, h: f64) {

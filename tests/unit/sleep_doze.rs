@@ -61,12 +61,11 @@ fn a_box_at_rest_dozes_with_its_points_held_aside_and_sleeps_where_the_run_witho
         on.step().unwrap();
         if on.dozing("m") == Some(true) {
             dozed += 1;
-            // awake, counted awake; its points out of the step's list but
-            // still reported through the forces and the penetration
+            // awake, counted awake; its points out of the step's list (no
+            // detection) but their forces still reported
             assert_eq!((on.awake(), on.sleeping("m")), (1, Some(false)));
             assert!(on.contact_points().is_empty());
-            assert!(!on.contact_forces().is_empty());
-            assert!(on.penetration() > 0.0);
+            assert!(on.contact_forces().len() >= 4);
         }
     }
     // 7 steps of 8 doze once the box is still for 50 ms
@@ -84,9 +83,10 @@ fn a_box_at_rest_dozes_with_its_points_held_aside_and_sleeps_where_the_run_witho
 fn a_ball_rolling_below_sleep_velocity_sleeps_where_the_run_without_doze_puts_it() {
     let s = scene(&[("b", "tests/urdf/heavy_ball.urdf", [0.0, 0.0, 0.08])]);
     let mut v = s.v0.clone();
-    // 0.4 mm/s along x, rolling (its points at most 0.8 mm/s) (body frame = world frame at the start)
-    v[0] = 4e-4;
-    v[4] = 4e-4 / 0.08;
+    // 0.2 mm/s along x, rolling (body frame = world frame at the start): its
+    // points at most 0.4 mm/s, below half sleep_velocity, where a tree dozes
+    v[0] = 2e-4;
+    v[4] = 2e-4 / 0.08;
     let run = |doze: bool| {
         let mut sim = simulation(&s, doze);
         sim.set_state(&s.q0, &v).unwrap();
@@ -100,7 +100,7 @@ fn a_ball_rolling_below_sleep_velocity_sleeps_where_the_run_without_doze_puts_it
     // within a few N h sleep_velocity (8 µm) of where it sleeps without doze
     let dx = max_diff(&q_on[..3], &q_off[..3]);
     assert!(dx < 3e-5, "{dx} m from the run without doze");
-    assert!((q_on[0] - q_off[0]).abs() < 3e-5 && q_off[0] > 2e-4, "{q_on:?} {q_off:?}");
+    assert!((q_on[0] - q_off[0]).abs() < 3e-5 && q_off[0] > 5e-5, "{q_on:?} {q_off:?}");
 }
 
 #[test]
