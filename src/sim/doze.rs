@@ -67,6 +67,8 @@ pub(crate) struct Doze {
     may: Vec<bool>,
     /// Tree-steps taken dozing.
     pub tree_steps: u64,
+    /// Per tree: it fell asleep dozing at this step (scratch of `after_step`).
+    pub slept: Vec<bool>,
     /// The contact slots of the islands that began to doze at this step's
     /// end, sorted (their warm starts are kept: `Constraints::hold_warm`).
     pub new_slots: Vec<usize>,
@@ -85,6 +87,7 @@ impl Doze {
             vs: DVector::zeros(nv),
             may: vec![false; nt],
             tree_steps: 0,
+            slept: vec![false; nt],
             new_slots: Vec::new(),
         }
     }

@@ -377,6 +377,7 @@ impl Sleep {
             }
             slept = true;
             let dozed = std::mem::take(&mut self.doze.left[t]) > 0;
+            self.doze.slept[t] = dozed;
             self.asleep[t] = true;
             self.masked[t] = true;
             self.island[t] = r;
@@ -405,8 +406,12 @@ impl Sleep {
             self.any_asleep = true;
             let asleep = &self.body_asleep;
             let sleeping = |b: usize| asleep.get(b) == Some(&true);
+            // (a dozing tree's forces are among the frozen ones already)
+            let dozed = &self.doze.slept;
+            let tree = |b: usize| self.tree_of_body.get(b).copied().unwrap_or(WORLD);
             for f in forces {
-                if sleeping(f.point.body) {
+                let b = f.point.body;
+                if sleeping(b) && dozed.get(tree(b)) != Some(&true) {
                     self.frozen_forces.push(*f);
                 }
             }
@@ -421,6 +426,7 @@ impl Sleep {
             });
             self.awake = self.count_awake();
         }
+        self.doze.slept.iter_mut().for_each(|d| *d = false);
         self.begin_doze(model, forced, q, v, points, forces, body_forces);
         self.awake_sum += self.awake as f64;
         slept

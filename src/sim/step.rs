@@ -69,7 +69,7 @@ impl Simulation {
         }
         let h = if self.sleep.all_dozing() {
             // every awake tree dozes (`doze`): their step is `doze_step`'s
-            self.cons.clear_forces();
+            // (the last solve's forces stand, as a sleeping island's do)
             self.smooth.fsal_ok = false;
             h_fixed
         } else if time_stepping {
