@@ -273,6 +273,12 @@ impl Constraints {
         self.warm_slots.clear();
     }
 
+    /// Keeps the warm starts of `slots` (sorted) through the next solves (a
+    /// dozing island's contacts, kept aside until its next full step: `sim::doze`).
+    pub fn hold_warm(&mut self, slots: &[usize]) {
+        self.warm_slots.retain(|k| slots.binary_search(k).is_err());
+    }
+
     /// Forgets the last step's forces (a step taken without constraints).
     pub fn clear_forces(&mut self) {
         self.fext.iter_mut().for_each(|f| *f = Force::zero());

@@ -76,6 +76,7 @@ pub use contact_view::Violation;
 mod build;
 mod sensors;
 mod servo;
+mod doze;
 mod sleep;
 pub mod solver;
 mod state;

@@ -32,15 +32,15 @@ pub(crate) struct Sleep {
     /// Sleep is on (`SimOptions::sleep`).
     pub on: bool,
     /// m/s.
-    v_tol: f64,
+    pub(super) v_tol: f64,
     /// s.
     t_tol: f64,
     /// Each body's tree (`WORLD` for body 0).
     pub tree_of_body: Vec<usize>,
     /// Per tree: it never sleeps (fixed base, no dofs, its own `"sleep": false`).
-    never: Vec<bool>,
+    pub(super) never: Vec<bool>,
     /// Per tree: it has degrees of freedom (it counts in `awake`).
-    has_dof: Vec<bool>,
+    pub(super) has_dof: Vec<bool>,
     /// Bounding spheres of the collision shapes: (body, centre in the body
     /// frame, radius); bodies without one use their centre of mass and 0.1 m.
     spheres: Vec<(usize, Vector3<f64>, f64)>,
@@ -48,35 +48,35 @@ pub(crate) struct Sleep {
     /// Per tree: its spheres, a range of `spheres` (sorted by tree).
     tree_spheres: Vec<(usize, usize)>,
     /// The trees not asleep, ascending (the per-step loops run over these).
-    awake_trees: Vec<usize>,
+    pub(super) awake_trees: Vec<usize>,
     /// Per tree: how long it has been still (s).
-    still: Vec<f64>,
+    pub(super) still: Vec<f64>,
     /// Per tree: asleep.
     pub asleep: Vec<bool>,
     /// Per body: its tree is asleep (the detection's skip mask).
     pub body_asleep: Vec<bool>,
     /// Union-find parents (per tree) of this step's islands.
-    parent: Vec<usize>,
+    pub(super) parent: Vec<usize>,
     /// Pairs of bodies an active loop constraint joins (one island).
     pub joins: Vec<(usize, usize)>,
     /// Per tree: the island it fell asleep in (its root tree).
     island: Vec<usize>,
     /// Per tree: its largest point speed this step (m/s).
-    speed: Vec<f64>,
+    pub(super) speed: Vec<f64>,
     /// The configuration the sleeping trees are held at.
     pub q_frozen: DVector<f64>,
     /// The sleeping islands' last contact points and forces.
     pub frozen_points: Vec<ContactPoint>,
     pub frozen_forces: Vec<ContactForce>,
     /// The sleeping bodies' last contact wrenches (per body).
-    frozen_body: Vec<Force>,
+    pub(super) frozen_body: Vec<Force>,
     /// The last solve's contact forces and wrenches with the frozen ones
     /// (in use while anything sleeps). The forces' list is made when first
     /// read after a step ([`Sleep::forces`]), not at every step: a sleeping
     /// pile's frozen forces copied every step cost more than the rest of its
     /// bookkeeping (a lock: `Simulation` is `Sync`).
     all_forces: std::sync::OnceLock<Vec<ContactForce>>,
-    all_body: Vec<Force>,
+    pub(super) all_body: Vec<Force>,
     /// v plus the position pass's pseudo-velocity (scratch: a point pushed out
     /// of a penetration is moving).
     pub vw: DVector<f64>,
@@ -87,9 +87,13 @@ pub(crate) struct Sleep {
     pub steps: u64,
     /// Everything wakes at the next step (the forcing or the state was set).
     pub wake_pending: bool,
-    any_asleep: bool,
+    pub(super) any_asleep: bool,
     /// Per island root: it may sleep (scratch).
     may: Vec<bool>,
+    /// Per tree: asleep or dozing (the factor's mask, `super::doze`).
+    pub(super) masked: Vec<bool>,
+    /// The quiet islands' multirate step (`super::doze`).
+    pub(super) doze: super::doze::Doze,
 }
 
 impl Sleep {
@@ -171,12 +175,14 @@ impl Sleep {
             wake_pending: false,
             any_asleep: false,
             may: vec![true; nt],
+            masked: vec![false; nt],
+            doze: super::doze::Doze::new(nt, model.nv, model.nq, on),
         }
     }
 
     /// Per tree: asleep, when any tree sleeps (`None`: every tree is awake).
     pub fn sleeping_trees(&self) -> Option<&[bool]> {
-        (self.on && self.any_asleep).then_some(&self.asleep[..])
+        (self.on && (self.any_asleep || self.doze.any)).then_some(&self.masked[..])
     }
 
     /// The awake trees with dofs now.
@@ -203,7 +209,7 @@ impl Sleep {
     /// Wakes every sleeping tree; true when one woke.
     pub fn wake_all(&mut self, model: &Model) -> bool {
         self.wake_pending = false;
-        let mut woke = false;
+        let mut woke = self.undoze_all(model);
         for t in 0..self.asleep.len() {
             if self.asleep[t] {
                 self.wake_tree(model, t);
@@ -220,6 +226,7 @@ impl Sleep {
 
     fn wake_tree(&mut self, model: &Model, t: usize) {
         self.asleep[t] = false;
+        self.masked[t] = false;
         self.still[t] = 0.0;
         for b in model.trees[t].bodies.clone() {
             self.body_asleep[b] = false;
@@ -263,7 +270,7 @@ impl Sleep {
         self.tree_of_body.get(body).copied().unwrap_or(WORLD)
     }
 
-    fn find(&mut self, mut t: usize) -> usize {
+    pub(super) fn find(&mut self, mut t: usize) -> usize {
         while self.parent[t] != t {
             self.parent[t] = self.parent[self.parent[t]];
             t = self.parent[t];
@@ -300,6 +307,12 @@ impl Sleep {
         // order of the points), its still time, its own island
         let awake_trees = std::mem::take(&mut self.awake_trees);
         for &t in &awake_trees {
+            self.parent[t] = t;
+            if self.doze.left[t] > 0 {
+                // dozing: its speed is held below sleep_velocity
+                self.still[t] = if forced[t] { 0.0 } else { self.still[t] + h };
+                continue;
+            }
             let mut speed = 0.0f64;
             let (s0, s1) = self.tree_spheres[t];
             for &(b, c, r) in &self.spheres[s0..s1] {
@@ -324,8 +337,8 @@ impl Sleep {
             } else {
                 0.0
             };
-            self.parent[t] = t;
         }
+        self.link_dozing(&awake_trees);
         // islands: trees joined by a contact point or a loop constraint
         let joins = std::mem::take(&mut self.joins);
         let pairs = points.iter().map(|p| (p.body, p.other));
@@ -363,7 +376,10 @@ impl Sleep {
                 continue;
             }
             slept = true;
+            let dozed = std::mem::take(&mut self.doze.left[t]) > 0;
+            self.doze.slept[t] = dozed;
             self.asleep[t] = true;
+            self.masked[t] = true;
             self.island[t] = r;
             let tree = &model.trees[t];
             for k in tree.v.clone() {
@@ -374,7 +390,11 @@ impl Sleep {
             }
             for b in tree.bodies.clone() {
                 self.body_asleep[b] = true;
-                let f = body_forces.get(b).copied().unwrap_or(Force::zero());
+                // (a dozing body's: those kept when it began to doze)
+                let f = match dozed {
+                    true => self.all_body[b],
+                    false => body_forces.get(b).copied().unwrap_or(Force::zero()),
+                };
                 self.frozen_body[b] = f;
                 self.all_body[b] = f;
             }
@@ -386,8 +406,12 @@ impl Sleep {
             self.any_asleep = true;
             let asleep = &self.body_asleep;
             let sleeping = |b: usize| asleep.get(b) == Some(&true);
+            // (a dozing tree's forces are among the frozen ones already)
+            let dozed = &self.doze.slept;
+            let tree = |b: usize| self.tree_of_body.get(b).copied().unwrap_or(WORLD);
             for f in forces {
-                if sleeping(f.point.body) {
+                let b = f.point.body;
+                if sleeping(b) && dozed.get(tree(b)) != Some(&true) {
                     self.frozen_forces.push(*f);
                 }
             }
@@ -402,6 +426,8 @@ impl Sleep {
             });
             self.awake = self.count_awake();
         }
+        self.doze.slept.iter_mut().for_each(|d| *d = false);
+        self.begin_doze(model, forced, q, v, points, forces, body_forces);
         self.awake_sum += self.awake as f64;
         slept
     }
@@ -440,7 +466,7 @@ impl Sleep {
     /// made at their first read ([`Sleep::forces`]: nothing they are made of
     /// changes before the next step's solve and its `compose`).
     pub fn compose(&mut self, model: &Model, body: &[Force]) {
-        if !self.any_asleep {
+        if !self.any_asleep && !self.doze.any {
             return;
         }
         self.all_forces.take();
@@ -451,6 +477,9 @@ impl Sleep {
             *out = get(0);
         }
         for &t in &self.awake_trees {
+            if self.doze.left[t] > 0 {
+                continue;
+            }
             for b in model.trees[t].bodies.clone() {
                 self.all_body[b] = get(b);
             }
@@ -460,7 +489,7 @@ impl Sleep {
     /// the frozen ones while anything sleeps.
     /// (`awake`: the last solve's, those [`Sleep::compose`] was given.)
     pub fn forces<'a>(&'a self, awake: &'a [ContactForce]) -> &'a [ContactForce] {
-        if self.any_asleep {
+        if self.any_asleep || self.doze.any {
             self.all_forces.get_or_init(|| {
                 // (the last solve's forces on islands that fell asleep after
                 // it are the frozen ones already)
@@ -477,7 +506,7 @@ impl Sleep {
     }
     /// The body contact wrenches to report (as [`Sleep::forces`]).
     pub fn body_forces<'a>(&'a self, awake: &'a [Force]) -> &'a [Force] {
-        if self.any_asleep {
+        if self.any_asleep || self.doze.any {
             &self.all_body
         } else {
             awake
@@ -486,7 +515,7 @@ impl Sleep {
 
     /// Per body: asleep, when any tree sleeps (empty: every body is awake).
     pub fn bodies_asleep(&self) -> &[bool] {
-        if self.on && self.any_asleep {
+        if self.on && (self.any_asleep || self.doze.any) {
             &self.body_asleep
         } else {
             &[]
@@ -509,30 +538,6 @@ impl Sleep {
 }
 
 impl super::Simulation {
-    /// The awake models with degrees of freedom now (cli.md's `awake`).
-    pub fn awake(&self) -> usize {
-        self.sleep.awake
-    }
-    /// The mean of [`Simulation::awake`] over the steps taken.
-    pub fn mean_awake(&self) -> f64 {
-        self.sleep.mean_awake()
-    }
-    /// Whether the scene model `name` sleeps (`None`: no such model; a lone
-    /// URDF's one model is named "").
-    pub fn sleeping(&self, name: &str) -> Option<bool> {
-        let t = self.model.trees.iter().position(|t| t.name == name)?;
-        Some(self.sleep.tree_asleep(t))
-    }
-    /// Wakes every sleeping island now (their contacts are found anew).
-    pub fn wake(&mut self) {
-        if self.sleep.wake_all(&self.model) {
-            // (the energy guard's C computed ahead left the sleeping trees
-            // out, `Sleep::bodies_asleep`: not the step's)
-            self.data.step_bias_ok = false;
-            self.refresh_contacts();
-        }
-    }
-
     /// Sleep's work at the end of a step of `h`: islands that an awake body
     /// touches woken (their contacts found), then the still islands put to sleep.
     pub(super) fn update_sleep(&mut self, h: f64) {
@@ -550,7 +555,9 @@ impl super::Simulation {
             );
             return;
         }
-        while self.sleep.wake_touched(&self.model, &self.points) {
+        while self.sleep.wake_touched(&self.model, &self.points)
+            | self.sleep.undoze_touched(&self.model, &self.points)
+        {
             self.refresh_contacts();
         }
         if !self.fk_valid {
@@ -597,6 +604,9 @@ impl super::Simulation {
         );
         if slept {
             self.energy_now = None;
+        }
+        if !self.sleep.doze.new_slots.is_empty() {
+            self.cons.hold_warm(&self.sleep.doze.new_slots);
         }
         self.sleep.compose(&self.model, self.cons.body_forces());
     }

@@ -67,7 +67,12 @@ impl Simulation {
         if !time_stepping {
             h_max = h_max.min(self.limit_reach_cap());
         }
-        let h = if time_stepping {
+        let h = if self.sleep.all_dozing() {
+            // every awake tree dozes (`doze`): their step is `doze_step`'s
+            // (the last solve's forces stand, as a sleeping island's do)
+            self.smooth.fsal_ok = false;
+            h_fixed
+        } else if time_stepping {
             self.euler_step(h_fixed, counts.total() > 0)?;
             self.smooth.fsal_ok = false;
             h_fixed
@@ -84,6 +89,8 @@ impl Simulation {
         self.sensors.end(h);
         self.steps += 1;
         self.sleep.hold(&self.model, &mut self.q, &mut self.v);
+        self.sleep
+            .doze_step(&self.model, h, &mut self.q, &mut self.v);
         normalize_quats(&self.model, &mut self.q);
         // 3. the new state: finite, its contacts, its energy
         self.check_finite()?;

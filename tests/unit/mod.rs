@@ -24,6 +24,7 @@ mod sim_add_body;
 mod sim_build;
 mod sim_dense;
 mod sim_factor;
+mod sleep_doze;
 mod spatial;
 mod view_geometry;
 mod view_page;
