@@ -176,7 +176,7 @@ impl Sleep {
             any_asleep: false,
             may: vec![true; nt],
             masked: vec![false; nt],
-            doze: super::doze::Doze::new(nt, model.nv, model.nq, on),
+            doze: super::doze::Doze::new(model, on),
         }
     }
 
