@@ -83,7 +83,11 @@ fn lone_free_solves_take_the_general_loops_bits() {
         assert_eq!(rl[k].to_bits(), rm[k].to_bits(), "apply_r, dof {k}");
         assert_eq!(zl2[k].to_bits(), zm2[k].to_bits(), "half_solve2 z, dof {k}");
         assert_eq!(wl2[k].to_bits(), wm2[k].to_bits(), "half_solve2 w, dof {k}");
-        assert_eq!(zl2[k].to_bits(), zl[k].to_bits(), "half_solve2 z = half_solve, dof {k}");
+        assert_eq!(
+            zl2[k].to_bits(),
+            zl[k].to_bits(),
+            "half_solve2 z = half_solve, dof {k}"
+        );
     }
 }
 
@@ -109,6 +113,11 @@ fn lone_free_solve_is_the_dense_solve() {
     f.apply_r(b.as_slice(), &mut z);
     f.half_solve(&mut z);
     for k in 0..18 {
-        assert!((z[k] - b[k]).abs() < 1e-12 * b.amax(), "dof {k}: {} vs {}", z[k], b[k]);
+        assert!(
+            (z[k] - b[k]).abs() < 1e-12 * b.amax(),
+            "dof {k}: {} vs {}",
+            z[k],
+            b[k]
+        );
     }
 }

@@ -47,7 +47,10 @@ fn until_asleep(sim: &mut Simulation, m: &str, t_max: f64) -> (f64, Vec<f64>) {
 }
 
 fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -74,7 +77,11 @@ fn a_box_at_rest_dozes_with_its_points_held_aside_and_sleeps_where_the_run_witho
     let (t_off, q_off) = until_asleep(&mut off, "m", 1.5);
     assert_eq!(off.doze_steps(), 0);
     // asleep at the same step, within 1e-6 m and rad of the same pose
-    assert!((on.time() - t_off).abs() < 1e-9, "{} s, {t_off} s", on.time());
+    assert!(
+        (on.time() - t_off).abs() < 1e-9,
+        "{} s, {t_off} s",
+        on.time()
+    );
     let d = max_diff(on.q().as_slice(), &q_off);
     assert!(d < 1e-6, "{d} from the run without doze");
 }
@@ -100,7 +107,10 @@ fn a_ball_rolling_below_sleep_velocity_sleeps_where_the_run_without_doze_puts_it
     // within a few N h sleep_velocity (8 µm) of where it sleeps without doze
     let dx = max_diff(&q_on[..3], &q_off[..3]);
     assert!(dx < 3e-5, "{dx} m from the run without doze");
-    assert!((q_on[0] - q_off[0]).abs() < 3e-5 && q_off[0] > 5e-5, "{q_on:?} {q_off:?}");
+    assert!(
+        (q_on[0] - q_off[0]).abs() < 3e-5 && q_off[0] > 5e-5,
+        "{q_on:?} {q_off:?}"
+    );
 }
 
 #[test]

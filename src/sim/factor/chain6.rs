@@ -22,7 +22,10 @@ impl MassFactor {
                 && self.root_chain.get(k1 - 1) == Some(&true)
                 && self.len.get(k1 - 1) == Some(&6)
                 && self.start.get(k0).map(|s| s + TRI6[5]) == self.start.get(k1 - 1).copied()
-                && self.start.get(k0).is_some_and(|&s| s + 21 <= self.anc.len())
+                && self
+                    .start
+                    .get(k0)
+                    .is_some_and(|&s| s + 21 <= self.anc.len())
                 && k1 <= self.dval.len()
         };
         if !self.lone_ranges.iter().all(chain6) {
@@ -78,9 +81,11 @@ impl MassFactor {
             return false;
         }
         for &(k0, k1) in self.solve_ranges() {
-            if let (Some(l), Some(s), Some(z)) =
-                (self.tri6(k0), self.inv_sqrt_d.get(k0..k1), z.get_mut(k0..k1))
-            {
+            if let (Some(l), Some(s), Some(z)) = (
+                self.tri6(k0),
+                self.inv_sqrt_d.get(k0..k1),
+                z.get_mut(k0..k1),
+            ) {
                 half_solve(l, s, z);
             }
         }
