@@ -72,8 +72,8 @@ pub fn integrate_config_held(
 }
 
 /// One free joint's q ⊕ h v, its q at `iq..iq + 7`, its v at `iv..iv + 6`
-/// (out of range: left as is).
-fn integrate_free(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize, iv: usize) {
+/// (out of range: left as is). [`integrate_config`]'s step for each free joint.
+pub fn integrate_free(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize, iv: usize) {
     // (through the joint's slices: one bounds test each, not one an entry)
     let (Some(qs), Some(&[vx, vy, vz, wx, wy, wz])) = (
         q.as_mut_slice().get_mut(iq..iq + 7),

@@ -8,7 +8,7 @@
 //! of the bias pass; their contact points and forces kept aside with the frozen
 //! ones for `contacts`, `penetration` and the forces), and each such step holds
 //! their velocity and integrates their configuration, q ← q ⊕ h v (the model's
-//! own joint integration, `integrate_config`). Then they take a full step
+//! own free-joint integration, `integrate_free`). Then they take a full step
 //! (found by detection, in the rows and the solve) and may doze again.
 //!
 //! Holding v is the exact step at an equilibrium (gravity and support
@@ -29,7 +29,7 @@
 use super::sleep::Sleep;
 use super::ContactForce;
 use crate::contact::ContactPoint;
-use crate::model::configuration::integrate_config;
+use crate::model::configuration::integrate_free;
 use crate::model::Model;
 use crate::spatial::Force;
 use nalgebra::DVector;
@@ -67,9 +67,6 @@ pub(crate) struct Doze {
     /// hull (hector's quadrotor) finds one ground point too high at its first
     /// full step after a doze and falls 56 µm into the ground.
     lone: Vec<bool>,
-    /// Scratch of the configuration step (nq, nv).
-    qs: DVector<f64>,
-    vs: DVector<f64>,
     /// Per island root: it may doze (scratch).
     may: Vec<bool>,
     /// Tree-steps taken dozing.
@@ -83,7 +80,7 @@ pub(crate) struct Doze {
 
 impl Doze {
     pub fn new(model: &Model, on: bool) -> Self {
-        let (nt, nv, nq) = (model.trees.len(), model.nv, model.nq);
+        let (nt, nv) = (model.trees.len(), model.nv);
         let mesh = |b: usize| {
             model
                 .collisions
@@ -94,7 +91,10 @@ impl Doze {
             .trees
             .iter()
             .map(|t| {
-                t.free.is_some() && t.bodies.len() == 1 && t.v.len() == 6 && !t.bodies.clone().any(mesh)
+                t.free.is_some()
+                    && t.bodies.len() == 1
+                    && t.v.len() == 6
+                    && !t.bodies.clone().any(mesh)
             })
             .collect();
         Self {
@@ -105,8 +105,6 @@ impl Doze {
             root: (0..nt).collect(),
             v_held: DVector::zeros(nv),
             any: false,
-            qs: DVector::zeros(nq),
-            vs: DVector::zeros(nv),
             may: vec![false; nt],
             tree_steps: 0,
             slept: vec![false; nt],
@@ -191,7 +189,10 @@ impl Sleep {
 
     /// A body's tree (`None`: the world or an obstacle).
     fn tree_of(&self, body: usize) -> Option<usize> {
-        self.tree_of_body.get(body).copied().filter(|&t| t < self.asleep.len())
+        self.tree_of_body
+            .get(body)
+            .copied()
+            .filter(|&t| t < self.asleep.len())
     }
 
     /// The dozing trees joined to their island's root (their points are kept
@@ -224,17 +225,9 @@ impl Sleep {
         if !self.doze.any {
             return;
         }
+        // (a dozing tree is one body on a free joint, `Doze::lone`: its step
+        // is that joint's q ⊕ h v from where its last one left it)
         let d = &mut self.doze;
-        d.qs.copy_from(&self.q_frozen);
-        d.vs.fill(0.0);
-        for (t, tree) in model.trees.iter().enumerate() {
-            if d.left[t] > 0 {
-                for k in tree.v.clone() {
-                    d.vs[k] = d.v_held[k];
-                }
-            }
-        }
-        integrate_config(model, &mut d.qs, &d.vs, h);
         let mut ended = false;
         for (t, tree) in model.trees.iter().enumerate() {
             if d.left[t] == 0 {
@@ -244,8 +237,13 @@ impl Sleep {
                 v[k] = d.v_held[k];
             }
             for k in tree.q.clone() {
-                q[k] = d.qs[k];
-                self.q_frozen[k] = d.qs[k];
+                q[k] = self.q_frozen[k];
+            }
+            if let Some(f) = tree.free.and_then(|f| model.free_joints.get(f)) {
+                integrate_free(q, v, h, f.iq, f.iv);
+            }
+            for k in tree.q.clone() {
+                self.q_frozen[k] = q[k];
             }
             d.tree_steps += 1;
             d.left[t] -= 1;
@@ -334,7 +332,10 @@ impl Sleep {
         let asleep = &self.asleep;
         let tree_of = &self.tree_of_body;
         let new = |b: usize| {
-            dozing(b) && tree_of.get(b).is_some_and(|&t| asleep.get(t) == Some(&false))
+            dozing(b)
+                && tree_of
+                    .get(b)
+                    .is_some_and(|&t| asleep.get(t) == Some(&false))
         };
         // (the forces of the last solve: no dozing tree had rows in it)
         for f in forces {

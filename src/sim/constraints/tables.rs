@@ -81,23 +81,14 @@ pub(crate) fn add_body_rows(
     p: &Vector3<f64>,
     row: &dyn Fn(Vector3<f64>) -> [f64; 3],
 ) -> ([Vec<f64>; 3], usize) {
-    let zero = Column {
-        s: Motion::zero(),
-        ang_zero: true,
-        lin_zero: true,
-    };
     let mut bc = BodyColumns {
-        s: [zero; 6],
+        s: [Column::of(Motion::zero()); 6],
         nv: cols.len().min(6),
         iv,
     };
     let mut sw = [Motion::zero(); 6];
     for ((c, w), &s) in bc.s.iter_mut().zip(&mut sw).zip(cols) {
-        *c = Column {
-            s,
-            ang_zero: s.ang == Vector3::zeros(),
-            lin_zero: s.lin == Vector3::zeros(),
-        };
+        *c = Column::of(s);
         *w = s;
     }
     let mut j = [
@@ -182,15 +173,22 @@ pub(super) struct Column {
     pub(super) lin_zero: bool,
 }
 
+impl Column {
+    /// Column `s`, its zero parts marked (exactly zero vectors).
+    #[inline]
+    pub(super) fn of(s: Motion) -> Self {
+        Column {
+            s,
+            ang_zero: s.ang == Vector3::zeros(),
+            lin_zero: s.lin == Vector3::zeros(),
+        }
+    }
+}
+
 impl BodyColumns {
     pub(super) fn of(model: &Model, i: usize) -> Self {
-        let zero = Column {
-            s: Motion::zero(),
-            ang_zero: true,
-            lin_zero: true,
-        };
         let mut cols = Self {
-            s: [zero; 6],
+            s: [Column::of(Motion::zero()); 6],
             nv: 0,
             iv: 0,
         };
@@ -198,12 +196,7 @@ impl BodyColumns {
             cols.iv = j.iv;
             cols.nv = if i == 0 { 0 } else { j.nv().min(6) };
             for (k, c) in cols.s.iter_mut().enumerate().take(cols.nv) {
-                let s = j.subspace_column(k);
-                *c = Column {
-                    s,
-                    ang_zero: s.ang == Vector3::zeros(),
-                    lin_zero: s.lin == Vector3::zeros(),
-                };
+                *c = Column::of(j.subspace_column(k));
             }
         }
         cols
