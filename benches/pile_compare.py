@@ -16,7 +16,8 @@ Each scene (benches/scenes/pile_KIND_N.json) is run
   implicitfast with sleep off and on (mjENBL_SLEEP); perf_counter around a Python loop of mj_step.
 The ratio is urdyn's faster run (sleep on, its default) over MuJoCo's fastest of the four.
 Growth: the step time ratio from 64 to 1024 objects (≤ 16: no faster than linear); beside it
-the same ratio per awake object (step time over the run's mean awake count).
+the same ratio per awake object (step time over the run's mean awake count), and the ratio at equal
+durations (the 64 pile run again over the 1024 pile's 2 s, both engines; --no-equal-growth skips it).
 
 --settled N: the N-box pile's steps/s falling against settled, urdyn with sleep on, by
 `examples/pile_settled.rs` (500 steps from the drop, and 2000 steps from the state the run reaches
@@ -94,6 +95,17 @@ def one(args, kind, n, tmp):
     best = max(mj, key=mj.get)
     row["mujoco_best"], row["mujoco_best_cfg"] = mj[best], best
     row["ratio"] = max(row["urdyn_sleep"], row["urdyn_nosleep"] or 0) / mj[best]
+    if n == 64 and args.equal_growth and args.duration_1024 != dur:
+        # the 64 pile again over the 1024 pile's duration: growth at equal durations (a 4 s run of
+        # a small pile is mostly asleep or resting, a 2 s run of the large one mostly falling)
+        d2, s2 = args.duration_1024, int(round(args.duration_1024 / 0.001))
+        row["equal"] = {
+            "duration": d2,
+            "urdyn_sleep": max(urdyn(args, path, d2)["steps_per_s"] for _ in range(args.repeats)),
+            "urdyn_nosleep": max(urdyn(args, path, d2, ["--no-sleep"])["steps_per_s"]
+                                 for _ in range(args.repeats)),
+            "mujoco_best": max(max(time_mj(model, qpos, qvel, integ, sleep, s2) for _ in range(args.repeats))
+                               for integ in INTEG for sleep in (False, True))}
     print("%s %d: urdyn %.0f (no sleep %s), MuJoCo %.0f (%s), ratio %.2f" % (
         kind, n, row["urdyn_sleep"], row["urdyn_nosleep"] and "%.0f" % row["urdyn_nosleep"],
         mj[best], best, row["ratio"]), file=sys.stderr, flush=True)
@@ -152,6 +164,12 @@ def write_md(path, rows, meta, st):
             g_m = by[64]["mujoco_best"] / by[1024]["mujoco_best"]
             out.append("- %s, step time 1024 / 64 objects (16× the objects): urdyn %.1f× (no sleep %.1f×), MuJoCo %.1f×."
                        % (kind, g_u, g_un, g_m))
+            eq = by[64].get("equal")
+            if eq and by[1024]["duration"] == eq["duration"]:
+                out.append("  At equal durations (%g s each): urdyn %.1f× (no sleep %.1f×), MuJoCo %.1f×."
+                           % (eq["duration"], eq["urdyn_sleep"] / by[1024]["urdyn_sleep"],
+                              eq["urdyn_nosleep"] / by[1024]["urdyn_nosleep"] if by[1024]["urdyn_nosleep"] else float("nan"),
+                              eq["mujoco_best"] / by[1024]["mujoco_best"]))
             # the same ratio per awake object: what a step costs for each model it integrates
             # (sleep on; the larger pile stays awake through more of its run)
             a64, a1024 = by[64]["urdyn_awake_mean"], by[1024]["urdyn_awake_mean"]
@@ -181,6 +199,8 @@ def main():
                     help="examples/pile_settled binary (default target/release/examples/pile_settled)")
     ap.add_argument("--repeats", type=int, default=1, help="best of this many runs of each engine and setting")
     ap.add_argument("--no-nosleep", action="store_true", help="skip urdyn's --no-sleep runs")
+    ap.add_argument("--no-equal-growth", dest="equal_growth", action="store_false",
+                    help="skip the 64 pile's runs over the 1024 pile's duration (growth at equal durations)")
     ap.add_argument("--md", default="")
     args = ap.parse_args()
     t0 = time.time()
