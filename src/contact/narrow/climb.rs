@@ -75,8 +75,10 @@ impl WarmSimplex {
 }
 
 /// The gap (m) within which two hulls touch: GJK's answer is asked from
-/// parry's start ([`climb_manifold`]).
-const TOUCHING: f64 = 1e-6;
+/// parry's start ([`climb_manifold`]). GJK's relative stop (√(10 ε) ≈ 5·10⁻⁸
+/// of the CSO point's length, ~1 m here) cannot be met within ~5·10⁻⁸ m of
+/// contact: 0.1 µm keeps twice that (docs/theory.md §"Warm-started GJK").
+const TOUCHING: f64 = 1e-7;
 
 /// parry's `contact_manifold_pfm_pfm` for two climbing hulls (no border, no
 /// normal constraint; the caller has cleared the points, so parry's reuse of
@@ -110,7 +112,7 @@ pub(crate) fn climb_manifold<S1, S2>(
         cold(&mut simplex);
     }
     let mut contact = gjk::closest_points(pos12, g1, g2, prediction, true, &mut simplex);
-    // touching (a gap within 1 µm of zero): GJK's direction there is any of
+    // touching (a gap within 0.1 µm of zero): GJK's direction there is any of
     // the contact features' normal cone, and the one it ends at depends on
     // the start; asked again from parry's start, so that the features (and
     // the points clipped from them) are those parry finds
