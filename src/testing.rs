@@ -244,6 +244,19 @@ pub mod contact {
         }
     }
 
+    /// `contact::narrow::cylinder::pfm`: whether it takes the pair, and if so
+    /// (and it ran) true with `manifolds` written as parry's dispatcher would.
+    pub fn cylinder_pfm_manifold(
+        pos12: &Pose,
+        a: &PairShape,
+        b: &PairShape,
+        margin: f64,
+        manifolds: &mut Vec<ContactManifold<(), ()>>,
+    ) -> bool {
+        use crate::contact::narrow::cylinder::pfm;
+        pfm::takes(a, b) && pfm::manifold(pos12, a, b, margin, manifolds)
+    }
+
     /// `Round::of`.
     pub fn round_of(s: &PairShape, w: &Se3<f64>) -> Option<Round> {
         Round::of(s, w)

@@ -150,6 +150,9 @@ pub(crate) fn parry_points(
             climb_manifolds(&pos12, ha, hb, margin, manifolds, workspace);
             return Ok(());
         }
+        if cylinder::pfm::takes(a, b) && cylinder::pfm::manifold(&pos12, a, b, margin, manifolds) {
+            return Ok(());
+        }
         dispatcher.contact_manifolds(&pos12, &*a.shape, &*b.shape, margin, manifolds, workspace)
     };
     // a convex pair that has barely moved since parry found its points

@@ -42,6 +42,7 @@ use crate::spatial::Se3;
 use nalgebra::Vector3;
 
 mod boxed;
+pub(crate) mod pfm;
 use boxed::box_feature;
 pub(crate) use boxed::box_on_cap;
 

@@ -57,7 +57,7 @@ pub(crate) type Now<'a> = (&'a Vector3<f64>, &'a Se3<f64>, f64);
 /// |w·c₀ − w₀·c₀| + ‖R − R₀‖_F |h| (c₀, h its box's centre and half extents
 /// in its frame: every point lies within |h| of c₀), so across that plane the
 /// shapes are still g − D_a − D_b apart (conservative advancement).
-#[inline]
+#[inline(always)]
 pub(crate) fn still_apart_at(then: Option<&Apart>, a: Now, b: Now, margin: f64) -> bool {
     let Some(t) = then else {
         return false;

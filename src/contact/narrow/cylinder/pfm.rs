@@ -1,0 +1,159 @@
+//! The cylinder pairs the closed forms decline (a rim on a box's edge, a
+//! rim on another cylinder's side, ...), by parry's own generator
+//! `contact_manifold_pfm_pfm` (GJK, EPA when GJK finds the shapes
+//! overlapping, the support features clipped) redone here step for step
+//! with one difference: EPA's polytope (its vertices, faces, silhouette and
+//! heap) is kept between calls on this thread instead of allocated anew at
+//! each (parry's `contact_support_map_support_map_with_params` builds an
+//! `EPA::new()` every time; `EPA::closest_points` clears it first, so the
+//! same operations give the same points). On the mixed piles EPA runs on
+//! about half of these pairs and its vectors' growth (`grow_one`, `realloc`)
+//! was ~1.5 % of the step.
+
+use super::super::super::shapes::PairShape;
+use parry3d_f64::math::{Pose, Vector};
+use parry3d_f64::query::epa::EPA;
+use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
+use parry3d_f64::query::{ContactManifold, TrackedContact};
+use parry3d_f64::shape::{PackedFeatureId, PolygonalFeature, PolygonalFeatureMap};
+use std::cell::RefCell;
+
+/// parry's `utils::COS_1_DEGREES` (crate-private there): the normal's tilt
+/// under which its generator keeps a manifold's points.
+const COS_1_DEGREES: f64 = 0.99984769515;
+
+thread_local! {
+    /// EPA's polytope, kept between calls.
+    static EPA_KEPT: RefCell<EPA> = RefCell::new(EPA::new());
+}
+
+/// Whether [`manifold`] takes the pair: a cylinder and a cylinder or a box,
+/// the pairs for which parry's dispatcher calls `contact_manifold_pfm_pfm`.
+pub(crate) fn takes(a: &PairShape, b: &PairShape) -> bool {
+    let cyl_or_box = |s: &PairShape| s.cylinder.is_some() || s.cuboid.is_some();
+    (a.cylinder.is_some() && cyl_or_box(b)) || (cyl_or_box(a) && b.cylinder.is_some())
+}
+
+/// parry's `DefaultQueryDispatcher::contact_manifolds` of a pair that
+/// [`takes`] (both convex, neither composite: the dispatcher's first
+/// manifold, made if there is none, by `contact_manifold_pfm_pfm` with no
+/// normal constraints), with EPA's polytope kept (module doc). False (and
+/// nothing touched) when a shape has no polygonal feature map. Out of
+/// line: inlined, it grew [`super::super::parry_points`] and the pair visit
+/// past what the inliner keeps whole (talos_fall +0.25 %).
+#[inline(never)]
+pub(crate) fn manifold(
+    pos12: &Pose,
+    a: &PairShape,
+    b: &PairShape,
+    prediction: f64,
+    manifolds: &mut Vec<ContactManifold<(), ()>>,
+) -> bool {
+    let (Some((pfm1, border_radius1)), Some((pfm2, border_radius2))) = (
+        a.shape.as_polygonal_feature_map(),
+        b.shape.as_polygonal_feature_map(),
+    ) else {
+        return false;
+    };
+    if manifolds.is_empty() {
+        manifolds.push(ContactManifold::new());
+    }
+    let manifold = &mut manifolds[0];
+    // contact_manifold_pfm_pfm, its lines in its order
+    if manifold.try_update_contacts_eps(pos12, COS_1_DEGREES, 1.0e-6) {
+        return true;
+    }
+    let init_dir = manifold.local_n1.try_normalize();
+    let total_prediction = prediction + border_radius1 + border_radius2;
+    let contact = EPA_KEPT.with(|epa| {
+        with_params(
+            pos12,
+            pfm1,
+            pfm2,
+            total_prediction,
+            &mut VoronoiSimplex::new(),
+            init_dir,
+            &mut epa.borrow_mut(),
+        )
+    });
+    let old_manifold_points = manifold.points.clone();
+    manifold.clear();
+    match contact {
+        GJKResult::ClosestPoints(p1, p2_1, dir) => {
+            let local_n1 = dir;
+            let local_n2 = pos12.rotation.inverse() * -dir;
+            let mut feature1 = PolygonalFeature::default();
+            let mut feature2 = PolygonalFeature::default();
+            pfm1.local_support_feature_toward(local_n1, p1, &mut feature1);
+            pfm2.local_support_feature_toward(
+                local_n2,
+                pos12.inverse_transform_point(p2_1),
+                &mut feature2,
+            );
+            PolygonalFeature::contacts(
+                pos12,
+                &pos12.inverse(),
+                local_n1,
+                local_n2,
+                &feature1,
+                &feature2,
+                manifold,
+                false,
+            );
+            // parry's GJK point (no normal constraint moved the normal)
+            manifold.points.push(TrackedContact::new(
+                p1,
+                pos12.inverse_transform_point(p2_1),
+                PackedFeatureId::UNKNOWN,
+                PackedFeatureId::UNKNOWN,
+                (p2_1 - p1).dot(local_n1),
+            ));
+            if border_radius1 != 0.0 || border_radius2 != 0.0 {
+                for contact in &mut manifold.points {
+                    contact.local_p1 += local_n1 * border_radius1;
+                    contact.local_p2 += local_n2 * border_radius2;
+                    contact.dist -= border_radius1 + border_radius2;
+                }
+            }
+            manifold.local_n1 = local_n1;
+            manifold.local_n2 = local_n2;
+        }
+        GJKResult::NoIntersection(dir) => {
+            manifold.local_n1 = dir;
+        }
+        _ => {
+            manifold.local_n1 = Vector::ZERO;
+        }
+    }
+    manifold.match_contacts(&old_manifold_points);
+    true
+}
+
+/// parry's `contact_support_map_support_map_with_params` with EPA's
+/// polytope `epa` kept by the caller.
+fn with_params(
+    pos12: &Pose,
+    g1: &dyn PolygonalFeatureMap,
+    g2: &dyn PolygonalFeatureMap,
+    prediction: f64,
+    simplex: &mut VoronoiSimplex,
+    init_dir: Option<Vector>,
+    epa: &mut EPA,
+) -> GJKResult {
+    let dir = if let Some(init_dir) = init_dir {
+        init_dir
+    } else if let Some(init_dir) = (pos12.translation).try_normalize() {
+        init_dir
+    } else {
+        Vector::X
+    };
+    simplex.reset(CsoPoint::from_shapes(pos12, g1, g2, dir));
+    let cpts = gjk::closest_points(pos12, g1, g2, prediction, true, simplex);
+    if cpts != GJKResult::Intersection {
+        return cpts;
+    }
+    if let Some((p1, p2, n)) = epa.closest_points(pos12, g1, g2, simplex) {
+        return GJKResult::ClosestPoints(p1, p2, n);
+    }
+    GJKResult::NoIntersection(Vector::X)
+}
