@@ -8,7 +8,9 @@
 //! `EPA::new()` every time; `EPA::closest_points` clears it first, so the
 //! same operations give the same points). On the mixed piles EPA runs on
 //! about half of these pairs and its vectors' growth (`grow_one`, `realloc`)
-//! was ~1.5 % of the step.
+//! was ~1.5 % of the step. GJK and EPA are called on the shapes' own types
+//! (`Cylinder`, `Cuboid`) where parry's dispatcher passes `dyn`
+//! `PolygonalFeatureMap`s: the same support functions, inlined.
 
 use super::super::super::shapes::PairShape;
 use parry3d_f64::math::{Pose, Vector};
@@ -49,19 +51,46 @@ pub(crate) fn manifold(
     prediction: f64,
     manifolds: &mut Vec<ContactManifold<(), ()>>,
 ) -> bool {
-    let (Some((pfm1, border_radius1)), Some((pfm2, border_radius2))) = (
+    let (Some((_, border_radius1)), Some((_, border_radius2))) = (
         a.shape.as_polygonal_feature_map(),
         b.shape.as_polygonal_feature_map(),
     ) else {
         return false;
     };
+    let radii = (border_radius1, border_radius2);
+    let (sa, sb) = (&*a.shape, &*b.shape);
+    // the shapes' own types: GJK's and EPA's support calls inlined, not
+    // through `dyn` (the same functions, so the same arithmetic)
+    match (
+        sa.as_cylinder(),
+        sa.as_cuboid(),
+        sb.as_cylinder(),
+        sb.as_cuboid(),
+    ) {
+        (Some(c1), _, Some(c2), _) => run(pos12, c1, c2, radii, prediction, manifolds),
+        (Some(c1), _, _, Some(c2)) => run(pos12, c1, c2, radii, prediction, manifolds),
+        (_, Some(c1), Some(c2), _) => run(pos12, c1, c2, radii, prediction, manifolds),
+        _ => return false,
+    }
+    true
+}
+
+/// [`manifold`] of shapes `pfm1`, `pfm2` (border radii `radii`).
+fn run<S1: PolygonalFeatureMap, S2: PolygonalFeatureMap>(
+    pos12: &Pose,
+    pfm1: &S1,
+    pfm2: &S2,
+    (border_radius1, border_radius2): (f64, f64),
+    prediction: f64,
+    manifolds: &mut Vec<ContactManifold<(), ()>>,
+) {
     if manifolds.is_empty() {
         manifolds.push(ContactManifold::new());
     }
     let manifold = &mut manifolds[0];
     // contact_manifold_pfm_pfm, its lines in its order
     if manifold.try_update_contacts_eps(pos12, COS_1_DEGREES, 1.0e-6) {
-        return true;
+        return;
     }
     let init_dir = manifold.local_n1.try_normalize();
     let total_prediction = prediction + border_radius1 + border_radius2;
@@ -126,15 +155,14 @@ pub(crate) fn manifold(
         }
     }
     manifold.match_contacts(&old_manifold_points);
-    true
 }
 
 /// parry's `contact_support_map_support_map_with_params` with EPA's
 /// polytope `epa` kept by the caller.
-fn with_params(
+fn with_params<S1: PolygonalFeatureMap, S2: PolygonalFeatureMap>(
     pos12: &Pose,
-    g1: &dyn PolygonalFeatureMap,
-    g2: &dyn PolygonalFeatureMap,
+    g1: &S1,
+    g2: &S2,
     prediction: f64,
     simplex: &mut VoronoiSimplex,
     init_dir: Option<Vector>,
