@@ -13,14 +13,14 @@
 //! (found by detection, in the rows and the solve) and may doze again. A full
 //! step that finds the island as its doze left it (the same contact points,
 //! every tree slower than [`GROW_SPEED`]·sleep_velocity) doubles its next
-//! period, up to [`N_MAX`] = 16 steps; any other start of a doze is at
+//! period, up to [`N_MAX`] = 32 steps; any other start of a doze is at
 //! N_DOZE. A step in which every awake tree dozes on is that alone
 //! (`Simulation::dozing_step`: no detection, rows or solve).
 //!
 //! Holding v is the exact step at an equilibrium (gravity and support
 //! cancel) and drifts by at most N_DOZE·h·DOZE_SPEED·sleep_velocity (4 µm at
 //! 1 ms and 1e-3 m/s) in a first period and N_MAX·h·GROW_SPEED·sleep_velocity
-//! (0.32 µm, ≤ [`DRIFT`]) in a grown one: far inside the contact slop (0.1 mm)
+//! (0.64 µm, ≤ [`DRIFT`]) in a grown one: far inside the contact slop (0.1 mm)
 //! and margin (5 mm), so no contact appears unseen between full steps. The
 //! last solve's Δv is not replayed: it holds the velocity-cancelling part
 //! −(v + h g) and its replay diverges.
@@ -54,10 +54,7 @@ pub(super) const N_DOZE: u32 = 8;
 /// The longest period: each full step that ends a doze and finds its island
 /// as it left it (the same contact points, every tree slower than
 /// [`GROW_SPEED`]) doubles the island's next period, up to this many steps.
-/// (32 cut 2 % more instructions on the box piles, but one of 26 perturbed
-/// copies of the 16-box pile had an island kicked to 1e-3 m/s at the full
-/// step after a 32-step doze, and slept 0.36 s later; at 16 none did.)
-pub(super) const N_MAX: u32 = 16;
+pub(super) const N_MAX: u32 = 32;
 /// A period grows only while each tree's speed at the full step is below
 /// this fraction of `sleep_velocity` (a box at rest in a pile: ~1e-6 m/s; a
 /// creeping one stays at `N_DOZE`, where its blips are seen as before; with
@@ -67,8 +64,8 @@ pub(super) const N_MAX: u32 = 16;
 pub(super) const GROW_SPEED: f64 = 0.02;
 /// The farthest (m) a dozing tree drifts between full steps in a grown
 /// period, N·h·GROW_SPEED·sleep_velocity (a period doubles only while this
-/// holds): 0.32 µm at 1 ms, 1e-3 m/s and N_MAX, a 300th of the contact slop
-/// (0.1 mm: nothing is pushed below it) and a 15000th of the contact margin
+/// holds): 0.64 µm at 1 ms, 1e-3 m/s and N_MAX, a 150th of the contact slop
+/// (0.1 mm: nothing is pushed below it) and a 7800th of the contact margin
 /// (5 mm): no contact appears or parts unseen between full steps. (At
 /// `N_DOZE`, N·h·DOZE_SPEED·sleep_velocity = 4 µm.)
 pub(super) const DRIFT: f64 = 1e-5;
