@@ -311,8 +311,6 @@ impl Sleep {
             if self.doze.left[t] > 0 {
                 // dozing: its speed is held below sleep_velocity
                 self.still[t] = if forced[t] { 0.0 } else { self.still[t] + h };
-                let slow = self.speed[t] < super::doze::GROW_SPEED * self.v_tol;
-                self.doze.rest(t, slow && !forced[t], h);
                 continue;
             }
             let mut speed = 0.0f64;
@@ -339,11 +337,6 @@ impl Sleep {
             } else {
                 0.0
             };
-            self.doze.rest(
-                t,
-                speed < super::doze::GROW_SPEED * self.v_tol && !forced[t],
-                h,
-            );
         }
         self.link_dozing(&awake_trees);
         // islands: trees joined by a contact point or a loop constraint
@@ -385,7 +378,6 @@ impl Sleep {
             slept = true;
             let dozed = std::mem::take(&mut self.doze.left[t]) > 0;
             self.doze.slept[t] = dozed;
-            self.doze.ran_out[t] = false;
             self.asleep[t] = true;
             self.masked[t] = true;
             self.island[t] = r;
@@ -435,7 +427,7 @@ impl Sleep {
             self.awake = self.count_awake();
         }
         self.doze.slept.iter_mut().for_each(|d| *d = false);
-        self.begin_doze(model, h, forced, q, v, points, forces, body_forces);
+        self.begin_doze(model, forced, q, v, points, forces, body_forces);
         self.awake_sum += self.awake as f64;
         slept
     }

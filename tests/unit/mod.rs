@@ -16,7 +16,6 @@ mod contact_hull;
 mod contact_narrow;
 mod contact_prim;
 mod contact_travel;
-mod doze_period;
 mod mesh_cache;
 mod mesh_dae;
 mod mesh_inertia;
