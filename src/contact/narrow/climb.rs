@@ -144,37 +144,57 @@ pub(crate) fn climb_manifold<S1, S2>(
     manifold.clear();
     match contact {
         GJKResult::ClosestPoints(p1, p2_1, dir) => {
-            let local_n1 = dir;
-            let local_n2 = pos12.rotation.inverse() * -dir;
-            let mut feature1 = PolygonalFeature::default();
-            let mut feature2 = PolygonalFeature::default();
-            g1.local_support_feature_toward(local_n1, p1, &mut feature1);
-            g2.local_support_feature_toward(
-                local_n2,
-                pos12.inverse_transform_point(p2_1),
-                &mut feature2,
-            );
-            PolygonalFeature::contacts(
-                pos12,
-                &pos12.inverse(),
-                local_n1,
-                local_n2,
-                &feature1,
-                &feature2,
-                manifold,
-                false,
-            );
-            manifold.points.push(TrackedContact::new(
-                p1,
-                pos12.inverse_transform_point(p2_1),
-                PackedFeatureId::UNKNOWN,
-                PackedFeatureId::UNKNOWN,
-                (p2_1 - p1).dot(local_n1),
-            ));
+            let (local_n1, local_n2) = clip_at_closest(pos12, g1, g2, p1, p2_1, dir, manifold);
             manifold.local_n1 = local_n1;
             manifold.local_n2 = local_n2;
         }
         GJKResult::NoIntersection(dir) => manifold.local_n1 = dir,
         _ => manifold.local_n1 = Vector::ZERO,
     }
+}
+
+/// parry's `contact_manifold_pfm_pfm` at GJK's closest points `p1` (shape 1's
+/// frame) and `p2_1` (shape 2's, in shape 1's frame) with normal `dir`: each
+/// shape's support feature toward the normal, clipped against the other's,
+/// and GJK's own point (no normal constraint moved the normal); returns the
+/// normals in each shape's frame. The climbing hulls' query and the cylinder
+/// pairs' (`cylinder::pfm`) both end here.
+#[inline(always)]
+pub(crate) fn clip_at_closest<S1, S2>(
+    pos12: &Pose,
+    g1: &S1,
+    g2: &S2,
+    p1: Vector,
+    p2_1: Vector,
+    dir: Vector,
+    manifold: &mut ContactManifold<(), ()>,
+) -> (Vector, Vector)
+where
+    S1: PolygonalFeatureMap + ?Sized,
+    S2: PolygonalFeatureMap + ?Sized,
+{
+    let local_n1 = dir;
+    let local_n2 = pos12.rotation.inverse() * -dir;
+    let mut feature1 = PolygonalFeature::default();
+    let mut feature2 = PolygonalFeature::default();
+    g1.local_support_feature_toward(local_n1, p1, &mut feature1);
+    g2.local_support_feature_toward(local_n2, pos12.inverse_transform_point(p2_1), &mut feature2);
+    PolygonalFeature::contacts(
+        pos12,
+        &pos12.inverse(),
+        local_n1,
+        local_n2,
+        &feature1,
+        &feature2,
+        manifold,
+        false,
+    );
+    manifold.points.push(TrackedContact::new(
+        p1,
+        pos12.inverse_transform_point(p2_1),
+        PackedFeatureId::UNKNOWN,
+        PackedFeatureId::UNKNOWN,
+        (p2_1 - p1).dot(local_n1),
+    ));
+    (local_n1, local_n2)
 }

@@ -16,8 +16,8 @@ use super::super::super::shapes::PairShape;
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::epa::EPA;
 use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
-use parry3d_f64::query::{ContactManifold, TrackedContact};
-use parry3d_f64::shape::{PackedFeatureId, PolygonalFeature, PolygonalFeatureMap};
+use parry3d_f64::query::ContactManifold;
+use parry3d_f64::shape::PolygonalFeatureMap;
 use std::cell::RefCell;
 
 /// parry's `utils::COS_1_DEGREES` (crate-private there): the normal's tilt
@@ -109,34 +109,8 @@ fn run<S1: PolygonalFeatureMap, S2: PolygonalFeatureMap>(
     manifold.clear();
     match contact {
         GJKResult::ClosestPoints(p1, p2_1, dir) => {
-            let local_n1 = dir;
-            let local_n2 = pos12.rotation.inverse() * -dir;
-            let mut feature1 = PolygonalFeature::default();
-            let mut feature2 = PolygonalFeature::default();
-            pfm1.local_support_feature_toward(local_n1, p1, &mut feature1);
-            pfm2.local_support_feature_toward(
-                local_n2,
-                pos12.inverse_transform_point(p2_1),
-                &mut feature2,
-            );
-            PolygonalFeature::contacts(
-                pos12,
-                &pos12.inverse(),
-                local_n1,
-                local_n2,
-                &feature1,
-                &feature2,
-                manifold,
-                false,
-            );
-            // parry's GJK point (no normal constraint moved the normal)
-            manifold.points.push(TrackedContact::new(
-                p1,
-                pos12.inverse_transform_point(p2_1),
-                PackedFeatureId::UNKNOWN,
-                PackedFeatureId::UNKNOWN,
-                (p2_1 - p1).dot(local_n1),
-            ));
+            let (local_n1, local_n2) =
+                super::super::climb::clip_at_closest(pos12, pfm1, pfm2, p1, p2_1, dir, manifold);
             if border_radius1 != 0.0 || border_radius2 != 0.0 {
                 for contact in &mut manifold.points {
                     contact.local_p1 += local_n1 * border_radius1;
