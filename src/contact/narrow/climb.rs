@@ -19,6 +19,21 @@ use parry3d_f64::query::{
 };
 use parry3d_f64::shape::{PackedFeatureId, PolygonalFeature, PolygonalFeatureMap};
 
+thread_local! {
+    /// EPA's polytope (its vertices, faces, silhouette and heap), kept
+    /// between the calls on this thread: parry builds an `EPA::new()` at each
+    /// query, and `EPA::closest_points` clears it first, so the same
+    /// operations give the same points without the vectors' regrowth.
+    static EPA_KEPT: std::cell::RefCell<EPA> = std::cell::RefCell::new(EPA::new());
+}
+
+/// `f` with this thread's kept EPA ([`EPA_KEPT`]): the climbing hulls' query
+/// and the cylinder pairs' (`cylinder::pfm`).
+#[inline(always)]
+pub(crate) fn with_kept_epa<R>(f: impl FnOnce(&mut EPA) -> R) -> R {
+    EPA_KEPT.with(|epa| f(&mut epa.borrow_mut()))
+}
+
 /// The vertex pairs of a pair's last GJK simplex: a's point in a's frame,
 /// b's in b's (valid at any pose). Kept in the pair's parry workspace.
 #[derive(Clone, Copy, Debug, Default)]
@@ -136,7 +151,7 @@ pub(crate) fn climb_manifold<S1, S2>(
     }
     if contact == GJKResult::Intersection {
         // the origin inside the CSO: EPA from GJK's simplex
-        contact = match EPA::new().closest_points(pos12, g1, g2, &simplex) {
+        contact = match with_kept_epa(|epa| epa.closest_points(pos12, g1, g2, &simplex)) {
             Some((p1, p2, n)) => GJKResult::ClosestPoints(p1, p2, n),
             None => GJKResult::NoIntersection(Vector::X),
         };

@@ -3,7 +3,8 @@
 //! `contact_manifold_pfm_pfm` (GJK, EPA when GJK finds the shapes
 //! overlapping, the support features clipped) redone here step for step
 //! with one difference: EPA's polytope (its vertices, faces, silhouette and
-//! heap) is kept between calls on this thread instead of allocated anew at
+//! heap) is kept between calls on this thread (`climb::with_kept_epa`, shared
+//! with the climbing hulls' query) instead of allocated anew at
 //! each (parry's `contact_support_map_support_map_with_params` builds an
 //! `EPA::new()` every time; `EPA::closest_points` clears it first, so the
 //! same operations give the same points). On the mixed piles EPA runs on
@@ -18,16 +19,10 @@ use parry3d_f64::query::epa::EPA;
 use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
 use parry3d_f64::query::ContactManifold;
 use parry3d_f64::shape::PolygonalFeatureMap;
-use std::cell::RefCell;
 
 /// parry's `utils::COS_1_DEGREES` (crate-private there): the normal's tilt
 /// under which its generator keeps a manifold's points.
 const COS_1_DEGREES: f64 = 0.99984769515;
-
-thread_local! {
-    /// EPA's polytope, kept between calls.
-    static EPA_KEPT: RefCell<EPA> = RefCell::new(EPA::new());
-}
 
 /// Whether [`manifold`] takes the pair: a cylinder and a cylinder or a box,
 /// the pairs for which parry's dispatcher calls `contact_manifold_pfm_pfm`.
@@ -94,7 +89,7 @@ fn run<S1: PolygonalFeatureMap, S2: PolygonalFeatureMap>(
     }
     let init_dir = manifold.local_n1.try_normalize();
     let total_prediction = prediction + border_radius1 + border_radius2;
-    let contact = EPA_KEPT.with(|epa| {
+    let contact = super::super::climb::with_kept_epa(|epa| {
         with_params(
             pos12,
             pfm1,
@@ -102,7 +97,7 @@ fn run<S1: PolygonalFeatureMap, S2: PolygonalFeatureMap>(
             total_prediction,
             &mut VoronoiSimplex::new(),
             init_dir,
-            &mut epa.borrow_mut(),
+            epa,
         )
     });
     let old_manifold_points = manifold.points.clone();
