@@ -187,6 +187,15 @@ impl Sleep {
                 .all(|&t| !self.has_dof[t] || self.doze.left[t] > 0)
     }
 
+    /// Every awake tree dozes and dozes on after the next step (none runs
+    /// out in it), and no contact point is listed: the next step has nothing
+    /// to find or solve (`Simulation::dozing_step`).
+    pub(super) fn quiet_dozing(&self, points: &[ContactPoint]) -> bool {
+        self.doze.any
+            && points.is_empty()
+            && self.awake_trees.iter().all(|&t| self.doze.left[t] >= 2)
+    }
+
     /// A body's tree (`None`: the world or an obstacle).
     fn tree_of(&self, body: usize) -> Option<usize> {
         self.tree_of_body
@@ -229,10 +238,12 @@ impl Sleep {
         // is that joint's q ⊕ h v from where its last one left it)
         let d = &mut self.doze;
         let mut ended = false;
-        for (t, tree) in model.trees.iter().enumerate() {
+        // (a dozing tree is awake: the awake ones are listed)
+        for &t in &self.awake_trees {
             if d.left[t] == 0 {
                 continue;
             }
+            let tree = &model.trees[t];
             for k in tree.v.clone() {
                 v[k] = d.v_held[k];
             }
