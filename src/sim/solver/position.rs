@@ -241,6 +241,8 @@ pub(crate) struct PosWarm {
     slots: Vec<usize>,
     /// μ of each dof's lower and upper limit rows (entries 1, 2 as `which`).
     by_dof: Vec<[f64; 3]>,
+    /// The dofs of `by_dof` written by the last solve (only these are cleared).
+    dofs: Vec<usize>,
     /// This pass's start, by row.
     start: Vec<f64>,
     /// 1 − β: how much of a violation held still is left after a pass.
@@ -254,6 +256,7 @@ impl PosWarm {
             by_slot: vec![0.0; nslots],
             slots: Vec::with_capacity(cap),
             by_dof: vec![[0.0; 3]; ndof],
+            dofs: Vec::with_capacity(ndof),
             start: Vec::with_capacity(cap),
             decay: 1.0,
         }
@@ -270,6 +273,7 @@ impl PosWarm {
         self.by_slot.iter_mut().for_each(|w| *w = 0.0);
         self.slots.clear();
         self.by_dof.iter_mut().for_each(|w| *w = [0.0; 3]);
+        self.dofs.clear();
     }
 
     /// Keeps the warm starts of `slots` (sorted) through the next solves.
@@ -322,7 +326,12 @@ impl PosWarm {
             }
         }
         self.slots.clear();
-        self.by_dof.iter_mut().for_each(|w| *w = [0.0; 3]);
+        for &d in &self.dofs {
+            if let Some(w) = self.by_dof.get_mut(d) {
+                *w = [0.0; 3];
+            }
+        }
+        self.dofs.clear();
         if !pushed {
             return;
         }
@@ -343,6 +352,7 @@ impl PosWarm {
                 && let Some(w) = self.by_dof.get_mut(d)
             {
                 w[which as usize % 3] = m;
+                self.dofs.push(d);
             }
         }
     }
