@@ -24,7 +24,7 @@ use super::factor::MassFactor;
 use super::islands::Islands;
 use super::loops::Loops;
 use super::newton::Newton;
-use super::solver::{RowKind, Rows, Scratch};
+use super::solver::{PosWarm, RowKind, Rows, Scratch};
 use super::{ContactForce, Solver};
 use crate::contact::{tangents, ContactPoint};
 use crate::model::{JointKind, Model};
@@ -119,6 +119,8 @@ pub(crate) struct Constraints {
     /// This step's warm starts of the points, gathered before the rows are
     /// built (the loads are independent there: their cache misses overlap).
     warm_points: Vec<[f64; 3]>,
+    /// The position pass's warm starts (μ by contact slot and limit: solver/position.rs).
+    pos_warm: PosWarm,
     /// World-frame motion subspace columns of each body (≤ 6), set this
     /// step where `sw_done` holds `sw_stamp`.
     sw: Vec<[Motion; 6]>,
@@ -212,6 +214,7 @@ impl Constraints {
             warm_slots: Vec::with_capacity(max_points),
             warm_joint: vec![[0.0; 3]; ndof],
             warm_points: Vec::with_capacity(max_points),
+            pos_warm: PosWarm::new(nslots, ndof, cap),
             sw: vec![[Motion::zero(); 6]; model.nbodies],
             sw_done: vec![0; model.nbodies],
             cols: (0..model.nbodies)
@@ -271,12 +274,14 @@ impl Constraints {
         }
         self.warm_joint.iter_mut().for_each(|w| *w = [0.0; 3]);
         self.warm_slots.clear();
+        self.pos_warm.reset();
     }
 
     /// Keeps the warm starts of `slots` (sorted) through the next solves (a
     /// dozing island's contacts, kept aside until its next full step: `sim::doze`).
     pub fn hold_warm(&mut self, slots: &[usize]) {
         self.warm_slots.retain(|k| slots.binary_search(k).is_err());
+        self.pos_warm.hold(slots);
     }
 
     /// Forgets the last step's forces (a step taken without constraints).
@@ -338,6 +343,7 @@ impl Constraints {
         self.spin.torsion = p.torsion;
         self.spin.rolling = p.rolling;
         self.spin.touch = p.contact_slop.max(1e-6);
+        self.pos_warm.set_beta(p.beta);
         let rows = &mut self.rows;
         rows.clear();
         self.joint_rows.clear();

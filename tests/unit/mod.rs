@@ -27,6 +27,7 @@ mod sim_dense;
 mod sim_factor;
 mod sleep_doze;
 mod spatial;
+mod step_position_warm;
 mod view_geometry;
 mod view_page;
 mod view_scene;

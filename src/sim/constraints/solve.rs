@@ -119,6 +119,8 @@ impl Constraints {
         if pushing {
             self.push.as_mut_slice().fill(0.0);
             rows.mu[..rows.n].fill(0.0);
+            let (rp, jr, fj) = (&self.row_point, &self.joint_rows, self.first_joint_row);
+            let warm = self.pos_warm.gather(rows.n, rp, points, fj, jr);
             for i in 0..count {
                 let isl = if pgs { self.islands.get(i) } else { whole };
                 let violated = |&(_, s, e): &(usize, usize, usize)| {
@@ -130,7 +132,8 @@ impl Constraints {
                     continue;
                 }
                 let dw = self.push.as_mut_slice();
-                let s = rows.solve_position_runs(isl.runs, dofs(pgs, &isl), dw, iterations, tol);
+                let d = dofs(pgs, &isl);
+                let s = rows.solve_position_runs(isl.runs, d, dw, iterations, tol, Some(warm));
                 self.work += (isl.rows() * s) as u64;
             }
             // Δv = R⁻¹ Δv', w = R⁻¹ w'
@@ -142,6 +145,8 @@ impl Constraints {
         if let Some(l) = self.loops.as_mut() {
             l.read(rows);
         }
+        let (rp, jr, fj) = (&self.row_point, &self.joint_rows, self.first_joint_row);
+        self.pos_warm.write(&rows.mu[..rows.n], pushing, rp, points, fj, jr);
         // joint rows: warm starts and generalized force
         for w in self.warm_joint.iter_mut() {
             *w = [0.0; 3];

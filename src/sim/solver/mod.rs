@@ -30,6 +30,7 @@ mod subspace;
 mod wff;
 
 pub(crate) use pgs::{IslandOut, Scratch};
+pub(crate) use position::PosWarm;
 
 use super::factor::MassFactor;
 use subspace::Subspace;

@@ -2,6 +2,7 @@
 
 use super::loop_block::BlockRows;
 use super::{MassFactor, PosRow, RowKind, Rows};
+use crate::contact::ContactPoint;
 
 impl Rows {
     /// The position pass (split impulse): projected Gauss–Seidel on the same
@@ -27,12 +28,14 @@ impl Rows {
             return 0;
         }
         let all = [(0, 0, n)];
-        self.solve_position_runs(&all, None, dw, max_iter, tol)
+        self.solve_position_runs(&all, None, dw, max_iter, tol, None)
     }
 
     /// [`Rows::solve_position`] on the rows of `runs` only (an island's,
     /// [`Rows::solve_runs`]), whose w' lives on `dofs` (`None`: every dof):
-    /// only those entries of `dw` are zeroed and written.
+    /// only those entries of `dw` are zeroed and written. `warm`: each row's
+    /// μ to start from (a unilateral row's, by row index; see [`pos_warm`]),
+    /// else μ = 0.
     pub(crate) fn solve_position_runs(
         &mut self,
         runs: &[(usize, usize, usize)],
@@ -40,6 +43,7 @@ impl Rows {
         dw: &mut [f64],
         max_iter: usize,
         tol: f64,
+        warm: Option<&[f64]>,
     ) -> usize {
         let (nv, n) = (self.nv, self.n);
         if dw.len() < nv
@@ -50,7 +54,7 @@ impl Rows {
             return 0;
         }
         let table_v = std::mem::take(&mut self.table);
-        let it = self.position_sweeps(&table_v, runs, dofs, dw, max_iter, tol);
+        let it = self.position_sweeps(&table_v, runs, dofs, dw, max_iter, tol, warm);
         self.table = table_v;
         it
     }
@@ -65,6 +69,7 @@ impl Rows {
         dw: &mut [f64],
         max_iter: usize,
         tol: f64,
+        warm: Option<&[f64]>,
     ) -> usize {
         let (nv, st) = (self.nv, self.stride);
         let dw = &mut dw[..nv];
@@ -136,6 +141,28 @@ impl Rows {
             }
         }
         let mu = &mut self.mu[..n];
+        // the warm start: μ of the unilateral rows from the last pass (by
+        // contact slot and joint limit), w' = Σ μᵣ yᵣ; from there the same
+        // sweeps to the same complementarity conditions
+        if let Some(warm) = warm {
+            for &PosRow { r, ps, pl, bilateral } in &list {
+                let m = warm.get(r).copied().unwrap_or(0.0);
+                if bilateral || !(m > 0.0) {
+                    continue;
+                }
+                mu[r] = m;
+                // SAFETY: as in the sweeps below (checked when listed)
+                let (p, yr) = unsafe {
+                    (
+                        table.get_unchecked(ps..ps + pl),
+                        y.get_unchecked(r * st..r * st + pl),
+                    )
+                };
+                for (a, &k) in yr.iter().zip(p) {
+                    unsafe { *dw.get_unchecked_mut(k) += m * a };
+                }
+            }
+        }
         let loops = &mut self.sm.loops;
         let mut it = 0;
         while it < max_iter {
@@ -192,5 +219,141 @@ impl Rows {
         }
         self.pos_rows = list;
         it
+    }
+}
+
+/// The position pass's warm start (μ of the last pass), kept by contact slot
+/// for the contact normals (as the velocity solve's λ, `warm_contact` in
+/// sim/constraints.rs) and by dof for the joint limits, and gathered by row
+/// index for [`Rows::solve_position_runs`], scaled by 1 − β.
+///
+/// Why 1 − β: the pass moves q by Δt w, which removes β of each violation
+/// beyond the slop (b_pos = β(−φ − slop)/Δt, sim/constraints.rs), so a
+/// violation held still is (1 − β) times the last one at the next step, its
+/// b_pos too, and with the same active rows and W the exact μ (W_AA μ_A =
+/// b_A) is (1 − β) times the last (the last μ itself starts above it). The
+/// sweeps' exit test (max |Δμᵣ| Wᵣᵣ ≤ tol) and cap are the cold pass's.
+#[derive(Clone, Debug)]
+pub(crate) struct PosWarm {
+    /// μ of the normal of each contact slot at the last pass (0 elsewhere).
+    by_slot: Vec<f64>,
+    /// The slots of `by_slot` written by the last solve (only these are cleared).
+    slots: Vec<usize>,
+    /// μ of each dof's lower and upper limit rows (entries 1, 2 as `which`).
+    by_dof: Vec<[f64; 3]>,
+    /// The dofs of `by_dof` written by the last solve (only these are cleared).
+    dofs: Vec<usize>,
+    /// This pass's start, by row.
+    start: Vec<f64>,
+    /// 1 − β: how much of a violation held still is left after a pass.
+    decay: f64,
+}
+
+impl PosWarm {
+    /// Room for `nslots` contact slots, `ndof` joints and `cap` rows.
+    pub fn new(nslots: usize, ndof: usize, cap: usize) -> Self {
+        Self {
+            by_slot: vec![0.0; nslots],
+            slots: Vec::with_capacity(cap),
+            by_dof: vec![[0.0; 3]; ndof],
+            dofs: Vec::with_capacity(ndof),
+            start: Vec::with_capacity(cap),
+            decay: 1.0,
+        }
+    }
+
+    /// The pass removes `beta` of a violation a step (RowParams::beta): the
+    /// warm start is 1 − `beta` of the last μ.
+    pub fn set_beta(&mut self, beta: f64) {
+        self.decay = (1.0 - beta).clamp(0.0, 1.0);
+    }
+
+    /// Forgets the warm starts (a new state was set).
+    pub fn reset(&mut self) {
+        self.by_slot.iter_mut().for_each(|w| *w = 0.0);
+        self.slots.clear();
+        self.by_dof.iter_mut().for_each(|w| *w = [0.0; 3]);
+        self.dofs.clear();
+    }
+
+    /// Keeps the warm starts of `slots` (sorted) through the next solves.
+    pub fn hold(&mut self, slots: &[usize]) {
+        self.slots.retain(|k| slots.binary_search(k).is_err());
+    }
+
+    /// The start of this pass by row (`n` rows): contact triple c (rows 3c..)
+    /// of point `row_point[c]`, a fresh point from 0; joint row
+    /// `first_joint + k` of `joint_rows[k]` = (dof, which); every other row 0.
+    pub fn gather(
+        &mut self,
+        n: usize,
+        row_point: &[usize],
+        points: &[ContactPoint],
+        first_joint: usize,
+        joint_rows: &[(usize, u8)],
+    ) -> &[f64] {
+        self.start.clear();
+        self.start.resize(n, 0.0);
+        for (c, &pi) in row_point.iter().enumerate() {
+            if let (Some(pt), Some(x)) = (points.get(pi), self.start.get_mut(3 * c))
+                && !pt.fresh
+            {
+                *x = self.decay * self.by_slot.get(pt.slot).copied().unwrap_or(0.0);
+            }
+        }
+        for (k, &(d, which)) in joint_rows.iter().enumerate() {
+            if let (Some(w), Some(x)) = (self.by_dof.get(d), self.start.get_mut(first_joint + k)) {
+                *x = if which > 0 { self.decay * w[which as usize % 3] } else { 0.0 };
+            }
+        }
+        &self.start
+    }
+
+    /// Keeps this solve's μ (`mu`, by row; `pushed`: the pass ran, else
+    /// every start is 0) for the next pass, as [`PosWarm::gather`] reads it.
+    pub fn write(
+        &mut self,
+        mu: &[f64],
+        pushed: bool,
+        row_point: &[usize],
+        points: &[ContactPoint],
+        first_joint: usize,
+        joint_rows: &[(usize, u8)],
+    ) {
+        for &k in &self.slots {
+            if let Some(w) = self.by_slot.get_mut(k) {
+                *w = 0.0;
+            }
+        }
+        self.slots.clear();
+        for &d in &self.dofs {
+            if let Some(w) = self.by_dof.get_mut(d) {
+                *w = [0.0; 3];
+            }
+        }
+        self.dofs.clear();
+        if !pushed {
+            return;
+        }
+        for (c, &pi) in row_point.iter().enumerate() {
+            let m = mu.get(3 * c).copied().unwrap_or(0.0);
+            if let Some(pt) = points.get(pi)
+                && m > 0.0
+                && let Some(w) = self.by_slot.get_mut(pt.slot)
+            {
+                *w = m;
+                self.slots.push(pt.slot);
+            }
+        }
+        for (k, &(d, which)) in joint_rows.iter().enumerate() {
+            let m = mu.get(first_joint + k).copied().unwrap_or(0.0);
+            if which > 0
+                && m > 0.0
+                && let Some(w) = self.by_dof.get_mut(d)
+            {
+                w[which as usize % 3] = m;
+                self.dofs.push(d);
+            }
+        }
     }
 }
