@@ -6,8 +6,8 @@
 //! Both shapes convex, their penetration depth is the least overlap
 //! h(n) = h_C(n) + h_B(−n) over the unit directions n (h_C the cylinder's
 //! support function, h_B the box's: the Minkowski difference C − B's support
-//! function, whose least value is the origin's distance to its boundary,
-//! docs/theory.md on the pair's depth). At the least n the nearest boundary
+//! function, whose least value is the origin's distance to its boundary).
+//! At the least n the nearest boundary
 //! point of C − B is a smooth one (the ball of that radius about the origin
 //! lies inside and touches there, so the support plane there is unique):
 //! the pair of features meeting there has one common normal. For a cylinder
@@ -26,7 +26,8 @@
 //! Every h(n) evaluated is exact (an upper bound on the depth); the least of
 //! all these candidates is the depth, its n the normal. An edge's arc is
 //! skipped when its lower bound (the least of A cos φ + B sin φ on the arc,
-//! plus min(h, r) ≤ h|t| + r√(1 − t²)) is not below the best so far. The
+//! plus the least of h|t| + r√(1 − t²), concave in |t|, at the ends of the
+//! range of |t| on the arc) is not below the best so far. The
 //! answer is taken only when the least is a rim point's stationary point
 //! inside the arc with the rim point over the edge, and that rim point lies
 //! in the box (the shapes overlap: parry's GJK would find them so and run
@@ -49,6 +50,28 @@ const OFF_CAP: f64 = 1e-12;
 /// The samples of each edge's arc before Newton: φ = mπ/32 (the overlap
 /// on an arc may have two local leasts, ~30° apart in the tests).
 const SAMPLES: usize = 17;
+
+/// (sin φ, cos φ) of the samples, φ = m (π/2)/16 (`f64::sin_cos` of those
+/// φ, written out: no sine at each sample).
+const SIN_COS: [(f64, f64); SAMPLES] = [
+    (0.0, 1.0),
+    (0.0980171403295606, 0.9951847266721969),
+    (0.19509032201612825, 0.9807852804032304),
+    (0.29028467725446233, 0.9569403357322088),
+    (0.3826834323650898, 0.9238795325112867),
+    (0.47139673682599764, 0.881921264348355),
+    (0.5555702330196022, 0.8314696123025452),
+    (0.6343932841636455, 0.773010453362737),
+    (0.7071067811865475, 0.7071067811865476),
+    (0.773010453362737, 0.6343932841636455),
+    (0.8314696123025452, 0.5555702330196023),
+    (0.8819212643483549, 0.4713967368259978),
+    (0.9238795325112867, 0.38268343236508984),
+    (0.9569403357322089, 0.29028467725446233),
+    (0.9807852804032304, 0.19509032201612833),
+    (0.9951847266721968, 0.09801714032956077),
+    (1.0, 6.123233995736766e-17),
+];
 
 /// The rim-on-edge contact in the box's frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,9 +96,14 @@ fn overlap(n: Vector, c: Vector, u: Vector, (h, r): (f64, f64), e: Vector) -> f6
 
 /// The value, slope and curvature of h(φ) (module doc) on an edge's arc.
 #[inline]
-fn arc(phi: f64, k: &[f64; 4], (h, r): (f64, f64)) -> (f64, f64, f64) {
+fn arc(phi: f64, k: &[f64; 4], hr: (f64, f64)) -> (f64, f64, f64) {
+    arc_at(phi.sin_cos(), k, hr)
+}
+
+/// [`arc`] at (sin φ, cos φ).
+#[inline]
+fn arc_at((s, c): (f64, f64), k: &[f64; 4], (h, r): (f64, f64)) -> (f64, f64, f64) {
     let [a, b, al, be] = *k;
-    let (s, c) = phi.sin_cos();
     let t = al * c + be * s;
     let tp = -al * s + be * c;
     let ss = (1.0 - t * t).max(1e-300);
@@ -86,6 +114,31 @@ fn arc(phi: f64, k: &[f64; 4], (h, r): (f64, f64)) -> (f64, f64, f64) {
     let g2 =
         -a * c - b * s - h * t.abs() - r * ((tp * tp - t * t) / sq + t * t * tp * tp / (ss * sq));
     (g, g1, g2)
+}
+
+/// The least of h|t| + r√(1 − t²) over the arc, t = α cos φ + β sin φ,
+/// φ ∈ [0, π/2]: concave in |t|, so at an end of the range of |t|.
+#[inline]
+fn floor(al: f64, be: f64, (h, r): (f64, f64)) -> f64 {
+    // t's range: the ends, and its extreme inside when α, β share a sign
+    let rho = al.hypot(be);
+    let lo = if al <= 0.0 && be <= 0.0 {
+        -rho
+    } else {
+        al.min(be)
+    };
+    let hi = if al >= 0.0 && be >= 0.0 {
+        rho
+    } else {
+        al.max(be)
+    };
+    let (x0, x1) = if lo <= 0.0 && hi >= 0.0 {
+        (0.0, hi.max(-lo))
+    } else {
+        (lo.abs().min(hi.abs()), lo.abs().max(hi.abs()))
+    };
+    let f = |x: f64| h * x + r * (1.0 - x * x).max(0.0).sqrt();
+    f(x0).min(f(x1))
 }
 
 /// The least of h on [lo, hi] where h' < 0 at lo and > 0 at hi: Newton
@@ -151,7 +204,6 @@ pub fn rim_on_edge(cyl: &Cylinder, cub: &Cuboid, b_m_c: &Pose) -> Option<RimEdge
         return None;
     }
     // edges: along axis i at (σⱼeⱼ, σₖeₖ)
-    let floor = h.min(r);
     let step = std::f64::consts::FRAC_PI_2 / (SAMPLES - 1) as f64;
     let mut found: Option<(f64, usize, f64, f64, f64)> = None;
     for i in 0..3 {
@@ -166,17 +218,18 @@ pub fn rim_on_edge(cyl: &Cylinder, cub: &Cuboid, b_m_c: &Pose) -> Option<RimEdge
             } else {
                 a.min(b)
             };
-            if least + floor >= best {
+            let (al, be) = (sj * u[j], sk * u[k]);
+            if least + floor(al, be, hr) >= best {
                 continue;
             }
-            let kk = [a, b, sj * u[j], sk * u[k]];
+            let kk = [a, b, al, be];
             // the samples, then Newton in each interval where h' turns
             // from falling to rising (each local least the samples part)
-            let mut prev = arc(0.0, &kk, hr);
+            let mut prev = arc_at(SIN_COS[0], &kk, hr);
             best = best.min(prev.0);
-            for m in 1..SAMPLES {
+            for (m, &sc) in SIN_COS.iter().enumerate().skip(1) {
                 let phi = m as f64 * step;
-                let next = arc(phi, &kk, hr);
+                let next = arc_at(sc, &kk, hr);
                 best = best.min(next.0);
                 if prev.1 < 0.0 && next.1 > 0.0 {
                     let phi = newton(phi - step, phi, &kk, hr);
