@@ -257,6 +257,33 @@ pub mod contact {
         pfm::takes(a, b) && pfm::manifold(pos12, a, b, margin, manifolds)
     }
 
+    /// `contact::narrow::cylinder::pfm::manifold_with`: [`cylinder_pfm_manifold`]
+    /// with the rim-on-edge closed form on (`closed`) or off (parry's GJK and
+    /// EPA throughout).
+    pub fn cylinder_pfm_manifold_with(
+        pos12: &Pose,
+        a: &PairShape,
+        b: &PairShape,
+        margin: f64,
+        manifolds: &mut Vec<ContactManifold<(), ()>>,
+        closed: bool,
+    ) -> bool {
+        use crate::contact::narrow::cylinder::pfm;
+        pfm::takes(a, b) && pfm::manifold_with(pos12, a, b, margin, manifolds, closed)
+    }
+
+    /// `contact::narrow::cylinder::rim::rim_on_edge` of a cylinder at `b_m_c`
+    /// (its frame in the box's): (normal from the cylinder into the box,
+    /// depth, rim point, its foot on the edge), the box's frame.
+    pub fn cylinder_rim_on_edge(
+        cyl: &parry3d_f64::shape::Cylinder,
+        cub: &parry3d_f64::shape::Cuboid,
+        b_m_c: &Pose,
+    ) -> Option<(PVec, f64, PVec, PVec)> {
+        crate::contact::narrow::cylinder::rim::rim_on_edge(cyl, cub, b_m_c)
+            .map(|r| (r.n, r.depth, r.rim, r.edge))
+    }
+
     /// `Round::of`.
     pub fn round_of(s: &PairShape, w: &Se3<f64>) -> Option<Round> {
         Round::of(s, w)

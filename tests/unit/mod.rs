@@ -11,6 +11,7 @@ mod contact_broad;
 mod contact_climb_step;
 mod contact_cylinder;
 mod contact_cylinder_pfm;
+mod contact_cylinder_rim;
 mod contact_face;
 mod contact_hull;
 mod contact_narrow;

@@ -43,6 +43,7 @@ use nalgebra::Vector3;
 
 mod boxed;
 pub(crate) mod pfm;
+pub(crate) mod rim;
 use boxed::box_feature;
 pub(crate) use boxed::box_on_cap;
 

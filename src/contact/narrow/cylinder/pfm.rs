@@ -20,6 +20,8 @@ use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
 use parry3d_f64::query::ContactManifold;
 use parry3d_f64::shape::PolygonalFeatureMap;
 
+use super::rim;
+
 /// parry's `utils::COS_1_DEGREES` (crate-private there): the normal's tilt
 /// under which its generator keeps a manifold's points.
 const COS_1_DEGREES: f64 = 0.99984769515;
@@ -46,6 +48,19 @@ pub(crate) fn manifold(
     prediction: f64,
     manifolds: &mut Vec<ContactManifold<(), ()>>,
 ) -> bool {
+    manifold_with(pos12, a, b, prediction, manifolds, true)
+}
+
+/// [`manifold`], a cylinder's rim on a box's edge in closed form
+/// ([`rim::rim_on_edge`], in place of GJK and EPA) when `closed`.
+pub(crate) fn manifold_with(
+    pos12: &Pose,
+    a: &PairShape,
+    b: &PairShape,
+    prediction: f64,
+    manifolds: &mut Vec<ContactManifold<(), ()>>,
+    closed: bool,
+) -> bool {
     let (Some((_, border_radius1)), Some((_, border_radius2))) = (
         a.shape.as_polygonal_feature_map(),
         b.shape.as_polygonal_feature_map(),
@@ -62,15 +77,22 @@ pub(crate) fn manifold(
         sb.as_cylinder(),
         sb.as_cuboid(),
     ) {
-        (Some(c1), _, Some(c2), _) => run(pos12, c1, c2, radii, prediction, manifolds),
-        (Some(c1), _, _, Some(c2)) => run(pos12, c1, c2, radii, prediction, manifolds),
-        (_, Some(c1), Some(c2), _) => run(pos12, c1, c2, radii, prediction, manifolds),
+        (Some(c1), _, Some(c2), _) => run(pos12, c1, c2, radii, prediction, manifolds, || None),
+        (Some(c1), _, _, Some(c2)) => {
+            let rim = || closed.then(|| rim::as_epa(c1, c2, pos12, true)).flatten();
+            run(pos12, c1, c2, radii, prediction, manifolds, rim)
+        }
+        (_, Some(c1), Some(c2), _) => {
+            let rim = || closed.then(|| rim::as_epa(c2, c1, pos12, false)).flatten();
+            run(pos12, c1, c2, radii, prediction, manifolds, rim)
+        }
         _ => return false,
     }
     true
 }
 
-/// [`manifold`] of shapes `pfm1`, `pfm2` (border radii `radii`).
+/// [`manifold`] of shapes `pfm1`, `pfm2` (border radii `radii`), EPA's
+/// answer from `rim` when it gives one.
 fn run<S1: PolygonalFeatureMap, S2: PolygonalFeatureMap>(
     pos12: &Pose,
     pfm1: &S1,
@@ -78,6 +100,7 @@ fn run<S1: PolygonalFeatureMap, S2: PolygonalFeatureMap>(
     (border_radius1, border_radius2): (f64, f64),
     prediction: f64,
     manifolds: &mut Vec<ContactManifold<(), ()>>,
+    rim: impl FnOnce() -> Option<(Vector, Vector, Vector)>,
 ) {
     if manifolds.is_empty() {
         manifolds.push(ContactManifold::new());
@@ -89,17 +112,22 @@ fn run<S1: PolygonalFeatureMap, S2: PolygonalFeatureMap>(
     }
     let init_dir = manifold.local_n1.try_normalize();
     let total_prediction = prediction + border_radius1 + border_radius2;
-    let contact = super::super::climb::with_kept_epa(|epa| {
-        with_params(
-            pos12,
-            pfm1,
-            pfm2,
-            total_prediction,
-            &mut VoronoiSimplex::new(),
-            init_dir,
-            epa,
-        )
-    });
+    // a rim on an edge: EPA's answer in closed form (`rim`)
+    let contact = if let Some((p1, p2, n)) = rim() {
+        GJKResult::ClosestPoints(p1, p2, n)
+    } else {
+        super::super::climb::with_kept_epa(|epa| {
+            with_params(
+                pos12,
+                pfm1,
+                pfm2,
+                total_prediction,
+                &mut VoronoiSimplex::new(),
+                init_dir,
+                epa,
+            )
+        })
+    };
     let old_manifold_points = manifold.points.clone();
     manifold.clear();
     match contact {
