@@ -582,19 +582,27 @@ impl super::Simulation {
                 data.v[i] = vi;
             }
         }
+        self.account_sleep(h);
+    }
+
+    /// Sleep's count after a step of `h` from the body velocities in
+    /// `data.v` (set by [`Simulation::update_sleep`]; held through a dozing
+    /// step, `Simulation::dozing_step`): the driven trees, the still times,
+    /// the islands that fall asleep, the new dozes' warm starts kept aside.
+    pub(super) fn account_sleep(&mut self, h: f64) {
         // trees driven now: a nonzero applied force, or a servo on one of its
         // dofs (read for the awake trees only)
         for &t in self.sleep.awake_trees() {
-            let tree = &model.trees[t];
+            let tree = &self.model.trees[t];
             self.sleep_forced[t] = tree.v.clone().any(|k| {
                 self.tau_applied[k] != 0.0
                     || (self.servo.active && (self.servo.kp[k] != 0.0 || self.servo.kd[k] != 0.0))
             });
         }
         let slept = self.sleep.after_step(
-            model,
+            &self.model,
             h,
-            &data.v,
+            &self.data.v,
             &self.sleep_forced,
             &self.q,
             &mut self.v,

@@ -89,21 +89,8 @@ impl Simulation {
                 _ => self.dop853_step(remaining, h_max, counts.friction > 0)?,
             }
         };
-        self.t = if h >= remaining { t_end } else { self.t + h };
-        self.sensors.end(h);
-        self.steps += 1;
-        self.sleep.hold(&self.model, &mut self.q, &mut self.v);
-        self.sleep
-            .doze_step(&self.model, h, &mut self.q, &mut self.v);
-        normalize_quats(&self.model, &mut self.q);
         // 3. the new state: finite, its contacts, its energy
-        self.check_finite()?;
-        self.fk_valid = false;
-        if let Some(c) = self.contact.as_mut() {
-            // the speculative margin measures this step's travel (its next
-            // step may be the full dt)
-            c.stepped(if h > 0.0 { (self.dt / h).max(1.0) } else { 1.0 });
-        }
+        self.advance(h, remaining, t_end)?;
         self.refresh_contacts();
         if self.cons.loops.is_some() {
             self.project_loops();
@@ -139,48 +126,36 @@ impl Simulation {
         t_end: f64,
     ) -> Result<f64, SimError> {
         self.smooth.fsal_ok = false;
+        self.advance(h, remaining, t_end)?;
+        self.energy_now = None;
+        self.data.step_bias_ok = false;
+        // (sleep's count on the body velocities of the last full step: a
+        // dozing tree's speed is held, and no tree is awake but the dozing ones)
+        self.account_sleep(h);
+        Ok(h)
+    }
+
+    /// The end of a step of `h` (to `t_end` when `h` covers `remaining`):
+    /// time and sensors, the sleeping trees' q back to where they fell asleep
+    /// and the dozing ones' `doze_step` before the quaternions are normalised
+    /// (bit for bit), a finite state, the pose-dependent caches dropped, the
+    /// contact pipeline told the step's travel.
+    fn advance(&mut self, h: f64, remaining: f64, t_end: f64) -> Result<(), SimError> {
         self.t = if h >= remaining { t_end } else { self.t + h };
         self.sensors.end(h);
         self.steps += 1;
-        // (as a full step: the sleeping trees' q back to where they fell
-        // asleep before the quaternions are normalised, bit for bit)
         self.sleep.hold(&self.model, &mut self.q, &mut self.v);
         self.sleep
             .doze_step(&self.model, h, &mut self.q, &mut self.v);
         normalize_quats(&self.model, &mut self.q);
         self.check_finite()?;
         self.fk_valid = false;
-        self.energy_now = None;
-        self.data.step_bias_ok = false;
         if let Some(c) = self.contact.as_mut() {
-            // (the next detection measures the travel since its last one)
+            // the speculative margin measures this step's travel (its next
+            // step may be the full dt)
             c.stepped(if h > 0.0 { (self.dt / h).max(1.0) } else { 1.0 });
         }
-        // (update_sleep's bookkeeping without the body velocities: a dozing
-        // tree's speed is held, and no tree is awake but the dozing ones)
-        for &t in self.sleep.awake_trees() {
-            let tree = &self.model.trees[t];
-            self.sleep_forced[t] = tree.v.clone().any(|k| {
-                self.tau_applied[k] != 0.0
-                    || (self.servo.active && (self.servo.kp[k] != 0.0 || self.servo.kd[k] != 0.0))
-            });
-        }
-        let slept = self.sleep.after_step(
-            &self.model,
-            h,
-            &self.data.v,
-            &self.sleep_forced,
-            &self.q,
-            &mut self.v,
-            &mut self.points,
-            self.cons.contact_forces(),
-            self.cons.body_forces(),
-        );
-        if slept {
-            self.energy_now = None;
-        }
-        self.sleep.compose(&self.model, self.cons.body_forces());
-        Ok(h)
+        Ok(())
     }
 
     /// The longest step in which no joint moving toward a limit can reach it

@@ -146,7 +146,8 @@ impl Constraints {
             l.read(rows);
         }
         let (rp, jr, fj) = (&self.row_point, &self.joint_rows, self.first_joint_row);
-        self.pos_warm.write(&rows.mu[..rows.n], pushing, rp, points, fj, jr);
+        self.pos_warm
+            .write(&rows.mu[..rows.n], pushing, rp, points, fj, jr);
         // joint rows: warm starts and generalized force
         for w in self.warm_joint.iter_mut() {
             *w = [0.0; 3];

@@ -145,7 +145,13 @@ impl Rows {
         // contact slot and joint limit), w' = Σ μᵣ yᵣ; from there the same
         // sweeps to the same complementarity conditions
         if let Some(warm) = warm {
-            for &PosRow { r, ps, pl, bilateral } in &list {
+            for &PosRow {
+                r,
+                ps,
+                pl,
+                bilateral,
+            } in &list
+            {
                 let m = warm.get(r).copied().unwrap_or(0.0);
                 if bilateral || !(m > 0.0) {
                     continue;
@@ -303,7 +309,11 @@ impl PosWarm {
         }
         for (k, &(d, which)) in joint_rows.iter().enumerate() {
             if let (Some(w), Some(x)) = (self.by_dof.get(d), self.start.get_mut(first_joint + k)) {
-                *x = if which > 0 { self.decay * w[which as usize % 3] } else { 0.0 };
+                *x = if which > 0 {
+                    self.decay * w[which as usize % 3]
+                } else {
+                    0.0
+                };
             }
         }
         &self.start
