@@ -9,6 +9,7 @@
 //! closed form is off here (`contact_cylinder_rim.rs` tests it).
 
 use crate::common::lcg::Lcg;
+use parry3d_f64::math::Pose;
 use parry3d_f64::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
@@ -21,7 +22,8 @@ use urdyn::testing::contact::{
 
 type Man = ContactManifold<(), ()>;
 
-fn unit(g: &mut Lcg) -> Unit<Vector3<f64>> {
+/// A random unit vector (not uniform on the sphere: a cube's directions).
+pub(super) fn unit(g: &mut Lcg) -> Unit<Vector3<f64>> {
     Unit::new_normalize(Vector3::new(
         g.uniform(-1.0, 1.0),
         g.uniform(-1.0, 1.0),
@@ -47,12 +49,29 @@ fn same(a: &[Man], b: &[Man]) -> bool {
         })
 }
 
+/// One call of each narrow phase (margin 5 mm) on a pair at `pos12` (b's
+/// frame in a's): ours (the cylinder pairs' `pfm`, the rim-on-edge closed form on or off
+/// by `rim`) into `ours`, parry's dispatcher into `theirs` with its
+/// `workspace`; the manifolds kept as the caller left them.
+pub(super) fn both(
+    pos12: &Pose,
+    (a, b): (&PairShape, &PairShape),
+    (ours, theirs): (&mut Vec<Man>, &mut Vec<Man>),
+    workspace: &mut Option<ContactManifoldsWorkspace>,
+    rim: bool,
+) {
+    let margin = 0.005;
+    assert!(cylinder_pfm_manifold_with(pos12, a, b, margin, ours, rim));
+    DefaultQueryDispatcher
+        .contact_manifolds(pos12, &*a.shape, &*b.shape, margin, theirs, workspace)
+        .expect("parry's dispatcher takes a cylinder pair");
+}
+
 /// Runs `paths` random paths of `steps` poses of b about a (centres `reach`
 /// apart ± 20 %, turning), both manifolds kept along each; returns the
 /// number of calls whose deepest point overlaps.
 fn run(a: &PairShape, b: &PairShape, reach: f64, seed: u64, paths: usize, steps: usize) -> usize {
     let mut g = Lcg(seed);
-    let margin = 0.005;
     let mut overlapping = 0;
     for path in 0..paths {
         let dir = unit(&mut g);
@@ -73,19 +92,13 @@ fn run(a: &PairShape, b: &PairShape, reach: f64, seed: u64, paths: usize, steps:
             for m in ours.iter_mut().chain(theirs.iter_mut()) {
                 m.points.clear();
             }
-            assert!(cylinder_pfm_manifold_with(
-                &pos12, a, b, margin, &mut ours, false
-            ));
-            DefaultQueryDispatcher
-                .contact_manifolds(
-                    &pos12,
-                    &*a.shape,
-                    &*b.shape,
-                    margin,
-                    &mut theirs,
-                    &mut workspace,
-                )
-                .expect("parry's dispatcher takes a cylinder pair");
+            both(
+                &pos12,
+                (a, b),
+                (&mut ours, &mut theirs),
+                &mut workspace,
+                false,
+            );
             assert!(
                 same(&ours, &theirs),
                 "path {path} step {k}: {ours:?} vs {theirs:?}"

@@ -5,26 +5,15 @@
 
 use crate::common::lcg::Lcg;
 use parry3d_f64::math::{Pose, Vector as PVec};
-use parry3d_f64::query::{
-    self, ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher,
-    PersistentQueryDispatcher,
-};
+use parry3d_f64::query::{self, ContactManifold, ContactManifoldsWorkspace};
 use parry3d_f64::shape::{Cuboid, Cylinder, SharedShape, SupportMap};
 use urdyn::nalgebra::{Rotation3, Unit, Vector3};
 use urdyn::spatial::Se3;
-use urdyn::testing::contact::{
-    cylinder_pfm_manifold_with, cylinder_rim_on_edge, pair_shape, to_pose,
-};
+use urdyn::testing::contact::{cylinder_rim_on_edge, pair_shape, to_pose};
+
+use super::contact_cylinder_pfm::{both, unit};
 
 type Man = ContactManifold<(), ()>;
-
-fn unit(g: &mut Lcg) -> Unit<Vector3<f64>> {
-    Unit::new_normalize(Vector3::new(
-        g.uniform(-1.0, 1.0),
-        g.uniform(-1.0, 1.0),
-        g.uniform(-1.0, 1.0),
-    ))
-}
 
 /// A pose (the cylinder's frame in the box's) with a rim point `depth` past
 /// a random point of a random edge of the box along a random direction of
@@ -151,7 +140,6 @@ fn manifolds(
     seed: u64,
 ) -> (usize, usize) {
     let mut g = Lcg(seed);
-    let margin = 0.005;
     let (mut taken, mut matched) = (0, 0);
     for _ in 0..200 {
         let dir = unit(&mut g);
@@ -167,19 +155,13 @@ fn manifolds(
                 m.points.clear();
             }
             let mut ours = theirs.clone();
-            assert!(cylinder_pfm_manifold_with(
-                &pos12, a, b, margin, &mut ours, true
-            ));
-            DefaultQueryDispatcher
-                .contact_manifolds(
-                    &pos12,
-                    &*a.shape,
-                    &*b.shape,
-                    margin,
-                    &mut theirs,
-                    &mut workspace,
-                )
-                .expect("parry's dispatcher takes a cylinder pair");
+            both(
+                &pos12,
+                (a, b),
+                (&mut ours, &mut theirs),
+                &mut workspace,
+                true,
+            );
             let (m, n) = (&ours[0], &theirs[0]);
             let bits = |v: PVec| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
             if bits(m.local_n1) == bits(n.local_n1) {
