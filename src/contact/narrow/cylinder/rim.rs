@@ -121,14 +121,14 @@ fn arc_at((s, c): (f64, f64), k: &[f64; 4], (h, r): (f64, f64)) -> (f64, f64, f6
 #[inline]
 fn floor(al: f64, be: f64, (h, r): (f64, f64)) -> f64 {
     // t's range: the ends, and its extreme inside when α, β share a sign
-    let rho = al.hypot(be);
+    // (|(α, β)| only then: no hypot on the other arcs)
     let lo = if al <= 0.0 && be <= 0.0 {
-        -rho
+        -al.hypot(be)
     } else {
         al.min(be)
     };
     let hi = if al >= 0.0 && be >= 0.0 {
-        rho
+        al.hypot(be)
     } else {
         al.max(be)
     };
@@ -205,7 +205,8 @@ pub fn rim_on_edge(cyl: &Cylinder, cub: &Cuboid, b_m_c: &Pose) -> Option<RimEdge
     }
     // edges: along axis i at (σⱼeⱼ, σₖeₖ)
     let step = std::f64::consts::FRAC_PI_2 / (SAMPLES - 1) as f64;
-    let mut found: Option<(f64, usize, f64, f64, f64)> = None;
+    // the least's (depth, axis, signs, φ, (sin φ, cos φ))
+    let mut found: Option<(f64, usize, f64, f64, f64, (f64, f64))> = None;
     for i in 0..3 {
         let (j, k) = ((i + 1) % 3, (i + 2) % 3);
         for sg in 0..4 {
@@ -233,17 +234,18 @@ pub fn rim_on_edge(cyl: &Cylinder, cub: &Cuboid, b_m_c: &Pose) -> Option<RimEdge
                 best = best.min(next.0);
                 if prev.1 < 0.0 && next.1 > 0.0 {
                     let phi = newton(phi - step, phi, &kk, hr);
-                    let g = arc(phi, &kk, hr).0;
+                    let sc = phi.sin_cos();
+                    let g = arc_at(sc, &kk, hr).0;
                     if g <= best {
                         best = g;
-                        found = Some((g, i, sj, sk, phi));
+                        found = Some((g, i, sj, sk, phi, sc));
                     }
                 }
                 prev = next;
             }
         }
     }
-    let (depth, i, sj, sk, phi) = found?;
+    let (depth, i, sj, sk, phi, (s, co)) = found?;
     if depth > best || !(depth >= 0.0) {
         return None;
     }
@@ -251,7 +253,6 @@ pub fn rim_on_edge(cyl: &Cylinder, cub: &Cuboid, b_m_c: &Pose) -> Option<RimEdge
     if !(phi > 0.0 && phi < std::f64::consts::FRAC_PI_2) {
         return None;
     }
-    let (s, co) = phi.sin_cos();
     let mut n = Vector::ZERO;
     n[j] = -co * sj;
     n[k] = -s * sk;
