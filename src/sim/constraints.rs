@@ -111,15 +111,18 @@ pub(crate) struct Constraints {
     first_joint_row: usize,
     /// The contact point (index into the step's points) of each contact triple.
     row_point: Vec<usize>,
-    /// Warm-start impulses per contact slot (n, t1, t2) and per joint (friction, lower, upper).
-    warm_contact: Vec<[f64; 3]>,
+    /// Warm-start impulses per contact slot (n, t1, t2, and the position
+    /// pass's μ of the normal: solver/position.rs) and per joint (friction,
+    /// lower, upper).
+    warm_contact: Vec<[f64; 4]>,
     /// The slots of `warm_contact` written by the last solve (only these are cleared).
     warm_slots: Vec<usize>,
     warm_joint: Vec<[f64; 3]>,
     /// This step's warm starts of the points, gathered before the rows are
     /// built (the loads are independent there: their cache misses overlap).
     warm_points: Vec<[f64; 3]>,
-    /// The position pass's warm starts (μ by contact slot and limit: solver/position.rs).
+    /// The position pass's warm starts of the joint limits and its start by
+    /// row (its contact normals' are `warm_contact`'s fourth entries).
     pos_warm: PosWarm,
     /// World-frame motion subspace columns of each body (≤ 6), set this
     /// step where `sw_done` holds `sw_stamp`.
@@ -210,11 +213,11 @@ impl Constraints {
             jrows: JointRowSource::of(model),
             first_joint_row: 0,
             row_point: Vec::with_capacity(max_points),
-            warm_contact: vec![[0.0; 3]; nslots],
+            warm_contact: vec![[0.0; 4]; nslots],
             warm_slots: Vec::with_capacity(max_points),
             warm_joint: vec![[0.0; 3]; ndof],
             warm_points: Vec::with_capacity(max_points),
-            pos_warm: PosWarm::new(nslots, ndof, cap),
+            pos_warm: PosWarm::new(ndof, cap),
             sw: vec![[Motion::zero(); 6]; model.nbodies],
             sw_done: vec![0; model.nbodies],
             cols: (0..model.nbodies)
@@ -267,7 +270,7 @@ impl Constraints {
     pub fn reset_warm_start(&mut self) {
         // the self-stress shedding's count of solves goes with them
         self.rows.forget_solves();
-        self.warm_contact.iter_mut().for_each(|w| *w = [0.0; 3]);
+        self.warm_contact.iter_mut().for_each(|w| *w = [0.0; 4]);
         self.spin.reset();
         if let Some(l) = self.loops.as_mut() {
             l.reset_warm_start();
@@ -281,7 +284,6 @@ impl Constraints {
     /// dozing island's contacts, kept aside until its next full step: `sim::doze`).
     pub fn hold_warm(&mut self, slots: &[usize]) {
         self.warm_slots.retain(|k| slots.binary_search(k).is_err());
-        self.pos_warm.hold(slots);
     }
 
     /// Forgets the last step's forces (a step taken without constraints).
@@ -388,7 +390,7 @@ impl Constraints {
             self.warm_points
                 .extend(points.iter().map(|pt| match pt.fresh {
                     true => [0.0; 3],
-                    false => wc.get(pt.slot).copied().unwrap_or([0.0; 3]),
+                    false => wc.get(pt.slot).map_or([0.0; 3], |w| [w[0], w[1], w[2]]),
                 }));
             let cols = &self.cols;
             let body_path = |b: usize| {

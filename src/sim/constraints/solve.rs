@@ -119,8 +119,9 @@ impl Constraints {
         if pushing {
             self.push.as_mut_slice().fill(0.0);
             rows.mu[..rows.n].fill(0.0);
-            let (rp, jr, fj) = (&self.row_point, &self.joint_rows, self.first_joint_row);
-            let warm = self.pos_warm.gather(rows.n, rp, points, fj, jr);
+            let (rp, wc) = (&self.row_point, &self.warm_contact);
+            let (jr, fj) = (&self.joint_rows, self.first_joint_row);
+            let warm = self.pos_warm.gather(rows.n, rp, points, wc, fj, jr);
             for i in 0..count {
                 let isl = if pgs { self.islands.get(i) } else { whole };
                 let violated = |&(_, s, e): &(usize, usize, usize)| {
@@ -145,9 +146,8 @@ impl Constraints {
         if let Some(l) = self.loops.as_mut() {
             l.read(rows);
         }
-        let (rp, jr, fj) = (&self.row_point, &self.joint_rows, self.first_joint_row);
-        self.pos_warm
-            .write(&rows.mu[..rows.n], pushing, rp, points, fj, jr);
+        let (jr, fj) = (&self.joint_rows, self.first_joint_row);
+        self.pos_warm.write(&rows.mu[..rows.n], pushing, fj, jr);
         // joint rows: warm starts and generalized force
         for w in self.warm_joint.iter_mut() {
             *w = [0.0; 3];
@@ -163,7 +163,7 @@ impl Constraints {
         // contact rows: warm starts by slot, forces
         for &k in &self.warm_slots {
             if let Some(w) = self.warm_contact.get_mut(k) {
-                *w = [0.0; 3];
+                *w = [0.0; 4];
             }
         }
         self.warm_slots.clear();
@@ -174,7 +174,12 @@ impl Constraints {
                 continue;
             };
             if let Some(w) = self.warm_contact.get_mut(pt.slot) {
-                *w = [ln, l1, l2];
+                // (the position pass's μ only where it ran and pushed)
+                let mu = match pushing {
+                    true => rows.mu[..rows.n].get(rn).copied().unwrap_or(0.0),
+                    false => 0.0,
+                };
+                *w = [ln, l1, l2, if mu > 0.0 { mu } else { 0.0 }];
                 self.warm_slots.push(pt.slot);
             }
             if ln > 0.0 {

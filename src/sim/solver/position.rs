@@ -228,10 +228,11 @@ impl Rows {
     }
 }
 
-/// The position pass's warm start (μ of the last pass), kept by contact slot
-/// for the contact normals (as the velocity solve's λ, `warm_contact` in
-/// sim/constraints.rs) and by dof for the joint limits, and gathered by row
-/// index for [`Rows::solve_position_runs`], scaled by 1 − β.
+/// The position pass's warm start (μ of the last pass): the contact
+/// normals' kept by contact slot with the velocity solve's λ (the fourth
+/// entry of `warm_contact` in sim/constraints.rs, written and held with it),
+/// the joint limits' by dof here; gathered by row index for
+/// [`Rows::solve_position_runs`], scaled by 1 − β.
 ///
 /// Why 1 − β: the pass moves q by Δt w, which removes β of each violation
 /// beyond the slop (b_pos = β(−φ − slop)/Δt, sim/constraints.rs), so a
@@ -241,10 +242,6 @@ impl Rows {
 /// sweeps' exit test (max |Δμᵣ| Wᵣᵣ ≤ tol) and cap are the cold pass's.
 #[derive(Clone, Debug)]
 pub(crate) struct PosWarm {
-    /// μ of the normal of each contact slot at the last pass (0 elsewhere).
-    by_slot: Vec<f64>,
-    /// The slots of `by_slot` written by the last solve (only these are cleared).
-    slots: Vec<usize>,
     /// μ of each dof's lower and upper limit rows (entries 1, 2 as `which`).
     by_dof: Vec<[f64; 3]>,
     /// The dofs of `by_dof` written by the last solve (only these are cleared).
@@ -256,11 +253,9 @@ pub(crate) struct PosWarm {
 }
 
 impl PosWarm {
-    /// Room for `nslots` contact slots, `ndof` joints and `cap` rows.
-    pub fn new(nslots: usize, ndof: usize, cap: usize) -> Self {
+    /// Room for `ndof` joints and `cap` rows.
+    pub fn new(ndof: usize, cap: usize) -> Self {
         Self {
-            by_slot: vec![0.0; nslots],
-            slots: Vec::with_capacity(cap),
             by_dof: vec![[0.0; 3]; ndof],
             dofs: Vec::with_capacity(ndof),
             start: Vec::with_capacity(cap),
@@ -274,27 +269,22 @@ impl PosWarm {
         self.decay = (1.0 - beta).clamp(0.0, 1.0);
     }
 
-    /// Forgets the warm starts (a new state was set).
+    /// Forgets the joint limits' warm starts (a new state was set).
     pub fn reset(&mut self) {
-        self.by_slot.iter_mut().for_each(|w| *w = 0.0);
-        self.slots.clear();
         self.by_dof.iter_mut().for_each(|w| *w = [0.0; 3]);
         self.dofs.clear();
     }
 
-    /// Keeps the warm starts of `slots` (sorted) through the next solves.
-    pub fn hold(&mut self, slots: &[usize]) {
-        self.slots.retain(|k| slots.binary_search(k).is_err());
-    }
-
     /// The start of this pass by row (`n` rows): contact triple c (rows 3c..)
-    /// of point `row_point[c]`, a fresh point from 0; joint row
-    /// `first_joint + k` of `joint_rows[k]` = (dof, which); every other row 0.
+    /// of point `row_point[c]` from its slot's entry 3 of `warm_contact`, a
+    /// fresh point from 0; joint row `first_joint + k` of `joint_rows[k]` =
+    /// (dof, which); every other row 0.
     pub fn gather(
         &mut self,
         n: usize,
         row_point: &[usize],
         points: &[ContactPoint],
+        warm_contact: &[[f64; 4]],
         first_joint: usize,
         joint_rows: &[(usize, u8)],
     ) -> &[f64] {
@@ -304,7 +294,7 @@ impl PosWarm {
             if let (Some(pt), Some(x)) = (points.get(pi), self.start.get_mut(3 * c))
                 && !pt.fresh
             {
-                *x = self.decay * self.by_slot.get(pt.slot).copied().unwrap_or(0.0);
+                *x = self.decay * warm_contact.get(pt.slot).map_or(0.0, |w| w[3]);
             }
         }
         for (k, &(d, which)) in joint_rows.iter().enumerate() {
@@ -319,23 +309,16 @@ impl PosWarm {
         &self.start
     }
 
-    /// Keeps this solve's μ (`mu`, by row; `pushed`: the pass ran, else
-    /// every start is 0) for the next pass, as [`PosWarm::gather`] reads it.
+    /// Keeps this solve's μ of the joint limits (`mu`, by row; `pushed`: the
+    /// pass ran, else every start is 0) for the next pass, as
+    /// [`PosWarm::gather`] reads it.
     pub fn write(
         &mut self,
         mu: &[f64],
         pushed: bool,
-        row_point: &[usize],
-        points: &[ContactPoint],
         first_joint: usize,
         joint_rows: &[(usize, u8)],
     ) {
-        for &k in &self.slots {
-            if let Some(w) = self.by_slot.get_mut(k) {
-                *w = 0.0;
-            }
-        }
-        self.slots.clear();
         for &d in &self.dofs {
             if let Some(w) = self.by_dof.get_mut(d) {
                 *w = [0.0; 3];
@@ -344,16 +327,6 @@ impl PosWarm {
         self.dofs.clear();
         if !pushed {
             return;
-        }
-        for (c, &pi) in row_point.iter().enumerate() {
-            let m = mu.get(3 * c).copied().unwrap_or(0.0);
-            if let Some(pt) = points.get(pi)
-                && m > 0.0
-                && let Some(w) = self.by_slot.get_mut(pt.slot)
-            {
-                *w = m;
-                self.slots.push(pt.slot);
-            }
         }
         for (k, &(d, which)) in joint_rows.iter().enumerate() {
             let m = mu.get(first_joint + k).copied().unwrap_or(0.0);
