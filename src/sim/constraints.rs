@@ -31,7 +31,7 @@ use crate::model::{JointKind, Model};
 use crate::spatial::{Force, Motion, Se3};
 use nalgebra::{DVector, Vector3};
 pub(crate) use tables::add_body_rows;
-use tables::{act_column, add_body, BodyColumns, JointRowSource};
+use tables::{act_column, add_body, BodyColumns, BodyHead, JointRowSource};
 
 /// What the rows are built from, besides the state.
 #[derive(Clone, Copy, Debug)]
@@ -131,6 +131,9 @@ pub(crate) struct Constraints {
     /// Each body's joint's motion subspace columns in the body frame (the
     /// joint's constants: kind, axis, `mult`), the world-frame ones' source.
     cols: Vec<BodyColumns>,
+    /// `cols`' first dofs, counts and zero angular parts (what the contacts'
+    /// walks read, [`BodyHead`]).
+    heads: Vec<BodyHead>,
     sw_stamp: u64,
     counts: RowCounts,
     dv: DVector<f64>,
@@ -207,6 +210,9 @@ impl Constraints {
         }
         rows.set_jointed(&jointed);
         let rows_scratch = rows.scratch();
+        let cols: Vec<_> = (0..model.nbodies)
+            .map(|i| BodyColumns::of(model, i))
+            .collect();
         Self {
             rows,
             joint_rows: Vec::with_capacity(3 * ndof),
@@ -220,9 +226,8 @@ impl Constraints {
             pos_warm: PosWarm::new(ndof, cap),
             sw: vec![[Motion::zero(); 6]; model.nbodies],
             sw_done: vec![0; model.nbodies],
-            cols: (0..model.nbodies)
-                .map(|i| BodyColumns::of(model, i))
-                .collect(),
+            heads: cols.iter().map(BodyHead::of).collect(),
+            cols,
             sw_stamp: 0,
             counts: RowCounts::default(),
             dv: DVector::zeros(nv),
@@ -347,7 +352,10 @@ impl Constraints {
         self.spin.touch = p.contact_slop.max(1e-6);
         self.pos_warm.set_beta(p.beta);
         let rows = &mut self.rows;
-        rows.clear();
+        // the last assembly's contact rows (the first rows) are zeroed one
+        // contact at a time below, just before they are written again
+        let keep = 3 * self.row_point.len();
+        rows.clear_but(keep);
         self.joint_rows.clear();
         self.row_point.clear();
         let mut counts = RowCounts::default();
@@ -392,9 +400,9 @@ impl Constraints {
                     true => [0.0; 3],
                     false => wc.get(pt.slot).map_or([0.0; 3], |w| [w[0], w[1], w[2]]),
                 }));
-            let cols = &self.cols;
+            let heads = &self.heads;
             let body_path = |b: usize| {
-                let (iv, nv) = cols.get(b).map_or((0, 0), |c| (c.iv, c.nv));
+                let (iv, nv) = heads.get(b).map_or((0, 0), |c| (c.iv, c.nv));
                 f.path_of((iv + nv).saturating_sub(1))
             };
             for (pi, (pt, &warm)) in points.iter().zip(&self.warm_points).enumerate() {
@@ -405,6 +413,9 @@ impl Constraints {
                 } else {
                     rows.union_path(body_path(pt.body), body_path(pt.other))
                 };
+                if rows.n + 3 <= keep {
+                    rows.zero_contact(rows.n);
+                }
                 let Some(rn) = rows.push_contact(pt.friction, warm, path) else {
                     break;
                 };
@@ -425,7 +436,7 @@ impl Constraints {
                     // v_c + ω_c × p of each ancestor's world-frame subspace column c
                     let (mut b, mut hi) = (pt.body, on_path.len());
                     while b != 0
-                        && let (Some(bc), Some(sw)) = (self.cols.get(b), self.sw.get(b))
+                        && let (Some(bc), Some(sw)) = (self.heads.get(b), self.sw.get(b))
                     {
                         let j = [&mut *j0, &mut *j1, &mut *j2];
                         hi = add_body(j, on_path, hi, bc, sw, at, |vp| [vp.z, vp.x, vp.y]);
@@ -444,7 +455,7 @@ impl Constraints {
                         let (mut b, mut hi) = (start, on_path.len());
                         while b != lca
                             && b != 0
-                            && let (Some(bc), Some(sw)) = (self.cols.get(b), self.sw.get(b))
+                            && let (Some(bc), Some(sw)) = (self.heads.get(b), self.sw.get(b))
                         {
                             let j = [&mut *j0, &mut *j1, &mut *j2];
                             hi = add_body(j, on_path, hi, bc, sw, at, |vp| {
@@ -477,9 +488,12 @@ impl Constraints {
                     counts.violated += 1;
                 }
             }
+            rows.zero_stale(keep);
             // torsional and rolling friction where a pair has few points
             let (sw, rp) = (&self.sw[..], &self.row_point[..]);
             counts.spin = self.spin.push(rows, model, sw, points, rp, &mut self.jd);
+        } else {
+            rows.zero_stale(keep);
         }
         self.first_joint_row = rows.n;
         // joint rows: friction (|λ| ≤ F h), limits (λ ≥ 0)

@@ -23,7 +23,7 @@ pub(super) fn add_body(
     j: [&mut [f64]; 3],
     on_path: &[usize],
     hi: usize,
-    bc: &BodyColumns,
+    bc: &BodyHead,
     sw: &[Motion; 6],
     p: &Vector3<f64>,
     row: impl Fn(Vector3<f64>) -> [f64; 3],
@@ -37,7 +37,7 @@ pub(super) fn add_body(
         Some(&d) if d == iv => guess,
         _ => on_path.partition_point(|&d| d < iv),
     };
-    let cols = bc.s.iter().zip(sw).take(nv);
+    let cols = bc.ang_zero.iter().zip(sw).take(nv);
     let [j0, j1, j2] = j;
     if on_path.get(t0 + last) == Some(&(iv + last))
         && on_path.get(t0) == Some(&iv)
@@ -47,21 +47,21 @@ pub(super) fn add_body(
             j2.get_mut(t0..t0 + nv),
         )
     {
-        for ((((c, s), x0), x1), x2) in cols.zip(r0).zip(r1).zip(r2) {
-            let [a, b, e] = row(point_velocity(s, c.ang_zero, p));
+        for ((((&az, s), x0), x1), x2) in cols.zip(r0).zip(r1).zip(r2) {
+            let [a, b, e] = row(point_velocity(s, az, p));
             *x0 += a;
             *x1 += b;
             *x2 += e;
         }
         return t0;
     }
-    for (k, (c, s)) in cols.enumerate() {
+    for (k, (&az, s)) in cols.enumerate() {
         let col = iv + k;
         let t = on_path.partition_point(|&d| d < col);
         if on_path.get(t) == Some(&col)
             && let (Some(x0), Some(x1), Some(x2)) = (j0.get_mut(t), j1.get_mut(t), j2.get_mut(t))
         {
-            let [a, b, e] = row(point_velocity(s, c.ang_zero, p));
+            let [a, b, e] = row(point_velocity(s, az, p));
             *x0 += a;
             *x1 += b;
             *x2 += e;
@@ -97,7 +97,7 @@ pub(crate) fn add_body_rows(
         vec![0.0; path.len()],
     ];
     let [a, b, c] = &mut j;
-    let t0 = add_body([a, b, c], path, hi, &bc, &sw, p, row);
+    let t0 = add_body([a, b, c], path, hi, &BodyHead::of(&bc), &sw, p, row);
     (j, t0)
 }
 
@@ -163,6 +163,27 @@ pub(super) struct BodyColumns {
     pub(super) nv: usize,
     /// The joint's first velocity coordinate.
     pub(super) iv: usize,
+}
+
+/// What [`add_body`] reads of a body's joint besides its world columns: its
+/// first velocity coordinate, its column count and which columns have no
+/// angular part ([`BodyColumns`]' own, copied: one small entry a body, so a
+/// contact's walk touches one cache line of it, not the six columns').
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BodyHead {
+    pub(super) iv: usize,
+    pub(super) nv: usize,
+    pub(super) ang_zero: [bool; 6],
+}
+
+impl BodyHead {
+    pub(super) fn of(c: &BodyColumns) -> Self {
+        Self {
+            iv: c.iv,
+            nv: c.nv,
+            ang_zero: c.s.map(|x| x.ang_zero),
+        }
+    }
 }
 
 /// One subspace column and which of its parts are zero.

@@ -308,6 +308,47 @@ impl Rows {
         self.w_block[r] = [o[0], o[1], o[2]];
     }
 
+    /// [`Rows::clear`] that leaves the Jacobian entries of rows `..keep` (the
+    /// last assembly's contact triples, rows 3c..3c + 3) unzeroed: the caller
+    /// zeroes each triple just before it writes it ([`Rows::zero_contact`])
+    /// and the rest after ([`Rows::zero_stale`]), so that a row's zeros and
+    /// its entries meet in the cache, not a pass over every row before (on a
+    /// thousand-box pile the rows outgrow the cache between the two).
+    pub(crate) fn clear_but(&mut self, keep: usize) {
+        let n = self.n;
+        self.zero_rows(keep.min(n), n);
+        // (`clear` then zeroes nothing more: rows 0..0)
+        self.n = 0;
+        self.clear();
+    }
+
+    /// Zeroes what the last assembly wrote of rows `r..r + 3`, one contact's
+    /// three rows on one path then (as [`Rows::clear`]'s pass would), before
+    /// they are pushed again: call it with `r = self.n`, below `clear_but`'s
+    /// `keep`.
+    pub(crate) fn zero_contact(&mut self, r: usize) {
+        let st = self.stride;
+        let pl = self.path.get(r).map_or(st, |p| p.1.min(st));
+        if let Some(j) = self.j.get_mut(r * st..(r + 3) * st) {
+            // (as `zero_rows`: a row's entries past its path were not written)
+            if pl + 16 < st {
+                for row in j.chunks_exact_mut(st) {
+                    row[..pl].fill(0.0);
+                }
+            } else {
+                j.fill(0.0);
+            }
+        }
+    }
+
+    /// Zeroes the rows `self.n..keep` ([`Rows::clear_but`]) not pushed again.
+    pub(crate) fn zero_stale(&mut self, keep: usize) {
+        let n = self.n;
+        if n < keep {
+            self.zero_rows(n, keep);
+        }
+    }
+
     /// Whether row r is a contact normal followed by its two tangent rows on
     /// the same path (as `sim::constraints` pushes them).
     #[inline(always)]
