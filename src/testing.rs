@@ -273,14 +273,16 @@ pub mod contact {
     }
 
     /// `contact::narrow::cylinder::rim::rim_on_edge` of a cylinder at `b_m_c`
-    /// (its frame in the box's): (normal from the cylinder into the box,
-    /// depth, rim point, its foot on the edge), the box's frame.
+    /// (its frame in the box's; the side line on an edge too with `side`):
+    /// (normal from the cylinder into the box, depth, rim point, its foot
+    /// on the edge), the box's frame.
     pub fn cylinder_rim_on_edge(
         cyl: &parry3d_f64::shape::Cylinder,
         cub: &parry3d_f64::shape::Cuboid,
         b_m_c: &Pose,
+        side: bool,
     ) -> Option<(PVec, f64, PVec, PVec)> {
-        crate::contact::narrow::cylinder::rim::rim_on_edge(cyl, cub, b_m_c)
+        crate::contact::narrow::cylinder::rim::rim_on_edge(cyl, cub, b_m_c, side)
             .map(|r| (r.n, r.depth, r.rim, r.edge))
     }
 

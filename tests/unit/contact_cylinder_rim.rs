@@ -55,17 +55,58 @@ fn near_edge(g: &mut Lcg, cyl: &Cylinder, e: PVec, depth: f64) -> Se3<f64> {
     Se3::new(*rot.matrix(), q + n * depth - support)
 }
 
-/// How many of `tries` random poses near an edge the closed form takes; each
-/// taken one against parry's GJK + EPA from scratch: normal, depth and the
-/// pair of points within EPA's tolerance.
-fn against_epa(cyl: &Cylinder, cub: &Cuboid, seed: u64, tries: usize) -> usize {
+/// A pose (the cylinder's frame in the box's) with its side line crossing
+/// a random edge of the box, `depth` past it along n = ±u × eᵢ (the
+/// kink of the edge's normal arc), the axis at a random angle to the edge
+/// (≥ 0.5°), the crossing at a random height of the side.
+fn side_on_edge(g: &mut Lcg, cyl: &Cylinder, e: PVec, depth: f64) -> Se3<f64> {
+    let i = (g.uniform(0.0, 3.0) as usize).min(2);
+    let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+    let sign = |g: &mut Lcg| {
+        if g.uniform(-1.0, 1.0) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        }
+    };
+    let (sj, sk) = (sign(g), sign(g));
+    let phi = g.uniform(0.0, std::f64::consts::FRAC_PI_2);
+    let mut q = Vector3::zeros();
+    q[i] = g.uniform(-e[i], e[i]);
+    q[j] = sj * e[j];
+    q[k] = sk * e[k];
+    let mut n = Vector3::zeros();
+    n[j] = -phi.cos() * sj;
+    n[k] = -phi.sin() * sk;
+    let mut ei = Vector3::zeros();
+    ei[i] = 1.0;
+    let psi = g.uniform(0.01, std::f64::consts::PI - 0.01);
+    let u = ei * psi.cos() + n.cross(&ei) * psi.sin();
+    let spin = Rotation3::from_axis_angle(&Vector3::y_axis(), g.uniform(-3.2, 3.2));
+    let rot = Rotation3::rotation_between(&Vector3::y(), &u).unwrap_or(spin) * spin;
+    let s = g.uniform(-0.9, 0.9) * cyl.half_height;
+    Se3::new(*rot.matrix(), q + n * depth - n * cyl.radius - u * s)
+}
+
+/// How many of `tries` random poses from `pose` the closed form takes, and
+/// how many of those are the side line's kink (n ⊥ the axis); each taken
+/// one against parry's GJK + EPA from scratch: normal, depth and the pair
+/// of points within EPA's tolerance.
+fn against_epa(
+    cyl: &Cylinder,
+    cub: &Cuboid,
+    seed: u64,
+    tries: usize,
+    pose: fn(&mut Lcg, &Cylinder, PVec, f64) -> Se3<f64>,
+    side: bool,
+) -> (usize, usize) {
     let mut g = Lcg(seed);
-    let mut taken = 0;
-    let (mut dn, mut dd, mut dp) = (0.0f64, 0.0f64, 0.0f64);
+    let (mut taken, mut kinks) = (0, 0);
+    let (mut dn, mut dd, mut dp, mut df) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     for t in 0..tries {
         let depth = g.uniform(-2e-4, 2e-3);
-        let b_m_c = to_pose(&near_edge(&mut g, cyl, cub.half_extents, depth));
-        let Some((n, d, rim, edge)) = cylinder_rim_on_edge(cyl, cub, &b_m_c) else {
+        let b_m_c = to_pose(&pose(&mut g, cyl, cub.half_extents, depth));
+        let Some((n, d, rim, edge)) = cylinder_rim_on_edge(cyl, cub, &b_m_c, side) else {
             continue;
         };
         taken += 1;
@@ -90,12 +131,70 @@ fn against_epa(cyl: &Cylinder, cub: &Cuboid, seed: u64, tries: usize) -> usize {
             -c.dist,
             along(c.normal1)
         );
+        // and no sampled direction (300 within ~3° of ours, 300 anywhere)
+        // has a smaller overlap: ours is the least, not only EPA's match
+        let mut gs = Lcg(seed ^ (t as u64 + 1) << 20);
+        for m in 0..600 {
+            let v = unit(&mut gs).into_inner();
+            let v = if m < 300 {
+                n + PVec::new(v.x, v.y, v.z) * 0.05
+            } else {
+                PVec::new(v.x, v.y, v.z)
+            };
+            let v = v.normalize();
+            assert!(
+                along(v) >= d - 1e-12,
+                "try {t}: ({n:?}, {d}), but {} along {v:?}",
+                along(v)
+            );
+        }
+        // EPA's depth: within its tolerance of ours, and (its polytope
+        // inside C − B) not deeper; at the kink its stop leaves it up to
+        // ~3e-6 short where the rim's is 1.5e-8 (a flat face of C − B
+        // whose support points along n are a whole parallelogram)
+        let tol = if side { 1e-5 } else { 1e-7 };
         assert!(
-            (-c.dist - d).abs() < 1e-7,
+            (-c.dist - d).abs() < tol && -c.dist <= d + 1e-9,
             "try {t}: ({n:?}, {d}) vs parry's ({:?}, {})",
             c.normal1,
             -c.dist
         );
+        // the closed form's pair: the rim point over the edge, depth apart
+        assert!(((rim - edge).dot(n) - d).abs() < 1e-12 && (rim - edge - n * d).length() < 1e-12);
+        // the points on their features: the cylinder's on its rim or
+        // side, the box's on an edge, to 1 µm (the rim point's direction
+        // across the axis, w = (n − u n·u)/√(1 − (n·u)²), loses its norm's
+        // digits where the cap is near square to n: up to ~1e-16/(1 − (n·u)²)
+        // relative, ≤ 3.3e-8 m off the rim seen here; the foot is off the
+        // edge line by ~3e-11, Newton's φ)
+        let pc = b_m_c.inverse_transform_point(rim);
+        let radial = (pc.x * pc.x + pc.z * pc.z).sqrt();
+        let off_rim = (pc.y.abs() - cyl.half_height).abs();
+        let off_side = (radial - cyl.radius).abs();
+        let in_cyl = (pc.y.abs() - cyl.half_height).max(radial - cyl.radius);
+        let at_face = (edge.abs() - cub.half_extents).abs();
+        let mut at = [at_face.x, at_face.y, at_face.z];
+        at.sort_by(f64::total_cmp);
+        let off_edge = at[1].max((edge.abs() - cub.half_extents).max_element());
+        // a rim point on the cap's plane and the side, a kink's on the side
+        let kink = n.dot(b_m_c.rotation * PVec::Y).abs() < 1e-9;
+        kinks += kink as usize;
+        let off = if kink {
+            off_side
+        } else {
+            off_rim.max(off_side)
+        };
+        df = df.max(off.max(in_cyl)).max(off_edge);
+        assert!(
+            off < 1e-6 && in_cyl < 1e-6 && off_edge < 1e-6,
+            "try {t}: {pc:?} (cylinder's frame) or {edge:?} (box's) off their features"
+        );
+        // EPA's points where its depth converged (to 1e-7): at the kink
+        // with the side near parallel to the edge its pair slides along
+        // the edge (a thin parallelogram face, its polytope short of it)
+        if (-c.dist - d).abs() >= 1e-7 {
+            continue;
+        }
         assert!(
             (c.normal1 - n).length() < 1e-2
                 && (c.point1 - rim).length() < 5e-4
@@ -105,11 +204,11 @@ fn against_epa(cyl: &Cylinder, cub: &Cuboid, seed: u64, tries: usize) -> usize {
             c.point1,
             c.point2
         );
-        // the closed form's pair: the rim point over the edge, depth apart
-        assert!(((rim - edge).dot(n) - d).abs() < 1e-12 && (rim - edge - n * d).length() < 1e-12);
     }
-    eprintln!("taken {taken} of {tries}: |Δn| ≤ {dn:e}, |Δdepth| ≤ {dd:e}, |Δp| ≤ {dp:e}");
-    taken
+    eprintln!(
+        "taken {taken} ({kinks} kinks) of {tries}: |Δn| ≤ {dn:e}, |Δdepth| ≤ {dd:e}, |Δp| ≤ {dp:e}, off features ≤ {df:e}"
+    );
+    (taken, kinks)
 }
 
 #[test]
@@ -122,8 +221,28 @@ fn rim_on_edge_matches_epa() {
         .into_iter()
         .enumerate()
     {
-        let taken = against_epa(c, b, 11 + i as u64, 400);
+        let (taken, _) = against_epa(c, b, 11 + i as u64, 400, near_edge, false);
         assert!(taken >= 100, "case {i}: only {taken} of 400 taken");
+    }
+}
+
+/// The side line on an edge (the kink of the edge's arc, n = ±u × eᵢ: a
+/// parallelogram face of C − B) against EPA, as the rim above.
+#[test]
+fn side_on_edge_matches_epa() {
+    let cube = Cuboid::new(PVec::new(0.05, 0.05, 0.05));
+    let slab = Cuboid::new(PVec::new(0.3, 0.05, 0.2));
+    let cyl = Cylinder::new(0.05, 0.05);
+    let thin = Cylinder::new(0.2, 0.03);
+    for (i, (c, b)) in [(&cyl, &cube), (&thin, &cube), (&cyl, &slab), (&thin, &slab)]
+        .into_iter()
+        .enumerate()
+    {
+        let (taken, kinks) = against_epa(c, b, 41 + i as u64, 400, side_on_edge, true);
+        assert!(
+            kinks >= 100,
+            "case {i}: only {kinks} kinks of {taken} taken of 400"
+        );
     }
 }
 
