@@ -294,8 +294,10 @@ impl Sleep {
         for &t in &awake_trees {
             may[t] = true;
         }
+        // (the roots `after_step` found: no union since, and the trees still
+        // awake were all awake there)
         for &t in &awake_trees {
-            let r = self.find(t);
+            let r = self.root[t];
             let d = &self.doze;
             if self.never[t]
                 || !d.lone[t]
@@ -310,7 +312,7 @@ impl Sleep {
         }
         let mut began = false;
         for &t in &awake_trees {
-            let r = self.find(t);
+            let r = self.root[t];
             if !may[r] || !self.has_dof[t] {
                 continue;
             }

@@ -44,9 +44,16 @@ pub(crate) struct Sleep {
     /// Bounding spheres of the collision shapes: (body, centre in the body
     /// frame, radius); bodies without one use their centre of mass and 0.1 m.
     spheres: Vec<(usize, Vector3<f64>, f64)>,
-    has_sphere: Vec<bool>,
     /// Per tree: its spheres, a range of `spheres` (sorted by tree).
     tree_spheres: Vec<(usize, usize)>,
+    /// The bodies without a sphere (the world excluded), tree after tree, each
+    /// with its centre of mass; per tree its range of them (the speed test
+    /// reads these, not the model's trees).
+    bare: Vec<(usize, Vector3<f64>)>,
+    tree_bare: Vec<(usize, usize)>,
+    /// Per awake tree: its island's root this step (scratch of `after_step`,
+    /// found once after the unions and read by the sleep and doze verdicts).
+    pub(super) root: Vec<usize>,
     /// The trees not asleep, ascending (the per-step loops run over these).
     pub(super) awake_trees: Vec<usize>,
     /// Per tree: how long it has been still (s).
@@ -144,6 +151,20 @@ impl Sleep {
                 *r = (s, i);
             }
         }
+        let mut bare = Vec::new();
+        let mut tree_bare = vec![(0, 0); nt];
+        for (t, tree) in model.trees.iter().enumerate() {
+            let s = bare.len();
+            for b in tree.bodies.clone() {
+                if b == 0 || has_sphere.get(b) != Some(&false) {
+                    continue;
+                }
+                if let Some(i) = model.inertias.get(b) {
+                    bare.push((b, i.com));
+                }
+            }
+            tree_bare[t] = (s, bare.len());
+        }
         Self {
             on,
             v_tol,
@@ -152,8 +173,10 @@ impl Sleep {
             never,
             has_dof,
             spheres,
-            has_sphere,
             tree_spheres,
+            bare,
+            tree_bare,
+            root: (0..nt).collect(),
             awake_trees: (0..nt).collect(),
             still: vec![0.0; nt],
             asleep: vec![false; nt],
@@ -321,12 +344,10 @@ impl Sleep {
                     speed = speed.max(s);
                 }
             }
-            for b in model.trees[t].bodies.clone() {
-                if b == 0 || self.has_sphere[b] {
-                    continue;
-                }
+            // (the tree's bodies without a sphere, ascending)
+            let (b0, b1) = self.tree_bare[t];
+            for &(b, c) in &self.bare[b0..b1] {
                 if let Some(m) = body_v.get(b) {
-                    let c = model.inertias[b].com;
                     let s = (m.lin + m.ang.cross(&c)).norm() + m.ang.norm() * 0.1;
                     speed = speed.max(s);
                 }
@@ -360,8 +381,11 @@ impl Sleep {
         for &t in &awake_trees {
             may[t] = true;
         }
+        // (the unions are done: each tree's root is found once, kept in
+        // `root` for the verdicts here and in `begin_doze`)
         for &t in &awake_trees {
             let r = self.find(t);
+            self.root[t] = r;
             if self.never[t] || forced[t] || self.still[t] < self.t_tol {
                 may[r] = false;
             }
@@ -371,7 +395,7 @@ impl Sleep {
             if !self.has_dof[t] {
                 continue;
             }
-            let r = self.find(t);
+            let r = self.root[t];
             if !may[r] {
                 continue;
             }
