@@ -15,23 +15,21 @@ use super::contact_cylinder_pfm::{both, unit};
 
 type Man = ContactManifold<(), ()>;
 
-/// A pose (the cylinder's frame in the box's) with a rim point `depth` past
-/// a random point of a random edge of the box along a random direction of
-/// the edge's normal arc.
-fn near_edge(g: &mut Lcg, cyl: &Cylinder, e: PVec, depth: f64) -> Se3<f64> {
-    let mut rot = Rotation3::from_axis_angle(&unit(g), g.uniform(-3.2, 3.2));
+/// A random point q on a random edge (along axis i) of the box of half
+/// extents `e`, and n, a random direction of that edge's normal arc (in the
+/// plane across the edge, between its two faces' normals) negated: n
+/// points into the box. Returns (i, q, n); the draws in a fixed order.
+fn on_edge(g: &mut Lcg, e: PVec) -> (usize, Vector3<f64>, Vector3<f64>) {
     let i = (g.uniform(0.0, 3.0) as usize).min(2);
     let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-    let sj = if g.uniform(-1.0, 1.0) < 0.0 {
-        -1.0
-    } else {
-        1.0
+    let mut sign = || {
+        if g.uniform(-1.0, 1.0) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        }
     };
-    let sk = if g.uniform(-1.0, 1.0) < 0.0 {
-        -1.0
-    } else {
-        1.0
-    };
+    let (sj, sk) = (sign(), sign());
     let phi = g.uniform(0.0, std::f64::consts::FRAC_PI_2);
     let mut q = Vector3::zeros();
     q[i] = g.uniform(-e[i], e[i]);
@@ -40,6 +38,15 @@ fn near_edge(g: &mut Lcg, cyl: &Cylinder, e: PVec, depth: f64) -> Se3<f64> {
     let mut n = Vector3::zeros();
     n[j] = -phi.cos() * sj;
     n[k] = -phi.sin() * sk;
+    (i, q, n)
+}
+
+/// A pose (the cylinder's frame in the box's) with a rim point `depth` past
+/// a random point of a random edge of the box along a random direction of
+/// the edge's normal arc.
+fn near_edge(g: &mut Lcg, cyl: &Cylinder, e: PVec, depth: f64) -> Se3<f64> {
+    let mut rot = Rotation3::from_axis_angle(&unit(g), g.uniform(-3.2, 3.2));
+    let (_, q, n) = on_edge(g, e);
     // a third with the cap nearly square to n (a cap pressed on the edge
     // near its rim: n within 0.1° of the axis)
     if g.uniform(0.0, 3.0) < 1.0 {
@@ -60,24 +67,7 @@ fn near_edge(g: &mut Lcg, cyl: &Cylinder, e: PVec, depth: f64) -> Se3<f64> {
 /// kink of the edge's normal arc), the axis at a random angle to the edge
 /// (≥ 0.5°), the crossing at a random height of the side.
 fn side_on_edge(g: &mut Lcg, cyl: &Cylinder, e: PVec, depth: f64) -> Se3<f64> {
-    let i = (g.uniform(0.0, 3.0) as usize).min(2);
-    let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-    let sign = |g: &mut Lcg| {
-        if g.uniform(-1.0, 1.0) < 0.0 {
-            -1.0
-        } else {
-            1.0
-        }
-    };
-    let (sj, sk) = (sign(g), sign(g));
-    let phi = g.uniform(0.0, std::f64::consts::FRAC_PI_2);
-    let mut q = Vector3::zeros();
-    q[i] = g.uniform(-e[i], e[i]);
-    q[j] = sj * e[j];
-    q[k] = sk * e[k];
-    let mut n = Vector3::zeros();
-    n[j] = -phi.cos() * sj;
-    n[k] = -phi.sin() * sk;
+    let (i, q, n) = on_edge(g, e);
     let mut ei = Vector3::zeros();
     ei[i] = 1.0;
     let psi = g.uniform(0.01, std::f64::consts::PI - 0.01);
@@ -211,16 +201,19 @@ fn against_epa(
     (taken, kinks)
 }
 
-#[test]
-fn rim_on_edge_matches_epa() {
+/// The four cylinder–box pairs the rim and side tests run on: a cube and a
+/// long slab, each against a squat and a thin wide cylinder.
+fn cases() -> [(Cylinder, Cuboid); 4] {
     let cube = Cuboid::new(PVec::new(0.05, 0.05, 0.05));
     let slab = Cuboid::new(PVec::new(0.3, 0.05, 0.2));
     let cyl = Cylinder::new(0.05, 0.05);
     let thin = Cylinder::new(0.2, 0.03);
-    for (i, (c, b)) in [(&cyl, &cube), (&thin, &cube), (&cyl, &slab), (&thin, &slab)]
-        .into_iter()
-        .enumerate()
-    {
+    [(cyl, cube), (thin, cube), (cyl, slab), (thin, slab)]
+}
+
+#[test]
+fn rim_on_edge_matches_epa() {
+    for (i, (c, b)) in cases().iter().enumerate() {
         let (taken, _) = against_epa(c, b, 11 + i as u64, 400, near_edge, false);
         assert!(taken >= 100, "case {i}: only {taken} of 400 taken");
     }
@@ -230,14 +223,7 @@ fn rim_on_edge_matches_epa() {
 /// parallelogram face of C − B) against EPA, as the rim above.
 #[test]
 fn side_on_edge_matches_epa() {
-    let cube = Cuboid::new(PVec::new(0.05, 0.05, 0.05));
-    let slab = Cuboid::new(PVec::new(0.3, 0.05, 0.2));
-    let cyl = Cylinder::new(0.05, 0.05);
-    let thin = Cylinder::new(0.2, 0.03);
-    for (i, (c, b)) in [(&cyl, &cube), (&thin, &cube), (&cyl, &slab), (&thin, &slab)]
-        .into_iter()
-        .enumerate()
-    {
+    for (i, (c, b)) in cases().iter().enumerate() {
         let (taken, kinks) = against_epa(c, b, 41 + i as u64, 400, side_on_edge, true);
         assert!(
             kinks >= 100,
