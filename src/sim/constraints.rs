@@ -113,16 +113,16 @@ pub(crate) struct Constraints {
     row_point: Vec<usize>,
     /// Warm-start impulses per contact slot (n, t1, t2, and the position
     /// pass's μ of the normal: solver/position.rs) and per joint (friction,
-    /// lower, upper).
+    /// lower, upper, and the position pass's μ of the lower and upper limit).
     warm_contact: Vec<[f64; 4]>,
     /// The slots of `warm_contact` written by the last solve (only these are cleared).
     warm_slots: Vec<usize>,
-    warm_joint: Vec<[f64; 3]>,
+    warm_joint: Vec<[f64; 5]>,
     /// This step's warm starts of the points, gathered before the rows are
     /// built (the loads are independent there: their cache misses overlap).
     warm_points: Vec<[f64; 3]>,
-    /// The position pass's warm starts of the joint limits and its start by
-    /// row (its contact normals' are `warm_contact`'s fourth entries).
+    /// The position pass's start by row (gathered from `warm_contact`'s and
+    /// `warm_joint`'s μ entries).
     pos_warm: PosWarm,
     /// World-frame motion subspace columns of each body (≤ 6), set this
     /// step where `sw_done` holds `sw_stamp`.
@@ -221,9 +221,9 @@ impl Constraints {
             row_point: Vec::with_capacity(max_points),
             warm_contact: vec![[0.0; 4]; nslots],
             warm_slots: Vec::with_capacity(max_points),
-            warm_joint: vec![[0.0; 3]; ndof],
+            warm_joint: vec![[0.0; 5]; ndof],
             warm_points: Vec::with_capacity(max_points),
-            pos_warm: PosWarm::new(ndof, cap),
+            pos_warm: PosWarm::new(cap),
             sw: vec![[Motion::zero(); 6]; model.nbodies],
             sw_done: vec![0; model.nbodies],
             heads: cols.iter().map(BodyHead::of).collect(),
@@ -280,9 +280,8 @@ impl Constraints {
         if let Some(l) = self.loops.as_mut() {
             l.reset_warm_start();
         }
-        self.warm_joint.iter_mut().for_each(|w| *w = [0.0; 3]);
+        self.warm_joint.iter_mut().for_each(|w| *w = [0.0; 5]);
         self.warm_slots.clear();
-        self.pos_warm.reset();
     }
 
     /// Keeps the warm starts of `slots` (sorted) through the next solves (a

@@ -120,8 +120,8 @@ impl Constraints {
             self.push.as_mut_slice().fill(0.0);
             rows.mu[..rows.n].fill(0.0);
             let (rp, wc) = (&self.row_point, &self.warm_contact);
-            let (jr, fj) = (&self.joint_rows, self.first_joint_row);
-            let warm = self.pos_warm.gather(rows.n, rp, points, wc, fj, jr);
+            let (jr, fj, wj) = (&self.joint_rows, self.first_joint_row, &self.warm_joint);
+            let warm = self.pos_warm.gather(rows.n, rp, points, wc, fj, jr, wj);
             for i in 0..count {
                 let isl = if pgs { self.islands.get(i) } else { whole };
                 let violated = |&(_, s, e): &(usize, usize, usize)| {
@@ -146,16 +146,22 @@ impl Constraints {
         if let Some(l) = self.loops.as_mut() {
             l.read(rows);
         }
-        let (jr, fj) = (&self.joint_rows, self.first_joint_row);
-        self.pos_warm.write(&rows.mu[..rows.n], pushing, fj, jr);
-        // joint rows: warm starts and generalized force
+        // joint rows: warm starts (λ, and the position pass's μ of a limit
+        // where it ran and pushed) and generalized force
         for w in self.warm_joint.iter_mut() {
-            *w = [0.0; 3];
+            *w = [0.0; 5];
         }
         for (k, &(d, which)) in self.joint_rows.iter().enumerate() {
             let r = self.first_joint_row + k;
             let lam = rows.lambda[r];
             self.warm_joint[d][which as usize] = lam;
+            let mu = match pushing {
+                true => rows.mu[..rows.n].get(r).copied().unwrap_or(0.0),
+                false => 0.0,
+            };
+            if which > 0 && mu > 0.0 {
+                self.warm_joint[d][2 + which as usize % 3] = mu;
+            }
             let iv = model.dof_v(d);
             let jv = joint_entry(rows, r, iv);
             self.tau_joint[iv] += jv * lam / h;

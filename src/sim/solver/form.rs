@@ -327,18 +327,7 @@ impl Rows {
     /// they are pushed again: call it with `r = self.n`, below `clear_but`'s
     /// `keep`.
     pub(crate) fn zero_contact(&mut self, r: usize) {
-        let st = self.stride;
-        let pl = self.path.get(r).map_or(st, |p| p.1.min(st));
-        if let Some(j) = self.j.get_mut(r * st..(r + 3) * st) {
-            // (as `zero_rows`: a row's entries past its path were not written)
-            if pl + 16 < st {
-                for row in j.chunks_exact_mut(st) {
-                    row[..pl].fill(0.0);
-                }
-            } else {
-                j.fill(0.0);
-            }
-        }
+        self.zero_rows(r, r + 3);
     }
 
     /// Zeroes the rows `self.n..keep` ([`Rows::clear_but`]) not pushed again.

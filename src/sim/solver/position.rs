@@ -230,9 +230,9 @@ impl Rows {
 
 /// The position pass's warm start (μ of the last pass): the contact
 /// normals' kept by contact slot with the velocity solve's λ (the fourth
-/// entry of `warm_contact` in sim/constraints.rs, written and held with it),
-/// the joint limits' by dof here; gathered by row index for
-/// [`Rows::solve_position_runs`], scaled by 1 − β.
+/// entry of `warm_contact` in sim/constraints.rs), the joint limits' by dof
+/// (the fourth and fifth of `warm_joint`), both written and held with λ;
+/// gathered by row index for [`Rows::solve_position_runs`], scaled by 1 − β.
 ///
 /// Why 1 − β: the pass moves q by Δt w, which removes β of each violation
 /// beyond the slop (b_pos = β(−φ − slop)/Δt, sim/constraints.rs), so a
@@ -242,10 +242,6 @@ impl Rows {
 /// sweeps' exit test (max |Δμᵣ| Wᵣᵣ ≤ tol) and cap are the cold pass's.
 #[derive(Clone, Debug)]
 pub(crate) struct PosWarm {
-    /// μ of each dof's lower and upper limit rows (entries 1, 2 as `which`).
-    by_dof: Vec<[f64; 3]>,
-    /// The dofs of `by_dof` written by the last solve (only these are cleared).
-    dofs: Vec<usize>,
     /// This pass's start, by row.
     start: Vec<f64>,
     /// 1 − β: how much of a violation held still is left after a pass.
@@ -253,11 +249,9 @@ pub(crate) struct PosWarm {
 }
 
 impl PosWarm {
-    /// Room for `ndof` joints and `cap` rows.
-    pub fn new(ndof: usize, cap: usize) -> Self {
+    /// Room for `cap` rows.
+    pub fn new(cap: usize) -> Self {
         Self {
-            by_dof: vec![[0.0; 3]; ndof],
-            dofs: Vec::with_capacity(ndof),
             start: Vec::with_capacity(cap),
             decay: 1.0,
         }
@@ -269,16 +263,12 @@ impl PosWarm {
         self.decay = (1.0 - beta).clamp(0.0, 1.0);
     }
 
-    /// Forgets the joint limits' warm starts (a new state was set).
-    pub fn reset(&mut self) {
-        self.by_dof.iter_mut().for_each(|w| *w = [0.0; 3]);
-        self.dofs.clear();
-    }
-
     /// The start of this pass by row (`n` rows): contact triple c (rows 3c..)
     /// of point `row_point[c]` from its slot's entry 3 of `warm_contact`, a
     /// fresh point from 0; joint row `first_joint + k` of `joint_rows[k]` =
-    /// (dof, which); every other row 0.
+    /// (dof, which) from entry 2 + which of `warm_joint` (a limit's; a
+    /// friction row from 0); every other row 0.
+    #[allow(clippy::too_many_arguments)]
     pub fn gather(
         &mut self,
         n: usize,
@@ -287,6 +277,7 @@ impl PosWarm {
         warm_contact: &[[f64; 4]],
         first_joint: usize,
         joint_rows: &[(usize, u8)],
+        warm_joint: &[[f64; 5]],
     ) -> &[f64] {
         self.start.clear();
         self.start.resize(n, 0.0);
@@ -298,45 +289,14 @@ impl PosWarm {
             }
         }
         for (k, &(d, which)) in joint_rows.iter().enumerate() {
-            if let (Some(w), Some(x)) = (self.by_dof.get(d), self.start.get_mut(first_joint + k)) {
+            if let (Some(w), Some(x)) = (warm_joint.get(d), self.start.get_mut(first_joint + k)) {
                 *x = if which > 0 {
-                    self.decay * w[which as usize % 3]
+                    self.decay * w[2 + which as usize % 3]
                 } else {
                     0.0
                 };
             }
         }
         &self.start
-    }
-
-    /// Keeps this solve's μ of the joint limits (`mu`, by row; `pushed`: the
-    /// pass ran, else every start is 0) for the next pass, as
-    /// [`PosWarm::gather`] reads it.
-    pub fn write(
-        &mut self,
-        mu: &[f64],
-        pushed: bool,
-        first_joint: usize,
-        joint_rows: &[(usize, u8)],
-    ) {
-        for &d in &self.dofs {
-            if let Some(w) = self.by_dof.get_mut(d) {
-                *w = [0.0; 3];
-            }
-        }
-        self.dofs.clear();
-        if !pushed {
-            return;
-        }
-        for (k, &(d, which)) in joint_rows.iter().enumerate() {
-            let m = mu.get(first_joint + k).copied().unwrap_or(0.0);
-            if which > 0
-                && m > 0.0
-                && let Some(w) = self.by_dof.get_mut(d)
-            {
-                w[which as usize % 3] = m;
-                self.dofs.push(d);
-            }
-        }
     }
 }
