@@ -521,6 +521,7 @@ impl Rows {
                     winv,
                     c,
                     b,
+                    diag: (&self.w[..n], &self.w_block[..n]),
                 };
                 if subspace_step(&mut out.sm.0, &rows, lambda, dv) {
                     polished = true;

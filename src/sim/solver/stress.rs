@@ -128,6 +128,7 @@ impl Rows {
         let lanes = Lanes {
             contact: &self.is_block,
             ylanes: &self.ylanes,
+            diag: (&self.w, &self.w_block),
         };
         sm.group(&self.path);
         if !sm.form_w_ff(&self.y, st, &self.path, table, lanes, self.nv, 0, false) {

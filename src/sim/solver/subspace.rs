@@ -110,6 +110,9 @@ pub(super) struct Solved<'a> {
     pub(super) winv: &'a [f64],
     pub(super) c: &'a [f64],
     pub(super) b: &'a [f64],
+    /// W's diagonal and contact blocks (`Rows::w`, `Rows::w_block`: Y Yᵀ's,
+    /// not the loop block's reduced ones), [`Lanes::diag`].
+    pub(super) diag: (&'a [f64], &'a [[f64; 3]]),
 }
 
 /// One subspace-minimisation step of projected Gauss–Seidel (PGS-SM,
@@ -145,6 +148,7 @@ pub(super) fn subspace_step(
         winv,
         c,
         b,
+        diag,
     } = *rows;
     let path = |r: usize| {
         let (s, l) = paths[r];
@@ -227,7 +231,11 @@ pub(super) fn subspace_step(
         RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
         _ => b[r],
     };
-    let lanes = Lanes { contact, ylanes };
+    let lanes = Lanes {
+        contact,
+        ylanes,
+        diag,
+    };
     sm.group(paths);
     let mut a = 0;
     while a < m {

@@ -148,6 +148,22 @@ impl Subspace {
                     bb += sb;
                     continue;
                 }
+                if bb == a {
+                    // the group's own block: the entries `Rows::form` summed
+                    // as W's diagonal and a contact's w_block, from −0 (an
+                    // entry here is the same products in the same order from
+                    // +0: the same bits but for a sum of −0, which + 0.0 makes
+                    // the +0 the sum here gives)
+                    if let Some(own) = lanes.own(r, sa) {
+                        for (i, oi) in own.iter().enumerate().take(sa) {
+                            for (j, &oij) in oi.iter().enumerate().take(i + 1) {
+                                put(a + i, a + j, oij + 0.0);
+                            }
+                        }
+                        bb += sb;
+                        continue;
+                    }
+                }
                 if !scattered {
                     scattered = true;
                     if sa == 3 {
@@ -195,9 +211,11 @@ impl Subspace {
                                 }
                             }
                         }
+                        // (below the diagonal block every entry: bb + 3 ≤ a)
+                        let below = bb < a;
                         for (i, si) in sum.iter().enumerate() {
                             for (j, &sij) in si.iter().enumerate() {
-                                if bb + j <= a + i {
+                                if below || j <= i {
                                     put(a + i, bb + j, sij);
                                 }
                             }
@@ -282,15 +300,36 @@ impl Subspace {
 /// A free row not in the last factor ([`Subspace::map_old`]).
 const NEW: usize = usize::MAX;
 
-/// The contacts' rows of Y interleaved (`Rows::ylanes`) and which rows are a
-/// contact's normal (`Rows::is_block`), for [`Subspace::form_w_ff`].
+/// The contacts' rows of Y interleaved (`Rows::ylanes`), which rows are a
+/// contact's normal (`Rows::is_block`), and W's diagonal and contact blocks
+/// (`Rows::w`, `Rows::w_block`, as `Rows::form` made them: not the loop
+/// block's reduced ones), for [`Subspace::form_w_ff`].
 #[derive(Clone, Copy)]
 pub(super) struct Lanes<'a> {
     pub(super) contact: &'a [bool],
     pub(super) ylanes: &'a [[f64; 4]],
+    pub(super) diag: (&'a [f64], &'a [[f64; 3]]),
 }
 
 impl<'a> Lanes<'a> {
+    /// W's own block of the free-row group at row `r` (`s` rows: a contact's
+    /// three, or one row), lower triangle, each entry Σₜ yᵢₜ yⱼₜ over the
+    /// row's path in its order from −0 (`Rows::form`: W's diagonal ‖yᵣ‖²,
+    /// a contact's w_block [y₀·y₁, y₀·y₂, y₁·y₂]); `None` for three rows
+    /// that are not a contact's (no w_block), or out of range.
+    #[inline]
+    pub(super) fn own(&self, r: usize, s: usize) -> Option<[[f64; 3]; 3]> {
+        let (w, wb) = self.diag;
+        match s {
+            1 => Some([[*w.get(r)?, 0.0, 0.0], [0.0; 3], [0.0; 3]]),
+            3 if *self.contact.get(r)? => {
+                let (d, [o01, o02, o12]) = (w.get(r..r + 3)?, *wb.get(r)?);
+                Some([[d[0], 0.0, 0.0], [o01, d[1], 0.0], [o02, o12, d[2]]])
+            }
+            _ => None,
+        }
+    }
+
     /// The interleaved rows of the contact whose normal is row `q` (its path
     /// `len` long), or `None` (not a contact's normal, or out of range).
     #[inline]
