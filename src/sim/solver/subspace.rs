@@ -156,6 +156,14 @@ pub(super) fn subspace_step(
     };
     let inside =
         |t1: f64, t2: f64, ln: f64, mu: f64| (t1 * t1 + t2 * t2).sqrt() < mu * ln * (1.0 - 1e-9);
+    // a contact that is not free (its normal not taken) and whose tangent
+    // impulses are both 0 (either sign): the walk's projection leaves it as
+    // it is (its norm 0, its scale 0 or 1, each impulse t·s the same bits,
+    // each change +0, no Δv' update) and passes it by
+    #[inline(always)]
+    fn passed(lambda: &[f64], normal: bool, r: usize, e: usize) -> bool {
+        !normal && r + 3 <= e && lambda[r + 1] == 0.0 && lambda[r + 2] == 0.0
+    }
     // F: the free rows
     sm.rows.clear();
     for &(_, s, e) in runs {
@@ -167,8 +175,12 @@ pub(super) fn subspace_step(
                     RowKind::Tangent { mu, .. } => mu,
                     _ => 0.0,
                 };
-                sm.sliding[r + 1] = !inside(lambda[r + 1], lambda[r + 2], lambda[r], mu);
-                if lambda[r] > 0.0 && live(r) {
+                let normal = lambda[r] > 0.0 && live(r);
+                // (not needed where the walk below passes the contact by)
+                if !passed(lambda, normal, r, e) {
+                    sm.sliding[r + 1] = !inside(lambda[r + 1], lambda[r + 2], lambda[r], mu);
+                }
+                if normal {
                     sm.rows.push(r);
                     if !sm.sliding[r + 1] && live(r + 1) && live(r + 2) {
                         sm.rows.push(r + 1);
@@ -340,9 +352,18 @@ pub(super) fn subspace_step(
     // took them in this order, each once): a cursor finds a row's place
     let mut next = 0;
     'walk: for &(_, s, e) in runs {
+        let mut skip = s;
         for r in s..e {
             if r + 1 >= n {
                 break 'walk;
+            }
+            if r < skip {
+                // (a passed contact's tangents: not free, so not on the cursor)
+                continue;
+            }
+            if contact[r] && sm.rows.get(next) != Some(&r) && passed(lambda, false, r, e) {
+                skip = r + 3;
+                continue;
             }
             let at = if sm.rows.get(next) == Some(&r) {
                 next += 1;

@@ -287,12 +287,12 @@ impl Subspace {
 
     /// Keeps W_FF's rows `from..` (in `w`, about to be factored) in `wf`.
     pub(super) fn keep_w_ff(&mut self, from: usize) {
-        let (m, ld) = (self.rows.len(), self.ld);
-        for a in from..m.min(ld) {
-            let i = a * ld;
-            if let (Some(d), Some(s)) = (self.wf.get_mut(i..=i + a), self.w.get(i..=i + a)) {
-                d.copy_from_slice(s);
-            }
+        let (m, ld) = (self.rows.len().min(self.ld), self.ld);
+        // whole rows in one copy (their entries past the diagonal are never
+        // read from `wf`: [`Subspace::form_w_ff`] reads its lower triangle)
+        let (s, e) = (from.min(m) * ld, m * ld);
+        if let (Some(d), Some(s)) = (self.wf.get_mut(s..e), self.w.get(s..e)) {
+            d.copy_from_slice(s);
         }
     }
 }
