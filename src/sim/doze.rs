@@ -155,7 +155,14 @@ impl Sleep {
             return false;
         }
         let mut woke = false;
+        // (a pair's points come one after another: a repeat of the last pair
+        // finds what that pair found, its island undozed already)
+        let mut last = (usize::MAX, usize::MAX);
         for p in points {
+            if (p.body, p.other) == last {
+                continue;
+            }
+            last = (p.body, p.other);
             let (ta, tb) = (self.tree_of(p.body), self.tree_of(p.other));
             for (s, o) in [(ta, tb), (tb, ta)] {
                 let dozing = |t: Option<usize>| t.is_some_and(|t| self.doze.left[t] > 0);

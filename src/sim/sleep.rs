@@ -362,8 +362,15 @@ impl Sleep {
         self.link_dozing(&awake_trees);
         // islands: trees joined by a contact point or a loop constraint
         let joins = std::mem::take(&mut self.joins);
+        // (a pair's points come one after another: the repeats of the last
+        // pair are skipped, a union already made; finds only shorten paths)
         let pairs = points.iter().map(|p| (p.body, p.other));
+        let mut last = (WORLD, WORLD);
         for (a, b) in pairs.chain(joins.iter().copied()) {
+            if (a, b) == last {
+                continue;
+            }
+            last = (a, b);
             let (ta, tb) = (self.tree(a), self.tree(b));
             if ta == WORLD || tb == WORLD || ta == tb {
                 continue;
