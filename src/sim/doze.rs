@@ -155,7 +155,14 @@ impl Sleep {
             return false;
         }
         let mut woke = false;
+        // (a pair's points come one after another: a repeat of the last pair
+        // finds what that pair found, its island undozed already)
+        let mut last = (usize::MAX, usize::MAX);
         for p in points {
+            if (p.body, p.other) == last {
+                continue;
+            }
+            last = (p.body, p.other);
             let (ta, tb) = (self.tree_of(p.body), self.tree_of(p.other));
             for (s, o) in [(ta, tb), (tb, ta)] {
                 let dozing = |t: Option<usize>| t.is_some_and(|t| self.doze.left[t] > 0);
@@ -244,18 +251,13 @@ impl Sleep {
                 continue;
             }
             let tree = &model.trees[t];
-            for k in tree.v.clone() {
-                v[k] = d.v_held[k];
-            }
-            for k in tree.q.clone() {
-                q[k] = self.q_frozen[k];
-            }
+            // (a tree's coordinates are one range: slice copies)
+            copy_range(v, &d.v_held, tree.v.clone());
+            copy_range(q, &self.q_frozen, tree.q.clone());
             if let Some(f) = tree.free.and_then(|f| model.free_joints.get(f)) {
                 integrate_free(q, v, h, f.iq, f.iv);
             }
-            for k in tree.q.clone() {
-                self.q_frozen[k] = q[k];
-            }
+            copy_range(&mut self.q_frozen, q, tree.q.clone());
             d.tree_steps += 1;
             d.left[t] -= 1;
             ended |= d.left[t] == 0;
@@ -321,12 +323,8 @@ impl Sleep {
             self.doze.root[t] = r;
             self.masked[t] = true;
             let tree = &model.trees[t];
-            for k in tree.v.clone() {
-                self.doze.v_held[k] = v[k];
-            }
-            for k in tree.q.clone() {
-                self.q_frozen[k] = q[k];
-            }
+            copy_range(&mut self.doze.v_held, v, tree.v.clone());
+            copy_range(&mut self.q_frozen, q, tree.q.clone());
             for b in tree.bodies.clone() {
                 self.body_asleep[b] = true;
                 self.all_body[b] = body_forces.get(b).copied().unwrap_or(Force::zero());
@@ -368,6 +366,14 @@ impl Sleep {
             }
         });
         slots.sort_unstable();
+    }
+}
+
+/// `to[r] = from[r]` (a range out of either: nothing copied).
+#[inline]
+fn copy_range(to: &mut DVector<f64>, from: &DVector<f64>, r: std::ops::Range<usize>) {
+    if let (Some(t), Some(f)) = (to.as_mut_slice().get_mut(r.clone()), from.as_slice().get(r)) {
+        t.copy_from_slice(f);
     }
 }
 

@@ -362,8 +362,15 @@ impl Sleep {
         self.link_dozing(&awake_trees);
         // islands: trees joined by a contact point or a loop constraint
         let joins = std::mem::take(&mut self.joins);
+        // (a pair's points come one after another: the repeats of the last
+        // pair are skipped, a union already made; finds only shorten paths)
         let pairs = points.iter().map(|p| (p.body, p.other));
+        let mut last = (WORLD, WORLD);
         for (a, b) in pairs.chain(joins.iter().copied()) {
+            if (a, b) == last {
+                continue;
+            }
+            last = (a, b);
             let (ta, tb) = (self.tree(a), self.tree(b));
             if ta == WORLD || tb == WORLD || ta == tb {
                 continue;
@@ -461,15 +468,15 @@ impl Sleep {
         if !self.any_asleep {
             return;
         }
-        for (t, tree) in model.trees.iter().enumerate() {
-            if !self.asleep[t] {
-                continue;
+        // (a tree's coordinates are one range: one slice fill and one copy,
+        // not a bounds test an entry)
+        let (q, v, frozen) = (q.as_mut_slice(), v.as_mut_slice(), self.q_frozen.as_slice());
+        for (tree, _) in model.trees.iter().zip(&self.asleep).filter(|&(_, &a)| a) {
+            if let Some(v) = v.get_mut(tree.v.clone()) {
+                v.fill(0.0);
             }
-            for k in tree.v.clone() {
-                v[k] = 0.0;
-            }
-            for k in tree.q.clone() {
-                q[k] = self.q_frozen[k];
+            if let (Some(q), Some(f)) = (q.get_mut(tree.q.clone()), frozen.get(tree.q.clone())) {
+                q.copy_from_slice(f);
             }
         }
     }
@@ -616,12 +623,16 @@ impl super::Simulation {
     pub(super) fn account_sleep(&mut self, h: f64) {
         // trees driven now: a nonzero applied force, or a servo on one of its
         // dofs (read for the awake trees only)
+        // (each tree's dofs one range: a slice test of each vector)
+        let tau = self.tau_applied.as_slice();
+        let servo = self
+            .servo
+            .active
+            .then(|| (self.servo.kp.as_slice(), self.servo.kd.as_slice()));
         for &t in self.sleep.awake_trees() {
-            let tree = &self.model.trees[t];
-            self.sleep_forced[t] = tree.v.clone().any(|k| {
-                self.tau_applied[k] != 0.0
-                    || (self.servo.active && (self.servo.kp[k] != 0.0 || self.servo.kd[k] != 0.0))
-            });
+            let r = self.model.trees[t].v.clone();
+            let set = |x: &[f64]| x.get(r.clone()).is_some_and(|x| x.iter().any(|&x| x != 0.0));
+            self.sleep_forced[t] = set(tau) || servo.is_some_and(|(kp, kd)| set(kp) || set(kd));
         }
         let slept = self.sleep.after_step(
             &self.model,
