@@ -26,7 +26,7 @@
 //! Nothing but the step count and the state decides: the run is as
 //! deterministic as without it.
 
-use super::sleep::Sleep;
+use super::sleep::{copy_range, Sleep};
 use super::ContactForce;
 use crate::contact::ContactPoint;
 use crate::model::configuration::integrate_free;
@@ -366,14 +366,6 @@ impl Sleep {
             }
         });
         slots.sort_unstable();
-    }
-}
-
-/// `to[r] = from[r]` (a range out of either: nothing copied).
-#[inline]
-fn copy_range(to: &mut DVector<f64>, from: &DVector<f64>, r: std::ops::Range<usize>) {
-    if let (Some(t), Some(f)) = (to.as_mut_slice().get_mut(r.clone()), from.as_slice().get(r)) {
-        t.copy_from_slice(f);
     }
 }
 

@@ -470,14 +470,11 @@ impl Sleep {
         }
         // (a tree's coordinates are one range: one slice fill and one copy,
         // not a bounds test an entry)
-        let (q, v, frozen) = (q.as_mut_slice(), v.as_mut_slice(), self.q_frozen.as_slice());
         for (tree, _) in model.trees.iter().zip(&self.asleep).filter(|&(_, &a)| a) {
-            if let Some(v) = v.get_mut(tree.v.clone()) {
+            if let Some(v) = v.as_mut_slice().get_mut(tree.v.clone()) {
                 v.fill(0.0);
             }
-            if let (Some(q), Some(f)) = (q.get_mut(tree.q.clone()), frozen.get(tree.q.clone())) {
-                q.copy_from_slice(f);
-            }
+            copy_range(q, &self.q_frozen, tree.q.clone());
         }
     }
 
@@ -631,7 +628,10 @@ impl super::Simulation {
             .then(|| (self.servo.kp.as_slice(), self.servo.kd.as_slice()));
         for &t in self.sleep.awake_trees() {
             let r = self.model.trees[t].v.clone();
-            let set = |x: &[f64]| x.get(r.clone()).is_some_and(|x| x.iter().any(|&x| x != 0.0));
+            let set = |x: &[f64]| {
+                x.get(r.clone())
+                    .is_some_and(|x| x.iter().any(|&x| x != 0.0))
+            };
             self.sleep_forced[t] = set(tau) || servo.is_some_and(|(kp, kd)| set(kp) || set(kd));
         }
         let slept = self.sleep.after_step(
@@ -652,5 +652,14 @@ impl super::Simulation {
             self.cons.hold_warm(&self.sleep.doze.new_slots);
         }
         self.sleep.compose(&self.model, self.cons.body_forces());
+    }
+}
+
+/// `to[r] = from[r]` (a range out of either: nothing copied): a tree's
+/// coordinates, one range of q or v.
+#[inline]
+pub(super) fn copy_range(to: &mut DVector<f64>, from: &DVector<f64>, r: std::ops::Range<usize>) {
+    if let (Some(t), Some(f)) = (to.as_mut_slice().get_mut(r.clone()), from.as_slice().get(r)) {
+        t.copy_from_slice(f);
     }
 }

@@ -160,7 +160,7 @@ impl Constraints {
                 false => 0.0,
             };
             if which > 0 && mu > 0.0 {
-                self.warm_joint[d][2 + which as usize % 3] = mu;
+                self.warm_joint[d][PosWarm::limit_entry(which)] = mu;
             }
             let iv = model.dof_v(d);
             let jv = joint_entry(rows, r, iv);

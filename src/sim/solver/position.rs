@@ -263,6 +263,14 @@ impl PosWarm {
         self.decay = (1.0 - beta).clamp(0.0, 1.0);
     }
 
+    /// The entry of a dof's `warm_joint` (λ of friction, lower, upper at
+    /// 0, 1, 2) that keeps the pass's μ of its limit row `which` (1 lower,
+    /// 2 upper): 3 or 4.
+    #[inline]
+    pub fn limit_entry(which: u8) -> usize {
+        2 + which as usize % 3
+    }
+
     /// The start of this pass by row (`n` rows): contact triple c (rows 3c..)
     /// of point `row_point[c]` from its slot's entry 3 of `warm_contact`, a
     /// fresh point from 0; joint row `first_joint + k` of `joint_rows[k]` =
@@ -291,7 +299,7 @@ impl PosWarm {
         for (k, &(d, which)) in joint_rows.iter().enumerate() {
             if let (Some(w), Some(x)) = (warm_joint.get(d), self.start.get_mut(first_joint + k)) {
                 *x = if which > 0 {
-                    self.decay * w[2 + which as usize % 3]
+                    self.decay * w[PosWarm::limit_entry(which)]
                 } else {
                     0.0
                 };
