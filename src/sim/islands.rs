@@ -19,6 +19,11 @@
 use super::solver::Rows;
 use crate::model::Model;
 
+mod split;
+
+/// A group's key while it is left out of the solve (split.rs).
+const LEFT: usize = usize::MAX - 1;
+
 /// This step's islands: their row runs and their dofs.
 #[derive(Clone, Debug)]
 pub(crate) struct Islands {
@@ -31,6 +36,39 @@ pub(crate) struct Islands {
     /// and each group's island root tree (`usize::MAX`: a row on no dof).
     groups: Vec<(usize, usize)>,
     gkey: Vec<usize>,
+    /// Each group's first tree (`usize::MAX`: a row on no dof; [`LEFT`]: a
+    /// contact group all left out of the solve).
+    gtree: Vec<usize>,
+    /// The contacts left out of this step's solve (split.rs): (normal row,
+    /// group, the tree of its first dof, of its last).
+    left: Vec<(usize, usize, usize, usize)>,
+    /// Each row: a left-out contact's normal (split.rs); each group: some
+    /// contact of it is left out.
+    out: Vec<bool>,
+    gpart: Vec<bool>,
+    /// Δv' at the warm start (split.rs), every island's own warm start
+    /// ([`Islands::warm`]), made when `warm_made`.
+    warm: Vec<f64>,
+    warm_made: bool,
+    /// Per island: it was made by the last join (split.rs); its root tree
+    /// (`usize::MAX`: rows on no dof; [`LEFT`]: emptied by a join).
+    dirty: Vec<bool>,
+    iroot: Vec<usize>,
+    /// Per tree: the island it roots (`usize::MAX`: none), and whether that
+    /// island's Δv' (or w') moved since the last check of the left-out
+    /// contacts; every contact is checked while `check_all` (split.rs).
+    iof: Vec<usize>,
+    touched: Vec<bool>,
+    check_all: bool,
+    /// Scratch of a join (split.rs): the failed contacts (row, group, trees),
+    /// and the pieces of the new islands (root, island or row).
+    fails: Vec<(usize, usize, usize, usize)>,
+    pieces: Vec<(usize, usize, usize)>,
+    /// The islands to solve: every one after a grouping, the dirty ones
+    /// after a join.
+    todo: Vec<usize>,
+    /// Contact groups likely inactive are left out of the solve (split.rs).
+    split: bool,
     /// The group starting at each row (read at runs' first rows only).
     group_at: Vec<usize>,
     /// Runs of consecutive rows of one island: (island key, first row, end).
@@ -113,6 +151,21 @@ impl Islands {
             parent: (0..nt).collect(),
             groups: Vec::with_capacity(rows),
             gkey: Vec::with_capacity(rows),
+            gtree: Vec::with_capacity(rows),
+            left: Vec::with_capacity(rows),
+            out: vec![false; rows],
+            gpart: Vec::with_capacity(rows),
+            warm: vec![0.0; model.nv],
+            warm_made: false,
+            dirty: Vec::with_capacity(rows.min(nt + 1)),
+            iroot: Vec::with_capacity(rows.min(nt + 1)),
+            iof: vec![usize::MAX; nt],
+            touched: vec![false; nt],
+            check_all: false,
+            fails: Vec::with_capacity(rows),
+            pieces: Vec::with_capacity(rows),
+            todo: Vec::with_capacity(rows.min(nt + 1)),
+            split: split::enabled(),
             group_at: vec![0; rows],
             runs: Vec::with_capacity(rows),
             sorted: Vec::with_capacity(rows),
@@ -149,12 +202,22 @@ impl Islands {
         Some((t(first)?, t(last)?))
     }
 
-    /// Groups the assembled rows into islands.
+    /// Groups the assembled rows into islands. With the split on (split.rs),
+    /// a contact group between trees whose every point is likely inactive
+    /// this step joins nothing and is left out of the islands' rows, to be
+    /// checked at their solution ([`Islands::join_failed`]).
     pub fn group(&mut self, rows: &Rows) {
         let n = rows.n.min(self.group_at.len());
+        // (a scene of one tree is never split; nor is one whose rows all lie
+        // on the factor's own paths, with no contact between two trees —
+        // without the split on, every grouping of the same paths is the same)
+        // (nor a step of few rows: its islands are small, and the split's
+        // bookkeeping costs more than the sweeps it saves, split.rs)
+        let may_split = self.split && self.parent.len() > 1 && n >= split::min_rows();
         // the same rows' paths as the last grouping, each one of the factor's
         // (fixed for the rows' life, [`Rows::set_table`]): the same islands
-        let fixed = rows.unions_empty();
+        let fixed = rows.unions_empty() && !may_split;
+        self.warm_made = false;
         if fixed && self.cached && rows.path[..n] == self.last[..] {
             return;
         }
@@ -180,48 +243,100 @@ impl Islands {
             self.group_at[s] = self.groups.len();
             self.groups.push((s, r));
         }
-        self.gkey.clear();
+        self.gtree.clear();
+        for &(r, _, _, _) in &self.left {
+            self.out[r] = false;
+        }
+        self.left.clear();
+        self.gpart.clear();
+        self.gpart.resize(self.groups.len(), false);
+        self.check_all = true;
         if self.parent.len() == 1 {
             // one tree (a single robot): every row on a dof joins tree 0, no
             // union to find (the keys the general pass gives, without it)
             for g in 0..self.groups.len() {
                 let k = self.ends(rows, self.groups[g].0).map_or(usize::MAX, |_| 0);
-                self.gkey.push(k);
+                self.gtree.push(k);
             }
         } else {
-            // (each group's first tree kept in `gkey` meanwhile: its ends
-            // looked up once)
+            if may_split {
+                rows.warm_velocity(&mut self.warm);
+            }
+            self.warm_made = may_split;
+            // (each group's first tree kept in `gtree`: its ends looked up once)
             for g in 0..self.groups.len() {
-                let k = match self.ends(rows, self.groups[g].0) {
+                let (s, e) = self.groups[g];
+                let k = match self.ends(rows, s) {
                     Some((a, b)) => {
-                        let (ra, rb) = (self.find(a), self.find(b));
-                        if ra != rb {
-                            self.parent[ra.max(rb)] = ra.min(rb);
+                        let kept = !may_split || self.leave_out(rows, g, s, e, a, b);
+                        if kept {
+                            let (ra, rb) = (self.find(a), self.find(b));
+                            if ra != rb {
+                                self.parent[ra.max(rb)] = ra.min(rb);
+                            }
+                            a
+                        } else {
+                            LEFT
                         }
-                        a
                     }
                     None => usize::MAX,
                 };
-                self.gkey.push(k);
-            }
-            for g in 0..self.gkey.len() {
-                let a = self.gkey[g];
-                if a != usize::MAX {
-                    self.gkey[g] = self.find(a);
-                }
+                self.gtree.push(k);
             }
         }
-        // runs of consecutive rows with one key (whole groups), then grouped
-        // by key (stable: row order within an island)
+        self.build(rows);
+    }
+
+    /// The islands' runs and dofs from the groups' trees and the union-find.
+    fn build(&mut self, rows: &Rows) {
+        self.gkey.clear();
+        for g in 0..self.gtree.len() {
+            let a = self.gtree[g];
+            let k = if a < LEFT { self.find(a) } else { a };
+            self.gkey.push(k);
+        }
+        // runs of consecutive rows with one key (whole groups, but for the
+        // contacts left out), then grouped by key (stable: row order within
+        // an island)
         self.runs.clear();
-        let mut g = 0;
-        while g < self.groups.len() {
+        let mut cur = (usize::MAX, 0, 0);
+        for g in 0..self.groups.len() {
             let k = self.gkey[g];
-            let s = self.groups[g].0;
-            while g < self.groups.len() && self.gkey[g] == k {
-                g += 1;
+            if k == LEFT {
+                continue;
             }
-            self.runs.push((k, s, self.groups[g - 1].1));
+            let (s, e) = self.groups[g];
+            if !self.gpart[g] {
+                if cur.0 == k && cur.2 == s {
+                    cur.2 = e;
+                } else {
+                    if cur.2 > cur.1 {
+                        self.runs.push(cur);
+                    }
+                    cur = (k, s, e);
+                }
+                continue;
+            }
+            // a group with contacts left out: its kept triples
+            let mut r = s;
+            while r < e {
+                if !self.out[r] {
+                    if cur.0 == k && cur.2 == r {
+                        cur.2 = r + 3;
+                    } else {
+                        if cur.2 > cur.1 {
+                            self.runs.push(cur);
+                        }
+                        // (a run starting inside a group: its group recorded)
+                        self.group_at[r] = g;
+                        cur = (k, r, r + 3);
+                    }
+                }
+                r += 3;
+            }
+        }
+        if cur.2 > cur.1 {
+            self.runs.push(cur);
         }
         // (a counting sort over the keys: the runs are in row order, so each
         // key's stay in it; the trees' keys, then rows on no dof, as a sort by
@@ -246,8 +361,11 @@ impl Islands {
         std::mem::swap(&mut self.runs, &mut self.sorted);
         // each island's runs and dofs
         self.islands.clear();
+        self.iroot.clear();
+        self.iof.fill(usize::MAX);
         self.dofs.clear();
         let table = rows.table();
+        let path = &rows.path[..rows.n.min(self.group_at.len())];
         let mut i = 0;
         while i < self.runs.len() {
             let k = self.runs[i].0;
@@ -316,7 +434,20 @@ impl Islands {
                 }
             }
             self.islands.push(((r0, i), (d0, self.dofs.len())));
+            if let Some(x) = self.iof.get_mut(k) {
+                *x = self.iroot.len();
+            }
+            self.iroot.push(k);
         }
+        self.dirty.clear();
+        self.dirty.resize(self.islands.len(), false);
+        self.todo.clear();
+        self.todo.extend(0..self.islands.len());
+    }
+
+    /// The islands to solve ([`Islands::join_failed`]).
+    pub fn todo(&self) -> &[usize] {
+        &self.todo
     }
 
     /// The islands of the last grouping.

@@ -46,47 +46,74 @@ impl Constraints {
             // each island on its own (on several threads: docs/theory.md
             // §"Islands"), every island's result independent of the others'
             self.islands.group(rows);
-            let count = self.islands.len();
-            if self.isl_sweeps.len() < count {
-                self.isl_sweeps.resize(count, 0);
-            }
             let written = rows.take_written();
             let (mut lam, mut up) = written;
             let dv = self.dv.as_mut_slice();
             let args = (iterations, tol, relaxation);
-            match self.pool.as_ref().filter(|_| count > 1) {
-                Some(pool) => {
-                    // a = R v* for the threads' energy-safe exits, before them
-                    f.apply_r(vfree.as_slice(), &mut self.a);
-                    par_islands(
-                        pool,
-                        rows,
-                        &self.islands,
-                        &mut self.scratch,
-                        &mut self.isl_sweeps[..count],
-                        (&mut lam, &mut up, dv),
-                        (&self.a[..], iterations, tol, relaxation),
-                    )
+            // every island's warm start, made in the grouping: the first
+            // solves take it ([`Islands::warm`])
+            let mut given = false;
+            if let Some(w) = self.islands.warm()
+                && w.len() == dv.len()
+            {
+                dv.copy_from_slice(w);
+                given = true;
+            }
+            // every island, then those a left-out contact that failed its
+            // check joined (src/sim/islands/split.rs), until none fails
+            let mut a_ready = false;
+            let mut first = true;
+            loop {
+                let todo = self.islands.todo();
+                if self.isl_sweeps.len() < todo.len() {
+                    self.isl_sweeps.resize(todo.len(), 0);
                 }
-                None => {
-                    let mut out = IslandOut {
-                        lambda: &mut lam,
-                        u_prev: &mut up,
-                        sm: &mut self.scratch[0],
-                    };
-                    // a = R v* only if an island's energy-safe exit needs it
-                    let mut a = FreeR::Lazy(f, vfree.as_slice(), &mut self.a[..], false);
-                    for (i, s) in self.isl_sweeps[..count].iter_mut().enumerate() {
-                        let isl = self.islands.get(i);
-                        *s = solve_island(rows, &mut out, &isl, dv, &mut a, args);
+                let done = &mut self.isl_sweeps[..todo.len()];
+                match self.pool.as_ref().filter(|_| todo.len() > 1) {
+                    Some(pool) => {
+                        // a = R v* for the threads' energy-safe exits, before them
+                        if !a_ready {
+                            f.apply_r(vfree.as_slice(), &mut self.a);
+                            a_ready = true;
+                        }
+                        par_islands(
+                            pool,
+                            rows,
+                            (&self.islands, todo),
+                            &mut self.scratch,
+                            done,
+                            (&mut lam, &mut up, &mut *dv),
+                            (&self.a[..], iterations, tol, relaxation),
+                            given && first,
+                        )
+                    }
+                    None => {
+                        let mut out = IslandOut {
+                            lambda: &mut lam,
+                            u_prev: &mut up,
+                            sm: &mut self.scratch[0],
+                            warm_given: false,
+                        };
+                        // a = R v* only if an island's energy-safe exit needs it
+                        let mut a = FreeR::Lazy(f, vfree.as_slice(), &mut self.a[..], a_ready);
+                        for (&i, s) in todo.iter().zip(done.iter_mut()) {
+                            let isl = self.islands.get(i);
+                            out.warm_given = given && first;
+                            *s = solve_island(rows, &mut out, &isl, dv, &mut a, args);
+                        }
+                        a_ready = a.ready();
                     }
                 }
+                for (&i, &s) in todo.iter().zip(self.isl_sweeps.iter()) {
+                    self.work += (self.islands.get(i).rows() * s) as u64;
+                    sweeps = sweeps.max(s);
+                }
+                if !self.islands.join_failed(rows, dv, false, tol) {
+                    break;
+                }
+                first = false;
             }
             rows.put_written((lam, up));
-            for (i, &s) in self.isl_sweeps[..count].iter().enumerate() {
-                self.work += (self.islands.get(i).rows() * s) as u64;
-                sweeps = sweeps.max(s);
-            }
         } else {
             // Newton: the whole scene at once; a solve stopped by the cap is
             // scaled onto the exact solution's energy bound, never swept
@@ -99,6 +126,7 @@ impl Constraints {
                     lambda: &mut lam,
                     u_prev: &mut up,
                     sm: &mut self.scratch[0],
+                    warm_given: false,
                 };
                 let d = self.dv.as_mut_slice();
                 s += energy_safe_exit(rows, &mut out, &whole, None, &self.a, d, 0, tol);
@@ -108,7 +136,6 @@ impl Constraints {
             sweeps = s;
         }
         let pgs = solver == Solver::Pgs;
-        let count = if pgs { self.islands.len() } else { 1 };
         fn dofs<'a>(pgs: bool, isl: &Island<'a>) -> Option<&'a [usize]> {
             pgs.then_some(isl.dofs)
         }
@@ -122,20 +149,36 @@ impl Constraints {
             let (rp, wc) = (&self.row_point, &self.warm_contact);
             let (jr, fj, wj) = (&self.joint_rows, self.first_joint_row, &self.warm_joint);
             let warm = self.pos_warm.gather(rows.n, rp, points, wc, fj, jr, wj);
-            for i in 0..count {
-                let isl = if pgs { self.islands.get(i) } else { whole };
-                let violated = |&(_, s, e): &(usize, usize, usize)| {
-                    rows.bpos[s..e]
-                        .iter()
-                        .fold(false, |any, &b| any | (b != 0.0))
-                };
-                if pgs && !isl.runs.iter().any(violated) {
-                    continue;
+            // every island, then those a left-out contact the pass would
+            // close joined (src/sim/islands/split.rs), until none would
+            let mut again = false;
+            if pgs {
+                self.islands.untouch();
+            }
+            loop {
+                let count = if pgs { self.islands.len() } else { 1 };
+                for i in 0..count {
+                    let isl = if pgs { self.islands.get(i) } else { whole };
+                    let violated = |&(_, s, e): &(usize, usize, usize)| {
+                        rows.bpos[s..e]
+                            .iter()
+                            .fold(false, |any, &b| any | (b != 0.0))
+                    };
+                    if pgs && ((again && !self.islands.dirty(i)) || !isl.runs.iter().any(violated)) {
+                        continue;
+                    }
+                    let dw = self.push.as_mut_slice();
+                    let d = dofs(pgs, &isl);
+                    let s = rows.solve_position_runs(isl.runs, d, dw, iterations, tol, Some(warm));
+                    self.work += (isl.rows() * s) as u64;
+                    if pgs {
+                        self.islands.touch(i);
+                    }
                 }
-                let dw = self.push.as_mut_slice();
-                let d = dofs(pgs, &isl);
-                let s = rows.solve_position_runs(isl.runs, d, dw, iterations, tol, Some(warm));
-                self.work += (isl.rows() * s) as u64;
+                if !pgs || !self.islands.join_failed(rows, self.push.as_slice(), true, tol) {
+                    break;
+                }
+                again = true;
             }
             // Δv = R⁻¹ Δv', w = R⁻¹ w'
             f.half_solve2(self.dv.as_mut_slice(), self.push.as_mut_slice());
@@ -284,6 +327,10 @@ enum FreeR<'a> {
 }
 
 impl FreeR<'_> {
+    /// a is computed.
+    fn ready(&self) -> bool {
+        matches!(self, FreeR::Ready(_) | FreeR::Lazy(_, _, _, true))
+    }
     /// a, computed here the first time for a `Lazy` one.
     fn get(&mut self) -> &[f64] {
         match self {
@@ -334,23 +381,24 @@ struct Shared {
 unsafe impl Send for Shared {}
 unsafe impl Sync for Shared {}
 
-/// The islands solved on the threads of `pool`: cut into one run of
-/// consecutive islands a thread, of about equal rows; each island's result
+/// The islands `todo` of `islands` solved on the threads of `pool`: cut
+/// into one run of consecutive islands a thread, of about equal rows; each island's result
 /// (its impulses, its Δv', its sweeps in `sweeps`) is the one a single
 /// thread computes, whatever the cut (bit for bit: nothing an island reads
 /// is written by another).
 fn par_islands(
     pool: &rayon::ThreadPool,
     rows: &Rows,
-    islands: &Islands,
+    (islands, todo): (&Islands, &[usize]),
     scratch: &mut [Scratch],
     sweeps: &mut [usize],
     (lambda, u_prev, dv): (&mut [f64], &mut [f64], &mut [f64]),
     (a, iterations, tol, relax): (&[f64], usize, f64, f64),
+    given: bool,
 ) {
     let args = (iterations, tol, relax);
-    let count = sweeps.len();
-    let total: usize = (0..count).map(|i| islands.get(i).rows()).sum();
+    let count = sweeps.len().min(todo.len());
+    let total: usize = todo[..count].iter().map(|&i| islands.get(i).rows()).sum();
     let parts = scratch.len().max(1);
     let sh = Shared {
         lambda: (lambda.as_mut_ptr(), lambda.len()),
@@ -364,7 +412,7 @@ fn par_islands(
             let goal = total * (k + 1) / parts;
             let mut end = first;
             while end < count && (acc < goal || k + 1 == parts) {
-                acc += islands.get(end).rows();
+                acc += islands.get(todo[end]).rows();
                 end += 1;
             }
             let (mine, more) = rest.split_at_mut(end - first);
@@ -385,10 +433,17 @@ fn par_islands(
                         std::slice::from_raw_parts_mut(sh.dv.0, sh.dv.1),
                     )
                 };
-                let mut out = IslandOut { lambda, u_prev, sm };
+                let mut out = IslandOut {
+                    lambda,
+                    u_prev,
+                    sm,
+                    warm_given: false,
+                };
                 let mut a = FreeR::Ready(a);
                 for (j, s) in mine.iter_mut().enumerate() {
-                    *s = solve_island(rows, &mut out, &islands.get(start + j), dv, &mut a, args);
+                    let isl = islands.get(todo[start + j]);
+                    out.warm_given = given;
+                    *s = solve_island(rows, &mut out, &isl, dv, &mut a, args);
                 }
             });
         }

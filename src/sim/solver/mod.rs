@@ -354,6 +354,93 @@ impl Rows {
         self.path[r..r + 3].fill(path);
         Some(r)
     }
+    /// Rows `s..e` are contact triples.
+    pub(crate) fn contacts_only(&self, s: usize, e: usize) -> bool {
+        e <= self.n && (e - s) % 3 == 0 && (s..e).step_by(3).all(|r| self.is_block[r])
+    }
+    /// Δv' at the warm start of every row, Σ λᵣ yᵣ (`x`, nv entries, every
+    /// entry written): on each island's dofs bit for bit the start its own
+    /// sweeps make ([`Rows::sweeps`]: the same updates in row order, a
+    /// contact's three rows in one pass when all three are nonzero; rows of
+    /// other islands touch other dofs). Leaves `x` untouched if the rows are
+    /// not well formed (the sweeps' checks).
+    pub(crate) fn warm_velocity(&self, x: &mut [f64]) {
+        let (table, n, st) = (&self.table[..], self.n, self.stride);
+        if x.len() < self.nv
+            || self.y.len() < n * st
+            || self.ylanes.len() < n * st
+            || self.lambda.len() < n
+            || self.path[..n].iter().any(|&(s, l)| s + l > table.len() || l > st)
+        {
+            return;
+        }
+        x.iter_mut().for_each(|v| *v = 0.0);
+        let (lambda, contact) = (&self.lambda[..n], &self.is_block[..n]);
+        let mut r = 0;
+        while r < n {
+            let l = lambda[r];
+            let (s, pl) = self.path[r];
+            let p = &table[s..s + pl];
+            if contact[r] && r + 2 < n && l != 0.0 && lambda[r + 1] != 0.0 && lambda[r + 2] != 0.0 {
+                // (as the sweeps' warm start: path indices < nv ≤ x.len())
+                kernels::warm3([l, lambda[r + 1], lambda[r + 2]], &self.ylanes[r * st..r * st + pl], p, x);
+                r += 3;
+                continue;
+            }
+            if l != 0.0 {
+                for (&k, &v) in p.iter().zip(&self.y[r * st..r * st + pl]) {
+                    if let Some(xk) = x.get_mut(k) {
+                        *xk += l * v;
+                    }
+                }
+            }
+            r += 1;
+        }
+    }
+
+    /// The contact triple at row `r` is not likely to push this step
+    /// (src/sim/islands/split.rs): no impulse warm-started on its rows, its
+    /// normal not violated (b_pos = 0), and its normal velocity both free
+    /// (cᵣ) and at the warm start's Δv' (`warm`) at least `margin` above
+    /// its target.
+    pub(crate) fn contact_idle(&self, r: usize, warm: &[f64], margin: f64) -> bool {
+        let l = &self.lambda[r..r + 3];
+        if !(self.c[r] >= self.b[r]) || self.bpos[r] > 0.0 || l[0] != 0.0 || l[1] != 0.0 || l[2] != 0.0 {
+            return false;
+        }
+        let st = self.stride;
+        let (ps, pl) = self.path[r];
+        let (Some(p), Some(y)) = (self.table.get(ps..ps + pl), self.y.get(r * st..r * st + pl)) else {
+            return false;
+        };
+        let d: f64 = y.iter().zip(p).map(|(a, &k)| a * warm.get(k).copied().unwrap_or(0.0)).sum();
+        self.c[r] + d >= self.b[r] + margin
+    }
+    /// The normal of the contact at row `r` holds at λ = 0 to `tol` for the
+    /// Δv' `x` (src/sim/islands/split.rs): uₙ = cₙ + yₙ·x ≥ bₙ − tol, or, for
+    /// the position pass's w' (`position`), yₙ·x ≥ b_pos − tol. A row no
+    /// impulse moves (Wᵣᵣ = 0) holds.
+    pub(crate) fn contact_holds(&self, r: usize, x: &[f64], position: bool, tol: f64) -> bool {
+        if r >= self.n || self.winv[r] == 0.0 {
+            return true;
+        }
+        let st = self.stride;
+        let (ps, pl) = self.path[r];
+        let (Some(p), Some(y)) = (self.table.get(ps..ps + pl), self.y.get(r * st..r * st + pl)) else {
+            return false;
+        };
+        let mut d = 0.0;
+        for (&v, &k) in y.iter().zip(p) {
+            // (a row's path holds dof indices < nv ≤ x.len(): the sweeps'
+            // invariant; a short `x` reads 0 past its end)
+            d += v * x.get(k).copied().unwrap_or(0.0);
+        }
+        if position {
+            d >= self.bpos[r] - tol
+        } else {
+            self.c[r] + d >= self.b[r] - tol
+        }
+    }
     /// Marks the dofs of joints other than free ones (`jointed[d]`, nv
     /// entries): the contacts whose rows reach one get
     /// the self-stress shedding of stress.rs.

@@ -52,6 +52,7 @@ impl Rows {
             lambda: &mut lambda,
             u_prev: &mut u_prev,
             sm: &mut sm,
+            warm_given: false,
         };
         let (it, polished) = self.sweeps(&mut out, runs, dofs, dv, max_iter, tol, relax);
         self.lambda = lambda;
@@ -227,12 +228,18 @@ impl Rows {
             let (s, l) = paths[r];
             &table[s..s + l]
         };
-        // Δv' from the warm start
+        // Δv' from the warm start (given: already in `dv` on the island's
+        // dofs, [`Rows::warm_velocity`])
+        let given = std::mem::replace(&mut out.warm_given, false);
         match dofs {
+            _ if given => {}
             Some(d) => d.iter().for_each(|&k| dv[k] = 0.0),
             None => dv.iter_mut().for_each(|x| *x = 0.0),
         }
         for &(_, s, e) in runs {
+            if given {
+                break;
+            }
             let mut r = s;
             while r < e {
                 let l = lambda[r];
@@ -578,6 +585,9 @@ pub(crate) struct IslandOut<'a> {
     pub u_prev: &'a mut [f64],
     /// The subspace step's scratch.
     pub sm: &'a mut Scratch,
+    /// `dv` holds the island's Δv' at its warm start already (the next
+    /// sweeps skip making it, and clear this).
+    pub warm_given: bool,
 }
 
 /// A subspace step's scratch ([`Rows::scratch`]).

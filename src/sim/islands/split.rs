@@ -1,0 +1,239 @@
+//! The solve's islands split by the contacts likely active (issue #30;
+//! docs/theory.md §"Islands").
+//!
+//! A contact's rows are made for every point within the contact margin and
+//! the speculative margin, and most of a pile's points there carry no
+//! impulse: a third to two fifths of a big island's contacts stay at λ = 0
+//! through its whole solve. Joining trees through them makes islands larger
+//! than the impulses couple, and projected Gauss–Seidel's rate falls with an
+//! island's size. So a contact joins its two trees for the solve only when
+//! it is likely to push this step, and each contact (its three rows) is
+//! left out on its own, at λ = 0, when none of these holds: its normal's
+//! free velocity closes the gap this step (cᵣ < bᵣ), it was warm-started
+//! with an impulse (last step's λ ≠ 0 on one of its rows), its position is
+//! violated (b_pos > 0), or the warm start's Δv' (every row's λ_warm yᵣ,
+//! [`Rows::warm_velocity`], made once and taken by each island as its own
+//! start) leaves its normal less than [`MARGIN`] above its target. Steps of
+//! fewer than [`MIN_ROWS`] rows are not split.
+//!
+//! λ = 0 on a left-out point is its solution exactly when uₙ ≥ bₙ at the
+//! solved velocities (its tangents are then held at 0 by the cone of radius
+//! μλₙ = 0): that is checked for every left-out point once the islands are
+//! solved, to the solve's tolerance (a row's own residual, the measure the
+//! sweeps stop on). Where it fails, the contact joins its trees, the islands
+//! of those trees are merged into one new island (nothing else rebuilt), and
+//! it is solved again, warm from the split solution; the rest stand (their
+//! rows and dofs are untouched by it), and only the left-out points on a
+//! re-solved island are checked again. The end is a solution of
+//! the whole rows' conditions, to the same tolerance as one solve of them.
+//! The position pass is held the same way: a left-out point must not close
+//! its gap under the pass's pseudo-velocity (yₙ·w' ≥ −tol).
+//!
+//! The sleep islands (src/sim/sleep.rs) are not these: they join trees by
+//! every point, as before.
+
+use super::{Islands, LEFT};
+use crate::sim::solver::Rows;
+
+/// The split is on (`URDYN_SPLIT=0` turns it off: a measurement knob).
+pub(super) fn enabled() -> bool {
+    std::env::var("URDYN_SPLIT").map_or(true, |v| v != "0")
+}
+
+/// A contact is left out only when the warm start leaves its normal this
+/// much above its target (m/s).
+const MARGIN: f64 = 1e-3;
+
+/// A step is split only with at least this many rows (64 contacts): below
+/// it the warm start and the checks cost more than the sweeps saved (mixed
+/// 16 pile, 81 rows a solve at the median: +3.7 % instructions of split
+/// bookkeeping against −2 % of sweeps; boxes 64, 330 rows: −6.4 % in all).
+const MIN_ROWS: usize = 192;
+
+pub(super) fn min_rows() -> usize {
+    static M: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *M.get_or_init(|| std::env::var("URDYN_SPLIT_MIN").ok().and_then(|v| v.parse().ok()).unwrap_or(MIN_ROWS))
+}
+
+fn margin() -> f64 {
+    static M: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
+    *M.get_or_init(|| std::env::var("URDYN_SPLIT_MARGIN").ok().and_then(|v| v.parse().ok()).unwrap_or(MARGIN))
+}
+
+impl Islands {
+    /// Marks the contacts of group `g` (rows `s..e`, on trees `a` and `b`)
+    /// left out of the solve: contact triples none likely to push this step
+    /// ([`Rows::contact_idle`]). Returns whether the group keeps a row (it
+    /// joins its trees).
+    pub(super) fn leave_out(&mut self, rows: &Rows, g: usize, s: usize, e: usize, a: usize, b: usize) -> bool {
+        if !rows.contacts_only(s, e) {
+            return true;
+        }
+        let (mut kept, mut part) = (false, false);
+        let mut r = s;
+        while r < e {
+            if rows.contact_idle(r, &self.warm, margin()) {
+                self.out[r] = true;
+                self.left.push((r, g, a, b));
+                part = true;
+            } else {
+                kept = true;
+            }
+            r += 3;
+        }
+        self.gpart[g] = part;
+        kept
+    }
+
+    /// Checks the left-out contacts at the solved Δv' `x` (velocity) or w'
+    /// (`position`), to `tol`: after a grouping every one, then only those
+    /// on a tree of an island solved (or pushed) since the last check
+    /// ([`Islands::touch`]; the others' velocities have not moved). Each that
+    /// fails joins its two trees and leaves the left-out list; the islands it
+    /// joins are merged into one new island (their runs and the contact's
+    /// rows, in row order; their dofs and its path's, ascending), the old
+    /// ones emptied, and the new ones are the islands to solve
+    /// ([`Islands::todo`], [`Islands::dirty`]). Returns whether any joined.
+    pub fn join_failed(&mut self, rows: &Rows, x: &[f64], position: bool, tol: f64) -> bool {
+        self.fails.clear();
+        let mut keep = 0;
+        for i in 0..self.left.len() {
+            let (r, g, a, b) = self.left[i];
+            let moved = self.check_all || {
+                let (ra, rb) = (self.find(a), self.find(b));
+                self.touched[ra] || self.touched[rb]
+            };
+            if !moved || rows.contact_holds(r, x, position, tol) {
+                self.left[keep] = self.left[i];
+                keep += 1;
+                continue;
+            }
+            self.fails.push((r, g, a, b));
+        }
+        self.left.truncate(keep);
+        self.check_all = false;
+        self.touched.fill(false);
+        if self.fails.is_empty() {
+            return false;
+        }
+        // the pieces of the new islands: the islands of the failed contacts'
+        // trees (before their unions), and the contacts' rows
+        self.pieces.clear();
+        for i in 0..self.fails.len() {
+            let (r, _, a, b) = self.fails[i];
+            for t in [a, b] {
+                let ri = self.find(t);
+                let k = self.iof[ri];
+                if k != usize::MAX {
+                    self.pieces.push((t, 0, k));
+                }
+            }
+            self.pieces.push((a, 1, r));
+        }
+        for i in 0..self.fails.len() {
+            let (r, g, a, b) = self.fails[i];
+            let (ra, rb) = (self.find(a), self.find(b));
+            if ra != rb {
+                self.parent[ra.max(rb)] = ra.min(rb);
+            }
+            self.out[r] = false;
+            if self.gtree[g] == LEFT {
+                self.gtree[g] = a;
+            }
+        }
+        for i in 0..self.pieces.len() {
+            let t = self.pieces[i].0;
+            self.pieces[i].0 = self.find(t);
+        }
+        self.pieces.sort_unstable();
+        self.pieces.dedup();
+        self.dirty.fill(false);
+        self.todo.clear();
+        let (table, path) = (rows.table(), &rows.path[..]);
+        let mut i = 0;
+        while i < self.pieces.len() {
+            let root = self.pieces[i].0;
+            let (r0, d0) = (self.runs.len(), self.dofs.len());
+            while i < self.pieces.len() && self.pieces[i].0 == root {
+                let (_, kind, k) = self.pieces[i];
+                i += 1;
+                if kind == 0 {
+                    // an island merged: its runs and dofs moved, it emptied
+                    let ((s0, s1), (e0, e1)) = self.islands[k];
+                    for j in s0..s1 {
+                        let (_, s, e) = self.runs[j];
+                        self.runs.push((root, s, e));
+                    }
+                    self.dofs.extend_from_within(e0..e1);
+                    self.islands[k] = ((s0, s0), (e0, e0));
+                    self.iroot[k] = LEFT;
+                } else {
+                    self.runs.push((root, k, k + 3));
+                    let (ps, pl) = path.get(k).copied().unwrap_or((0, 0));
+                    self.dofs.extend_from_slice(table.get(ps..ps + pl).unwrap_or(&[]));
+                }
+            }
+            // row order, adjacent runs one
+            let runs = &mut self.runs[r0..];
+            runs.sort_unstable_by_key(|run| run.1);
+            let mut w = 0;
+            for j in 0..runs.len() {
+                if w > 0 && runs[w - 1].2 == runs[j].1 {
+                    runs[w - 1].2 = runs[j].2;
+                } else {
+                    runs[w] = runs[j];
+                    w += 1;
+                }
+            }
+            self.runs.truncate(r0 + w);
+            // ascending, once each
+            let dofs = &mut self.dofs[d0..];
+            dofs.sort_unstable();
+            let mut w = 0;
+            for j in 0..dofs.len() {
+                if w == 0 || dofs[w - 1] != dofs[j] {
+                    dofs[w] = dofs[j];
+                    w += 1;
+                }
+            }
+            self.dofs.truncate(d0 + w);
+            let ni = self.islands.len();
+            self.islands.push(((r0, self.runs.len()), (d0, self.dofs.len())));
+            self.iroot.push(root);
+            self.iof[root] = ni;
+            self.touched[root] = true;
+            self.dirty.push(true);
+            self.todo.push(ni);
+        }
+        true
+    }
+
+    /// Island `i` was made by the last [`Islands::join_failed`] (its
+    /// solution is to be made again).
+    pub fn dirty(&self, i: usize) -> bool {
+        self.dirty.get(i) == Some(&true)
+    }
+
+    /// Island `i`'s Δv' (or w') moved: the left-out contacts on its trees
+    /// are checked at the next [`Islands::join_failed`].
+    pub fn touch(&mut self, i: usize) {
+        if let Some(&k) = self.iroot.get(i)
+            && let Some(t) = self.touched.get_mut(k)
+        {
+            *t = true;
+        }
+    }
+
+    /// The position pass's checks start: none but those of the islands it
+    /// pushes ([`Islands::touch`]).
+    pub fn untouch(&mut self) {
+        self.check_all = false;
+        self.touched.fill(false);
+    }
+
+    /// Δv' at the warm start of every island of the last grouping, if made
+    /// (split.rs; bit for bit each island's own: [`Rows::warm_velocity`]).
+    pub fn warm(&self) -> Option<&[f64]> {
+        self.warm_made.then_some(&self.warm[..])
+    }
+}
