@@ -164,7 +164,8 @@ impl Constraints {
                             .iter()
                             .fold(false, |any, &b| any | (b != 0.0))
                     };
-                    if pgs && ((again && !self.islands.dirty(i)) || !isl.runs.iter().any(violated)) {
+                    if pgs && ((again && !self.islands.dirty(i)) || !isl.runs.iter().any(violated))
+                    {
                         continue;
                     }
                     let dw = self.push.as_mut_slice();
@@ -175,7 +176,11 @@ impl Constraints {
                         self.islands.touch(i);
                     }
                 }
-                if !pgs || !self.islands.join_failed(rows, self.push.as_slice(), true, tol) {
+                if !pgs
+                    || !self
+                        .islands
+                        .join_failed(rows, self.push.as_slice(), true, tol)
+                {
                     break;
                 }
                 again = true;

@@ -52,12 +52,22 @@ const MIN_ROWS: usize = 192;
 
 pub(super) fn min_rows() -> usize {
     static M: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-    *M.get_or_init(|| std::env::var("URDYN_SPLIT_MIN").ok().and_then(|v| v.parse().ok()).unwrap_or(MIN_ROWS))
+    *M.get_or_init(|| {
+        std::env::var("URDYN_SPLIT_MIN")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(MIN_ROWS)
+    })
 }
 
 fn margin() -> f64 {
     static M: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
-    *M.get_or_init(|| std::env::var("URDYN_SPLIT_MARGIN").ok().and_then(|v| v.parse().ok()).unwrap_or(MARGIN))
+    *M.get_or_init(|| {
+        std::env::var("URDYN_SPLIT_MARGIN")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(MARGIN)
+    })
 }
 
 impl Islands {
@@ -65,7 +75,15 @@ impl Islands {
     /// left out of the solve: contact triples none likely to push this step
     /// ([`Rows::contact_idle`]). Returns whether the group keeps a row (it
     /// joins its trees).
-    pub(super) fn leave_out(&mut self, rows: &Rows, g: usize, s: usize, e: usize, a: usize, b: usize) -> bool {
+    pub(super) fn leave_out(
+        &mut self,
+        rows: &Rows,
+        g: usize,
+        s: usize,
+        e: usize,
+        a: usize,
+        b: usize,
+    ) -> bool {
         if !rows.contacts_only(s, e) {
             return true;
         }
@@ -170,7 +188,8 @@ impl Islands {
                 } else {
                     self.runs.push((root, k, k + 3));
                     let (ps, pl) = path.get(k).copied().unwrap_or((0, 0));
-                    self.dofs.extend_from_slice(table.get(ps..ps + pl).unwrap_or(&[]));
+                    self.dofs
+                        .extend_from_slice(table.get(ps..ps + pl).unwrap_or(&[]));
                 }
             }
             // row order, adjacent runs one
@@ -198,7 +217,8 @@ impl Islands {
             }
             self.dofs.truncate(d0 + w);
             let ni = self.islands.len();
-            self.islands.push(((r0, self.runs.len()), (d0, self.dofs.len())));
+            self.islands
+                .push(((r0, self.runs.len()), (d0, self.dofs.len())));
             self.iroot.push(root);
             self.iof[root] = ni;
             self.touched[root] = true;

@@ -370,7 +370,9 @@ impl Rows {
             || self.y.len() < n * st
             || self.ylanes.len() < n * st
             || self.lambda.len() < n
-            || self.path[..n].iter().any(|&(s, l)| s + l > table.len() || l > st)
+            || self.path[..n]
+                .iter()
+                .any(|&(s, l)| s + l > table.len() || l > st)
         {
             return;
         }
@@ -383,7 +385,12 @@ impl Rows {
             let p = &table[s..s + pl];
             if contact[r] && r + 2 < n && l != 0.0 && lambda[r + 1] != 0.0 && lambda[r + 2] != 0.0 {
                 // (as the sweeps' warm start: path indices < nv ≤ x.len())
-                kernels::warm3([l, lambda[r + 1], lambda[r + 2]], &self.ylanes[r * st..r * st + pl], p, x);
+                kernels::warm3(
+                    [l, lambda[r + 1], lambda[r + 2]],
+                    &self.ylanes[r * st..r * st + pl],
+                    p,
+                    x,
+                );
                 r += 3;
                 continue;
             }
@@ -405,15 +412,25 @@ impl Rows {
     /// its target.
     pub(crate) fn contact_idle(&self, r: usize, warm: &[f64], margin: f64) -> bool {
         let l = &self.lambda[r..r + 3];
-        if !(self.c[r] >= self.b[r]) || self.bpos[r] > 0.0 || l[0] != 0.0 || l[1] != 0.0 || l[2] != 0.0 {
+        if !(self.c[r] >= self.b[r])
+            || self.bpos[r] > 0.0
+            || l[0] != 0.0
+            || l[1] != 0.0
+            || l[2] != 0.0
+        {
             return false;
         }
         let st = self.stride;
         let (ps, pl) = self.path[r];
-        let (Some(p), Some(y)) = (self.table.get(ps..ps + pl), self.y.get(r * st..r * st + pl)) else {
+        let (Some(p), Some(y)) = (self.table.get(ps..ps + pl), self.y.get(r * st..r * st + pl))
+        else {
             return false;
         };
-        let d: f64 = y.iter().zip(p).map(|(a, &k)| a * warm.get(k).copied().unwrap_or(0.0)).sum();
+        let d: f64 = y
+            .iter()
+            .zip(p)
+            .map(|(a, &k)| a * warm.get(k).copied().unwrap_or(0.0))
+            .sum();
         self.c[r] + d >= self.b[r] + margin
     }
     /// The normal of the contact at row `r` holds at λ = 0 to `tol` for the
@@ -426,7 +443,8 @@ impl Rows {
         }
         let st = self.stride;
         let (ps, pl) = self.path[r];
-        let (Some(p), Some(y)) = (self.table.get(ps..ps + pl), self.y.get(r * st..r * st + pl)) else {
+        let (Some(p), Some(y)) = (self.table.get(ps..ps + pl), self.y.get(r * st..r * st + pl))
+        else {
             return false;
         };
         let mut d = 0.0;
