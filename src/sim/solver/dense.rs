@@ -2,8 +2,11 @@
 //! operations of [`crate::dynamics::linalg::ldlt_dropping`] on the same
 //! numbers in the same order (each entry the same bits), laid out for a
 //! small m: four rows' sums carried side by side (independent chains, so
-//! that one does not wait on another's latency) and no test on a dropped
-//! pivot in the inner loops.
+//! that one does not wait on another's latency; two a register on x86_64,
+//! each lane the scalar operations), no test on a dropped pivot in the inner
+//! loops, and raw indices with the bounds checked once a call (a column has
+//! few rows and few terms at these m: per-column bookkeeping, not the
+//! products, was most of the cost).
 //!
 //! Why the test can go: a pivot dropped at column k (D = 0) leaves its column
 //! of L exactly +0 below the diagonal, so every term lᵢₖ lⱼₖ dₖ of a later
@@ -35,77 +38,138 @@ pub(crate) fn ldlt_dropping(a: &mut [f64], ld: usize, m: usize, from: usize, dro
         }
         return;
     }
-    let a = &mut a[..m * ld];
     let mut d = [0.0f64; CAP];
-    // the factored columns: their pivots, and their entries in rows from..
-    for j in 0..from {
-        d[j] = a[j * ld + j];
-        let (head, tail) = a.split_at_mut((j + 1) * ld);
-        let rows = &mut tail[(from - j - 1) * ld..];
-        column(&head[j * ld..j * ld + j], &d[..j], d[j], rows, ld, j);
-    }
-    for j in from..m {
-        let (head, tail) = a.split_at_mut((j + 1) * ld);
-        let (rowj, diag) = {
-            let r = &head[j * ld..j * ld + j + 1];
-            (&r[..j], r[j])
-        };
-        let mut dj = diag;
-        for (&l, &dk) in rowj.iter().zip(&d[..j]) {
-            dj -= l * l * dk;
-        }
-        let dj = if dj > drop * diag && dj > 0.0 {
-            dj
-        } else {
-            0.0
-        };
-        head[j * ld + j] = dj;
-        d[j] = dj;
-        column(&head[j * ld..j * ld + j], &d[..j], dj, tail, ld, j);
-    }
+    // SAFETY: every index read or written below is i·ld + k with i < m and
+    // k ≤ j < m, at most (m − 1)·ld + m − 1 < m·ld ≤ a.len() (checked above);
+    // d's indices are < m ≤ CAP
+    unsafe { factor(a.as_mut_ptr(), ld, m, from, drop, &mut d) }
 }
 
-/// Column j of L in `rows` (whole rows of `ld` entries, each with its entries
-/// before j factored): lᵢⱼ = (aᵢⱼ − Σₖ lᵢₖ lⱼₖ dₖ) / dⱼ over k < j in order
-/// (0 when dⱼ was dropped), `rowj` = lⱼ.., `dk` the pivots before j; four
-/// rows' sums side by side.
+/// [`ldlt_dropping`]'s loops on `a` (m rows of `ld`, the first `from`
+/// factored), column by column: column j's pivot (rows from `from` on),
+/// then its entries in the rows below it that are not factored yet, lᵢⱼ =
+/// (aᵢⱼ − Σₖ lᵢₖ lⱼₖ dₖ) / dⱼ over k < j in order, four rows' sums side by side
+/// (two a register: each lane the scalar operations), +0 for a dropped pivot
+/// (the library's `s / dⱼ` not taken: no sum then).
+///
+/// # Safety
+/// `a` must hold m · ld entries, ld ≥ m, from ≤ m ≤ CAP.
 #[inline(always)]
-fn column(rowj: &[f64], dk: &[f64], dj: f64, rows: &mut [f64], ld: usize, j: usize) {
-    let fin = |s: f64| if dj != 0.0 { s / dj } else { 0.0 };
-    let mut rest = rows;
-    while rest.len() >= 4 * ld {
-        let (four, more) = rest.split_at_mut(4 * ld);
-        rest = more;
-        let (r0, x) = four.split_at_mut(ld);
-        let (r1, x) = x.split_at_mut(ld);
-        let (r2, r3) = x.split_at_mut(ld);
-        let (mut s0, mut s1, mut s2, mut s3) = (r0[j], r1[j], r2[j], r3[j]);
-        let (r0j, r1j, r2j, r3j) = (&r0[..j], &r1[..j], &r2[..j], &r3[..j]);
-        for k in 0..j {
-            let (lk, dk) = (rowj[k], dk[k]);
-            s0 -= r0j[k] * lk * dk;
-            s1 -= r1j[k] * lk * dk;
-            s2 -= r2j[k] * lk * dk;
-            s3 -= r3j[k] * lk * dk;
+unsafe fn factor(a: *mut f64, ld: usize, m: usize, from: usize, drop: f64, d: &mut [f64; CAP]) {
+    // SAFETY: the caller's contract (every index within a and d)
+    unsafe {
+        let d = d.as_mut_ptr();
+        for j in 0..m {
+            let rj = a.add(j * ld);
+            let dj = if j < from {
+                *rj.add(j)
+            } else {
+                // the pivot: its sum over k < j in order, two terms a step
+                let diag = *rj.add(j);
+                let mut s = diag;
+                let mut k = 0;
+                while k + 1 < j {
+                    let (l0, l1) = (*rj.add(k), *rj.add(k + 1));
+                    s -= l0 * l0 * *d.add(k);
+                    s -= l1 * l1 * *d.add(k + 1);
+                    k += 2;
+                }
+                if k < j {
+                    let l = *rj.add(k);
+                    s -= l * l * *d.add(k);
+                }
+                let dj = if s > drop * diag && s > 0.0 { s } else { 0.0 };
+                *rj.add(j) = dj;
+                dj
+            };
+            *d.add(j) = dj;
+            let mut i = if j < from { from } else { j + 1 };
+            if dj == 0.0 {
+                while i < m {
+                    *a.add(i * ld + j) = 0.0;
+                    i += 1;
+                }
+                continue;
+            }
+            #[cfg(target_arch = "x86_64")]
+            {
+                use std::arch::x86_64::*;
+                // SSE2 is part of x86_64
+                let dd = _mm_set1_pd(dj);
+                while i + 4 <= m {
+                    let r0 = a.add(i * ld);
+                    let (r1, r2, r3) = (r0.add(ld), r0.add(2 * ld), r0.add(3 * ld));
+                    let mut s01 = _mm_set_pd(*r1.add(j), *r0.add(j));
+                    let mut s23 = _mm_set_pd(*r3.add(j), *r2.add(j));
+                    for k in 0..j {
+                        let lk = _mm_set1_pd(*rj.add(k));
+                        let dk = _mm_set1_pd(*d.add(k));
+                        let x01 = _mm_set_pd(*r1.add(k), *r0.add(k));
+                        let x23 = _mm_set_pd(*r3.add(k), *r2.add(k));
+                        s01 = _mm_sub_pd(s01, _mm_mul_pd(_mm_mul_pd(x01, lk), dk));
+                        s23 = _mm_sub_pd(s23, _mm_mul_pd(_mm_mul_pd(x23, lk), dk));
+                    }
+                    let (l01, l23) = (_mm_div_pd(s01, dd), _mm_div_pd(s23, dd));
+                    _mm_storel_pd(r0.add(j), l01);
+                    _mm_storeh_pd(r1.add(j), l01);
+                    _mm_storel_pd(r2.add(j), l23);
+                    _mm_storeh_pd(r3.add(j), l23);
+                    i += 4;
+                }
+                if i + 2 <= m {
+                    let r0 = a.add(i * ld);
+                    let r1 = r0.add(ld);
+                    let mut s01 = _mm_set_pd(*r1.add(j), *r0.add(j));
+                    for k in 0..j {
+                        let lk = _mm_set1_pd(*rj.add(k));
+                        let dk = _mm_set1_pd(*d.add(k));
+                        let x01 = _mm_set_pd(*r1.add(k), *r0.add(k));
+                        s01 = _mm_sub_pd(s01, _mm_mul_pd(_mm_mul_pd(x01, lk), dk));
+                    }
+                    let l01 = _mm_div_pd(s01, dd);
+                    _mm_storel_pd(r0.add(j), l01);
+                    _mm_storeh_pd(r1.add(j), l01);
+                    i += 2;
+                }
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            while i + 4 <= m {
+                let r0 = a.add(i * ld);
+                let (r1, r2, r3) = (r0.add(ld), r0.add(2 * ld), r0.add(3 * ld));
+                let (mut s0, mut s1, mut s2, mut s3) =
+                    (*r0.add(j), *r1.add(j), *r2.add(j), *r3.add(j));
+                for k in 0..j {
+                    let (lk, dk) = (*rj.add(k), *d.add(k));
+                    s0 -= *r0.add(k) * lk * dk;
+                    s1 -= *r1.add(k) * lk * dk;
+                    s2 -= *r2.add(k) * lk * dk;
+                    s3 -= *r3.add(k) * lk * dk;
+                }
+                *r0.add(j) = s0 / dj;
+                *r1.add(j) = s1 / dj;
+                *r2.add(j) = s2 / dj;
+                *r3.add(j) = s3 / dj;
+                i += 4;
+            }
+            while i < m {
+                let ri = a.add(i * ld);
+                let mut s = *ri.add(j);
+                for k in 0..j {
+                    s -= *ri.add(k) * *rj.add(k) * *d.add(k);
+                }
+                *ri.add(j) = s / dj;
+                i += 1;
+            }
         }
-        r0[j] = fin(s0);
-        r1[j] = fin(s1);
-        r2[j] = fin(s2);
-        r3[j] = fin(s3);
-    }
-    for ri in rest.chunks_exact_mut(ld) {
-        let mut s = ri[j];
-        for ((&x, &lk), &dk) in ri[..j].iter().zip(rowj).zip(dk) {
-            s -= x * lk * dk;
-        }
-        ri[j] = fin(s);
     }
 }
 
 /// [`linalg::ldlt_dropping_solve`] (L D Lᵀ x = b in place, the factor of
 /// [`ldlt_dropping`] in the lower triangle of the m × m `a`, row i at
 /// `a[i * ld..]`, a dropped pivot's x set to 0), the same operations in the
-/// same order on each entry, without the index checks of the library's loops.
+/// same order on each entry, without the index checks of the library's loops
+/// and with fewer loop steps (two rows' sums a step forward, two terms a step
+/// back).
 pub(crate) fn ldlt_dropping_solve(a: &[f64], ld: usize, m: usize, x: &mut [f64]) {
     if m == 0 || ld < m || a.len() < (m - 1) * ld + m || x.len() < m {
         return;
@@ -114,8 +178,23 @@ pub(crate) fn ldlt_dropping_solve(a: &[f64], ld: usize, m: usize, x: &mut [f64])
     // at most (m − 1)·ld + m − 1 < a.len(), and i < m ≤ x.len() in `x`
     let (a, x) = (a.as_ptr(), x.as_mut_ptr());
     unsafe {
-        // L z = b: row i's sum over k < i in order
-        for i in 1..m {
+        // L z = b: row i's sum over k < i in order, rows i and i + 1 side
+        // by side (two chains) over k < i, then row i + 1's term k = i
+        let mut i = 1;
+        while i + 1 < m {
+            let (r0, r1) = (a.add(i * ld), a.add((i + 1) * ld));
+            let (mut s0, mut s1) = (*x.add(i), *x.add(i + 1));
+            for k in 0..i {
+                let xk = *x.add(k);
+                s0 -= *r0.add(k) * xk;
+                s1 -= *r1.add(k) * xk;
+            }
+            *x.add(i) = s0;
+            s1 -= *r1.add(i) * s0;
+            *x.add(i + 1) = s1;
+            i += 2;
+        }
+        if i < m {
             let row = a.add(i * ld);
             let mut s = *x.add(i);
             for k in 0..i {
@@ -135,7 +214,13 @@ pub(crate) fn ldlt_dropping_solve(a: &[f64], ld: usize, m: usize, x: &mut [f64])
                 continue;
             }
             let mut s = *x.add(i);
-            for k in i + 1..m {
+            let mut k = i + 1;
+            while k + 1 < m {
+                s -= *a.add(k * ld + i) * *x.add(k);
+                s -= *a.add((k + 1) * ld + i) * *x.add(k + 1);
+                k += 2;
+            }
+            if k < m {
                 s -= *a.add(k * ld + i) * *x.add(k);
             }
             *x.add(i) = s;
