@@ -1,6 +1,7 @@
 //! The narrow phase of one pair of shapes: a hull on a flat face by the face
 //! path ([`super::face`]), two spheres or capsules in closed form
-//! ([`prim`]), two boxes by parry's box–box manifold redone without parry
+//! ([`prim`]), a ball on a box or a cylinder by parry's generator in closed
+//! form ([`ball`]), two boxes by parry's box–box manifold redone without parry
 //! ([`boxes`]), everything else by parry's contact manifolds, and
 //! the reduction of the points found to a persistent patch of at most
 //! `max_points_per_shape`.
@@ -18,6 +19,7 @@ use parry3d_f64::query::{
 };
 use parry3d_f64::shape::ShapeType;
 
+pub(crate) mod ball;
 pub(crate) mod boxes;
 pub(crate) mod climb;
 pub(crate) mod cylinder;
@@ -81,6 +83,12 @@ pub(crate) fn parry_points(
         manifolds.clear();
         *workspace = None;
         return;
+    }
+    // a ball on a box or a cylinder: parry's generator in closed form
+    if let Some(ball_is_a) = ball::kind(a, b) {
+        if ball::ball_points(a, b, wa, wb, ball_is_a, margin, manifolds, raw) {
+            return;
+        }
     }
     // two boxes: the closed form (`boxes`), parry's manifold without parry
     if let (Some(ha), Some(hb)) = (&a.cuboid, &b.cuboid) {

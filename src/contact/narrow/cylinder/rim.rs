@@ -249,10 +249,19 @@ pub fn rim_on_edge(cyl: &Cylinder, cub: &Cuboid, b_m_c: &Pose, side: bool) -> Op
             // from falling to rising (each local least the samples part)
             let mut prev = arc_at(SIN_COS[0], &kk, hr);
             best = best.min(prev.0);
+            // apart along a sample (best < 0): the answer is None whatever
+            // follows (best only falls, and a found depth is ≥ 0 only if it
+            // is the best), so the rest of the arcs is not looked at
+            if best < 0.0 {
+                return None;
+            }
             for (m, &sc) in SIN_COS.iter().enumerate().skip(1) {
                 let phi = m as f64 * step;
                 let next = arc_at(sc, &kk, hr);
                 best = best.min(next.0);
+                if best < 0.0 {
+                    return None;
+                }
                 if prev.1 < 0.0 && next.1 > 0.0 {
                     let phi = newton(phi - step, phi, &kk, hr);
                     let sc = phi.sin_cos();
