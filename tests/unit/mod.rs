@@ -28,6 +28,7 @@ mod sim_build;
 mod sim_dense;
 mod sim_factor;
 mod sleep_doze;
+mod sleep_doze_energy;
 mod spatial;
 mod step_position_warm;
 mod view_geometry;
