@@ -67,8 +67,6 @@ pub(crate) struct Islands {
     /// The islands to solve: every one after a grouping, the dirty ones
     /// after a join.
     todo: Vec<usize>,
-    /// Contact groups likely inactive are left out of the solve (split.rs).
-    split: bool,
     /// The group starting at each row (read at runs' first rows only).
     group_at: Vec<usize>,
     /// Runs of consecutive rows of one island: (island key, first row, end).
@@ -165,7 +163,6 @@ impl Islands {
             fails: Vec::with_capacity(rows),
             pieces: Vec::with_capacity(rows),
             todo: Vec::with_capacity(rows.min(nt + 1)),
-            split: split::enabled(),
             group_at: vec![0; rows],
             runs: Vec::with_capacity(rows),
             sorted: Vec::with_capacity(rows),
@@ -213,7 +210,7 @@ impl Islands {
         // without the split on, every grouping of the same paths is the same)
         // (nor a step of few rows: its islands are small, and the split's
         // bookkeeping costs more than the sweeps it saves, split.rs)
-        let may_split = self.split && self.parent.len() > 1 && n >= split::min_rows();
+        let may_split = self.parent.len() > 1 && n >= split::MIN_ROWS;
         // the same rows' paths as the last grouping, each one of the factor's
         // (fixed for the rows' life, [`Rows::set_table`]): the same islands
         let fixed = rows.unions_empty() && !may_split;

@@ -35,11 +35,6 @@
 use super::{Islands, LEFT};
 use crate::sim::solver::Rows;
 
-/// The split is on (`URDYN_SPLIT=0` turns it off: a measurement knob).
-pub(super) fn enabled() -> bool {
-    std::env::var("URDYN_SPLIT").map_or(true, |v| v != "0")
-}
-
 /// A contact is left out only when the warm start leaves its normal this
 /// much above its target (m/s).
 const MARGIN: f64 = 1e-3;
@@ -48,27 +43,7 @@ const MARGIN: f64 = 1e-3;
 /// it the warm start and the checks cost more than the sweeps saved (mixed
 /// 16 pile, 81 rows a solve at the median: +3.7 % instructions of split
 /// bookkeeping against −2 % of sweeps; boxes 64, 330 rows: −6.4 % in all).
-const MIN_ROWS: usize = 192;
-
-pub(super) fn min_rows() -> usize {
-    static M: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-    *M.get_or_init(|| {
-        std::env::var("URDYN_SPLIT_MIN")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(MIN_ROWS)
-    })
-}
-
-fn margin() -> f64 {
-    static M: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
-    *M.get_or_init(|| {
-        std::env::var("URDYN_SPLIT_MARGIN")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(MARGIN)
-    })
-}
+pub(super) const MIN_ROWS: usize = 192;
 
 impl Islands {
     /// Marks the contacts of group `g` (rows `s..e`, on trees `a` and `b`)
@@ -90,7 +65,7 @@ impl Islands {
         let (mut kept, mut part) = (false, false);
         let mut r = s;
         while r < e {
-            if rows.contact_idle(r, &self.warm, margin()) {
+            if rows.contact_idle(r, &self.warm, MARGIN) {
                 self.out[r] = true;
                 self.left.push((r, g, a, b));
                 part = true;
