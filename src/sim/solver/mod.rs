@@ -420,18 +420,24 @@ impl Rows {
         {
             return false;
         }
-        let st = self.stride;
-        let (ps, pl) = self.path[r];
-        let (Some(p), Some(y)) = (self.table.get(ps..ps + pl), self.y.get(r * st..r * st + pl))
-        else {
+        let Some(d) = self.y_dot(r, warm) else {
             return false;
         };
-        let d: f64 = y
-            .iter()
-            .zip(p)
-            .map(|(a, &k)| a * warm.get(k).copied().unwrap_or(0.0))
-            .sum();
         self.c[r] + d >= self.b[r] + margin
+    }
+    /// yᵣ·x over row `r`'s path, in the path's order (None: the row's path
+    /// or y out of range). A row's path holds dof indices < nv ≤ x.len()
+    /// (the sweeps' invariant); a short `x` reads 0 past its end.
+    fn y_dot(&self, r: usize, x: &[f64]) -> Option<f64> {
+        let st = self.stride;
+        let (ps, pl) = *self.path.get(r)?;
+        let p = self.table.get(ps..ps + pl)?;
+        let y = self.y.get(r * st..r * st + pl)?;
+        let mut d = 0.0;
+        for (&v, &k) in y.iter().zip(p) {
+            d += v * x.get(k).copied().unwrap_or(0.0);
+        }
+        Some(d)
     }
     /// The normal of the contact at row `r` holds at λ = 0 to `tol` for the
     /// Δv' `x` (src/sim/islands/split.rs): uₙ = cₙ + yₙ·x ≥ bₙ − tol, or, for
@@ -441,18 +447,9 @@ impl Rows {
         if r >= self.n || self.winv[r] == 0.0 {
             return true;
         }
-        let st = self.stride;
-        let (ps, pl) = self.path[r];
-        let (Some(p), Some(y)) = (self.table.get(ps..ps + pl), self.y.get(r * st..r * st + pl))
-        else {
+        let Some(d) = self.y_dot(r, x) else {
             return false;
         };
-        let mut d = 0.0;
-        for (&v, &k) in y.iter().zip(p) {
-            // (a row's path holds dof indices < nv ≤ x.len(): the sweeps'
-            // invariant; a short `x` reads 0 past its end)
-            d += v * x.get(k).copied().unwrap_or(0.0);
-        }
         if position {
             d >= self.bpos[r] - tol
         } else {
