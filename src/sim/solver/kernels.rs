@@ -75,6 +75,52 @@ pub(super) fn dot3_from(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) ->
     }
 }
 
+/// Δv' += Σᵣ λᵣ yᵣ over rows `s..e` in row order, a contact's three rows in
+/// one pass over their path ([`warm3`]) when all three λ ≠ 0: the warm start
+/// of an island's runs in its sweeps (pgs.rs) and of every row at once
+/// ([`super::Rows::warm_velocity`], split.rs), one arithmetic for both, so the
+/// two starts are the same bits on an island's dofs.
+///
+/// # Safety
+/// The caller has checked the rows `s..e`: every path within `table`, at
+/// most `st` long, its dofs < `x.len()`; `y` and `ylanes` hold `st` entries
+/// a row (the sweeps' checks, [`super::Rows::sweeps`]).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) unsafe fn warm_rows(
+    lambda: &[f64],
+    contact: &[bool],
+    paths: &[(usize, usize)],
+    table: &[usize],
+    y: &[f64],
+    ylanes: &[[f64; 4]],
+    st: usize,
+    (s, e): (usize, usize),
+    x: &mut [f64],
+) {
+    let mut r = s;
+    while r < e {
+        let l = lambda[r];
+        let (ps, pl) = paths[r];
+        // SAFETY: the caller's checks (the path in `table`, its row of y
+        // and ylanes within them, its dofs < x.len())
+        let p = unsafe { table.get_unchecked(ps..ps + pl) };
+        if contact[r] && r + 2 < e && l != 0.0 && lambda[r + 1] != 0.0 && lambda[r + 2] != 0.0 {
+            // each entry ((x + λₙyₙ) + λ₁y₁) + λ₂y₂, the row-by-row order
+            let lanes = unsafe { ylanes.get_unchecked(r * st..r * st + pl) };
+            warm3([l, lambda[r + 1], lambda[r + 2]], lanes, p, x);
+            r += 3;
+            continue;
+        }
+        if l != 0.0 {
+            for (t, &k) in p.iter().enumerate() {
+                unsafe { *x.get_unchecked_mut(k) += l * y.get_unchecked(r * st + t) };
+            }
+        }
+        r += 1;
+    }
+}
+
 /// The warm start of a contact's three rows: x[pₜ] = ((x[pₜ] + a₀ lₜ₀) + a₁ lₜ₁) +
 /// a₂ lₜ₂ over its path `p` (`l`: its rows of y interleaved, `Rows::ylanes`),
 /// each entry the same sum as three row-by-row updates (a path's dofs are

@@ -377,32 +377,21 @@ impl Rows {
             return;
         }
         x.iter_mut().for_each(|v| *v = 0.0);
-        let (lambda, contact) = (&self.lambda[..n], &self.is_block[..n]);
-        let mut r = 0;
-        while r < n {
-            let l = lambda[r];
-            let (s, pl) = self.path[r];
-            let p = &table[s..s + pl];
-            if contact[r] && r + 2 < n && l != 0.0 && lambda[r + 1] != 0.0 && lambda[r + 2] != 0.0 {
-                // (as the sweeps' warm start: path indices < nv ≤ x.len())
-                kernels::warm3(
-                    [l, lambda[r + 1], lambda[r + 2]],
-                    &self.ylanes[r * st..r * st + pl],
-                    p,
-                    x,
-                );
-                r += 3;
-                continue;
-            }
-            if l != 0.0 {
-                for (&k, &v) in p.iter().zip(&self.y[r * st..r * st + pl]) {
-                    if let Some(xk) = x.get_mut(k) {
-                        *xk += l * v;
-                    }
-                }
-            }
-            r += 1;
-        }
+        // SAFETY: the paths, y and ylanes checked above; path indices < nv ≤
+        // x.len() (the sweeps' invariant)
+        unsafe {
+            kernels::warm_rows(
+                &self.lambda[..n],
+                &self.is_block[..n],
+                &self.path[..n],
+                table,
+                &self.y,
+                &self.ylanes,
+                st,
+                (0, n),
+                x,
+            )
+        };
     }
 
     /// The contact triple at row `r` is not likely to push this step

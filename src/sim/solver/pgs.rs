@@ -2,7 +2,7 @@
 //! contact's three rows taken in one pass and the exact Coulomb slide onto
 //! the friction disc.
 
-use super::kernels::{axpy3, dot3, pinned_until, slide_onto_cone, warm3};
+use super::kernels::{axpy3, dot3, pinned_until, slide_onto_cone, warm_rows};
 use super::loop_block::{BlockRows, LoopBlock};
 use super::subspace::{subspace_step, Solved, Subspace};
 use super::{MassFactor, RowKind, Rows, SUBSPACE_MAX};
@@ -240,29 +240,8 @@ impl Rows {
             if given {
                 break;
             }
-            let mut r = s;
-            while r < e {
-                let l = lambda[r];
-                if contact[r] && l != 0.0 && lambda[r + 1] != 0.0 && lambda[r + 2] != 0.0 {
-                    // a contact's three rows in one pass over their path: each
-                    // entry ((x + λₙyₙ) + λ₁y₁) + λ₂y₂, the row-by-row order
-                    // SAFETY: as the sweeps' contact update below
-                    let (p, lanes) = unsafe {
-                        let (s, l) = *paths.get_unchecked(r);
-                        (
-                            table.get_unchecked(s..s + l),
-                            ylanes.get_unchecked(r * st..r * st + l),
-                        )
-                    };
-                    warm3([l, lambda[r + 1], lambda[r + 2]], lanes, p, dv);
-                    r += 3;
-                    continue;
-                }
-                if l != 0.0 {
-                    raxpy(l, y, r, st, path(r), dv);
-                }
-                r += 1;
-            }
+            // SAFETY: the paths, y and ylanes checked above (rdot/raxpy's)
+            unsafe { warm_rows(lambda, contact, paths, table, y, ylanes, st, (s, e), dv) };
         }
         if block {
             lb.solve(&view, Some(c), b, lambda, dv);
