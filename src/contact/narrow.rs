@@ -422,7 +422,8 @@ fn directions(dirs: usize) -> Option<&'static [(f64, f64)]> {
 /// Appends at most `maxp` of `raw` to `out` as `make` makes them: all when
 /// they fit, else the deepest, then the extremes along `maxp − 1` tangent
 /// directions of the deepest point's normal among the points within
-/// [`EXTREME_BAND`] of it. (Preferring last step's points
+/// [`EXTREME_BAND`] of it, then, while slots are left, the nearest of the
+/// others (not the face path's, [`FACE_KEY`]). (Preferring last step's points
 /// within a hold of the best, as the ground's reduction does, left points
 /// deeper than the kept ones unchosen: solo12 landing on the box step sank
 /// 2 mm instead of 0.06.)
@@ -466,6 +467,27 @@ pub(crate) fn reduce_pair(
             .unwrap_or(0);
         if !out[start..].iter().any(|p| p.key == raw[best].key) {
             out.push(make(&raw[best]));
+        }
+    }
+    // the slots the extremes left free (they repeat a point: one or two
+    // within the band, the rest above it) go to the other points, nearest
+    // first: a corner closing on the pair is in the rows within the margin,
+    // not first found inside (docs/theory.md §"Speculative margin"). Not to
+    // the face path's: it collects above the band only some of the points
+    // (`face_points`)
+    while out.len() - start < maxp {
+        let next = (0..raw.len())
+            .filter(|&i| raw[i].key & FACE_KEY == 0)
+            .filter(|&i| !out[start..].iter().any(|p| p.key == raw[i].key))
+            .min_by(|&i, &j| {
+                raw[i]
+                    .gap
+                    .total_cmp(&raw[j].gap)
+                    .then(raw[i].key.cmp(&raw[j].key))
+            });
+        match next {
+            Some(i) => out.push(make(&raw[i])),
+            None => break,
         }
     }
 }

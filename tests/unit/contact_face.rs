@@ -154,7 +154,8 @@ fn reduced(pts: &[FacePoint], n: Vector3<f64>) -> Vec<(u64, f64, Vector3<f64>)> 
             point: p.point,
             normal: n,
             gap: p.gap,
-            key: p.vertex as u64,
+            // the face path's key (`narrow::FACE_KEY`)
+            key: (1 << 62) | p.vertex as u64,
         })
         .collect();
     let mut out = Vec::new();

@@ -7,6 +7,7 @@
 mod cli_output;
 mod contact_apart;
 mod contact_ball;
+mod contact_box_corner;
 mod contact_boxes;
 mod contact_broad;
 mod contact_climb_step;
