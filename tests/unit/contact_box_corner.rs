@@ -20,10 +20,12 @@ fn cube() -> urdyn::testing::contact::PairShape {
     pair_shape(SharedShape::cuboid(H, H, H), Se3::identity(), true)
 }
 
-/// b (a 0.1 m cube) turned by `phi` about a horizontal axis, its lowest
-/// corner `depth` below a's top face, its centre moved by (`dx`, `dy`).
-fn pose(phi: f64, axis: Vector3<f64>, dx: f64, dy: f64, depth: f64) -> Se3<f64> {
-    let r = Rotation3::from_axis_angle(&Unit::new_normalize(axis), phi);
+/// b (a 0.1 m cube) turned by `yaw` about z, then by `phi` about a
+/// horizontal axis, its lowest corner `clear` above a's top face, its centre
+/// moved by (`dx`, `dy`): the two squares' outlines cross at eight points.
+fn pose(phi: f64, yaw: f64, axis: Vector3<f64>, dx: f64, dy: f64, clear: f64) -> Se3<f64> {
+    let r = Rotation3::from_axis_angle(&Unit::new_normalize(axis), phi)
+        * Rotation3::from_axis_angle(&Vector3::z_axis(), yaw);
     // the lowest corner's height relative to the centre
     let low = (0..8)
         .map(|k| {
@@ -35,7 +37,7 @@ fn pose(phi: f64, axis: Vector3<f64>, dx: f64, dy: f64, depth: f64) -> Se3<f64> 
             (r * c).z
         })
         .fold(f64::INFINITY, f64::min);
-    Se3::new(r.into_inner(), Vector3::new(dx, dy, H - depth - low))
+    Se3::new(r.into_inner(), Vector3::new(dx, dy, H + clear - low))
 }
 
 fn kept(raw: &[Raw]) -> Vec<ContactPoint> {
@@ -63,19 +65,20 @@ fn a_closing_corner_is_kept_while_within_the_margin() {
     let wa = Se3::identity();
     let mut cases = 0;
     let mut crowded = 0;
-    for (axis, dx, dy) in [
-        (Vector3::new(1.0, 0.3, 0.0), 0.03, 0.02),
-        (Vector3::new(0.2, 1.0, 0.0), -0.04, 0.01),
-        (Vector3::new(1.0, -0.7, 0.0), 0.02, -0.05),
-        (Vector3::new(-0.4, 1.0, 0.0), 0.06, 0.03),
+    for (yaw, axis, dx, dy) in [
+        (0.5, Vector3::new(1.0, 0.3, 0.0), 0.01, 0.005),
+        (0.6, Vector3::new(0.2, 1.0, 0.0), -0.008, 0.004),
+        (0.45, Vector3::new(1.0, -0.7, 0.0), 0.006, -0.01),
+        (0.7, Vector3::new(-0.4, 1.0, 0.0), 0.0, 0.008),
     ] {
-        // b turns down onto a, one step of 2.5 mrad at a time, its lowest
-        // corner touching (5 µm in)
+        // b turns down onto a, one step of 1 mrad at a time, its lowest
+        // corner 0.1 mm above a's top face (beside a: the points are the
+        // outlines' crossings, gaps from 0.1 mm up)
         let mut manifolds = Vec::new();
         let mut ws = None;
         for k in 0..=60 {
-            let phi = 0.15 - 0.0025 * k as f64;
-            let wb = pose(phi, axis, dx, dy, 5e-6);
+            let phi = 0.06 - 0.001 * k as f64;
+            let wb = pose(phi, yaw, axis, dx, dy, 1e-4);
             let mut raw = Vec::new();
             parry_points(&a, &b, &wa, &wb, MARGIN, &mut manifolds, &mut ws, &mut raw);
             let out = kept(&raw);
@@ -101,9 +104,11 @@ fn a_closing_corner_is_kept_while_within_the_margin() {
             }
             // the nearest point above the band (the corner that closes
             // next) is kept while within the margin
+            // (when the band holds fewer points than the slots)
+            let in_band = raw.iter().filter(|r| r.gap <= band).count();
             if let Some(next) = raw
                 .iter()
-                .filter(|r| r.gap > band && r.gap < MARGIN)
+                .filter(|r| in_band < 4 && r.gap > band && r.gap < MARGIN)
                 .min_by(|x, y| x.gap.total_cmp(&y.gap))
             {
                 assert!(
