@@ -119,6 +119,21 @@ fn threads_one_and_two_give_identical_csvs_on_a_pile_with_sleep_on_and_off() {
     }
 }
 
+/// The mixed pile of 256 (balls, boxes and cylinders: a hundred islands a
+/// solve, the position pass's joins) on 1 and 2 threads: the same CSV, byte
+/// for byte, whichever thread solved which island.
+#[test]
+fn threads_one_and_two_give_identical_csvs_on_the_mixed_256_pile() {
+    let scene = dir().join("pile_mixed_256.json");
+    // (`--every 1`, the default: a file name of its own)
+    let one = csv(&scene, 0.4, &["--every", "1", "--threads", "1"]);
+    let two = csv(&scene, 0.4, &["--every", "1", "--threads", "2"]);
+    assert_eq!(one.lines().count(), 401 + 1);
+    let first_diff = one.lines().zip(two.lines()).position(|(a, b)| a != b);
+    assert_eq!(first_diff, None, "rows differ from line {first_diff:?}");
+    assert_eq!(one, two);
+}
+
 /// `Simulation::new_at` (built at the scene's start state: contacts looked
 /// for once, there) steps exactly as `new` then `set_state` (which first looks
 /// for contacts with every model at the origin, all pairs overlapping: the

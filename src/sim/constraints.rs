@@ -24,14 +24,21 @@ use super::factor::MassFactor;
 use super::islands::Islands;
 use super::loops::Loops;
 use super::newton::Newton;
+use super::parallel::Team;
 use super::solver::{PosWarm, RowKind, Rows, Scratch};
 use super::{ContactForce, Solver};
 use crate::contact::{tangents, ContactPoint};
 use crate::model::{JointKind, Model};
 use crate::spatial::{Force, Motion, Se3};
 use nalgebra::{DVector, Vector3};
+use std::sync::Arc;
 pub(crate) use tables::add_body_rows;
 use tables::{act_column, add_body, BodyColumns, BodyHead, JointRowSource};
+
+/// The least row-sweeps a parallel solve must take off this thread's share
+/// (else the islands are solved here: a job's dispatch and wait cost about
+/// what a few hundred row-sweeps do).
+const MIN_WORK: usize = 500;
 
 /// What the rows are built from, besides the state.
 #[derive(Clone, Copy, Debug)]
@@ -152,7 +159,14 @@ pub(crate) struct Constraints {
     /// This step's islands of rows (the PGS solve's units).
     islands: Islands,
     /// The threads islands are solved on (`None`: this one).
-    pool: Option<std::sync::Arc<rayon::ThreadPool>>,
+    team: Option<Arc<Team>>,
+    /// The islands of a parallel solve, largest first ([`parallel::cut`]).
+    order: Vec<(usize, usize)>,
+    /// The last solve ran islands on the team.
+    went_parallel: bool,
+    /// Row-sweeps per row of the last solve's islands (its first round): the
+    /// next solve's estimate of its work.
+    per_row: f64,
     /// A subspace step's scratch for each thread (at least one).
     scratch: Vec<Scratch>,
     /// Torsional and rolling friction rows ([`spin`]).
@@ -240,7 +254,10 @@ impl Constraints {
             newton: Newton::new(if newton { nv } else { 0 }, if newton { cap } else { 0 }),
             loops,
             islands: Islands::new(model, cap),
-            pool: None,
+            team: None,
+            order: Vec::new(),
+            went_parallel: false,
+            per_row: 1.0,
             scratch: vec![rows_scratch],
             spin: spin::Spin::new(max_points, nslots),
             isl_sweeps: vec![0; model.trees.len() + 1],
@@ -253,22 +270,19 @@ impl Constraints {
     /// (scene.md §"Large scenes: islands and sleep"). A pool that cannot be
     /// started leaves the solve on this thread.
     pub fn set_threads(&mut self, threads: usize) {
-        self.pool = None;
+        self.team = None;
         self.scratch.truncate(1);
-        if threads == 1 {
-            return;
-        }
-        let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(threads).build() else {
+        let n = match threads {
+            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            n => n,
+        };
+        let Some(team) = Team::new(n) else {
             return;
         };
-        let n = pool.current_num_threads();
-        if n <= 1 {
-            return;
-        }
-        while self.scratch.len() < n {
+        while self.scratch.len() < team.threads() {
             self.scratch.push(self.rows.scratch());
         }
-        self.pool = Some(std::sync::Arc::new(pool));
+        self.team = Some(Arc::new(team));
     }
 
     /// Forgets the warm starts (a new state was set).

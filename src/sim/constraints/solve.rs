@@ -5,8 +5,10 @@
 //! of the scene; then what the impulses do (forces, warm starts).
 
 use super::super::islands::{Island, Islands};
+use super::super::parallel::{self, Team};
 use super::super::solver::{IslandOut, Scratch};
 use super::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 impl Constraints {
     /// Solves the assembled rows given the factor `l` of H̃ (column-major, lower
@@ -28,6 +30,11 @@ impl Constraints {
         solver: Solver,
     ) -> Impulses<'_> {
         self.clear_forces();
+        if let Some(t) = self.team.as_ref().filter(|_| self.went_parallel) {
+            // the last solve ran on the team: wake its sleeping threads now,
+            // to be spinning by this one's dispatch
+            t.nudge();
+        }
         self.dv.as_mut_slice().fill(0.0);
         // torsion and rolling rows (spin.rs) couple a point's rotation to its
         // normal: a step with them may take twice the sweeps before the cap
@@ -63,23 +70,32 @@ impl Constraints {
             // check joined (src/sim/islands/split.rs), until none fails
             let mut a_ready = false;
             let mut first = true;
+            self.went_parallel = false;
             loop {
                 let todo = self.islands.todo();
                 if self.isl_sweeps.len() < todo.len() {
                     self.isl_sweeps.resize(todo.len(), 0);
                 }
                 let done = &mut self.isl_sweeps[..todo.len()];
-                match self.pool.as_ref().filter(|_| todo.len() > 1) {
-                    Some(pool) => {
+                let (isl, order) = (&self.islands, &mut self.order);
+                let sizes = todo.iter().map(|&i| isl.get(i).rows());
+                // (worth a dispatch where the cut takes enough sweeps off this
+                // thread: at the last solve's sweeps per row)
+                let least = (MIN_WORK as f64 / self.per_row.max(1.0)) as usize;
+                let cut = |t: &&Arc<Team>| parallel::cut(sizes, t.threads(), least, order);
+                let team = self.team.as_ref().filter(cut);
+                self.went_parallel |= team.is_some();
+                match team {
+                    Some(team) => {
                         // a = R v* for the threads' energy-safe exits, before them
                         if !a_ready {
                             f.apply_r(vfree.as_slice(), &mut self.a);
                             a_ready = true;
                         }
                         par_islands(
-                            pool,
+                            team,
                             rows,
-                            (&self.islands, todo),
+                            (&self.islands, todo, &self.order),
                             &mut self.scratch,
                             done,
                             (&mut lam, &mut up, &mut *dv),
@@ -104,9 +120,15 @@ impl Constraints {
                         a_ready = a.ready();
                     }
                 }
+                let (mut rows_all, mut work) = (0, 0);
                 for (&i, &s) in todo.iter().zip(self.isl_sweeps.iter()) {
-                    self.work += (self.islands.get(i).rows() * s) as u64;
+                    let r = self.islands.get(i).rows();
+                    (rows_all, work) = (rows_all + r, work + r * s);
+                    self.work += (r * s) as u64;
                     sweeps = sweeps.max(s);
+                }
+                if first && rows_all > 0 {
+                    self.per_row = work as f64 / rows_all as f64;
                 }
                 if !self.islands.join_failed(rows, dv, false, tol) {
                     break;
@@ -372,29 +394,36 @@ fn solve_island(
     s
 }
 
-/// Every row's impulse and last velocity and Δv', shared by the threads
-/// solving islands at once ([`par_islands`]).
+/// Every row's impulse and last velocity and Δv', each thread's scratch and
+/// each island's sweeps, shared by the threads solving islands at once
+/// ([`par_islands`]).
 #[derive(Clone, Copy)]
 struct Shared {
     lambda: (*mut f64, usize),
     u_prev: (*mut f64, usize),
     dv: (*mut f64, usize),
+    scratch: (*mut Scratch, usize),
+    sweeps: (*mut usize, usize),
 }
-// SAFETY: the threads given a `Shared` read and write only their own
-// islands' rows (of `lambda`, `u_prev`) and dofs (of `dv`): islands share no
-// row and no dof (src/sim/islands.rs), so no element is touched by two threads.
+// SAFETY: the threads given a `Shared` read and write only the rows (of
+// `lambda`, `u_prev`), dofs (of `dv`) and sweeps of the islands they took,
+// and their own scratch: islands share no row and no dof
+// (src/sim/islands.rs), an island is taken once (an atomic counter) and a
+// thread has one scratch, so no element is touched by two threads.
 unsafe impl Send for Shared {}
 unsafe impl Sync for Shared {}
 
-/// The islands `todo` of `islands` solved on the threads of `pool`: cut
-/// into one run of consecutive islands a thread, of about equal rows; each island's result
-/// (its impulses, its Δv', its sweeps in `sweeps`) is the one a single
-/// thread computes, whatever the cut (bit for bit: nothing an island reads
+/// The islands `todo` of `islands` solved on the threads of `team`, each
+/// thread taking the next island of `order` (largest first,
+/// [`parallel::cut`]) until none is left; each island's result (its
+/// impulses, its Δv', its sweeps in `sweeps`) is the one a single thread
+/// computes, whichever thread takes it (bit for bit: nothing an island reads
 /// is written by another).
+#[allow(clippy::too_many_arguments)]
 fn par_islands(
-    pool: &rayon::ThreadPool,
+    team: &Team,
     rows: &Rows,
-    (islands, todo): (&Islands, &[usize]),
+    (islands, todo, order): (&Islands, &[usize], &[(usize, usize)]),
     scratch: &mut [Scratch],
     sweeps: &mut [usize],
     (lambda, u_prev, dv): (&mut [f64], &mut [f64], &mut [f64]),
@@ -403,56 +432,57 @@ fn par_islands(
 ) {
     let args = (iterations, tol, relax);
     let count = sweeps.len().min(todo.len());
-    let total: usize = todo[..count].iter().map(|&i| islands.get(i).rows()).sum();
-    let parts = scratch.len().max(1);
     let sh = Shared {
         lambda: (lambda.as_mut_ptr(), lambda.len()),
         u_prev: (u_prev.as_mut_ptr(), u_prev.len()),
         dv: (dv.as_mut_ptr(), dv.len()),
+        scratch: (scratch.as_mut_ptr(), scratch.len()),
+        sweeps: (sweeps.as_mut_ptr(), count),
     };
-    pool.scope(|sc| {
-        let (mut rest, mut first, mut acc) = (sweeps, 0, 0);
-        for (k, sm) in scratch.iter_mut().enumerate() {
-            // the islands up to about (k + 1)/parts of the rows
-            let goal = total * (k + 1) / parts;
-            let mut end = first;
-            while end < count && (acc < goal || k + 1 == parts) {
-                acc += islands.get(todo[end]).rows();
-                end += 1;
-            }
-            let (mine, more) = rest.split_at_mut(end - first);
-            rest = more;
-            let start = first;
-            first = end;
-            if mine.is_empty() {
+    let (next, done) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    team.run(&|k| {
+        let sh = sh;
+        if k >= sh.scratch.1 {
+            return;
+        }
+        // SAFETY: see `Shared`; the pointers and lengths are those of live
+        // slices borrowed for the whole of `run`, and thread k alone takes
+        // scratch k (k < its length, checked)
+        let (lambda, u_prev, dv, sm) = unsafe {
+            (
+                std::slice::from_raw_parts_mut(sh.lambda.0, sh.lambda.1),
+                std::slice::from_raw_parts_mut(sh.u_prev.0, sh.u_prev.1),
+                std::slice::from_raw_parts_mut(sh.dv.0, sh.dv.1),
+                &mut *sh.scratch.0.add(k),
+            )
+        };
+        let mut out = IslandOut {
+            lambda,
+            u_prev,
+            sm,
+            warm_given: false,
+        };
+        let mut a = FreeR::Ready(a);
+        loop {
+            let t = next.fetch_add(1, Ordering::Relaxed);
+            let Some(&(_, j)) = order.get(t) else { break };
+            let Some(&i) = todo.get(j).filter(|_| j < sh.sweeps.1) else {
+                done.fetch_add(1, Ordering::Release);
                 continue;
-            }
-            sc.spawn(move |_| {
-                let sh = sh;
-                // SAFETY: see `Shared`; the pointers and lengths are those of
-                // live slices borrowed for the whole scope
-                let (lambda, u_prev, dv) = unsafe {
-                    (
-                        std::slice::from_raw_parts_mut(sh.lambda.0, sh.lambda.1),
-                        std::slice::from_raw_parts_mut(sh.u_prev.0, sh.u_prev.1),
-                        std::slice::from_raw_parts_mut(sh.dv.0, sh.dv.1),
-                    )
-                };
-                let mut out = IslandOut {
-                    lambda,
-                    u_prev,
-                    sm,
-                    warm_given: false,
-                };
-                let mut a = FreeR::Ready(a);
-                for (j, s) in mine.iter_mut().enumerate() {
-                    let isl = islands.get(todo[start + j]);
-                    out.warm_given = given;
-                    *s = solve_island(rows, &mut out, &isl, dv, &mut a, args);
-                }
-            });
+            };
+            let isl = islands.get(i);
+            out.warm_given = given;
+            let s = solve_island(rows, &mut out, &isl, dv, &mut a, args);
+            // SAFETY: j < the sweeps' length (checked); island j taken here alone
+            unsafe { *sh.sweeps.0.add(j) = s };
+            done.fetch_add(1, Ordering::Release);
         }
     });
+    // (an island left undone: its thread panicked, as `run` lets it)
+    assert!(
+        done.load(Ordering::Acquire) >= order.len(),
+        "a thread of the islands' solve panicked"
+    );
 }
 
 /// A solve stopped by the sweep cap may leave an iterate that adds kinetic

@@ -1,0 +1,346 @@
+//! A fixed team of threads for the step's parallel work (the islands'
+//! velocity solve, src/sim/constraints/solve.rs): the calling thread and
+//! `n − 1` workers started once, sharing a job's items through the job's own
+//! counter.
+//!
+//! Built for a step that dispatches a short job (tens of µs to a few ms)
+//! hundreds of times a second on a loaded machine: the caller works on the
+//! job itself from the start (no hand-off to a pool and back) and waits only
+//! for the items a worker has already taken (a worker that comes late, asleep
+//! or descheduled, finds the job closed and the caller never waits for it); a
+//! worker spins on the job counter for a while after each job before it
+//! sleeps, and can be woken ahead of a job ([`Team::nudge`]): a sleeping
+//! thread's wake-up costs tens of µs on a virtual machine. docs/theory.md
+//! §"Islands".
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// A job, as the workers see it: a pointer to the caller's closure (alive
+/// while the job is open, and until every worker that took it is done:
+/// [`Team::run`] closes it and waits).
+#[derive(Clone, Copy)]
+struct Job(*const (dyn Fn(usize) + Sync));
+// SAFETY: the closure is `Sync` (its parts may run on any thread at once), and
+// the pointer is dereferenced only by a worker counted in `active`, which
+// `Team::run`, owning the borrow, waits to see at 0 before it returns.
+unsafe impl Send for Job {}
+
+/// What the caller and the workers share.
+struct Inner {
+    /// The open job (`None`: none, or closed by the caller).
+    job: Mutex<Option<Job>>,
+    /// Jobs so far: a worker looks for a job when this moves past the last it saw.
+    epoch: AtomicU64,
+    /// Workers running a part of the open or just-closed job (counted up under `job`'s lock).
+    active: AtomicUsize,
+    /// Workers asleep (waiting on `wake`): only then does a dispatch take the lock to wake them.
+    sleeping: AtomicUsize,
+    /// Nudges so far ([`Team::nudge`]): a sleeping worker wakes to spin.
+    nudges: AtomicU64,
+    wake: Condvar,
+    /// A job is running (a second caller, e.g. a clone of the simulation on
+    /// another thread, runs its job alone).
+    busy: AtomicBool,
+    stop: AtomicBool,
+}
+
+/// The caller and `n − 1` worker threads.
+pub(crate) struct Team {
+    inner: Arc<Inner>,
+    workers: Vec<JoinHandle<()>>,
+}
+
+impl std::fmt::Debug for Team {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Team({} threads)", self.threads())
+    }
+}
+
+/// How long a worker spins on the job counter after a job (or a nudge)
+/// before it sleeps: longer than a join round's bookkeeping and than most of
+/// a solve's grouping, shorter than a big pile's detection.
+const SPIN: Duration = Duration::from_micros(100);
+
+impl Team {
+    /// The caller and `threads − 1` workers; `None` with fewer than two
+    /// threads, or when a worker cannot be started.
+    pub fn new(threads: usize) -> Option<Self> {
+        if threads < 2 {
+            return None;
+        }
+        let inner = Arc::new(Inner {
+            job: Mutex::new(None),
+            epoch: AtomicU64::new(0),
+            active: AtomicUsize::new(0),
+            sleeping: AtomicUsize::new(0),
+            nudges: AtomicU64::new(0),
+            wake: Condvar::new(),
+            busy: AtomicBool::new(false),
+            stop: AtomicBool::new(false),
+        });
+        let mut team = Team {
+            inner,
+            workers: Vec::with_capacity(threads - 1),
+        };
+        for part in 1..threads {
+            let inner = Arc::clone(&team.inner);
+            let h = std::thread::Builder::new()
+                .name(format!("urdyn-{part}"))
+                .spawn(move || work(&inner, part));
+            match h {
+                Ok(h) => team.workers.push(h),
+                // (dropping `team` stops the workers started so far)
+                Err(_) => return None,
+            }
+        }
+        Some(team)
+    }
+
+    /// The threads of a job: the caller and the workers.
+    pub fn threads(&self) -> usize {
+        self.workers.len() + 1
+    }
+
+    /// Runs `f(0)` on this thread and `f(k)` on each worker k (1 … threads −
+    /// 1) that takes the job before `f(0)` returns; returns when every part
+    /// begun has finished. A worker may come late and skip the job, so `f`
+    /// shares its items through its own counter: any set of parts that
+    /// includes part 0 does all of them. A panic of part 0 is resumed here; a
+    /// worker's part that panics leaves its items undone, so `f` must see to
+    /// that (the islands' solve counts its items done).
+    pub fn run(&self, f: &(dyn Fn(usize) + Sync)) {
+        let inner = &*self.inner;
+        if inner.busy.swap(true, Ordering::Acquire) {
+            // another caller's job is on the workers: this one alone
+            f(0);
+            return;
+        }
+        // SAFETY (of the lifetime's erasure): see `Job`; the job is closed and
+        // every worker that took it is waited for below, before `f`'s borrow ends
+        let job: *const (dyn Fn(usize) + Sync + '_) = f;
+        let job = Job(unsafe { std::mem::transmute(job) });
+        if let Ok(mut g) = inner.job.lock() {
+            *g = Some(job);
+        }
+        inner.epoch.fetch_add(1, Ordering::SeqCst);
+        if inner.sleeping.load(Ordering::SeqCst) > 0 {
+            // (the lock orders this notify after a sleeper's check of the epoch)
+            let _g = inner.job.lock();
+            inner.wake.notify_all();
+        }
+        let mine = catch_unwind(AssertUnwindSafe(|| f(0)));
+        // closed: a worker not yet in finds nothing; those in are waited for
+        match inner.job.lock() {
+            Ok(mut g) => *g = None,
+            Err(p) => *p.into_inner() = None,
+        }
+        let mut spins = 0u32;
+        while inner.active.load(Ordering::Acquire) != 0 {
+            spins = spins.wrapping_add(1);
+            if spins % 64 == 0 {
+                std::thread::yield_now();
+            } else {
+                std::hint::spin_loop();
+            }
+        }
+        inner.busy.store(false, Ordering::Release);
+        if let Err(e) = mine {
+            std::panic::resume_unwind(e);
+        }
+    }
+
+    /// Wakes the sleeping workers to spin for the next job (called ahead of
+    /// one, so that the wake-up overlaps the caller's own work).
+    pub fn nudge(&self) {
+        let inner = &*self.inner;
+        inner.nudges.fetch_add(1, Ordering::SeqCst);
+        if inner.sleeping.load(Ordering::SeqCst) > 0 {
+            let _g = inner.job.lock();
+            inner.wake.notify_all();
+        }
+    }
+}
+
+impl Drop for Team {
+    fn drop(&mut self) {
+        self.inner.stop.store(true, Ordering::SeqCst);
+        {
+            let _g = self.inner.job.lock();
+            self.inner.wake.notify_all();
+        }
+        for h in self.workers.drain(..) {
+            let _ = h.join();
+        }
+    }
+}
+
+/// Worker `part`'s loop: wait for a new epoch (spinning, then asleep), take
+/// the job if it is still open, run its part.
+fn work(inner: &Inner, part: usize) {
+    let mut seen = inner.epoch.load(Ordering::Acquire);
+    loop {
+        let mut spins = 0u32;
+        let mut since = Instant::now();
+        let mut nudged = inner.nudges.load(Ordering::Relaxed);
+        loop {
+            if inner.stop.load(Ordering::Acquire) {
+                return;
+            }
+            let e = inner.epoch.load(Ordering::Acquire);
+            if e != seen {
+                seen = e;
+                break;
+            }
+            spins = spins.wrapping_add(1);
+            if spins % 128 != 0 {
+                std::hint::spin_loop();
+                continue;
+            }
+            let n = inner.nudges.load(Ordering::Relaxed);
+            if n != nudged {
+                // nudged while spinning: a job is near, spin on
+                nudged = n;
+                since = Instant::now();
+            }
+            if since.elapsed() < SPIN {
+                continue;
+            }
+            // asleep until a job, a nudge or the team's drop
+            let Ok(mut g) = inner.job.lock() else { return };
+            inner.sleeping.fetch_add(1, Ordering::SeqCst);
+            nudged = inner.nudges.load(Ordering::SeqCst);
+            while inner.epoch.load(Ordering::SeqCst) == seen
+                && inner.nudges.load(Ordering::SeqCst) == nudged
+                && !inner.stop.load(Ordering::SeqCst)
+            {
+                g = match inner.wake.wait(g) {
+                    Ok(g) => g,
+                    Err(_) => return,
+                };
+            }
+            inner.sleeping.fetch_sub(1, Ordering::SeqCst);
+            nudged = inner.nudges.load(Ordering::SeqCst);
+            since = Instant::now();
+        }
+        // the job, if still open, counted in `active` under the lock (so the
+        // caller's close then wait sees this worker)
+        let job = match inner.job.lock() {
+            Ok(g) => (*g).inspect(|_| {
+                inner.active.fetch_add(1, Ordering::AcqRel);
+            }),
+            Err(_) => return,
+        };
+        if let Some(Job(f)) = job {
+            // SAFETY: see `Job`: counted in `active`, which `run` waits on
+            let f = unsafe { &*f };
+            // (a panic leaves the part's items undone: the job's own count)
+            let _ = catch_unwind(AssertUnwindSafe(|| f(part)));
+            inner.active.fetch_sub(1, Ordering::AcqRel);
+        }
+    }
+}
+
+/// The jobs of `sizes` (j their index) into `order` as (size, j), largest
+/// first (ties by index: the same order for the same sizes), the order
+/// threads take them in. Returns whether sharing them among `parts` threads
+/// is worth a dispatch: whether handing each, largest first, to the thread
+/// with the least so far (a bound on what taking them in `order` does)
+/// takes at least `min_gain` off the largest share, the work of one thread.
+pub(crate) fn cut(
+    sizes: impl Iterator<Item = usize>,
+    parts: usize,
+    min_gain: usize,
+    order: &mut Vec<(usize, usize)>,
+) -> bool {
+    order.clear();
+    order.extend(sizes.enumerate().map(|(j, s)| (s, j)));
+    let parts = parts.clamp(1, 8);
+    let total: usize = order.iter().map(|&(s, _)| s).sum();
+    if parts < 2 || order.len() < 2 || total < min_gain {
+        return false;
+    }
+    order.sort_unstable_by(|x, y| y.0.cmp(&x.0).then(x.1.cmp(&y.1)));
+    let mut load = [0usize; 8];
+    for &(s, _) in order.iter() {
+        let mut k = 0;
+        for p in 1..parts {
+            if load[p] < load[k] {
+                k = p;
+            }
+        }
+        load[k] += s;
+    }
+    let most = load.iter().copied().max().unwrap_or(total);
+    total - most >= min_gain
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::AtomicUsize;
+
+    #[test]
+    fn every_item_is_done_once_whoever_takes_it() {
+        let team = Team::new(3).expect("a team of three");
+        assert_eq!(team.threads(), 3);
+        for round in 0..300 {
+            let items: Vec<AtomicUsize> = (0..64).map(|_| AtomicUsize::new(0)).collect();
+            let next = AtomicUsize::new(0);
+            team.run(&|_| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(x) = items.get(i) else { break };
+                x.fetch_add(1, Ordering::Relaxed);
+            });
+            assert!(
+                items.iter().all(|h| h.load(Ordering::Relaxed) == 1),
+                "round {round}"
+            );
+            if round % 100 == 0 {
+                // long enough for the workers to fall asleep, then a nudge
+                std::thread::sleep(Duration::from_millis(2));
+                team.nudge();
+            }
+        }
+    }
+
+    #[test]
+    fn part_zero_runs_here_and_its_panic_reaches_the_caller() {
+        let team = Team::new(2).expect("a team of two");
+        let here = std::thread::current().id();
+        let r = catch_unwind(AssertUnwindSafe(|| {
+            team.run(&|k| {
+                if k == 0 {
+                    assert_eq!(std::thread::current().id(), here);
+                    panic!("part 0");
+                }
+            })
+        }));
+        assert!(r.is_err());
+        // the team goes on
+        let n = AtomicUsize::new(0);
+        team.run(&|k| {
+            if k == 0 {
+                n.fetch_add(1, Ordering::Relaxed);
+            }
+        });
+        assert_eq!(n.load(Ordering::Relaxed), 1);
+    }
+
+    #[test]
+    fn the_cut_orders_largest_first_and_keeps_small_jobs_here() {
+        let mut order = Vec::new();
+        let sizes = [10, 50, 40, 10, 30, 20];
+        // 50 + 20 + 10 against 40 + 30 + 10: 80 off one thread's 160
+        assert!(cut(sizes.iter().copied(), 2, 80, &mut order));
+        let js: Vec<usize> = order.iter().map(|x| x.1).collect();
+        assert_eq!(js, [1, 2, 4, 5, 0, 3]);
+        assert!(!cut(sizes.iter().copied(), 2, 81, &mut order));
+        // one island: nothing to share
+        assert!(!cut([500].into_iter(), 2, 10, &mut order));
+        assert!(!cut(sizes.iter().copied(), 1, 10, &mut order));
+    }
+}
