@@ -467,3 +467,38 @@ pub mod solver {
         crate::sim::solver::dense::ldlt_dropping_solve(a, ld, m, x)
     }
 }
+
+/// The island solve's team of threads (`sim::parallel`).
+pub mod parallel {
+    /// `sim::parallel::Team`.
+    pub struct Team(crate::sim::parallel::Team);
+
+    impl Team {
+        /// `Team::new`.
+        pub fn new(threads: usize) -> Option<Self> {
+            crate::sim::parallel::Team::new(threads).map(Team)
+        }
+        /// `Team::threads`.
+        pub fn threads(&self) -> usize {
+            self.0.threads()
+        }
+        /// `Team::run`.
+        pub fn run(&self, f: &(dyn Fn(usize) + Sync)) {
+            self.0.run(f)
+        }
+        /// `Team::nudge`.
+        pub fn nudge(&self) {
+            self.0.nudge()
+        }
+    }
+
+    /// `sim::parallel::cut` of `sizes`.
+    pub fn cut(
+        sizes: &[usize],
+        parts: usize,
+        min_gain: usize,
+        order: &mut Vec<(usize, usize)>,
+    ) -> bool {
+        crate::sim::parallel::cut(sizes.iter().copied(), parts, min_gain, order)
+    }
+}

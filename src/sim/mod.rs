@@ -72,7 +72,7 @@ pub use loops::LoopForce;
 pub(crate) mod integrators;
 mod islands;
 pub mod newton;
-mod parallel;
+pub(crate) mod parallel;
 pub use contact_view::Violation;
 mod build;
 mod doze;

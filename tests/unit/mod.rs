@@ -28,6 +28,7 @@ mod sim_add_body;
 mod sim_build;
 mod sim_dense;
 mod sim_factor;
+mod sim_parallel;
 mod sleep_doze;
 mod sleep_doze_energy;
 mod spatial;

@@ -1,0 +1,67 @@
+//! The island solve's team of threads and its cut (src/sim/parallel.rs).
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Duration;
+use urdyn::testing::parallel::{cut, Team};
+
+#[test]
+fn every_item_is_done_once_whoever_takes_it() {
+    let team = Team::new(3).expect("a team of three");
+    assert_eq!(team.threads(), 3);
+    for round in 0..300 {
+        let items: Vec<AtomicUsize> = (0..64).map(|_| AtomicUsize::new(0)).collect();
+        let next = AtomicUsize::new(0);
+        team.run(&|_| loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            let Some(x) = items.get(i) else { break };
+            x.fetch_add(1, Ordering::Relaxed);
+        });
+        assert!(
+            items.iter().all(|h| h.load(Ordering::Relaxed) == 1),
+            "round {round}"
+        );
+        if round % 100 == 0 {
+            // long enough for the workers to fall asleep, then a nudge
+            std::thread::sleep(Duration::from_millis(2));
+            team.nudge();
+        }
+    }
+}
+
+#[test]
+fn part_zero_runs_here_and_its_panic_reaches_the_caller() {
+    let team = Team::new(2).expect("a team of two");
+    let here = std::thread::current().id();
+    let r = catch_unwind(AssertUnwindSafe(|| {
+        team.run(&|k| {
+            if k == 0 {
+                assert_eq!(std::thread::current().id(), here);
+                panic!("part 0");
+            }
+        })
+    }));
+    assert!(r.is_err());
+    // the team goes on
+    let n = AtomicUsize::new(0);
+    team.run(&|k| {
+        if k == 0 {
+            n.fetch_add(1, Ordering::Relaxed);
+        }
+    });
+    assert_eq!(n.load(Ordering::Relaxed), 1);
+}
+
+#[test]
+fn the_cut_orders_largest_first_and_keeps_small_jobs_here() {
+    let mut order = Vec::new();
+    let sizes = [10, 50, 40, 10, 30, 20];
+    // 50 + 20 + 10 against 40 + 30 + 10: 80 off one thread's 160
+    assert!(cut(&sizes, 2, 80, &mut order));
+    let js: Vec<usize> = order.iter().map(|x| x.1).collect();
+    assert_eq!(js, [1, 2, 4, 5, 0, 3]);
+    assert!(!cut(&sizes, 2, 81, &mut order));
+    // one island: nothing to share
+    assert!(!cut(&[500], 2, 10, &mut order));
+    assert!(!cut(&sizes, 1, 10, &mut order));
+}
