@@ -50,9 +50,8 @@ pub(crate) struct Islands {
     /// ([`Islands::warm`]), made when `warm_made`.
     warm: Vec<f64>,
     warm_made: bool,
-    /// Per island: it was made by the last join (split.rs); its root tree
-    /// (`usize::MAX`: rows on no dof; [`LEFT`]: emptied by a join).
-    dirty: Vec<bool>,
+    /// Per island: its root tree (`usize::MAX`: rows on no dof; [`LEFT`]:
+    /// emptied by a join, split.rs).
     iroot: Vec<usize>,
     /// Per tree: the island it roots (`usize::MAX`: none), and whether that
     /// island's Δv' (or w') moved since the last check of the left-out
@@ -60,12 +59,14 @@ pub(crate) struct Islands {
     iof: Vec<usize>,
     touched: Vec<bool>,
     check_all: bool,
+    /// Scratch of the split's tests (split.rs): a Δv' on one row's path.
+    xpath: Vec<f64>,
     /// Scratch of a join (split.rs): the failed contacts (row, group, trees),
     /// and the pieces of the new islands (root, island or row).
     fails: Vec<(usize, usize, usize, usize)>,
     pieces: Vec<(usize, usize, usize)>,
-    /// The islands to solve: every one after a grouping, the dirty ones
-    /// after a join.
+    /// The islands to solve: every one after a grouping, the ones a join
+    /// made after it.
     todo: Vec<usize>,
     /// The group starting at each row (read at runs' first rows only).
     group_at: Vec<usize>,
@@ -155,11 +156,11 @@ impl Islands {
             gpart: Vec::with_capacity(rows),
             warm: vec![0.0; model.nv],
             warm_made: false,
-            dirty: Vec::with_capacity(rows.min(nt + 1)),
             iroot: Vec::with_capacity(rows.min(nt + 1)),
             iof: vec![usize::MAX; nt],
             touched: vec![false; nt],
             check_all: false,
+            xpath: vec![0.0; model.nv],
             fails: Vec::with_capacity(rows),
             pieces: Vec::with_capacity(rows),
             todo: Vec::with_capacity(rows.min(nt + 1)),
@@ -281,11 +282,13 @@ impl Islands {
                 self.gtree.push(k);
             }
         }
-        self.build(rows);
+        self.build(rows, false);
     }
 
-    /// The islands' runs and dofs from the groups' trees and the union-find.
-    fn build(&mut self, rows: &Rows) {
+    /// The islands' runs and dofs from the groups' trees and the union-find;
+    /// with `pushed_only`, the dofs of the islands whose root is `touched`
+    /// only (split.rs: the position pass's; the others' are left empty).
+    fn build(&mut self, rows: &Rows, pushed_only: bool) {
         self.gkey.clear();
         for g in 0..self.gtree.len() {
             let a = self.gtree[g];
@@ -367,6 +370,17 @@ impl Islands {
         while i < self.runs.len() {
             let k = self.runs[i].0;
             let (r0, d0) = (i, self.dofs.len());
+            if pushed_only && self.touched.get(k) == Some(&false) {
+                while i < self.runs.len() && self.runs[i].0 == k {
+                    i += 1;
+                }
+                self.islands.push(((r0, i), (d0, d0)));
+                if let Some(x) = self.iof.get_mut(k) {
+                    *x = self.iroot.len();
+                }
+                self.iroot.push(k);
+                continue;
+            }
             // the dofs marked (listed, and their range)
             let (mut lo, mut hi) = (usize::MAX, 0);
             while i < self.runs.len() && self.runs[i].0 == k {
@@ -436,8 +450,6 @@ impl Islands {
             }
             self.iroot.push(k);
         }
-        self.dirty.clear();
-        self.dirty.resize(self.islands.len(), false);
         self.todo.clear();
         self.todo.extend(0..self.islands.len());
     }

@@ -130,7 +130,7 @@ impl Constraints {
                 if first && rows_all > 0 {
                     self.per_row = work as f64 / rows_all as f64;
                 }
-                if !self.islands.join_failed(rows, dv, false, tol) {
+                if !self.islands.join_failed(rows, dv, tol) {
                     break;
                 }
                 first = false;
@@ -171,41 +171,22 @@ impl Constraints {
             let (rp, wc) = (&self.row_point, &self.warm_contact);
             let (jr, fj, wj) = (&self.joint_rows, self.first_joint_row, &self.warm_joint);
             let warm = self.pos_warm.gather(rows.n, rp, points, wc, fj, jr, wj);
-            // every island, then those a left-out contact the pass would
-            // close joined (src/sim/islands/split.rs), until none would
-            let mut again = false;
+            // on the islands of every contact: the left-out ones on an island
+            // the pass pushes join it first (src/sim/islands/split.rs), as a
+            // pushed body often closes a left-out point's gap
             if pgs {
-                self.islands.untouch();
+                self.islands.join_pushed(rows);
             }
-            loop {
-                let count = if pgs { self.islands.len() } else { 1 };
-                for i in 0..count {
-                    let isl = if pgs { self.islands.get(i) } else { whole };
-                    let violated = |&(_, s, e): &(usize, usize, usize)| {
-                        rows.bpos[s..e]
-                            .iter()
-                            .fold(false, |any, &b| any | (b != 0.0))
-                    };
-                    if pgs && ((again && !self.islands.dirty(i)) || !isl.runs.iter().any(violated))
-                    {
-                        continue;
-                    }
-                    let dw = self.push.as_mut_slice();
-                    let d = dofs(pgs, &isl);
-                    let s = rows.solve_position_runs(isl.runs, d, dw, iterations, tol, Some(warm));
-                    self.work += (isl.rows() * s) as u64;
-                    if pgs {
-                        self.islands.touch(i);
-                    }
+            let count = if pgs { self.islands.len() } else { 1 };
+            for i in 0..count {
+                let isl = if pgs { self.islands.get(i) } else { whole };
+                if pgs && !isl.runs.iter().any(|&(_, s, e)| rows.violated(s, e)) {
+                    continue;
                 }
-                if !pgs
-                    || !self
-                        .islands
-                        .join_failed(rows, self.push.as_slice(), true, tol)
-                {
-                    break;
-                }
-                again = true;
+                let dw = self.push.as_mut_slice();
+                let d = dofs(pgs, &isl);
+                let s = rows.solve_position_runs(isl.runs, d, dw, iterations, tol, Some(warm));
+                self.work += (isl.rows() * s) as u64;
             }
             // Δv = R⁻¹ Δv', w = R⁻¹ w'
             f.half_solve2(self.dv.as_mut_slice(), self.push.as_mut_slice());

@@ -26,8 +26,8 @@
 //! rows and dofs are untouched by it), and only the left-out points on a
 //! re-solved island are checked again. The end is a solution of
 //! the whole rows' conditions, to the same tolerance as one solve of them.
-//! The position pass is held the same way: a left-out point must not close
-//! its gap under the pass's pseudo-velocity (yₙ·w' ≥ −tol).
+//! The position pass runs on the islands of every contact: before it, the
+//! left-out contacts on an island it pushes join it ([`Islands::join_pushed`]).
 //!
 //! The sleep islands (src/sim/sleep.rs) are not these: they join trees by
 //! every point, as before.
@@ -48,7 +48,7 @@ pub(super) const MIN_ROWS: usize = 192;
 impl Islands {
     /// Marks the contacts of group `g` (rows `s..e`, on trees `a` and `b`)
     /// left out of the solve: contact triples none likely to push this step
-    /// ([`Rows::contact_idle`]). Returns whether the group keeps a row (it
+    /// ([`Rows::contact_quiet`], [`Rows::contact_clear`]). Returns whether the group keeps a row (it
     /// joins its trees).
     pub(super) fn leave_out(
         &mut self,
@@ -63,9 +63,17 @@ impl Islands {
             return true;
         }
         let (mut kept, mut part) = (false, false);
+        // the warm start's Δv' on the group's one path, gathered once, at
+        // its first quiet contact
+        let mut xs: Option<&[f64]> = None;
         let mut r = s;
         while r < e {
-            if rows.contact_idle(r, &self.warm, MARGIN) {
+            let mut idle = rows.contact_quiet(r);
+            if idle && xs.is_none() {
+                xs = rows.on_path(s, &self.warm, &mut self.xpath);
+            }
+            idle = idle && xs.is_some_and(|xs| rows.contact_clear(r, xs, MARGIN));
+            if idle {
                 self.out[r] = true;
                 self.left.push((r, g, a, b));
                 part = true;
@@ -78,25 +86,37 @@ impl Islands {
         kept
     }
 
-    /// Checks the left-out contacts at the solved Δv' `x` (velocity) or w'
-    /// (`position`), to `tol`: after a grouping every one, then only those
-    /// on a tree of an island solved (or pushed) since the last check
-    /// ([`Islands::touch`]; the others' velocities have not moved). Each that
-    /// fails joins its two trees and leaves the left-out list; the islands it
-    /// joins are merged into one new island (their runs and the contact's
-    /// rows, in row order; their dofs and its path's, ascending), the old
-    /// ones emptied, and the new ones are the islands to solve
-    /// ([`Islands::todo`], [`Islands::dirty`]). Returns whether any joined.
-    pub fn join_failed(&mut self, rows: &Rows, x: &[f64], position: bool, tol: f64) -> bool {
+    /// Checks the left-out contacts at the solved Δv' `x`, to `tol`: after a
+    /// grouping every one, then only those on a tree of an island solved
+    /// since the last check (the others' velocities have not moved). Each
+    /// that fails joins its two trees and leaves the left-out list; the
+    /// islands it joins are merged into one new island (their runs and the
+    /// contact's rows, in row order; their dofs and its path's, ascending),
+    /// the old ones emptied, and the new ones are the islands to solve
+    /// ([`Islands::todo`]). Returns whether any joined.
+    pub fn join_failed(&mut self, rows: &Rows, x: &[f64], tol: f64) -> bool {
         self.fails.clear();
         let mut keep = 0;
+        // (x on the last group's path: a group's contacts share it, and
+        // are listed one after another)
+        let mut at = usize::MAX;
         for i in 0..self.left.len() {
             let (r, g, a, b) = self.left[i];
             let moved = self.check_all || {
                 let (ra, rb) = (self.find(a), self.find(b));
                 self.touched[ra] || self.touched[rb]
             };
-            if !moved || rows.contact_holds(r, x, position, tol) {
+            let holds = !moved || {
+                if at != g {
+                    at = match rows.on_path(r, x, &mut self.xpath) {
+                        Some(_) => g,
+                        None => usize::MAX,
+                    };
+                }
+                let pl = rows.path.get(r).map_or(0, |p| p.1);
+                at == g && rows.contact_holds(r, &self.xpath[..pl], tol)
+            };
+            if holds {
                 self.left[keep] = self.left[i];
                 keep += 1;
                 continue;
@@ -140,7 +160,6 @@ impl Islands {
         }
         self.pieces.sort_unstable();
         self.pieces.dedup();
-        self.dirty.fill(false);
         self.todo.clear();
         let (table, path) = (rows.table(), &rows.path[..]);
         let mut i = 0;
@@ -197,32 +216,66 @@ impl Islands {
             self.iroot.push(root);
             self.iof[root] = ni;
             self.touched[root] = true;
-            self.dirty.push(true);
             self.todo.push(ni);
         }
         true
     }
 
-    /// Island `i` was made by the last [`Islands::join_failed`] (its
-    /// solution is to be made again).
-    pub fn dirty(&self, i: usize) -> bool {
-        self.dirty.get(i) == Some(&true)
-    }
-
-    /// Island `i`'s Δv' (or w') moved: the left-out contacts on its trees
-    /// are checked at the next [`Islands::join_failed`].
-    pub fn touch(&mut self, i: usize) {
-        if let Some(&k) = self.iroot.get(i)
-            && let Some(t) = self.touched.get_mut(k)
-        {
-            *t = true;
+    /// The position pass's islands: every left-out contact on an island
+    /// with a violated row (b_pos ≠ 0, the islands the pass pushes) joins
+    /// it, and so on from the islands so grown, then the islands are built
+    /// again (the dofs of the pushed ones only). The pushed islands are then those of every contact (the sleep
+    /// islands' rows, in row order); the rest are not pushed (w' = 0 on
+    /// them), so every contact still left out holds (yₙ·w' = 0 ≥ b_pos = 0)
+    /// and none is checked. (Left out, a point the pass pushes in would be
+    /// found only after the pass, and its island pushed again: mixed 256,
+    /// 22.7 such joins a solve in 1.7 rounds, docs/theory.md §"Islands".)
+    pub fn join_pushed(&mut self, rows: &Rows) {
+        if self.left.is_empty() {
+            return;
         }
-    }
-
-    /// The position pass's checks start: none but those of the islands it
-    /// pushes ([`Islands::touch`]).
-    pub fn untouch(&mut self) {
-        self.check_all = false;
+        // the pushed islands' roots
+        self.touched.fill(false);
+        for i in 0..self.islands.len() {
+            let ((r0, r1), _) = self.islands[i];
+            let pushed = self.runs[r0..r1]
+                .iter()
+                .any(|&(_, s, e)| rows.violated(s, e));
+            if pushed && let Some(t) = self.touched.get_mut(self.iroot[i]) {
+                *t = true;
+            }
+        }
+        let mut any = false;
+        loop {
+            let (mut more, mut keep) = (false, 0);
+            for i in 0..self.left.len() {
+                let (r, g, a, b) = self.left[i];
+                let (ra, rb) = (self.find(a), self.find(b));
+                if !(self.touched[ra] || self.touched[rb]) {
+                    self.left[keep] = self.left[i];
+                    keep += 1;
+                    continue;
+                }
+                if ra != rb {
+                    self.parent[ra.max(rb)] = ra.min(rb);
+                    self.touched[ra.min(rb)] = true;
+                }
+                self.out[r] = false;
+                if self.gtree[g] == LEFT {
+                    self.gtree[g] = a;
+                }
+                more = true;
+            }
+            self.left.truncate(keep);
+            any |= more;
+            if !more {
+                break;
+            }
+        }
+        if any {
+            // (the dofs of the pushed islands only: the pass reads no other)
+            self.build(rows, true);
+        }
         self.touched.fill(false);
     }
 
