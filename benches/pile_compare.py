@@ -4,7 +4,7 @@
 Usage:
     /work/venv/bin/python benches/pile_compare.py --urdyn BIN [--kinds boxes,mixed]
         [--sizes 16,64,256,1024] [--duration 4] [--duration-1024 2] [--md benches/pile_results.md]
-        [--settled 256] [--repeats 3]
+        [--settled 256] [--repeats 3] [--threads 2]
 
 Each scene (benches/scenes/pile_KIND_N.json) is run
 - by urdyn: `urdyn simulate --scene FILE --duration T --dt 0.001 --every 1000000000 --out /dev/null`
@@ -15,6 +15,8 @@ Each scene (benches/scenes/pile_KIND_N.json) is run
   its scenes (build_mujoco), dt 1 ms, islands on (MuJoCo's default), for each of Euler and
   implicitfast with sleep off and on (mjENBL_SLEEP); perf_counter around a Python loop of mj_step.
 The ratio is urdyn's faster run (sleep on, its default) over MuJoCo's fastest of the four.
+--threads N adds urdyn with `--threads N` (sleep on) as a column of its own and its ratio beside
+the headline's, which stays one thread's (MuJoCo's `mj_step` runs on one thread).
 Growth: the step time ratio from 64 to 1024 objects (≤ 16: no faster than linear); beside it
 the same ratio per awake object (step time over the run's mean awake count), and the ratio at equal
 durations (the 64 pile run again over the 1024 pile's 2 s, both engines; --no-equal-growth skips it).
@@ -85,6 +87,9 @@ def one(args, kind, n, tmp):
     row["urdyn_awake_mean"] = ur["summary"].rsplit("mean awake", 1)[-1].strip() if "mean awake" in ur["summary"] else ""
     row["urdyn_nosleep"] = max(urdyn(args, path, dur, ["--no-sleep"])["steps_per_s"]
                                for _ in range(args.repeats)) if not args.no_nosleep else None
+    if args.threads:
+        row["urdyn_threads"] = max(urdyn(args, path, dur, ["--threads", str(args.threads)])["steps_per_s"]
+                                   for _ in range(args.repeats))
     model, qpos, qvel, _ = build_mujoco(sc, [], 0.001)
     mj = {}
     for integ in INTEG:
@@ -95,6 +100,8 @@ def one(args, kind, n, tmp):
     best = max(mj, key=mj.get)
     row["mujoco_best"], row["mujoco_best_cfg"] = mj[best], best
     row["ratio"] = max(row["urdyn_sleep"], row["urdyn_nosleep"] or 0) / mj[best]
+    if args.threads:
+        row["ratio_threads"] = row["urdyn_threads"] / mj[best]
     if n == 64 and args.equal_growth and args.duration_1024 != dur:
         # the 64 pile again over the 1024 pile's duration: growth at equal durations (a 4 s run of
         # a small pile is mostly asleep or resting, a 2 s run of the large one mostly falling)
@@ -106,8 +113,9 @@ def one(args, kind, n, tmp):
                                  for _ in range(args.repeats)),
             "mujoco_best": max(max(time_mj(model, qpos, qvel, integ, sleep, s2) for _ in range(args.repeats))
                                for integ in INTEG for sleep in (False, True))}
-    print("%s %d: urdyn %.0f (no sleep %s), MuJoCo %.0f (%s), ratio %.2f" % (
+    print("%s %d: urdyn %.0f (no sleep %s%s), MuJoCo %.0f (%s), ratio %.2f" % (
         kind, n, row["urdyn_sleep"], row["urdyn_nosleep"] and "%.0f" % row["urdyn_nosleep"],
+        ", threads %d %.0f" % (args.threads, row["urdyn_threads"]) if args.threads else "",
         mj[best], best, row["ratio"]), file=sys.stderr, flush=True)
     return row
 
@@ -139,7 +147,9 @@ def settled(args, n, tmp):
             "bound": diff < 1e-4, "how": "4.5 s run minus 4 s run"}
 
 
-def write_md(path, rows, meta, st):
+def write_md(path, rows, meta, st, threads=0):
+    th_head = " urdyn --threads %d |" % threads if threads else ""
+    th_ratio = " ratio (threads %d) |" % threads if threads else ""
     out = ["# Piles in a bin: urdyn and MuJoCo 4.0.0", "",
            "Made by `%s` on %s (%.0f s wall), urdyn commit %s, %s. Load at the start: `%s`; at the end: `%s`."
            % (meta["cmd"], meta["date"], meta["wall"], meta["commit"], meta["machine"], meta["load0"], meta["load1"]),
@@ -147,14 +157,17 @@ def write_md(path, rows, meta, st):
            "dt = 0.001 s; 4 s per run (1024 objects: 2 s). urdyn: sleep on (default) and `--no-sleep`; "
            "MuJoCo: Euler and implicitfast, sleep off and on, islands on; ratio = urdyn (faster of its two) / "
            "MuJoCo's fastest.", "",
-           "| pile | objects | urdyn steps/s (sleep) | urdyn --no-sleep | mean awake | MuJoCo euler | euler+sleep | implicitfast | implicitfast+sleep | ratio |",
-           "|---|---|---|---|---|---|---|---|---|---|"]
+           "| pile | objects | urdyn steps/s (sleep) | urdyn --no-sleep |" + th_head + " mean awake | MuJoCo euler |"
+           " euler+sleep | implicitfast | implicitfast+sleep | ratio |" + th_ratio,
+           "|---|---|---|---|" + ("---|" if threads else "") + "---|---|---|---|---|---|" + ("---|" if threads else "")]
     for r in rows:
         mj = r["mujoco"]
-        out.append("| %s | %d | %.0f | %s | %s | %.0f | %.0f | %.0f | %.0f | %.2f |" % (
+        th = " %.0f |" % r["urdyn_threads"] if threads else ""
+        thr = " %.2f |" % r["ratio_threads"] if threads else ""
+        out.append("| %s | %d | %.0f | %s |%s %s | %.0f | %.0f | %.0f | %.0f | %.2f |%s" % (
             r["kind"], r["n"], r["urdyn_sleep"], "%.0f" % r["urdyn_nosleep"] if r["urdyn_nosleep"] else "-",
-            r["urdyn_awake_mean"] or "-", mj["euler"], mj["euler+sleep"], mj["implicitfast"],
-            mj["implicitfast+sleep"], r["ratio"]))
+            th, r["urdyn_awake_mean"] or "-", mj["euler"], mj["euler+sleep"], mj["implicitfast"],
+            mj["implicitfast+sleep"], r["ratio"], thr))
     out.append("")
     for kind in sorted({r["kind"] for r in rows}):
         by = {r["n"]: r for r in rows if r["kind"] == kind}
@@ -198,6 +211,8 @@ def main():
     ap.add_argument("--pile-settled", default=None,
                     help="examples/pile_settled binary (default target/release/examples/pile_settled)")
     ap.add_argument("--repeats", type=int, default=1, help="best of this many runs of each engine and setting")
+    ap.add_argument("--threads", type=int, default=0,
+                    help="also run urdyn with --threads N (sleep on): a column and a ratio of its own")
     ap.add_argument("--no-nosleep", action="store_true", help="skip urdyn's --no-sleep runs")
     ap.add_argument("--no-equal-growth", dest="equal_growth", action="store_false",
                     help="skip the 64 pile's runs over the 1024 pile's duration (growth at equal durations)")
@@ -218,7 +233,7 @@ def main():
                 "date": datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC"),
                 "wall": time.time() - t0, "commit": commit(), "machine": machine(),
                 "load0": load0, "load1": uptime()}
-        write_md(args.md, rows, meta, st)
+        write_md(args.md, rows, meta, st, args.threads)
 
 
 if __name__ == "__main__":
