@@ -59,8 +59,6 @@ pub(crate) struct Islands {
     iof: Vec<usize>,
     touched: Vec<bool>,
     check_all: bool,
-    /// Scratch of the split's tests (split.rs): a Δv' on one row's path.
-    xpath: Vec<f64>,
     /// Scratch of a join (split.rs): the failed contacts (row, group, trees),
     /// and the pieces of the new islands (root, island or row).
     fails: Vec<(usize, usize, usize, usize)>,
@@ -160,7 +158,6 @@ impl Islands {
             iof: vec![usize::MAX; nt],
             touched: vec![false; nt],
             check_all: false,
-            xpath: vec![0.0; model.nv],
             fails: Vec::with_capacity(rows),
             pieces: Vec::with_capacity(rows),
             todo: Vec::with_capacity(rows.min(nt + 1)),

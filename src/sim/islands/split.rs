@@ -48,7 +48,7 @@ pub(super) const MIN_ROWS: usize = 192;
 impl Islands {
     /// Marks the contacts of group `g` (rows `s..e`, on trees `a` and `b`)
     /// left out of the solve: contact triples none likely to push this step
-    /// ([`Rows::contact_quiet`], [`Rows::contact_clear`]). Returns whether the group keeps a row (it
+    /// ([`Rows::contact_idle`]). Returns whether the group keeps a row (it
     /// joins its trees).
     pub(super) fn leave_out(
         &mut self,
@@ -63,17 +63,9 @@ impl Islands {
             return true;
         }
         let (mut kept, mut part) = (false, false);
-        // the warm start's Δv' on the group's one path, gathered once, at
-        // its first quiet contact
-        let mut xs: Option<&[f64]> = None;
         let mut r = s;
         while r < e {
-            let mut idle = rows.contact_quiet(r);
-            if idle && xs.is_none() {
-                xs = rows.on_path(s, &self.warm, &mut self.xpath);
-            }
-            idle = idle && xs.is_some_and(|xs| rows.contact_clear(r, xs, MARGIN));
-            if idle {
+            if rows.contact_idle(r, &self.warm, MARGIN) {
                 self.out[r] = true;
                 self.left.push((r, g, a, b));
                 part = true;
@@ -97,26 +89,13 @@ impl Islands {
     pub fn join_failed(&mut self, rows: &Rows, x: &[f64], tol: f64) -> bool {
         self.fails.clear();
         let mut keep = 0;
-        // (x on the last group's path: a group's contacts share it, and
-        // are listed one after another)
-        let mut at = usize::MAX;
         for i in 0..self.left.len() {
             let (r, g, a, b) = self.left[i];
             let moved = self.check_all || {
                 let (ra, rb) = (self.find(a), self.find(b));
                 self.touched[ra] || self.touched[rb]
             };
-            let holds = !moved || {
-                if at != g {
-                    at = match rows.on_path(r, x, &mut self.xpath) {
-                        Some(_) => g,
-                        None => usize::MAX,
-                    };
-                }
-                let pl = rows.path.get(r).map_or(0, |p| p.1);
-                at == g && rows.contact_holds(r, &self.xpath[..pl], tol)
-            };
-            if holds {
+            if !moved || rows.contact_holds(r, x, tol) {
                 self.left[keep] = self.left[i];
                 keep += 1;
                 continue;

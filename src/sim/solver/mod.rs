@@ -395,57 +395,47 @@ impl Rows {
     }
 
     /// The contact triple at row `r` is not likely to push this step
-    /// (src/sim/islands/split.rs) by what needs no Δv': no impulse
-    /// warm-started on its rows, its normal not violated (b_pos = 0), and its
-    /// normal's free velocity cᵣ not below its target.
-    pub(crate) fn contact_quiet(&self, r: usize) -> bool {
+    /// (src/sim/islands/split.rs): no impulse warm-started on its rows, its
+    /// normal not violated (b_pos = 0), and its normal velocity both free
+    /// (cᵣ) and at the warm start's Δv' (`warm`) at least `margin` above
+    /// its target.
+    pub(crate) fn contact_idle(&self, r: usize, warm: &[f64], margin: f64) -> bool {
         let l = &self.lambda[r..r + 3];
-        self.c[r] >= self.b[r] && !(self.bpos[r] > 0.0) && l == [0.0; 3]
-    }
-    /// The quiet contact at row `r` ([`Rows::contact_quiet`]) is not likely
-    /// to push: its normal velocity at the warm start's Δv', given on the
-    /// row's path as `xs` ([`Rows::on_path`]), at least `margin` above its
-    /// target.
-    pub(crate) fn contact_clear(&self, r: usize, xs: &[f64], margin: f64) -> bool {
-        let Some(d) = self.y_dot(r, xs) else {
+        if !(self.c[r] >= self.b[r])
+            || self.bpos[r] > 0.0
+            || l[0] != 0.0
+            || l[1] != 0.0
+            || l[2] != 0.0
+        {
+            return false;
+        }
+        let Some(d) = self.y_dot(r, warm) else {
             return false;
         };
         self.c[r] + d >= self.b[r] + margin
     }
-    /// `x` on row `r`'s path, into `buf` (None: the path out of range, or
-    /// longer than `buf`): what [`Rows::contact_clear`] and
-    /// [`Rows::contact_holds`] read, gathered once for the rows of one path
-    /// (a pair's points). A row's path holds dof indices < nv ≤ x.len()
+    /// yᵣ·x over row `r`'s path, in the path's order (None: the row's path
+    /// or y out of range). A row's path holds dof indices < nv ≤ x.len()
     /// (the sweeps' invariant); a short `x` reads 0 past its end.
-    pub(crate) fn on_path<'b>(&self, r: usize, x: &[f64], buf: &'b mut [f64]) -> Option<&'b [f64]> {
+    fn y_dot(&self, r: usize, x: &[f64]) -> Option<f64> {
+        let st = self.stride;
         let (ps, pl) = *self.path.get(r)?;
         let p = self.table.get(ps..ps + pl)?;
-        let xs = buf.get_mut(..pl)?;
-        for (v, &k) in xs.iter_mut().zip(p) {
-            *v = x.get(k).copied().unwrap_or(0.0);
-        }
-        Some(xs)
-    }
-    /// yᵣ·x over row `r`'s path, in the path's order, `xs` being x on the
-    /// path ([`Rows::on_path`]; None: the row's y out of range).
-    fn y_dot(&self, r: usize, xs: &[f64]) -> Option<f64> {
-        let st = self.stride;
-        let y = self.y.get(r * st..r * st + xs.len())?;
+        let y = self.y.get(r * st..r * st + pl)?;
         let mut d = 0.0;
-        for (&v, &xk) in y.iter().zip(xs) {
-            d += v * xk;
+        for (&v, &k) in y.iter().zip(p) {
+            d += v * x.get(k).copied().unwrap_or(0.0);
         }
         Some(d)
     }
     /// The normal of the contact at row `r` holds at λ = 0 to `tol` for the
-    /// Δv' x, given on the row's path as `xs` ([`Rows::on_path`]) (src/sim/
-    /// islands/split.rs): uₙ = cₙ + yₙ·x ≥ bₙ − tol. A row no impulse moves
-    /// (Wᵣᵣ = 0) holds.
-    pub(crate) fn contact_holds(&self, r: usize, xs: &[f64], tol: f64) -> bool {
+    /// Δv' `x` (src/sim/islands/split.rs): uₙ = cₙ + yₙ·x ≥ bₙ − tol. A row
+    /// no impulse moves (Wᵣᵣ = 0) holds.
+    pub(crate) fn contact_holds(&self, r: usize, x: &[f64], tol: f64) -> bool {
         if r >= self.n || self.winv[r] == 0.0 {
             return true;
         }
-        let Some(d) = self.y_dot(r, xs) else {
+        let Some(d) = self.y_dot(r, x) else {
             return false;
         };
         self.c[r] + d >= self.b[r] - tol
