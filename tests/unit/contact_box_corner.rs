@@ -8,10 +8,11 @@
 //! reduction kept only those within `EXTREME_BAND` of the deepest, the
 //! touching one, and the corner entered the rows already 1.5 mm in.
 
+use super::reduce4;
 use parry3d_f64::shape::SharedShape;
 use urdyn::nalgebra::{Rotation3, Unit, Vector3};
 use urdyn::spatial::Se3;
-use urdyn::testing::contact::{pair_shape, parry_points, reduce_pair, ContactPoint, Raw};
+use urdyn::testing::contact::{pair_shape, parry_points, Raw};
 
 const MARGIN: f64 = 0.005;
 const H: f64 = 0.05;
@@ -40,25 +41,6 @@ fn pose(phi: f64, yaw: f64, axis: Vector3<f64>, dx: f64, dy: f64, clear: f64) ->
     Se3::new(r.into_inner(), Vector3::new(dx, dy, H + clear - low))
 }
 
-fn kept(raw: &[Raw]) -> Vec<ContactPoint> {
-    let mut out = Vec::new();
-    reduce_pair(raw, 4, &mut out, &|r| ContactPoint {
-        shape: 0,
-        slot: 0,
-        body: 1,
-        point: r.point,
-        gap: r.gap,
-        geom: 0,
-        other: 2,
-        other_geom: 0,
-        normal: r.normal,
-        friction: 1.0,
-        fresh: true,
-        key: r.key,
-    });
-    out
-}
-
 #[test]
 fn a_closing_corner_is_kept_while_within_the_margin() {
     let (a, b) = (cube(), cube());
@@ -81,7 +63,7 @@ fn a_closing_corner_is_kept_while_within_the_margin() {
             let wb = pose(phi, yaw, axis, dx, dy, 1e-4);
             let mut raw = Vec::new();
             parry_points(&a, &b, &wa, &wb, MARGIN, &mut manifolds, &mut ws, &mut raw);
-            let out = kept(&raw);
+            let out = reduce4(&raw);
             cases += 1;
             assert_eq!(out.len(), raw.len().min(4), "phi {phi}: {raw:?}");
             if raw.len() > 4 {
@@ -144,7 +126,7 @@ fn the_extremes_of_the_band_come_first() {
         p(0.05, 0.2, 1e-3, 5),
         p(0.2, 0.05, 2e-3, 6),
     ];
-    let out = kept(&raw);
+    let out = reduce4(&raw);
     let mut keys: Vec<u64> = out.iter().map(|c| c.key).collect();
     keys.sort();
     assert_eq!(keys, [1, 2, 3, 4]);
@@ -156,6 +138,6 @@ fn the_extremes_of_the_band_come_first() {
         p(0.1, 0.1, 3e-3, 7),
         p(0.3, 0.1, 4e-3, 8),
     ];
-    let keys: Vec<u64> = kept(&raw).iter().map(|c| c.key).collect();
+    let keys: Vec<u64> = reduce4(&raw).iter().map(|c| c.key).collect();
     assert_eq!(keys, [1, 5, 6, 7]);
 }

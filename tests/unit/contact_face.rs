@@ -1,15 +1,14 @@
 //! The face path's tests: against parry's distances, and the dense first
 //! pass against the whole band (formerly `src/contact/face/tests.rs`).
 
-use super::superellipsoid;
+use super::{reduce4, superellipsoid};
 use parry3d_f64::math::{Pose, Vector as PVec};
 use parry3d_f64::shape::{Cuboid, Shape, SharedShape};
-use urdyn::contact::ContactPoint;
 use urdyn::nalgebra::{self, Vector3};
 use urdyn::spatial::Se3;
 use urdyn::testing::contact::{
-    hull_on_face, reduce_pair, to_pose, to_v, FaceContact, FacePoint, FaceShape, Raw, TestHull,
-    BAND, EXTREME_BAND,
+    hull_on_face, to_pose, to_v, FaceContact, FacePoint, FaceShape, Raw, TestHull, BAND,
+    EXTREME_BAND,
 };
 
 /// A rounded box hull (many vertices: the climbing kind): points on a
@@ -158,22 +157,10 @@ fn reduced(pts: &[FacePoint], n: Vector3<f64>) -> Vec<(u64, f64, Vector3<f64>)> 
             key: (1 << 62) | p.vertex as u64,
         })
         .collect();
-    let mut out = Vec::new();
-    reduce_pair(&raw, 4, &mut out, &|r| ContactPoint {
-        shape: 0,
-        slot: 0,
-        body: 1,
-        point: r.point,
-        gap: r.gap,
-        geom: 0,
-        other: 0,
-        other_geom: 0,
-        normal: r.normal,
-        friction: 1.0,
-        fresh: true,
-        key: r.key,
-    });
-    out.iter().map(|p| (p.key, p.gap, p.point)).collect()
+    reduce4(&raw)
+        .iter()
+        .map(|p| (p.key, p.gap, p.point))
+        .collect()
 }
 
 #[test]

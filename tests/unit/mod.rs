@@ -40,7 +40,28 @@ mod view_trajectory;
 mod view_visuals;
 
 use parry3d_f64::math::Vector as PVec;
-use urdyn::testing::contact::TestHull;
+use urdyn::testing::contact::{reduce_pair, ContactPoint, Raw, TestHull};
+
+/// What `narrow::reduce_pair` keeps of one pair's raw points (4 at most), as
+/// the points of bodies 1 and 2 (contact_box_corner.rs, contact_face.rs).
+pub(crate) fn reduce4(raw: &[Raw]) -> Vec<ContactPoint> {
+    let mut out = Vec::new();
+    reduce_pair(raw, 4, &mut out, &|r| ContactPoint {
+        shape: 0,
+        slot: 0,
+        body: 1,
+        point: r.point,
+        gap: r.gap,
+        geom: 0,
+        other: 2,
+        other_geom: 0,
+        normal: r.normal,
+        friction: 1.0,
+        fresh: true,
+        key: r.key,
+    });
+    out
+}
 
 /// A superellipsoid's hull of 266 points (`|x/a|^(2/p) + ... = 1` sampled on
 /// a 24 × 11 grid plus the poles): the climbing kind of hull, many vertices.
