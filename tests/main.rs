@@ -21,6 +21,7 @@ mod api;
 mod bad_cli;
 mod bad_inputs;
 mod cli_errors;
+mod cli_tour;
 mod constraint_dynamics;
 mod contact_pairs;
 mod contact_spin;

@@ -104,6 +104,10 @@ const CASES: &[(&str, &[&str])] = &[
     ("no_models.json", &["models", "at least one model"]),
     ("bad_base.json", &["models[0].base", "flying"]),
     ("negative_friction.json", &["models[0].friction", "-1"]),
+    (
+        "urdf_is_directory.json",
+        &["models[0].urdf: \"../scene\" is a directory"],
+    ),
 ];
 
 #[test]

@@ -95,6 +95,9 @@ impl Loader<'_> {
         } else {
             self.base_dir.join(p)
         };
+        if path.is_dir() {
+            return Err(self.err(key, format!("\"{name}\" is a directory, not a file")));
+        }
         if !path.is_file() {
             let mut e = self.err(key, format!("file \"{name}\" not found"));
             if path.as_path() != p {

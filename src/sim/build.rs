@@ -3,6 +3,11 @@
 
 use super::*;
 
+/// The most threads [`SimOptions::threads`] may ask for: far more than a
+/// step's islands use, and few enough to start (100000 aborted the process
+/// as each thread's stack guard could not be mapped).
+pub(crate) const MAX_THREADS: usize = 1024;
+
 /// The joint springs of `model` (an MJCF joint's `stiffness` about its
 /// `springref`, on hinge and slide joints) as servo gains and targets, `None`
 /// when there is none (or joint dynamics are off).
@@ -195,6 +200,12 @@ impl Simulation {
         if !(a.is_finite() && a >= 0.0) {
             return Err(SimError::Invalid(format!(
                 "--armature must be a non-negative number (got {a})"
+            )));
+        }
+        if opts.threads > MAX_THREADS {
+            return Err(SimError::Invalid(format!(
+                "threads (--threads, a scene's \"threads\", Python's threads=) must be at most {MAX_THREADS} (got {})",
+                opts.threads
             )));
         }
         crate::dynamics::check_massless(&model)?;

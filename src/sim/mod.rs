@@ -156,7 +156,8 @@ pub struct SimOptions {
     pub sleep_velocity: f64,
     /// How long an island is still before it sleeps (s, 0.5).
     pub sleep_time: f64,
-    /// Threads the islands are solved on (0: every core; 1 the default).
+    /// Threads the islands are solved on (0: every core; 1 the default; at
+    /// most 1024).
     pub threads: usize,
     /// Scene models that never sleep (their own `"sleep": false`), by name.
     pub never_sleep: Vec<String>,

@@ -154,7 +154,7 @@ pub(crate) struct SimulateCmd {
     /// No island sleeps (sleep is on by default: still islands stop costing).
     #[arg(long)]
     pub(crate) no_sleep: bool,
-    /// Threads the islands are solved on (0: every core; default the scene's, else 1).
+    /// Threads the islands are solved on (0: every core; at most 1024; default the scene's, else 1).
     #[arg(long, value_name = "N")]
     pub(crate) threads: Option<usize>,
     /// Gravity vector.

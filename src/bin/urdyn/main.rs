@@ -92,7 +92,7 @@ fn bench(a: BenchArgs) -> Result<()> {
     let (results, notes) =
         bench::run(&model, &opts).map_err(|e| anyhow!("{}: {e}", a.urdf.display()))?;
     for n in notes {
-        eprintln!("urdyn: {n}");
+        say(format_args!("urdyn: {n}"));
     }
     let text = if a.json {
         let mut j = serde_json::to_string(&bench::to_json(&model, &results))?;
@@ -196,9 +196,9 @@ fn run(cli: Cli) -> Result<()> {
                 }
             };
             for w in &summary.warnings {
-                eprintln!("warning: {w}");
+                say(format_args!("warning: {w}"));
             }
-            eprintln!("urdyn {summary}");
+            say(format_args!("urdyn {summary}"));
         }
     }
     Ok(())
@@ -208,8 +208,9 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
     use std::io::IsTerminal;
     use urdyn::sim::Integrator;
     if c.list_integrators {
+        let mut out = std::io::stdout().lock();
         for i in Integrator::ALL {
-            println!("{}", i.name());
+            writeln!(out, "{}", i.name())?;
         }
         return Ok(());
     }
@@ -271,8 +272,14 @@ fn run_simulate(c: SimulateCmd) -> Result<()> {
         threads: c.threads,
     };
     let summary = urdyn::cli::simulate::run(&args)?;
-    eprintln!("urdyn {summary}");
+    say(format_args!("urdyn {summary}"));
     Ok(())
+}
+
+/// One line to standard error; a closed stderr (`2>&1 | head -1`) is not an
+/// error (`eprintln!` panics on it, and in the panic hook aborts).
+fn say(line: std::fmt::Arguments) {
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
 }
 
 fn main() {
@@ -287,7 +294,9 @@ fn main() {
             .location()
             .map(|l| format!(" at {}:{}", l.file(), l.line()))
             .unwrap_or_default();
-        eprintln!("urdyn: internal error{at}: {msg} (please report this bug)");
+        say(format_args!(
+            "urdyn: internal error{at}: {msg} (please report this bug)"
+        ));
     }));
     let cli = match Cli::try_parse() {
         Ok(c) => c,
@@ -311,13 +320,16 @@ fn main() {
             let argv: Vec<String> = std::env::args_os()
                 .map(|a| a.to_string_lossy().into_owned())
                 .collect();
-            eprintln!("urdyn: {}", parse_error_line(&e, &argv));
+            say(format_args!("urdyn: {}", parse_error_line(&e, &argv)));
             std::process::exit(2);
         }
     };
     if let Err(e) = run(cli) {
         let text = format!("{e:#}{}", cli_hint(&e));
-        eprintln!("urdyn: {}", text.lines().collect::<Vec<_>>().join(" "));
+        say(format_args!(
+            "urdyn: {}",
+            text.lines().collect::<Vec<_>>().join(" ")
+        ));
         std::process::exit(1);
     }
 }
