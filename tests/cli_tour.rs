@@ -166,3 +166,81 @@ fn a_symlink_or_fifo_output_is_written_through_not_replaced() {
         .file_type()
         .is_fifo());
 }
+
+/// An output naming one of the command's inputs, or the other output, is
+/// refused before anything runs, the input untouched: `simulate --scene s.json
+/// --out s.json` replaced the scene with the trajectory (and `eval --output`,
+/// `view --out` their URDF or CSV). `/dev/null` may take both outputs.
+#[test]
+fn an_output_naming_an_input_is_refused_and_the_input_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scene(dir.path(), "").display().to_string();
+    let text = std::fs::read_to_string(&s).unwrap();
+    let urdf = dir.path().join("lamp.urdf");
+    std::fs::copy(lamp(), &urdf).unwrap();
+    let u = urdf.display().to_string();
+    let urdf_text = std::fs::read_to_string(&urdf).unwrap();
+    let states = dir.path().join("states.json");
+    std::fs::write(&states, r#"{"states": [{}]}"#).unwrap();
+    let st = states.display().to_string();
+    let traj = dir.path().join("t.csv").display().to_string();
+    let ok = [
+        "simulate",
+        "--duration",
+        "0.01",
+        "--scene",
+        &s,
+        "--out",
+        &traj,
+    ];
+    let r = run_in(dir.path(), &ok, Duration::from_secs(60));
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let traj_text = std::fs::read_to_string(&traj).unwrap();
+    fn sim<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+        let mut v = vec!["simulate", "--duration", "0.01"];
+        v.extend_from_slice(extra);
+        v
+    }
+    let cases: Vec<(Vec<&str>, Vec<&str>)> = vec![
+        (
+            sim(&["--scene", &s, "--out", "scene.json"]),
+            vec!["--out scene.json", "--scene"],
+        ),
+        (
+            sim(&["--scene", &s, "--out", "a.csv", "--html", "./a.csv"]),
+            vec!["--html ./a.csv", "--out a.csv"],
+        ),
+        (
+            sim(&["--scene", &s, "--html", &s]),
+            vec!["--html", "--scene"],
+        ),
+        (
+            sim(&[&u, "--out", "lamp.urdf"]),
+            vec!["--out lamp.urdf", "the model"],
+        ),
+        (
+            vec!["eval", &u, "--states", &st, "--output", &st],
+            vec!["--output", "--states"],
+        ),
+        (
+            vec!["view", "--scene", &s, &traj, "--out", &traj],
+            vec!["--out", "the trajectory"],
+        ),
+        (
+            vec!["view", &u, &traj, "--out", "lamp.urdf"],
+            vec!["--out lamp.urdf", "the model"],
+        ),
+    ];
+    for (a, expect) in &cases {
+        let r = run_in(dir.path(), a, Duration::from_secs(60));
+        assert_refused(&a.join(" "), r.code, &r.stdout, &r.stderr, expect);
+        assert!(r.stderr.contains("not overwritten"), "{}", r.stderr);
+    }
+    assert_eq!(std::fs::read_to_string(&s).unwrap(), text);
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), urdf_text);
+    assert_eq!(std::fs::read_to_string(&traj).unwrap(), traj_text);
+    assert!(!dir.path().join("a.csv").exists());
+    let a = sim(&["--scene", &s, "--out", "/dev/null", "--html", "/dev/null"]);
+    let r = run_in(dir.path(), &a, Duration::from_secs(60));
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+}

@@ -20,6 +20,9 @@
 //!   taken back.
 //! - a **directory** (also through a link): an error naming the path.
 //!
+//! An output naming one of the command's inputs, or its other output, is refused
+//! before anything runs ([`not_an_input`]).
+//!
 //! Every error is one line naming the path as given.
 
 use std::fs::{File, OpenOptions};
@@ -161,5 +164,44 @@ where
             }
             result
         }
+    }
+}
+
+/// `a` and `b` name one file: both exist and resolve (through symbolic links)
+/// to one path, or neither exists and their folders resolve to one with the
+/// same file name.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        (Err(_), Err(_)) => {
+            let key = |p: &Path| {
+                let dir = match p.parent() {
+                    Some(d) if !d.as_os_str().is_empty() => d,
+                    _ => Path::new("."),
+                };
+                Some((std::fs::canonicalize(dir).ok()?, p.file_name()?.to_owned()))
+            };
+            key(a).is_some_and(|k| key(b) == Some(k))
+        }
+        _ => false,
+    }
+}
+
+/// Refuses an output `out` (given as option `opt`) that names one of the
+/// command's inputs (`inputs`: the option or argument naming it, and its
+/// path) or another output: `urdyn simulate --scene s.json --out s.json`
+/// replaced the scene with the trajectory. A FIFO or device (`/dev/null`) is
+/// streamed into, never replaced: any may share it.
+pub fn not_an_input(out: &Path, opt: &str, inputs: &[(&str, &Path)]) -> Result<(), String> {
+    if std::fs::metadata(out).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        return Ok(());
+    }
+    match inputs.iter().find(|(_, p)| same_file(out, p)) {
+        Some((what, p)) => Err(format!(
+            "{opt} {}: names the same file as {what} {} (not overwritten)",
+            out.display(),
+            p.display()
+        )),
+        None => Ok(()),
     }
 }

@@ -136,6 +136,13 @@ fn run(cli: Cli) -> Result<()> {
             floating_base,
             output,
         } => {
+            if let Some(o) = &output {
+                let inputs = [
+                    ("the model", urdf.as_path()),
+                    ("--states", states.as_path()),
+                ];
+                output::not_an_input(o, "--output", &inputs).map_err(|e| anyhow!(e))?;
+            }
             let model = urdyn::load_model(&urdf, LoadOptions { floating_base })?;
             let states_name = states.display().to_string();
             let text = state::read_text(&states)?;
@@ -161,6 +168,23 @@ fn run(cli: Cli) -> Result<()> {
             package_path,
             out,
         } => {
+            let inputs: Vec<(&str, &std::path::Path)> = [
+                ("--scene", scene.as_deref()),
+                // (with --scene the first argument is the trajectory)
+                (
+                    if scene.is_some() {
+                        "the trajectory"
+                    } else {
+                        "the model"
+                    },
+                    urdf.as_deref(),
+                ),
+                ("the trajectory", traj.as_deref()),
+            ]
+            .into_iter()
+            .filter_map(|(w, p)| Some((w, p?)))
+            .collect();
+            output::not_an_input(&out, "--out", &inputs).map_err(|e| anyhow!(e))?;
             let summary = match (scene, urdf, traj) {
                 (Some(scene), Some(traj), None) if !floating_base => {
                     urdyn::cli::view::run_scene(&urdyn::cli::view::SceneViewArgs {

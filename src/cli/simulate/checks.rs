@@ -2,6 +2,7 @@
 //! start's violations (one warning line each) before anything is simulated.
 
 use super::{warn, SimulateArgs, SimulateError};
+use crate::cli::output::not_an_input;
 use crate::sim::{Integrator, Simulation};
 
 /// Checks every option's value and combination; returns the integrator asked for.
@@ -96,6 +97,20 @@ pub(super) fn options(args: &SimulateArgs) -> Result<Option<Integrator>, Simulat
                 scene.display()
             )));
         }
+    }
+    // an output naming an input (or the other output) would replace it
+    let mut inputs: Vec<(&str, &std::path::Path)> = match &args.scene {
+        Some(scene) => vec![("--scene", scene.as_path())],
+        None => vec![("the model", args.urdf.as_path())],
+    };
+    inputs.extend(args.initial.as_deref().map(|p| ("--initial", p)));
+    inputs.extend(args.controls.as_deref().map(|p| ("--controls", p)));
+    if let Some(out) = &args.out {
+        not_an_input(out, "--out", &inputs).map_err(SimulateError::Option)?;
+        inputs.push(("--out", out.as_path()));
+    }
+    if let Some(html) = &args.html {
+        not_an_input(html, "--html", &inputs).map_err(SimulateError::Option)?;
     }
     Ok(integrator)
 }
