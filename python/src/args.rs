@@ -70,7 +70,18 @@ pub fn read_count(x: &Bound<'_, PyAny>, name: &str, min: i64) -> PyResult<usize>
 /// `threads=None` or a count ≥ 1.
 pub fn read_threads(x: Option<&Bound<'_, PyAny>>) -> PyResult<Option<usize>> {
     match x {
-        Some(t) if !t.is_none() => read_count(t, "threads", 1).map(Some),
+        Some(t) if !t.is_none() => {
+            let n = read_count(t, "threads", 1)?;
+            // the library's bound (a batch's pool is started here, before any
+            // simulation checks its own options)
+            if n > urdyn::sim::MAX_THREADS {
+                return Err(value_error(format!(
+                    "threads must be at most {} (got {n})",
+                    urdyn::sim::MAX_THREADS
+                )));
+            }
+            Ok(Some(n))
+        }
         _ => Ok(None),
     }
 }

@@ -90,3 +90,16 @@ def test_wrong_types_of_names_and_paths_are_value_errors_naming_the_argument():
     urdyn.Model.from_urdf(str(UR5), package_dirs=[ROOT])
     urdyn.Simulation(model, integrator=None)
     sim.transition_jacobians(method="analytic")
+
+
+def test_threads_beyond_the_librarys_bound_is_a_value_error_not_a_crash():
+    # rollout and linearize start their pool before any simulation checks its
+    # options: 100000 threads aborted the process (stack guards not mapped)
+    model = urdyn.Model.from_urdf(UR5)
+    q0, v0 = model.neutral()[None, :], np.zeros((1, model.nv))
+    with pytest.raises(ValueError, match="^threads must be at most 1024 \\(got 100000\\)"):
+        urdyn.rollout(model, q0, v0, nstep=1, threads=100000)
+    with pytest.raises(ValueError, match="^threads must be at most 1024"):
+        urdyn.Simulation(model, threads=5000)
+    q, v = urdyn.rollout(model, q0, v0, nstep=1, threads=1024)
+    assert q.shape == (1, 2, model.nq)

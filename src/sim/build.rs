@@ -6,7 +6,7 @@ use super::*;
 /// The most threads [`SimOptions::threads`] may ask for: far more than a
 /// step's islands use, and few enough to start (100000 aborted the process
 /// as each thread's stack guard could not be mapped).
-pub(crate) const MAX_THREADS: usize = 1024;
+pub const MAX_THREADS: usize = 1024;
 
 /// The joint springs of `model` (an MJCF joint's `stiffness` about its
 /// `springref`, on hinge and slide joints) as servo gains and targets, `None`

@@ -75,6 +75,7 @@ pub mod newton;
 pub(crate) mod parallel;
 pub use contact_view::Violation;
 mod build;
+pub use build::MAX_THREADS;
 mod doze;
 mod sensors;
 mod servo;
