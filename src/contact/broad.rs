@@ -114,16 +114,19 @@ pub struct SweepAndPrune {
     strip: Vec<i64>,
     big: Vec<bool>,
     /// Scratch: the y-extents (for their median), the shapes wider than a
-    /// strip, and two strips merged by lower x (shape, in the lower strip).
+    /// strip, and two strips merged by lower x (lower x, shape, in the
+    /// lower strip).
     ext: Vec<f64>,
     wide: Vec<u32>,
-    merged: Vec<(u32, bool)>,
+    merged: Vec<(f64, u32, bool)>,
     /// The sweep's pairs whose boxes overlap, in the sweep's order, before
     /// the table is read (then read a few ahead of use).
     cand: Vec<(u32, u32)>,
     /// Scratch of the one sweep: the lower x of `order`'s shapes, in its
     /// order (sorted with it, read by the sweep without a gather).
     xs: Vec<f64>,
+    /// Scratch of the strips' sort: (strip, lower x) in `order`'s order.
+    keys: Vec<(i64, f64)>,
 }
 
 /// Shapes from which the floor is cut into strips.
@@ -146,6 +149,7 @@ impl SweepAndPrune {
             merged: Vec::with_capacity(n),
             cand: Vec::new(),
             xs: Vec::with_capacity(n),
+            keys: Vec::with_capacity(n),
         }
     }
 
@@ -189,17 +193,6 @@ impl SweepAndPrune {
         self.cand = cand;
     }
 
-    /// Shapes i and j (both boxes known to overlap in x) kept if their
-    /// boxes overlap in y and z.
-    #[inline(always)]
-    fn report(&self, i: usize, j: usize, cand: &mut Vec<(u32, u32)>) {
-        let (li, hi, lj, hj) = (self.lo[i], self.hi[i], self.lo[j], self.hi[j]);
-        if lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2] {
-            return;
-        }
-        cand.push((i as u32, j as u32));
-    }
-
     /// One sweep along x over every shape.
     fn sweep_x(&mut self, cand: &mut Vec<(u32, u32)>) {
         let n = self.order.len();
@@ -222,12 +215,17 @@ impl SweepAndPrune {
         }
         for k in 0..n {
             let i = self.order[k] as usize;
-            let hx = self.hi[i][0];
+            // (i's box read once for the shapes it meets)
+            let (li, hi) = (self.lo[i], self.hi[i]);
+            let hx = hi[0];
             for (&x, &j) in buf[k + 1..n].iter().zip(&self.order[k + 1..]) {
                 if x > hx {
                     break;
                 }
-                self.report(i, j as usize, cand);
+                let j = j as usize;
+                if meet_yz(li, hi, self.lo[j], self.hi[j]) {
+                    cand.push((i as u32, j as u32));
+                }
             }
         }
         self.xs = buf;
@@ -256,15 +254,19 @@ impl SweepAndPrune {
         };
         let w = if w > 0.0 { w } else { f64::INFINITY };
         self.wide.clear();
-        for i in 0..n {
-            let e = self.hi[i][1] - self.lo[i][1];
-            let ly = self.lo[i][1];
+        // (the boxes, flags and strips read as one pass of slices, no index
+        // tests: every per-shape vector holds n entries)
+        let boxes = self.lo.iter().zip(&self.hi);
+        let flags = self.big.iter_mut().zip(self.strip.iter_mut());
+        for (i, ((l, h), (big, strip))) in boxes.zip(flags).enumerate() {
+            let e = h[1] - l[1];
+            let ly = l[1];
             // a shape with no box (never set) or no finite strip: with the wide ones
             let s = (ly / w).floor();
             let ordinary = e <= w && s.is_finite() && s.abs() <= 1e15;
-            self.big[i] = !ordinary;
-            self.strip[i] = if self.big[i] { 0 } else { s as i64 };
-            if self.big[i] {
+            *big = !ordinary;
+            *strip = if ordinary { s as i64 } else { 0 };
+            if !ordinary {
                 self.wide.push(i as u32);
             }
         }
@@ -284,36 +286,43 @@ impl SweepAndPrune {
                 }
             }
         }
-        let before = |a: usize, b: usize, lo: &[[f64; 3]], st: &[i64]| {
-            st[a] > st[b] || (st[a] == st[b] && lo[a][0] > lo[b][0])
-        };
-        for k in 1..self.order.len() {
-            let mut m = k;
-            while m > 0
-                && before(
-                    self.order[m - 1] as usize,
-                    self.order[m] as usize,
-                    &self.lo,
-                    &self.strip,
-                )
-            {
-                self.order.swap(m - 1, m);
-                m -= 1;
+        // (the sort's keys, (strip, lower x), gathered once in last step's
+        // order and sorted with it: the same compares, the same swaps)
+        let mut keys = std::mem::take(&mut self.keys);
+        keys.clear();
+        keys.extend(
+            self.order
+                .iter()
+                .map(|&i| (self.strip[i as usize], self.lo[i as usize][0])),
+        );
+        let len = self.order.len();
+        {
+            let (order, keys) = (&mut self.order[..len], &mut keys[..len]);
+            for k in 1..len {
+                let mut m = k;
+                while m > 0
+                    && (keys[m - 1].0 > keys[m].0
+                        || (keys[m - 1].0 == keys[m].0 && keys[m - 1].1 > keys[m].1))
+                {
+                    keys.swap(m - 1, m);
+                    order.swap(m - 1, m);
+                    m -= 1;
+                }
             }
         }
         // each strip merged with the next by lower x, swept
         let mut merged = std::mem::take(&mut self.merged);
-        let len = self.order.len();
+        let (order, ks) = (&self.order[..len], &keys[..len]);
         let mut a = 0;
         while a < len {
-            let s = self.strip[self.order[a] as usize];
+            let s = ks[a].0;
             let mut b = a;
-            while b < len && self.strip[self.order[b] as usize] == s {
+            while b < len && ks[b].0 == s {
                 b += 1;
             }
             let mut c = b;
-            if b < len && self.strip[self.order[b] as usize] == s + 1 {
-                while c < len && self.strip[self.order[c] as usize] == s + 1 {
+            if b < len && ks[b].0 == s + 1 {
+                while c < len && ks[c].0 == s + 1 {
                     c += 1;
                 }
             }
@@ -323,48 +332,59 @@ impl SweepAndPrune {
                 // (as the sort: i first unless its lower x is greater)
                 let take_i = j >= c
                     || (i < b
-                        && self.lo[self.order[i] as usize][0]
-                            .partial_cmp(&self.lo[self.order[j] as usize][0])
-                            != Some(std::cmp::Ordering::Greater));
+                        && ks[i].1.partial_cmp(&ks[j].1) != Some(std::cmp::Ordering::Greater));
                 if take_i {
-                    merged.push((self.order[i], true));
+                    merged.push((ks[i].1, order[i], true));
                     i += 1;
                 } else {
-                    merged.push((self.order[j], false));
+                    merged.push((ks[j].1, order[j], false));
                     j += 1;
                 }
             }
             for k in 0..merged.len() {
-                let (i, in_s) = merged[k];
+                let (_, i, in_s) = merged[k];
                 let i = i as usize;
-                let hx = self.hi[i][0];
-                for &(j, jn_s) in &merged[k + 1..] {
-                    let j = j as usize;
-                    if self.lo[j][0] > hx {
+                // (i's box read once for the shapes it meets)
+                let (li, hi) = (self.lo[i], self.hi[i]);
+                let hx = hi[0];
+                for &(x, j, jn_s) in &merged[k + 1..] {
+                    if x > hx {
                         break;
                     }
-                    if in_s || jn_s {
-                        self.report(i, j, cand);
+                    let j = j as usize;
+                    if (in_s || jn_s) && meet_yz(li, hi, self.lo[j], self.hi[j]) {
+                        cand.push((i as u32, j as u32));
                     }
                 }
             }
             a = b;
         }
         self.merged = merged;
+        self.keys = keys;
         // the wide shapes against every shape (a pair of two wide ones once)
         for wi in 0..self.wide.len() {
             let i = self.wide[wi] as usize;
-            for j in 0..n {
-                if j == i || (self.big[j] && j < i) {
+            let (li, hi) = (self.lo[i], self.hi[i]);
+            let shapes = self.lo.iter().zip(&self.hi).zip(&self.big).enumerate();
+            for (j, ((lj, hj), &bj)) in shapes {
+                if j == i || (bj && j < i) {
                     continue;
                 }
-                if self.lo[j][0] > self.hi[i][0] || self.lo[i][0] > self.hi[j][0] {
+                if lj[0] > hi[0] || li[0] > hj[0] {
                     continue;
                 }
-                self.report(i, j, cand);
+                if meet_yz(li, hi, *lj, *hj) {
+                    cand.push((i as u32, j as u32));
+                }
             }
         }
     }
+}
+
+/// Two boxes (lower, upper corners; known to overlap in x) overlap in y and z.
+#[inline(always)]
+fn meet_yz(li: [f64; 3], hi: [f64; 3], lj: [f64; 3], hj: [f64; 3]) -> bool {
+    !(lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2])
 }
 
 /// The broad phase of fewer than 64 shapes whose allowed pairs are all

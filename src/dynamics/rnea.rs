@@ -1,6 +1,6 @@
 use super::crba::is_f64;
 use super::{check_sizes, DynamicsError};
-use crate::model::joint::dispatch_of;
+use crate::model::joint::{dispatch_of, Dispatch};
 use crate::model::{dispatch_keyed, Axis, Data, JointModel, Model};
 use crate::spatial::ops::add_cross;
 use crate::spatial::{Force, Motion, Scalar, Se3};
@@ -293,6 +293,10 @@ fn rnea_pass<
         let p = parent[i];
         let (vp, ap) = (vel[p], acc[p]);
         let key = if K { keys[i] } else { dispatch_of(&joints[i]) };
+        // (the bias pass: a free body on the world moves the world's zero
+        // velocity into its frame as zeros, each of its six velocity
+        // components then added to one: the move is left out)
+        let on_world = K && exact && p == 0 && matches!(key.0, Dispatch::Free);
         let (li, vi, ai) = dispatch_keyed!(&joints[i], key, ident[i], jm => {
             // ᵢXₚ at q, or (K) as forward kinematics left it at this q
             let li = if K { li_m_i[i] } else { jm.placement(&placements[i], q) };
@@ -303,7 +307,9 @@ fn rnea_pass<
             // docs/theory.md §"Velocity recursion": v̂ᵢ = ᵢX̂ₚ v̂ₚ + ŝᵢ q̇ᵢ
             let mut vi = Motion::zero();
             if V {
-                vi = move_motion(&li, ax, rot, &vp);
+                if !on_world {
+                    vi = move_motion(&li, ax, rot, &vp);
+                }
                 jm.add_motion(&mut vi, v);
             }
             // docs/theory.md §"Acceleration recursion": âᵢ = ᵢX̂ₚ âₚ + v̂ᵢ × ŝᵢ q̇ᵢ + ŝᵢ q̈ᵢ

@@ -367,21 +367,16 @@ impl Islands {
         while i < self.runs.len() {
             let k = self.runs[i].0;
             let (r0, d0) = (i, self.dofs.len());
-            if pushed_only && self.touched.get(k) == Some(&false) {
-                while i < self.runs.len() && self.runs[i].0 == k {
-                    i += 1;
-                }
-                self.islands.push(((r0, i), (d0, d0)));
-                if let Some(x) = self.iof.get_mut(k) {
-                    *x = self.iroot.len();
-                }
-                self.iroot.push(k);
-                continue;
-            }
+            // (an island not pushed, with `pushed_only`: its runs, no dofs)
+            let listed = !pushed_only || self.touched.get(k) != Some(&false);
             // the dofs marked (listed, and their range)
             let (mut lo, mut hi) = (usize::MAX, 0);
             while i < self.runs.len() && self.runs[i].0 == k {
                 let (_, s, e) = self.runs[i];
+                if !listed {
+                    i += 1;
+                    continue;
+                }
                 // the run's groups (a run starts a group), one path each
                 let mut g = self.group_at[s];
                 while let Some(&(q, _)) = self.groups.get(g)

@@ -602,10 +602,18 @@ impl super::Simulation {
         }
         // (the awake trees' bodies: a tree's bodies are one range after their
         // parents, whose root hangs from the world; sleeping ones are not read)
+        // (a body on the world: its parent's velocity is zero, moved into its
+        // frame a zero but for the signs of its zeros; these velocities are
+        // read only by the speed tests' norms, here and in a dozing step's
+        // `account_sleep`, until the energy pass writes them anew)
         data.v[0] = crate::spatial::Motion::zero();
         for &t in self.sleep.awake_trees() {
             for i in model.trees[t].bodies.clone() {
-                let mut vi = data.li_m_i[i].inv_act_motion(&data.v[model.parent[i]]);
+                let p = model.parent[i];
+                let mut vi = match p {
+                    0 => crate::spatial::Motion::zero(),
+                    _ => data.li_m_i[i].inv_act_motion(&data.v[p]),
+                };
                 model.joints[i].add_motion(&mut vi, &self.sleep.vw);
                 data.v[i] = vi;
             }

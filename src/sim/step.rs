@@ -295,8 +295,17 @@ impl Simulation {
     /// Applied generalized force with joint torques clamped to effort limits.
     pub(super) fn clamped_tau(&self, out: &mut DVector<f64>) {
         let (out, tau) = (out.as_mut_slice(), self.tau_applied.as_slice());
+        // (`f64::clamp` without its test of the bounds at every entry: an
+        // effort limit is +∞ or positive, build.rs)
         for ((o, &t), &e) in out.iter_mut().zip(tau).zip(&self.effort) {
-            *o = t.clamp(-e, e);
+            let mut x = t;
+            if x < -e {
+                x = -e;
+            }
+            if x > e {
+                x = e;
+            }
+            *o = x;
         }
     }
 }

@@ -295,6 +295,18 @@ impl Rows {
         // `rep stos` above 2 KiB, one instruction a byte to callgrind.
         const GAP: usize = 16;
         const CHUNK: usize = 192;
+        if st <= GAP {
+            // (no row leaves a gap of more than `GAP`: rows from..to are one
+            // run, filled without reading their paths — a pile's contact, one
+            // call a contact)
+            let (a, b) = (from * st, to.min(self.cap) * st);
+            if let Some(j) = self.j.get_mut(a..b) {
+                for c in j.chunks_mut(CHUNK) {
+                    c.fill(0.0);
+                }
+            }
+            return;
+        }
         let mut run = from * st;
         for r in from..to.min(self.cap) {
             let pl = self.path[r].1.min(st);
