@@ -3,7 +3,7 @@
 
 use super::filter::DroppedPair;
 use super::ground::GroundContact;
-use super::pairs::PairContact;
+use super::pairs::{PairContact, Runner};
 use super::{ContactError, ContactParams, ContactPoint};
 use crate::model::Model;
 use crate::spatial::Se3;
@@ -104,12 +104,24 @@ impl Collision {
     /// searched against the static world or each other (a sleeping island's
     /// contacts are frozen, `sim::sleep`).
     pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
+        self.detect_on(o_m_i, out, asleep, None);
+    }
+
+    /// [`Self::detect`], the pairs' narrow phase on `run`'s threads when it
+    /// is worth it (the same points, bit for bit: src/contact/pairs/visit.rs).
+    pub(crate) fn detect_on(
+        &mut self,
+        o_m_i: &[Se3<f64>],
+        out: &mut Vec<ContactPoint>,
+        asleep: &[bool],
+        run: Option<&dyn Runner>,
+    ) {
         out.clear();
         if let Some(g) = self.ground.as_mut() {
             g.detect(o_m_i, out, asleep);
         }
         if let Some(p) = self.pairs.as_mut() {
-            p.detect(o_m_i, out, asleep);
+            p.detect_on(o_m_i, out, asleep, run);
         }
     }
 

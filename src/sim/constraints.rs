@@ -162,8 +162,6 @@ pub(crate) struct Constraints {
     team: Option<Arc<Team>>,
     /// The islands of a parallel solve, largest first ([`parallel::cut`]).
     order: Vec<(usize, usize)>,
-    /// The last solve ran islands on the team.
-    went_parallel: bool,
     /// Row-sweeps per row of the last solve's islands (its first round): the
     /// next solve's estimate of its work.
     per_row: f64,
@@ -256,7 +254,6 @@ impl Constraints {
             islands: Islands::new(model, cap),
             team: None,
             order: Vec::new(),
-            went_parallel: false,
             per_row: 1.0,
             scratch: vec![rows_scratch],
             spin: spin::Spin::new(max_points, nslots),
@@ -283,6 +280,12 @@ impl Constraints {
             self.scratch.push(self.rows.scratch());
         }
         self.team = Some(Arc::new(team));
+    }
+
+    /// The team of threads (`None`: one thread), for the step's other
+    /// parallel stages (the pairs' narrow phase).
+    pub(crate) fn team(&self) -> Option<&Team> {
+        self.team.as_deref()
     }
 
     /// Forgets the warm starts (a new state was set).

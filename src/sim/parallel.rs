@@ -1,5 +1,6 @@
 //! A fixed team of threads for the step's parallel work (the islands'
-//! velocity solve, src/sim/constraints/solve.rs): the calling thread and
+//! velocity solve, src/sim/constraints/solve.rs, and the pairs' narrow
+//! phase, src/contact/pairs/visit.rs): the calling thread and
 //! `n − 1` workers started once, sharing a job's items through the job's own
 //! counter.
 //!
@@ -8,13 +9,12 @@
 //! job itself from the start (no hand-off to a pool and back) and waits only
 //! for the items a worker has already taken (a worker that comes late, asleep
 //! or descheduled, finds the job closed and the caller never waits for it); a
-//! worker spins on the job counter for a while after each job before it
-//! sleeps, and can be woken ahead of a job ([`Team::nudge`]): a sleeping
-//! thread's wake-up costs tens of µs on a virtual machine. docs/theory.md
-//! §"Islands".
+//! worker sleeps right after a job ([`SPIN`]) and can be woken ahead of one
+//! ([`Team::nudge`]); a caller held up by a worker descheduled mid-item runs
+//! its next jobs alone ([`COOL`]). docs/theory.md §"Islands".
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -46,6 +46,8 @@ struct Inner {
     /// another thread, runs its job alone).
     busy: AtomicBool,
     stop: AtomicBool,
+    /// Jobs left that the caller runs alone ([`COOL`]).
+    cool: AtomicU32,
 }
 
 /// The caller and `n − 1` worker threads.
@@ -61,9 +63,17 @@ impl std::fmt::Debug for Team {
 }
 
 /// How long a worker spins on the job counter after a job (or a nudge)
-/// before it sleeps: longer than a join round's bookkeeping and than most of
-/// a solve's grouping, shorter than a big pile's detection.
-const SPIN: Duration = Duration::from_micros(100);
+/// before it sleeps: none (a few hundred spins). Round 27's 0.1 ms made two
+/// threads slower than one at load ~5 and gained nothing near quiet; round
+/// 28 measured spin 0 as fast as or faster than 0.1 ms at load ~6 on every
+/// pile (benches/pile_results.md). A job's dispatch wakes a sleeping worker;
+/// the caller never waits for one that has not begun.
+const SPIN: Duration = Duration::ZERO;
+
+/// Jobs a caller runs alone after a worker held it up (its wait at the
+/// close longer than half its own part: on a loaded machine, a worker
+/// descheduled in the middle of an item), before it shares again.
+const COOL: u32 = 64;
 
 impl Team {
     /// The caller and `threads − 1` workers; `None` with fewer than two
@@ -81,6 +91,7 @@ impl Team {
             wake: Condvar::new(),
             busy: AtomicBool::new(false),
             stop: AtomicBool::new(false),
+            cool: AtomicU32::new(0),
         });
         let mut team = Team {
             inner,
@@ -114,6 +125,14 @@ impl Team {
     /// that (the islands' solve counts its items done).
     pub fn run(&self, f: &(dyn Fn(usize) + Sync)) {
         let inner = &*self.inner;
+        let cool = inner.cool.load(Ordering::Relaxed);
+        if cool > 0 {
+            // a worker held this thread up lately (descheduled mid-item on
+            // a loaded machine): the next jobs alone
+            inner.cool.store(cool - 1, Ordering::Relaxed);
+            f(0);
+            return;
+        }
         if inner.busy.swap(true, Ordering::Acquire) {
             // another caller's job is on the workers: this one alone
             f(0);
@@ -132,7 +151,9 @@ impl Team {
             let _g = inner.job.lock();
             inner.wake.notify_all();
         }
+        let start = Instant::now();
         let mine = catch_unwind(AssertUnwindSafe(|| f(0)));
+        let own = start.elapsed();
         // closed: a worker not yet in finds nothing; those in are waited for
         match inner.job.lock() {
             Ok(mut g) => *g = None,
@@ -146,6 +167,11 @@ impl Team {
             } else {
                 std::hint::spin_loop();
             }
+        }
+        // a wait longer than half this thread's own part: a worker's item
+        // took far longer than its share (descheduled), not a job's tail
+        if start.elapsed() > own + own / 2 {
+            inner.cool.store(COOL, Ordering::Relaxed);
         }
         inner.busy.store(false, Ordering::Release);
         if let Err(e) = mine {
@@ -162,6 +188,17 @@ impl Team {
             let _g = inner.job.lock();
             inner.wake.notify_all();
         }
+    }
+}
+
+/// The team as the contact layer sees it (the pairs' narrow phase,
+/// src/contact/pairs/visit.rs).
+impl crate::contact::pairs::Runner for Team {
+    fn threads(&self) -> usize {
+        Team::threads(self)
+    }
+    fn run(&self, f: &(dyn Fn(usize) + Sync)) {
+        Team::run(self, f)
     }
 }
 

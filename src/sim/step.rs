@@ -11,7 +11,13 @@ impl Simulation {
         self.energy_now = None;
         if let Some(c) = self.contact.as_mut() {
             forward_kinematics(&self.model, &mut self.data, &self.q);
-            c.detect(&self.data.o_m_i, &mut self.points, &self.sleep.body_asleep);
+            // (the pairs' narrow phase on the team: the same points)
+            let run = self
+                .cons
+                .team()
+                .map(|t| t as &dyn crate::contact::pairs::Runner);
+            let asleep = &self.sleep.body_asleep;
+            c.detect_on(&self.data.o_m_i, &mut self.points, asleep, run);
             self.fk_valid = true;
         }
     }

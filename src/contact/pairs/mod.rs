@@ -13,11 +13,10 @@
 //! pair's slots: the slot of the same features last step (its impulse warm
 //! starts the solve), else a free one marked fresh (no warm start).
 
-use super::broad::{prefetch, PairMasks, PairTable, SweepAndPrune, LAZY_PAIR};
+use super::broad::{PairMasks, PairTable, SweepAndPrune, LAZY_PAIR};
 use super::filter::{is_self_pair, may_touch};
-use super::narrow::prim::{round_points_at, Round};
-use super::narrow::{face_points, parry_points, reduce_pair, FaceScratch, Raw};
-use super::shapes::{from_pvec, pair_shape, PairShape};
+use super::narrow::prim::Round;
+use super::shapes::{pair_shape, PairShape};
 use super::travel::{moved_from, Travel};
 use super::{ContactError, ContactParams, ContactPoint};
 use crate::model::Model;
@@ -30,8 +29,9 @@ pub(crate) mod apart;
 mod make;
 mod order;
 mod start;
-use apart::{apart_along, still_apart_at, Apart};
-use order::assign_slots;
+pub(crate) mod visit;
+use apart::Apart;
+pub(crate) use visit::Runner;
 
 /// One shape of pair contact.
 #[derive(Clone, Debug)]
@@ -136,9 +136,12 @@ pub struct PairContact {
     /// A sphere or capsule member placed at the last detection (its closed
     /// form's input, once a member, not once a pair).
     rounds: Vec<Option<Round>>,
-    scratch: FaceScratch,
-    stamp: u32,
-    raw: Vec<Raw>,
+    /// Each visited pair's boxes overlap (with `visit`).
+    hits: Vec<bool>,
+    /// Each thread's query scratch (the calling thread's first).
+    queries_scratch: Vec<visit::Query>,
+    /// Each chunk's output of a visit on several threads ([`visit`]).
+    chunks: Vec<visit::ChunkOut>,
     /// Members that move (their boxes are refreshed each step).
     moving: Vec<usize>,
     /// Slots in all.
@@ -257,9 +260,9 @@ impl PairContact {
             centres: Vec::with_capacity(n),
             radii: Vec::with_capacity(n),
             rounds: Vec::with_capacity(n),
-            scratch: FaceScratch::default(),
-            stamp: 0,
-            raw: Vec::new(),
+            hits: Vec::new(),
+            queries_scratch: Vec::new(),
+            chunks: Vec::new(),
             moving: Vec::new(),
             queries: 0,
             travel: Travel::new(params, Vec::new()),
@@ -291,7 +294,8 @@ impl PairContact {
         made.overlapping.reserve(room);
         made.live.reserve(room);
         made.visit.reserve(2 * room);
-        made.raw.reserve(RAW_ROOM);
+        made.hits.reserve(2 * room);
+        made.queries_scratch.push(visit::Query::with_room(RAW_ROOM));
         let fixed = made.members.iter().map(|m| m.body == 0).collect();
         made.travel = Travel::new(params, fixed);
         for (k, m) in made.members.iter().enumerate() {
@@ -358,6 +362,18 @@ impl PairContact {
     /// Pairs whose two bodies are flagged in `asleep` (or static) keep what
     /// they held and are not queried.
     pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
+        self.detect_on(o_m_i, out, asleep, None);
+    }
+
+    /// [`Self::detect`], its narrow phase on `run`'s threads when there are
+    /// enough pairs (the same points, bit for bit: [`visit`]).
+    pub(crate) fn detect_on(
+        &mut self,
+        o_m_i: &[Se3<f64>],
+        out: &mut Vec<ContactPoint>,
+        asleep: &[bool],
+        run: Option<&dyn Runner>,
+    ) {
         let stepped = self.travel.begin();
         // (c = 0: every margin is δ, the members' travel is not measured)
         let measure = self.travel.measures();
@@ -410,161 +426,18 @@ impl PairContact {
         }
         // visited: the overlapping pairs and those that held anything
         self.visit.clear();
+        self.hits.clear();
         let (mut i, mut j) = (0, 0);
         let (ov, live) = (&self.overlapping, &self.live);
         while i < ov.len() || j < live.len() {
             let x = ov.get(i).copied().unwrap_or((u64::MAX, u32::MAX));
             let y = live.get(j).copied().unwrap_or((u64::MAX, u32::MAX));
             self.visit.push(x.min(y));
+            self.hits.push(x <= y);
             i += usize::from(x <= y);
             j += usize::from(y <= x);
         }
-        self.live.clear();
-        let mut next = 0;
-        let maxp = self.max_points;
-        for vi in 0..self.visit.len() {
-            let (ord, pi) = self.visit[vi];
-            let pi = pi as usize;
-            // the pair four visits on fetched now (a pile's pairs lie far
-            // apart in memory: a cache miss each), while this one is worked
-            if let Some(&(_, ahead)) = self.visit.get(vi + 4) {
-                let ahead = ahead as usize;
-                if let Some(p) = self.pairs.get(ahead) {
-                    prefetch(p);
-                }
-                if let Some(k) = self.keys.get(ahead * maxp) {
-                    prefetch(k);
-                }
-            }
-            let hit = next < self.overlapping.len() && self.overlapping[next].1 as usize == pi;
-            if hit {
-                next += 1;
-            }
-            let (Some(pair), Some(keys)) = (
-                self.pairs.get_mut(pi),
-                self.keys.get_mut(pi * maxp..(pi + 1) * maxp),
-            ) else {
-                continue;
-            };
-            if !hit || self.dropped[pi] {
-                pair.apart = None;
-                if keys[0] != NO_KEY || !pair.manifolds.is_empty() {
-                    keys.fill(NO_KEY);
-                    pair.manifolds.clear();
-                }
-                continue;
-            }
-            self.live.push((ord, pi as u32));
-            let still = |b: usize| b == 0 || asleep.get(b) == Some(&true);
-            if still(self.members[pair.a].body) && still(self.members[pair.b].body) {
-                continue;
-            }
-            let (ma, mb) = (&self.members[pair.a], &self.members[pair.b]);
-            let (wa, wb) = (&self.poses[pair.a], &self.poses[pair.b]);
-            let margin = self.travel.pair_margin(pair.a, pair.b);
-            self.queries += 1;
-            self.raw.clear();
-            if let (Some(ra), Some(rb)) = (&self.rounds[pair.a], &self.rounds[pair.b]) {
-                // two spheres or capsules: their closed form (no manifold,
-                // never a separating axis: `parry_points`' first case)
-                round_points_at(ra, rb, margin, &mut self.raw);
-                pair.manifolds.clear();
-                pair.workspace = None;
-                pair.axis = Vector3::zeros();
-                pair.apart = None;
-            } else {
-                // a hull on a box's face or a flat height field: the plane
-                // contact where it is the exact one (`face`), else parry
-                let plane = match pair.face {
-                    Some(hull_is_a) => {
-                        self.stamp = self.stamp.wrapping_add(1).max(1);
-                        face_points(
-                            &ma.shape,
-                            &mb.shape,
-                            wa,
-                            wb,
-                            hull_is_a,
-                            margin,
-                            self.max_points,
-                            &mut self.scratch,
-                            &mut self.raw,
-                            self.stamp,
-                        )
-                    }
-                    None => false,
-                };
-                // two convex shapes apart along last step's axis by more than
-                // the margin: no point, no parry query
-                let convex = ma.shape.convex && mb.shape.convex;
-                let (ca, cb) = (&self.centres[pair.a], &self.centres[pair.b]);
-                let now_a = (ca, wa, self.radii[pair.a]);
-                let now_b = (cb, wb, self.radii[pair.b]);
-                let apart = convex
-                    && (still_apart_at(pair.apart.as_ref(), now_a, now_b, margin) || {
-                        let gap = apart_along(&pair.axis, ma, mb, wa, wb);
-                        pair.apart = (gap > margin).then_some(Apart {
-                            gap,
-                            ca: *ca,
-                            ra: wa.rot,
-                            cb: *cb,
-                            rb: wb.rot,
-                        });
-                        gap > margin
-                    });
-                if !plane && !apart {
-                    parry_points(
-                        &ma.shape,
-                        &mb.shape,
-                        wa,
-                        wb,
-                        margin,
-                        &mut pair.manifolds,
-                        &mut pair.workspace,
-                        &mut self.raw,
-                    );
-                    // parry's last direction (a's frame, from a toward b): its
-                    // separating axis when apart, else the contact normal
-                    pair.axis = match pair.manifolds.first() {
-                        Some(m) if convex && pair.manifolds.len() == 1 => {
-                            let n = from_pvec(m.local_n1);
-                            let l = n.norm();
-                            if l > 0.5 && l.is_finite() {
-                                n / l
-                            } else {
-                                Vector3::zeros()
-                            }
-                        }
-                        _ => Vector3::zeros(),
-                    };
-                }
-            }
-            if self.raw.is_empty() {
-                // no point: every slot free (`assign_slots` of none)
-                keys.fill(NO_KEY);
-                continue;
-            }
-            let start = out.len();
-            // the moving side first: a static a (an obstacle or a fixed
-            // model's welded link) against a moving b swaps sides
-            let swap = ma.body == 0;
-            let (first, second) = if swap { (mb, ma) } else { (ma, mb) };
-            let sign = if swap { -1.0 } else { 1.0 };
-            reduce_pair(&self.raw, self.max_points, out, |r| ContactPoint {
-                shape: pi,
-                slot: 0,
-                body: first.body,
-                point: r.point,
-                gap: r.gap,
-                geom: first.geom,
-                other: second.body,
-                other_geom: second.geom,
-                normal: r.normal * sign,
-                friction: pair.friction,
-                fresh: true,
-                key: r.key,
-            });
-            assign_slots(pair.slot_base, keys, &mut out[start..]);
-        }
+        self.visit_pairs(out, asleep, run);
     }
 
     /// The first slot of pair contact.

@@ -30,11 +30,6 @@ impl Constraints {
         solver: Solver,
     ) -> Impulses<'_> {
         self.clear_forces();
-        if let Some(t) = self.team.as_ref().filter(|_| self.went_parallel) {
-            // the last solve ran on the team: wake its sleeping threads now,
-            // to be spinning by this one's dispatch
-            t.nudge();
-        }
         self.dv.as_mut_slice().fill(0.0);
         // torsion and rolling rows (spin.rs) couple a point's rotation to its
         // normal: a step with them may take twice the sweeps before the cap
@@ -70,7 +65,6 @@ impl Constraints {
             // check joined (src/sim/islands/split.rs), until none fails
             let mut a_ready = false;
             let mut first = true;
-            self.went_parallel = false;
             loop {
                 let todo = self.islands.todo();
                 if self.isl_sweeps.len() < todo.len() {
@@ -84,7 +78,6 @@ impl Constraints {
                 let least = (MIN_WORK as f64 / self.per_row.max(1.0)) as usize;
                 let cut = |t: &&Arc<Team>| parallel::cut(sizes, t.threads(), least, order);
                 let team = self.team.as_ref().filter(cut);
-                self.went_parallel |= team.is_some();
                 match team {
                     Some(team) => {
                         // a = R v* for the threads' energy-safe exits, before them
