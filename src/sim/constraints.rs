@@ -36,9 +36,13 @@ pub(crate) use tables::add_body_rows;
 use tables::{act_column, add_body, BodyColumns, BodyHead, JointRowSource};
 
 /// The least row-sweeps a parallel solve must take off this thread's share
-/// (else the islands are solved here: a job's dispatch and wait cost about
-/// what a few hundred row-sweeps do).
-const MIN_WORK: usize = 500;
+/// (else the islands are solved here). A worker sleeps between jobs, so a
+/// dispatch pays its wake-up: at 500 the 64-box pile went to the team on
+/// about a third of its solves, the worker took 11 % of the work and two
+/// threads ran 7 % slower than one (quiet A/B, benches/pile_results.md,
+/// round 28); at 2000 it stays here, the 256- and 1024-object piles
+/// (6,000–48,000 row-sweeps a solve) still go to the team.
+const MIN_WORK: usize = 2000;
 
 /// What the rows are built from, besides the state.
 #[derive(Clone, Copy, Debug)]
