@@ -486,10 +486,6 @@ pub mod parallel {
         pub fn run(&self, f: &(dyn Fn(usize) + Sync)) {
             self.0.run(f)
         }
-        /// `Team::nudge`.
-        pub fn nudge(&self) {
-            self.0.nudge()
-        }
     }
 
     /// `sim::parallel::cut` of `sizes`.

@@ -9,9 +9,9 @@
 //! job itself from the start (no hand-off to a pool and back) and waits only
 //! for the items a worker has already taken (a worker that comes late, asleep
 //! or descheduled, finds the job closed and the caller never waits for it); a
-//! worker sleeps right after a job ([`SPIN`]) and can be woken ahead of one
-//! ([`Team::nudge`]); a caller held up by a worker descheduled mid-item runs
-//! its next jobs alone ([`COOL`]). docs/theory.md §"Islands".
+//! worker sleeps right after a job ([`SPIN`]) and a dispatch wakes it; a
+//! caller held up by a worker descheduled mid-item runs its next jobs alone
+//! ([`COOL`]). docs/theory.md §"Islands".
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, AtomicUsize, Ordering};
@@ -39,8 +39,6 @@ struct Inner {
     active: AtomicUsize,
     /// Workers asleep (waiting on `wake`): only then does a dispatch take the lock to wake them.
     sleeping: AtomicUsize,
-    /// Nudges so far ([`Team::nudge`]): a sleeping worker wakes to spin.
-    nudges: AtomicU64,
     wake: Condvar,
     /// A job is running (a second caller, e.g. a clone of the simulation on
     /// another thread, runs its job alone).
@@ -62,8 +60,7 @@ impl std::fmt::Debug for Team {
     }
 }
 
-/// How long a worker spins on the job counter after a job (or a nudge)
-/// before it sleeps: none (a few hundred spins). Round 27's 0.1 ms made two
+/// How long a worker spins on the job counter after a job before it sleeps: none (a few hundred spins). Round 27's 0.1 ms made two
 /// threads slower than one at load ~5 and gained nothing near quiet; round
 /// 28 measured spin 0 as fast as or faster than 0.1 ms at load ~6 on every
 /// pile (benches/pile_results.md). A job's dispatch wakes a sleeping worker;
@@ -87,7 +84,6 @@ impl Team {
             epoch: AtomicU64::new(0),
             active: AtomicUsize::new(0),
             sleeping: AtomicUsize::new(0),
-            nudges: AtomicU64::new(0),
             wake: Condvar::new(),
             busy: AtomicBool::new(false),
             stop: AtomicBool::new(false),
@@ -178,17 +174,6 @@ impl Team {
             std::panic::resume_unwind(e);
         }
     }
-
-    /// Wakes the sleeping workers to spin for the next job (called ahead of
-    /// one, so that the wake-up overlaps the caller's own work).
-    pub fn nudge(&self) {
-        let inner = &*self.inner;
-        inner.nudges.fetch_add(1, Ordering::SeqCst);
-        if inner.sleeping.load(Ordering::SeqCst) > 0 {
-            let _g = inner.job.lock();
-            inner.wake.notify_all();
-        }
-    }
 }
 
 /// The team as the contact layer sees it (the pairs' narrow phase,
@@ -221,8 +206,7 @@ fn work(inner: &Inner, part: usize) {
     let mut seen = inner.epoch.load(Ordering::Acquire);
     loop {
         let mut spins = 0u32;
-        let mut since = Instant::now();
-        let mut nudged = inner.nudges.load(Ordering::Relaxed);
+        let since = Instant::now();
         loop {
             if inner.stop.load(Ordering::Acquire) {
                 return;
@@ -237,31 +221,20 @@ fn work(inner: &Inner, part: usize) {
                 std::hint::spin_loop();
                 continue;
             }
-            let n = inner.nudges.load(Ordering::Relaxed);
-            if n != nudged {
-                // nudged while spinning: a job is near, spin on
-                nudged = n;
-                since = Instant::now();
-            }
             if since.elapsed() < SPIN {
                 continue;
             }
-            // asleep until a job, a nudge or the team's drop
+            // asleep until a job or the team's drop (then the checks above
+            // take it)
             let Ok(mut g) = inner.job.lock() else { return };
             inner.sleeping.fetch_add(1, Ordering::SeqCst);
-            nudged = inner.nudges.load(Ordering::SeqCst);
-            while inner.epoch.load(Ordering::SeqCst) == seen
-                && inner.nudges.load(Ordering::SeqCst) == nudged
-                && !inner.stop.load(Ordering::SeqCst)
-            {
+            while inner.epoch.load(Ordering::SeqCst) == seen && !inner.stop.load(Ordering::SeqCst) {
                 g = match inner.wake.wait(g) {
                     Ok(g) => g,
                     Err(_) => return,
                 };
             }
             inner.sleeping.fetch_sub(1, Ordering::SeqCst);
-            nudged = inner.nudges.load(Ordering::SeqCst);
-            since = Instant::now();
         }
         // the job, if still open, counted in `active` under the lock (so the
         // caller's close then wait sees this worker)
