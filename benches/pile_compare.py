@@ -16,7 +16,10 @@ Each scene (benches/scenes/pile_KIND_N.json) is run
   implicitfast with sleep off and on (mjENBL_SLEEP); perf_counter around a Python loop of mj_step.
 The ratio is urdyn's faster run (sleep on, its default) over MuJoCo's fastest of the four.
 --threads N adds urdyn with `--threads N` (sleep on) as a column of its own and its ratio beside
-the headline's, which stays one thread's (MuJoCo's `mj_step` runs on one thread).
+the headline's, which stays one thread's (MuJoCo's `mj_step` runs on one thread by default). That
+ratio is against the faster of MuJoCo's one-thread best and its best with its own thread pool of N
+workers (`mujoco.mju_threadpool(d, N)`: collision and the islands' solve in parallel), the four
+configurations again.
 Growth: the step time ratio from 64 to 1024 objects (≤ 16: no faster than linear); beside it
 the same ratio per awake object (step time over the run's mean awake count), and the ratio at equal
 durations (the 64 pile run again over the 1024 pile's 2 s, both engines; --no-equal-growth skips it).
@@ -48,13 +51,16 @@ INTEG = {"euler": mujoco.mjtIntegrator.mjINT_EULER,
          "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST}
 
 
-def time_mj(model, qpos, qvel, integ, sleep, steps):
+def time_mj(model, qpos, qvel, integ, sleep, steps, pool=0):
     model.opt.integrator = INTEG[integ]
     if sleep:
         model.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_SLEEP)
     else:
         model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_SLEEP)
     d = mujoco.MjData(model)
+    if pool:
+        # MuJoCo's own thread pool: collision and the islands' solve on `pool` worker threads
+        mujoco.mju_threadpool(d, pool)
     d.qpos[:], d.qvel[:] = qpos, qvel
     mujoco.mj_forward(model, d)
     step = mujoco.mj_step
@@ -101,7 +107,16 @@ def one(args, kind, n, tmp):
     row["mujoco_best"], row["mujoco_best_cfg"] = mj[best], best
     row["ratio"] = max(row["urdyn_sleep"], row["urdyn_nosleep"] or 0) / mj[best]
     if args.threads:
-        row["ratio_threads"] = row["urdyn_threads"] / mj[best]
+        # against MuJoCo's fastest on one thread or with its own pool of the same size
+        pool = {}
+        for integ in INTEG:
+            for sleep in (False, True):
+                pool["%s%s" % (integ, "+sleep" if sleep else "")] = max(
+                    time_mj(model, qpos, qvel, integ, sleep, steps, args.threads) for _ in range(args.repeats))
+        row["mujoco_pool"] = pool
+        pbest = max(pool, key=pool.get)
+        row["mujoco_pool_best"], row["mujoco_pool_best_cfg"] = pool[pbest], pbest
+        row["ratio_threads"] = row["urdyn_threads"] / max(mj[best], pool[pbest])
     if n == 64 and args.equal_growth and args.duration_1024 != dur:
         # the 64 pile again over the 1024 pile's duration: growth at equal durations (a 4 s run of
         # a small pile is mostly asleep or resting, a 2 s run of the large one mostly falling)
@@ -149,7 +164,7 @@ def settled(args, n, tmp):
 
 def write_md(path, rows, meta, st, threads=0):
     th_head = " urdyn --threads %d |" % threads if threads else ""
-    th_ratio = " ratio (threads %d) |" % threads if threads else ""
+    th_ratio = (" MuJoCo pool %d (best) | ratio (threads %d) |" % (threads, threads)) if threads else ""
     out = ["# Piles in a bin: urdyn and MuJoCo 4.0.0", "",
            "Made by `%s` on %s (%.0f s wall), urdyn commit %s, %s. Load at the start: `%s`; at the end: `%s`."
            % (meta["cmd"], meta["date"], meta["wall"], meta["commit"], meta["machine"], meta["load0"], meta["load1"]),
@@ -159,11 +174,12 @@ def write_md(path, rows, meta, st, threads=0):
            "MuJoCo's fastest.", "",
            "| pile | objects | urdyn steps/s (sleep) | urdyn --no-sleep |" + th_head + " mean awake | MuJoCo euler |"
            " euler+sleep | implicitfast | implicitfast+sleep | ratio |" + th_ratio,
-           "|---|---|---|---|" + ("---|" if threads else "") + "---|---|---|---|---|---|" + ("---|" if threads else "")]
+           "|---|---|---|---|" + ("---|" if threads else "") + "---|---|---|---|---|---|" + ("---|---|" if threads else "")]
     for r in rows:
         mj = r["mujoco"]
         th = " %.0f |" % r["urdyn_threads"] if threads else ""
-        thr = " %.2f |" % r["ratio_threads"] if threads else ""
+        thr = (" %.0f (%s) | %.2f |" % (r["mujoco_pool_best"], r["mujoco_pool_best_cfg"], r["ratio_threads"])
+               if threads else "")
         out.append("| %s | %d | %.0f | %s |%s %s | %.0f | %.0f | %.0f | %.0f | %.2f |%s" % (
             r["kind"], r["n"], r["urdyn_sleep"], "%.0f" % r["urdyn_nosleep"] if r["urdyn_nosleep"] else "-",
             th, r["urdyn_awake_mean"] or "-", mj["euler"], mj["euler+sleep"], mj["implicitfast"],
@@ -212,7 +228,8 @@ def main():
                     help="examples/pile_settled binary (default target/release/examples/pile_settled)")
     ap.add_argument("--repeats", type=int, default=1, help="best of this many runs of each engine and setting")
     ap.add_argument("--threads", type=int, default=0,
-                    help="also run urdyn with --threads N (sleep on): a column and a ratio of its own")
+                    help="also run urdyn with --threads N (sleep on), and MuJoCo with its thread pool of N: "
+                         "a column and a ratio of their own")
     ap.add_argument("--no-nosleep", action="store_true", help="skip urdyn's --no-sleep runs")
     ap.add_argument("--no-equal-growth", dest="equal_growth", action="store_false",
                     help="skip the 64 pile's runs over the 1024 pile's duration (growth at equal durations)")
