@@ -46,6 +46,8 @@ struct Inner {
     stop: AtomicBool,
     /// Jobs left that the caller runs alone ([`COOL`]).
     cool: AtomicU32,
+    /// The cool-down's back-off: the next one runs `COOL_MIN << level` jobs alone.
+    level: AtomicU32,
 }
 
 /// The caller and `n − 1` worker threads.
@@ -67,10 +69,25 @@ impl std::fmt::Debug for Team {
 /// the caller never waits for one that has not begun.
 const SPIN: Duration = Duration::ZERO;
 
-/// Jobs a caller runs alone after a worker held it up (its wait at the
-/// close longer than half its own part: on a loaded machine, a worker
-/// descheduled in the middle of an item), before it shares again.
+/// The most jobs a caller runs alone after a worker held it up (its wait at
+/// the close longer than half its own part and than [`STALL`]: on a loaded
+/// machine, a worker descheduled in the middle of an item), before it shares
+/// again. The first hold-up costs [`COOL_MIN`] jobs alone, each one that
+/// follows the next shared job twice as many, up to `COOL`; a shared job
+/// closed without one halves it back. Round 29 measured round 28's fixed 64
+/// (at any wait over half the caller's part) keeping 66–98 % of the jobs
+/// off the worker (load 6–9): a short wait at the close of a short job (a worker's wake-up,
+/// the tail of its last item) is common, and each cost 64 jobs alone
+/// (benches/pile_results.md, round 29 threads).
 const COOL: u32 = 64;
+
+/// The cool-down's first length (jobs alone).
+const COOL_MIN: u32 = 4;
+
+/// A wait at a job's close that can be a descheduled worker (a scheduler's
+/// slice is a millisecond or more), not a wake-up or an item's tail (tens of
+/// µs): below it the caller keeps sharing.
+const STALL: Duration = Duration::from_micros(200);
 
 impl Team {
     /// The caller and `threads − 1` workers; `None` with fewer than two
@@ -88,6 +105,7 @@ impl Team {
             busy: AtomicBool::new(false),
             stop: AtomicBool::new(false),
             cool: AtomicU32::new(0),
+            level: AtomicU32::new(0),
         });
         let mut team = Team {
             inner,
@@ -164,10 +182,21 @@ impl Team {
                 std::hint::spin_loop();
             }
         }
-        // a wait longer than half this thread's own part: a worker's item
-        // took far longer than its share (descheduled), not a job's tail
-        if start.elapsed() > own + own / 2 {
-            inner.cool.store(COOL, Ordering::Relaxed);
+        // a wait longer than half this thread's own part and than a wake-up:
+        // a worker's item took far longer than its share (descheduled), not
+        // a job's tail; the cool-down doubles while hold-ups follow each other
+        let wait = start.elapsed().saturating_sub(own);
+        let level = inner.level.load(Ordering::Relaxed);
+        if wait > own / 2 && wait > STALL {
+            inner
+                .cool
+                .store((COOL_MIN << level).min(COOL), Ordering::Relaxed);
+            inner.level.store(
+                (level + 1).min((COOL / COOL_MIN).ilog2()),
+                Ordering::Relaxed,
+            );
+        } else if level > 0 {
+            inner.level.store(level - 1, Ordering::Relaxed);
         }
         inner.busy.store(false, Ordering::Release);
         if let Err(e) = mine {

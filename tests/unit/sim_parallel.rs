@@ -65,3 +65,42 @@ fn the_cut_orders_largest_first_and_keeps_small_jobs_here() {
     assert!(!cut(&[500], 2, 10, &mut order));
     assert!(!cut(&sizes, 1, 10, &mut order));
 }
+
+#[test]
+fn a_worker_that_holds_the_caller_up_costs_a_few_jobs_alone() {
+    use std::sync::atomic::AtomicBool;
+    use std::time::Instant;
+    let team = Team::new(2).expect("a team of two");
+    // a worker in the job holds the caller up for 50 ms (as one descheduled
+    // in the middle of an item would): far over the caller's own part
+    let inside = AtomicBool::new(false);
+    let late = AtomicBool::new(false);
+    team.run(&|k| {
+        if k == 0 {
+            let t = Instant::now();
+            while !inside.load(Ordering::Acquire) && t.elapsed() < Duration::from_secs(2) {
+                std::hint::spin_loop();
+            }
+            late.store(t.elapsed() > Duration::from_millis(20), Ordering::Relaxed);
+        } else {
+            inside.store(true, Ordering::Release);
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    });
+    if !inside.load(Ordering::Acquire) || late.load(Ordering::Relaxed) {
+        // the worker came late or never (a very loaded machine): the caller's
+        // own part was not short against the hold-up, nothing to check
+        return;
+    }
+    // the next jobs (the cool-down's first length, 4) run on this thread alone
+    for job in 0..4 {
+        let others = AtomicUsize::new(0);
+        team.run(&|k| {
+            if k != 0 {
+                others.fetch_add(1, Ordering::Relaxed);
+            }
+            std::thread::sleep(Duration::from_micros(200));
+        });
+        assert_eq!(others.load(Ordering::Relaxed), 0, "job {job}");
+    }
+}
