@@ -191,11 +191,9 @@ impl Rows {
                     )
                 };
                 // uᵣ = yᵣ·w' over the row's path
-                let u: f64 = yr
-                    .iter()
-                    .zip(p)
-                    .map(|(a, &k)| a * unsafe { *dw.get_unchecked(k) })
-                    .sum();
+                // SAFETY: the path's dofs are < nv = dw.len() (the factor's
+                // table and its unions, as above)
+                let u = unsafe { path_dot(yr, p, dw) };
                 let old = mu[r];
                 let x = old - (u - bpos[r]) / wrr;
                 let new = if bilateral { x } else { x.max(0.0) };
@@ -203,9 +201,8 @@ impl Rows {
                 if d != 0.0 {
                     mu[r] = new;
                     // w' += Δμ yᵣ
-                    for (a, &k) in yr.iter().zip(p) {
-                        unsafe { *dw.get_unchecked_mut(k) += d * a };
-                    }
+                    // SAFETY: as for `path_dot`
+                    unsafe { path_add(yr, p, d, dw) };
                     change = change.max((d * wrr).abs());
                 }
             }
@@ -225,6 +222,64 @@ impl Rows {
         }
         self.pos_rows = list;
         it
+    }
+}
+
+/// yᵣ·x over a row's path `p` (its y `yr`, as long), in the path's order
+/// as `Iterator::sum` adds (from −0, term after term): unrolled for the
+/// paths of one and two free bodies (6 and 12 dofs), the pass's rows on the
+/// piles, the same additions in the same order (bit for bit the loop's).
+///
+/// # Safety
+/// Every entry of `p` is < `x.len()`.
+#[inline(always)]
+unsafe fn path_dot(yr: &[f64], p: &[usize], x: &[f64]) -> f64 {
+    #[inline(always)]
+    unsafe fn fixed<const N: usize>(yr: &[f64; N], p: &[usize; N], x: &[f64]) -> f64 {
+        let mut u = -0.0;
+        for j in 0..N {
+            // SAFETY: the caller's
+            u += yr[j] * unsafe { *x.get_unchecked(p[j]) };
+        }
+        u
+    }
+    // SAFETY (the three): the caller's
+    if let (Ok(y), Ok(q)) = (<&[f64; 12]>::try_from(yr), <&[usize; 12]>::try_from(p)) {
+        return unsafe { fixed(y, q, x) };
+    }
+    if let (Ok(y), Ok(q)) = (<&[f64; 6]>::try_from(yr), <&[usize; 6]>::try_from(p)) {
+        return unsafe { fixed(y, q, x) };
+    }
+    yr.iter()
+        .zip(p)
+        // SAFETY: the caller's
+        .map(|(a, &k)| a * unsafe { *x.get_unchecked(k) })
+        .sum()
+}
+
+/// x += d yᵣ over a row's path `p` ([`path_dot`]'s unrolling).
+///
+/// # Safety
+/// Every entry of `p` is < `x.len()`.
+#[inline(always)]
+unsafe fn path_add(yr: &[f64], p: &[usize], d: f64, x: &mut [f64]) {
+    #[inline(always)]
+    unsafe fn fixed<const N: usize>(yr: &[f64; N], p: &[usize; N], d: f64, x: &mut [f64]) {
+        for j in 0..N {
+            // SAFETY: the caller's
+            unsafe { *x.get_unchecked_mut(p[j]) += d * yr[j] };
+        }
+    }
+    // SAFETY (the three): the caller's
+    if let (Ok(y), Ok(q)) = (<&[f64; 12]>::try_from(yr), <&[usize; 12]>::try_from(p)) {
+        return unsafe { fixed(y, q, d, x) };
+    }
+    if let (Ok(y), Ok(q)) = (<&[f64; 6]>::try_from(yr), <&[usize; 6]>::try_from(p)) {
+        return unsafe { fixed(y, q, d, x) };
+    }
+    for (a, &k) in yr.iter().zip(p) {
+        // SAFETY: the caller's
+        unsafe { *x.get_unchecked_mut(k) += d * a };
     }
 }
 
