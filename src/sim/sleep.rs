@@ -23,6 +23,8 @@ use crate::model::Model;
 use crate::spatial::Force;
 use nalgebra::{DVector, Vector3};
 
+mod step;
+
 /// "No tree": the world body.
 const WORLD: usize = usize::MAX;
 
@@ -562,104 +564,6 @@ impl Sleep {
         } else {
             self.awake_sum / self.steps as f64
         }
-    }
-}
-
-impl super::Simulation {
-    /// Sleep's work at the end of a step of `h`: islands that an awake body
-    /// touches woken (their contacts found), then the still islands put to sleep.
-    pub(super) fn update_sleep(&mut self, h: f64) {
-        if !self.sleep.on {
-            self.sleep.after_step(
-                &self.model,
-                h,
-                &[],
-                &[],
-                &self.q,
-                &mut self.v,
-                &mut self.points,
-                &[],
-                &[],
-            );
-            return;
-        }
-        while self.sleep.wake_touched(&self.model, &self.points)
-            | self.sleep.undoze_touched(&self.model, &self.points)
-        {
-            self.refresh_contacts();
-        }
-        if !self.fk_valid {
-            crate::dynamics::forward_kinematics_pass(&self.model, &mut self.data, &self.q);
-            self.fk_valid = true;
-        }
-        // body velocities (body frame) from the poses' joint transforms, the
-        // position pass's push included (a point pushed out moves)
-        let model = &self.model;
-        let data = &mut self.data;
-        self.sleep.vw.copy_from(&self.v);
-        if let Some(w) = self.cons.push_velocity() {
-            self.sleep.vw += w;
-        }
-        // (the awake trees' bodies: a tree's bodies are one range after their
-        // parents, whose root hangs from the world; sleeping ones are not read)
-        // (a body on the world: its parent's velocity is zero, moved into its
-        // frame a zero but for the signs of its zeros; these velocities are
-        // read only by the speed tests' norms, here and in a dozing step's
-        // `account_sleep`, until the energy pass writes them anew)
-        data.v[0] = crate::spatial::Motion::zero();
-        for &t in self.sleep.awake_trees() {
-            for i in model.trees[t].bodies.clone() {
-                let p = model.parent[i];
-                let mut vi = match p {
-                    0 => crate::spatial::Motion::zero(),
-                    _ => data.li_m_i[i].inv_act_motion(&data.v[p]),
-                };
-                model.joints[i].add_motion(&mut vi, &self.sleep.vw);
-                data.v[i] = vi;
-            }
-        }
-        self.account_sleep(h);
-    }
-
-    /// Sleep's count after a step of `h` from the body velocities in
-    /// `data.v` (set by [`Simulation::update_sleep`]; held through a dozing
-    /// step, `Simulation::dozing_step`): the driven trees, the still times,
-    /// the islands that fall asleep, the new dozes' warm starts kept aside.
-    pub(super) fn account_sleep(&mut self, h: f64) {
-        // trees driven now: a nonzero applied force, or a servo on one of its
-        // dofs (read for the awake trees only)
-        // (each tree's dofs one range: a slice test of each vector)
-        let tau = self.tau_applied.as_slice();
-        let servo = self
-            .servo
-            .active
-            .then(|| (self.servo.kp.as_slice(), self.servo.kd.as_slice()));
-        for &t in self.sleep.awake_trees() {
-            let r = self.model.trees[t].v.clone();
-            let set = |x: &[f64]| {
-                x.get(r.clone())
-                    .is_some_and(|x| x.iter().any(|&x| x != 0.0))
-            };
-            self.sleep_forced[t] = set(tau) || servo.is_some_and(|(kp, kd)| set(kp) || set(kd));
-        }
-        let slept = self.sleep.after_step(
-            &self.model,
-            h,
-            &self.data.v,
-            &self.sleep_forced,
-            &self.q,
-            &mut self.v,
-            &mut self.points,
-            self.cons.contact_forces(),
-            self.cons.body_forces(),
-        );
-        if slept {
-            self.energy_now = None;
-        }
-        if !self.sleep.doze.new_slots.is_empty() {
-            self.cons.hold_warm(&self.sleep.doze.new_slots);
-        }
-        self.sleep.compose(&self.model, self.cons.body_forces());
     }
 }
 
