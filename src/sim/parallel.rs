@@ -62,7 +62,8 @@ impl std::fmt::Debug for Team {
     }
 }
 
-/// How long a worker spins on the job counter after a job before it sleeps: none (a few hundred spins). Round 27's 0.1 ms made two
+/// How long a worker spins on the job counter after a job before it
+/// sleeps: none (a few hundred spins). Round 27's 0.1 ms made two
 /// threads slower than one at load ~5 and gained nothing near quiet; round
 /// 28 measured spin 0 as fast as or faster than 0.1 ms at load ~6 on every
 /// pile (benches/pile_results.md). A job's dispatch wakes a sleeping worker;
