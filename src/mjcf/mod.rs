@@ -22,6 +22,7 @@ mod collide;
 mod compile;
 mod convert;
 mod equality;
+mod geom;
 mod inertia;
 mod lower;
 mod orient;
