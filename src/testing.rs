@@ -452,6 +452,21 @@ pub mod constraints {
     ) -> ([Vec<f64>; 3], usize) {
         crate::sim::constraints::add_body_rows(path, hi, iv, cols, p, row)
     }
+
+    /// `sim::constraints::free::write`: a contact's three rows (12 entries
+    /// each) at `p` along `normal` on a root free body of world columns `a`
+    /// (dofs 0..6) against the ground (`b` None, `normal` +z) or a second of
+    /// columns `b` (dofs 6..12), written over rows all `stale`; None where the
+    /// free rows' plan declines.
+    pub fn free_rows(
+        a: &[Motion; 6],
+        b: Option<&[Motion; 6]>,
+        p: &Vector3<f64>,
+        normal: &Vector3<f64>,
+        stale: f64,
+    ) -> Option<[Vec<f64>; 3]> {
+        crate::sim::constraints::free_rows(a, b, p, normal, stale)
+    }
 }
 
 /// The subspace step's dense LDLᵀ of W_FF (sim/solver/dense.rs).

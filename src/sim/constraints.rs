@@ -16,6 +16,7 @@
 //!   kinetic energy); restitution e > 0 raises b to −e·u⁻ on fast impacts;
 //! - position pass: b_pos = min(β(−φ − slop)/Δt, cap) where φ < −slop.
 
+mod free;
 mod solve;
 mod spin;
 mod tables;
@@ -30,6 +31,7 @@ use super::{ContactForce, Solver};
 use crate::contact::{tangents, ContactPoint};
 use crate::model::{JointKind, Model};
 use crate::spatial::{Force, Motion, Se3};
+pub(crate) use free::free_rows;
 use nalgebra::{DVector, Vector3};
 use std::sync::Arc;
 pub(crate) use tables::add_body_rows;
@@ -242,7 +244,12 @@ impl Constraints {
             pos_warm: PosWarm::new(cap),
             sw: vec![[Motion::zero(); 6]; model.nbodies],
             sw_done: vec![0; model.nbodies],
-            heads: cols.iter().map(BodyHead::of).collect(),
+            heads: (cols.iter().enumerate())
+                .map(|(i, c)| BodyHead {
+                    free: BodyHead::of(c).free && model.parent.get(i) == Some(&0),
+                    ..BodyHead::of(c)
+                })
+                .collect(),
             cols,
             sw_stamp: 0,
             counts: RowCounts::default(),
@@ -433,7 +440,19 @@ impl Constraints {
                 } else {
                     rows.union_path(body_path(pt.body), body_path(pt.other))
                 };
-                if rows.n + 3 <= keep {
+                // root free bodies' rows are written whole ([`free`]): of the
+                // last assembly's entries there, only those past the path are
+                // zeroed (its length `stale`); any other's are zeroed first
+                let (ps, pl) = path;
+                let plan = rows
+                    .table()
+                    .get(ps..ps + pl)
+                    .and_then(|on| free::plan(&self.heads, on, rows.stride, pt));
+                let stale = match rows.path.get(rows.n) {
+                    Some(&(_, l)) if rows.n + 3 <= keep => l,
+                    _ => 0,
+                };
+                if plan.is_none() && rows.n + 3 <= keep {
                     rows.zero_contact(rows.n);
                 }
                 let Some(rn) = rows.push_contact(pt.friction, warm, path) else {
@@ -445,13 +464,16 @@ impl Constraints {
                 // by `clear`): entry t of a row is dof path[t] (a path is
                 // ascending: `add_body` finds a dof by bisection)
                 let st = rows.stride;
-                let (ps, pl) = path;
                 let (tab, jall) = rows.table_and_j();
                 let on_path = tab.get(ps..ps + pl).unwrap_or(&[]);
                 let (j0, rest) = jall[rn * st..(rn + 3) * st].split_at_mut(st);
                 let (j1, j2) = rest.split_at_mut(st);
                 let at = &pt.point;
-                if pt.other == 0 && pt.normal == Vector3::z() {
+                if let Some(plan) = plan
+                    && free::write(plan, [&mut *j0, &mut *j1, &mut *j2], stale, &self.sw, pt)
+                {
+                    // (written whole)
+                } else if pt.other == 0 && pt.normal == Vector3::z() {
                     // the ground: rows n = z, t₁ = x, t₂ = y: the point velocity
                     // v_c + ω_c × p of each ancestor's world-frame subspace column c
                     let (mut b, mut hi) = (pt.body, on_path.len());

@@ -174,14 +174,21 @@ pub(super) struct BodyHead {
     pub(super) iv: usize,
     pub(super) nv: usize,
     pub(super) ang_zero: [bool; 6],
+    /// A root body (its parent the world) of six columns, the first three
+    /// with no angular part and the last three with one (a free joint's):
+    /// its contacts' entries are written by `free.rs`, not [`add_body`].
+    pub(super) free: bool,
 }
 
 impl BodyHead {
+    /// `c`'s head (`free` as if a root body's: the caller clears it for others).
     pub(super) fn of(c: &BodyColumns) -> Self {
+        let ang_zero = c.s.map(|x| x.ang_zero);
         Self {
             iv: c.iv,
             nv: c.nv,
-            ang_zero: c.s.map(|x| x.ang_zero),
+            ang_zero,
+            free: c.nv == 6 && ang_zero == [true, true, true, false, false, false],
         }
     }
 }

@@ -228,6 +228,28 @@ impl MassFactor {
         self.tree && path.len() == N && self.is_chain(path) && self.chain_elim::<N>(path, w)
     }
 
+    /// [`Self::chain_lanes`] of two contacts' rows `w` and `v` on the same
+    /// chain path (two contacts of a free body on the ground): one walk of L
+    /// for both, each lane's entry the same operations in the same order as
+    /// [`Self::chain_lanes`] alone (the same bits). False where the factor is
+    /// dense or `path` is not the chain.
+    #[inline(always)]
+    pub fn chain_lanes2<const N: usize>(
+        &self,
+        path: &[usize],
+        w: &mut [[f64; 4]; N],
+        v: &mut [[f64; 4]; N],
+    ) -> bool {
+        self.tree && path.len() == N && self.is_chain(path) && self.chain_elim2::<N>(path, w, v)
+    }
+
+    /// Whether `path` is a tree factor's chain, root … leaf, of `N` dofs
+    /// (what [`Self::chain_lanes`] takes).
+    #[inline(always)]
+    pub fn is_chain_of<const N: usize>(&self, path: &[usize]) -> bool {
+        self.tree && path.len() == N && self.is_chain(path)
+    }
+
     /// Whether `path` is two trees' chains, root … leaf each, of `A` dofs
     /// then `B` (a tree factor's; what [`Self::two_chain_lanes`] takes).
     #[inline(always)]

@@ -35,11 +35,15 @@ impl Rows {
             // two contacts between the same two free bodies (6 + 6 dofs, the
             // same path): formed together, one walk of L for both
             let same = |(qs, ql): (usize, usize)| table.get(qs..qs + ql) == Some(path);
+            // (likewise two contacts of one free body on the ground: 6 dofs)
             if block
-                && pl == 12
+                && (pl == 12 || pl == 6)
                 && self.is_contact(r + 3)
                 && same(self.path[r + 3])
-                && self.form_pair(f, r, path, vfree)
+                && match pl {
+                    12 => self.form_pair::<6, 12>(f, r, path, vfree),
+                    _ => self.form_pair::<0, 6>(f, r, path, vfree),
+                }
             {
                 for q in r + 3..r + 6 {
                     self.is_block[q] = q == r + 3;
@@ -234,22 +238,32 @@ impl Rows {
     }
 
     /// Contacts r and r + 3 on the same path of two free bodies' chains
-    /// (6 + 6 dofs) formed as [`Rows::form_chain`] forms each
-    /// ([`MassFactor::two_chain_lanes2`]: one walk of L for both): the same
+    /// (`B` = 6: 6 + 6 dofs) or of one free body's chain (`B` = 0: 6 dofs,
+    /// two contacts of a body on the ground), `N` dofs, formed as
+    /// [`Rows::form_chain`] forms each ([`MassFactor::two_chain_lanes2`],
+    /// [`MassFactor::chain_lanes2`]: one walk of L for both): the same
     /// operations in the same order, the same bits. False, nothing written,
-    /// where `path` (contact r + 3's too: the caller's test) is not two such
-    /// chains.
+    /// where `path` (contact r + 3's too: the caller's test) is not such chains.
     // (kept out of `form`: inlined there, it costs every other path's rows)
     #[inline(never)]
-    fn form_pair(&mut self, f: &MassFactor, r: usize, path: &[usize], vfree: &[f64]) -> bool {
-        const N: usize = 12;
+    fn form_pair<const B: usize, const N: usize>(
+        &mut self,
+        f: &MassFactor,
+        r: usize,
+        path: &[usize],
+        vfree: &[f64],
+    ) -> bool {
         let st = self.stride;
         let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..(r + 6) * st)) else {
             return false;
         };
         // (the shape first: a robot's foot, one 12-dof chain, is not two
         // chains, and its rows are not gathered twice)
-        if N > st || !f.two_chains::<6, 6>(path) || path.iter().any(|&d| d >= vfree.len()) {
+        let shape = match B {
+            0 => N == 6 && f.is_chain_of::<N>(path),
+            _ => N == 6 + B && f.two_chains::<6, B>(path),
+        };
+        if N > st || !shape || path.iter().any(|&d| d >= vfree.len()) {
             return false;
         }
         let (mut w, mut v) = ([[0.0f64; 4]; N], [[0.0f64; 4]; N]);
@@ -266,7 +280,11 @@ impl Rows {
             vfree,
             &mut v,
         );
-        if !f.two_chain_lanes2::<6, 6>(path, &mut w, &mut v) {
+        let done = match B {
+            0 => f.chain_lanes2::<N>(path, &mut w, &mut v),
+            _ => f.two_chain_lanes2::<6, B>(path, &mut w, &mut v),
+        };
+        if !done {
             return false;
         }
         self.store_block(r, &w, c);

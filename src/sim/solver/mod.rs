@@ -230,6 +230,7 @@ impl Rows {
     /// The path of a row acting on the dofs of two paths `a` and `b` (entries
     /// of the table): their union, ascending (appended to the table for this
     /// step; the last union is reused when asked again).
+    #[inline]
     pub fn union_path(&mut self, a: (usize, usize), b: (usize, usize)) -> (usize, usize) {
         if a == b || b.1 == 0 {
             return a;
@@ -241,9 +242,31 @@ impl Rows {
         if la == a && lb == b && at.0 + at.1 <= self.table.len() && at.0 >= self.static_len {
             return at;
         }
+        self.union_new(a, b)
+    }
+    /// [`Rows::union_path`]'s new union of two nonempty paths.
+    #[inline(never)]
+    fn union_new(&mut self, a: (usize, usize), b: (usize, usize)) -> (usize, usize) {
         let start = self.table.len();
         let (mut i, mut j) = (a.0, b.0);
         let (ea, eb) = (a.0 + a.1, b.0 + b.1);
+        // two paths apart (two trees': every dof of one below every dof of
+        // the other) are each other's ends: the merge's entries, copied
+        if ea <= start && eb <= start {
+            let (ta, tb) = (&self.table[a.0..ea], &self.table[b.0..eb]);
+            let apart = match (ta.first(), ta.last(), tb.first(), tb.last()) {
+                (Some(_), Some(&al), Some(&bf), Some(_)) if al < bf => Some((a, b)),
+                (Some(&af), Some(_), Some(_), Some(&bl)) if bl < af => Some((b, a)),
+                _ => None,
+            };
+            if let Some((lo, hi)) = apart {
+                self.table.extend_from_within(lo.0..lo.0 + lo.1);
+                self.table.extend_from_within(hi.0..hi.0 + hi.1);
+                let at = (start, self.table.len() - start);
+                self.last_union = (a, b, at);
+                return at;
+            }
+        }
         while i < ea || j < eb {
             let x = if i < ea { self.table[i] } else { usize::MAX };
             let y = if j < eb { self.table[j] } else { usize::MAX };

@@ -1,0 +1,227 @@
+//! A contact's three rows where its bodies are root bodies with a free
+//! joint (every contact of a pile): each body's six entries a row written
+//! side by side from its world columns, not walked column by column
+//! ([`super::tables::add_body`]), the same values (the same bits).
+//!
+//! A free joint's world columns `sw` are three linear ones (no angular
+//! part: the point velocity is the column's linear part) and three with an
+//! angular part ω (point velocity v + ω × p); with those six point
+//! velocities by component, a row's six entries are one product each, taken
+//! six at a time. Each entry gets [`add_body`]'s operations in its order:
+//! nalgebra's cross (ω_y p_z − ω_z p_y, …) added to v, nalgebra's dot
+//! ((aₓvₓ + a_yv_y) + a_zv_z), negated for the second body, and summed onto
+//! +0 (written `e + 0.0`: the rows are not zeroed first, see [`write`]).
+//!
+//! [`add_body`]: super::tables::add_body
+
+use super::tables::BodyHead;
+use crate::contact::{tangents, ContactPoint};
+use crate::spatial::Motion;
+use nalgebra::Vector3;
+
+/// Where a contact's rows between root free bodies lie on its path.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Plan {
+    /// A free body on the ground (normal +z): its dofs the whole path.
+    Ground,
+    /// Two free bodies: the first body's dofs at `a`, the other's at `b`
+    /// (0 and 6, ascending by dof).
+    Pair { a: usize, b: usize },
+}
+
+/// The plan of contact `pt` on `path` (its dofs, ascending; at most
+/// `stride` of them), or `None` where its bodies are not root free bodies
+/// whose dofs make up the path back to back (the general walk then).
+#[inline]
+pub(super) fn plan(
+    heads: &[BodyHead],
+    path: &[usize],
+    stride: usize,
+    pt: &ContactPoint,
+) -> Option<Plan> {
+    if path.len() > stride {
+        return None;
+    }
+    let on = |b: usize, t: usize| {
+        heads.get(b).is_some_and(|h| {
+            h.free && path.get(t) == Some(&h.iv) && path.get(t + 5) == Some(&(h.iv + 5))
+        })
+    };
+    let (a, b) = (pt.body, pt.other);
+    if b == 0 {
+        return (pt.normal == Vector3::z() && path.len() == 6 && on(a, 0)).then_some(Plan::Ground);
+    }
+    let (ha, hb) = (heads.get(a)?, heads.get(b)?);
+    let (ta, tb) = if ha.iv < hb.iv { (0, 6) } else { (6, 0) };
+    (a != b && path.len() == 12 && on(a, ta) && on(b, tb)).then_some(Plan::Pair { a: ta, b: tb })
+}
+
+/// Writes contact `pt`'s three rows `j` by `plan` (every entry of the path:
+/// the entries' old values are overwritten, none read), `sw` each body's
+/// world columns; `stale`: how many entries of each row the last assembly
+/// may have left nonzero (a row is zero past its path), zeroed past the
+/// path. False where a row or a body is missing: the rows are then zeroed
+/// (their first `stale` entries), for the general walk.
+#[inline(always)]
+pub(super) fn write(
+    plan: Plan,
+    j: [&mut [f64]; 3],
+    stale: usize,
+    sw: &[[Motion; 6]],
+    pt: &ContactPoint,
+) -> bool {
+    let [j0, j1, j2] = j;
+    let pl = match plan {
+        Plan::Ground => 6,
+        Plan::Pair { .. } => 12,
+    };
+    let done = write_path(plan, [&mut *j0, &mut *j1, &mut *j2], sw, pt);
+    let from = if done { pl } else { 0 };
+    for r in [j0, j1, j2] {
+        let end = stale.min(r.len());
+        if let Some(x) = r.get_mut(from.min(end)..end) {
+            x.fill(0.0);
+        }
+    }
+    done
+}
+
+/// [`write`]'s entries on the path.
+#[inline(always)]
+fn write_path(plan: Plan, j: [&mut [f64]; 3], sw: &[[Motion; 6]], pt: &ContactPoint) -> bool {
+    let p = &pt.point;
+    match plan {
+        Plan::Ground => {
+            let Some(s) = sw.get(pt.body) else {
+                return false;
+            };
+            // rows n = z, t₁ = x, t₂ = y: the point velocity's components
+            put(j, 0, s, p, |i, v| v[[2, 0, 1][i]])
+        }
+        Plan::Pair { a, b } => {
+            let (Some(sa), Some(sb)) = (sw.get(pt.body), sw.get(pt.other)) else {
+                return false;
+            };
+            let [j0, j1, j2] = j;
+            if [&*j0, &*j1, &*j2].iter().any(|r| r.len() < 12) {
+                return false;
+            }
+            // J = J_a − J_b along (n, t₁, t₂), n from b toward a
+            let (n, (t1, t2)) = (pt.normal, tangents(&pt.normal));
+            let axes = [n, t1, t2];
+            put([j0, j1, j2], a, sa, p, |i, v| along::<false>(&axes[i], v))
+                && put([j0, j1, j2], b, sb, p, |i, v| along::<true>(&axes[i], v))
+        }
+    }
+}
+
+/// The six point velocities at `p` of a free body's world columns `sw` by
+/// component (`v[c][k]`: component c of column k's): [`super::tables`]'
+/// `point_velocity` of each, side by side.
+#[inline(always)]
+fn velocities(sw: &[Motion; 6], p: &Vector3<f64>) -> [[f64; 6]; 3] {
+    let mut v = [[0.0; 6]; 3];
+    for (k, s) in sw.iter().enumerate() {
+        for (c, vc) in v.iter_mut().enumerate() {
+            vc[k] = s.lin[c];
+        }
+    }
+    let mut w = [[0.0; 3]; 3];
+    for (k, s) in sw[3..].iter().enumerate() {
+        for (c, wc) in w.iter_mut().enumerate() {
+            wc[k] = s.ang[c];
+        }
+    }
+    let [wx, wy, wz] = w;
+    let [vx, vy, vz] = &mut v;
+    for k in 0..3 {
+        // v + ω × p, nalgebra's cross (ω_y p_z − ω_z p_y, ω_z p_x − ω_x p_z, ω_x p_y − ω_y p_x)
+        vx[3 + k] += wy[k] * p.z - wz[k] * p.y;
+        vy[3 + k] += wz[k] * p.x - wx[k] * p.z;
+        vz[3 + k] += wx[k] * p.y - wy[k] * p.x;
+    }
+    v
+}
+
+/// Row i's six entries at `t0` of `j[i]` are `row(i, v)` + 0.0 for the point
+/// velocities `v` at `p` of `sw` ([`velocities`]). False, nothing written,
+/// where a row is too short.
+#[inline(always)]
+fn put(
+    j: [&mut [f64]; 3],
+    t0: usize,
+    sw: &[Motion; 6],
+    p: &Vector3<f64>,
+    row: impl Fn(usize, &[[f64; 6]; 3]) -> [f64; 6],
+) -> bool {
+    let [j0, j1, j2] = j;
+    let (Some(r0), Some(r1), Some(r2)) = (
+        j0.get_mut(t0..t0 + 6),
+        j1.get_mut(t0..t0 + 6),
+        j2.get_mut(t0..t0 + 6),
+    ) else {
+        return false;
+    };
+    let v = velocities(sw, p);
+    for (i, r) in [r0, r1, r2].into_iter().enumerate() {
+        for (x, e) in r.iter_mut().zip(row(i, &v)) {
+            // (a zero's sign as the sum onto the +0 of a zeroed row leaves it)
+            *x = e + 0.0;
+        }
+    }
+    true
+}
+
+/// The entries `a·v` of the six point velocities `v` along `a` (nalgebra's
+/// dot, (aₓvₓ + a_yv_y) + a_zv_z), negated with `NEG`.
+#[inline(always)]
+fn along<const NEG: bool>(a: &Vector3<f64>, v: &[[f64; 6]; 3]) -> [f64; 6] {
+    let mut e = [0.0; 6];
+    for (k, x) in e.iter_mut().enumerate() {
+        let d = a.x * v[0][k] + a.y * v[1][k] + a.z * v[2][k];
+        *x = if NEG { -d } else { d };
+    }
+    e
+}
+
+/// The tests' hook (`urdyn::testing::constraints::free_rows`): a contact's
+/// three rows at `p` along `normal` on a root free body of world columns `a`
+/// (dofs 0..6), against the ground (`b` None: `normal` must be +z) or a
+/// second one of columns `b` (dofs 6..12), written by [`write`] over rows of
+/// 12 entries all `stale` (the last assembly's entries); None where [`plan`]
+/// declines.
+pub(crate) fn free_rows(
+    a: &[Motion; 6],
+    b: Option<&[Motion; 6]>,
+    p: &Vector3<f64>,
+    normal: &Vector3<f64>,
+    stale: f64,
+) -> Option<[Vec<f64>; 3]> {
+    let head = |iv: usize| BodyHead {
+        iv,
+        nv: 6,
+        ang_zero: [true, true, true, false, false, false],
+        free: true,
+    };
+    let heads = [head(0), head(0), head(6)];
+    let sw = [[Motion::zero(); 6], *a, *b.unwrap_or(a)];
+    let pt = ContactPoint {
+        shape: 0,
+        slot: 0,
+        body: 1,
+        point: *p,
+        gap: 0.0,
+        geom: 0,
+        other: if b.is_some() { 2 } else { 0 },
+        other_geom: 0,
+        normal: *normal,
+        friction: 1.0,
+        fresh: true,
+        key: 0,
+    };
+    let path: Vec<usize> = (0..if b.is_some() { 12 } else { 6 }).collect();
+    let plan = plan(&heads, &path, 12, &pt)?;
+    let mut j = [vec![stale; 12], vec![stale; 12], vec![stale; 12]];
+    let [j0, j1, j2] = &mut j;
+    write(plan, [j0, j1, j2], 12, &sw, &pt).then_some(j)
+}
