@@ -17,6 +17,7 @@
 //! - position pass: b_pos = min(β(−φ − slop)/Δt, cap) where φ < −slop.
 
 mod free;
+mod joints;
 mod solve;
 mod spin;
 mod tables;
@@ -386,14 +387,6 @@ impl Constraints {
         self.joint_rows.clear();
         self.row_point.clear();
         let mut counts = RowCounts::default();
-        let speculative = |gap: f64| if gap > 0.0 { -gap / h } else { 0.0 };
-        let pos_target = |gap: f64, slop: f64, cap: f64| {
-            if gap < -slop {
-                (p.beta * (-gap - slop) / h).min(cap)
-            } else {
-                0.0
-            }
-        };
         // contact rows first: a sweep then meets the joint rows (friction,
         // limits) after the contacts have moved (talos_reduced, whose every
         // joint has friction, converged in fewer sweeps this way)
@@ -515,7 +508,7 @@ impl Constraints {
                 // normal target: speculative; restitution only above the speed below
                 // which a bounce of one step under gravity could gain energy:
                 // |u| > 4 g h e / (1 − e²)
-                let mut bn = speculative(pt.gap);
+                let mut bn = speculative(pt.gap, h);
                 let e = p.restitution;
                 if e > 0.0 && e < 1.0 {
                     let un = rows.jdot(rn, v.as_slice());
@@ -525,7 +518,7 @@ impl Constraints {
                     }
                 }
                 rows.b[rn] = bn;
-                rows.bpos[rn] = pos_target(pt.gap, p.contact_slop, p.contact_push_cap);
+                rows.bpos[rn] = pos_target(pt.gap, p.contact_slop, p.contact_push_cap, p.beta, h);
                 if rows.bpos[rn] > 0.0 {
                     counts.violated += 1;
                 }
@@ -537,75 +530,10 @@ impl Constraints {
         } else {
             rows.zero_stale(keep);
         }
-        self.first_joint_row = rows.n;
-        // joint rows: friction (|λ| ≤ F h), limits (λ ≥ 0)
-        if p.joint_dynamics {
-            // (the 1-DoF joints with friction or a limit, in dof order: `jrows`)
-            for js in &self.jrows {
-                let (d, iq, iv) = (js.d, js.iq, js.iv);
-                let path = f.path_of(iv);
-                if js.friction > 0.0 {
-                    let kind = RowKind::Box {
-                        limit: js.friction * h,
-                    };
-                    if let Some(r) = rows.push(kind, 0.0, self.warm_joint[d][0], path) {
-                        add_joint_entry(rows, r, iv, 1.0);
-                        self.joint_rows.push((d, 0));
-                        counts.friction += 1;
-                    }
-                }
-                if js.continuous {
-                    continue;
-                }
-                let (qd, vd) = (q[iq], v[iv]);
-                let margin = 1e-3 + 2.0 * vd.abs() * h;
-                let sides = [(js.lower, 1.0, 1u8), (js.upper, -1.0, 2u8)];
-                for (limit, sign, which) in sides {
-                    let Some(l) = limit else { continue };
-                    // φ = q − lower, or upper − q
-                    let gap = sign * (qd - l);
-                    if gap >= margin {
-                        continue;
-                    }
-                    let w = self.warm_joint[d][which as usize];
-                    if let Some(r) = rows.push(RowKind::Unilateral, speculative(gap), w, path) {
-                        add_joint_entry(rows, r, iv, sign);
-                        rows.bpos[r] = pos_target(gap, p.limit_slop, p.limit_push_cap);
-                        if rows.bpos[r] > 0.0 {
-                            counts.violated += 1;
-                        }
-                        self.joint_rows.push((d, which));
-                        counts.limits += 1;
-                    }
-                }
-            }
-        }
+        self.first_joint_row = self.rows.n;
+        self.assemble_joint_rows(q, v, p, f, h, &mut counts);
         self.counts = counts;
         counts
-    }
-
-    /// Appends the loop constraints' rows (after every other row, so that a
-    /// run without loops is untouched) at (q, v); `data.o_m_i`: world poses at q.
-    #[allow(clippy::too_many_arguments)]
-    pub fn assemble_loops(
-        &mut self,
-        model: &Model,
-        data: &crate::model::Data,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        p: &RowParams,
-        f: &MassFactor,
-        h: f64,
-    ) -> RowCounts {
-        if let Some(l) = self.loops.as_mut() {
-            let cap = p.contact_push_cap.max(p.limit_push_cap);
-            let (n, violated) = l.assemble(&mut self.rows, model, data, q, v, f, h, cap);
-            self.counts.loops = n;
-            if violated {
-                self.counts.violated += 1;
-            }
-        }
-        self.counts
     }
 }
 
@@ -624,15 +552,24 @@ fn common_ancestor(parent: &[usize], mut a: usize, mut b: usize) -> usize {
     a
 }
 
-/// Adds `x` to J's entry of joint row `r` at its dof `iv`: the last of its
-/// path (`MassFactor::path_of(iv)` ends at `iv`), else where [`Rows::add_entry`]
-/// finds it.
+/// A row's velocity target for a gap φ: b = −φ/Δt while φ > 0 (speculative:
+/// the gap may close within the step, not overshoot), else 0.
 #[inline]
-fn add_joint_entry(rows: &mut Rows, r: usize, iv: usize, x: f64) {
-    let (ps, pl) = rows.path[r];
-    let last = (pl.checked_sub(1), rows.table().get(ps + pl.wrapping_sub(1)));
-    match last {
-        (Some(t), Some(&d)) if d == iv && t < rows.stride => rows.j[r * rows.stride + t] += x,
-        _ => rows.add_entry(r, iv, x),
+fn speculative(gap: f64, h: f64) -> f64 {
+    if gap > 0.0 {
+        -gap / h
+    } else {
+        0.0
+    }
+}
+
+/// The position pass's target for a gap φ: b_pos = min(β(−φ − slop)/Δt, cap)
+/// where φ < −slop, else 0.
+#[inline]
+fn pos_target(gap: f64, slop: f64, cap: f64, beta: f64, h: f64) -> f64 {
+    if gap < -slop {
+        (beta * (-gap - slop) / h).min(cap)
+    } else {
+        0.0
     }
 }
