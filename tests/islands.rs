@@ -121,7 +121,9 @@ fn threads_one_and_two_give_identical_csvs_on_a_pile_with_sleep_on_and_off() {
 
 /// The mixed pile of 256 (balls, boxes and cylinders: a hundred islands a
 /// solve, the position pass's joins) on 1 and 2 threads: the same CSV, byte
-/// for byte, whichever thread solved which island.
+/// for byte, whichever thread solved which island or searched which of the
+/// ground's shapes (256 shapes: the ground detection in chunks on the team,
+/// the pairs' broad phase beside it, src/contact/ground/team.rs).
 #[test]
 fn threads_one_and_two_give_identical_csvs_on_the_mixed_256_pile() {
     let scene = dir().join("pile_mixed_256.json");
@@ -137,7 +139,9 @@ fn threads_one_and_two_give_identical_csvs_on_the_mixed_256_pile() {
 /// The box pile of 256 on 1 and 2 threads: the same CSV, byte for byte,
 /// with the narrow phase on the team (a detection of this pile visits
 /// hundreds of pairs: chunks of them on both threads,
-/// src/contact/pairs/visit.rs) as well as the islands.
+/// src/contact/pairs/visit.rs) as well as the islands, and the ground
+/// detection's chunks of shapes beside the pairs' broad phase
+/// (src/contact/ground/team.rs).
 #[test]
 fn threads_one_and_two_give_identical_csvs_on_the_boxes_256_pile() {
     let scene = dir().join("pile_boxes_256.json");

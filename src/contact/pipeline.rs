@@ -107,8 +107,10 @@ impl Collision {
         self.detect_on(o_m_i, out, asleep, None);
     }
 
-    /// [`Self::detect`], the pairs' narrow phase on `run`'s threads when it
-    /// is worth it (the same points, bit for bit: src/contact/pairs/visit.rs).
+    /// [`Self::detect`], the ground's shapes (with the pairs' broad phase
+    /// beside them) and the pairs' narrow phase on `run`'s threads when it is
+    /// worth it (the same points, bit for bit: src/contact/ground/team.rs,
+    /// src/contact/pairs/visit.rs).
     pub(crate) fn detect_on(
         &mut self,
         o_m_i: &[Se3<f64>],
@@ -117,11 +119,27 @@ impl Collision {
         run: Option<&dyn Runner>,
     ) {
         out.clear();
-        if let Some(g) = self.ground.as_mut() {
-            g.detect(o_m_i, out, asleep);
-        }
-        if let Some(p) = self.pairs.as_mut() {
-            p.detect_on(o_m_i, out, asleep, run);
+        match (self.ground.as_mut(), self.pairs.as_mut()) {
+            (Some(g), Some(p)) if run.is_some_and(|r| r.threads() > 1) => {
+                // the pairs' broad phase as one item of the ground's job (the
+                // two touch nothing of each other's): on a team, the two at once
+                let pairs = std::sync::Mutex::new(&mut *p);
+                let broad = || match pairs.lock() {
+                    Ok(mut p) => p.broad(o_m_i),
+                    Err(e) => e.into_inner().broad(o_m_i),
+                };
+                g.detect_on(o_m_i, out, asleep, run, Some(&broad));
+                drop(pairs);
+                p.visit_pairs(out, asleep, run);
+            }
+            (g, p) => {
+                if let Some(g) = g {
+                    g.detect_on(o_m_i, out, asleep, run, None);
+                }
+                if let Some(p) = p {
+                    p.detect_on(o_m_i, out, asleep, run);
+                }
+            }
         }
     }
 

@@ -82,6 +82,14 @@ impl Travel {
         }
     }
 
+    /// Every shape's travel (to be written apart: a detection on several
+    /// threads, each its own shapes'), with δ and c: shape k's margin is
+    /// [`margin`]`(δ, c, s[k])`, as [`Self::margin`]'s.
+    #[inline]
+    pub fn split(&mut self) -> (&mut [f64], f64, f64) {
+        (&mut self.s, self.delta, self.factor)
+    }
+
     /// Shape `k`'s margin, max(δ, c·s).
     #[inline]
     pub fn margin(&self, k: usize) -> f64 {

@@ -251,6 +251,9 @@ impl GroundContact {
         }
         let cap = shapes.iter().map(|s| s.nslots).max().unwrap_or(0);
         let nshapes = shapes.len();
+        let hulls = shapes
+            .iter()
+            .any(|s| s.manifold == super::Manifold::Vertices && !s.adj.is_empty());
         Ok(Some(Self {
             cull: shapes.iter().map(super::Cull::of).collect(),
             shapes: shapes.into(),
@@ -280,6 +283,8 @@ impl GroundContact {
             stack: Vec::with_capacity(n),
             anchor: vec![[f64::NAN; 4]; nshapes],
             travel: super::Travel::new(&params, vec![false; nshapes]),
+            hulls,
+            parts: Vec::new(),
         }))
     }
 }

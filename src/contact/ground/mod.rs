@@ -6,7 +6,9 @@
 mod build;
 mod patch;
 mod reduce;
+mod team;
 
+use super::pairs::Runner;
 use super::shapes::to_pose;
 use super::travel::{self, Travel};
 use super::{ContactParams, ContactPoint};
@@ -169,6 +171,11 @@ pub struct GroundContact {
     /// detection, and how far down it moved in the last step.
     anchor: Vec<[f64; 4]>,
     travel: Travel,
+    /// Some shape is a hull searched on its vertex graph (its search's
+    /// scratch is one for all shapes: such a detection stays on one thread).
+    hulls: bool,
+    /// The chunks of shapes of a detection on a team ([`team`]).
+    parts: Vec<team::Part>,
 }
 
 impl GroundShape {
@@ -274,12 +281,48 @@ impl GroundContact {
     /// [`max_points`](Self::max_points) capacity.
     /// Shapes of bodies flagged in `asleep` are skipped.
     pub fn detect(&mut self, o_m_i: &[Se3<f64>], out: &mut Vec<ContactPoint>, asleep: &[bool]) {
+        self.detect_on(o_m_i, out, asleep, None, None);
+    }
+
+    /// [`Self::detect`], the shapes searched on `run`'s threads when there
+    /// are enough of them and no hull among them (the same points in the
+    /// same order, bit for bit: [`team`]); `side`, work of the caller's that
+    /// touches nothing of this detection (the pairs' broad phase), run once
+    /// (on a team by the calling thread, first, else after the shapes).
+    pub(crate) fn detect_on(
+        &mut self,
+        o_m_i: &[Se3<f64>],
+        out: &mut Vec<ContactPoint>,
+        asleep: &[bool],
+        run: Option<&dyn Runner>,
+        side: Option<&(dyn Fn() + Sync)>,
+    ) {
         out.clear();
-        let ground = self.ground;
-        let maxp = self.params.max_points_per_shape.max(1);
         let stepped = self.travel.begin();
         // (c = 0: every margin is δ, the shapes' travel is not measured)
         let measure = self.travel.measures();
+        match run.filter(|r| self.team_worth(r.threads())) {
+            Some(r) => self.detect_team(o_m_i, out, asleep, r, (stepped, measure), side),
+            None => {
+                self.detect_serial(o_m_i, out, asleep, (stepped, measure));
+                if let Some(f) = side {
+                    f();
+                }
+            }
+        }
+        self.keep_picks(out);
+    }
+
+    /// The search of every shape on this thread, its points into `out`.
+    fn detect_serial(
+        &mut self,
+        o_m_i: &[Se3<f64>],
+        out: &mut Vec<ContactPoint>,
+        asleep: &[bool],
+        step: (f64, bool),
+    ) {
+        let ground = self.ground;
+        let maxp = self.params.max_points_per_shape.max(1);
         // (the shapes never change: held apart from `self`, which the search mutates)
         let shapes = std::sync::Arc::clone(&self.shapes);
         let cull = std::sync::Arc::clone(&self.cull);
@@ -290,33 +333,12 @@ impl GroundContact {
             if asleep.get(cu.body) == Some(&true) {
                 continue;
             }
-            // broad phase: the bounding sphere clear of the plane (the height of
-            // the geometry origin alone, before the whole pose is composed)
-            let r = &o_m_b.rot;
-            let pt = &cu.origin;
-            let z = r[(2, 0)] * pt[0] + r[(2, 1)] * pt[1] + r[(2, 2)] * pt[2] + o_m_b.trans.z;
-            // the speculative margin: max(δ, c·s), s how far down the shape
-            // moved in the last step (docs/theory.md §"Speculative margin")
-            let row = [r[(2, 0)], r[(2, 1)], r[(2, 2)]];
-            if measure {
-                if stepped > 0.0 {
-                    let down = travel::dropped(&self.anchor[si], z, row, cu.bound);
-                    self.travel.set(si, down * stepped);
-                }
-                self.anchor[si] = [z, row[0], row[1], row[2]];
-            }
-            let margin = self.travel.margin(si);
-            if z - ground - cu.bound > margin {
+            let (ts, delta, c) = self.travel.split();
+            let anchor = &mut self.anchor[si];
+            let Some(margin) = reach(cu, o_m_b, ground, step, anchor, ts.get_mut(si), (delta, c))
+            else {
                 continue;
-            }
-            if let Some((c, e)) = &cu.low_box {
-                let zc = row[0] * c[0] + row[1] * c[1] + row[2] * c[2] + o_m_b.trans.z;
-                let reach = row[0].abs() * e[0] + row[1].abs() * e[1] + row[2].abs() * e[2];
-                // (a nanometre of slack for the rounding of the two ways)
-                if zc - reach - ground > margin + 1e-9 {
-                    continue;
-                }
-            }
+            };
             let o_m_g = o_m_b.compose(&s.placement);
             self.queries += 1;
             // a hull or point set: its lowest vertex is its support point toward
@@ -327,80 +349,26 @@ impl GroundContact {
                 self.hull_patch(si, s, &o_m_g, margin, maxp, out);
                 continue;
             }
-            if s.manifold == Manifold::Vertices {
-                let r = &o_m_g.rot;
-                let (rx, ry, rz) = (r[(2, 0)], r[(2, 1)], r[(2, 2)]);
-                let tz = o_m_g.trans.z - ground;
-                let height = |v: &Vector3<f64>| rx * v.x + ry * v.y + rz * v.z + tz;
-                let base = self.slot_offset[si];
-                let scratch = &mut self.scratch;
-                scratch.clear();
-                let mut candidate = |k: usize| {
-                    let p = o_m_g.act_point(&s.verts[k]);
-                    scratch.push(s.contact_at(si, base + k, p, ground));
-                };
-                // a small vertex set: scanned whole
-                let low = s.verts.iter().map(height).fold(f64::INFINITY, f64::min);
-                if low > margin {
-                    continue;
-                }
-                for (k, v) in s.verts.iter().enumerate() {
-                    if height(v) <= margin {
-                        candidate(k);
-                    }
-                }
-                reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
-                continue;
-            }
-            // a sphere, capsule or cylinder: its manifold points are computed
-            // directly (a sphere's and a capsule's lowest points, a cylinder's
-            // lowest rim points, where its lowest point always lies, and its
-            // rim samples); none within the margin, no contact
-            let base = self.slot_offset[si];
-            let scratch = &mut self.scratch;
-            scratch.clear();
-            let mut push = |slot: usize, p: Vector3<f64>| {
-                let gap = p.z - ground;
-                if gap <= margin {
-                    scratch.push(s.contact_at(si, base + slot, p, ground));
-                }
+            let cx = Plain {
+                ground,
+                maxp,
+                slot_offset: &self.slot_offset,
+                prev_flag: &self.prev_flag,
+                reduce_dirs: &self.reduce_dirs,
             };
-            let down = Vector3::new(0.0, 0.0, -1.0);
-            match s.manifold {
-                Manifold::Vertices => {
-                    for (k, v) in s.verts.iter().enumerate() {
-                        push(k, o_m_g.act_point(v));
-                    }
-                }
-                Manifold::Sphere(r) => push(0, o_m_g.trans + down * r),
-                Manifold::Capsule { half, radius } => {
-                    let a = o_m_g.rot.column(2).into_owned();
-                    push(0, o_m_g.trans - a * half + down * radius);
-                    push(1, o_m_g.trans + a * half + down * radius);
-                }
-                Manifold::Cylinder { half, radius } => {
-                    let a = o_m_g.rot.column(2).into_owned();
-                    // lowest point of each rim: centre + r·(−z projected off the axis)
-                    let d = down - a * a.dot(&down);
-                    let dn = d.norm();
-                    if dn > 1e-9 {
-                        let d = d / dn;
-                        push(0, o_m_g.trans - a * half + d * radius);
-                        push(1, o_m_g.trans + a * half + d * radius);
-                    }
-                    for (k, v) in s.verts.iter().enumerate() {
-                        push(2 + k, o_m_g.act_point(v));
-                    }
-                }
-            }
-            reduce(scratch, maxp, out, &self.prev_flag, &self.reduce_dirs);
+            plain_points(s, si, &o_m_g, margin, &cx, &mut self.scratch, out);
         }
+    }
+
+    /// The slots of this detection's points `out` kept for the next one
+    /// (`prev_flag`, `prev_list`, `prev_range`), the picks forgotten.
+    fn keep_picks(&mut self, out: &[ContactPoint]) {
         for &k in &self.prev_list {
             self.prev_flag[k] = false;
         }
         self.prev_list.clear();
         self.prev_range.fill((0, 0, 0));
-        for p in out.iter() {
+        for p in out {
             if let Some(f) = self.prev_flag.get_mut(p.slot) {
                 *f = true;
                 // a shape's points are contiguous in `out`, its picks first
@@ -419,4 +387,140 @@ impl GroundContact {
         }
         self.picks.fill(usize::MAX);
     }
+}
+
+/// Shape `cu`'s test against the ground, its body at `o_m_b`: its travel
+/// since the last detection measured (`step`: the travel's scale and whether
+/// it is measured; `anchor`, `travel`: the shape's entries, δ and c) and
+/// its margin, `None` when its bounding sphere or box is clear of the
+/// ground by more than the margin.
+#[inline(always)]
+fn reach(
+    cu: &Cull,
+    o_m_b: &Se3<f64>,
+    ground: f64,
+    (stepped, measure): (f64, bool),
+    anchor: &mut [f64; 4],
+    mut travel: Option<&mut f64>,
+    (delta, c): (f64, f64),
+) -> Option<f64> {
+    // broad phase: the bounding sphere clear of the plane (the height of
+    // the geometry origin alone, before the whole pose is composed)
+    let r = &o_m_b.rot;
+    let pt = &cu.origin;
+    let z = r[(2, 0)] * pt[0] + r[(2, 1)] * pt[1] + r[(2, 2)] * pt[2] + o_m_b.trans.z;
+    // the speculative margin: max(δ, c·s), s how far down the shape
+    // moved in the last step (docs/theory.md §"Speculative margin")
+    let row = [r[(2, 0)], r[(2, 1)], r[(2, 2)]];
+    if measure {
+        if stepped > 0.0 {
+            let down = travel::dropped(anchor, z, row, cu.bound);
+            if let Some(x) = travel.as_deref_mut() {
+                *x = down * stepped;
+            }
+        }
+        *anchor = [z, row[0], row[1], row[2]];
+    }
+    let margin = travel::margin(delta, c, travel.map_or(0.0, |x| *x));
+    if z - ground - cu.bound > margin {
+        return None;
+    }
+    if let Some((c, e)) = &cu.low_box {
+        let zc = row[0] * c[0] + row[1] * c[1] + row[2] * c[2] + o_m_b.trans.z;
+        let reach = row[0].abs() * e[0] + row[1].abs() * e[1] + row[2].abs() * e[2];
+        // (a nanometre of slack for the rounding of the two ways)
+        if zc - reach - ground > margin + 1e-9 {
+            return None;
+        }
+    }
+    Some(margin)
+}
+
+/// What a shape's points read of the detection, apart from the shape.
+pub(super) struct Plain<'a> {
+    ground: f64,
+    maxp: usize,
+    slot_offset: &'a [usize],
+    /// The slots the last detection kept (read only during a detection).
+    prev_flag: &'a [bool],
+    reduce_dirs: &'a [(f64, f64); MAX_DIRS],
+}
+
+/// Shape `si` (`s`, not a hull searched on its graph) at the geometry
+/// pose `o_m_g`: its points within `margin` reduced into `out` (`scratch`:
+/// its candidates).
+#[inline(always)]
+fn plain_points(
+    s: &GroundShape,
+    si: usize,
+    o_m_g: &Se3<f64>,
+    margin: f64,
+    cx: &Plain<'_>,
+    scratch: &mut Vec<ContactPoint>,
+    out: &mut Vec<ContactPoint>,
+) {
+    let ground = cx.ground;
+    let base = cx.slot_offset[si];
+    scratch.clear();
+    if s.manifold == Manifold::Vertices {
+        let r = &o_m_g.rot;
+        let (rx, ry, rz) = (r[(2, 0)], r[(2, 1)], r[(2, 2)]);
+        let tz = o_m_g.trans.z - ground;
+        let height = |v: &Vector3<f64>| rx * v.x + ry * v.y + rz * v.z + tz;
+        let mut candidate = |k: usize| {
+            let p = o_m_g.act_point(&s.verts[k]);
+            scratch.push(s.contact_at(si, base + k, p, ground));
+        };
+        // a small vertex set: scanned whole
+        let low = s.verts.iter().map(height).fold(f64::INFINITY, f64::min);
+        if low > margin {
+            return;
+        }
+        for (k, v) in s.verts.iter().enumerate() {
+            if height(v) <= margin {
+                candidate(k);
+            }
+        }
+        reduce(scratch, cx.maxp, out, cx.prev_flag, cx.reduce_dirs);
+        return;
+    }
+    // a sphere, capsule or cylinder: its manifold points are computed
+    // directly (a sphere's and a capsule's lowest points, a cylinder's
+    // lowest rim points, where its lowest point always lies, and its
+    // rim samples); none within the margin, no contact
+    let mut push = |slot: usize, p: Vector3<f64>| {
+        let gap = p.z - ground;
+        if gap <= margin {
+            scratch.push(s.contact_at(si, base + slot, p, ground));
+        }
+    };
+    let down = Vector3::new(0.0, 0.0, -1.0);
+    match s.manifold {
+        Manifold::Vertices => {
+            for (k, v) in s.verts.iter().enumerate() {
+                push(k, o_m_g.act_point(v));
+            }
+        }
+        Manifold::Sphere(r) => push(0, o_m_g.trans + down * r),
+        Manifold::Capsule { half, radius } => {
+            let a = o_m_g.rot.column(2).into_owned();
+            push(0, o_m_g.trans - a * half + down * radius);
+            push(1, o_m_g.trans + a * half + down * radius);
+        }
+        Manifold::Cylinder { half, radius } => {
+            let a = o_m_g.rot.column(2).into_owned();
+            // lowest point of each rim: centre + r·(−z projected off the axis)
+            let d = down - a * a.dot(&down);
+            let dn = d.norm();
+            if dn > 1e-9 {
+                let d = d / dn;
+                push(0, o_m_g.trans - a * half + d * radius);
+                push(1, o_m_g.trans + a * half + d * radius);
+            }
+            for (k, v) in s.verts.iter().enumerate() {
+                push(2 + k, o_m_g.act_point(v));
+            }
+        }
+    }
+    reduce(scratch, cx.maxp, out, cx.prev_flag, cx.reduce_dirs);
 }

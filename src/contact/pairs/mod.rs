@@ -374,6 +374,14 @@ impl PairContact {
         asleep: &[bool],
         run: Option<&dyn Runner>,
     ) {
+        self.broad(o_m_i);
+        self.visit_pairs(out, asleep, run);
+    }
+
+    /// The broad phase of [`Self::detect_on`] at the body poses `o_m_i`: the
+    /// members' boxes, the overlapping pairs and the pairs to visit
+    /// (`visit_pairs`, the narrow phase, follows).
+    pub(crate) fn broad(&mut self, o_m_i: &[Se3<f64>]) {
         let stepped = self.travel.begin();
         // (c = 0: every margin is δ, the members' travel is not measured)
         let measure = self.travel.measures();
@@ -437,7 +445,6 @@ impl PairContact {
             i += usize::from(x <= y);
             j += usize::from(y <= x);
         }
-        self.visit_pairs(out, asleep, run);
     }
 
     /// The first slot of pair contact.

@@ -116,7 +116,7 @@ impl PairContact {
     /// boxes overlap), its points appended to `out`, the pairs that hold
     /// anything after it into `self.live`; on `run`'s threads when there
     /// are enough pairs.
-    pub(super) fn visit_pairs(
+    pub(crate) fn visit_pairs(
         &mut self,
         out: &mut Vec<ContactPoint>,
         asleep: &[bool],
