@@ -286,6 +286,19 @@ pub mod contact {
             .map(|r| (r.n, r.depth, r.rim, r.edge))
     }
 
+    /// `contact::narrow::cylinder::apart::as_gjk`: a cylinder and a box apart
+    /// near an edge or a corner as GJK's answer (shape 1's frame, the
+    /// cylinder shape 1 when `cyl_first`), or None.
+    pub fn cylinder_box_apart(
+        cyl: &parry3d_f64::shape::Cylinder,
+        cub: &parry3d_f64::shape::Cuboid,
+        pos12: &Pose,
+        cyl_first: bool,
+        max_dist: f64,
+    ) -> Option<parry3d_f64::query::gjk::GJKResult> {
+        crate::contact::narrow::cylinder::apart::as_gjk(cyl, cub, pos12, cyl_first, max_dist)
+    }
+
     /// `Round::of`.
     pub fn round_of(s: &PairShape, w: &Se3<f64>) -> Option<Round> {
         Round::of(s, w)

@@ -12,6 +12,7 @@ mod contact_boxes;
 mod contact_broad;
 mod contact_climb_step;
 mod contact_cylinder;
+mod contact_cylinder_apart;
 mod contact_cylinder_pfm;
 mod contact_cylinder_rim;
 mod contact_face;

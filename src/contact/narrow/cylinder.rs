@@ -41,6 +41,7 @@ use super::Raw;
 use crate::spatial::Se3;
 use nalgebra::Vector3;
 
+pub(crate) mod apart;
 mod boxed;
 pub(crate) mod pfm;
 pub(crate) mod rim;

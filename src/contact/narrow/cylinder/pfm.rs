@@ -18,9 +18,9 @@ use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::epa::EPA;
 use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
 use parry3d_f64::query::ContactManifold;
-use parry3d_f64::shape::PolygonalFeatureMap;
+use parry3d_f64::shape::{Cuboid, Cylinder, PolygonalFeatureMap};
 
-use super::rim;
+use super::{apart, rim};
 
 /// parry's `utils::COS_1_DEGREES` (crate-private there): the normal's tilt
 /// under which its generator keeps a manifold's points.
@@ -51,8 +51,9 @@ pub(crate) fn manifold(
     manifold_with(pos12, a, b, prediction, manifolds, true)
 }
 
-/// [`manifold`], a cylinder's rim on a box's edge in closed form
-/// ([`rim::rim_on_edge`], in place of GJK and EPA) when `closed`.
+/// [`manifold`], a cylinder's rim on a box's edge ([`rim::rim_on_edge`], in
+/// place of GJK and EPA) and a cylinder apart from a box's edge or corner
+/// ([`apart`], in place of GJK) in closed form when `closed`.
 pub(crate) fn manifold_with(
     pos12: &Pose,
     a: &PairShape,
@@ -77,13 +78,21 @@ pub(crate) fn manifold_with(
         sb.as_cylinder(),
         sb.as_cuboid(),
     ) {
-        (Some(c1), _, Some(c2), _) => run(pos12, c1, c2, radii, prediction, manifolds, || None),
+        (Some(c1), _, Some(c2), _) => run(pos12, c1, c2, radii, prediction, manifolds, |_| None),
         (Some(c1), _, _, Some(c2)) => {
-            let rim = || closed.then(|| rim::as_epa(c1, c2, pos12, true)).flatten();
+            let rim = |max| {
+                closed
+                    .then(|| closed_form(c1, c2, pos12, true, max))
+                    .flatten()
+            };
             run(pos12, c1, c2, radii, prediction, manifolds, rim)
         }
         (_, Some(c1), Some(c2), _) => {
-            let rim = || closed.then(|| rim::as_epa(c2, c1, pos12, false)).flatten();
+            let rim = |max| {
+                closed
+                    .then(|| closed_form(c2, c1, pos12, false, max))
+                    .flatten()
+            };
             run(pos12, c1, c2, radii, prediction, manifolds, rim)
         }
         _ => return false,
@@ -91,8 +100,24 @@ pub(crate) fn manifold_with(
     true
 }
 
-/// [`manifold`] of shapes `pfm1`, `pfm2` (border radii `radii`), EPA's
-/// answer from `rim` when it gives one.
+/// GJK's (or EPA's) answer for a cylinder and a box in closed form: the
+/// rim on an edge ([`rim::as_epa`]), else the pair apart near an edge or a
+/// corner ([`apart::as_gjk`], within `max_dist`); None: GJK's path.
+fn closed_form(
+    cyl: &Cylinder,
+    cub: &Cuboid,
+    pos12: &Pose,
+    cyl_first: bool,
+    max_dist: f64,
+) -> Option<GJKResult> {
+    if let Some((p1, p2, n)) = rim::as_epa(cyl, cub, pos12, cyl_first) {
+        return Some(GJKResult::ClosestPoints(p1, p2, n));
+    }
+    apart::as_gjk(cyl, cub, pos12, cyl_first, max_dist)
+}
+
+/// [`manifold`] of shapes `pfm1`, `pfm2` (border radii `radii`), GJK's or
+/// EPA's answer from `rim` (given the prediction) when it gives one.
 fn run<S1: PolygonalFeatureMap, S2: PolygonalFeatureMap>(
     pos12: &Pose,
     pfm1: &S1,
@@ -100,7 +125,7 @@ fn run<S1: PolygonalFeatureMap, S2: PolygonalFeatureMap>(
     (border_radius1, border_radius2): (f64, f64),
     prediction: f64,
     manifolds: &mut Vec<ContactManifold<(), ()>>,
-    rim: impl FnOnce() -> Option<(Vector, Vector, Vector)>,
+    rim: impl FnOnce(f64) -> Option<GJKResult>,
 ) {
     if manifolds.is_empty() {
         manifolds.push(ContactManifold::new());
@@ -112,9 +137,10 @@ fn run<S1: PolygonalFeatureMap, S2: PolygonalFeatureMap>(
     }
     let init_dir = manifold.local_n1.try_normalize();
     let total_prediction = prediction + border_radius1 + border_radius2;
-    // a rim on an edge: EPA's answer in closed form (`rim`)
-    let contact = if let Some((p1, p2, n)) = rim() {
-        GJKResult::ClosestPoints(p1, p2, n)
+    // a rim on an edge, or the pair apart: EPA's or GJK's answer in
+    // closed form (`rim`)
+    let contact = if let Some(found) = rim(total_prediction) {
+        found
     } else {
         super::super::climb::with_kept_epa(|epa| {
             with_params(
