@@ -16,6 +16,7 @@
 mod chain6;
 mod elim;
 mod rows;
+mod unroll;
 
 use super::factor_dense::{dense_backward, dense_forward};
 use crate::dynamics::crba_packed;
@@ -24,6 +25,7 @@ use crate::model::{Data, JointKind, Model};
 use crate::spatial::ops::madd;
 use crate::spatial::CompositeInertia;
 use nalgebra::{DMatrix, DVector};
+use unroll::{fold_n, scatter_row};
 
 const NONE: usize = usize::MAX;
 
@@ -570,41 +572,4 @@ impl MassFactor {
         self.x = x;
         r
     }
-}
-
-/// `f(t, j[t])` for t from the last entry of `a` to the first (`a`, `j` of
-/// equal length: a row's multipliers beside their dofs, from the nearest ancestor to the root): each entry's own update, in the same order; a
-/// row of up to 11 unrolled (constant bounds), as [`MassFactor::fold_row`].
-#[inline(always)]
-fn scatter_row(a: &[f64], j: &[usize], mut f: impl FnMut(usize, usize)) {
-    let n = a.len().min(j.len());
-    macro_rules! unrolled {
-        ($($n:literal)*) => {
-            match n {
-                $($n => {
-                    let j = &j[..$n];
-                    for t in (0..$n).rev() {
-                        f(t, j[t]);
-                    }
-                })*
-                _ => {
-                    for t in (0..n).rev() {
-                        f(t, j[t]);
-                    }
-                }
-            }
-        };
-    }
-    unrolled!(0 1 2 3 4 5 6 7 8 9 10 11);
-}
-
-/// [`MassFactor::fold_row`] on `N` entries (`a[..N]`, `j[..N]`), the last first.
-#[inline(always)]
-fn fold_n<const N: usize, T>(a: &[f64], j: &[usize], init: T, f: impl Fn(T, f64, usize) -> T) -> T {
-    let (a, j) = (&a[..N], &j[..N]);
-    let mut acc = init;
-    for t in (0..N).rev() {
-        acc = f(acc, a[t], j[t]);
-    }
-    acc
 }
