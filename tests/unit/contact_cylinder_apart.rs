@@ -8,12 +8,13 @@ use crate::common::lcg::Lcg;
 use parry3d_f64::math::{Pose, Vector as PVec};
 use parry3d_f64::query::gjk::GJKResult;
 use parry3d_f64::query::{self, ContactManifold, ContactManifoldsWorkspace};
-use parry3d_f64::shape::{Cuboid, Cylinder, SharedShape};
+use parry3d_f64::shape::{Cylinder, SharedShape};
 use urdyn::nalgebra::{Rotation3, Vector3};
 use urdyn::spatial::Se3;
 use urdyn::testing::contact::{cylinder_box_apart, pair_shape, to_pose};
 
 use super::contact_cylinder_pfm::{both, unit};
+use super::contact_cylinder_rim::cases;
 
 type Man = ContactManifold<(), ()>;
 
@@ -65,16 +66,6 @@ fn apart_pose(g: &mut Lcg, cyl: &Cylinder, e: PVec, gap: f64) -> (Pose, PVec, PV
     let support = -u * cyl.half_height.copysign(nu) - w * cyl.radius;
     let at = Vector3::new(q.x, q.y, q.z) + nv * gap - support;
     (to_pose(&Se3::new(*rot.matrix(), at)), q, n)
-}
-
-/// The four cylinder–box pairs: a cube and a long slab, each against a
-/// squat and a thin wide cylinder (the rim tests' cases).
-fn cases() -> [(Cylinder, Cuboid); 4] {
-    let cube = Cuboid::new(PVec::new(0.05, 0.05, 0.05));
-    let slab = Cuboid::new(PVec::new(0.3, 0.05, 0.2));
-    let cyl = Cylinder::new(0.05, 0.05);
-    let thin = Cylinder::new(0.2, 0.03);
-    [(cyl, cube), (thin, cube), (cyl, slab), (thin, slab)]
 }
 
 #[test]

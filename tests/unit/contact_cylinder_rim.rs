@@ -203,7 +203,7 @@ fn against_epa(
 
 /// The four cylinder–box pairs the rim and side tests run on: a cube and a
 /// long slab, each against a squat and a thin wide cylinder.
-fn cases() -> [(Cylinder, Cuboid); 4] {
+pub(super) fn cases() -> [(Cylinder, Cuboid); 4] {
     let cube = Cuboid::new(PVec::new(0.05, 0.05, 0.05));
     let slab = Cuboid::new(PVec::new(0.3, 0.05, 0.2));
     let cyl = Cylinder::new(0.05, 0.05);
