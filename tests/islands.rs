@@ -153,6 +153,22 @@ fn threads_one_and_two_give_identical_csvs_on_the_boxes_256_pile() {
     assert_eq!(one, two);
 }
 
+/// The box pile of 1024 on 1 and 2 threads: the same CSV, byte for byte,
+/// with the rows' form on the team (from 0.1 s its contacts' rows are
+/// thousands: ranges of them formed on both threads,
+/// src/sim/solver/form/team.rs) as well as the islands, the narrow phase
+/// and the ground detection.
+#[test]
+fn threads_one_and_two_give_identical_csvs_on_the_boxes_1024_pile() {
+    let scene = dir().join("pile_boxes_1024.json");
+    let one = csv(&scene, 0.15, &["--every", "5", "--threads", "1"]);
+    let two = csv(&scene, 0.15, &["--every", "5", "--threads", "2"]);
+    assert_eq!(one.lines().count(), 31 + 1);
+    let first_diff = one.lines().zip(two.lines()).position(|(a, b)| a != b);
+    assert_eq!(first_diff, None, "rows differ from line {first_diff:?}");
+    assert_eq!(one, two);
+}
+
 /// `Simulation::new_at` (built at the scene's start state: contacts looked
 /// for once, there) steps exactly as `new` then `set_state` (which first looks
 /// for contacts with every model at the origin, all pairs overlapping: the

@@ -36,8 +36,9 @@ impl Constraints {
         let iterations = iterations * if self.counts.spin > 0 { 2 } else { 1 };
         let rows = &mut self.rows;
         // Y rows = R⁻ᵀ jᵣ (H̃ = RᵀR, each over its path): W = J H̃⁻¹ Jᵀ = Y Yᵀ,
-        // the solver works on Δv' = R Δv with uᵣ = cᵣ + yᵣ·Δv'
-        rows.form(f, vfree.as_slice());
+        // the solver works on Δv' = R Δv with uᵣ = cᵣ + yᵣ·Δv' (on the team
+        // by ranges of rows where they are many)
+        rows.form_on(f, vfree.as_slice(), self.team.as_deref());
         let all = [(0, 0, rows.n)];
         let whole = Island {
             runs: &all,

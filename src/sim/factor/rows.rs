@@ -327,6 +327,53 @@ impl MassFactor {
     /// entries are not all there.
     #[inline(always)]
     fn chain_elim<const N: usize>(&self, path: &[usize], w: &mut [[f64; 4]; N]) -> bool {
+        self.chain_elim_n::<N, 4>(path, w)
+    }
+
+    /// [`Self::chain_lanes2`] of two contacts' rows held six lanes a path
+    /// slot, `w[t] = [y₀ₜ, y₁ₜ, y₂ₜ, y₃ₜ, y₄ₜ, y₅ₜ]` (no pad lane: three
+    /// pairs of lanes where SSE has two lanes a register, so that both
+    /// blocks stay nearer the registers): each lane the same operations in
+    /// the same order (the same bits). False where the factor is dense or
+    /// `path` is not the chain.
+    #[inline(always)]
+    pub fn chain_lanes6<const N: usize>(&self, path: &[usize], w: &mut [[f64; 6]; N]) -> bool {
+        self.is_chain_of::<N>(path) && self.chain_elim_n::<N, 6>(path, w)
+    }
+
+    /// [`Self::two_chain_lanes2`] in [`Self::chain_lanes6`]'s six lanes a
+    /// path slot: each chain on its own, each lane the same operations in
+    /// the same order (the same bits). False where the factor is dense or
+    /// `path` is not two chains of `A` and `B` dofs.
+    #[inline(always)]
+    pub fn two_chain_lanes6<const A: usize, const B: usize>(
+        &self,
+        path: &[usize],
+        w: &mut [[f64; 6]],
+    ) -> bool {
+        if !(self.two_chains::<A, B>(path) && w.len() == A + B) {
+            return false;
+        }
+        let (pa, pb) = path.split_at(A);
+        let (wa, wb) = w.split_at_mut(A);
+        match (
+            <&mut [[f64; 6]; A]>::try_from(wa),
+            <&mut [[f64; 6]; B]>::try_from(wb),
+        ) {
+            (Ok(wa), Ok(wb)) => {
+                self.chain_elim_n::<B, 6>(pb, wb) && self.chain_elim_n::<A, 6>(pa, wa)
+            }
+            _ => false,
+        }
+    }
+
+    /// [`Self::chain_elim`] on `L` lanes a path slot.
+    #[inline(always)]
+    fn chain_elim_n<const N: usize, const L: usize>(
+        &self,
+        path: &[usize],
+        w: &mut [[f64; L]; N],
+    ) -> bool {
         let Some(path) = path.get(..N).filter(|_| N <= 16) else {
             return false;
         };

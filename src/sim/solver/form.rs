@@ -1,22 +1,96 @@
 //! The rows' Y = J R⁻ᵀ, the Delassus diagonal and the free velocity's J v*
-//! (the solve's data, formed once a step from the assembled rows).
+//! (the solve's data, formed once a step from the assembled rows; on the
+//! team's threads by ranges of rows above a size: team.rs).
 
+use super::super::parallel::Team;
 use super::{MassFactor, RowKind, Rows};
+
+mod team;
+pub(super) use team::PARTS;
+
+/// What [`Rows::form`] reads of the rows and writes: their fields borrowed
+/// apart, so that a thread of the team forms some rows while another forms
+/// others (team.rs). Each block of rows (a contact's three rows, two
+/// contacts' six, one row) writes only its own rows' entries.
+pub(super) struct Former<'a> {
+    st: usize,
+    /// The rows a block may reach: the rows in use, or the end of a team's
+    /// range (a contact's rows lie below it, [`Former::is_contact`]).
+    end: usize,
+    kind: &'a [RowKind],
+    path: &'a [(usize, usize)],
+    table: &'a [usize],
+    j: &'a [f64],
+    y: &'a mut [f64],
+    ylanes: &'a mut [[f64; 4]],
+    c: &'a mut [f64],
+    w: &'a mut [f64],
+    w_block: &'a mut [[f64; 3]],
+    is_block: &'a mut [bool],
+    winv: &'a mut [f64],
+    /// Scratch: a contact's three rows interleaved (`stride` entries).
+    lanes: &'a mut [[f64; 4]],
+}
 
 impl Rows {
     /// Fills y with the rows of Y = J R⁻ᵀ (H̃ = RᵀR, [`MassFactor`]), each over
     /// its path, the Delassus diagonal Wᵣᵣ = jᵣ·H̃⁻¹jᵣ = ‖yᵣ‖² and c = J v* for
     /// the free velocity `vfree`; counts the step ([`Rows::begin_solve`]).
     pub fn form(&mut self, f: &MassFactor, vfree: &[f64]) {
+        self.form_on(f, vfree, None);
+    }
+
+    /// [`Rows::form`], by ranges of rows on the threads of `team` where the
+    /// rows are many enough to pay a dispatch (team.rs): the same values,
+    /// bit for bit, each block formed by the same code whichever thread.
+    pub(crate) fn form_on(&mut self, f: &MassFactor, vfree: &[f64], team: Option<&Team>) {
         let (nv, n, st) = (self.nv, self.n, self.stride);
         if vfree.len() < nv || self.j.len() < n * st || self.y.len() < n * st {
             return;
         }
-        // (the table is put back below: taking it moves no entry)
-        let table_v = std::mem::take(&mut self.table);
-        let table = &table_v[..];
-        let mut r = 0;
-        while r < n {
+        let shared = team.filter(|t| t.threads() > 1 && n * st >= team::MIN_WORK);
+        if !shared.is_some_and(|t| team::form(self, f, vfree, t)) {
+            let mut fm = self.former();
+            fm.walk(f, vfree, 0, n);
+            fm.invert(0, n);
+        }
+        self.begin_solve();
+    }
+
+    /// The rows' fields [`Rows::form`] reads and writes, borrowed apart (the
+    /// first `stride` entries of the scratch `lanes`).
+    fn former(&mut self) -> Former<'_> {
+        let st = self.stride;
+        Former {
+            st,
+            end: self.n,
+            kind: &self.kind,
+            path: &self.path,
+            table: &self.table,
+            j: &self.j,
+            y: &mut self.y,
+            ylanes: &mut self.ylanes,
+            c: &mut self.c,
+            w: &mut self.w,
+            w_block: &mut self.w_block,
+            is_block: &mut self.is_block,
+            winv: &mut self.winv,
+            lanes: &mut self.lanes[..st],
+        }
+    }
+}
+
+impl Former<'_> {
+    /// Forms the blocks of rows from `start` (a block's first row) up to
+    /// `end` (where a block begins, or the rows' end): each contact's three
+    /// rows together, two contacts on one path of free bodies' chains
+    /// together ([`Former::form_pair`]), any other row alone.
+    fn walk(&mut self, f: &MassFactor, vfree: &[f64], start: usize, end: usize) {
+        let st = self.st;
+        self.end = end;
+        let table = self.table;
+        let mut r = start;
+        while r < end {
             let (ps, pl) = self.path[r];
             let Some(path) = table.get(ps..ps + pl).filter(|p| p.len() <= st) else {
                 if let Some(b) = self.is_block.get_mut(r) {
@@ -91,19 +165,24 @@ impl Rows {
             }
             r += k;
         }
-        for (w, wi) in self.w[..n].iter().zip(self.winv.iter_mut()) {
-            *wi = if *w > 1e-14 { 1.0 / w } else { 0.0 };
-        }
-        self.table = table_v;
-        self.begin_solve();
     }
 
-    /// A contact's three rows `r..r + 3` on `path` formed as [`Rows::form`]
-    /// does, interleaved in [`Rows::lanes`] so that the three rows' operations
+    /// Wᵣᵣ⁻¹ of rows `a..b` (0 where Wᵣᵣ ≤ 1e-14).
+    fn invert(&mut self, a: usize, b: usize) {
+        let (Some(w), Some(wi)) = (self.w.get(a..b), self.winv.get_mut(a..b)) else {
+            return;
+        };
+        for (w, wi) in w.iter().zip(wi.iter_mut()) {
+            *wi = if *w > 1e-14 { 1.0 / w } else { 0.0 };
+        }
+    }
+
+    /// A contact's three rows `r..r + 3` on `path` formed as [`Former::walk`]
+    /// does, interleaved in the scratch `lanes` so that the three rows' operations
     /// run side by side (each row's entries get the same operations in the
     /// same order: the same bits). False (nothing done) on a dense factor.
     fn form_lanes(&mut self, f: &MassFactor, r: usize, path: &[usize], vfree: &[f64]) -> bool {
-        let (st, pl) = (self.stride, path.len());
+        let (st, pl) = (self.st, path.len());
         if !f.is_tree() || pl > self.lanes.len() || self.j.len() < (r + 3) * st {
             return false;
         }
@@ -140,7 +219,7 @@ impl Rows {
     }
 
     /// Row r (not a contact's) on a chain path of 2–12 dofs formed as
-    /// [`Rows::form`] does, in registers ([`Rows::form_row_chain`]). False
+    /// [`Former::walk`] does, in registers ([`Former::form_row_chain`]). False
     /// (nothing done) on any other path or a dense factor.
     fn form_row(&mut self, f: &MassFactor, r: usize, path: &[usize], vfree: &[f64]) -> bool {
         if !f.is_tree() {
@@ -162,7 +241,7 @@ impl Rows {
         }
     }
 
-    /// [`Rows::form_row`] on a chain of `N` dofs ([`MassFactor::chain_row`]):
+    /// [`Former::form_row`] on a chain of `N` dofs ([`MassFactor::chain_row`]):
     /// c = J v* (a sum from 0 in path order), y ← R⁻ᵀ j and Wᵣᵣ = ‖y‖² (a sum
     /// from −0, as `Iterator::sum`), the same operations in the same order as
     /// the general way: the same bits. False, nothing written, where the path
@@ -175,7 +254,7 @@ impl Rows {
         path: &[usize],
         vfree: &[f64],
     ) -> bool {
-        let st = self.stride;
+        let st = self.st;
         let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..r * st + N)) else {
             return false;
         };
@@ -197,7 +276,7 @@ impl Rows {
         true
     }
 
-    /// [`Rows::form_lanes`] on a path of `N = A + B` dofs that is a chain
+    /// [`Former::form_lanes`] on a path of `N = A + B` dofs that is a chain
     /// (`B = 0`: [`MassFactor::chain_lanes`]) or two trees' chains
     /// ([`MassFactor::two_chain_lanes`]): the three rows gathered straight
     /// into registers, transformed there, and Y, its lanes, W and c written
@@ -212,7 +291,7 @@ impl Rows {
         path: &[usize],
         vfree: &[f64],
     ) -> bool {
-        let st = self.stride;
+        let st = self.st;
         let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..(r + 3) * st)) else {
             return false;
         };
@@ -240,7 +319,7 @@ impl Rows {
     /// Contacts r and r + 3 on the same path of two free bodies' chains
     /// (`B` = 6: 6 + 6 dofs) or of one free body's chain (`B` = 0: 6 dofs,
     /// two contacts of a body on the ground), `N` dofs, formed as
-    /// [`Rows::form_chain`] forms each ([`MassFactor::two_chain_lanes2`],
+    /// [`Former::form_chain`] forms each ([`MassFactor::two_chain_lanes2`],
     /// [`MassFactor::chain_lanes2`]: one walk of L for both): the same
     /// operations in the same order, the same bits. False, nothing written,
     /// where `path` (contact r + 3's too: the caller's test) is not such chains.
@@ -253,7 +332,7 @@ impl Rows {
         path: &[usize],
         vfree: &[f64],
     ) -> bool {
-        let st = self.stride;
+        let st = self.st;
         let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..(r + 6) * st)) else {
             return false;
         };
@@ -265,6 +344,21 @@ impl Rows {
         };
         if N > st || !shape || path.iter().any(|&d| d >= vfree.len()) {
             return false;
+        }
+        if SIX {
+            // the six rows in six lanes a path slot (no pad lane)
+            let mut u = [[0.0f64; 6]; N];
+            let Some(c) = gather_six(j, st, path, vfree, &mut u) else {
+                return false;
+            };
+            let done = match B {
+                0 => f.chain_lanes6::<N>(path, &mut u),
+                _ => f.two_chain_lanes6::<6, B>(path, &mut u),
+            };
+            if done {
+                self.store_six(r, &u, c);
+            }
+            return done;
         }
         let (mut w, mut v) = ([[0.0f64; 4]; N], [[0.0f64; 4]; N]);
         let c = gather_rows(
@@ -292,12 +386,52 @@ impl Rows {
         true
     }
 
+    /// Contacts r's and r + 3's formed blocks from their transformed rows `b`
+    /// (one [y₀ₜ … y₅ₜ] a path slot, [`Former::form_pair`]) and c = J v*, as
+    /// [`Former::store_block`] stores each (the pad lane of `ylanes` 0).
+    #[inline(always)]
+    fn store_six(&mut self, r: usize, b: &[[f64; 6]], c: [f64; 6]) {
+        let st = self.st;
+        // each sum in path order from −0, as store_block's
+        let (mut d, mut o) = ([-0.0f64; 6], [-0.0f64; 6]);
+        for bt in b {
+            let q = [
+                bt[0] * bt[1],
+                bt[0] * bt[2],
+                bt[1] * bt[2],
+                bt[3] * bt[4],
+                bt[3] * bt[5],
+                bt[4] * bt[5],
+            ];
+            for i in 0..6 {
+                d[i] += bt[i] * bt[i];
+                o[i] += q[i];
+            }
+        }
+        for (k, q) in [(0, r), (3, r + 3)] {
+            let y = &mut self.y[q * st..(q + 3) * st];
+            let (y0, rest) = y.split_at_mut(st);
+            let (y1, y2) = rest.split_at_mut(st);
+            for (((bt, a), b1), b2) in b.iter().zip(y0).zip(y1).zip(y2) {
+                (*a, *b1, *b2) = (bt[k], bt[k + 1], bt[k + 2]);
+            }
+            if let Some(yl) = self.ylanes.get_mut(q * st..q * st + b.len()) {
+                for (l, bt) in yl.iter_mut().zip(b) {
+                    *l = [bt[k], bt[k + 1], bt[k + 2], 0.0];
+                }
+            }
+            self.c[q..q + 3].copy_from_slice(&c[k..k + 3]);
+            self.w[q..q + 3].copy_from_slice(&d[k..k + 3]);
+            self.w_block[q] = [o[k], o[k + 1], o[k + 2]];
+        }
+    }
+
     /// Contact r's formed block from its transformed rows `b` (one
     /// [y₀ₜ, y₁ₜ, y₂ₜ, 0] a path slot) and c = J v*: Y's three rows, their
     /// lanes, c, W's diagonal and the block's off-diagonal entries.
     #[inline(always)]
     fn store_block(&mut self, r: usize, b: &[[f64; 4]], c: [f64; 4]) {
-        let st = self.stride;
+        let st = self.st;
         // W's diagonal and the block's off-diagonal entries, each a sum in
         // path order from −0 (as `Iterator::sum` of f64)
         let (mut d, mut o) = ([-0.0f64; 4], [-0.0f64; 4]);
@@ -326,6 +460,20 @@ impl Rows {
         self.w_block[r] = [o[0], o[1], o[2]];
     }
 
+    /// Whether row r is a contact normal followed by its two tangent rows on
+    /// the same path (as `sim::constraints` pushes them), below `end`.
+    #[inline(always)]
+    fn is_contact(&self, r: usize) -> bool {
+        r + 2 < self.end
+            && self.kind[r] == RowKind::Normal
+            && matches!(self.kind[r + 1], RowKind::Tangent { normal, .. } if normal == r)
+            && self.kind[r + 2] == RowKind::Tangent2
+            && self.path[r + 1] == self.path[r]
+            && self.path[r + 2] == self.path[r]
+    }
+}
+
+impl Rows {
     /// [`Rows::clear`] that leaves the Jacobian entries of rows `..keep` (the
     /// last assembly's contact triples, rows 3c..3c + 3) unzeroed: the caller
     /// zeroes each triple just before it writes it ([`Rows::zero_contact`])
@@ -367,6 +515,37 @@ impl Rows {
             && self.path[r + 1] == self.path[r]
             && self.path[r + 2] == self.path[r]
     }
+}
+
+/// Whether [`Former::form_pair`] holds its two contacts' six rows in six
+/// lanes a path slot (SSE: three registers a slot, not four with a pad lane
+/// each; with AVX the two blocks' [f64; 4] are two registers a slot either way).
+const SIX: bool = cfg!(not(target_feature = "avx"));
+
+/// c = J v* over two contacts' six rows (`j`, `stride` apart) on `path`
+/// (each row's sum from 0 in path order, as [`gather_rows`]'), the rows
+/// gathered into `out`, one [j₀ₜ … j₅ₜ] a path slot; `None` where `j` is
+/// short.
+#[inline(always)]
+fn gather_six<const N: usize>(
+    j: &[f64],
+    st: usize,
+    path: &[usize],
+    vfree: &[f64],
+    out: &mut [[f64; 6]; N],
+) -> Option<[f64; 6]> {
+    let row = |i: usize| -> Option<&[f64; N]> { j.get(i * st..i * st + N)?.try_into().ok() };
+    let rows = [row(0)?, row(1)?, row(2)?, row(3)?, row(4)?, row(5)?];
+    let mut c = [0.0f64; 6];
+    for (t, (o, &d)) in out.iter_mut().zip(path).enumerate() {
+        let x = vfree[d];
+        for i in 0..6 {
+            let b = rows[i][t];
+            o[i] = b;
+            c[i] += b * x;
+        }
+    }
+    Some(c)
 }
 
 /// c = J v* over a contact's three rows `j` on `path` (each row's sum from 0

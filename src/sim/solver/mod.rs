@@ -105,7 +105,8 @@ pub struct Rows {
     pub w_block: Vec<[f64; 3]>,
     is_block: Vec<bool>,
     /// Scratch of [`Rows::form`]: a contact's three rows interleaved (one
-    /// entry per path slot, `stride` of them).
+    /// entry per path slot, `stride` of them), one such for each thread of
+    /// a form on the team (form/team.rs).
     lanes: Vec<[f64; 4]>,
     /// At a contact's normal row r: its three rows of Y interleaved (entry t
     /// of the path at `ylanes[r·stride + t]`, lanes normal, t₁, t₂, unused),
@@ -180,7 +181,7 @@ impl Rows {
             path: vec![(0, 0); cap],
             w_block: vec![[0.0; 3]; cap],
             is_block: vec![false; cap],
-            lanes: vec![[0.0; 4]; stride],
+            lanes: vec![[0.0; 4]; stride * form::PARTS],
             ylanes: vec![[0.0; 4]; cap * stride],
             u_prev: vec![0.0; cap],
             pos_rows: Vec::with_capacity(cap),
