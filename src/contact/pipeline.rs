@@ -123,13 +123,11 @@ impl Collision {
             (Some(g), Some(p)) if run.is_some_and(|r| r.threads() > 1) => {
                 // the pairs' broad phase as one item of the ground's job (the
                 // two touch nothing of each other's): on a team, the two at once
-                let pairs = std::sync::Mutex::new(&mut *p);
-                let broad = || match pairs.lock() {
-                    Ok(mut p) => p.broad(o_m_i),
-                    Err(e) => e.into_inner().broad(o_m_i),
-                };
+                // (its member loop by ranges on every thread, its sweep on
+                // this one: src/contact/pairs/members.rs)
+                let broad = p.broad_team(o_m_i);
                 g.detect_on(o_m_i, out, asleep, run, Some(&broad));
-                drop(pairs);
+                drop(broad);
                 p.visit_pairs(out, asleep, run);
             }
             (g, p) => {

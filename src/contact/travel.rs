@@ -74,30 +74,12 @@ impl Travel {
         self.factor != 0.0 || !(self.delta >= 0.0)
     }
 
-    /// Shape `k` travelled `s` in the last step.
-    #[inline]
-    pub fn set(&mut self, k: usize, s: f64) {
-        if let Some(x) = self.s.get_mut(k) {
-            *x = s;
-        }
-    }
-
     /// Every shape's travel (to be written apart: a detection on several
     /// threads, each its own shapes'), with δ and c: shape k's margin is
-    /// [`margin`]`(δ, c, s[k])`, as [`Self::margin`]'s.
+    /// [`margin`]`(δ, c, s[k])`.
     #[inline]
     pub fn split(&mut self) -> (&mut [f64], f64, f64) {
         (&mut self.s, self.delta, self.factor)
-    }
-
-    /// Shape `k`'s margin, max(δ, c·s).
-    #[inline]
-    pub fn margin(&self, k: usize) -> f64 {
-        margin(
-            self.delta,
-            self.factor,
-            self.s.get(k).copied().unwrap_or(0.0),
-        )
     }
 
     /// The margin of the pair of shapes `a` and `b`: max(δ, c·(s_a + s_b)).

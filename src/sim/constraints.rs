@@ -18,9 +18,11 @@
 
 mod free;
 mod joints;
+mod point;
 mod solve;
 mod spin;
 mod tables;
+mod team;
 
 use super::factor::MassFactor;
 use super::islands::Islands;
@@ -36,7 +38,7 @@ pub(crate) use free::free_rows;
 use nalgebra::{DVector, Vector3};
 use std::sync::Arc;
 pub(crate) use tables::add_body_rows;
-use tables::{act_column, add_body, BodyColumns, BodyHead, JointRowSource};
+use tables::{BodyColumns, BodyHead, JointRowSource};
 
 /// The least row-sweeps a parallel solve must take off this thread's share
 /// (else the islands are solved here). A worker sleeps between jobs, so a
@@ -125,6 +127,10 @@ pub(crate) struct Constraints {
     first_joint_row: usize,
     /// The contact point (index into the step's points) of each contact triple.
     row_point: Vec<usize>,
+    /// The contacts whose rows the team writes ([`team`]), this step's.
+    fixed: Vec<team::Fixed>,
+    /// The bodies whose world columns the team computes ([`team`]).
+    bodies: Vec<usize>,
     /// Warm-start impulses per contact slot (n, t1, t2, and the position
     /// pass's μ of the normal: solver/position.rs) and per joint (friction,
     /// lower, upper, and the position pass's μ of the lower and upper limit).
@@ -238,6 +244,8 @@ impl Constraints {
             jrows: JointRowSource::of(model),
             first_joint_row: 0,
             row_point: Vec::with_capacity(max_points),
+            fixed: Vec::new(),
+            bodies: Vec::new(),
             warm_contact: vec![[0.0; 4]; nslots],
             warm_slots: Vec::with_capacity(max_points),
             warm_joint: vec![[0.0; 5]; ndof],
@@ -391,138 +399,21 @@ impl Constraints {
         // limits) after the contacts have moved (talos_reduced, whose every
         // joint has friction, converged in fewer sweeps this way)
         if !points.is_empty() {
-            // world-frame motion subspace columns of the bodies the points'
-            // rows reach (each point's two bodies and their ancestors), once
             self.sw_stamp = self.sw_stamp.wrapping_add(1).max(1);
-            // (the columns in the body frame are the joint's constants, kept
-            // from the start: `cols`)
-            for pt in points {
-                for start in [pt.body, pt.other] {
-                    let mut i = start;
-                    while i != 0
-                        && let Some(done) = self.sw_done.get_mut(i)
-                        && *done != self.sw_stamp
-                        && let (Some(cols), Some(o), Some(sw)) =
-                            (self.cols.get(i), o_m_i.get(i), self.sw.get_mut(i))
-                    {
-                        *done = self.sw_stamp;
-                        for (s, c) in sw.iter_mut().zip(&cols.s).take(cols.nv) {
-                            *s = act_column(o, c);
-                        }
-                        i = model.parent[i];
-                    }
-                }
-            }
-            self.warm_points.clear();
-            let wc = &self.warm_contact;
-            self.warm_points
-                .extend(points.iter().map(|pt| match pt.fresh {
-                    true => [0.0; 3],
-                    false => wc.get(pt.slot).map_or([0.0; 3], |w| [w[0], w[1], w[2]]),
-                }));
-            let heads = &self.heads;
-            let body_path = |b: usize| {
-                let (iv, nv) = heads.get(b).map_or((0, 0), |c| (c.iv, c.nv));
-                f.path_of((iv + nv).saturating_sub(1))
+            // on a team, the same rows by ranges of bodies and of contacts
+            // ([`team`]); rows of a pile's stride only (their zeroing reads
+            // no path)
+            let team = match points.len() >= team::MIN_POINTS && rows.stride <= Rows::GAP {
+                true => self.team.clone(),
+                false => None,
             };
-            for (pi, (pt, &warm)) in points.iter().zip(&self.warm_points).enumerate() {
-                // the body's path to the root: its joint's last dof and every
-                // ancestor; against another body, the union with that body's
-                let path = if pt.other == 0 {
-                    body_path(pt.body)
-                } else {
-                    rows.union_path(body_path(pt.body), body_path(pt.other))
-                };
-                // root free bodies' rows are written whole ([`free`]): of the
-                // last assembly's entries there, only those past the path are
-                // zeroed (its length `stale`); any other's are zeroed first
-                let (ps, pl) = path;
-                let plan = rows
-                    .table()
-                    .get(ps..ps + pl)
-                    .and_then(|on| free::plan(&self.heads, on, rows.stride, pt));
-                let stale = match rows.path.get(rows.n) {
-                    Some(&(_, l)) if rows.n + 3 <= keep => l,
-                    _ => 0,
-                };
-                if plan.is_none() && rows.n + 3 <= keep {
-                    rows.zero_contact(rows.n);
-                }
-                let Some(rn) = rows.push_contact(pt.friction, warm, path) else {
-                    break;
-                };
-                self.row_point.push(pi);
-                counts.contacts += 1;
-                // J's entries are added straight onto the rows' paths (zeroed
-                // by `clear`): entry t of a row is dof path[t] (a path is
-                // ascending: `add_body` finds a dof by bisection)
-                let st = rows.stride;
-                let (tab, jall) = rows.table_and_j();
-                let on_path = tab.get(ps..ps + pl).unwrap_or(&[]);
-                let (j0, rest) = jall[rn * st..(rn + 3) * st].split_at_mut(st);
-                let (j1, j2) = rest.split_at_mut(st);
-                let at = &pt.point;
-                if let Some(plan) = plan
-                    && free::write(plan, [&mut *j0, &mut *j1, &mut *j2], stale, &self.sw, pt)
-                {
-                    // (written whole)
-                } else if pt.other == 0 && pt.normal == Vector3::z() {
-                    // the ground: rows n = z, t₁ = x, t₂ = y: the point velocity
-                    // v_c + ω_c × p of each ancestor's world-frame subspace column c
-                    let (mut b, mut hi) = (pt.body, on_path.len());
-                    while b != 0
-                        && let (Some(bc), Some(sw)) = (self.heads.get(b), self.sw.get(b))
-                    {
-                        let j = [&mut *j0, &mut *j1, &mut *j2];
-                        hi = add_body(j, on_path, hi, bc, sw, at, |vp| [vp.z, vp.x, vp.y]);
-                        b = model.parent[b];
-                    }
-                } else {
-                    // two bodies: J = J_a − J_b, the relative velocity of the
-                    // point on a and on b along (n, t₁, t₂), n from b toward a
-                    // (a common ancestor's columns cancel: x + (−x) = +0, the
-                    // entry as zeroed, so each walk stops at the first of them);
-                    // b's entries are −(n·vp), the values of n·(−vp) but for
-                    // the sign of a zero, which the sum onto +0 drops
-                    let (n, (t1, t2)) = (pt.normal, tangents(&pt.normal));
-                    let lca = common_ancestor(&model.parent, pt.body, pt.other);
-                    for (start, neg) in [(pt.body, false), (pt.other, true)] {
-                        let (mut b, mut hi) = (start, on_path.len());
-                        while b != lca
-                            && b != 0
-                            && let (Some(bc), Some(sw)) = (self.heads.get(b), self.sw.get(b))
-                        {
-                            let j = [&mut *j0, &mut *j1, &mut *j2];
-                            hi = add_body(j, on_path, hi, bc, sw, at, |vp| {
-                                let r = [n.dot(&vp), t1.dot(&vp), t2.dot(&vp)];
-                                if neg {
-                                    r.map(|x| -x)
-                                } else {
-                                    r
-                                }
-                            });
-                            b = model.parent[b];
-                        }
-                    }
-                }
-                // normal target: speculative; restitution only above the speed below
-                // which a bounce of one step under gravity could gain energy:
-                // |u| > 4 g h e / (1 − e²)
-                let mut bn = speculative(pt.gap, h);
-                let e = p.restitution;
-                if e > 0.0 && e < 1.0 {
-                    let un = rows.jdot(rn, v.as_slice());
-                    let vmin = (4.0 * p.gravity * h * e / (1.0 - e * e).max(1e-12)).max(1e-3);
-                    if un < -vmin && pt.gap < -un * h {
-                        bn = bn.max(-e * un);
-                    }
-                }
-                rows.b[rn] = bn;
-                rows.bpos[rn] = pos_target(pt.gap, p.contact_slop, p.contact_push_cap, p.beta, h);
-                if rows.bpos[rn] > 0.0 {
-                    counts.violated += 1;
-                }
+            if let Some(team) = team {
+                let x = (model, o_m_i, v.as_slice(), p, h);
+                self.contacts_on_team(&team, x, points, f, keep, &mut counts);
+            } else {
+                self.contacts(model, o_m_i, v, points, p, f, h, keep, &mut counts);
             }
+            let rows = &mut self.rows;
             rows.zero_stale(keep);
             // torsional and rolling friction where a pair has few points
             let (sw, rp) = (&self.sw[..], &self.row_point[..]);

@@ -7,6 +7,7 @@ mod build;
 mod patch;
 mod reduce;
 mod team;
+pub(crate) use team::Side;
 
 use super::pairs::Runner;
 use super::shapes::to_pose;
@@ -295,7 +296,7 @@ impl GroundContact {
         out: &mut Vec<ContactPoint>,
         asleep: &[bool],
         run: Option<&dyn Runner>,
-        side: Option<&(dyn Fn() + Sync)>,
+        side: Option<&dyn Side>,
     ) {
         out.clear();
         let stepped = self.travel.begin();
@@ -306,7 +307,7 @@ impl GroundContact {
             None => {
                 self.detect_serial(o_m_i, out, asleep, (stepped, measure));
                 if let Some(f) = side {
-                    f();
+                    team::side_alone(f);
                 }
             }
         }

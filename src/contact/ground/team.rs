@@ -9,12 +9,34 @@
 //! with every shape: a detection with one stays on one thread. The calling
 //! thread first runs its side work (the pairs' broad phase, which touches
 //! nothing of the ground's) while the worker takes chunks: the two stages at
-//! once.
+//! once; the broad phase's member loop ([`Side`]'s items) first, on every
+//! thread, its sweep on the calling thread after.
 
 use super::{plain_points, reach, GroundContact, Plain, Runner};
 use crate::contact::ContactPoint;
 use crate::spatial::Se3;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+/// Work beside the ground's shapes in one job (the pairs' broad phase,
+/// src/contact/pairs/members.rs): `items` any thread may run, each once,
+/// then `rest` on the calling thread once every item is done.
+pub(crate) trait Side: Sync {
+    /// The items.
+    fn items(&self) -> usize;
+    /// Item `k` (< `items()`).
+    fn item(&self, k: usize);
+    /// What follows the items.
+    fn rest(&self);
+}
+
+/// Every item of `side`, then its rest, on this thread.
+pub(super) fn side_alone(side: &dyn Side) {
+    for k in 0..side.items() {
+        side.item(k);
+    }
+    side.rest();
+}
 
 /// The fewest shapes of a detection that goes to the team: under that, the
 /// search (tens of ns a culled shape, a µs or so a touching one) costs
@@ -72,7 +94,7 @@ impl GroundContact {
         asleep: &[bool],
         run: &dyn Runner,
         step: (f64, bool),
-        side: Option<&(dyn Fn() + Sync)>,
+        side: Option<&dyn Side>,
     ) {
         let n = self.shapes.len();
         let chunks = n.div_ceil(CHUNK);
@@ -99,13 +121,43 @@ impl GroundContact {
         };
         let ground = self.ground;
         let (next, done) = (AtomicUsize::new(0), AtomicUsize::new(0));
+        let (s_next, s_done, s_failed) = (
+            AtomicUsize::new(0),
+            AtomicUsize::new(0),
+            AtomicBool::new(false),
+        );
         run.run(&|part| {
             let sh = sh;
-            // `side` on the calling thread (part 0, which every job runs),
-            // first: the worker starts on the chunks, and never holds the
-            // caller up at the close with the larger item
-            if let (0, Some(f)) = (part, side) {
-                f();
+            // `side` first: its items on every thread that comes, then its
+            // rest on the calling thread (part 0, which every job runs) once
+            // they are done, while the others start on the chunks
+            if let Some(f) = side {
+                let items = f.items();
+                loop {
+                    let k = s_next.fetch_add(1, Ordering::Relaxed);
+                    if k >= items {
+                        break;
+                    }
+                    // (a panic is counted done, then resumed after the job)
+                    if catch_unwind(AssertUnwindSafe(|| f.item(k))).is_err() {
+                        s_failed.store(true, Ordering::Relaxed);
+                    }
+                    s_done.fetch_add(1, Ordering::Release);
+                }
+                if part == 0 {
+                    let mut spins = 0u32;
+                    while s_done.load(Ordering::Acquire) < items {
+                        spins = spins.wrapping_add(1);
+                        if spins % 64 == 0 {
+                            std::thread::yield_now();
+                        } else {
+                            std::hint::spin_loop();
+                        }
+                    }
+                    if !s_failed.load(Ordering::Relaxed) {
+                        f.rest();
+                    }
+                }
             }
             loop {
                 let k = next.fetch_add(1, Ordering::Relaxed);
@@ -155,8 +207,8 @@ impl GroundContact {
         });
         // (a chunk left undone: its thread panicked, as `run` lets it)
         assert!(
-            done.load(Ordering::Acquire) >= chunks,
-            "a thread of the ground detection panicked"
+            done.load(Ordering::Acquire) >= chunks && !s_failed.into_inner(),
+            "a thread of the ground detection or the broad phase panicked"
         );
         for p in &self.parts[..chunks] {
             out.extend_from_slice(&p.points);

@@ -17,7 +17,7 @@ use super::broad::{PairMasks, PairTable, SweepAndPrune, LAZY_PAIR};
 use super::filter::{is_self_pair, may_touch};
 use super::narrow::prim::Round;
 use super::shapes::{pair_shape, PairShape};
-use super::travel::{moved_from, Travel};
+use super::travel::Travel;
 use super::{ContactError, ContactParams, ContactPoint};
 use crate::model::Model;
 use crate::spatial::Se3;
@@ -27,6 +27,7 @@ use std::path::PathBuf;
 
 pub(crate) mod apart;
 mod make;
+mod members;
 mod order;
 mod start;
 pub(crate) mod visit;
@@ -382,27 +383,53 @@ impl PairContact {
     /// members' boxes, the overlapping pairs and the pairs to visit
     /// (`visit_pairs`, the narrow phase, follows).
     pub(crate) fn broad(&mut self, o_m_i: &[Se3<f64>]) {
+        let step = self.broad_begin();
+        self.broad_members(o_m_i, step);
+        self.broad_rest();
+    }
+
+    /// What precedes the broad phase's member loop: the travel's scale (0:
+    /// none) and whether it is measured.
+    pub(crate) fn broad_begin(&mut self) -> (f64, bool) {
         let stepped = self.travel.begin();
         // (c = 0: every margin is δ, the members' travel is not measured)
         let measure = self.travel.measures();
         self.keep_in_order();
+        (stepped, measure)
+    }
+
+    /// The broad phase's member loop on this thread ([`members::place`]).
+    pub(crate) fn broad_members(&mut self, o_m_i: &[Se3<f64>], step: (f64, bool)) {
+        let (ts, delta, factor) = self.travel.split();
         for &k in &self.moving {
-            let m = &self.members[k];
-            let w = world(m, o_m_i);
-            let c = w.act_point(&m.shape.mid);
-            // the speculative margin: max(δ, c·s), s how far the member
-            // moved in the last step (docs/theory.md §"Speculative margin")
-            if stepped > 0.0 && measure {
-                let s = moved_from(&self.centres[k], &c, &self.poses[k], &w, self.radii[k]);
-                self.travel.set(k, s * stepped);
-            }
-            set_box(&mut self.sap, k, m, &w, &c, self.travel.margin(k));
-            if m.shape.round.is_some() {
-                self.rounds[k] = Round::of(&m.shape, &w);
-            }
-            self.poses[k] = w;
-            self.centres[k] = c;
+            let (Some(m), Some(&radius)) = (self.members.get(k), self.radii.get(k)) else {
+                continue;
+            };
+            let (Some(travel), Some(lo), Some(hi), Some(round), Some(pose), Some(centre)) = (
+                ts.get_mut(k),
+                self.sap.lo.get_mut(k),
+                self.sap.hi.get_mut(k),
+                self.rounds.get_mut(k),
+                self.poses.get_mut(k),
+                self.centres.get_mut(k),
+            ) else {
+                continue;
+            };
+            let out = members::Placed {
+                travel,
+                lo,
+                hi,
+                round,
+                pose,
+                centre,
+            };
+            members::place(m, o_m_i, step, (delta, factor), radius, out);
         }
+    }
+
+    /// The broad phase after the member loop: the overlapping pairs and
+    /// the pairs to visit.
+    pub(crate) fn broad_rest(&mut self) {
         self.overlapping.clear();
         self.list_pairs();
         if let Some(masks) = self.listed.as_mut() {
@@ -470,9 +497,21 @@ fn set_box(
     c: &Vector3<f64>,
     margin: f64,
 ) {
+    let (lo, hi) = box_of(m, w, c, margin);
+    sap.lo[k] = lo;
+    sap.hi[k] = hi;
+}
+
+/// [`set_box`]'s box: its lower and upper corners.
+#[inline(always)]
+fn box_of(m: &Member, w: &Se3<f64>, c: &Vector3<f64>, margin: f64) -> ([f64; 3], [f64; 3]) {
     let h = &m.shape.half;
     let r = &w.rot;
     let e =
         |i: usize| r[(i, 0)].abs() * h.x + r[(i, 1)].abs() * h.y + r[(i, 2)].abs() * h.z + margin;
-    sap.set(k, [c.x, c.y, c.z], [e(0), e(1), e(2)]);
+    let (c, h) = ([c.x, c.y, c.z], [e(0), e(1), e(2)]);
+    (
+        [c[0] - h[0], c[1] - h[1], c[2] - h[2]],
+        [c[0] + h[0], c[1] + h[1], c[2] + h[2]],
+    )
 }

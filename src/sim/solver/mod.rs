@@ -219,6 +219,30 @@ impl Rows {
     pub(crate) fn table_and_j(&mut self) -> (&[usize], &mut [f64]) {
         (&self.table, &mut self.j)
     }
+    /// The path table and the per-row vectors a contact's rows are made of,
+    /// borrowed apart (the team's contact rows, sim/constraints/team.rs:
+    /// each contact writes its own rows, as [`Rows::push_contact`] would).
+    pub(crate) fn contact_parts(&mut self) -> ContactParts<'_> {
+        ContactParts {
+            table: &self.table,
+            j: &mut self.j,
+            b: &mut self.b,
+            bpos: &mut self.bpos,
+            lambda: &mut self.lambda,
+            kind: &mut self.kind,
+            path: &mut self.path,
+        }
+    }
+    /// A contact's three rows' place ([`Rows::push_contact`]'s, not
+    /// written: see [`Rows::contact_parts`]), or `None` when fewer than
+    /// three rows are left.
+    pub(crate) fn reserve_contact(&mut self) -> Option<usize> {
+        if self.n + 3 > self.cap {
+            return None;
+        }
+        self.n += 3;
+        Some(self.n - 3)
+    }
     /// Takes the path table out (no entry moved), for a solver that mutates
     /// the rows while reading it; [`Rows::put_table`] puts it back.
     pub(crate) fn take_table(&mut self) -> Vec<usize> {
@@ -307,6 +331,10 @@ impl Rows {
         self.n -= k;
         self.zero_rows(self.n, self.n + k);
     }
+    /// A gap of more than this many entries past a row's path is skipped
+    /// by [`Rows::zero_rows`]; rows of a stride at most this are zeroed whole
+    /// (without reading their paths).
+    pub(crate) const GAP: usize = 16;
     /// Zeroes the Jacobian entries of rows `from..to`.
     fn zero_rows(&mut self, from: usize, to: usize) {
         let st = self.stride;
@@ -317,9 +345,8 @@ impl Rows {
         // `GAP` of them (a robot's short rows on a long stride) is skipped.
         // A run is cut at `CHUNK` entries (+ a stride): glibc's memset takes
         // `rep stos` above 2 KiB, one instruction a byte to callgrind.
-        const GAP: usize = 16;
         const CHUNK: usize = 192;
-        if st <= GAP {
+        if st <= Self::GAP {
             // (no row leaves a gap of more than `GAP`: rows from..to are one
             // run, filled without reading their paths — a pile's contact, one
             // call a contact)
@@ -334,7 +361,7 @@ impl Rows {
         let mut run = from * st;
         for r in from..to.min(self.cap) {
             let pl = self.path[r].1.min(st);
-            let gap = pl + GAP < st;
+            let gap = pl + Self::GAP < st;
             let end = r * st + if gap { pl } else { st };
             if gap || end - run >= CHUNK {
                 self.j[run..end].fill(0.0);
@@ -554,6 +581,17 @@ impl Rows {
         let jr = &self.j[r * self.stride..r * self.stride + path.len().min(self.stride)];
         path.iter().copied().zip(jr.iter().copied())
     }
+}
+
+/// [`Rows::contact_parts`]: the path table and the per-row vectors.
+pub(crate) struct ContactParts<'a> {
+    pub table: &'a [usize],
+    pub j: &'a mut [f64],
+    pub b: &'a mut [f64],
+    pub bpos: &'a mut [f64],
+    pub lambda: &'a mut [f64],
+    pub kind: &'a mut [RowKind],
+    pub path: &'a mut [(usize, usize)],
 }
 
 /// `Σ aₖ bₖ` over the shorter of the two slices.
