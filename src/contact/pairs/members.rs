@@ -18,6 +18,11 @@ use std::sync::Mutex;
 /// Moving members a thread takes at once.
 const CHUNK: usize = 128;
 
+/// The fewest moving members whose loop is shared: below it the loop (a
+/// few hundred instructions a member) is too short to be worth the wait
+/// for a worker's chunk before the sweep, and runs here with the sweep.
+const MIN_MEMBERS: usize = 512;
+
 /// One member's entries.
 pub(super) struct Placed<'a> {
     pub travel: &'a mut f64,
@@ -98,7 +103,7 @@ impl PairContact {
         let step = self.broad_begin();
         let n = self.members.len();
         let ok = self.moving.windows(2).all(|w| w[0] < w[1]);
-        let chunks = match ok {
+        let chunks = match ok && self.moving.len() >= MIN_MEMBERS {
             true => self.moving.len().div_ceil(CHUNK),
             false => 0,
         };
@@ -176,7 +181,7 @@ impl Side for BroadTeam<'_> {
             Err(e) => e.into_inner(),
         };
         if self.chunks == 0 {
-            // (no chunks: the member loop here)
+            // (no chunks, a small scene's: the member loop here)
             p.broad_members(self.o_m_i, self.step);
         }
         p.broad_rest();
