@@ -158,7 +158,13 @@ impl Sleep {
         // (a pair's points come one after another: a repeat of the last pair
         // finds what that pair found, its island undozed already)
         let mut last = (usize::MAX, usize::MAX);
+        // (a point with neither body masked, `body_asleep`, has no dozing
+        // side: most of them, looked at by that mask alone)
         for p in points {
+            let masked = |b: usize| self.body_asleep.get(b) == Some(&true);
+            if !(masked(p.body) || masked(p.other)) {
+                continue;
+            }
             if (p.body, p.other) == last {
                 continue;
             }

@@ -78,8 +78,9 @@ pub(crate) struct Islands {
     islands: Vec<((usize, usize), (usize, usize))>,
     /// The islands' dofs, island after island (ascending within one).
     dofs: Vec<usize>,
-    /// Scratch: a dof already listed.
+    /// Scratch: a dof already listed; a join's dofs in merging (split.rs).
     mark: Vec<bool>,
+    dof_tmp: Vec<usize>,
     /// Each dof's parent on its path to the root ([`Model::dof_parent`],
     /// `usize::MAX` at a root).
     dof_parent: Vec<usize>,
@@ -168,6 +169,7 @@ impl Islands {
             islands: Vec::with_capacity(rows.min(nt + 1)),
             dofs: Vec::with_capacity(model.nv),
             mark: vec![false; model.nv],
+            dof_tmp: Vec::with_capacity(2 * model.nv),
             dof_parent: model.dof_parent.clone(),
             chain_len: chain_lengths(&model.dof_parent, model.nv),
             last: Vec::with_capacity(rows),
@@ -279,13 +281,11 @@ impl Islands {
                 self.gtree.push(k);
             }
         }
-        self.build(rows, false);
+        self.build(rows);
     }
 
-    /// The islands' runs and dofs from the groups' trees and the union-find;
-    /// with `pushed_only`, the dofs of the islands whose root is `touched`
-    /// only (split.rs: the position pass's; the others' are left empty).
-    fn build(&mut self, rows: &Rows, pushed_only: bool) {
+    /// The islands' runs and dofs from the groups' trees and the union-find.
+    fn build(&mut self, rows: &Rows) {
         self.gkey.clear();
         for g in 0..self.gtree.len() {
             let a = self.gtree[g];
@@ -367,16 +367,10 @@ impl Islands {
         while i < self.runs.len() {
             let k = self.runs[i].0;
             let (r0, d0) = (i, self.dofs.len());
-            // (an island not pushed, with `pushed_only`: its runs, no dofs)
-            let listed = !pushed_only || self.touched.get(k) != Some(&false);
             // the dofs marked (listed, and their range)
             let (mut lo, mut hi) = (usize::MAX, 0);
             while i < self.runs.len() && self.runs[i].0 == k {
                 let (_, s, e) = self.runs[i];
-                if !listed {
-                    i += 1;
-                    continue;
-                }
                 // the run's groups (a run starts a group), one path each
                 let mut g = self.group_at[s];
                 while let Some(&(q, _)) = self.groups.get(g)

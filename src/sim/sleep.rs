@@ -265,7 +265,13 @@ impl Sleep {
             return false;
         }
         let mut woke = false;
+        // (a point with neither body asleep or dozing, `body_asleep`, wakes
+        // nothing: most of them, looked at by that mask alone)
         for p in points {
+            let masked = |b: usize| self.body_asleep.get(b) == Some(&true);
+            if !(masked(p.body) || masked(p.other)) {
+                continue;
+            }
             let (ta, tb) = (self.tree(p.body), self.tree(p.other));
             for (s, o) in [(ta, tb), (tb, ta)] {
                 if s != WORLD && self.asleep[s] && (o == WORLD || !self.asleep[o]) {

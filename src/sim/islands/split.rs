@@ -133,6 +133,18 @@ impl Islands {
                 self.gtree[g] = a;
             }
         }
+        self.merge(rows);
+        true
+    }
+
+    /// The new islands of a join from its `pieces` (tree, 0, an island of
+    /// its root before the join) and (tree, 1, a joined contact's first
+    /// row): per root (after the join's unions) one new island, its runs
+    /// those of its pieces' islands and the contacts' rows in row order
+    /// (adjacent runs one), its dofs theirs and the contacts' paths',
+    /// ascending, once each; the merged islands emptied. The new ones are
+    /// the islands to solve ([`Islands::todo`]), their roots `touched`.
+    fn merge(&mut self, rows: &Rows) {
         for i in 0..self.pieces.len() {
             let t = self.pieces[i].0;
             self.pieces[i].0 = self.find(t);
@@ -166,8 +178,11 @@ impl Islands {
                 }
             }
             // row order, adjacent runs one
+            // (each piece's runs in order already: their stretches merged,
+            // not sorted anew — a sort of the pile's big islands cost more
+            // than the rebuild this replaces, round 29)
             let runs = &mut self.runs[r0..];
-            runs.sort_unstable_by_key(|run| run.1);
+            merge_stretches(runs, &mut self.sorted, |run| run.1);
             let mut w = 0;
             for j in 0..runs.len() {
                 if w > 0 && runs[w - 1].2 == runs[j].1 {
@@ -180,7 +195,7 @@ impl Islands {
             self.runs.truncate(r0 + w);
             // ascending, once each
             let dofs = &mut self.dofs[d0..];
-            dofs.sort_unstable();
+            merge_stretches(dofs, &mut self.dof_tmp, |&d| d);
             let mut w = 0;
             for j in 0..dofs.len() {
                 if w == 0 || dofs[w - 1] != dofs[j] {
@@ -197,13 +212,15 @@ impl Islands {
             self.touched[root] = true;
             self.todo.push(ni);
         }
-        true
     }
 
     /// The position pass's islands: every left-out contact on an island
     /// with a violated row (b_pos ≠ 0, the islands the pass pushes) joins
-    /// it, and so on from the islands so grown, then the islands are built
-    /// again (the dofs of the pushed ones only). The pushed islands are then those of every contact (the sleep
+    /// it, and so on from the islands so grown; the islands so joined are
+    /// merged as [`Islands::join_failed`] merges (the same rows in row order
+    /// and the same dofs as a new grouping gives, the others untouched: a
+    /// rebuild of every island cost twice this on the mixed piles). The
+    /// pushed islands are then those of every contact (the sleep
     /// islands' rows, in row order); the rest are not pushed (w' = 0 on
     /// them), so every contact still left out holds (yₙ·w' = 0 ≥ b_pos = 0)
     /// and none is checked. (Left out, a point the pass pushes in would be
@@ -225,6 +242,7 @@ impl Islands {
             }
         }
         let mut any = false;
+        self.pieces.clear();
         loop {
             let (mut more, mut keep) = (false, 0);
             for i in 0..self.left.len() {
@@ -235,6 +253,16 @@ impl Islands {
                     keep += 1;
                     continue;
                 }
+                // the pieces of the new islands (`merge`): the islands of its
+                // trees' roots (each a root before the join: a union's root
+                // is one of its two) and its rows
+                for t in [ra, rb] {
+                    let k = self.iof[t];
+                    if k != usize::MAX {
+                        self.pieces.push((t, 0, k));
+                    }
+                }
+                self.pieces.push((a, 1, r));
                 if ra != rb {
                     self.parent[ra.max(rb)] = ra.min(rb);
                     self.touched[ra.min(rb)] = true;
@@ -252,8 +280,7 @@ impl Islands {
             }
         }
         if any {
-            // (the dofs of the pushed islands only: the pass reads no other)
-            self.build(rows, true);
+            self.merge(rows);
         }
         self.touched.fill(false);
     }
@@ -262,5 +289,54 @@ impl Islands {
     /// (split.rs; bit for bit each island's own: [`Rows::warm_velocity`]).
     pub fn warm(&self) -> Option<&[f64]> {
         self.warm_made.then_some(&self.warm[..])
+    }
+}
+
+/// Sorts `v` by `key` as a merge of its ascending stretches (a join's
+/// pieces, each in order already): neighbouring stretches merged pairwise
+/// into `tmp` until one is left, O(n log m) for m stretches; nothing is
+/// allocated while `tmp` holds `v.len()` (the islands' scratch is sized
+/// for every row and dof). Equal keys keep their order.
+fn merge_stretches<T: Copy>(v: &mut [T], tmp: &mut Vec<T>, key: impl Fn(&T) -> usize) {
+    let n = v.len();
+    if n < 2 {
+        return;
+    }
+    loop {
+        tmp.clear();
+        let mut i = 0;
+        while i < n {
+            let a = i;
+            i += 1;
+            while i < n && key(&v[i - 1]) <= key(&v[i]) {
+                i += 1;
+            }
+            let m = i;
+            if m == n {
+                if a == 0 {
+                    // one stretch: in order
+                    return;
+                }
+                tmp.extend_from_slice(&v[a..]);
+                break;
+            }
+            i += 1;
+            while i < n && key(&v[i - 1]) <= key(&v[i]) {
+                i += 1;
+            }
+            let (mut x, mut y) = (a, m);
+            while x < m && y < i {
+                if key(&v[y]) < key(&v[x]) {
+                    tmp.push(v[y]);
+                    y += 1;
+                } else {
+                    tmp.push(v[x]);
+                    x += 1;
+                }
+            }
+            tmp.extend_from_slice(&v[x..m]);
+            tmp.extend_from_slice(&v[y..i]);
+        }
+        v.copy_from_slice(tmp);
     }
 }
