@@ -133,7 +133,7 @@ impl Islands {
                 self.gtree[g] = a;
             }
         }
-        self.merge(rows);
+        self.merge(rows, true);
         true
     }
 
@@ -144,7 +144,8 @@ impl Islands {
     /// (adjacent runs one), its dofs theirs and the contacts' paths',
     /// ascending, once each; the merged islands emptied. The new ones are
     /// the islands to solve ([`Islands::todo`]), their roots `touched`.
-    fn merge(&mut self, rows: &Rows) {
+    /// Without `sort_dofs`, the dofs are listed once each in no order.
+    fn merge(&mut self, rows: &Rows, sort_dofs: bool) {
         for i in 0..self.pieces.len() {
             let t = self.pieces[i].0;
             self.pieces[i].0 = self.find(t);
@@ -167,14 +168,27 @@ impl Islands {
                         let (_, s, e) = self.runs[j];
                         self.runs.push((root, s, e));
                     }
-                    self.dofs.extend_from_within(e0..e1);
+                    for j in e0..e1 {
+                        let d = self.dofs[j];
+                        if let Some(m) = self.mark.get_mut(d) {
+                            *m = true;
+                        }
+                        self.dofs.push(d);
+                    }
                     self.islands[k] = ((s0, s0), (e0, e0));
                     self.iroot[k] = LEFT;
                 } else {
                     self.runs.push((root, k, k + 3));
                     let (ps, pl) = path.get(k).copied().unwrap_or((0, 0));
-                    self.dofs
-                        .extend_from_slice(table.get(ps..ps + pl).unwrap_or(&[]));
+                    // (a path's dofs are mostly its trees' islands' already)
+                    for &d in table.get(ps..ps + pl).unwrap_or(&[]) {
+                        if let Some(m) = self.mark.get_mut(d)
+                            && !*m
+                        {
+                            *m = true;
+                            self.dofs.push(d);
+                        }
+                    }
                 }
             }
             // row order, adjacent runs one
@@ -193,17 +207,16 @@ impl Islands {
                 }
             }
             self.runs.truncate(r0 + w);
-            // ascending, once each
+            // once each (the marks cleared), ascending with `sort_dofs`
             let dofs = &mut self.dofs[d0..];
-            merge_stretches(dofs, &mut self.dof_tmp, |&d| d);
-            let mut w = 0;
-            for j in 0..dofs.len() {
-                if w == 0 || dofs[w - 1] != dofs[j] {
-                    dofs[w] = dofs[j];
-                    w += 1;
+            for &d in dofs.iter() {
+                if let Some(m) = self.mark.get_mut(d) {
+                    *m = false;
                 }
             }
-            self.dofs.truncate(d0 + w);
+            if sort_dofs {
+                merge_stretches(dofs, &mut self.dof_tmp, |&d| d);
+            }
             let ni = self.islands.len();
             self.islands
                 .push(((r0, self.runs.len()), (d0, self.dofs.len())));
@@ -280,7 +293,9 @@ impl Islands {
             }
         }
         if any {
-            self.merge(rows);
+            // (the pass reads a pushed island's dofs only to zero its w'
+            // there: listed once each, not sorted)
+            self.merge(rows, false);
         }
         self.touched.fill(false);
     }
