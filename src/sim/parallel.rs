@@ -174,15 +174,7 @@ impl Team {
             Ok(mut g) => *g = None,
             Err(p) => *p.into_inner() = None,
         }
-        let mut spins = 0u32;
-        while inner.active.load(Ordering::Acquire) != 0 {
-            spins = spins.wrapping_add(1);
-            if spins % 64 == 0 {
-                std::thread::yield_now();
-            } else {
-                std::hint::spin_loop();
-            }
-        }
+        crate::contact::pairs::spin_until(|| inner.active.load(Ordering::Acquire) == 0);
         // a wait longer than half this thread's own part and than a wake-up:
         // a worker's item took far longer than its share (descheduled), not
         // a job's tail; the cool-down doubles while hold-ups follow each other

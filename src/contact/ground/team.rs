@@ -13,6 +13,7 @@
 //! thread, its sweep on the calling thread after.
 
 use super::{plain_points, reach, GroundContact, Plain, Runner};
+use crate::contact::pairs::spin_until;
 use crate::contact::ContactPoint;
 use crate::spatial::Se3;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -145,15 +146,7 @@ impl GroundContact {
                     s_done.fetch_add(1, Ordering::Release);
                 }
                 if part == 0 {
-                    let mut spins = 0u32;
-                    while s_done.load(Ordering::Acquire) < items {
-                        spins = spins.wrapping_add(1);
-                        if spins % 64 == 0 {
-                            std::thread::yield_now();
-                        } else {
-                            std::hint::spin_loop();
-                        }
-                    }
+                    spin_until(|| s_done.load(Ordering::Acquire) >= items);
                     if !s_failed.load(Ordering::Relaxed) {
                         f.rest();
                     }

@@ -32,7 +32,7 @@ mod order;
 mod start;
 pub(crate) mod visit;
 use apart::Apart;
-pub(crate) use visit::Runner;
+pub(crate) use visit::{spin_until, Runner};
 
 /// One shape of pair contact.
 #[derive(Clone, Debug)]

@@ -31,6 +31,22 @@ pub(crate) trait Runner: Sync {
     fn run(&self, f: &(dyn Fn(usize) + Sync));
 }
 
+/// Waits on this thread until `done()` holds: a spin, giving the core
+/// away every 64 tries (the team's waits for its parts: a job's close,
+/// a barrier between a job's stages).
+#[inline]
+pub(crate) fn spin_until(done: impl Fn() -> bool) {
+    let mut spins = 0u32;
+    while !done() {
+        spins = spins.wrapping_add(1);
+        if spins % 64 == 0 {
+            std::thread::yield_now();
+        } else {
+            std::hint::spin_loop();
+        }
+    }
+}
+
 /// Pairs a chunk: a thread takes a chunk at a time (one atomic add), and
 /// the stepping thread waits for at most one chunk of the worker's.
 const CHUNK: usize = 32;

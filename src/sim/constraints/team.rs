@@ -187,15 +187,7 @@ impl Constraints {
                 b_done.fetch_add(1, Ordering::Release);
             }
             // every body's columns before any contact's rows
-            let mut spins = 0u32;
-            while b_done.load(Ordering::Acquire) < nb {
-                spins = spins.wrapping_add(1);
-                if spins % 64 == 0 {
-                    std::thread::yield_now();
-                } else {
-                    std::hint::spin_loop();
-                }
-            }
+            crate::contact::pairs::spin_until(|| b_done.load(Ordering::Acquire) >= nb);
             if failed.load(Ordering::Relaxed) {
                 return;
             }

@@ -464,12 +464,7 @@ impl Former<'_> {
     /// the same path (as `sim::constraints` pushes them), below `end`.
     #[inline(always)]
     fn is_contact(&self, r: usize) -> bool {
-        r + 2 < self.end
-            && self.kind[r] == RowKind::Normal
-            && matches!(self.kind[r + 1], RowKind::Tangent { normal, .. } if normal == r)
-            && self.kind[r + 2] == RowKind::Tangent2
-            && self.path[r + 1] == self.path[r]
-            && self.path[r + 2] == self.path[r]
+        contact_at(self.kind, self.path, self.end, r)
     }
 }
 
@@ -508,13 +503,20 @@ impl Rows {
     /// the same path (as `sim::constraints` pushes them).
     #[inline(always)]
     pub(super) fn is_contact(&self, r: usize) -> bool {
-        r + 2 < self.n
-            && self.kind[r] == RowKind::Normal
-            && matches!(self.kind[r + 1], RowKind::Tangent { normal, .. } if normal == r)
-            && self.kind[r + 2] == RowKind::Tangent2
-            && self.path[r + 1] == self.path[r]
-            && self.path[r + 2] == self.path[r]
+        contact_at(&self.kind, &self.path, self.n, r)
     }
+}
+
+/// Whether row r of rows `..end` (kinds `kind`, paths `path`) is a contact
+/// normal followed by its two tangent rows on the same path.
+#[inline(always)]
+fn contact_at(kind: &[RowKind], path: &[(usize, usize)], end: usize, r: usize) -> bool {
+    r + 2 < end
+        && kind[r] == RowKind::Normal
+        && matches!(kind[r + 1], RowKind::Tangent { normal, .. } if normal == r)
+        && kind[r + 2] == RowKind::Tangent2
+        && path[r + 1] == path[r]
+        && path[r + 2] == path[r]
 }
 
 /// Whether [`Former::form_pair`] holds its two contacts' six rows in six
