@@ -140,7 +140,8 @@ pub(super) fn warm3(a: [f64; 3], l: &[[f64; 4]], p: &[usize], x: &mut [f64]) {
 /// The contact's update x[pₜ] += (a₀ y₀ₜ + a₁ y₁ₜ) + a₂ y₂ₜ over a contact's path
 /// `p` (its three rows of y, `ys`, each at least `p.len()` long), each entry
 /// the same operations in the same order as the scalar loop, four path slots
-/// at a time (gathered and scattered: a path's dofs are distinct);
+/// at a time with AVX, then two at a time on x86_64 (gathered and scattered:
+/// a path's dofs are distinct);
 /// the indices of `p` must be < `x.len()` (a row's path: dof indices < nv).
 #[inline(always)]
 pub(super) fn axpy3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
@@ -186,6 +187,34 @@ pub(super) fn axpy3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
                 _mm_storel_pd(xp.add(k[2]), vhi);
                 _mm_storeh_pd(xp.add(k[3]), vhi);
                 t += 4;
+            }
+        }
+    }
+    // two path slots at a time (SSE2, part of x86_64): the whole path on SSE
+    // builds (x86-64, x86-64-v2), the slots past the last four with AVX (a
+    // ground contact's 6), each lane the scalar loop's operations in its order
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 is part of x86_64; t + 1 < n ≤ every slice's length;
+        // every k < x.len() (the sweeps' check of the paths), and the two k
+        // of a pair are distinct (a path lists a dof once)
+        unsafe {
+            let (a0, a1, a2) = (_mm_set1_pd(a[0]), _mm_set1_pd(a[1]), _mm_set1_pd(a[2]));
+            let xp = x.as_mut_ptr();
+            while t + 2 <= n {
+                let s = _mm_add_pd(
+                    _mm_add_pd(
+                        _mm_mul_pd(a0, _mm_loadu_pd(y0.as_ptr().add(t))),
+                        _mm_mul_pd(a1, _mm_loadu_pd(y1.as_ptr().add(t))),
+                    ),
+                    _mm_mul_pd(a2, _mm_loadu_pd(y2.as_ptr().add(t))),
+                );
+                let (k0, k1) = (*p.get_unchecked(t), *p.get_unchecked(t + 1));
+                let v = _mm_add_pd(_mm_loadh_pd(_mm_load_sd(xp.add(k0)), xp.add(k1)), s);
+                _mm_storel_pd(xp.add(k0), v);
+                _mm_storeh_pd(xp.add(k1), v);
+                t += 2;
             }
         }
     }
