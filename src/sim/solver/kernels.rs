@@ -93,7 +93,7 @@ pub(super) unsafe fn warm_rows(
     paths: &[(usize, usize)],
     table: &[usize],
     y: &[f64],
-    ylanes: &[[f64; 4]],
+    _ylanes: &[[f64; 4]],
     st: usize,
     (s, e): (usize, usize),
     x: &mut [f64],
@@ -107,8 +107,17 @@ pub(super) unsafe fn warm_rows(
         let p = unsafe { table.get_unchecked(ps..ps + pl) };
         if contact[r] && r + 2 < e && l != 0.0 && lambda[r + 1] != 0.0 && lambda[r + 2] != 0.0 {
             // each entry ((x + λₙyₙ) + λ₁y₁) + λ₂y₂, the row-by-row order
-            let lanes = unsafe { ylanes.get_unchecked(r * st..r * st + pl) };
-            warm3([l, lambda[r + 1], lambda[r + 2]], lanes, p, x);
+            // (read from the three rows of y, contiguous: `ylanes` holds the
+            // same numbers interleaved)
+            // SAFETY: rows r..r + 3 < e ≤ n, each st ≥ pl entries of y (the
+            // caller's checks)
+            let yr = |q: usize| unsafe { y.get_unchecked(q * st..q * st + pl) };
+            warm3(
+                [l, lambda[r + 1], lambda[r + 2]],
+                [yr(r), yr(r + 1), yr(r + 2)],
+                p,
+                x,
+            );
             r += 3;
             continue;
         }
@@ -121,19 +130,83 @@ pub(super) unsafe fn warm_rows(
     }
 }
 
-/// The warm start of a contact's three rows: x[pₜ] = ((x[pₜ] + a₀ lₜ₀) + a₁ lₜ₁) +
-/// a₂ lₜ₂ over its path `p` (`l`: its rows of y interleaved, `Rows::ylanes`),
-/// each entry the same sum as three row-by-row updates (a path's dofs are
-/// distinct); the indices of `p` must be < `x.len()`.
+/// The warm start of a contact's three rows: x[pₜ] = ((x[pₜ] + a₀ y₀ₜ) + a₁ y₁ₜ)
+/// + a₂ y₂ₜ over its path `p` (`ys`: its three rows of y, each at least
+/// `p.len()` long), each entry the same sum as three row-by-row updates,
+/// four path slots at a time with AVX, then two at a time on x86_64
+/// (gathered and scattered: a path's dofs are distinct); the indices of `p`
+/// must be < `x.len()`.
 #[inline(always)]
-pub(super) fn warm3(a: [f64; 3], l: &[[f64; 4]], p: &[usize], x: &mut [f64]) {
+pub(super) fn warm3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
     debug_assert!(p.iter().all(|&k| k < x.len()));
-    for (lt, &k) in l.iter().zip(p) {
-        // SAFETY: every k < x.len() (the sweeps' check of the paths)
+    debug_assert!(p.iter().enumerate().all(|(i, k)| !p[..i].contains(k)));
+    let n = p.len().min(ys[0].len()).min(ys[1].len()).min(ys[2].len());
+    let [y0, y1, y2] = ys;
+    #[allow(unused_mut)]
+    let mut t = 0;
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    {
+        use std::arch::x86_64::*;
+        // SAFETY: avx is enabled at compile time; t + 3 < n ≤ every slice's
+        // length; every k < x.len() (the sweeps' check of the paths), and the
+        // four k of a group are distinct (a path lists a dof once)
         unsafe {
-            let xk = x.get_unchecked_mut(k);
-            *xk = ((*xk + a[0] * lt[0]) + a[1] * lt[1]) + a[2] * lt[2];
+            let (a0, a1, a2) = (
+                _mm256_set1_pd(a[0]),
+                _mm256_set1_pd(a[1]),
+                _mm256_set1_pd(a[2]),
+            );
+            let xp = x.as_mut_ptr();
+            while t + 4 <= n {
+                let k = [
+                    *p.get_unchecked(t),
+                    *p.get_unchecked(t + 1),
+                    *p.get_unchecked(t + 2),
+                    *p.get_unchecked(t + 3),
+                ];
+                let lo = _mm_loadh_pd(_mm_load_sd(xp.add(k[0])), xp.add(k[1]));
+                let hi = _mm_loadh_pd(_mm_load_sd(xp.add(k[2])), xp.add(k[3]));
+                let mut v = _mm256_set_m128d(hi, lo);
+                v = _mm256_add_pd(v, _mm256_mul_pd(a0, _mm256_loadu_pd(y0.as_ptr().add(t))));
+                v = _mm256_add_pd(v, _mm256_mul_pd(a1, _mm256_loadu_pd(y1.as_ptr().add(t))));
+                v = _mm256_add_pd(v, _mm256_mul_pd(a2, _mm256_loadu_pd(y2.as_ptr().add(t))));
+                let (vlo, vhi) = (_mm256_castpd256_pd128(v), _mm256_extractf128_pd::<1>(v));
+                _mm_storel_pd(xp.add(k[0]), vlo);
+                _mm_storeh_pd(xp.add(k[1]), vlo);
+                _mm_storel_pd(xp.add(k[2]), vhi);
+                _mm_storeh_pd(xp.add(k[3]), vhi);
+                t += 4;
+            }
         }
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 is part of x86_64; t + 1 < n ≤ every slice's length;
+        // every k < x.len(), the two k of a pair distinct (as above)
+        unsafe {
+            let (a0, a1, a2) = (_mm_set1_pd(a[0]), _mm_set1_pd(a[1]), _mm_set1_pd(a[2]));
+            let xp = x.as_mut_ptr();
+            while t + 2 <= n {
+                let (k0, k1) = (*p.get_unchecked(t), *p.get_unchecked(t + 1));
+                let mut v = _mm_loadh_pd(_mm_load_sd(xp.add(k0)), xp.add(k1));
+                v = _mm_add_pd(v, _mm_mul_pd(a0, _mm_loadu_pd(y0.as_ptr().add(t))));
+                v = _mm_add_pd(v, _mm_mul_pd(a1, _mm_loadu_pd(y1.as_ptr().add(t))));
+                v = _mm_add_pd(v, _mm_mul_pd(a2, _mm_loadu_pd(y2.as_ptr().add(t))));
+                _mm_storel_pd(xp.add(k0), v);
+                _mm_storeh_pd(xp.add(k1), v);
+                t += 2;
+            }
+        }
+    }
+    while t < n {
+        // SAFETY: t < n ≤ every slice's length; p[t] < x.len() (as above)
+        unsafe {
+            let xk = x.get_unchecked_mut(*p.get_unchecked(t));
+            *xk = ((*xk + a[0] * y0.get_unchecked(t)) + a[1] * y1.get_unchecked(t))
+                + a[2] * y2.get_unchecked(t);
+        }
+        t += 1;
     }
 }
 
