@@ -67,8 +67,9 @@ pub(crate) struct Doze {
     /// hull (hector's quadrotor) finds one ground point too high at its first
     /// full step after a doze and falls 56 µm into the ground.
     lone: Vec<bool>,
-    /// Per island root: it may doze (scratch).
-    may: Vec<bool>,
+    /// Per island root: it may doze (scratch of `after_step`, read by
+    /// `begin_doze`).
+    pub(super) may: Vec<bool>,
     /// Tree-steps taken dozing.
     pub tree_steps: u64,
     /// Per tree: it fell asleep dozing at this step (scratch of `after_step`).
@@ -278,14 +279,28 @@ impl Sleep {
         }
     }
 
+    /// Whether tree `t` (awake, `forced` now) lets its island doze: it may
+    /// sleep, is one lone free body, and has been still for [`T_DOZE`] below
+    /// [`DOZE_SPEED`]; it did not just stop dozing and does not doze now.
+    /// (`after_step`'s verdict pass collects it on the island's root.)
+    pub(super) fn may_doze(&self, t: usize, forced: bool) -> bool {
+        let d = &self.doze;
+        !(self.never[t]
+            || !d.lone[t]
+            || forced
+            || self.still[t] < T_DOZE
+            || !(self.speed[t] < DOZE_SPEED * self.v_tol)
+            || d.fresh[t]
+            || d.left[t] > 0)
+    }
+
     /// At the end of `after_step`: the islands that could sleep but for time
-    /// (each tree may sleep and has been still for [`T_DOZE`]) begin to doze
-    /// for the next `N_DOZE` − 1 steps; their points and forces are kept aside.
-    #[allow(clippy::too_many_arguments)]
+    /// (each tree may sleep and has been still for [`T_DOZE`]: [`Sleep::may_doze`],
+    /// collected on each island's root by `after_step` in `doze.may`) begin to
+    /// doze for the next `N_DOZE` − 1 steps; their points and forces are kept aside.
     pub(super) fn begin_doze(
         &mut self,
         model: &Model,
-        forced: &[bool],
         q: &DVector<f64>,
         v: &DVector<f64>,
         points: &mut Vec<ContactPoint>,
@@ -298,33 +313,17 @@ impl Sleep {
             return;
         }
         let awake_trees = std::mem::take(&mut self.awake_trees);
-        let mut may = std::mem::take(&mut self.doze.may);
-        for &t in &awake_trees {
-            may[t] = true;
-        }
-        // (the roots `after_step` found: no union since, and the trees still
-        // awake were all awake there)
+        // (a dozing tree is awake: `any` is whether one of the awake trees
+        // dozes after this step)
+        let (mut began, mut any) = (false, false);
         for &t in &awake_trees {
             let r = self.root[t];
-            let d = &self.doze;
-            if self.never[t]
-                || !d.lone[t]
-                || forced[t]
-                || self.still[t] < T_DOZE
-                || !(self.speed[t] < DOZE_SPEED * self.v_tol)
-                || d.fresh[t]
-                || d.left[t] > 0
-            {
-                may[r] = false;
-            }
-        }
-        let mut began = false;
-        for &t in &awake_trees {
-            let r = self.root[t];
-            if !may[r] || !self.has_dof[t] {
+            if !self.doze.may[r] || !self.has_dof[t] {
+                any |= self.doze.left[t] > 0;
                 continue;
             }
             began = true;
+            any = true;
             self.doze.left[t] = N_DOZE - 1;
             self.doze.root[t] = r;
             self.masked[t] = true;
@@ -337,10 +336,9 @@ impl Sleep {
             }
         }
         self.doze.fresh.iter_mut().for_each(|f| *f = false);
-        self.doze.may = may;
         self.awake_trees = awake_trees;
-        // (trees that fell asleep at this step dozed no longer)
-        self.doze.any = self.doze.left.iter().any(|&l| l > 0);
+        // (trees that fell asleep at this step dozed no longer: not listed)
+        self.doze.any = any;
         if !began {
             return;
         }

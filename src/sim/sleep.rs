@@ -336,9 +336,15 @@ impl Sleep {
         }
         // each awake tree's largest point speed (a max: the same whatever the
         // order of the points), its still time, its own island
+        // (the verdicts' per-root flags set here too: an island's root is
+        // one of its awake trees)
         let awake_trees = std::mem::take(&mut self.awake_trees);
+        let mut may = std::mem::take(&mut self.may);
+        let mut may_doze = std::mem::take(&mut self.doze.may);
         for &t in &awake_trees {
             self.parent[t] = t;
+            may[t] = true;
+            may_doze[t] = true;
             if self.doze.left[t] > 0 {
                 // dozing: its speed is held below sleep_velocity
                 self.still[t] = if forced[t] { 0.0 } else { self.still[t] + h };
@@ -390,22 +396,29 @@ impl Sleep {
             }
         }
         self.joins = joins;
-        // an island sleeps when every tree in it may: the root (an awake
-        // tree) collects the verdict (true: may sleep)
-        let mut may = std::mem::take(&mut self.may);
-        for &t in &awake_trees {
-            may[t] = true;
-        }
+        // an island sleeps when every tree in it may, and begins to doze
+        // when every tree in it may (`begin_doze`): the root (an awake tree)
+        // collects the verdicts (true: may). (The doze verdict is taken
+        // before the islands that fall asleep leave the awake list: an
+        // island sleeps whole, its root with it, so what its trees say of
+        // their root is never read.)
+        let doze_on = self.doze.on && self.joins.is_empty();
         // (the unions are done: each tree's root is found once, kept in
         // `root` for the verdicts here and in `begin_doze`)
         for &t in &awake_trees {
             let r = self.find(t);
             self.root[t] = r;
-            if self.never[t] || forced[t] || self.still[t] < self.t_tol {
+            let forced = forced[t];
+            if self.never[t] || forced || self.still[t] < self.t_tol {
                 may[r] = false;
             }
+            if doze_on && !self.may_doze(t, forced) {
+                may_doze[r] = false;
+            }
         }
+        self.doze.may = may_doze;
         let mut slept = false;
+        let mut dozed_slept = false;
         for &t in &awake_trees {
             if !self.has_dof[t] {
                 continue;
@@ -417,6 +430,7 @@ impl Sleep {
             slept = true;
             let dozed = std::mem::take(&mut self.doze.left[t]) > 0;
             self.doze.slept[t] = dozed;
+            dozed_slept |= dozed;
             self.asleep[t] = true;
             self.masked[t] = true;
             self.island[t] = r;
@@ -465,8 +479,10 @@ impl Sleep {
             });
             self.awake = self.count_awake();
         }
-        self.doze.slept.iter_mut().for_each(|d| *d = false);
-        self.begin_doze(model, forced, q, v, points, forces, body_forces);
+        if dozed_slept {
+            self.doze.slept.iter_mut().for_each(|d| *d = false);
+        }
+        self.begin_doze(model, q, v, points, forces, body_forces);
         self.awake_sum += self.awake as f64;
         slept
     }

@@ -58,14 +58,10 @@ impl super::super::Simulation {
         self.account_sleep(h);
     }
 
-    /// Sleep's count after a step of `h` from the body velocities in
-    /// `data.v` (set by `Simulation::update_sleep`; held through a dozing
-    /// step, `Simulation::dozing_step`): the driven trees, the still times,
-    /// the islands that fall asleep, the new dozes' warm starts kept aside.
-    pub(in crate::sim) fn account_sleep(&mut self, h: f64) {
-        // trees driven now: a nonzero applied force, or a servo on one of its
-        // dofs (read for the awake trees only)
-        // (each tree's dofs one range: a slice test of each vector)
+    /// The awake trees driven now (`sleep_forced`): a nonzero applied force,
+    /// or a servo on one of its dofs (each tree's dofs one range: a slice
+    /// test of each vector).
+    fn mark_forced(&mut self) {
         let tau = self.tau_applied.as_slice();
         let servo = self
             .servo
@@ -78,6 +74,24 @@ impl super::super::Simulation {
                     .is_some_and(|x| x.iter().any(|&x| x != 0.0))
             };
             self.sleep_forced[t] = set(tau) || servo.is_some_and(|(kp, kd)| set(kp) || set(kd));
+        }
+    }
+
+    /// Sleep's count after a step of `h` from the body velocities in
+    /// `data.v` (set by `Simulation::update_sleep`; held through a dozing
+    /// step, `Simulation::dozing_step`): the driven trees, the still times,
+    /// the islands that fall asleep, the new dozes' warm starts kept aside.
+    pub(in crate::sim) fn account_sleep(&mut self, h: f64) {
+        // trees driven now (read for the awake trees only); with no applied
+        // force and no servo, the common case, none: found by one pass over
+        // tau instead of a slice test a tree (`mark_forced`)
+        let tau = self.tau_applied.as_slice();
+        if !self.servo.active && !tau.iter().fold(false, |any, &x| any | (x != 0.0)) {
+            // (the sleeping trees' entries are not read: each is set here
+            // again before its tree is counted awake)
+            self.sleep_forced.fill(false);
+        } else {
+            self.mark_forced();
         }
         let slept = self.sleep.after_step(
             &self.model,
