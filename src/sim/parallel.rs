@@ -131,8 +131,8 @@ impl Team {
         self.workers.len() + 1
     }
 
-    /// Runs `f(0)` on this thread and `f(k)` on each worker k (1 … threads −
-    /// 1) that takes the job before `f(0)` returns; returns when every part
+    /// Runs `f(0)` on this thread and `f(k)` on each worker k (from 1 to
+    /// threads − 1) that takes the job before `f(0)` returns; returns when every part
     /// begun has finished. A worker may come late and skip the job, so `f`
     /// shares its items through its own counter: any set of parts that
     /// includes part 0 does all of them. A panic of part 0 is resumed here; a

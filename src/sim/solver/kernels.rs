@@ -83,7 +83,7 @@ pub(super) fn dot3_from(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) ->
 ///
 /// # Safety
 /// The caller has checked the rows `s..e`: every path within `table`, at
-/// most `st` long, its dofs < `x.len()`; `y` and `ylanes` hold `st` entries
+/// most `st` long, its dofs < `x.len()`; `y` holds `st` entries
 /// a row (the sweeps' checks, [`super::Rows::sweeps`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
@@ -93,7 +93,6 @@ pub(super) unsafe fn warm_rows(
     paths: &[(usize, usize)],
     table: &[usize],
     y: &[f64],
-    _ylanes: &[[f64; 4]],
     st: usize,
     (s, e): (usize, usize),
     x: &mut [f64],
@@ -130,9 +129,9 @@ pub(super) unsafe fn warm_rows(
     }
 }
 
-/// The warm start of a contact's three rows: x[pₜ] = ((x[pₜ] + a₀ y₀ₜ) + a₁ y₁ₜ)
-/// + a₂ y₂ₜ over its path `p` (`ys`: its three rows of y, each at least
-/// `p.len()` long), each entry the same sum as three row-by-row updates,
+/// The warm start of a contact's three rows over its path `p`:
+/// x[pₜ] = ((x[pₜ] + a₀ y₀ₜ) + a₁ y₁ₜ) + a₂ y₂ₜ (`ys`: its three rows of y,
+/// each at least `p.len()` long), each entry the same sum as three row-by-row updates,
 /// four path slots at a time with AVX, then two at a time on x86_64
 /// (gathered and scattered: a path's dofs are distinct); the indices of `p`
 /// must be < `x.len()`.

@@ -431,7 +431,6 @@ impl Rows {
         let (table, n, st) = (&self.table[..], self.n, self.stride);
         if x.len() < self.nv
             || self.y.len() < n * st
-            || self.ylanes.len() < n * st
             || self.lambda.len() < n
             || self.path[..n]
                 .iter()
@@ -440,7 +439,7 @@ impl Rows {
             return;
         }
         x.iter_mut().for_each(|v| *v = 0.0);
-        // SAFETY: the paths, y and ylanes checked above; path indices < nv ≤
+        // SAFETY: the paths and y checked above; path indices < nv ≤
         // x.len() (the sweeps' invariant)
         unsafe {
             kernels::warm_rows(
@@ -449,7 +448,6 @@ impl Rows {
                 &self.path[..n],
                 table,
                 &self.y,
-                &self.ylanes,
                 st,
                 (0, n),
                 x,

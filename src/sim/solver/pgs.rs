@@ -241,7 +241,7 @@ impl Rows {
                 break;
             }
             // SAFETY: the paths, y and ylanes checked above (rdot/raxpy's)
-            unsafe { warm_rows(lambda, contact, paths, table, y, ylanes, st, (s, e), dv) };
+            unsafe { warm_rows(lambda, contact, paths, table, y, st, (s, e), dv) };
         }
         if block {
             lb.solve(&view, Some(c), b, lambda, dv);
