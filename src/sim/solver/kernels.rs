@@ -131,12 +131,133 @@ pub(super) unsafe fn warm_rows(
 
 /// The warm start of a contact's three rows over its path `p`:
 /// x[pₜ] = ((x[pₜ] + a₀ y₀ₜ) + a₁ y₁ₜ) + a₂ y₂ₜ (`ys`: its three rows of y,
-/// each at least `p.len()` long), each entry the same sum as three row-by-row updates,
-/// four path slots at a time with AVX, then two at a time on x86_64
-/// (gathered and scattered: a path's dofs are distinct); the indices of `p`
-/// must be < `x.len()`.
+/// each at least `p.len()` long), each entry the same sum as three row-by-row
+/// updates ([`path3`]'s lanes); the indices of `p` must be < `x.len()` and
+/// distinct.
 #[inline(always)]
 pub(super) fn warm3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
+    path3::<Warm>(a, ys, p, x);
+}
+
+/// The contact's update x[pₜ] += (a₀ y₀ₜ + a₁ y₁ₜ) + a₂ y₂ₜ over a contact's
+/// path `p` (its three rows of y, `ys`, each at least `p.len()` long), each
+/// entry the same operations in the same order as the scalar loop
+/// ([`path3`]'s lanes); the indices of `p` must be < `x.len()` (a row's path:
+/// dof indices < nv) and distinct.
+#[inline(always)]
+pub(super) fn axpy3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
+    path3::<Axpy>(a, ys, p, x);
+}
+
+/// How [`path3`] sums an entry x and a contact's three products aᵢyᵢ, the
+/// same order in every width: a scalar, two SSE2 lanes, four AVX lanes.
+trait Sum3 {
+    fn scalar(x: f64, a: [f64; 3], y: [f64; 3]) -> f64;
+    /// # Safety
+    /// SSE2 (part of x86_64): none beyond the target's.
+    #[cfg(target_arch = "x86_64")]
+    unsafe fn sse(
+        x: std::arch::x86_64::__m128d,
+        a: [std::arch::x86_64::__m128d; 3],
+        y: [std::arch::x86_64::__m128d; 3],
+    ) -> std::arch::x86_64::__m128d;
+    /// # Safety
+    /// AVX enabled at compile time (the only build that calls it).
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    unsafe fn avx(
+        x: std::arch::x86_64::__m256d,
+        a: [std::arch::x86_64::__m256d; 3],
+        y: [std::arch::x86_64::__m256d; 3],
+    ) -> std::arch::x86_64::__m256d;
+}
+
+/// [`warm3`]'s order: ((x + a₀y₀) + a₁y₁) + a₂y₂.
+struct Warm;
+/// [`axpy3`]'s order: x + ((a₀y₀ + a₁y₁) + a₂y₂).
+struct Axpy;
+
+impl Sum3 for Warm {
+    #[inline(always)]
+    fn scalar(x: f64, a: [f64; 3], y: [f64; 3]) -> f64 {
+        ((x + a[0] * y[0]) + a[1] * y[1]) + a[2] * y[2]
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn sse(
+        x: std::arch::x86_64::__m128d,
+        a: [std::arch::x86_64::__m128d; 3],
+        y: [std::arch::x86_64::__m128d; 3],
+    ) -> std::arch::x86_64::__m128d {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 is part of x86_64
+        unsafe {
+            let v = _mm_add_pd(x, _mm_mul_pd(a[0], y[0]));
+            let v = _mm_add_pd(v, _mm_mul_pd(a[1], y[1]));
+            _mm_add_pd(v, _mm_mul_pd(a[2], y[2]))
+        }
+    }
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    #[inline(always)]
+    unsafe fn avx(
+        x: std::arch::x86_64::__m256d,
+        a: [std::arch::x86_64::__m256d; 3],
+        y: [std::arch::x86_64::__m256d; 3],
+    ) -> std::arch::x86_64::__m256d {
+        use std::arch::x86_64::*;
+        // SAFETY: avx is enabled at compile time
+        unsafe {
+            let v = _mm256_add_pd(x, _mm256_mul_pd(a[0], y[0]));
+            let v = _mm256_add_pd(v, _mm256_mul_pd(a[1], y[1]));
+            _mm256_add_pd(v, _mm256_mul_pd(a[2], y[2]))
+        }
+    }
+}
+
+impl Sum3 for Axpy {
+    #[inline(always)]
+    fn scalar(x: f64, a: [f64; 3], y: [f64; 3]) -> f64 {
+        x + (a[0] * y[0] + a[1] * y[1] + a[2] * y[2])
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn sse(
+        x: std::arch::x86_64::__m128d,
+        a: [std::arch::x86_64::__m128d; 3],
+        y: [std::arch::x86_64::__m128d; 3],
+    ) -> std::arch::x86_64::__m128d {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 is part of x86_64
+        unsafe {
+            let s = _mm_add_pd(_mm_mul_pd(a[0], y[0]), _mm_mul_pd(a[1], y[1]));
+            _mm_add_pd(x, _mm_add_pd(s, _mm_mul_pd(a[2], y[2])))
+        }
+    }
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    #[inline(always)]
+    unsafe fn avx(
+        x: std::arch::x86_64::__m256d,
+        a: [std::arch::x86_64::__m256d; 3],
+        y: [std::arch::x86_64::__m256d; 3],
+    ) -> std::arch::x86_64::__m256d {
+        use std::arch::x86_64::*;
+        // SAFETY: avx is enabled at compile time
+        unsafe {
+            let s = _mm256_add_pd(_mm256_mul_pd(a[0], y[0]), _mm256_mul_pd(a[1], y[1]));
+            _mm256_add_pd(x, _mm256_add_pd(s, _mm256_mul_pd(a[2], y[2])))
+        }
+    }
+}
+
+/// x[pₜ] = S(x[pₜ], a, yₜ) over a contact's path `p` (its three rows of y,
+/// `ys`, each at least `p.len()` long; [`Sum3`]: the order of the sums),
+/// four path slots at a time with AVX, then two at a time in SSE2 lanes on
+/// x86_64 (the whole path on SSE builds, x86-64 and x86-64-v2: callgrind's;
+/// the slots past the last four with AVX, a ground contact's 6), then a
+/// scalar tail; gathered and scattered (a path's dofs are distinct), each
+/// lane the scalar operations in their order. The indices of `p` must be
+/// < `x.len()` (a row's path: dof indices < nv).
+#[inline(always)]
+fn path3<S: Sum3>(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
     debug_assert!(p.iter().all(|&k| k < x.len()));
     debug_assert!(p.iter().enumerate().all(|(i, k)| !p[..i].contains(k)));
     let n = p.len().min(ys[0].len()).min(ys[1].len()).min(ys[2].len());
@@ -150,13 +271,18 @@ pub(super) fn warm3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
         // length; every k < x.len() (the sweeps' check of the paths), and the
         // four k of a group are distinct (a path lists a dof once)
         unsafe {
-            let (a0, a1, a2) = (
+            let aa = [
                 _mm256_set1_pd(a[0]),
                 _mm256_set1_pd(a[1]),
                 _mm256_set1_pd(a[2]),
-            );
+            ];
             let xp = x.as_mut_ptr();
             while t + 4 <= n {
+                let yy = [
+                    _mm256_loadu_pd(y0.as_ptr().add(t)),
+                    _mm256_loadu_pd(y1.as_ptr().add(t)),
+                    _mm256_loadu_pd(y2.as_ptr().add(t)),
+                ];
                 let k = [
                     *p.get_unchecked(t),
                     *p.get_unchecked(t + 1),
@@ -165,10 +291,7 @@ pub(super) fn warm3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
                 ];
                 let lo = _mm_loadh_pd(_mm_load_sd(xp.add(k[0])), xp.add(k[1]));
                 let hi = _mm_loadh_pd(_mm_load_sd(xp.add(k[2])), xp.add(k[3]));
-                let mut v = _mm256_set_m128d(hi, lo);
-                v = _mm256_add_pd(v, _mm256_mul_pd(a0, _mm256_loadu_pd(y0.as_ptr().add(t))));
-                v = _mm256_add_pd(v, _mm256_mul_pd(a1, _mm256_loadu_pd(y1.as_ptr().add(t))));
-                v = _mm256_add_pd(v, _mm256_mul_pd(a2, _mm256_loadu_pd(y2.as_ptr().add(t))));
+                let v = S::avx(_mm256_set_m128d(hi, lo), aa, yy);
                 let (vlo, vhi) = (_mm256_castpd256_pd128(v), _mm256_extractf128_pd::<1>(v));
                 _mm_storel_pd(xp.add(k[0]), vlo);
                 _mm_storeh_pd(xp.add(k[1]), vlo);
@@ -182,16 +305,19 @@ pub(super) fn warm3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
     {
         use std::arch::x86_64::*;
         // SAFETY: SSE2 is part of x86_64; t + 1 < n ≤ every slice's length;
-        // every k < x.len(), the two k of a pair distinct (as above)
+        // every k < x.len() (the sweeps' check of the paths), and the two k
+        // of a pair are distinct (a path lists a dof once)
         unsafe {
-            let (a0, a1, a2) = (_mm_set1_pd(a[0]), _mm_set1_pd(a[1]), _mm_set1_pd(a[2]));
+            let aa = [_mm_set1_pd(a[0]), _mm_set1_pd(a[1]), _mm_set1_pd(a[2])];
             let xp = x.as_mut_ptr();
             while t + 2 <= n {
+                let yy = [
+                    _mm_loadu_pd(y0.as_ptr().add(t)),
+                    _mm_loadu_pd(y1.as_ptr().add(t)),
+                    _mm_loadu_pd(y2.as_ptr().add(t)),
+                ];
                 let (k0, k1) = (*p.get_unchecked(t), *p.get_unchecked(t + 1));
-                let mut v = _mm_loadh_pd(_mm_load_sd(xp.add(k0)), xp.add(k1));
-                v = _mm_add_pd(v, _mm_mul_pd(a0, _mm_loadu_pd(y0.as_ptr().add(t))));
-                v = _mm_add_pd(v, _mm_mul_pd(a1, _mm_loadu_pd(y1.as_ptr().add(t))));
-                v = _mm_add_pd(v, _mm_mul_pd(a2, _mm_loadu_pd(y2.as_ptr().add(t))));
+                let v = S::sse(_mm_loadh_pd(_mm_load_sd(xp.add(k0)), xp.add(k1)), aa, yy);
                 _mm_storel_pd(xp.add(k0), v);
                 _mm_storeh_pd(xp.add(k1), v);
                 t += 2;
@@ -202,101 +328,12 @@ pub(super) fn warm3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
         // SAFETY: t < n ≤ every slice's length; p[t] < x.len() (as above)
         unsafe {
             let xk = x.get_unchecked_mut(*p.get_unchecked(t));
-            *xk = ((*xk + a[0] * y0.get_unchecked(t)) + a[1] * y1.get_unchecked(t))
-                + a[2] * y2.get_unchecked(t);
-        }
-        t += 1;
-    }
-}
-
-/// The contact's update x[pₜ] += (a₀ y₀ₜ + a₁ y₁ₜ) + a₂ y₂ₜ over a contact's path
-/// `p` (its three rows of y, `ys`, each at least `p.len()` long), each entry
-/// the same operations in the same order as the scalar loop, four path slots
-/// at a time with AVX, then two at a time on x86_64 (gathered and scattered:
-/// a path's dofs are distinct);
-/// the indices of `p` must be < `x.len()` (a row's path: dof indices < nv).
-#[inline(always)]
-pub(super) fn axpy3(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
-    debug_assert!(p.iter().all(|&k| k < x.len()));
-    debug_assert!(p.iter().enumerate().all(|(i, k)| !p[..i].contains(k)));
-    let n = p.len().min(ys[0].len()).min(ys[1].len()).min(ys[2].len());
-    let [y0, y1, y2] = ys;
-    #[allow(unused_mut)]
-    let mut t = 0;
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-    {
-        use std::arch::x86_64::*;
-        // SAFETY: avx is enabled at compile time; t + 3 < n ≤ every slice's
-        // length; every k < x.len() (the sweeps' check of the paths), and the
-        // four k of a group are distinct (a path lists a dof once)
-        unsafe {
-            let (a0, a1, a2) = (
-                _mm256_set1_pd(a[0]),
-                _mm256_set1_pd(a[1]),
-                _mm256_set1_pd(a[2]),
-            );
-            let xp = x.as_mut_ptr();
-            while t + 4 <= n {
-                let s = _mm256_add_pd(
-                    _mm256_add_pd(
-                        _mm256_mul_pd(a0, _mm256_loadu_pd(y0.as_ptr().add(t))),
-                        _mm256_mul_pd(a1, _mm256_loadu_pd(y1.as_ptr().add(t))),
-                    ),
-                    _mm256_mul_pd(a2, _mm256_loadu_pd(y2.as_ptr().add(t))),
-                );
-                let k = [
-                    *p.get_unchecked(t),
-                    *p.get_unchecked(t + 1),
-                    *p.get_unchecked(t + 2),
-                    *p.get_unchecked(t + 3),
-                ];
-                let lo = _mm_loadh_pd(_mm_load_sd(xp.add(k[0])), xp.add(k[1]));
-                let hi = _mm_loadh_pd(_mm_load_sd(xp.add(k[2])), xp.add(k[3]));
-                let v = _mm256_add_pd(_mm256_set_m128d(hi, lo), s);
-                let (vlo, vhi) = (_mm256_castpd256_pd128(v), _mm256_extractf128_pd::<1>(v));
-                _mm_storel_pd(xp.add(k[0]), vlo);
-                _mm_storeh_pd(xp.add(k[1]), vlo);
-                _mm_storel_pd(xp.add(k[2]), vhi);
-                _mm_storeh_pd(xp.add(k[3]), vhi);
-                t += 4;
-            }
-        }
-    }
-    // two path slots at a time (SSE2, part of x86_64): the whole path on SSE
-    // builds (x86-64, x86-64-v2), the slots past the last four with AVX (a
-    // ground contact's 6), each lane the scalar loop's operations in its order
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        // SAFETY: SSE2 is part of x86_64; t + 1 < n ≤ every slice's length;
-        // every k < x.len() (the sweeps' check of the paths), and the two k
-        // of a pair are distinct (a path lists a dof once)
-        unsafe {
-            let (a0, a1, a2) = (_mm_set1_pd(a[0]), _mm_set1_pd(a[1]), _mm_set1_pd(a[2]));
-            let xp = x.as_mut_ptr();
-            while t + 2 <= n {
-                let s = _mm_add_pd(
-                    _mm_add_pd(
-                        _mm_mul_pd(a0, _mm_loadu_pd(y0.as_ptr().add(t))),
-                        _mm_mul_pd(a1, _mm_loadu_pd(y1.as_ptr().add(t))),
-                    ),
-                    _mm_mul_pd(a2, _mm_loadu_pd(y2.as_ptr().add(t))),
-                );
-                let (k0, k1) = (*p.get_unchecked(t), *p.get_unchecked(t + 1));
-                let v = _mm_add_pd(_mm_loadh_pd(_mm_load_sd(xp.add(k0)), xp.add(k1)), s);
-                _mm_storel_pd(xp.add(k0), v);
-                _mm_storeh_pd(xp.add(k1), v);
-                t += 2;
-            }
-        }
-    }
-    while t < n {
-        // SAFETY: t < n ≤ every slice's length; p[t] < x.len() (as above)
-        unsafe {
-            let k = *p.get_unchecked(t);
-            *x.get_unchecked_mut(k) += a[0] * y0.get_unchecked(t)
-                + a[1] * y1.get_unchecked(t)
-                + a[2] * y2.get_unchecked(t);
+            let yt = [
+                *y0.get_unchecked(t),
+                *y1.get_unchecked(t),
+                *y2.get_unchecked(t),
+            ];
+            *xk = S::scalar(*xk, a, yt);
         }
         t += 1;
     }
