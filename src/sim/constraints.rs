@@ -321,10 +321,11 @@ impl Constraints {
         self.warm_slots.clear();
     }
 
-    /// Keeps the warm starts of `slots` (sorted) through the next solves (a
-    /// dozing island's contacts, kept aside until its next full step: `sim::doze`).
-    pub fn hold_warm(&mut self, slots: &[usize]) {
-        self.warm_slots.retain(|k| slots.binary_search(k).is_err());
+    /// Keeps the warm starts of the slots flagged in `held` (per slot)
+    /// through the next solves (a dozing island's contacts, kept aside until
+    /// its next full step: `sim::doze`).
+    pub fn hold_warm(&mut self, held: &[bool]) {
+        self.warm_slots.retain(|&k| held.get(k) != Some(&true));
     }
 
     /// Forgets the last step's forces (a step taken without constraints).

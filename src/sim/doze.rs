@@ -75,8 +75,11 @@ pub(crate) struct Doze {
     /// Per tree: it fell asleep dozing at this step (scratch of `after_step`).
     pub slept: Vec<bool>,
     /// The contact slots of the islands that began to doze at this step's
-    /// end, sorted (their warm starts are kept: `Constraints::hold_warm`).
+    /// end (their warm starts are kept: `Constraints::hold_warm`), and per
+    /// slot whether it is one of them (grown to the largest slot seen; all
+    /// false again after `hold_warm`: [`Doze::unhold`]).
     pub new_slots: Vec<usize>,
+    pub held: Vec<bool>,
 }
 
 impl Doze {
@@ -110,7 +113,43 @@ impl Doze {
             tree_steps: 0,
             slept: vec![false; nt],
             new_slots: Vec::new(),
+            held: Vec::new(),
         }
+    }
+}
+
+impl Doze {
+    /// `held` all false again (after `Constraints::hold_warm` read it).
+    pub fn unhold(&mut self) {
+        for &k in &self.new_slots {
+            if let Some(h) = self.held.get_mut(k) {
+                *h = false;
+            }
+        }
+    }
+
+    /// Whether tree `t` (awake and not dozing, `never` sleeping or `forced`
+    /// now, `still` for that long at `speed` this step) lets its island doze:
+    /// it may sleep, is one lone free body, and has been still for [`T_DOZE`]
+    /// below [`DOZE_SPEED`]; it did not just stop dozing and does not doze now.
+    /// (`Sleep::after_step`'s verdicts, collected on each island's root.)
+    #[inline]
+    pub(super) fn may_begin(
+        &self,
+        t: usize,
+        never: bool,
+        forced: bool,
+        still: f64,
+        speed: f64,
+        v_tol: f64,
+    ) -> bool {
+        !(never
+            || !self.lone[t]
+            || forced
+            || still < T_DOZE
+            || !(speed < DOZE_SPEED * v_tol)
+            || self.fresh[t]
+            || self.left[t] > 0)
     }
 }
 
@@ -128,10 +167,7 @@ impl Sleep {
     /// After trees stopped dozing: their kept points and forces dropped (their
     /// detection finds them anew), the flags recounted.
     fn after_undoze(&mut self) {
-        let masked = &self.body_asleep;
-        let keep = |b: usize| masked.get(b) == Some(&true);
-        self.frozen_points.retain(|p| keep(p.body));
-        self.frozen_forces.retain(|f| keep(f.point.body));
+        self.drop_unmasked_frozen();
         self.doze.any = self.doze.left.iter().any(|&l| l > 0);
     }
 
@@ -279,25 +315,13 @@ impl Sleep {
         }
     }
 
-    /// Whether tree `t` (awake, `forced` now) lets its island doze: it may
-    /// sleep, is one lone free body, and has been still for [`T_DOZE`] below
-    /// [`DOZE_SPEED`]; it did not just stop dozing and does not doze now.
-    /// (`after_step`'s verdict pass collects it on the island's root.)
-    pub(super) fn may_doze(&self, t: usize, forced: bool) -> bool {
-        let d = &self.doze;
-        !(self.never[t]
-            || !d.lone[t]
-            || forced
-            || self.still[t] < T_DOZE
-            || !(self.speed[t] < DOZE_SPEED * self.v_tol)
-            || d.fresh[t]
-            || d.left[t] > 0)
-    }
-
     /// At the end of `after_step`: the islands that could sleep but for time
-    /// (each tree may sleep and has been still for [`T_DOZE`]: [`Sleep::may_doze`],
+    /// (each tree may sleep and has been still for [`T_DOZE`]: [`Doze::may_begin`],
     /// collected on each island's root by `after_step` in `doze.may`) begin to
     /// doze for the next `N_DOZE` − 1 steps; their points and forces are kept aside.
+    /// (`may`: some awake tree lets its island doze, else none begins;
+    /// `dozing`: some awake tree dozes now.)
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn begin_doze(
         &mut self,
         model: &Model,
@@ -306,10 +330,18 @@ impl Sleep {
         points: &mut Vec<ContactPoint>,
         forces: &[ContactForce],
         body_forces: &[Force],
+        may: bool,
+        dozing: bool,
     ) {
         self.doze.new_slots.clear();
         if !self.doze.on || !self.joins.is_empty() {
             self.doze.fresh.iter_mut().for_each(|f| *f = false);
+            return;
+        }
+        if !may {
+            // (no island begins: `any` is whether a tree dozes on)
+            self.doze.fresh.iter_mut().for_each(|f| *f = false);
+            self.doze.any = dozing;
             return;
         }
         let awake_trees = std::mem::take(&mut self.awake_trees);
@@ -360,16 +392,22 @@ impl Sleep {
         }
         let frozen = &mut self.frozen_points;
         let slots = &mut self.doze.new_slots;
+        let held = &mut self.doze.held;
         points.retain(|p| {
             if new(p.body) {
                 frozen.push(*p);
                 slots.push(p.slot);
+                if held.len() <= p.slot {
+                    held.resize(p.slot + 1, false);
+                }
+                if let Some(h) = held.get_mut(p.slot) {
+                    *h = true;
+                }
                 false
             } else {
                 true
             }
         });
-        slots.sort_unstable();
     }
 }
 

@@ -24,6 +24,7 @@ use crate::spatial::Force;
 use nalgebra::{DVector, Vector3};
 
 mod step;
+mod still;
 
 /// "No tree": the world body.
 const WORLD: usize = usize::MAX;
@@ -43,16 +44,14 @@ pub(crate) struct Sleep {
     pub(super) never: Vec<bool>,
     /// Per tree: it has degrees of freedom (it counts in `awake`).
     pub(super) has_dof: Vec<bool>,
-    /// Bounding spheres of the collision shapes: (body, centre in the body
-    /// frame, radius); bodies without one use their centre of mass and 0.1 m.
+    /// Bounding spheres of the collision shapes, tree after tree: (body,
+    /// centre in the body frame, radius), those another one holds left out
+    /// (`still::drop_held`), then the tree's bodies without one (the world
+    /// excluded), ascending, each with its centre of mass and 0.1 m.
     spheres: Vec<(usize, Vector3<f64>, f64)>,
-    /// Per tree: its spheres, a range of `spheres` (sorted by tree).
+    /// Per tree: its spheres, a range of `spheres` (the speed test reads
+    /// these, not the model's trees).
     tree_spheres: Vec<(usize, usize)>,
-    /// The bodies without a sphere (the world excluded), tree after tree, each
-    /// with its centre of mass; per tree its range of them (the speed test
-    /// reads these, not the model's trees).
-    bare: Vec<(usize, Vector3<f64>)>,
-    tree_bare: Vec<(usize, usize)>,
     /// Per awake tree: its island's root this step (scratch of `after_step`,
     /// found once after the unions and read by the sleep and doze verdicts).
     pub(super) root: Vec<usize>,
@@ -70,8 +69,9 @@ pub(crate) struct Sleep {
     pub joins: Vec<(usize, usize)>,
     /// Per tree: the island it fell asleep in (its root tree).
     island: Vec<usize>,
-    /// Per tree: its largest point speed this step (m/s).
-    pub(super) speed: Vec<f64>,
+    /// Per awake tree: its verdicts this step (`still::MAY_SLEEP`,
+    /// `still::MAY_DOZE`; scratch of `after_step`).
+    verdict: Vec<u8>,
     /// The configuration the sleeping trees are held at.
     pub q_frozen: DVector<f64>,
     /// The sleeping islands' last contact points and forces.
@@ -141,31 +141,25 @@ impl Sleep {
         let mut spheres = spheres;
         let tree_key = |b: usize| tree_of_body.get(b).copied().unwrap_or(WORLD);
         spheres.sort_by_key(|s| tree_key(s.0));
+        still::drop_held(&mut spheres, tree_key);
+        let mut bounds = Vec::with_capacity(spheres.len());
         let mut tree_spheres = vec![(0, 0); nt];
         let mut i = 0;
-        while i < spheres.len() {
-            let t = tree_key(spheres[i].0);
-            let s = i;
+        for (t, tree) in model.trees.iter().enumerate() {
+            let s = bounds.len();
             while i < spheres.len() && tree_key(spheres[i].0) == t {
+                bounds.push(spheres[i]);
                 i += 1;
             }
-            if let Some(r) = tree_spheres.get_mut(t) {
-                *r = (s, i);
-            }
-        }
-        let mut bare = Vec::new();
-        let mut tree_bare = vec![(0, 0); nt];
-        for (t, tree) in model.trees.iter().enumerate() {
-            let s = bare.len();
             for b in tree.bodies.clone() {
                 if b == 0 || has_sphere.get(b) != Some(&false) {
                     continue;
                 }
                 if let Some(i) = model.inertias.get(b) {
-                    bare.push((b, i.com));
+                    bounds.push((b, i.com, 0.1));
                 }
             }
-            tree_bare[t] = (s, bare.len());
+            tree_spheres[t] = (s, bounds.len());
         }
         Self {
             on,
@@ -174,10 +168,8 @@ impl Sleep {
             tree_of_body,
             never,
             has_dof,
-            spheres,
+            spheres: bounds,
             tree_spheres,
-            bare,
-            tree_bare,
             root: (0..nt).collect(),
             awake_trees: (0..nt).collect(),
             still: vec![0.0; nt],
@@ -186,7 +178,7 @@ impl Sleep {
             parent: (0..nt).collect(),
             joins: Vec::new(),
             island: vec![0; nt],
-            speed: vec![0.0; nt],
+            verdict: vec![0; nt],
             q_frozen: DVector::zeros(model.nq),
             frozen_points: Vec::new(),
             frozen_forces: Vec::new(),
@@ -286,10 +278,7 @@ impl Sleep {
             }
         }
         if woke {
-            let asleep = &self.body_asleep;
-            let keep = |b: usize| asleep.get(b) == Some(&true);
-            self.frozen_points.retain(|p| keep(p.body));
-            self.frozen_forces.retain(|f| keep(f.point.body));
+            self.drop_unmasked_frozen();
             self.any_asleep = self.asleep.iter().any(|&a| a);
             self.list_awake();
             self.awake = self.count_awake();
@@ -297,16 +286,33 @@ impl Sleep {
         woke
     }
 
+    /// The frozen points and forces of bodies no longer asleep or dozing
+    /// (`body_asleep`) dropped: their detection finds them anew.
+    pub(super) fn drop_unmasked_frozen(&mut self) {
+        let masked = &self.body_asleep;
+        let keep = |b: usize| masked.get(b) == Some(&true);
+        self.frozen_points.retain(|p| keep(p.body));
+        self.frozen_forces.retain(|f| keep(f.point.body));
+    }
+
+    /// Whether a point of `points` has a side asleep or dozing (else
+    /// [`Sleep::wake_touched`] and [`Sleep::undoze_touched`] have nothing
+    /// to do: each skips such a point).
+    pub fn touches_masked(&self, points: &[ContactPoint]) -> bool {
+        if !self.any_asleep && !self.doze.any {
+            return false;
+        }
+        let masked = &self.body_asleep[..];
+        let m = |b: usize| masked.get(b) == Some(&true);
+        points.iter().any(|p| m(p.body) | m(p.other))
+    }
+
     fn tree(&self, body: usize) -> usize {
         self.tree_of_body.get(body).copied().unwrap_or(WORLD)
     }
 
-    pub(super) fn find(&mut self, mut t: usize) -> usize {
-        while self.parent[t] != t {
-            self.parent[t] = self.parent[self.parent[t]];
-            t = self.parent[t];
-        }
-        t
+    pub(super) fn find(&mut self, t: usize) -> usize {
+        still::find(&mut self.parent, t)
     }
 
     /// One step's bookkeeping after a step of `h` (s): each awake tree's largest
@@ -334,67 +340,25 @@ impl Sleep {
             self.awake_sum += self.awake as f64;
             return false;
         }
-        // each awake tree's largest point speed (a max: the same whatever the
-        // order of the points), its still time, its own island
-        // (the verdicts' per-root flags set here too: an island's root is
-        // one of its awake trees)
+        // each awake tree's largest point speed, its still time, its
+        // verdicts, its own island (the per-root flags set true)
         let awake_trees = std::mem::take(&mut self.awake_trees);
         let mut may = std::mem::take(&mut self.may);
         let mut may_doze = std::mem::take(&mut self.doze.may);
-        for &t in &awake_trees {
-            self.parent[t] = t;
-            may[t] = true;
-            may_doze[t] = true;
-            if self.doze.left[t] > 0 {
-                // dozing: its speed is held below sleep_velocity
-                self.still[t] = if forced[t] { 0.0 } else { self.still[t] + h };
-                continue;
-            }
-            let mut speed = 0.0f64;
-            let (s0, s1) = self.tree_spheres[t];
-            for &(b, c, r) in &self.spheres[s0..s1] {
-                if let Some(m) = body_v.get(b) {
-                    let s = (m.lin + m.ang.cross(&c)).norm() + m.ang.norm() * r;
-                    speed = speed.max(s);
-                }
-            }
-            // (the tree's bodies without a sphere, ascending)
-            let (b0, b1) = self.tree_bare[t];
-            for &(b, c) in &self.bare[b0..b1] {
-                if let Some(m) = body_v.get(b) {
-                    let s = (m.lin + m.ang.cross(&c)).norm() + m.ang.norm() * 0.1;
-                    speed = speed.max(s);
-                }
-            }
-            self.speed[t] = speed;
-            self.still[t] = if speed < self.v_tol && !forced[t] {
-                self.still[t] + h
-            } else {
-                0.0
-            };
-        }
+        let doze_on = self.doze.on && self.joins.is_empty();
+        let dozing = self.still_pass(
+            &awake_trees,
+            h,
+            body_v,
+            forced,
+            doze_on,
+            &mut may,
+            &mut may_doze,
+        );
         self.link_dozing(&awake_trees);
         // islands: trees joined by a contact point or a loop constraint
         let joins = std::mem::take(&mut self.joins);
-        // (a pair's points come one after another: the repeats of the last
-        // pair are skipped, a union already made; finds only shorten paths)
-        let pairs = points.iter().map(|p| (p.body, p.other));
-        let mut last = (WORLD, WORLD);
-        for (a, b) in pairs.chain(joins.iter().copied()) {
-            if (a, b) == last {
-                continue;
-            }
-            last = (a, b);
-            let (ta, tb) = (self.tree(a), self.tree(b));
-            if ta == WORLD || tb == WORLD || ta == tb {
-                continue;
-            }
-            let (ra, rb) = (self.find(ta), self.find(tb));
-            if ra != rb {
-                let (lo, hi) = (ra.min(rb), ra.max(rb));
-                self.parent[hi] = lo;
-            }
-        }
+        self.join_islands(points, &joins);
         self.joins = joins;
         // an island sleeps when every tree in it may, and begins to doze
         // when every tree in it may (`begin_doze`): the root (an awake tree)
@@ -402,24 +366,35 @@ impl Sleep {
         // before the islands that fall asleep leave the awake list: an
         // island sleeps whole, its root with it, so what its trees say of
         // their root is never read.)
-        let doze_on = self.doze.on && self.joins.is_empty();
         // (the unions are done: each tree's root is found once, kept in
-        // `root` for the verdicts here and in `begin_doze`)
+        // `root` for the verdicts here and in `begin_doze`; `any`: the
+        // verdicts' union, no island may when no tree may, its root among them)
+        let mut any = 0;
+        let nt = self.parent.len();
+        let (verdict, root) = (&self.verdict[..nt], &mut self.root[..nt]);
         for &t in &awake_trees {
-            let r = self.find(t);
-            self.root[t] = r;
-            let forced = forced[t];
-            if self.never[t] || forced || self.still[t] < self.t_tol {
+            if t >= nt {
+                continue;
+            }
+            let r = still::find(&mut self.parent, t);
+            root[t] = r;
+            let v = verdict[t];
+            any |= v;
+            if v & still::MAY_SLEEP == 0 {
                 may[r] = false;
             }
-            if doze_on && !self.may_doze(t, forced) {
+            if v & still::MAY_DOZE == 0 {
                 may_doze[r] = false;
             }
         }
         self.doze.may = may_doze;
         let mut slept = false;
-        let mut dozed_slept = false;
-        for &t in &awake_trees {
+        let mut dozed_slept = 0;
+        let sleepers = match any & still::MAY_SLEEP {
+            0 => &[][..],
+            _ => &awake_trees[..],
+        };
+        for &t in sleepers {
             if !self.has_dof[t] {
                 continue;
             }
@@ -430,7 +405,7 @@ impl Sleep {
             slept = true;
             let dozed = std::mem::take(&mut self.doze.left[t]) > 0;
             self.doze.slept[t] = dozed;
-            dozed_slept |= dozed;
+            dozed_slept += dozed as usize;
             self.asleep[t] = true;
             self.masked[t] = true;
             self.island[t] = r;
@@ -479,10 +454,13 @@ impl Sleep {
             });
             self.awake = self.count_awake();
         }
-        if dozed_slept {
+        if dozed_slept > 0 {
             self.doze.slept.iter_mut().for_each(|d| *d = false);
         }
-        self.begin_doze(model, q, v, points, forces, body_forces);
+        // (the trees that doze on: those that dozed, less those that fell asleep)
+        let may_begin = any & still::MAY_DOZE != 0;
+        let dozing = dozing > dozed_slept;
+        self.begin_doze(model, q, v, points, forces, body_forces, may_begin, dozing);
         self.awake_sum += self.awake as f64;
         slept
     }

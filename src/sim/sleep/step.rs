@@ -20,8 +20,11 @@ impl super::super::Simulation {
             );
             return;
         }
-        while self.sleep.wake_touched(&self.model, &self.points)
-            | self.sleep.undoze_touched(&self.model, &self.points)
+        // (a point with no side asleep or dozing wakes nothing: one scan
+        // tells whether any has one)
+        while self.sleep.touches_masked(&self.points)
+            && (self.sleep.wake_touched(&self.model, &self.points)
+                | self.sleep.undoze_touched(&self.model, &self.points))
         {
             self.refresh_contacts();
         }
@@ -108,7 +111,8 @@ impl super::super::Simulation {
             self.energy_now = None;
         }
         if !self.sleep.doze.new_slots.is_empty() {
-            self.cons.hold_warm(&self.sleep.doze.new_slots);
+            self.cons.hold_warm(&self.sleep.doze.held);
+            self.sleep.doze.unhold();
         }
         self.sleep.compose(&self.model, self.cons.body_forces());
     }
