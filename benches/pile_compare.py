@@ -20,6 +20,10 @@ the headline's, which stays one thread's (MuJoCo's `mj_step` runs on one thread 
 ratio is against the faster of MuJoCo's one-thread best and its best with its own thread pool of N
 workers (`mujoco.mju_threadpool(d, N)`: collision and the islands' solve in parallel), the four
 configurations again.
+--elliptic adds MuJoCo's four configurations with its elliptic friction cone (`opt.cone =
+mjCONE_ELLIPTIC`: Coulomb's disc, the friction law urdyn solves; MuJoCo's default, used above, is a
+pyramid, which ends a box's 3D wobble sooner: round 34's rock room, benches/rocking.py), its best
+and urdyn's ratio to it as columns of their own; the headline ratio is unchanged.
 Growth: the step time ratio from 64 to 1024 objects (≤ 16: no faster than linear); beside it
 the same ratio per awake object (step time over the run's mean awake count), and the ratio at equal
 durations (the 64 pile run again over the 1024 pile's 2 s, both engines; --no-equal-growth skips it).
@@ -51,8 +55,11 @@ INTEG = {"euler": mujoco.mjtIntegrator.mjINT_EULER,
          "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST}
 
 
-def time_mj(model, qpos, qvel, integ, sleep, steps, pool=0):
+def time_mj(model, qpos, qvel, integ, sleep, steps, pool=0, cone=None):
     model.opt.integrator = INTEG[integ]
+    # the friction cone: MuJoCo's default pyramid, or (--elliptic) the elliptic cone, Coulomb's
+    # disc as urdyn solves it
+    model.opt.cone = cone if cone is not None else mujoco.mjtCone.mjCONE_PYRAMIDAL
     if sleep:
         model.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_SLEEP)
     else:
@@ -106,6 +113,19 @@ def one(args, kind, n, tmp):
     best = max(mj, key=mj.get)
     row["mujoco_best"], row["mujoco_best_cfg"] = mj[best], best
     row["ratio"] = max(row["urdyn_sleep"], row["urdyn_nosleep"] or 0) / mj[best]
+    if args.elliptic:
+        # like for like in the friction law: MuJoCo with the elliptic cone (Coulomb's disc, as urdyn's
+        # solve); the issue's ratio stays against MuJoCo's fastest (its default pyramid)
+        ell = {}
+        for integ in INTEG:
+            for sleep in (False, True):
+                ell["%s%s" % (integ, "+sleep" if sleep else "")] = max(
+                    time_mj(model, qpos, qvel, integ, sleep, steps, cone=mujoco.mjtCone.mjCONE_ELLIPTIC)
+                    for _ in range(args.repeats))
+        row["mujoco_elliptic"] = ell
+        ebest = max(ell, key=ell.get)
+        row["mujoco_elliptic_best"], row["mujoco_elliptic_best_cfg"] = ell[ebest], ebest
+        row["ratio_elliptic"] = max(row["urdyn_sleep"], row["urdyn_nosleep"] or 0) / ell[ebest]
     if args.threads:
         # against MuJoCo's fastest on one thread or with its own pool of the same size
         pool = {}
@@ -162,7 +182,8 @@ def settled(args, n, tmp):
             "bound": diff < 1e-4, "how": "4.5 s run minus 4 s run"}
 
 
-def write_md(path, rows, meta, st, threads=0):
+def write_md(path, rows, meta, st, threads=0, elliptic=False):
+    el_head = " MuJoCo elliptic (best) | ratio (elliptic) |" if elliptic else ""
     th_head = " urdyn --threads %d |" % threads if threads else ""
     th_ratio = (" MuJoCo pool %d (best) | ratio (threads %d) |" % (threads, threads)) if threads else ""
     out = ["# Piles in a bin: urdyn and MuJoCo 4.0.0", "",
@@ -173,17 +194,20 @@ def write_md(path, rows, meta, st, threads=0):
            "MuJoCo: Euler and implicitfast, sleep off and on, islands on; ratio = urdyn (faster of its two) / "
            "MuJoCo's fastest.", "",
            "| pile | objects | urdyn steps/s (sleep) | urdyn --no-sleep |" + th_head + " mean awake | MuJoCo euler |"
-           " euler+sleep | implicitfast | implicitfast+sleep | ratio |" + th_ratio,
-           "|---|---|---|---|" + ("---|" if threads else "") + "---|---|---|---|---|---|" + ("---|---|" if threads else "")]
+           " euler+sleep | implicitfast | implicitfast+sleep | ratio |" + th_ratio + el_head,
+           "|---|---|---|---|" + ("---|" if threads else "") + "---|---|---|---|---|---|" + ("---|---|" if threads else "")
+           + ("---|---|" if elliptic else "")]
     for r in rows:
         mj = r["mujoco"]
         th = " %.0f |" % r["urdyn_threads"] if threads else ""
         thr = (" %.0f (%s) | %.2f |" % (r["mujoco_pool_best"], r["mujoco_pool_best_cfg"], r["ratio_threads"])
                if threads else "")
-        out.append("| %s | %d | %.0f | %s |%s %s | %.0f | %.0f | %.0f | %.0f | %.2f |%s" % (
+        el = (" %.0f (%s) | %.2f |" % (r["mujoco_elliptic_best"], r["mujoco_elliptic_best_cfg"], r["ratio_elliptic"])
+              if elliptic else "")
+        out.append("| %s | %d | %.0f | %s |%s %s | %.0f | %.0f | %.0f | %.0f | %.2f |%s%s" % (
             r["kind"], r["n"], r["urdyn_sleep"], "%.0f" % r["urdyn_nosleep"] if r["urdyn_nosleep"] else "-",
             th, r["urdyn_awake_mean"] or "-", mj["euler"], mj["euler+sleep"], mj["implicitfast"],
-            mj["implicitfast+sleep"], r["ratio"], thr))
+            mj["implicitfast+sleep"], r["ratio"], thr, el))
     out.append("")
     for kind in sorted({r["kind"] for r in rows}):
         by = {r["n"]: r for r in rows if r["kind"] == kind}
@@ -230,6 +254,9 @@ def main():
     ap.add_argument("--threads", type=int, default=0,
                     help="also run urdyn with --threads N (sleep on), and MuJoCo with its thread pool of N: "
                          "a column and a ratio of their own")
+    ap.add_argument("--elliptic", action="store_true",
+                    help="also run MuJoCo with its elliptic friction cone (Coulomb's disc, urdyn's friction law; "
+                         "its default is a pyramid): a column and a like-for-like ratio of their own")
     ap.add_argument("--no-nosleep", action="store_true", help="skip urdyn's --no-sleep runs")
     ap.add_argument("--no-equal-growth", dest="equal_growth", action="store_false",
                     help="skip the 64 pile's runs over the 1024 pile's duration (growth at equal durations)")
@@ -250,7 +277,7 @@ def main():
                 "date": datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC"),
                 "wall": time.time() - t0, "commit": commit(), "machine": machine(),
                 "load0": load0, "load1": uptime()}
-        write_md(args.md, rows, meta, st, args.threads)
+        write_md(args.md, rows, meta, st, args.threads, args.elliptic)
 
 
 if __name__ == "__main__":
