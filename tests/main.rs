@@ -48,6 +48,7 @@ mod mjcf_view;
 mod output_files;
 mod pinocchio_derivatives;
 mod pinocchio_fixtures;
+mod rocking;
 mod scene;
 mod scene_bad;
 mod scene_mjcf;
