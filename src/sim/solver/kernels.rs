@@ -6,44 +6,39 @@
 /// Σₜ lₜ x[pₜ] in each of the four lanes of `l` (a contact's three rows of
 /// y interleaved, `Rows::ylanes`), each lane a sum from 0 in path order; the
 /// indices of `p` must be < `x.len()` (a row's path: dof indices < nv).
+/// ([`dot3_from`] from +0: the same sums, +0 + a = a for every a.)
 #[inline(always)]
 pub(super) fn dot3(l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
-    debug_assert!(p.iter().all(|&k| k < x.len()));
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-    {
-        use std::arch::x86_64::*;
-        let mut s = [0.0f64; 4];
-        // SAFETY: avx is enabled at compile time; every k < x.len() (the
-        // sweeps' check of the paths); `l`'s entries are 4 f64 each
-        unsafe {
-            let mut acc = _mm256_setzero_pd();
-            for (li, &k) in l.iter().zip(p) {
-                let xk = _mm256_broadcast_sd(x.get_unchecked(k));
-                acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_loadu_pd(li.as_ptr()), xk));
-            }
-            _mm256_storeu_pd(s.as_mut_ptr(), acc);
-        }
-        s
-    }
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
-    {
-        let mut s = [0.0f64; 4];
-        for (li, &k) in l.iter().zip(p) {
-            // SAFETY: every k < x.len() (the sweeps' check of the paths)
-            let xk = unsafe { *x.get_unchecked(k) };
-            for (si, &v) in s.iter_mut().zip(li) {
-                *si += v * xk;
-            }
-        }
-        s
-    }
+    dot3_from([0.0; 4], l, p, x)
 }
 
 /// `s0` + Σₜ lₜ x[pₜ] in each of the four lanes (as [`dot3`], each lane's
 /// sum started from its `s0` instead of 0: ((s0 + l₀x) + l₁x) + …, the
-/// scalar loop `u += y x` from `u = s0`).
+/// scalar loop `u += y x` from `u = s0`). A free body's path (6 dofs: a
+/// ground contact's) and two free bodies' (12: a pair's) run a loop of
+/// that fixed length, unrolled whole (no loop bookkeeping): the same sums
+/// in the same order.
 #[inline(always)]
 pub(super) fn dot3_from(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
+    let n = p.len().min(l.len());
+    // SAFETY: n ≤ both lengths
+    let cut = |m: usize| unsafe { (l.get_unchecked(..m), p.get_unchecked(..m)) };
+    match n {
+        6 => {
+            let (l, p) = cut(6);
+            dot3_run(s0, l, p, x)
+        }
+        12 => {
+            let (l, p) = cut(12);
+            dot3_run(s0, l, p, x)
+        }
+        _ => dot3_run(s0, l, p, x),
+    }
+}
+
+/// [`dot3_from`]'s loop (over the shorter of `l` and `p`).
+#[inline(always)]
+fn dot3_run(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
     debug_assert!(p.iter().all(|&k| k < x.len()));
     #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
     {
@@ -258,9 +253,38 @@ impl Sum3 for Axpy {
 /// < `x.len()` (a row's path: dof indices < nv).
 #[inline(always)]
 fn path3<S: Sum3>(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
+    let n = p.len().min(ys[0].len()).min(ys[1].len()).min(ys[2].len());
+    // a free body's path (6 dofs) and two free bodies' (12) at their fixed
+    // length, unrolled whole ([`dot3_from`]'s): the same lanes
+    // SAFETY: n ≤ every slice's length
+    let cut = |m: usize| unsafe {
+        let [y0, y1, y2] = ys;
+        let y = [
+            y0.get_unchecked(..m),
+            y1.get_unchecked(..m),
+            y2.get_unchecked(..m),
+        ];
+        (y, p.get_unchecked(..m))
+    };
+    match n {
+        6 => {
+            let (ys, p) = cut(6);
+            path3_run::<S>(a, ys, p, x, 6)
+        }
+        12 => {
+            let (ys, p) = cut(12);
+            path3_run::<S>(a, ys, p, x, 12)
+        }
+        _ => path3_run::<S>(a, ys, p, x, n),
+    }
+}
+
+/// [`path3`]'s loops over the first `n` slots (n ≤ every slice's length).
+#[inline(always)]
+fn path3_run<S: Sum3>(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64], n: usize) {
     debug_assert!(p.iter().all(|&k| k < x.len()));
     debug_assert!(p.iter().enumerate().all(|(i, k)| !p[..i].contains(k)));
-    let n = p.len().min(ys[0].len()).min(ys[1].len()).min(ys[2].len());
+    debug_assert!(n <= p.len().min(ys[0].len()).min(ys[1].len()).min(ys[2].len()));
     let [y0, y1, y2] = ys;
     #[allow(unused_mut)]
     let mut t = 0;
