@@ -2,7 +2,7 @@
 //! free rows solved exactly by a dense LDLᵀ.
 
 use super::dense::{ldlt_dropping, ldlt_dropping_solve};
-use super::kernels::dot3_from;
+use super::kernels::{axpy1, axpy2, dot1_from, dot3_from};
 use super::loop_block::LoopBlock;
 use super::wff::Lanes;
 use super::{RowKind, SUBSPACE_MAX};
@@ -274,11 +274,8 @@ pub(super) fn subspace_step(
             a += 3;
             continue;
         }
-        let mut u = c[r];
-        for (&yt, &k) in yr(0).iter().zip(pa) {
-            // SAFETY: a path's dofs are < nv ≤ dv.len() (checked above)
-            u += yt * unsafe { *dv.get_unchecked(k) };
-        }
+        // (a path's dofs are < nv ≤ dv.len(): checked above)
+        let u = dot1_from(c[r], yr(0), pa, dv);
         sm.rhs[a] = target(r) - u;
         a += 1;
     }
@@ -326,13 +323,11 @@ pub(super) fn subspace_step(
     // sticking pair into the cone of its new normal, a sliding one (held in
     // the solve) along its direction onto that cone's boundary, μλₙ
     // Δv' += d yᵣ over row r's path
+    // (a path's dofs are < nv ≤ dv.len(): the sweeps' check)
     #[inline(always)]
     fn add(p: &[usize], yr: &[f64], d: f64, dv: &mut [f64]) {
         if d != 0.0 {
-            for (&yt, &k) in yr.iter().zip(p) {
-                // SAFETY: a path's dofs are < nv ≤ dv.len() (the sweeps' check)
-                unsafe { *dv.get_unchecked_mut(k) += d * yt };
-            }
+            axpy1(d, yr, p, dv);
         }
     }
     let yrow = |r: usize, l: usize| &y[r * st..r * st + l];
@@ -399,14 +394,8 @@ pub(super) fn subspace_step(
             if d1 != 0.0 && d2 != 0.0 && paths[r + 1] == paths[r] {
                 // the pair on one path (a contact's) in one pass: each entry
                 // (x + d₁y₁) + d₂y₂, the row-by-row order
-                let (y1, y2) = (yrow(r, p.len()), yrow(r + 1, p.len()));
-                for ((&a, &b), &k) in y1.iter().zip(y2).zip(p) {
-                    // SAFETY: a path's dofs are < nv ≤ dv.len() (the sweeps' check)
-                    unsafe {
-                        let x = dv.get_unchecked_mut(k);
-                        *x = (*x + d1 * a) + d2 * b;
-                    }
-                }
+                // (a path's dofs are < nv ≤ dv.len(): the sweeps' check)
+                axpy2([d1, d2], yrow(r, p.len()), yrow(r + 1, p.len()), p, dv);
             } else {
                 add(p, yrow(r, p.len()), d1, dv);
                 let p2 = path(r + 1);

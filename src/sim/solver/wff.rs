@@ -346,8 +346,29 @@ impl<'a> Lanes<'a> {
 /// contacts' rows: `l` one contact's rows interleaved over its path `p`, `x3`
 /// the other's scattered to full width; each entry a sum from 0 in path order
 /// (the scalar loop's); the indices of `p` must be < `x3.len()`.
+/// A free body's path (6 dofs) and two free bodies' (12) at that fixed
+/// length, unrolled whole (as `kernels::dot3_from`): the same sums.
 #[inline(always)]
 fn dot3x3(l: &[[f64; 4]], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 4]; 3] {
+    let n = p.len().min(l.len());
+    // SAFETY: n ≤ both lengths
+    let cut = |m: usize| unsafe { (l.get_unchecked(..m), p.get_unchecked(..m)) };
+    match n {
+        6 => {
+            let (l, p) = cut(6);
+            dot3x3_run(l, p, x3)
+        }
+        12 => {
+            let (l, p) = cut(12);
+            dot3x3_run(l, p, x3)
+        }
+        _ => dot3x3_run(l, p, x3),
+    }
+}
+
+/// [`dot3x3`]'s loop (over the shorter of `l` and `p`).
+#[inline(always)]
+fn dot3x3_run(l: &[[f64; 4]], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 4]; 3] {
     debug_assert!(p.iter().all(|&k| k < x3.len()));
     #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
     {
