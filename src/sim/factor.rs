@@ -13,6 +13,7 @@
 //! tree-sparse `mj_factorI` / `mj_solveM` idea). With mimic joints H̃ is not
 //! tree-shaped: a dense Cholesky H̃ = L Lᵀ (R = Lᵀ) and full-length rows.
 
+mod awake;
 mod chain6;
 mod elim;
 mod rows;
@@ -76,6 +77,15 @@ pub struct MassFactor {
     dof_ranges: Vec<(usize, usize)>,
     body_ranges: Vec<(usize, usize)>,
     partial: bool,
+    /// The mask the ranges were listed for and the `partial` it gave
+    /// ([`Self::set_awake`]: the lists are made again only when it changes).
+    ranges_mask: Vec<bool>,
+    ranges_partial: bool,
+    /// Per tree of the model (in order), its dof and body ranges, for the
+    /// lists (`None`: a tree on the world body, never listed); `spans_cover`:
+    /// the trees cover the model's dofs and bodies exactly.
+    spans: Vec<Option<((usize, usize), (usize, usize))>>,
+    spans_cover: bool,
     /// Tree, lone free bodies: every tree's dof range (the solves' ranges
     /// when none sleeps, `chain6`); else empty.
     lone_ranges: Vec<(usize, usize)>,
@@ -178,6 +188,18 @@ impl MassFactor {
             dof_ranges: Vec::with_capacity(model.trees.len()),
             body_ranges: Vec::with_capacity(model.trees.len()),
             partial: false,
+            ranges_mask: Vec::new(),
+            ranges_partial: false,
+            spans: model
+                .trees
+                .iter()
+                .map(|t| {
+                    (t.bodies.start >= 1)
+                        .then_some(((t.v.start, t.v.end), (t.bodies.start, t.bodies.end)))
+                })
+                .collect(),
+            spans_cover: model.trees.iter().map(|t| t.v.len()).sum::<usize>() == n
+                && model.trees.iter().map(|t| t.bodies.len()).sum::<usize>() + 1 == model.nbodies,
             lone_ranges: chain6::lone_ranges(model, n, lone_free),
             all: (0, n),
             table,
@@ -311,30 +333,6 @@ impl MassFactor {
         self.held_inertia.clear();
         self.held_inertia.extend_from_slice(&model.inertias_origin);
         self.held = self.held_diag.len() == self.n;
-    }
-
-    /// The next [`Self::factor_at`] (and the solves until the next factor)
-    /// work on the trees of `model` not flagged in `asleep` (per tree;
-    /// `None`: every tree): a forest's trees are independent blocks of H̃.
-    pub fn set_awake(&mut self, model: &Model, asleep: Option<&[bool]>) {
-        self.partial = false;
-        let Some(asleep) = asleep.filter(|_| self.tree) else {
-            return;
-        };
-        self.dof_ranges.clear();
-        self.body_ranges.clear();
-        let (mut nv, mut nb) = (0, 0);
-        for (t, tree) in model.trees.iter().enumerate() {
-            nv += tree.v.len();
-            nb += tree.bodies.len();
-            if asleep.get(t) == Some(&true) || tree.bodies.start < 1 {
-                continue;
-            }
-            self.dof_ranges.push((tree.v.start, tree.v.end));
-            self.body_ranges.push((tree.bodies.start, tree.bodies.end));
-        }
-        // the trees must cover the model exactly, else everything is done
-        self.partial = nv == self.n && nb + 1 == model.nbodies && asleep.len() == model.trees.len();
     }
 
     /// The dof ranges worked on: every dof, or the awake trees'.
