@@ -364,7 +364,7 @@ impl Sleep {
             copy_range(&mut self.q_frozen, q, tree.q.clone());
             for b in tree.bodies.clone() {
                 self.body_asleep[b] = true;
-                self.all_body[b] = body_forces.get(b).copied().unwrap_or(Force::zero());
+                self.frozen_body[b] = body_forces.get(b).copied().unwrap_or(Force::zero());
             }
         }
         self.doze.fresh.iter_mut().for_each(|f| *f = false);

@@ -77,7 +77,8 @@ pub(crate) struct Sleep {
     /// The sleeping islands' last contact points and forces.
     pub frozen_points: Vec<ContactPoint>,
     pub frozen_forces: Vec<ContactForce>,
-    /// The sleeping bodies' last contact wrenches (per body).
+    /// The masked (sleeping or dozing) bodies' kept contact wrenches (per
+    /// body: set when the body falls asleep or begins to doze).
     pub(super) frozen_body: Vec<Force>,
     /// The last solve's contact forces and wrenches with the frozen ones
     /// (in use while anything sleeps). The forces' list is made when first
@@ -85,7 +86,12 @@ pub(crate) struct Sleep {
     /// pile's frozen forces copied every step cost more than the rest of its
     /// bookkeeping (a lock: `Simulation` is `Sync`).
     all_forces: std::sync::OnceLock<Vec<ContactForce>>,
-    pub(super) all_body: Vec<Force>,
+    /// The body wrenches to report, made when first read after a step
+    /// ([`Sleep::body_forces`]): the masked bodies' kept ones, the others'
+    /// the last solve's; `composed` is the mask when the step ended
+    /// ([`Sleep::compose`]).
+    all_body: std::sync::OnceLock<Vec<Force>>,
+    composed: Vec<bool>,
     /// v plus the position pass's pseudo-velocity (scratch: a point pushed out
     /// of a penetration is moving).
     pub vw: DVector<f64>,
@@ -184,7 +190,8 @@ impl Sleep {
             frozen_forces: Vec::new(),
             frozen_body: vec![Force::zero(); model.nbodies],
             all_forces: std::sync::OnceLock::new(),
-            all_body: vec![Force::zero(); model.nbodies],
+            all_body: std::sync::OnceLock::new(),
+            composed: vec![false; model.nbodies],
             vw: DVector::zeros(model.nv),
             awake,
             awake_sum: 0.0,
@@ -419,12 +426,9 @@ impl Sleep {
             for b in tree.bodies.clone() {
                 self.body_asleep[b] = true;
                 // (a dozing body's: those kept when it began to doze)
-                let f = match dozed {
-                    true => self.all_body[b],
-                    false => body_forces.get(b).copied().unwrap_or(Force::zero()),
-                };
-                self.frozen_body[b] = f;
-                self.all_body[b] = f;
+                if !dozed {
+                    self.frozen_body[b] = body_forces.get(b).copied().unwrap_or(Force::zero());
+                }
             }
         }
         self.may = may;
@@ -491,29 +495,20 @@ impl Sleep {
         self.awake_sum += self.awake as f64;
     }
 
-    /// The last solve's body wrenches joined with the sleeping islands'
-    /// frozen ones; its contact forces joined with theirs are left to be
-    /// made at their first read ([`Sleep::forces`]: nothing they are made of
-    /// changes before the next step's solve and its `compose`).
-    pub fn compose(&mut self, model: &Model, body: &[Force]) {
+    /// The step ends: the contact forces and body wrenches to report are
+    /// left to be made at their first read ([`Sleep::forces`],
+    /// [`Sleep::body_forces`]: nothing they are made of changes before the
+    /// next step's solve and its `compose`), from the mask kept here.
+    /// (Made eagerly, the awake bodies' wrenches were copied at every step:
+    /// the body wrench of each awake body the last solve's, `body`, each
+    /// masked one's its kept one, the world's the solve's.)
+    pub fn compose(&mut self) {
         if !self.any_asleep && !self.doze.any {
             return;
         }
         self.all_forces.take();
-        // the sleeping bodies' entries are their frozen wrenches (set when
-        // they fell asleep): the awake bodies' (the world's too) are copied
-        let get = |b: usize| body.get(b).copied().unwrap_or(Force::zero());
-        if let Some(out) = self.all_body.get_mut(0) {
-            *out = get(0);
-        }
-        for &t in &self.awake_trees {
-            if self.doze.left[t] > 0 {
-                continue;
-            }
-            for b in model.trees[t].bodies.clone() {
-                self.all_body[b] = get(b);
-            }
-        }
+        self.all_body.take();
+        self.composed.copy_from_slice(&self.body_asleep);
     }
     /// The contact forces to report: `awake` (the last solve's) joined with
     /// the frozen ones while anything sleeps.
@@ -537,7 +532,19 @@ impl Sleep {
     /// The body contact wrenches to report (as [`Sleep::forces`]).
     pub fn body_forces<'a>(&'a self, awake: &'a [Force]) -> &'a [Force] {
         if self.any_asleep || self.doze.any {
-            &self.all_body
+            self.all_body.get_or_init(|| {
+                // (a body masked when the step ended: its kept wrench; a
+                // body of no tree but the world: none, as it never had one)
+                let get = |b: usize| awake.get(b).copied().unwrap_or(Force::zero());
+                let tree = &self.tree_of_body;
+                (0..self.frozen_body.len())
+                    .map(|b| match b {
+                        0 => get(0),
+                        _ if self.composed[b] || tree[b] == WORLD => self.frozen_body[b],
+                        _ => get(b),
+                    })
+                    .collect()
+            })
         } else {
             awake
         }
