@@ -40,21 +40,31 @@ impl super::super::Simulation {
         if let Some(w) = self.cons.push_velocity() {
             self.sleep.vw += w;
         }
+        let vw = self.sleep.vw.as_slice();
         // (the awake trees' bodies: a tree's bodies are one range after their
         // parents, whose root hangs from the world; sleeping ones are not read)
         // (a body on the world: its parent's velocity is zero, moved into its
         // frame a zero but for the signs of its zeros; these velocities are
         // read only by the speed tests' norms, here and in a dozing step's
         // `account_sleep`, until the energy pass writes them anew)
+        // (the joint kind matched by the key `data.dispatch` keeps for each
+        // body, not found again from the joint at each use)
+        use crate::model::JointModel as _;
         data.v[0] = crate::spatial::Motion::zero();
         for &t in self.sleep.awake_trees() {
-            for i in model.trees[t].bodies.clone() {
+            let tree = &model.trees[t];
+            for i in tree.bodies.clone() {
                 let p = model.parent[i];
                 let mut vi = match p {
                     0 => crate::spatial::Motion::zero(),
                     _ => data.li_m_i[i].inv_act_motion(&data.v[p]),
                 };
-                model.joints[i].add_motion(&mut vi, &self.sleep.vw);
+                match data.dispatch.get(i) {
+                    Some(&key) => crate::model::dispatch_keyed!(
+                        &model.joints[i], key, false, jm => jm.add_motion(&mut vi, vw)
+                    ),
+                    None => model.joints[i].add_motion(&mut vi, &self.sleep.vw),
+                }
                 data.v[i] = vi;
             }
         }
@@ -114,6 +124,6 @@ impl super::super::Simulation {
             self.cons.hold_warm(&self.sleep.doze.held);
             self.sleep.doze.unhold();
         }
-        self.sleep.compose(&self.model, self.cons.body_forces());
+        self.sleep.compose();
     }
 }
