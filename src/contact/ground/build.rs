@@ -229,6 +229,8 @@ impl GroundContact {
                 },
                 link,
                 placement: g.placement,
+                at_body: g.placement.rot == nalgebra::Matrix3::identity()
+                    && g.placement.trans == Vector3::zeros(),
                 parry_offset,
                 shape,
                 manifold,

@@ -57,6 +57,9 @@ pub struct GroundShape {
     pub link: String,
     /// `body_M_geom` (URDF geometry frame).
     pub placement: Se3<f64>,
+    /// `placement` is exactly the identity: the geometry's pose is its
+    /// body's (no compose in the detection; see [`GroundShape::pose`]).
+    at_body: bool,
     /// `geom_M_parry` (parry's own shape frame).
     parry_offset: Se3<f64>,
     shape: ParryShape,
@@ -94,6 +97,21 @@ pub(super) struct Cull {
     bound: f64,
     /// `low_box`, when there is one.
     low_box: Option<([f64; 3], [f64; 3])>,
+}
+
+impl GroundShape {
+    /// The geometry's world pose `o_m_b · placement`, its body's pose itself
+    /// when the placement is the identity (the compose skipped: R·I and
+    /// R·0 + t give back R and t but for the sign of a zero sum, which no
+    /// point's sum of nonzero terms keeps).
+    #[inline(always)]
+    pub(super) fn pose(&self, o_m_b: &Se3<f64>) -> Se3<f64> {
+        if self.at_body {
+            *o_m_b
+        } else {
+            o_m_b.compose(&self.placement)
+        }
+    }
 }
 
 impl Cull {
@@ -340,7 +358,7 @@ impl GroundContact {
             else {
                 continue;
             };
-            let o_m_g = o_m_b.compose(&s.placement);
+            let o_m_g = s.pose(o_m_b);
             self.queries += 1;
             // a hull or point set: its lowest vertex is its support point toward
             // −z; only the heights are needed to find it and the candidates
@@ -447,6 +465,9 @@ pub(super) struct Plain<'a> {
     reduce_dirs: &'a [(f64, f64); MAX_DIRS],
 }
 
+/// A vertex set this small keeps its heights on the stack ([`plain_points`]).
+const SMALL_SET: usize = 8;
+
 /// Shape `si` (`s`, not a hull searched on its graph) at the geometry
 /// pose `o_m_g`: its points within `margin` reduced into `out` (`scratch`:
 /// its candidates).
@@ -472,13 +493,27 @@ fn plain_points(
             let p = o_m_g.act_point(&s.verts[k]);
             scratch.push(s.contact_at(si, base + k, p, ground));
         };
-        // a small vertex set: scanned whole
-        let low = s.verts.iter().map(height).fold(f64::INFINITY, f64::min);
+        // a small vertex set: scanned whole (up to a box's 8 vertices, the
+        // heights kept for the second pass: the same values)
+        let small = s.verts.len() <= SMALL_SET;
+        let mut hs = [0.0; SMALL_SET];
+        let low = if small {
+            for (h, v) in hs.iter_mut().zip(&s.verts) {
+                *h = height(v);
+            }
+            hs[..s.verts.len()]
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min)
+        } else {
+            s.verts.iter().map(height).fold(f64::INFINITY, f64::min)
+        };
         if low > margin {
             return;
         }
         for (k, v) in s.verts.iter().enumerate() {
-            if height(v) <= margin {
+            let h = if small { hs[k % SMALL_SET] } else { height(v) };
+            if h <= margin {
                 candidate(k);
             }
         }

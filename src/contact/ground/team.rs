@@ -191,7 +191,7 @@ impl GroundContact {
                     else {
                         continue;
                     };
-                    let o_m_g = o_m_b.compose(&s.placement);
+                    let o_m_g = s.pose(o_m_b);
                     *queries += 1;
                     plain_points(s, a + j, &o_m_g, margin, &cx, scratch, points);
                 }
