@@ -3,6 +3,30 @@
 //! the same order as the scalar row-by-row loop, four lanes at a time where
 //! AVX is enabled.
 
+/// `$run` with the slices named cut to 6 or 12 entries when `$n` is that
+/// length (a free body's path, two free bodies': a loop of that known trip
+/// count, which LLVM unrolls whole, with no loop bookkeeping), else with the
+/// slices as they are: the same operations in the same order either way.
+/// `$n` must be ≤ every named slice's length.
+macro_rules! at_path_len {
+    ($n:expr; $($s:ident),+ => $run:expr) => {
+        match $n {
+            6 => {
+                // SAFETY: 6 = n ≤ every slice's length (the caller's)
+                $( let $s = unsafe { $s.get_unchecked(..6) }; )+
+                $run
+            }
+            12 => {
+                // SAFETY: 12 = n ≤ every slice's length (the caller's)
+                $( let $s = unsafe { $s.get_unchecked(..12) }; )+
+                $run
+            }
+            _ => $run,
+        }
+    };
+}
+pub(super) use at_path_len;
+
 /// Σₜ lₜ x[pₜ] in each of the four lanes of `l` (a contact's three rows of
 /// y interleaved, `Rows::ylanes`), each lane a sum from 0 in path order; the
 /// indices of `p` must be < `x.len()` (a row's path: dof indices < nv).
@@ -20,20 +44,7 @@ pub(super) fn dot3(l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
 /// in the same order.
 #[inline(always)]
 pub(super) fn dot3_from(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
-    let n = p.len().min(l.len());
-    // SAFETY: n ≤ both lengths
-    let cut = |m: usize| unsafe { (l.get_unchecked(..m), p.get_unchecked(..m)) };
-    match n {
-        6 => {
-            let (l, p) = cut(6);
-            dot3_run(s0, l, p, x)
-        }
-        12 => {
-            let (l, p) = cut(12);
-            dot3_run(s0, l, p, x)
-        }
-        _ => dot3_run(s0, l, p, x),
-    }
+    at_path_len!(p.len().min(l.len()); l, p => dot3_run(s0, l, p, x))
 }
 
 /// [`dot3_from`]'s loop (over the shorter of `l` and `p`).
@@ -256,27 +267,8 @@ fn path3<S: Sum3>(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
     let n = p.len().min(ys[0].len()).min(ys[1].len()).min(ys[2].len());
     // a free body's path (6 dofs) and two free bodies' (12) at their fixed
     // length, unrolled whole ([`dot3_from`]'s): the same lanes
-    // SAFETY: n ≤ every slice's length
-    let cut = |m: usize| unsafe {
-        let [y0, y1, y2] = ys;
-        let y = [
-            y0.get_unchecked(..m),
-            y1.get_unchecked(..m),
-            y2.get_unchecked(..m),
-        ];
-        (y, p.get_unchecked(..m))
-    };
-    match n {
-        6 => {
-            let (ys, p) = cut(6);
-            path3_run::<S>(a, ys, p, x, 6)
-        }
-        12 => {
-            let (ys, p) = cut(12);
-            path3_run::<S>(a, ys, p, x, 12)
-        }
-        _ => path3_run::<S>(a, ys, p, x, n),
-    }
+    let [y0, y1, y2] = ys;
+    at_path_len!(n; y0, y1, y2, p => path3_run::<S>(a, [y0, y1, y2], p, x, n))
 }
 
 /// [`path3`]'s loops over the first `n` slots (n ≤ every slice's length).
@@ -368,20 +360,7 @@ fn path3_run<S: Sum3>(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64], 
 /// or 12 as [`axpy1`]; the indices of `p` must be < `x.len()`.
 #[inline(always)]
 pub(super) fn dot1_from(s0: f64, y: &[f64], p: &[usize], x: &[f64]) -> f64 {
-    let n = p.len().min(y.len());
-    // SAFETY: n ≤ both lengths
-    let cut = |m: usize| unsafe { (y.get_unchecked(..m), p.get_unchecked(..m)) };
-    match n {
-        6 => {
-            let (y, p) = cut(6);
-            dot1_run(s0, y, p, x)
-        }
-        12 => {
-            let (y, p) = cut(12);
-            dot1_run(s0, y, p, x)
-        }
-        _ => dot1_run(s0, y, p, x),
-    }
+    at_path_len!(p.len().min(y.len()); y, p => dot1_run(s0, y, p, x))
 }
 
 /// [`dot1_from`]'s loop (over the shorter of `y` and `p`).
@@ -403,20 +382,7 @@ fn dot1_run(s0: f64, y: &[f64], p: &[usize], x: &[f64]) -> f64 {
 /// dof indices < nv).
 #[inline(always)]
 pub(super) fn axpy1(a: f64, y: &[f64], p: &[usize], x: &mut [f64]) {
-    let n = p.len().min(y.len());
-    // SAFETY: n ≤ both lengths
-    let cut = |m: usize| unsafe { (y.get_unchecked(..m), p.get_unchecked(..m)) };
-    match n {
-        6 => {
-            let (y, p) = cut(6);
-            axpy1_run(a, y, p, x)
-        }
-        12 => {
-            let (y, p) = cut(12);
-            axpy1_run(a, y, p, x)
-        }
-        _ => axpy1_run(a, y, p, x),
-    }
+    at_path_len!(p.len().min(y.len()); y, p => axpy1_run(a, y, p, x))
 }
 
 /// [`axpy1`]'s loop (over the shorter of `y` and `p`).
@@ -436,25 +402,7 @@ fn axpy1_run(a: f64, y: &[f64], p: &[usize], x: &mut [f64]) {
 #[inline(always)]
 pub(super) fn axpy2(a: [f64; 2], y0: &[f64], y1: &[f64], p: &[usize], x: &mut [f64]) {
     let n = p.len().min(y0.len()).min(y1.len());
-    // SAFETY: n ≤ every length
-    let cut = |m: usize| unsafe {
-        (
-            y0.get_unchecked(..m),
-            y1.get_unchecked(..m),
-            p.get_unchecked(..m),
-        )
-    };
-    match n {
-        6 => {
-            let (y0, y1, p) = cut(6);
-            axpy2_run(a, y0, y1, p, x)
-        }
-        12 => {
-            let (y0, y1, p) = cut(12);
-            axpy2_run(a, y0, y1, p, x)
-        }
-        _ => axpy2_run(a, y0, y1, p, x),
-    }
+    at_path_len!(n; y0, y1, p => axpy2_run(a, y0, y1, p, x))
 }
 
 /// [`axpy2`]'s loop (over the shortest of `y0`, `y1` and `p`).

@@ -2,7 +2,7 @@
 //! its lower triangle formed a pair of row groups at a time (a contact's
 //! three rows side by side), entries kept from the solve's last W_FF copied.
 
-use super::kernels::dot3;
+use super::kernels::{at_path_len, dot3};
 use super::subspace::Subspace;
 
 impl Subspace {
@@ -350,20 +350,7 @@ impl<'a> Lanes<'a> {
 /// length, unrolled whole (as `kernels::dot3_from`): the same sums.
 #[inline(always)]
 fn dot3x3(l: &[[f64; 4]], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 4]; 3] {
-    let n = p.len().min(l.len());
-    // SAFETY: n ≤ both lengths
-    let cut = |m: usize| unsafe { (l.get_unchecked(..m), p.get_unchecked(..m)) };
-    match n {
-        6 => {
-            let (l, p) = cut(6);
-            dot3x3_run(l, p, x3)
-        }
-        12 => {
-            let (l, p) = cut(12);
-            dot3x3_run(l, p, x3)
-        }
-        _ => dot3x3_run(l, p, x3),
-    }
+    at_path_len!(p.len().min(l.len()); l, p => dot3x3_run(l, p, x3))
 }
 
 /// [`dot3x3`]'s loop (over the shorter of `l` and `p`).
