@@ -4,8 +4,9 @@
 use nalgebra::Vector3;
 
 /// Two unit tangents completing the unit normal n to a right-handed frame
-/// (t₁, t₂, n); x and y for n = +z.
-#[inline]
+/// (t₁, t₂, n); x and y for n = +z. (Always inlined: the contact rows' hot
+/// loops, whose inlining otherwise follows the crate's codegen split.)
+#[inline(always)]
 pub fn tangents(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     if n.x == 0.0 && n.y == 0.0 && n.z > 0.0 {
         return (Vector3::x(), Vector3::y());

@@ -28,6 +28,10 @@ impl PairContact {
         let maxp = self.max_points;
         let self_pair = self.model_of[a].is_some() && self.model_of[a] == self.model_of[b];
         let ord = ga.min(gb) * self.ngeoms + ga.max(gb);
+        // (still numbered in visiting order: ranked with those before it)
+        if self.ranked == self.ords.len() && self.ords.last().is_none_or(|&l| l <= ord) {
+            self.ranked += 1;
+        }
         self.ords.push(ord);
         self.keys.extend(std::iter::repeat_n(NO_KEY, maxp));
         self.dropped.push(false);

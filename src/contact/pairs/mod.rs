@@ -99,6 +99,13 @@ pub struct PairContact {
     dropped: Vec<bool>,
     /// Pairs made since they were last put in visiting order ([`order`]).
     made_since_sort: usize,
+    /// Pairs `0..ranked` are numbered in visiting order (their `ords`
+    /// ascend); the pairs made since follow ([`order`]).
+    ranked: usize,
+    /// Scratch of [`Self::by_ord`]: the ranked pairs overlapping, a bit each,
+    /// and the others as (ord, pair).
+    seen: Vec<u64>,
+    tail: Vec<(u64, u32)>,
     /// The pair of members i, j (`table.get(i, j)`: none allowed, allowed
     /// and not made yet, or its index).
     table: PairTable,
@@ -274,6 +281,9 @@ impl PairContact {
             keys: Vec::new(),
             dropped: Vec::new(),
             made_since_sort: 0,
+            ranked: 0,
+            seen: Vec::new(),
+            tail: Vec::new(),
         };
         // self pairs now (rule 4 looks at them before the first step)
         for a in 0..n {
@@ -451,13 +461,11 @@ impl PairContact {
                 let (i, j) = self.fresh[f];
                 ids.push(self.make_pair(i as usize, j as usize));
             }
-            self.overlapping
-                .extend(ids.iter().map(|&p| (self.ords[p as usize], p)));
-            self.sap_ids = ids;
             // the pairs not overlapping forget their points
-            // (sorted: the same order every step, whatever the sweep's or the
+            // (by ord: the same order every step, whatever the sweep's or the
             // order the pairs were made in)
-            self.overlapping.sort_unstable();
+            self.by_ord(&ids);
+            self.sap_ids = ids;
         }
         // visited: the overlapping pairs and those that held anything
         self.visit.clear();
