@@ -18,6 +18,7 @@ mod chain6;
 mod elim;
 mod rows;
 mod unroll;
+mod zeros;
 
 use super::factor_dense::{dense_backward, dense_forward};
 use crate::dynamics::crba_packed;
@@ -104,6 +105,10 @@ pub struct MassFactor {
     /// (root, root + 1, …, the dof: a floating base's six), whose packed rows
     /// then lie back to back as one triangle.
     root_chain: Vec<bool>,
+    /// Tree, lone free bodies: per dof, L's row and its ancestors' rows are
+    /// all zeros (either sign): the chain eliminations skip their steps on
+    /// plain rows (zeros.rs). False on every other model.
+    zero_l: Vec<bool>,
     /// Tree: every body a lone free body on the world (each tree one body).
     /// H is then each body's spatial inertia in its body frame (the free
     /// joint's S = 1, docs/theory.md §"Floating base"), the same numbers at
@@ -209,6 +214,7 @@ impl MassFactor {
             dval: vec![1.0; if tree { n } else { 0 }],
             mult: vec![0.0; if tree { 3 * n } else { 0 }],
             root_chain,
+            zero_l: vec![false; n],
         };
         f.check_lone_ranges();
         f
@@ -354,7 +360,9 @@ impl MassFactor {
         let tiny = 64.0 * f64::EPSILON;
         for r in 0..self.ranges().len() {
             let (k0, k1) = self.ranges()[r];
-            self.factor_range(k0, k1, tiny)?;
+            let r = self.factor_range(k0, k1, tiny);
+            self.mark_zeros(k0, k1, r.is_ok());
+            r?;
         }
         Ok(())
     }

@@ -4,6 +4,7 @@
 //! four lanes at once.
 
 use super::super::factor_dense::dense_forward;
+use super::zeros::plain;
 use super::MassFactor;
 use crate::dynamics::linalg::by_size;
 
@@ -294,8 +295,15 @@ impl MassFactor {
         let Some(path) = path.get(..N) else {
             return false;
         };
+        // (L zero on the chain and both sides plain: no step changes a bit, zeros.rs)
+        let zero = path.last().is_some_and(|&d| self.zero_chain(d));
+        let steps = if zero && plain(w.as_flattened()) && plain(v.as_flattened()) {
+            1
+        } else {
+            N
+        };
         // y[j] −= L[path[t], path[j]]·y[t] for t from the leaf in, both sides
-        for t in (1..N).rev() {
+        for t in (1..steps).rev() {
             let (a, b) = (w[t], v[t]);
             let s = self.start[path[t]];
             let Some(anc) = self.anc.get(s..s + t) else {
@@ -377,11 +385,14 @@ impl MassFactor {
         let Some(path) = path.get(..N).filter(|_| N <= 16) else {
             return false;
         };
+        // (L zero on the chain and the rows plain: no step changes a bit, zeros.rs)
+        let zero = path.last().is_some_and(|&d| self.zero_chain(d));
+        let steps = !(zero && plain(w.as_flattened()));
         // the step at each t from the leaf in, t a constant (the loop written
         // out: each step's loop over y[..t] unrolled, no loop over t)
         macro_rules! steps {
             ($($t:literal)*) => {$(
-                if $t < N {
+                if steps && $t < N {
                     let (Some(&a), Some(&d)) = (w.get($t), path.get($t)) else {
                         return false;
                     };

@@ -1,0 +1,141 @@
+//! L's exact zeros on a lone free body's chain (docs/theory.md §"Tree-sparse
+//! LTDL"): a body whose frame sits at its centre of mass on its principal
+//! axes (a pile's box, ball or cylinder) has H̃ diagonal, so every entry of
+//! L along its chain is ±0, and each step of a row's elimination, y[j] −=
+//! l·y[t], subtracts a zero. On rows whose entries are all finite and none
+//! is −0, no such step changes a bit (below), and the steps are skipped.
+//!
+//! Why: with y[t] finite, l·y[t] is ±0; x − (±0) is x for every x ≠ 0, and
+//! +0 − (±0) is +0; so a step leaves every entry that is not −0 as it was,
+//! and by induction from the leaf in every y[t] a later step reads is still
+//! its finite input. (An entry of −0 would turn +0 where the product is −0:
+//! those rows, and rows with an entry ±∞ or NaN, take every step.)
+
+use super::MassFactor;
+
+impl MassFactor {
+    /// After the factor of dofs `[k0, k1)` (whole trees; `ok`: it succeeded):
+    /// marks each dof whose row of L and every ancestor's row are zeros
+    /// (either sign). On a model of lone free bodies only (its factor is
+    /// made again only when H̃ changes); no dof of any other model is
+    /// marked, the scan kept out of a robot's every step.
+    pub(super) fn mark_zeros(&mut self, k0: usize, k1: usize, ok: bool) {
+        if !self.lone_free {
+            return;
+        }
+        for k in k0..k1.min(self.zero_l.len()) {
+            let (s, l) = (self.start[k], self.len[k]);
+            // (the last ancestor on k's path is its parent, below k: marked already)
+            let parent = l < 2 || self.zero_l.get(self.table[s + l - 2]) == Some(&true);
+            let own = self
+                .anc
+                .get(s..s + l - 1)
+                .is_some_and(|a| a.iter().all(|&x| x == 0.0));
+            self.zero_l[k] = ok && own && parent;
+        }
+    }
+
+    /// Whether L is zero on every row of the chain root … `leaf`.
+    #[inline(always)]
+    pub(super) fn zero_chain(&self, leaf: usize) -> bool {
+        self.zero_l.get(leaf) == Some(&true)
+    }
+}
+
+/// Every entry of `x` finite and none −0: rows whose elimination on a chain
+/// of zeros ([`MassFactor::zero_chain`]) changes no bit. (Without SSE4.1 a
+/// +0 is refused too: one float compare for both signs.)
+///
+/// Finite by each lane's sum: a term ±∞ or NaN leaves a sum ±∞ or NaN
+/// whatever follows, so a finite sum has finite terms (an overflow only
+/// sends the caller the long way). In vector lanes: the test is a few
+/// instructions a register, the steps it spares dozens.
+#[inline(always)]
+pub(super) fn plain(x: &[f64]) -> bool {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    {
+        use std::arch::x86_64::*;
+        let mut quads = x.chunks_exact(4);
+        // SAFETY: AVX2 is enabled for this build (the cfg); each load is of
+        // the four f64 of one chunk
+        let (sum, neg_zero) = unsafe {
+            let m = _mm256_set1_epi64x(NEG_ZERO);
+            let (mut s, mut z) = (_mm256_setzero_pd(), _mm256_setzero_si256());
+            for q in &mut quads {
+                let v = _mm256_loadu_pd(q.as_ptr());
+                s = _mm256_add_pd(s, v);
+                z = _mm256_or_si256(z, _mm256_cmpeq_epi64(_mm256_castpd_si256(v), m));
+            }
+            let mut a = [0.0f64; 4];
+            _mm256_storeu_pd(a.as_mut_ptr(), s);
+            (a, _mm256_movemask_pd(_mm256_castsi256_pd(z)) != 0)
+        };
+        tail(sum, neg_zero, quads.remainder())
+    }
+    #[cfg(all(target_arch = "x86_64", not(target_feature = "avx2")))]
+    {
+        use std::arch::x86_64::*;
+        let mut pairs = x.chunks_exact(2);
+        // SAFETY: SSE2 is every x86_64's (SSE4.1 where the cfg says); each
+        // load is of the two f64 of one chunk
+        let (sum, neg_zero) = unsafe {
+            let (mut s, mut z) = (_mm_setzero_pd(), _mm_setzero_pd());
+            for p in &mut pairs {
+                let v = _mm_loadu_pd(p.as_ptr());
+                s = _mm_add_pd(s, v);
+                #[cfg(target_feature = "sse4.1")]
+                let hit = _mm_castsi128_pd(_mm_cmpeq_epi64(
+                    _mm_castpd_si128(v),
+                    _mm_set1_epi64x(NEG_ZERO),
+                ));
+                #[cfg(not(target_feature = "sse4.1"))]
+                let hit = _mm_cmpeq_pd(v, _mm_setzero_pd());
+                z = _mm_or_pd(z, hit);
+            }
+            let mut a = [0.0f64; 2];
+            _mm_storeu_pd(a.as_mut_ptr(), s);
+            (a, _mm_movemask_pd(z) != 0)
+        };
+        tail(sum, neg_zero, pairs.remainder())
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    tail([0.0], false, x)
+}
+
+/// The bits of −0 (as the lanes' integer compare takes them).
+#[cfg(target_arch = "x86_64")]
+const NEG_ZERO: i64 = i64::MIN;
+
+/// [`plain`] of the lanes' sums and −0 test so far and the entries left.
+#[inline(always)]
+fn tail<const K: usize>(mut sum: [f64; K], neg_zero: bool, rest: &[f64]) -> bool {
+    let mut neg_zero = neg_zero;
+    for &v in rest {
+        sum[0] += v;
+        neg_zero |= v.to_bits() == 1 << 63;
+    }
+    !neg_zero && sum.iter().all(|s| s.is_finite())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::plain;
+
+    #[test]
+    fn plain_rows() {
+        assert!(plain(&[1.0, -2.0, 0.5, 3.5, -1e-300]));
+        assert!(
+            plain(&[0.0, 1.0, 2.0, 0.0, 4.0, 5.0, 6.0, 0.0, 8.0])
+                || cfg!(not(target_feature = "sse4.1"))
+        );
+        assert!(!plain(&[1.0, -0.0, 2.0]));
+        assert!(!plain(&[1.0, 2.0, 3.0, 4.0, 5.0, -0.0]));
+        assert!(!plain(&[1.0, 2.0, 3.0, -0.0, 5.0, 6.0, 7.0, 8.0]));
+        assert!(!plain(&[1.0, 2.0, -0.0]));
+        assert!(!plain(&[f64::INFINITY, 1.0]));
+        assert!(!plain(&[1.0, f64::NEG_INFINITY, f64::INFINITY, 2.0]));
+        assert!(!plain(&[1.0, 2.0, f64::NAN]));
+        // an overflowing sum only refuses (the long way is exact too)
+        assert!(!plain(&[f64::MAX, 1.0, f64::MAX]));
+    }
+}
