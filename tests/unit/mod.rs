@@ -20,6 +20,7 @@ mod contact_hull;
 mod contact_narrow;
 mod contact_prim;
 mod contact_travel;
+mod factor_zeros;
 mod mesh_cache;
 mod mesh_dae;
 mod mesh_inertia;
