@@ -6,9 +6,9 @@
 //! and takes every step), on plain entries and on the entries that take the
 //! steps (a −0 that a step turns +0, a +0, ±∞, NaN).
 
-use nalgebra::DVector;
+use super::piles_chain6::factor;
 use urdyn::sim::factor::MassFactor;
-use urdyn::{Data, Model};
+use urdyn::Model;
 
 /// Three free bodies, each geom at its body's origin on its axes: every
 /// off-diagonal entry of H a zero (some −0: the skew of a zero first moment).
@@ -24,26 +24,6 @@ const BODIES: &str = r#"
 fn model(extra: &str) -> Model {
     let xml = format!("<mujoco><worldbody>{BODIES}{extra}</worldbody></mujoco>");
     urdyn::mjcf::load_str(&xml, "factor_zeros.xml", std::path::Path::new(".")).expect("mjcf")
-}
-
-fn factor(m: &Model) -> MassFactor {
-    let mut q: DVector<f64> = m.neutral();
-    for k in 0..m.nq {
-        q[k] += 0.3 * ((k as f64) * 1.7).sin();
-    }
-    for b in 0..3 {
-        let at = 7 * b + 3;
-        let n = q.rows(at, 4).norm();
-        for r in 0..4 {
-            q[at + r] /= n;
-        }
-    }
-    let mut f = MassFactor::new(m);
-    let r = f.factor_at(m, &mut Data::new(m), q.as_slice(), false, |k| {
-        0.01 + 0.001 * k as f64
-    });
-    assert_eq!(r, Some(Ok(())));
-    f
 }
 
 /// The entries' cases: plain; a −0 at the root slot (the step of the leaf's
@@ -73,7 +53,7 @@ fn zero_chains_take_every_steps_bits() {
         r#"<body name="arm" pos="0 0 2"><joint type="hinge" axis="0 1 0"/>
              <geom type="capsule" size="0.05 0.3" mass="1"/></body>"#,
     );
-    let (fl, fm) = (factor(&lone), factor(&mixed));
+    let (fl, fm) = (factor(&lone).0, factor(&mixed).0);
     let path = |f: &MassFactor, dof: usize| {
         let (s, l) = f.path_of(dof);
         f.table()[s..s + l].to_vec()

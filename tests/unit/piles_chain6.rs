@@ -28,7 +28,7 @@ fn model(extra: &str) -> Model {
 /// The model's factor of H̃ = H(q) + [`diag`] at a pose q away from the
 /// neutral one (the free bodies' coordinates the same in every model: they
 /// come first), and q.
-fn factor(m: &Model) -> (MassFactor, DVector<f64>) {
+pub(super) fn factor(m: &Model) -> (MassFactor, DVector<f64>) {
     let mut q: DVector<f64> = m.neutral();
     for k in 0..m.nq {
         q[k] += 0.3 * ((k as f64) * 1.7).sin();
