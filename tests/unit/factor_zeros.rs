@@ -6,7 +6,7 @@
 //! and takes every step), on plain entries and on the entries that take the
 //! steps (a −0 that a step turns +0, a +0, ±∞, NaN).
 
-use super::piles_chain6::factor;
+use super::piles_chain6::{factor, ARM};
 use urdyn::sim::factor::MassFactor;
 use urdyn::Model;
 
@@ -49,10 +49,7 @@ fn same(a: &[f64], b: &[f64], what: &str) {
 #[test]
 fn zero_chains_take_every_steps_bits() {
     let lone = model("");
-    let mixed = model(
-        r#"<body name="arm" pos="0 0 2"><joint type="hinge" axis="0 1 0"/>
-             <geom type="capsule" size="0.05 0.3" mass="1"/></body>"#,
-    );
+    let mixed = model(ARM);
     let (fl, fm) = (factor(&lone).0, factor(&mixed).0);
     let path = |f: &MassFactor, dof: usize| {
         let (s, l) = f.path_of(dof);

@@ -20,6 +20,11 @@ const BODIES: &str = r#"
     <geom type="capsule" size="0.05 0.2" pos="0 0.02 0.03" euler="0 30 0" mass="0.4"/></body>
 "#;
 
+/// A hinged body beside the free ones: a model that is not all lone free
+/// bodies (its factor takes the general loops).
+pub(super) const ARM: &str = r#"<body name="arm" pos="0 0 2"><joint type="hinge" axis="0 1 0"/>
+  <geom type="capsule" size="0.05 0.3" mass="1"/></body>"#;
+
 fn model(extra: &str) -> Model {
     let xml = format!("<mujoco><worldbody>{BODIES}{extra}</worldbody></mujoco>");
     urdyn::mjcf::load_str(&xml, "piles_chain6.xml", std::path::Path::new(".")).expect("mjcf")
@@ -53,10 +58,7 @@ fn diag(k: usize) -> f64 {
 #[test]
 fn lone_free_solves_take_the_general_loops_bits() {
     let lone = model("");
-    let mixed = model(
-        r#"<body name="arm" pos="0 0 2"><joint type="hinge" axis="0 1 0"/>
-             <geom type="capsule" size="0.05 0.3" mass="1"/></body>"#,
-    );
+    let mixed = model(ARM);
     assert_eq!((lone.nv, mixed.nv), (18, 19));
     let (fl, fm) = (factor(&lone).0, factor(&mixed).0);
     let b = |n: usize| DVector::from_fn(n, |k, _| ((k as f64) * 0.9).cos() + 0.1);
