@@ -103,7 +103,10 @@ pub(super) fn plain(x: &[f64]) -> bool {
 }
 
 /// The bits of −0 (as the lanes' integer compare takes them).
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(
+    target_arch = "x86_64",
+    any(target_feature = "avx2", target_feature = "sse4.1")
+))]
 const NEG_ZERO: i64 = i64::MIN;
 
 /// [`plain`] of the lanes' sums and −0 test so far and the entries left.
