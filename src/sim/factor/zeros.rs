@@ -119,26 +119,3 @@ fn tail<const K: usize>(mut sum: [f64; K], neg_zero: bool, rest: &[f64]) -> bool
     }
     !neg_zero && sum.iter().all(|s| s.is_finite())
 }
-
-#[cfg(test)]
-mod tests {
-    use super::plain;
-
-    #[test]
-    fn plain_rows() {
-        assert!(plain(&[1.0, -2.0, 0.5, 3.5, -1e-300]));
-        assert!(
-            plain(&[0.0, 1.0, 2.0, 0.0, 4.0, 5.0, 6.0, 0.0, 8.0])
-                || cfg!(not(target_feature = "sse4.1"))
-        );
-        assert!(!plain(&[1.0, -0.0, 2.0]));
-        assert!(!plain(&[1.0, 2.0, 3.0, 4.0, 5.0, -0.0]));
-        assert!(!plain(&[1.0, 2.0, 3.0, -0.0, 5.0, 6.0, 7.0, 8.0]));
-        assert!(!plain(&[1.0, 2.0, -0.0]));
-        assert!(!plain(&[f64::INFINITY, 1.0]));
-        assert!(!plain(&[1.0, f64::NEG_INFINITY, f64::INFINITY, 2.0]));
-        assert!(!plain(&[1.0, 2.0, f64::NAN]));
-        // an overflowing sum only refuses (the long way is exact too)
-        assert!(!plain(&[f64::MAX, 1.0, f64::MAX]));
-    }
-}
