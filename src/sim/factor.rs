@@ -85,7 +85,7 @@ pub struct MassFactor {
     /// Per tree of the model (in order), its dof and body ranges, for the
     /// lists (`None`: a tree on the world body, never listed); `spans_cover`:
     /// the trees cover the model's dofs and bodies exactly.
-    spans: Vec<Option<((usize, usize), (usize, usize))>>,
+    spans: Vec<awake::TreeSpan>,
     spans_cover: bool,
     /// Tree, lone free bodies: every tree's dof range (the solves' ranges
     /// when none sleeps, `chain6`); else empty.
@@ -169,6 +169,7 @@ impl MassFactor {
             && model.parent.len() == nb
             && model.joints.len() == nb
             && (1..nb).all(|i| model.parent[i] == 0 && model.joints[i].kind == JointKind::Free);
+        let (spans, spans_cover) = awake::tree_spans(model, n);
         let mut f = Self {
             tree,
             n,
@@ -195,16 +196,8 @@ impl MassFactor {
             partial: false,
             ranges_mask: Vec::new(),
             ranges_partial: false,
-            spans: model
-                .trees
-                .iter()
-                .map(|t| {
-                    (t.bodies.start >= 1)
-                        .then_some(((t.v.start, t.v.end), (t.bodies.start, t.bodies.end)))
-                })
-                .collect(),
-            spans_cover: model.trees.iter().map(|t| t.v.len()).sum::<usize>() == n
-                && model.trees.iter().map(|t| t.bodies.len()).sum::<usize>() + 1 == model.nbodies,
+            spans,
+            spans_cover,
             lone_ranges: chain6::lone_ranges(model, n, lone_free),
             all: (0, n),
             table,
