@@ -136,6 +136,18 @@ fn arc_at((s, c): (f64, f64), k: &[f64; 4], (h, r): (f64, f64)) -> (f64, f64, f6
     (g, g1, g2)
 }
 
+/// h(φ) and h'(φ) ([`arc_at`]) at each of the arc's samples ([`SIN_COS`]),
+/// in one pass with no exit: the samples run in vector lanes (each lane the
+/// same operations as [`arc_at`] alone, so the same values).
+#[inline]
+fn at_samples(k: &[f64; 4], hr: (f64, f64)) -> ([f64; SAMPLES], [f64; SAMPLES]) {
+    let (mut g, mut g1) = ([0.0; SAMPLES], [0.0; SAMPLES]);
+    for (m, &sc) in SIN_COS.iter().enumerate() {
+        (g[m], g1[m], _) = arc_at(sc, k, hr);
+    }
+    (g, g1)
+}
+
 /// The least of h|t| + r√(1 − t²) over the arc, t = α cos φ + β sin φ,
 /// φ ∈ [0, π/2]: concave in |t|, so at an end of the range of |t|.
 #[inline]
@@ -247,22 +259,18 @@ pub fn rim_on_edge(cyl: &Cylinder, cub: &Cuboid, b_m_c: &Pose, side: bool) -> Op
             let kk = [a, b, al, be];
             // the samples, then Newton in each interval where h' turns
             // from falling to rising (each local least the samples part)
-            let mut prev = arc_at(SIN_COS[0], &kk, hr);
-            best = best.min(prev.0);
-            // apart along a sample (best < 0): the answer is None whatever
-            // follows (best only falls, and a found depth is ≥ 0 only if it
-            // is the best), so the rest of the arcs is not looked at
-            if best < 0.0 {
-                return None;
-            }
-            for (m, &sc) in SIN_COS.iter().enumerate().skip(1) {
-                let phi = m as f64 * step;
-                let next = arc_at(sc, &kk, hr);
-                best = best.min(next.0);
+            let (g, g1) = at_samples(&kk, hr);
+            for m in 0..SAMPLES {
+                best = best.min(g[m]);
+                // apart along a sample (best < 0): the answer is None
+                // whatever follows (best only falls, and a found depth is
+                // ≥ 0 only if it is the best), so the rest of the arcs is
+                // not looked at
                 if best < 0.0 {
                     return None;
                 }
-                if prev.1 < 0.0 && next.1 > 0.0 {
+                if m > 0 && g1[m - 1] < 0.0 && g1[m] > 0.0 {
+                    let phi = m as f64 * step;
                     let phi = newton(phi - step, phi, &kk, hr);
                     let sc = phi.sin_cos();
                     let g = arc_at(sc, &kk, hr).0;
@@ -271,7 +279,6 @@ pub fn rim_on_edge(cyl: &Cylinder, cub: &Cuboid, b_m_c: &Pose, side: bool) -> Op
                         found = Some((g, i, sj, sk, phi, sc));
                     }
                 }
-                prev = next;
             }
             // the side line on the edge: the kink t = 0, inside the arc
             // when α, β have opposite signs (n = ±u × eᵢ; after the
