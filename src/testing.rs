@@ -286,6 +286,18 @@ pub mod contact {
             .map(|r| (r.n, r.depth, r.rim, r.edge))
     }
 
+    /// `contact::narrow::cylinder::side::rim_in_side` of cylinder `a` at
+    /// `b_m_a` (its frame in b's) in cylinder `b`'s side: (normal from a into
+    /// b, depth, a's rim point, its foot on b's side), b's frame.
+    pub fn cylinder_rim_in_side(
+        a: &parry3d_f64::shape::Cylinder,
+        b: &parry3d_f64::shape::Cylinder,
+        b_m_a: &Pose,
+    ) -> Option<(PVec, f64, PVec, PVec)> {
+        crate::contact::narrow::cylinder::side::rim_in_side(a, b, b_m_a)
+            .map(|r| (r.n, r.depth, r.rim, r.edge))
+    }
+
     /// `contact::narrow::cylinder::apart::as_gjk`: a cylinder and a box apart
     /// near an edge or a corner as GJK's answer (shape 1's frame, the
     /// cylinder shape 1 when `cyl_first`), or None.

@@ -239,7 +239,7 @@ fn side_on_edge_matches_epa() {
 /// 1e-9, in all but the calls where a feature parry clips flips with the
 /// normal's last digits (a box face's choice at 45°, a point on a clip's
 /// boundary); returns (calls taken, calls matched).
-fn manifolds(
+pub(super) fn manifolds(
     a: &urdyn::testing::contact::PairShape,
     b: &urdyn::testing::contact::PairShape,
     seed: u64,

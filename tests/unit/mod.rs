@@ -15,6 +15,7 @@ mod contact_cylinder;
 mod contact_cylinder_apart;
 mod contact_cylinder_pfm;
 mod contact_cylinder_rim;
+mod contact_cylinder_side;
 mod contact_face;
 mod contact_hull;
 mod contact_narrow;

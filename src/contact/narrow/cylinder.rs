@@ -45,6 +45,7 @@ pub(crate) mod apart;
 mod boxed;
 pub(crate) mod pfm;
 pub(crate) mod rim;
+pub(crate) mod side;
 use boxed::box_feature;
 pub(crate) use boxed::box_on_cap;
 

@@ -20,7 +20,7 @@ use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
 use parry3d_f64::query::ContactManifold;
 use parry3d_f64::shape::{Cuboid, Cylinder, PolygonalFeatureMap};
 
-use super::{apart, rim};
+use super::{apart, rim, side};
 
 /// parry's `utils::COS_1_DEGREES` (crate-private there): the normal's tilt
 /// under which its generator keeps a manifold's points.
@@ -51,9 +51,10 @@ pub(crate) fn manifold(
     manifold_with(pos12, a, b, prediction, manifolds, true)
 }
 
-/// [`manifold`], a cylinder's rim on a box's edge ([`rim::rim_on_edge`], in
-/// place of GJK and EPA) and a cylinder apart from a box's edge or corner
-/// ([`apart`], in place of GJK) in closed form when `closed`.
+/// [`manifold`], a cylinder's rim on a box's edge ([`rim::rim_on_edge`]) or
+/// in another cylinder's side ([`side::rim_in_side`]), in place of GJK and
+/// EPA, and a cylinder apart from a box's edge or corner ([`apart`], in
+/// place of GJK) in closed form when `closed`.
 pub(crate) fn manifold_with(
     pos12: &Pose,
     a: &PairShape,
@@ -78,7 +79,15 @@ pub(crate) fn manifold_with(
         sb.as_cylinder(),
         sb.as_cuboid(),
     ) {
-        (Some(c1), _, Some(c2), _) => run(pos12, c1, c2, radii, prediction, manifolds, |_| None),
+        (Some(c1), _, Some(c2), _) => {
+            let rim = |_| {
+                closed
+                    .then(|| side::as_epa(c1, c2, pos12))
+                    .flatten()
+                    .map(|(p1, p2, n)| GJKResult::ClosestPoints(p1, p2, n))
+            };
+            run(pos12, c1, c2, radii, prediction, manifolds, rim)
+        }
         (Some(c1), _, _, Some(c2)) => {
             let rim = |max| {
                 closed

@@ -43,11 +43,11 @@ use parry3d_f64::shape::{Cuboid, Cylinder};
 
 /// How far off the kink (|n·u|, a side line on the edge: no one rim point)
 /// the rim's stationary point must lie to be taken.
-const OFF_SIDE: f64 = 1e-6;
+pub(super) const OFF_SIDE: f64 = 1e-6;
 
 /// How far off the cap's normal (1 − |n·u|): nearer, the rim point's
 /// azimuth (n's part across the axis, normalised) loses its digits.
-const OFF_CAP: f64 = 1e-12;
+pub(super) const OFF_CAP: f64 = 1e-12;
 
 /// The φ recorded for the kink (the side line on the edge): none of the
 /// arc's, which lie in [0, π/2].
@@ -66,7 +66,7 @@ const SIDE_ON_EDGE: bool = false;
 
 /// The samples of each edge's arc before Newton: φ = mπ/32 (the overlap
 /// on an arc may have two local leasts, ~30° apart in the tests).
-const SAMPLES: usize = 17;
+pub(super) const SAMPLES: usize = 17;
 
 /// (sin φ, cos φ) of the samples, φ = m (π/2)/16 (`f64::sin_cos` of those
 /// φ, written out: no sine at each sample; bit for bit, so at π/4 the sine
@@ -122,7 +122,7 @@ fn arc(phi: f64, k: &[f64; 4], hr: (f64, f64)) -> (f64, f64, f64) {
 
 /// [`arc`] at (sin φ, cos φ).
 #[inline]
-fn arc_at((s, c): (f64, f64), k: &[f64; 4], (h, r): (f64, f64)) -> (f64, f64, f64) {
+pub(super) fn arc_at((s, c): (f64, f64), k: &[f64; 4], (h, r): (f64, f64)) -> (f64, f64, f64) {
     let [a, b, al, be] = *k;
     let t = al * c + be * s;
     let tp = -al * s + be * c;
@@ -140,7 +140,7 @@ fn arc_at((s, c): (f64, f64), k: &[f64; 4], (h, r): (f64, f64)) -> (f64, f64, f6
 /// in one pass with no exit: the samples run in vector lanes (each lane the
 /// same operations as [`arc_at`] alone, so the same values).
 #[inline]
-fn at_samples(k: &[f64; 4], hr: (f64, f64)) -> ([f64; SAMPLES], [f64; SAMPLES]) {
+pub(super) fn at_samples(k: &[f64; 4], hr: (f64, f64)) -> ([f64; SAMPLES], [f64; SAMPLES]) {
     let (mut g, mut g1) = ([0.0; SAMPLES], [0.0; SAMPLES]);
     for (m, &sc) in SIN_COS.iter().enumerate() {
         (g[m], g1[m], _) = arc_at(sc, k, hr);
@@ -175,7 +175,7 @@ fn floor(al: f64, be: f64, (h, r): (f64, f64)) -> f64 {
 
 /// The least of h on [lo, hi] where h' < 0 at lo and > 0 at hi: Newton
 /// kept inside the bracket, else bisection. Returns φ.
-fn newton(mut lo: f64, mut hi: f64, k: &[f64; 4], hr: (f64, f64)) -> f64 {
+pub(super) fn newton(mut lo: f64, mut hi: f64, k: &[f64; 4], hr: (f64, f64)) -> f64 {
     let mut phi = 0.5 * (lo + hi);
     for _ in 0..60 {
         let (_, g1, g2) = arc(phi, k, hr);
