@@ -175,6 +175,7 @@ fn floor(al: f64, be: f64, (h, r): (f64, f64)) -> f64 {
 
 /// The least of h on [lo, hi] where h' < 0 at lo and > 0 at hi: Newton
 /// kept inside the bracket, else bisection. Returns φ.
+#[inline]
 pub(super) fn newton(mut lo: f64, mut hi: f64, k: &[f64; 4], hr: (f64, f64)) -> f64 {
     let mut phi = 0.5 * (lo + hi);
     for _ in 0..60 {

@@ -37,12 +37,21 @@ const BALL_SLACK: f64 = 1e-12;
 /// with cylinder `b` (module doc), b's frame: n from a into b, the depth,
 /// a's rim point and its foot on b's side (`edge`).
 pub fn rim_in_side(a: &Cylinder, b: &Cylinder, b_m_a: &Pose) -> Option<RimEdge> {
+    look(a, b, b_m_a).ok().flatten()
+}
+
+/// The shapes apart along a sampled direction (a negative overlap): no
+/// penetration, neither way round.
+struct Apart;
+
+/// [`rim_in_side`], or [`Apart`] when a sample found the shapes apart.
+fn look(a: &Cylinder, b: &Cylinder, b_m_a: &Pose) -> Result<Option<RimEdge>, Apart> {
     let hr = (a.half_height, a.radius);
     let c = b_m_a.translation;
     let u = b_m_a.rotation * Vector::Y;
     let rho_c = c.x.hypot(c.z);
     if !(rho_c > 0.0) {
-        return None;
+        return Ok(None);
     }
     // m toward c across b's axis, and the quarters either side of it
     let (x0, z0) = (c.x / rho_c, c.z / rho_c);
@@ -58,7 +67,7 @@ pub fn rim_in_side(a: &Cylinder, b: &Cylinder, b_m_a: &Pose) -> Option<RimEdge> 
         for m in 1..SAMPLES {
             // apart along a sample: GJK's case
             if g[m - 1] + b.radius < 0.0 {
-                return None;
+                return Err(Apart);
             }
             if g1[m - 1] < 0.0 && g1[m] > 0.0 {
                 let phi = m as f64 * step;
@@ -71,36 +80,39 @@ pub fn rim_in_side(a: &Cylinder, b: &Cylinder, b_m_a: &Pose) -> Option<RimEdge> 
             }
         }
     }
-    let (depth, phi, (s, co), d0, d1) = found?;
+    let Some((depth, phi, (s, co), d0, d1)) = found else {
+        return Ok(None);
+    };
     if !(depth > 0.0 && phi > 0.0 && phi < std::f64::consts::FRAC_PI_2) {
-        return None;
+        return Ok(None);
     }
     // n = −m; the rim point p = c + h sgn(n·u) u + r w
     let n = -(d0 * co + d1 * s);
     let nu = n.dot(u);
     if !(nu.abs() > OFF_SIDE && nu.abs() < 1.0 - OFF_CAP) {
-        return None;
+        return Ok(None);
     }
     let w = (n - u * nu) / (1.0 - nu * nu).sqrt();
     let rim = c + u * hr.0.copysign(nu) + w * hr.1;
     // the ball of radius d about p inside b
     let rho = rim.x.hypot(rim.z);
     if !(rho + depth <= b.radius + BALL_SLACK && rim.y.abs() + depth <= b.half_height) {
-        return None;
+        return Ok(None);
     }
-    Some(RimEdge {
+    Ok(Some(RimEdge {
         n,
         depth,
         rim,
         edge: rim - n * depth,
-    })
+    }))
 }
 
 /// [`rim_in_side`] as EPA's answer to parry's `contact_manifold_pfm_pfm`
 /// (points in shape 1's frame, the normal from shape 1 toward 2): shape 1's
-/// rim in shape 2's side, else shape 2's in shape 1's.
+/// rim in shape 2's side, else shape 2's in shape 1's (not looked for when
+/// the first found the shapes apart).
 pub fn as_epa(c1: &Cylinder, c2: &Cylinder, pos12: &Pose) -> Option<(Vector, Vector, Vector)> {
-    if let Some(re) = rim_in_side(c1, c2, &pos12.inverse()) {
+    if let Some(re) = look(c1, c2, &pos12.inverse()).ok()? {
         return Some((
             pos12.transform_point(re.rim),
             pos12.transform_point(re.edge),
