@@ -7,7 +7,7 @@
 //! any order, on any thread, with the same bits.
 
 use super::free::{self, Plan};
-use super::tables::{act_column, add_body, BodyHead};
+use super::tables::{add_body, BodyHead};
 use super::{common_ancestor, pos_target, speculative, Constraints, RowCounts, RowParams};
 use crate::contact::{tangents, ContactPoint};
 use crate::model::Model;
@@ -143,9 +143,7 @@ impl Constraints {
                         (self.cols.get(i), o_m_i.get(i), self.sw.get_mut(i))
                 {
                     *done = self.sw_stamp;
-                    for (s, c) in sw.iter_mut().zip(&cols.s).take(cols.nv) {
-                        *s = act_column(o, c);
-                    }
+                    cols.world(o, sw);
                     i = model.parent[i];
                 }
             }

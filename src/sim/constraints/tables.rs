@@ -5,7 +5,7 @@
 use crate::model::Model;
 use crate::spatial::ops::{add_cross, mat_vec};
 use crate::spatial::{Motion, Se3};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 /// Adds one body's entries to a contact's three rows `j` (the path's
 /// entries, `on_path` its dofs, ascending as every row path is, see
@@ -85,6 +85,7 @@ pub(crate) fn add_body_rows(
         s: [Column::of(Motion::zero()); 6],
         nv: cols.len().min(6),
         iv,
+        identity: false,
     };
     let mut sw = [Motion::zero(); 6];
     for ((c, w), &s) in bc.s.iter_mut().zip(&mut sw).zip(cols) {
@@ -163,6 +164,9 @@ pub(super) struct BodyColumns {
     pub(super) nv: usize,
     /// The joint's first velocity coordinate.
     pub(super) iv: usize,
+    /// The columns are S = 1, linear first (a free joint's): column k is
+    /// (lin e_k, 0) for k < 3, (0, e_{k−3}) after ([`BodyColumns::world`]).
+    pub(super) identity: bool,
 }
 
 /// What [`add_body`] reads of a body's joint besides its world columns: its
@@ -193,23 +197,51 @@ impl BodyHead {
     }
 }
 
-/// One subspace column and which of its parts are zero.
+/// One subspace column, which of its parts are zero and which are a unit
+/// axis.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Column {
     pub(super) s: Motion,
     pub(super) ang_zero: bool,
     pub(super) lin_zero: bool,
+    /// k where the angular part is exactly the unit axis e_k.
+    pub(super) ang_unit: Option<u8>,
+    /// k where the linear part is exactly the unit axis e_k.
+    pub(super) lin_unit: Option<u8>,
 }
 
 impl Column {
-    /// Column `s`, its zero parts marked (exactly zero vectors).
+    /// Column `s`, its zero parts marked (exactly zero vectors), and its
+    /// unit-axis parts (every column of a free joint's, S = 1).
     #[inline]
     pub(super) fn of(s: Motion) -> Self {
         Column {
             s,
             ang_zero: s.ang == Vector3::zeros(),
             lin_zero: s.lin == Vector3::zeros(),
+            ang_unit: unit_axis(&s.ang),
+            lin_unit: unit_axis(&s.lin),
         }
+    }
+}
+
+/// k where `x` is exactly the unit axis e_k.
+fn unit_axis(x: &Vector3<f64>) -> Option<u8> {
+    (0..3u8).find(|&k| *x == Vector3::ith(usize::from(k), 1.0))
+}
+
+/// `R x` for a column part `x` of [`Column`]: the column k of `R` where `x`
+/// is the unit axis e_k (`unit`), else [`mat_vec`]. The same values but for
+/// the sign of a zero (the products by 0 and 1 are exact for a finite R:
+/// each entry of R e_k is (±0 ± 0) + r, r itself unless r is a zero).
+#[inline(always)]
+fn rotate(r: &Matrix3<f64>, x: &Vector3<f64>, unit: Option<u8>) -> Vector3<f64> {
+    match unit {
+        Some(k) => {
+            let k = usize::from(k.min(2));
+            Vector3::new(r[(0, k)], r[(1, k)], r[(2, k)])
+        }
+        None => mat_vec(r, x),
     }
 }
 
@@ -219,6 +251,7 @@ impl BodyColumns {
             s: [Column::of(Motion::zero()); 6],
             nv: 0,
             iv: 0,
+            identity: false,
         };
         if let Some(j) = model.joints.get(i) {
             cols.iv = j.iv;
@@ -227,25 +260,57 @@ impl BodyColumns {
                 *c = Column::of(j.subspace_column(k));
             }
         }
+        cols.identity = cols.nv == 6
+            && (cols.s.iter().enumerate()).all(|(k, c)| match k < 3 {
+                true => c.ang_zero && c.lin_unit == Some(k as u8),
+                false => c.lin_zero && c.ang_unit == Some(k as u8 - 3),
+            });
         cols
+    }
+
+    /// The world-frame columns `sw` at pose `o`: [`act_column`] of each
+    /// (`nv` of them); S = 1 (`identity`) read off R, R's column k the
+    /// linear column k's and the angular column k's ω' (the values
+    /// [`act_column`] gives, [`rotate`]), v' = 0 + t × ω'.
+    #[inline(always)]
+    pub(super) fn world(&self, o: &Se3<f64>, sw: &mut [Motion; 6]) {
+        if !self.identity {
+            for (s, c) in sw.iter_mut().zip(&self.s).take(self.nv) {
+                *s = act_column(o, c);
+            }
+            return;
+        }
+        let (r, zero) = (&o.rot, Vector3::zeros());
+        for k in 0..3 {
+            let ang = Vector3::new(r[(0, k)], r[(1, k)], r[(2, k)]);
+            sw[k] = Motion {
+                lin: ang,
+                ang: zero,
+            };
+            sw[3 + k] = Motion {
+                lin: add_cross(&zero, &o.trans, &ang),
+                ang,
+            };
+        }
     }
 }
 
 /// `o.act_motion(&c.s)` (ω' = R ω, v' = R v + t × ω'), a zero part's
-/// products left out: the same values but for the sign of a zero, which no
-/// row keeps (J's entries are sums onto the +0 that [`Rows::clear`] left;
-/// the spin rows' sums start from 0 too).
+/// products left out and a unit axis's R e_k read off R ([`rotate`]): the
+/// same values but for the sign of a zero, which no row keeps (J's entries
+/// are sums onto the +0 that [`Rows::clear`] left; the spin rows' sums
+/// start from 0 too).
 #[inline(always)]
 pub(super) fn act_column(o: &Se3<f64>, c: &Column) -> Motion {
     let ang = if c.ang_zero {
         Vector3::zeros()
     } else {
-        mat_vec(&o.rot, &c.s.ang)
+        rotate(&o.rot, &c.s.ang, c.ang_unit)
     };
     let lin = if c.lin_zero {
         Vector3::zeros()
     } else {
-        mat_vec(&o.rot, &c.s.lin)
+        rotate(&o.rot, &c.s.lin, c.lin_unit)
     };
     Motion {
         lin: if c.ang_zero {

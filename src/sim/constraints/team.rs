@@ -13,7 +13,6 @@
 //! written by one thread, with the one-thread arithmetic.
 
 use super::point::{self, PointInputs};
-use super::tables::act_column;
 use super::{free, Constraints, RowCounts, RowParams, Team};
 use crate::contact::ContactPoint;
 use crate::model::Model;
@@ -176,9 +175,7 @@ impl Constraints {
                         // SAFETY: i < the columns' length (checked); body i
                         // listed once, in this chunk alone (see `Shared`)
                         let sw = unsafe { &mut *sh.sw.0.add(i) };
-                        for (s, c) in sw.iter_mut().zip(&c.s).take(c.nv) {
-                            *s = act_column(o, c);
-                        }
+                        c.world(o, sw);
                     }
                 }));
                 if r.is_err() {
