@@ -40,6 +40,28 @@ impl MassFactor {
     pub(super) fn zero_chain(&self, leaf: usize) -> bool {
         self.zero_l.get(leaf) == Some(&true)
     }
+
+    /// D^-½ on `path`, chains ending at `path[A − 1]` and `path[N − 1]` (one
+    /// where A = N), where L is zero on both and every row of `rows` is
+    /// plain: there each row's elimination changes no bit (above), and Y =
+    /// J·D^-½ entry by entry. None elsewhere (the rows take the steps).
+    #[inline(always)]
+    pub(crate) fn zero_scale<const A: usize, const N: usize>(
+        &self,
+        path: &[usize],
+        rows: &[&[f64; N]; 6],
+    ) -> Option<[f64; N]> {
+        let path: &[usize; N] = path.get(..N)?.try_into().ok()?;
+        let zero = A >= 1 && A <= N && self.zero_chain(path[A - 1]) && self.zero_chain(path[N - 1]);
+        if !(zero && plain_rows(&rows.map(|r| &r[..]))) {
+            return None;
+        }
+        let mut s = [0.0f64; N];
+        for (s, &k) in s.iter_mut().zip(path) {
+            *s = *self.inv_sqrt_d.get(k)?;
+        }
+        Some(s)
+    }
 }
 
 /// Every entry of `x` finite and none −0: rows whose elimination on a chain
@@ -52,54 +74,78 @@ impl MassFactor {
 /// instructions a register, the steps it spares dozens.
 #[inline(always)]
 pub(super) fn plain(x: &[f64]) -> bool {
+    plain_rows(&[x])
+}
+
+/// [`plain`] of every row of `rows` at once (one lanes' sum and test for all).
+#[inline(always)]
+fn plain_rows<const R: usize>(rows: &[&[f64]; R]) -> bool {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
     {
         use std::arch::x86_64::*;
-        let mut quads = x.chunks_exact(4);
+        let (mut sum, mut neg_zero) = ([0.0f64; 4], false);
         // SAFETY: AVX2 is enabled for this build (the cfg); each load is of
         // the four f64 of one chunk
-        let (sum, neg_zero) = unsafe {
+        unsafe {
             let m = _mm256_set1_epi64x(NEG_ZERO);
             let (mut s, mut z) = (_mm256_setzero_pd(), _mm256_setzero_si256());
-            for q in &mut quads {
-                let v = _mm256_loadu_pd(q.as_ptr());
-                s = _mm256_add_pd(s, v);
-                z = _mm256_or_si256(z, _mm256_cmpeq_epi64(_mm256_castpd_si256(v), m));
+            for x in rows {
+                let mut quads = x.chunks_exact(4);
+                for q in &mut quads {
+                    let v = _mm256_loadu_pd(q.as_ptr());
+                    s = _mm256_add_pd(s, v);
+                    z = _mm256_or_si256(z, _mm256_cmpeq_epi64(_mm256_castpd_si256(v), m));
+                }
+                neg_zero |= tail(&mut sum, quads.remainder());
             }
             let mut a = [0.0f64; 4];
             _mm256_storeu_pd(a.as_mut_ptr(), s);
-            (a, _mm256_movemask_pd(_mm256_castsi256_pd(z)) != 0)
-        };
-        tail(sum, neg_zero, quads.remainder())
+            neg_zero |= _mm256_movemask_pd(_mm256_castsi256_pd(z)) != 0;
+            sum[1] += a[1];
+            sum[2] += a[2];
+            sum[3] += a[3];
+            sum[0] += a[0];
+        }
+        !neg_zero && sum.iter().all(|s| s.is_finite())
     }
     #[cfg(all(target_arch = "x86_64", not(target_feature = "avx2")))]
     {
         use std::arch::x86_64::*;
-        let mut pairs = x.chunks_exact(2);
+        let (mut sum, mut neg_zero) = ([0.0f64; 2], false);
         // SAFETY: SSE2 is every x86_64's (SSE4.1 where the cfg says); each
         // load is of the two f64 of one chunk
-        let (sum, neg_zero) = unsafe {
+        unsafe {
             let (mut s, mut z) = (_mm_setzero_pd(), _mm_setzero_pd());
-            for p in &mut pairs {
-                let v = _mm_loadu_pd(p.as_ptr());
-                s = _mm_add_pd(s, v);
-                #[cfg(target_feature = "sse4.1")]
-                let hit = _mm_castsi128_pd(_mm_cmpeq_epi64(
-                    _mm_castpd_si128(v),
-                    _mm_set1_epi64x(NEG_ZERO),
-                ));
-                #[cfg(not(target_feature = "sse4.1"))]
-                let hit = _mm_cmpeq_pd(v, _mm_setzero_pd());
-                z = _mm_or_pd(z, hit);
+            for x in rows {
+                let mut pairs = x.chunks_exact(2);
+                for p in &mut pairs {
+                    let v = _mm_loadu_pd(p.as_ptr());
+                    s = _mm_add_pd(s, v);
+                    #[cfg(target_feature = "sse4.1")]
+                    let hit = _mm_castsi128_pd(_mm_cmpeq_epi64(
+                        _mm_castpd_si128(v),
+                        _mm_set1_epi64x(NEG_ZERO),
+                    ));
+                    #[cfg(not(target_feature = "sse4.1"))]
+                    let hit = _mm_cmpeq_pd(v, _mm_setzero_pd());
+                    z = _mm_or_pd(z, hit);
+                }
+                neg_zero |= tail(&mut sum, pairs.remainder());
             }
             let mut a = [0.0f64; 2];
             _mm_storeu_pd(a.as_mut_ptr(), s);
-            (a, _mm_movemask_pd(z) != 0)
-        };
-        tail(sum, neg_zero, pairs.remainder())
+            neg_zero |= _mm_movemask_pd(z) != 0;
+            sum[1] += a[1];
+            sum[0] += a[0];
+        }
+        !neg_zero && sum.iter().all(|s| s.is_finite())
     }
     #[cfg(not(target_arch = "x86_64"))]
-    tail([0.0], false, x)
+    {
+        let mut sum = [0.0f64];
+        let neg_zero = rows.iter().fold(false, |n, x| n | tail(&mut sum, x));
+        !neg_zero && sum[0].is_finite()
+    }
 }
 
 /// The bits of −0 (as the lanes' integer compare takes them).
@@ -109,13 +155,13 @@ pub(super) fn plain(x: &[f64]) -> bool {
 ))]
 const NEG_ZERO: i64 = i64::MIN;
 
-/// [`plain`] of the lanes' sums and −0 test so far and the entries left.
+/// The entries a row's lanes leave, added to `sum[0]`: whether one is −0.
 #[inline(always)]
-fn tail<const K: usize>(mut sum: [f64; K], neg_zero: bool, rest: &[f64]) -> bool {
-    let mut neg_zero = neg_zero;
+fn tail<const K: usize>(sum: &mut [f64; K], rest: &[f64]) -> bool {
+    let mut neg_zero = false;
     for &v in rest {
         sum[0] += v;
         neg_zero |= v.to_bits() == 1 << 63;
     }
-    !neg_zero && sum.iter().all(|s| s.is_finite())
+    neg_zero
 }

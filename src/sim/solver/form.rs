@@ -6,6 +6,7 @@ use super::super::parallel::Team;
 use super::{MassFactor, RowKind, Rows};
 
 mod team;
+mod zero;
 pub(super) use team::PARTS;
 
 /// What [`Rows::form`] reads of the rows and writes: their fields borrowed
@@ -344,6 +345,10 @@ impl Former<'_> {
         };
         if N > st || !shape || path.iter().any(|&d| d >= vfree.len()) {
             return false;
+        }
+        // (L zero on both chains and the rows plain: Y = J·D^-½, zero.rs)
+        if self.form_zero_pair::<6, N>(f, r, path, vfree) {
+            return true;
         }
         if SIX {
             // the six rows in six lanes a path slot (no pad lane)
