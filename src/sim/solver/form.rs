@@ -400,18 +400,7 @@ impl Former<'_> {
         // each sum in path order from −0, as store_block's
         let (mut d, mut o) = ([-0.0f64; 6], [-0.0f64; 6]);
         for bt in b {
-            let q = [
-                bt[0] * bt[1],
-                bt[0] * bt[2],
-                bt[1] * bt[2],
-                bt[3] * bt[4],
-                bt[3] * bt[5],
-                bt[4] * bt[5],
-            ];
-            for i in 0..6 {
-                d[i] += bt[i] * bt[i];
-                o[i] += q[i];
-            }
+            add_w_six(&mut d, &mut o, bt);
         }
         for (k, q) in [(0, r), (3, r + 3)] {
             let y = &mut self.y[q * st..(q + 3) * st];
@@ -528,6 +517,25 @@ fn contact_at(kind: &[RowKind], path: &[(usize, usize)], end: usize, r: usize) -
 /// lanes a path slot (SSE: three registers a slot, not four with a pad lane
 /// each; with AVX the two blocks' [f64; 4] are two registers a slot either way).
 const SIX: bool = cfg!(not(target_feature = "avx"));
+
+/// One path slot's transformed six rows `bt` added to W's diagonal `d`
+/// (d_i += y_i²) and the two blocks' off-diagonal entries `o` (y₀y₁, y₀y₂,
+/// y₁y₂ and y₃y₄, y₃y₅, y₄y₅): the sums' next terms, in path order.
+#[inline(always)]
+fn add_w_six(d: &mut [f64; 6], o: &mut [f64; 6], bt: &[f64; 6]) {
+    let q = [
+        bt[0] * bt[1],
+        bt[0] * bt[2],
+        bt[1] * bt[2],
+        bt[3] * bt[4],
+        bt[3] * bt[5],
+        bt[4] * bt[5],
+    ];
+    for i in 0..6 {
+        d[i] += bt[i] * bt[i];
+        o[i] += q[i];
+    }
+}
 
 /// c = J v* over two contacts' six rows (`j`, `stride` apart) on `path`
 /// (each row's sum from 0 in path order, as [`gather_rows`]'), the rows

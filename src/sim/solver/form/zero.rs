@@ -7,7 +7,7 @@
 //! (`gather_six`, `store_six`).
 
 use super::super::MassFactor;
-use super::Former;
+use super::{add_w_six, Former};
 
 impl Former<'_> {
     /// Contacts r's and r + 3's rows (six rows of J, N path slots; chains
@@ -71,18 +71,7 @@ impl Former<'_> {
                 c[i] += b[i] * x;
                 e[i] = b[i] * s[t];
             }
-            let q = [
-                e[0] * e[1],
-                e[0] * e[2],
-                e[1] * e[2],
-                e[3] * e[4],
-                e[3] * e[5],
-                e[4] * e[5],
-            ];
-            for i in 0..6 {
-                d[i] += e[i] * e[i];
-                o[i] += q[i];
-            }
+            add_w_six(&mut d, &mut o, &e);
             (y0[t], y1[t], y2[t]) = (e[0], e[1], e[2]);
             (y3[t], y4[t], y5[t]) = (e[3], e[4], e[5]);
             l0[t] = [e[0], e[1], e[2], 0.0];
