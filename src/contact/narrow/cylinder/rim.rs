@@ -122,7 +122,7 @@ fn arc(phi: f64, k: &[f64; 4], hr: (f64, f64)) -> (f64, f64, f64) {
 
 /// [`arc`] at (sin φ, cos φ).
 #[inline]
-pub(super) fn arc_at((s, c): (f64, f64), k: &[f64; 4], (h, r): (f64, f64)) -> (f64, f64, f64) {
+fn arc_at((s, c): (f64, f64), k: &[f64; 4], (h, r): (f64, f64)) -> (f64, f64, f64) {
     let [a, b, al, be] = *k;
     let t = al * c + be * s;
     let tp = -al * s + be * c;
@@ -146,6 +146,18 @@ pub(super) fn at_samples(k: &[f64; 4], hr: (f64, f64)) -> ([f64; SAMPLES], [f64;
         (g[m], g1[m], _) = arc_at(sc, k, hr);
     }
     (g, g1)
+}
+
+/// The local least of h in the samples' interval (m − 1, m), where h' turns
+/// from falling to rising ([`at_samples`]): Newton there ([`newton`]), as
+/// (h(φ*), φ*, (sin φ*, cos φ*)).
+#[inline]
+pub(super) fn least_in(m: usize, k: &[f64; 4], hr: (f64, f64)) -> (f64, f64, (f64, f64)) {
+    let step = std::f64::consts::FRAC_PI_2 / (SAMPLES - 1) as f64;
+    let phi = m as f64 * step;
+    let phi = newton(phi - step, phi, k, hr);
+    let sc = phi.sin_cos();
+    (arc_at(sc, k, hr).0, phi, sc)
 }
 
 /// The least of h|t| + r√(1 − t²) over the arc, t = α cos φ + β sin φ,
@@ -176,7 +188,7 @@ fn floor(al: f64, be: f64, (h, r): (f64, f64)) -> f64 {
 /// The least of h on [lo, hi] where h' < 0 at lo and > 0 at hi: Newton
 /// kept inside the bracket, else bisection. Returns φ.
 #[inline]
-pub(super) fn newton(mut lo: f64, mut hi: f64, k: &[f64; 4], hr: (f64, f64)) -> f64 {
+fn newton(mut lo: f64, mut hi: f64, k: &[f64; 4], hr: (f64, f64)) -> f64 {
     let mut phi = 0.5 * (lo + hi);
     for _ in 0..60 {
         let (_, g1, g2) = arc(phi, k, hr);
@@ -238,7 +250,6 @@ pub fn rim_on_edge(cyl: &Cylinder, cub: &Cuboid, b_m_c: &Pose, side: bool) -> Op
         return None;
     }
     // edges: along axis i at (σⱼeⱼ, σₖeₖ)
-    let step = std::f64::consts::FRAC_PI_2 / (SAMPLES - 1) as f64;
     // the least's (depth, axis, signs, φ, (sin φ, cos φ))
     let mut found: Option<(f64, usize, f64, f64, f64, (f64, f64))> = None;
     for i in 0..3 {
@@ -271,10 +282,7 @@ pub fn rim_on_edge(cyl: &Cylinder, cub: &Cuboid, b_m_c: &Pose, side: bool) -> Op
                     return None;
                 }
                 if m > 0 && g1[m - 1] < 0.0 && g1[m] > 0.0 {
-                    let phi = m as f64 * step;
-                    let phi = newton(phi - step, phi, &kk, hr);
-                    let sc = phi.sin_cos();
-                    let g = arc_at(sc, &kk, hr).0;
+                    let (g, phi, sc) = least_in(m, &kk, hr);
                     if g <= best {
                         best = g;
                         found = Some((g, i, sj, sk, phi, sc));

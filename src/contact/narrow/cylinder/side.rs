@@ -24,7 +24,7 @@
 //! parry's own, its clip of the two support features at n, with p and its
 //! foot p − d n on B's side as EPA's pair.
 
-use super::rim::{arc_at, at_samples, newton, RimEdge, OFF_CAP, OFF_SIDE, SAMPLES};
+use super::rim::{at_samples, least_in, RimEdge, OFF_CAP, OFF_SIDE, SAMPLES};
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::shape::Cylinder;
 
@@ -55,7 +55,6 @@ fn look(a: &Cylinder, b: &Cylinder, b_m_a: &Pose) -> Result<Option<RimEdge>, Apa
     }
     // m toward c across b's axis, and the quarters either side of it
     let (x0, z0) = (c.x / rho_c, c.z / rho_c);
-    let step = std::f64::consts::FRAC_PI_2 / (SAMPLES - 1) as f64;
     // the least's (depth, φ, (sin φ, cos φ), d₀, d₁)
     let mut found: Option<(f64, f64, (f64, f64), Vector, Vector)> = None;
     for (d0, d1) in [
@@ -70,10 +69,8 @@ fn look(a: &Cylinder, b: &Cylinder, b_m_a: &Pose) -> Result<Option<RimEdge>, Apa
                 return Err(Apart);
             }
             if g1[m - 1] < 0.0 && g1[m] > 0.0 {
-                let phi = m as f64 * step;
-                let phi = newton(phi - step, phi, &kk, hr);
-                let sc = phi.sin_cos();
-                let depth = arc_at(sc, &kk, hr).0 + b.radius;
+                let (g, phi, sc) = least_in(m, &kk, hr);
+                let depth = g + b.radius;
                 if found.is_none_or(|f| depth < f.0) {
                     found = Some((depth, phi, sc, d0, d1));
                 }
