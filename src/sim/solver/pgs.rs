@@ -355,18 +355,20 @@ impl Rows {
                                 lb.follow(&view, r, &[dln, dl1, dl2], lambda, dv);
                             }
                         }
-                        change = most(
-                            change,
-                            measure(first, (dln * wnn).abs(), un, &mut u_prev[r]),
-                        );
-                        change = most(
-                            change,
-                            measure(first, (dl1 * w11).abs(), u1, &mut u_prev[r + 1]),
-                        );
-                        change = most(
-                            change,
-                            measure(first, (dl2 * w22).abs(), u2, &mut u_prev[r + 2]),
-                        );
+                        if change > tol {
+                            // a sweep over `tol` already stays over whatever
+                            // its other rows measure (`change` only grows):
+                            // their velocities kept for the next, no measure
+                            (u_prev[r], u_prev[r + 1], u_prev[r + 2]) = (un, u1, u2);
+                        } else {
+                            let up = &mut u_prev[r..r + 3];
+                            change =
+                                most(change, measure(first, (dln * wnn).abs(), un, &mut up[0]));
+                            change =
+                                most(change, measure(first, (dl1 * w11).abs(), u1, &mut up[1]));
+                            change =
+                                most(change, measure(first, (dl2 * w22).abs(), u2, &mut up[2]));
+                        }
                         r += 3;
                         continue;
                     }
