@@ -27,6 +27,84 @@ macro_rules! at_path_len {
 }
 pub(super) use at_path_len;
 
+/// Where the slots of a contact's path lie in Δv': the path itself (slot t
+/// at dof `p[t]`, gathered), or [`Runs`]. The kernels below read and write
+/// the same entries either way, in the same order.
+pub(super) trait Dofs: Copy {
+    /// Slot t's dof.
+    fn at(self, t: usize) -> usize;
+    /// Slots t … t + w − 1 are consecutive dofs (a constant for [`Runs`]
+    /// once the loop is unrolled; never for a gathered path).
+    fn consecutive(self, t: usize, w: usize) -> bool;
+}
+
+impl Dofs for &[usize] {
+    #[inline(always)]
+    fn at(self, t: usize) -> usize {
+        // SAFETY: the kernels ask for t < their length ≤ the path's
+        unsafe { *self.get_unchecked(t) }
+    }
+    #[inline(always)]
+    fn consecutive(self, _: usize, _: usize) -> bool {
+        false
+    }
+}
+
+/// `K` runs of six consecutive dofs, from their first (a free body's chain,
+/// two free bodies': a pile's ground contact, its pair contact): slot t at
+/// dof `self.0[t / 6] + t % 6`, read without the path.
+#[derive(Clone, Copy)]
+pub(super) struct Runs<const K: usize>(pub [usize; K]);
+
+impl<const K: usize> Dofs for Runs<K> {
+    #[inline(always)]
+    fn at(self, t: usize) -> usize {
+        self.0[t / 6] + t % 6
+    }
+    #[inline(always)]
+    fn consecutive(self, t: usize, w: usize) -> bool {
+        t % 6 + w <= 6
+    }
+}
+
+/// A contact's path as the sweeps' update writes it (pgs.rs, [`axpy3_path`]):
+/// one run of six dofs, two, or any other path (gathered, [`axpy3`]).
+#[derive(Clone, Copy)]
+pub(super) enum Path<'a> {
+    One(Runs<1>),
+    Two(Runs<2>),
+    Any(&'a [usize]),
+}
+
+impl<'a> Path<'a> {
+    /// `p`'s runs: a path is ascending (root … leaf, or two such joined,
+    /// [`super::Rows::union_path`]), so six slots that span six dofs are
+    /// consecutive; every dof read stays within the path's first and last.
+    #[inline(always)]
+    pub(super) fn of(p: &'a [usize]) -> Self {
+        debug_assert!(p.windows(2).all(|w| w[0] < w[1]));
+        match *p {
+            [a, _, _, _, _, f] if f == a + 5 => Path::One(Runs([a])),
+            [a, _, _, _, _, f, b, _, _, _, _, g] if f == a + 5 && g == b + 5 => {
+                Path::Two(Runs([a, b]))
+            }
+            _ => Path::Any(p),
+        }
+    }
+}
+
+/// [`axpy3`] over a contact's [`Path`] (each of `ys` at least its length).
+#[inline(always)]
+pub(super) fn axpy3_path(a: [f64; 3], ys: [&[f64]; 3], p: Path, x: &mut [f64]) {
+    // SAFETY: each of ys is at least the path's length (the caller's)
+    let cut = |n: usize| ys.map(|y| unsafe { y.get_unchecked(..n) });
+    match p {
+        Path::One(d) => path3_run::<Axpy, _>(a, cut(6), d, x, 6),
+        Path::Two(d) => path3_run::<Axpy, _>(a, cut(12), d, x, 12),
+        Path::Any(p) => axpy3(a, ys, p, x),
+    }
+}
+
 /// Σₜ lₜ x[pₜ] in each of the four lanes of `l` (a contact's three rows of
 /// y interleaved, `Rows::ylanes`), each lane a sum from 0 in path order; the
 /// indices of `p` must be < `x.len()` (a row's path: dof indices < nv).
@@ -44,13 +122,16 @@ pub(super) fn dot3(l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
 /// in the same order.
 #[inline(always)]
 pub(super) fn dot3_from(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
-    at_path_len!(p.len().min(l.len()); l, p => dot3_run(s0, l, p, x))
+    let n = p.len().min(l.len());
+    // SAFETY: n ≤ l.len()
+    let l = unsafe { l.get_unchecked(..n) };
+    at_path_len!(n; l, p => dot3_run(s0, l, p, x))
 }
 
-/// [`dot3_from`]'s loop (over the shorter of `l` and `p`).
+/// [`dot3_from`]'s loop over `l` (`p` at least as long: slot t at `p.at(t)`).
 #[inline(always)]
-fn dot3_run(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
-    debug_assert!(p.iter().all(|&k| k < x.len()));
+fn dot3_run<D: Dofs>(s0: [f64; 4], l: &[[f64; 4]], p: D, x: &[f64]) -> [f64; 4] {
+    debug_assert!((0..l.len()).all(|t| p.at(t) < x.len()));
     #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
     {
         use std::arch::x86_64::*;
@@ -59,8 +140,8 @@ fn dot3_run(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
         // sweeps' check of the paths); `l`'s entries are 4 f64 each
         unsafe {
             let mut acc = _mm256_loadu_pd(s.as_ptr());
-            for (li, &k) in l.iter().zip(p) {
-                let xk = _mm256_broadcast_sd(x.get_unchecked(k));
+            for (t, li) in l.iter().enumerate() {
+                let xk = _mm256_broadcast_sd(x.get_unchecked(p.at(t)));
                 acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_loadu_pd(li.as_ptr()), xk));
             }
             _mm256_storeu_pd(s.as_mut_ptr(), acc);
@@ -70,9 +151,9 @@ fn dot3_run(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
     {
         let mut s = s0;
-        for (li, &k) in l.iter().zip(p) {
-            // SAFETY: every k < x.len() (the sweeps' check of the paths)
-            let xk = unsafe { *x.get_unchecked(k) };
+        for (t, li) in l.iter().enumerate() {
+            // SAFETY: every dof < x.len() (the sweeps' check of the paths)
+            let xk = unsafe { *x.get_unchecked(p.at(t)) };
             for (si, &v) in s.iter_mut().zip(li) {
                 *si += v * xk;
             }
@@ -268,15 +349,53 @@ fn path3<S: Sum3>(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
     // a free body's path (6 dofs) and two free bodies' (12) at their fixed
     // length, unrolled whole ([`dot3_from`]'s): the same lanes
     let [y0, y1, y2] = ys;
-    at_path_len!(n; y0, y1, y2, p => path3_run::<S>(a, [y0, y1, y2], p, x, n))
+    at_path_len!(n; y0, y1, y2, p => path3_run::<S, _>(a, [y0, y1, y2], p, x, n))
+}
+
+/// Slots t, t + 1's entries of x (at `xp`) in two lanes: one load where
+/// their dofs are consecutive, else gathered.
+///
+/// # Safety
+/// Both dofs < x's length.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn x2<D: Dofs>(xp: *const f64, p: D, t: usize) -> std::arch::x86_64::__m128d {
+    use std::arch::x86_64::*;
+    // SAFETY: the caller's
+    unsafe {
+        if p.consecutive(t, 2) {
+            _mm_loadu_pd(xp.add(p.at(t)))
+        } else {
+            _mm_loadh_pd(_mm_load_sd(xp.add(p.at(t))), xp.add(p.at(t + 1)))
+        }
+    }
+}
+
+/// [`x2`]'s store of `v` back (the same entries).
+///
+/// # Safety
+/// Both dofs < x's length.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn put2<D: Dofs>(xp: *mut f64, p: D, t: usize, v: std::arch::x86_64::__m128d) {
+    use std::arch::x86_64::*;
+    // SAFETY: the caller's
+    unsafe {
+        if p.consecutive(t, 2) {
+            _mm_storeu_pd(xp.add(p.at(t)), v);
+        } else {
+            _mm_storel_pd(xp.add(p.at(t)), v);
+            _mm_storeh_pd(xp.add(p.at(t + 1)), v);
+        }
+    }
 }
 
 /// [`path3`]'s loops over the first `n` slots (n ≤ every slice's length).
 #[inline(always)]
-fn path3_run<S: Sum3>(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64], n: usize) {
-    debug_assert!(p.iter().all(|&k| k < x.len()));
-    debug_assert!(p.iter().enumerate().all(|(i, k)| !p[..i].contains(k)));
-    debug_assert!(n <= p.len().min(ys[0].len()).min(ys[1].len()).min(ys[2].len()));
+fn path3_run<S: Sum3, D: Dofs>(a: [f64; 3], ys: [&[f64]; 3], p: D, x: &mut [f64], n: usize) {
+    debug_assert!((0..n).all(|t| p.at(t) < x.len()));
+    debug_assert!((0..n).all(|t| (0..t).all(|i| p.at(i) != p.at(t))));
+    debug_assert!(n <= ys[0].len().min(ys[1].len()).min(ys[2].len()));
     let [y0, y1, y2] = ys;
     #[allow(unused_mut)]
     let mut t = 0;
@@ -299,20 +418,19 @@ fn path3_run<S: Sum3>(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64], 
                     _mm256_loadu_pd(y1.as_ptr().add(t)),
                     _mm256_loadu_pd(y2.as_ptr().add(t)),
                 ];
-                let k = [
-                    *p.get_unchecked(t),
-                    *p.get_unchecked(t + 1),
-                    *p.get_unchecked(t + 2),
-                    *p.get_unchecked(t + 3),
-                ];
-                let lo = _mm_loadh_pd(_mm_load_sd(xp.add(k[0])), xp.add(k[1]));
-                let hi = _mm_loadh_pd(_mm_load_sd(xp.add(k[2])), xp.add(k[3]));
+                let k = [p.at(t), p.at(t + 1), p.at(t + 2), p.at(t + 3)];
+                if p.consecutive(t, 4) {
+                    let v = S::avx(_mm256_loadu_pd(xp.add(k[0])), aa, yy);
+                    _mm256_storeu_pd(xp.add(k[0]), v);
+                    t += 4;
+                    continue;
+                }
+                let lo = x2(xp, p, t);
+                let hi = x2(xp, p, t + 2);
                 let v = S::avx(_mm256_set_m128d(hi, lo), aa, yy);
                 let (vlo, vhi) = (_mm256_castpd256_pd128(v), _mm256_extractf128_pd::<1>(v));
-                _mm_storel_pd(xp.add(k[0]), vlo);
-                _mm_storeh_pd(xp.add(k[1]), vlo);
-                _mm_storel_pd(xp.add(k[2]), vhi);
-                _mm_storeh_pd(xp.add(k[3]), vhi);
+                put2(xp, p, t, vlo);
+                put2(xp, p, t + 2, vhi);
                 t += 4;
             }
         }
@@ -332,10 +450,8 @@ fn path3_run<S: Sum3>(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64], 
                     _mm_loadu_pd(y1.as_ptr().add(t)),
                     _mm_loadu_pd(y2.as_ptr().add(t)),
                 ];
-                let (k0, k1) = (*p.get_unchecked(t), *p.get_unchecked(t + 1));
-                let v = S::sse(_mm_loadh_pd(_mm_load_sd(xp.add(k0)), xp.add(k1)), aa, yy);
-                _mm_storel_pd(xp.add(k0), v);
-                _mm_storeh_pd(xp.add(k1), v);
+                let v = S::sse(x2(xp, p, t), aa, yy);
+                put2(xp, p, t, v);
                 t += 2;
             }
         }
@@ -343,7 +459,7 @@ fn path3_run<S: Sum3>(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64], 
     while t < n {
         // SAFETY: t < n ≤ every slice's length; p[t] < x.len() (as above)
         unsafe {
-            let xk = x.get_unchecked_mut(*p.get_unchecked(t));
+            let xk = x.get_unchecked_mut(p.at(t));
             let yt = [
                 *y0.get_unchecked(t),
                 *y1.get_unchecked(t),

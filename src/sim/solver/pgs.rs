@@ -2,7 +2,7 @@
 //! contact's three rows taken in one pass and the exact Coulomb slide onto
 //! the friction disc.
 
-use super::kernels::{axpy3, dot3, pinned_until, slide_onto_cone, warm_rows};
+use super::kernels::{axpy3_path, dot3, pinned_until, slide_onto_cone, warm_rows, Path};
 use super::loop_block::{BlockRows, LoopBlock};
 use super::subspace::{subspace_step, Solved, Subspace};
 use super::{MassFactor, RowKind, Rows, SUBSPACE_MAX};
@@ -345,7 +345,8 @@ impl Rows {
                             // SAFETY: r + 2 < n and l ≤ st (checked above), and
                             // y holds n·st entries
                             let yr = |q: usize| unsafe { y.get_unchecked(q * st..q * st + l) };
-                            axpy3([dln, dl1, dl2], [yr(r), yr(r + 1), yr(r + 2)], p, dv);
+                            let at = Path::of(p);
+                            axpy3_path([dln, dl1, dl2], [yr(r), yr(r + 1), yr(r + 2)], at, dv);
                             if SKIP && armed {
                                 drift += dln.abs() * wnn.sqrt()
                                     + dl1.abs() * w11.sqrt()
