@@ -32,7 +32,10 @@ pub(super) use at_path_len;
 /// the same entries either way, in the same order.
 pub(super) trait Dofs: Copy {
     /// Slot t's dof.
-    fn at(self, t: usize) -> usize;
+    ///
+    /// # Safety
+    /// t is below the path's length (a gathered path is read unchecked).
+    unsafe fn at(self, t: usize) -> usize;
     /// Slots t … t + w − 1 are consecutive dofs (a constant for [`Runs`]
     /// once the loop is unrolled; never for a gathered path).
     fn consecutive(self, t: usize, w: usize) -> bool;
@@ -40,8 +43,8 @@ pub(super) trait Dofs: Copy {
 
 impl Dofs for &[usize] {
     #[inline(always)]
-    fn at(self, t: usize) -> usize {
-        // SAFETY: the kernels ask for t < their length ≤ the path's
+    unsafe fn at(self, t: usize) -> usize {
+        // SAFETY: t < the path's length (the caller's)
         unsafe { *self.get_unchecked(t) }
     }
     #[inline(always)]
@@ -58,7 +61,7 @@ pub(super) struct Runs<const K: usize>(pub [usize; K]);
 
 impl<const K: usize> Dofs for Runs<K> {
     #[inline(always)]
-    fn at(self, t: usize) -> usize {
+    unsafe fn at(self, t: usize) -> usize {
         self.0[t / 6] + t % 6
     }
     #[inline(always)]
@@ -131,7 +134,8 @@ pub(super) fn dot3_from(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) ->
 /// [`dot3_from`]'s loop over `l` (`p` at least as long: slot t at `p.at(t)`).
 #[inline(always)]
 fn dot3_run<D: Dofs>(s0: [f64; 4], l: &[[f64; 4]], p: D, x: &[f64]) -> [f64; 4] {
-    debug_assert!((0..l.len()).all(|t| p.at(t) < x.len()));
+    // SAFETY: t < l's length ≤ the path's (the caller's)
+    debug_assert!((0..l.len()).all(|t| unsafe { p.at(t) } < x.len()));
     #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
     {
         use std::arch::x86_64::*;
@@ -393,8 +397,10 @@ unsafe fn put2<D: Dofs>(xp: *mut f64, p: D, t: usize, v: std::arch::x86_64::__m1
 /// [`path3`]'s loops over the first `n` slots (n ≤ every slice's length).
 #[inline(always)]
 fn path3_run<S: Sum3, D: Dofs>(a: [f64; 3], ys: [&[f64]; 3], p: D, x: &mut [f64], n: usize) {
-    debug_assert!((0..n).all(|t| p.at(t) < x.len()));
-    debug_assert!((0..n).all(|t| (0..t).all(|i| p.at(i) != p.at(t))));
+    // SAFETY: t < n ≤ the path's length (the caller's)
+    let at = |t: usize| unsafe { p.at(t) };
+    debug_assert!((0..n).all(|t| at(t) < x.len()));
+    debug_assert!((0..n).all(|t| (0..t).all(|i| at(i) != at(t))));
     debug_assert!(n <= ys[0].len().min(ys[1].len()).min(ys[2].len()));
     let [y0, y1, y2] = ys;
     #[allow(unused_mut)]
