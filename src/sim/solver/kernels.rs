@@ -96,9 +96,12 @@ impl<'a> Path<'a> {
     }
 }
 
-/// [`axpy3`] over a contact's [`Path`] (each of `ys` at least its length).
+/// [`axpy3`] over a contact's [`Path`].
+///
+/// # Safety
+/// Each of `ys` is at least the path's length (its runs are read unchecked).
 #[inline(always)]
-pub(super) fn axpy3_path(a: [f64; 3], ys: [&[f64]; 3], p: Path, x: &mut [f64]) {
+pub(super) unsafe fn axpy3_path(a: [f64; 3], ys: [&[f64]; 3], p: Path, x: &mut [f64]) {
     // SAFETY: each of ys is at least the path's length (the caller's)
     let cut = |n: usize| ys.map(|y| unsafe { y.get_unchecked(..n) });
     match p {

@@ -346,7 +346,9 @@ impl Rows {
                             // y holds n·st entries
                             let yr = |q: usize| unsafe { y.get_unchecked(q * st..q * st + l) };
                             let at = Path::of(p);
-                            axpy3_path([dln, dl1, dl2], [yr(r), yr(r + 1), yr(r + 2)], at, dv);
+                            let ys = [yr(r), yr(r + 1), yr(r + 2)];
+                            // SAFETY: each of ys is l = the path's length
+                            unsafe { axpy3_path([dln, dl1, dl2], ys, at, dv) };
                             if SKIP && armed {
                                 drift += dln.abs() * wnn.sqrt()
                                     + dl1.abs() * w11.sqrt()
