@@ -74,11 +74,14 @@ fn two_piles_ten_metres_apart_cost_what_each_costs_alone() {
     assert!(two as f64 <= 2.2 * wa as f64, "two piles {two}, one {wa}");
 }
 
-/// `urdyn simulate --scene` of `scene` for `t` s with `args`: its CSV.
+/// `urdyn simulate --scene` of `scene` for `t` s with `args`: its CSV (a
+/// file named by the scene and the arguments: the tests run at once).
 fn csv(scene: &std::path::Path, t: f64, args: &[&str]) -> String {
+    let stem = scene.file_stem().map(|s| s.to_string_lossy().into_owned());
     let out = std::env::temp_dir().join(format!(
-        "urdyn_islands_{}_{}.csv",
+        "urdyn_islands_{}_{}_{}.csv",
         std::process::id(),
+        stem.unwrap_or_default(),
         args.join("_").replace('-', "")
     ));
     let st = std::process::Command::new(env!("CARGO_BIN_EXE_urdyn"))
@@ -127,7 +130,6 @@ fn threads_one_and_two_give_identical_csvs_on_a_pile_with_sleep_on_and_off() {
 #[test]
 fn threads_one_and_two_give_identical_csvs_on_the_mixed_256_pile() {
     let scene = dir().join("pile_mixed_256.json");
-    // (`--every 1`, the default: a file name of its own)
     let one = csv(&scene, 0.4, &["--every", "1", "--threads", "1"]);
     let two = csv(&scene, 0.4, &["--every", "1", "--threads", "2"]);
     assert_eq!(one.lines().count(), 401 + 1);
