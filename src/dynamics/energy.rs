@@ -63,8 +63,20 @@ pub(crate) fn kinetic_energy_step_ahead(
         data.step_bias_ok = false;
         return kinetic_energy_from_placements(model, data, v).unwrap_or(f64::NAN);
     }
-    let ke = super::rnea::bias_at_placements_energy(model, data, v, skip);
-    data.step_bias.copy_from(&data.bias);
+    // (lone free bodies: one pass, C written where it is kept; `data.bias`
+    // is not read before the step swaps `step_bias` into it)
+    let mut c = std::mem::replace(&mut data.step_bias, DVector::zeros(0));
+    let lone =
+        super::rnea_lone::lone_bias_energy(model, data, v.as_slice(), skip, c.as_mut_slice());
+    data.step_bias = c;
+    let ke = match lone {
+        Some(ke) => ke,
+        None => {
+            let ke = super::rnea::bias_at_placements_energy(model, data, v, skip);
+            data.step_bias.copy_from(&data.bias);
+            ke
+        }
+    };
     data.step_bias_q.copy_from(q);
     data.step_bias_v.copy_from(v);
     data.step_bias_ok = true;

@@ -30,6 +30,7 @@ mod minv;
 mod rnea;
 mod rnea_derivatives;
 mod rnea_derivatives_rows;
+mod rnea_lone;
 
 pub use crate::spatial::CompositeInertia;
 pub use aba::aba;

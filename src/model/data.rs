@@ -27,6 +27,11 @@ pub struct Data<T: Scalar = f64> {
     /// of the model this workspace was made for): the simulation's bias pass
     /// leaves such a body's own force out.
     pub(crate) massless: Vec<bool>,
+    /// Every body but the world is a lone free body on the world, its
+    /// coordinates in body order ([`all_lone_free`] of the model
+    /// this workspace was made for): the simulation's bias pass with the
+    /// kinetic energy then runs as one pass over the bodies.
+    pub(crate) lone_free: bool,
     /// `oMf`: every URDF link frame in the world.
     pub o_m_f: Vec<Se3<T>>,
     /// Spatial velocity of each body (body frame).
@@ -305,13 +310,15 @@ impl<T: Scalar> Data<T> {
                 s_len = s_len.max(s_off[i] + 12 * nv);
             }
         }
+        let dispatch: Vec<_> = model.joints[..nb]
+            .iter()
+            .map(super::joint::dispatch_of)
+            .collect();
         Self {
             li_m_i: vec![Se3::identity(); nb],
             o_m_i: vec![Se3::identity(); nb],
-            dispatch: model.joints[..nb]
-                .iter()
-                .map(super::joint::dispatch_of)
-                .collect(),
+            lone_free: all_lone_free(model, &dispatch),
+            dispatch,
             axis_k2: model.joints[..nb]
                 .iter()
                 .map(|j| match super::joint::dispatch_of(j).0 {
@@ -472,4 +479,23 @@ fn derivative_columns<T: Scalar>(model: &Model<T>) -> (Vec<usize>, Vec<usize>, u
         }
     }
     (col0, sub_end, n, direct)
+}
+
+/// Whether every body of `model` but the world hangs from the world by a
+/// free joint (`dispatch`: each body's joint as [`Data`] keeps it) whose six
+/// velocity coordinates are body i's `6 (i − 1) .. 6 i`, and nothing else
+/// has one (nv = 6 (nb − 1)): the bias pass of `dynamics::rnea_lone` then
+/// writes every entry of C once.
+fn all_lone_free<T: Scalar>(
+    model: &Model<T>,
+    dispatch: &[(super::joint::Dispatch<T>, T, T)],
+) -> bool {
+    let nb = model.nbodies;
+    nb >= 2
+        && model.nv == 6 * (nb - 1)
+        && (1..nb).all(|i| {
+            model.parent.get(i) == Some(&0)
+                && matches!(dispatch.get(i), Some((super::joint::Dispatch::Free, _, _)))
+                && model.joints.get(i).is_some_and(|j| j.iv == 6 * (i - 1))
+        })
 }
