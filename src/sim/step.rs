@@ -327,3 +327,13 @@ fn all_finite(x: &[f64]) -> bool {
 fn any_nonzero(x: &[f64]) -> bool {
     x.iter().fold(false, |any, &v| any | (v != 0.0))
 }
+
+/// `out = a + b` entry by entry (the sum `out.copy_from(a); out += b` makes).
+#[inline]
+pub(in crate::sim) fn plus_into(out: &mut DVector<f64>, a: &DVector<f64>, b: &DVector<f64>) {
+    let (o, a, b) = (out.as_mut_slice(), a.as_slice(), b.as_slice());
+    debug_assert!(o.len() == a.len() && o.len() == b.len());
+    for ((o, &a), &b) in o.iter_mut().zip(a).zip(b) {
+        *o = a + b;
+    }
+}

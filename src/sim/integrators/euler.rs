@@ -50,11 +50,12 @@ impl Simulation {
                 h,
             );
             self.pgs_sweeps += imp.sweeps as u64;
-            self.v.copy_from(&self.mass.vfree);
-            self.v += imp.dv;
-            self.mass.vtot.copy_from(&self.v);
-            if let Some(w) = imp.push {
-                self.mass.vtot += w;
+            // v⁺ = v* + dv and v⁺ + w in one pass (the copies' and sums'
+            // operations, entry by entry)
+            crate::sim::step::plus_into(&mut self.v, &self.mass.vfree, imp.dv);
+            match imp.push {
+                Some(w) => crate::sim::step::plus_into(&mut self.mass.vtot, &self.v, w),
+                None => self.mass.vtot.copy_from(&self.v),
             }
             self.rows_total += self.cons.rows_len() as u64;
         } else {
@@ -116,8 +117,17 @@ impl Simulation {
                 .map_err(SimError::from)
         };
         if free.is_ok() {
-            self.mass.vfree.copy_from(&self.v);
-            self.mass.vfree.axpy(h, &tau, 1.0);
+            // v* = h a·1 + 1·v (`axpy`'s products and sum over a copy of v,
+            // in one pass)
+            let (vf, a, v) = (
+                self.mass.vfree.as_mut_slice(),
+                tau.as_slice(),
+                self.v.as_slice(),
+            );
+            debug_assert!(vf.len() == a.len() && vf.len() == v.len());
+            for ((o, &a), &v) in vf.iter_mut().zip(a).zip(v) {
+                *o = h * a * 1.0 + 1.0 * v;
+            }
         }
         self.mass.tau = tau;
         free

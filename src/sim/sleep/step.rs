@@ -36,11 +36,14 @@ impl super::super::Simulation {
         // position pass's push included (a point pushed out moves)
         let model = &self.model;
         let data = &mut self.data;
-        self.sleep.vw.copy_from(&self.v);
-        if let Some(w) = self.cons.push_velocity() {
-            self.sleep.vw += w;
-        }
-        let vw = self.sleep.vw.as_slice();
+        // (v itself without a push: no copy)
+        let vw = match self.cons.push_velocity() {
+            Some(w) => {
+                crate::sim::step::plus_into(&mut self.sleep.vw, &self.v, w);
+                self.sleep.vw.as_slice()
+            }
+            None => self.v.as_slice(),
+        };
         // (the awake trees' bodies: a tree's bodies are one range after their
         // parents, whose root hangs from the world; sleeping ones are not read)
         // (a body on the world: its parent's velocity is zero, moved into its
@@ -63,7 +66,9 @@ impl super::super::Simulation {
                     Some(&key) => crate::model::dispatch_keyed!(
                         &model.joints[i], key, false, jm => jm.add_motion(&mut vi, vw)
                     ),
-                    None => model.joints[i].add_motion(&mut vi, &self.sleep.vw),
+                    None => crate::model::dispatch_joint!(
+                        &model.joints[i], false, jm => jm.add_motion(&mut vi, vw)
+                    ),
                 }
                 data.v[i] = vi;
             }
