@@ -10,7 +10,7 @@
 use super::super::ground::Side;
 use super::super::narrow::prim::Round;
 use super::super::travel::{margin, moved_from};
-use super::{world, Member, PairContact};
+use super::{world_at, Member, PairContact};
 use crate::spatial::Se3;
 use nalgebra::Vector3;
 use std::sync::Mutex;
@@ -33,7 +33,8 @@ pub(super) struct Placed<'a> {
     pub centre: &'a mut Vector3<f64>,
 }
 
-/// Places member `m` (its box's `radius`) at the body poses `o_m_i`:
+/// Places member `m` (its box's `radius`; its placement the identity when
+/// `at_body`) at the body poses `o_m_i`:
 /// `step` = (the travel's scale, 0 for none; whether it is measured), `tv`
 /// = (δ, c) of the margin max(δ, c·s).
 #[inline(always)]
@@ -42,10 +43,10 @@ pub(super) fn place(
     o_m_i: &[Se3<f64>],
     (stepped, measure): (f64, bool),
     (delta, factor): (f64, f64),
-    radius: f64,
+    (radius, at_body): (f64, bool),
     out: Placed<'_>,
 ) {
-    let w = world(m, o_m_i);
+    let w = world_at(m, o_m_i, at_body);
     let c = w.act_point(&m.shape.mid);
     // the speculative margin: max(δ, c·s), s how far the member
     // moved in the last step (docs/theory.md §"Speculative margin")
@@ -67,6 +68,7 @@ pub(super) fn place(
 struct Shared {
     members: (*const Member, usize),
     radii: (*const f64, usize),
+    at_body: (*const bool, usize),
     moving: (*const usize, usize),
     travel: (*mut f64, usize),
     lo: (*mut [f64; 3], usize),
@@ -78,7 +80,7 @@ struct Shared {
 // SAFETY: `moving` is strictly increasing (checked when made), so the chunks
 // of its entries, each handed out once, are disjoint sets of members, and a
 // member's entries are written only by the thread of its chunk; `members`,
-// `radii` and `moving` are only read; every pointer is of a vector of the
+// `radii`, `at_body` and `moving` are only read; every pointer is of a vector of the
 // pairs borrowed mutably by the [`BroadTeam`] for as long as it lives, and
 // not resized while it does.
 unsafe impl Send for Shared {}
@@ -111,6 +113,7 @@ impl PairContact {
         let sh = Shared {
             members: (self.members.as_ptr(), n),
             radii: (self.radii.as_ptr(), self.radii.len()),
+            at_body: (self.at_body.as_ptr(), self.at_body.len()),
             moving: (self.moving.as_ptr(), if ok { self.moving.len() } else { 0 }),
             travel: (ts.as_mut_ptr(), ts.len()),
             lo: (self.sap.lo.as_mut_ptr(), self.sap.lo.len()),
@@ -145,6 +148,7 @@ impl Side for BroadTeam<'_> {
             let lens = [
                 sh.members.1,
                 sh.radii.1,
+                sh.at_body.1,
                 sh.travel.1,
                 sh.lo.1,
                 sh.hi.1,
@@ -160,7 +164,7 @@ impl Side for BroadTeam<'_> {
             let (m, radius, out) = unsafe {
                 (
                     &*sh.members.0.add(k),
-                    *sh.radii.0.add(k),
+                    (*sh.radii.0.add(k), *sh.at_body.0.add(k)),
                     Placed {
                         travel: &mut *sh.travel.0.add(k),
                         lo: &mut *sh.lo.0.add(k),

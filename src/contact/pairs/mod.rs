@@ -141,6 +141,8 @@ pub struct PairContact {
     /// radius of a sphere about it that holds the box (|half extents|).
     centres: Vec<Vector3<f64>>,
     radii: Vec<f64>,
+    /// Each member's placement is the identity ([`world_at`]).
+    at_body: Vec<bool>,
     /// A sphere or capsule member placed at the last detection (its closed
     /// form's input, once a member, not once a pair).
     rounds: Vec<Option<Round>>,
@@ -178,6 +180,37 @@ fn world(m: &Member, o_m_i: &[Se3<f64>]) -> Se3<f64> {
     o_m_i
         .get(m.body)
         .map_or(m.placement, |o| o.compose(&m.placement))
+}
+
+/// [`world`] of a member whose placement is the identity when `at_body`
+/// (`PairContact::at_body`): its body's pose itself where every entry of it
+/// is finite and nonzero. `o · I` is then `o` bit for bit: each entry of
+/// R·I is r·1 = r plus products of r's with ±0, which leave a nonzero r as
+/// it is, and each of R·0 + t is t plus ±0 products, likewise (with or
+/// without fused multiply–adds); only a zero's sign could differ.
+#[inline(always)]
+fn world_at(m: &Member, o_m_i: &[Se3<f64>], at_body: bool) -> Se3<f64> {
+    match o_m_i.get(m.body) {
+        Some(o) if at_body && all_plain(o) => *o,
+        Some(o) => o.compose(&m.placement),
+        None => m.placement,
+    }
+}
+
+/// Every entry of `o` finite and nonzero, by their product (finite and
+/// nonzero only then: a zero factor makes it zero or NaN, an infinite one
+/// infinite or NaN; an underflow or overflow of finite nonzero entries
+/// says no, and the caller composes).
+#[inline(always)]
+fn all_plain(o: &Se3<f64>) -> bool {
+    let [c0, c1, c2] = o.rot.data.0;
+    let t = &o.trans;
+    let p = (c0[0] * c0[1] * c0[2])
+        * (c1[0] * c1[1] * c1[2])
+        * (c2[0] * c2[1] * c2[2])
+        * (t.x * t.y * t.z);
+    let a = p.abs();
+    a > 0.0 && a < f64::INFINITY
 }
 
 /// The contact frame's tangents ([`super::frame::tangents`]), here too.
@@ -267,6 +300,7 @@ impl PairContact {
             poses: Vec::with_capacity(n),
             centres: Vec::with_capacity(n),
             radii: Vec::with_capacity(n),
+            at_body: Vec::with_capacity(n),
             rounds: Vec::with_capacity(n),
             hits: Vec::new(),
             queries_scratch: Vec::new(),
@@ -314,6 +348,9 @@ impl PairContact {
             let c = m.placement.act_point(&m.shape.mid);
             made.centres.push(c);
             made.radii.push(m.shape.half.norm());
+            let p = &m.placement;
+            made.at_body
+                .push(p.rot == nalgebra::Matrix3::identity() && p.trans == Vector3::zeros());
             made.rounds.push(Round::of(&m.shape, &m.placement));
             if m.body == 0 {
                 set_box(&mut made.sap, k, m, &m.placement, &c, params.margin);
@@ -412,7 +449,9 @@ impl PairContact {
     pub(crate) fn broad_members(&mut self, o_m_i: &[Se3<f64>], step: (f64, bool)) {
         let (ts, delta, factor) = self.travel.split();
         for &k in &self.moving {
-            let (Some(m), Some(&radius)) = (self.members.get(k), self.radii.get(k)) else {
+            let (Some(m), Some(&radius), Some(&at_body)) =
+                (self.members.get(k), self.radii.get(k), self.at_body.get(k))
+            else {
                 continue;
             };
             let (Some(travel), Some(lo), Some(hi), Some(round), Some(pose), Some(centre)) = (
@@ -433,7 +472,7 @@ impl PairContact {
                 pose,
                 centre,
             };
-            members::place(m, o_m_i, step, (delta, factor), radius, out);
+            members::place(m, o_m_i, step, (delta, factor), (radius, at_body), out);
         }
     }
 
