@@ -1,8 +1,8 @@
 use crate::model::joint::{dispatch_of, Dispatch};
 use crate::model::{dispatch_keyed, Data, FrameId, JointModel, Model, NameError};
 use crate::spatial::ops::mat_mat;
-use crate::spatial::{rodrigues, sin_cos, skew, Scalar, Se3};
-use nalgebra::DVector;
+use crate::spatial::{quat_to_matrix, rodrigues, sin_cos, skew, Scalar, Se3};
+use nalgebra::{DVector, Vector3};
 
 /// Forward kinematics of every body: `liMi = X_tree,i · X_J(q_i)` and
 /// `oMi = oM_λ(i) · liMi`.
@@ -52,10 +52,26 @@ fn fk_pass<T: Scalar, const KEYED: bool>(model: &Model<T>, data: &mut Data<T>, q
     let ident = &model.placement_identity[..nb];
     let keys = if KEYED { &data.dispatch[..nb] } else { &[] };
     let k2s = if KEYED { &data.axis_k2[..nb] } else { &[] };
+    let zt = &model.placement_zero_trans[..nb];
     let li_m_i = &mut data.li_m_i[..nb];
     let o_m_i = &mut data.o_m_i[..nb];
+    // (a free body on the world at an identity placement: its joint's pose
+    // M is λ(i)Mi and oMi as they are when `plain_pose` (I·M = M bit for bit);
+    // the world's pose is the identity)
+    let lone = KEYED && super::crba::is_f64::<T>() && o_m_i[0] == Se3::identity();
     for i in 1..nb {
         let op = o_m_i[parent[i]];
+        if lone && parent[i] == 0 && ident[i] && zt[i] && matches!(keys[i].0, Dispatch::Free) {
+            // M = (R(quaternion), p), `FreeJ::placement`'s
+            let qs = &q[joints[i].iq..joints[i].iq + 7];
+            let r = quat_to_matrix(qs[3], qs[4], qs[5], qs[6]);
+            let m = Se3::new(r, Vector3::new(qs[0], qs[1], qs[2]));
+            if plain_pose(&m) {
+                li_m_i[i] = m;
+                o_m_i[i] = m;
+                continue;
+            }
+        }
         let key = if KEYED {
             keys[i]
         } else {
@@ -88,6 +104,25 @@ fn fk_pass<T: Scalar, const KEYED: bool>(model: &Model<T>, data: &mut Data<T>, q
         li_m_i[i] = li;
         o_m_i[i] = om;
     }
+}
+
+/// Every entry of `m` finite and nonzero, by their product (finite and
+/// nonzero only then: a zero factor makes it zero or NaN, an infinite one
+/// infinite or NaN; an underflow or overflow of finite nonzero entries says
+/// no). Then `I·m` and `m·I` (an identity pose's rotation exactly I, its
+/// translation ±0) are `m` bit for bit: each entry is an entry of m plus
+/// products of entries with ±0, which leave a nonzero value as it is (with or
+/// without fused multiply–adds); only a zero's sign could differ.
+#[inline(always)]
+pub(crate) fn plain_pose<T: Scalar>(m: &Se3<T>) -> bool {
+    let [c0, c1, c2] = m.rot.data.0;
+    let t = &m.trans;
+    let p = (c0[0] * c0[1] * c0[2])
+        * (c1[0] * c1[1] * c1[2])
+        * (c2[0] * c2[1] * c2[2])
+        * (t.x * t.y * t.z);
+    let a = p.abs();
+    a > T::zero() && a.is_finite()
 }
 
 /// The world pose of every URDF link frame, `oMf = oMi · iMf`, from `data.o_m_i`

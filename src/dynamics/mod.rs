@@ -55,7 +55,7 @@ pub use energy::{energies, kinetic_energy, kinetic_energy_from_placements, poten
 pub use forward_rnea::{forward_dynamics_rnea, mass_matrix_rnea};
 pub use jacobian::{frame_jacobian, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, update_frames};
-pub(crate) use kinematics::{forward_kinematics_pass, forward_kinematics_unkeyed};
+pub(crate) use kinematics::{forward_kinematics_pass, forward_kinematics_unkeyed, plain_pose};
 pub use rnea::{bias, rnea};
 pub(crate) use rnea::{bias_at_placements, bias_at_placements_ahead};
 

@@ -184,33 +184,15 @@ fn world(m: &Member, o_m_i: &[Se3<f64>]) -> Se3<f64> {
 
 /// [`world`] of a member whose placement is the identity when `at_body`
 /// (`PairContact::at_body`): its body's pose itself where every entry of it
-/// is finite and nonzero. `o · I` is then `o` bit for bit: each entry of
-/// R·I is r·1 = r plus products of r's with ±0, which leave a nonzero r as
-/// it is, and each of R·0 + t is t plus ±0 products, likewise (with or
-/// without fused multiply–adds); only a zero's sign could differ.
+/// is finite and nonzero (`o · I` is then `o` bit for bit,
+/// [`crate::dynamics::plain_pose`]).
 #[inline(always)]
 fn world_at(m: &Member, o_m_i: &[Se3<f64>], at_body: bool) -> Se3<f64> {
     match o_m_i.get(m.body) {
-        Some(o) if at_body && all_plain(o) => *o,
+        Some(o) if at_body && crate::dynamics::plain_pose(o) => *o,
         Some(o) => o.compose(&m.placement),
         None => m.placement,
     }
-}
-
-/// Every entry of `o` finite and nonzero, by their product (finite and
-/// nonzero only then: a zero factor makes it zero or NaN, an infinite one
-/// infinite or NaN; an underflow or overflow of finite nonzero entries
-/// says no, and the caller composes).
-#[inline(always)]
-fn all_plain(o: &Se3<f64>) -> bool {
-    let [c0, c1, c2] = o.rot.data.0;
-    let t = &o.trans;
-    let p = (c0[0] * c0[1] * c0[2])
-        * (c1[0] * c1[1] * c1[2])
-        * (c2[0] * c2[1] * c2[2])
-        * (t.x * t.y * t.z);
-    let a = p.abs();
-    a > 0.0 && a < f64::INFINITY
 }
 
 /// The contact frame's tangents ([`super::frame::tangents`]), here too.
