@@ -58,7 +58,7 @@ fn fk_pass<T: Scalar, const KEYED: bool>(model: &Model<T>, data: &mut Data<T>, q
     // (a free body on the world at an identity placement: its joint's pose
     // M is λ(i)Mi and oMi as they are when `plain_pose` (I·M = M bit for bit);
     // the world's pose is the identity)
-    let lone = KEYED && super::crba::is_f64::<T>() && o_m_i[0] == Se3::identity();
+    let lone = KEYED && super::crba::is_f64::<T>() && o_m_i.first() == Some(&Se3::identity());
     for i in 1..nb {
         let op = o_m_i[parent[i]];
         if lone && parent[i] == 0 && ident[i] && zt[i] && matches!(keys[i].0, Dispatch::Free) {
