@@ -23,7 +23,6 @@ pub(super) struct Former<'a> {
     table: &'a [usize],
     j: &'a [f64],
     y: &'a mut [f64],
-    ylanes: &'a mut [[f64; 4]],
     c: &'a mut [f64],
     w: &'a mut [f64],
     w_block: &'a mut [[f64; 3]],
@@ -70,7 +69,6 @@ impl Rows {
             table: &self.table,
             j: &self.j,
             y: &mut self.y,
-            ylanes: &mut self.ylanes,
             c: &mut self.c,
             w: &mut self.w,
             w_block: &mut self.w_block,
@@ -149,11 +147,6 @@ impl Former<'_> {
                 let (b, c) = rest.split_at_mut(st);
                 let (y0, y1, y2) = (&mut a[..pl], &mut b[..pl], &mut c[..pl]);
                 f.row_transform3(path, y0, y1, y2);
-                if let Some(yl) = self.ylanes.get_mut(r * st..r * st + pl) {
-                    for (t, l) in yl.iter_mut().enumerate() {
-                        *l = [y0[t], y1[t], y2[t], 0.0];
-                    }
-                }
                 let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
                 self.w[r] = dot(y0, y0);
                 self.w[r + 1] = dot(y1, y1);
@@ -280,7 +273,7 @@ impl Former<'_> {
     /// [`Former::form_lanes`] on a path of `N = A + B` dofs that is a chain
     /// (`B = 0`: [`MassFactor::chain_lanes`]) or two trees' chains
     /// ([`MassFactor::two_chain_lanes`]): the three rows gathered straight
-    /// into registers, transformed there, and Y, its lanes, W and c written
+    /// into registers, transformed there, and Y, W and c written
     /// from them (no scratch, no copies between): each value the same
     /// operations in the same order, the same bits. False, nothing written,
     /// where the path is not such chains (the caller's general way then).
@@ -393,7 +386,7 @@ impl Former<'_> {
 
     /// Contacts r's and r + 3's formed blocks from their transformed rows `b`
     /// (one [y₀ₜ … y₅ₜ] a path slot, [`Former::form_pair`]) and c = J v*, as
-    /// [`Former::store_block`] stores each (the pad lane of `ylanes` 0).
+    /// [`Former::store_block`] stores each.
     #[inline(always)]
     fn store_six(&mut self, r: usize, b: &[[f64; 6]], c: [f64; 6]) {
         let st = self.st;
@@ -409,11 +402,6 @@ impl Former<'_> {
             for (((bt, a), b1), b2) in b.iter().zip(y0).zip(y1).zip(y2) {
                 (*a, *b1, *b2) = (bt[k], bt[k + 1], bt[k + 2]);
             }
-            if let Some(yl) = self.ylanes.get_mut(q * st..q * st + b.len()) {
-                for (l, bt) in yl.iter_mut().zip(b) {
-                    *l = [bt[k], bt[k + 1], bt[k + 2], 0.0];
-                }
-            }
             self.c[q..q + 3].copy_from_slice(&c[k..k + 3]);
             self.w[q..q + 3].copy_from_slice(&d[k..k + 3]);
             self.w_block[q] = [o[k], o[k + 1], o[k + 2]];
@@ -421,8 +409,8 @@ impl Former<'_> {
     }
 
     /// Contact r's formed block from its transformed rows `b` (one
-    /// [y₀ₜ, y₁ₜ, y₂ₜ, 0] a path slot) and c = J v*: Y's three rows, their
-    /// lanes, c, W's diagonal and the block's off-diagonal entries.
+    /// [y₀ₜ, y₁ₜ, y₂ₜ, 0] a path slot) and c = J v*: Y's three rows, c, W's
+    /// diagonal and the block's off-diagonal entries.
     #[inline(always)]
     fn store_block(&mut self, r: usize, b: &[[f64; 4]], c: [f64; 4]) {
         let st = self.st;
@@ -442,12 +430,6 @@ impl Former<'_> {
         let (y1, y2) = rest.split_at_mut(st);
         for (((bt, a), b1), b2) in b.iter().zip(y0).zip(y1).zip(y2) {
             (*a, *b1, *b2) = (bt[0], bt[1], bt[2]);
-        }
-        if let Some(yl) = self.ylanes.get_mut(r * st..r * st + b.len()) {
-            // entry by entry: inlined for a chain's N, where copy_from_slice calls memcpy
-            for (l, bt) in yl.iter_mut().zip(b) {
-                *l = *bt;
-            }
         }
         self.c[r..r + 3].copy_from_slice(&c[..3]);
         self.w[r..r + 3].copy_from_slice(&d[..3]);

@@ -111,64 +111,6 @@ pub(super) unsafe fn axpy3_path(a: [f64; 3], ys: [&[f64]; 3], p: Path, x: &mut [
     }
 }
 
-/// Σₜ lₜ x[pₜ] in each of the four lanes of `l` (a contact's three rows of
-/// y interleaved, `Rows::ylanes`), each lane a sum from 0 in path order; the
-/// indices of `p` must be < `x.len()` (a row's path: dof indices < nv).
-/// ([`dot3_from`] from +0: the same sums, +0 + a = a for every a.)
-#[inline(always)]
-pub(super) fn dot3(l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
-    dot3_from([0.0; 4], l, p, x)
-}
-
-/// `s0` + Σₜ lₜ x[pₜ] in each of the four lanes (as [`dot3`], each lane's
-/// sum started from its `s0` instead of 0: ((s0 + l₀x) + l₁x) + …, the
-/// scalar loop `u += y x` from `u = s0`). A free body's path (6 dofs: a
-/// ground contact's) and two free bodies' (12: a pair's) run a loop of
-/// that fixed length, unrolled whole (no loop bookkeeping): the same sums
-/// in the same order.
-#[inline(always)]
-pub(super) fn dot3_from(s0: [f64; 4], l: &[[f64; 4]], p: &[usize], x: &[f64]) -> [f64; 4] {
-    let n = p.len().min(l.len());
-    // SAFETY: n ≤ l.len()
-    let l = unsafe { l.get_unchecked(..n) };
-    at_path_len!(n; l, p => dot3_run(s0, l, p, x))
-}
-
-/// [`dot3_from`]'s loop over `l` (`p` at least as long: slot t at `p.at(t)`).
-#[inline(always)]
-fn dot3_run<D: Dofs>(s0: [f64; 4], l: &[[f64; 4]], p: D, x: &[f64]) -> [f64; 4] {
-    // SAFETY: t < l's length ≤ the path's (the caller's)
-    debug_assert!((0..l.len()).all(|t| unsafe { p.at(t) } < x.len()));
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-    {
-        use std::arch::x86_64::*;
-        let mut s = s0;
-        // SAFETY: avx is enabled at compile time; every k < x.len() (the
-        // sweeps' check of the paths); `l`'s entries are 4 f64 each
-        unsafe {
-            let mut acc = _mm256_loadu_pd(s.as_ptr());
-            for (t, li) in l.iter().enumerate() {
-                let xk = _mm256_broadcast_sd(x.get_unchecked(p.at(t)));
-                acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_loadu_pd(li.as_ptr()), xk));
-            }
-            _mm256_storeu_pd(s.as_mut_ptr(), acc);
-        }
-        s
-    }
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
-    {
-        let mut s = s0;
-        for (t, li) in l.iter().enumerate() {
-            // SAFETY: every dof < x.len() (the sweeps' check of the paths)
-            let xk = unsafe { *x.get_unchecked(p.at(t)) };
-            for (si, &v) in s.iter_mut().zip(li) {
-                *si += v * xk;
-            }
-        }
-        s
-    }
-}
-
 /// Δv' += Σᵣ λᵣ yᵣ over rows `s..e` in row order, a contact's three rows in
 /// one pass over their path ([`warm3`]) when all three λ ≠ 0: the warm start
 /// of an island's runs in its sweeps (pgs.rs) and of every row at once
@@ -196,12 +138,10 @@ pub(super) unsafe fn warm_rows(
         let l = lambda[r];
         let (ps, pl) = paths[r];
         // SAFETY: the caller's checks (the path in `table`, its row of y
-        // and ylanes within them, its dofs < x.len())
+        // within them, its dofs < x.len())
         let p = unsafe { table.get_unchecked(ps..ps + pl) };
         if contact[r] && r + 2 < e && l != 0.0 && lambda[r + 1] != 0.0 && lambda[r + 2] != 0.0 {
             // each entry ((x + λₙyₙ) + λ₁y₁) + λ₂y₂, the row-by-row order
-            // (read from the three rows of y, contiguous: `ylanes` holds the
-            // same numbers interleaved)
             // SAFETY: rows r..r + 3 < e ≤ n, each st ≥ pl entries of y (the
             // caller's checks)
             let yr = |q: usize| unsafe { y.get_unchecked(q * st..q * st + pl) };
@@ -354,7 +294,7 @@ impl Sum3 for Axpy {
 fn path3<S: Sum3>(a: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &mut [f64]) {
     let n = p.len().min(ys[0].len()).min(ys[1].len()).min(ys[2].len());
     // a free body's path (6 dofs) and two free bodies' (12) at their fixed
-    // length, unrolled whole ([`dot3_from`]'s): the same lanes
+    // length, unrolled whole (`dot3::dot3_from`'s): the same lanes
     let [y0, y1, y2] = ys;
     at_path_len!(n; y0, y1, y2, p => path3_run::<S, _>(a, [y0, y1, y2], p, x, n))
 }

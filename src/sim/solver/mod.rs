@@ -20,6 +20,7 @@
 //! moves q but never enters v.
 
 pub(crate) mod dense;
+mod dot3;
 mod form;
 mod kernels;
 mod loop_block;
@@ -108,10 +109,6 @@ pub struct Rows {
     /// entry per path slot, `stride` of them), one such for each thread of
     /// a form on the team (form/team.rs).
     lanes: Vec<[f64; 4]>,
-    /// At a contact's normal row r: its three rows of Y interleaved (entry t
-    /// of the path at `ylanes[r·stride + t]`, lanes normal, t₁, t₂, unused),
-    /// a copy of `y` that the sweeps read with one vector product a dof.
-    ylanes: Vec<[f64; 4]>,
     /// Each row's velocity at its update in the last sweep.
     u_prev: Vec<f64>,
     /// Scratch of the position pass: the rows it updates, in sweep order
@@ -182,7 +179,6 @@ impl Rows {
             w_block: vec![[0.0; 3]; cap],
             is_block: vec![false; cap],
             lanes: vec![[0.0; 4]; stride * form::PARTS],
-            ylanes: vec![[0.0; 4]; cap * stride],
             u_prev: vec![0.0; cap],
             pos_rows: Vec::with_capacity(cap),
             sm: Subspace::new(nv, cap),

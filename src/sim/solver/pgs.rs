@@ -2,7 +2,8 @@
 //! contact's three rows taken in one pass and the exact Coulomb slide onto
 //! the friction disc.
 
-use super::kernels::{axpy3_path, dot3, pinned_until, slide_onto_cone, warm_rows, Path};
+use super::dot3::dot3;
+use super::kernels::{axpy3_path, pinned_until, slide_onto_cone, warm_rows, Path};
 use super::loop_block::{BlockRows, LoopBlock};
 use super::subspace::{subspace_step, Solved, Subspace};
 use super::{MassFactor, RowKind, Rows, SUBSPACE_MAX};
@@ -137,7 +138,6 @@ impl Rows {
             || dofs.is_some_and(|d| d.iter().any(|&k| k >= nv))
             || out.lambda.len() < n
             || out.u_prev.len() < n
-            || self.ylanes.len() < n * st
         {
             return (0, false);
         }
@@ -145,7 +145,6 @@ impl Rows {
         let (y, paths) = (&self.y[..], &self.path[..n]);
         let (kinds, c, b) = (&self.kind[..n], &self.c[..n], &self.b[..n]);
         let contact = &self.is_block[..n];
-        let ylanes = &self.ylanes[..n * st];
         // no factor of an earlier solve's W_FF is reused (subspace.rs)
         out.sm.0.forget();
         // the loop rows as one exact block, every other row seen through them
@@ -240,7 +239,7 @@ impl Rows {
             if given {
                 break;
             }
-            // SAFETY: the paths, y and ylanes checked above (rdot/raxpy's)
+            // SAFETY: the paths and y checked above (rdot/raxpy's)
             unsafe { warm_rows(lambda, contact, paths, table, y, st, (s, e), dv) };
         }
         if block {
@@ -284,17 +283,18 @@ impl Rows {
                         // normal's change left (through the block's entries)
                         // SAFETY: r is a row of `runs`, whose paths lie in
                         // `table` and are at most `st` long (checked above), and
-                        // r < n, so r·st + len ≤ n·st = ylanes.len()
-                        let (p, lanes) = unsafe {
+                        // r + 2 < n (a contact's rows), so (r + 2)·st + len ≤
+                        // n·st ≤ y.len()
+                        let (p, ys) = unsafe {
                             let (s, l) = *paths.get_unchecked(r);
-                            (
-                                table.get_unchecked(s..s + l),
-                                ylanes.get_unchecked(r * st..r * st + l),
-                            )
+                            let o = r * st;
+                            let yr = |i: usize| y.get_unchecked(o + i * st..o + i * st + l);
+                            (table.get_unchecked(s..s + l), [yr(0), yr(1), yr(2)])
                         };
-                        // the three dots side by side over the interleaved
-                        // copy of their y (each a sum from 0 in path order)
-                        let [dn, d1, d2, _] = dot3(lanes, p, dv);
+                        // the three dots side by side over their rows of y
+                        // (each a sum from 0 in path order)
+                        // SAFETY: the path's dofs < nv ≤ dv.len() (checked above)
+                        let [dn, d1, d2] = unsafe { dot3(ys, p, dv) };
                         let [wn1, wn2, w12] = w_block[r];
                         let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
                         let on = lambda[r];
@@ -341,13 +341,8 @@ impl Rows {
                         let (dl1, dl2) = (t1 - o1, t2 - o2);
                         if dln != 0.0 || dl1 != 0.0 || dl2 != 0.0 {
                             // Δv' += Δλₙ yₙ + Δλ₁ y₁ + Δλ₂ y₂ over the path
-                            let l = p.len();
-                            // SAFETY: r + 2 < n and l ≤ st (checked above), and
-                            // y holds n·st entries
-                            let yr = |q: usize| unsafe { y.get_unchecked(q * st..q * st + l) };
                             let at = Path::of(p);
-                            let ys = [yr(r), yr(r + 1), yr(r + 2)];
-                            // SAFETY: each of ys is l = the path's length
+                            // SAFETY: each of ys is the path's length
                             unsafe { axpy3_path([dln, dl1, dl2], ys, at, dv) };
                             if SKIP && armed {
                                 drift += dln.abs() * wnn.sqrt()
@@ -508,7 +503,6 @@ impl Rows {
                     table,
                     kinds,
                     contact,
-                    ylanes,
                     winv,
                     c,
                     b,

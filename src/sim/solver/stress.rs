@@ -127,7 +127,6 @@ impl Rows {
         sm.forget();
         let lanes = Lanes {
             contact: &self.is_block,
-            ylanes: &self.ylanes,
             diag: (&self.w, &self.w_block),
         };
         sm.group(&self.path);

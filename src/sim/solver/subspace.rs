@@ -2,7 +2,8 @@
 //! free rows solved exactly by a dense LDLᵀ.
 
 use super::dense::{ldlt_dropping, ldlt_dropping_solve};
-use super::kernels::{axpy1, axpy2, dot1_from, dot3_from};
+use super::dot3::dot3_from;
+use super::kernels::{axpy1, axpy2, dot1_from};
 use super::loop_block::LoopBlock;
 use super::wff::Lanes;
 use super::{RowKind, SUBSPACE_MAX};
@@ -104,8 +105,6 @@ pub(super) struct Solved<'a> {
     pub(super) table: &'a [usize],
     pub(super) kinds: &'a [RowKind],
     pub(super) contact: &'a [bool],
-    /// The contacts' rows of Y interleaved (`Rows::ylanes`).
-    pub(super) ylanes: &'a [[f64; 4]],
     /// 1 / Wᵣᵣ (0: a row no impulse can move).
     pub(super) winv: &'a [f64],
     pub(super) c: &'a [f64],
@@ -144,7 +143,6 @@ pub(super) fn subspace_step(
         table,
         kinds,
         contact,
-        ylanes,
         winv,
         c,
         b,
@@ -243,11 +241,7 @@ pub(super) fn subspace_step(
         RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
         _ => b[r],
     };
-    let lanes = Lanes {
-        contact,
-        ylanes,
-        diag,
-    };
+    let lanes = Lanes { contact, diag };
     sm.group(paths);
     let mut a = 0;
     while a < m {
@@ -256,18 +250,9 @@ pub(super) fn subspace_step(
         let yr = |i: usize| &y[(r + i) * st..(r + i) * st + pa.len()];
         if sm.three[a] {
             // a contact's three rows in one pass, each sum in its order
-            let (mut u0, mut u1, mut u2) = (c[r], c[r + 1], c[r + 2]);
-            if let Some(l) = lanes.of(r, st, pa.len()) {
-                [u0, u1, u2, _] = dot3_from([u0, u1, u2, 0.0], l, pa, dv);
-            } else {
-                let (y0, y1, y2) = (yr(0), yr(1), yr(2));
-                for (t, &k) in pa.iter().enumerate() {
-                    let x = dv[k];
-                    u0 += y0[t] * x;
-                    u1 += y1[t] * x;
-                    u2 += y2[t] * x;
-                }
-            }
+            let (s0, ys) = ([c[r], c[r + 1], c[r + 2]], [yr(0), yr(1), yr(2)]);
+            // SAFETY: a path's dofs are < nv ≤ dv.len() (checked above)
+            let [u0, u1, u2] = unsafe { dot3_from(s0, ys, pa, dv) };
             sm.rhs[a] = target(r) - u0;
             sm.rhs[a + 1] = target(r + 1) - u1;
             sm.rhs[a + 2] = target(r + 2) - u2;

@@ -2,7 +2,8 @@
 //! its lower triangle formed a pair of row groups at a time (a contact's
 //! three rows side by side), entries kept from the solve's last W_FF copied.
 
-use super::kernels::{at_path_len, dot3};
+use super::dot3::dot3;
+use super::kernels::at_path_len;
 use super::subspace::Subspace;
 
 impl Subspace {
@@ -72,9 +73,9 @@ impl Subspace {
     /// without the merge's branches (the cost follows the rows' paths, never
     /// nv). Rows `r` of `y` have room `st`; row r's dofs are
     /// `table[paths[r]]`, each < nv (the sweeps' check). `x` must hold nv
-    /// entries, `w` m · ld. A contact's three rows q are read from their
-    /// interleaved copy (`lanes`, `Rows::ylanes`), the three sums side by side
-    /// in vector lanes: each the same sum in the same order. With `reuse`
+    /// entries, `w` m · ld. A contact's three rows q are summed side by side
+    /// in vector lanes ([`dot3x3`], `dot3::dot3`): each the same sum in the
+    /// same order. With `reuse`
     /// (`old` mapped, [`Subspace::map_old`]), an entry between two groups of
     /// rows all in the last W_FF (`wf`) is copied from there: the same sum,
     /// whichever group it was summed in. Returns whether it was formed
@@ -188,29 +189,10 @@ impl Subspace {
                         // a contact's three rows against another's: every
                         // entry (a + i, bb + j), bb + j ≤ a + i, the same sum
                         // in the same order as the single rows' below
-                        let mut sum = [[0.0f64; 3]; 3];
-                        if let Some(lq) = lanes.of(q, st, pq.len()) {
-                            let s4 = dot3x3(lq, pq, x3);
-                            for (si, s4i) in sum.iter_mut().zip(&s4) {
-                                si.copy_from_slice(&s4i[..3]);
-                            }
-                        } else {
-                            let (z0, z1, z2) = (
-                                yrow(q, pq.len()),
-                                yrow(q + 1, pq.len()),
-                                yrow(q + 2, pq.len()),
-                            );
-                            for (t, &k) in pq.iter().enumerate() {
-                                // SAFETY: k < nv ≤ x3.len() (the sweeps' check)
-                                let xk = unsafe { *x3.get_unchecked(k) };
-                                let zt = [z0[t], z1[t], z2[t]];
-                                for (si, &xi) in sum.iter_mut().zip(&xk) {
-                                    for (sij, &zj) in si.iter_mut().zip(&zt) {
-                                        *sij += zj * xi;
-                                    }
-                                }
-                            }
-                        }
+                        let l = pq.len();
+                        let zs = [yrow(q, l), yrow(q + 1, l), yrow(q + 2, l)];
+                        // SAFETY: k < nv ≤ x3.len() (the sweeps' check)
+                        let sum = unsafe { dot3x3(zs, pq, x3) };
                         // (below the diagonal block every entry: bb + 3 ≤ a)
                         let below = bb < a;
                         for (i, si) in sum.iter().enumerate() {
@@ -237,23 +219,10 @@ impl Subspace {
                     (_, 3) => {
                         // rows q on one path (a contact's three) summed side
                         // by side: each entry the same sum in the same order
-                        let (mut s0, mut s1, mut s2) = (0.0, 0.0, 0.0);
-                        if let Some(lq) = lanes.of(q, st, pq.len()) {
-                            [s0, s1, s2, _] = dot3(lq, pq, x);
-                        } else {
-                            let (y0, y1, y2) = (
-                                yrow(q, pq.len()),
-                                yrow(q + 1, pq.len()),
-                                yrow(q + 2, pq.len()),
-                            );
-                            for (t, &k) in pq.iter().enumerate() {
-                                // SAFETY: k < nv ≤ x.len() (the sweeps' check)
-                                let xk = unsafe { *x.get_unchecked(k) };
-                                s0 += y0[t] * xk;
-                                s1 += y1[t] * xk;
-                                s2 += y2[t] * xk;
-                            }
-                        }
+                        let l = pq.len();
+                        let ys = [yrow(q, l), yrow(q + 1, l), yrow(q + 2, l)];
+                        // SAFETY: k < nv ≤ x.len() (the sweeps' check)
+                        let [s0, s1, s2] = unsafe { dot3(ys, pq, x) };
                         put(a, bb, s0);
                         put(a, bb + 1, s1);
                         put(a, bb + 2, s2);
@@ -300,14 +269,12 @@ impl Subspace {
 /// A free row not in the last factor ([`Subspace::map_old`]).
 const NEW: usize = usize::MAX;
 
-/// The contacts' rows of Y interleaved (`Rows::ylanes`), which rows are a
-/// contact's normal (`Rows::is_block`), and W's diagonal and contact blocks
+/// Which rows are a contact's normal (`Rows::is_block`), and W's diagonal and contact blocks
 /// (`Rows::w`, `Rows::w_block`, as `Rows::form` made them: not the loop
 /// block's reduced ones), for [`Subspace::form_w_ff`].
 #[derive(Clone, Copy)]
 pub(super) struct Lanes<'a> {
     pub(super) contact: &'a [bool],
-    pub(super) ylanes: &'a [[f64; 4]],
     pub(super) diag: (&'a [f64], &'a [[f64; 3]]),
 }
 
@@ -329,70 +296,67 @@ impl<'a> Lanes<'a> {
             _ => None,
         }
     }
-
-    /// The interleaved rows of the contact whose normal is row `q` (its path
-    /// `len` long), or `None` (not a contact's normal, or out of range).
-    #[inline]
-    pub(super) fn of(&self, q: usize, st: usize, len: usize) -> Option<&'a [[f64; 4]]> {
-        if *self.contact.get(q)? && len <= st {
-            self.ylanes.get(q * st..q * st + len)
-        } else {
-            None
-        }
-    }
 }
 
-/// The 3 × 3 block Σₜ x3[pₜ][i] lₜ[j] (i, j < 3; lane 3 unused) of two
-/// contacts' rows: `l` one contact's rows interleaved over its path `p`, `x3`
-/// the other's scattered to full width; each entry a sum from 0 in path order
-/// (the scalar loop's); the indices of `p` must be < `x3.len()`.
-/// A free body's path (6 dofs) and two free bodies' (12) at that fixed
-/// length, unrolled whole (as `kernels::dot3_from`): the same sums.
+/// The 3 × 3 block Σₜ x3[pₜ][i] zⱼₜ (i, j < 3) of two contacts' rows: `zs`
+/// one contact's three rows of y over its path `p`, `x3` the other's
+/// scattered to full width; each entry a sum from 0 in path order (the
+/// scalar loop's). A free body's path (6 dofs) and two free bodies' (12)
+/// at that fixed length, unrolled whole (as `dot3::dot3_from`): the same
+/// sums.
+///
+/// # Safety
+/// Every index of `p` is < `x3.len()` (a path's dofs are < nv).
 #[inline(always)]
-fn dot3x3(l: &[[f64; 4]], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 4]; 3] {
-    at_path_len!(p.len().min(l.len()); l, p => dot3x3_run(l, p, x3))
+unsafe fn dot3x3(zs: [&[f64]; 3], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 3]; 3] {
+    let [z0, z1, z2] = zs;
+    let n = p.len().min(z0.len()).min(z1.len()).min(z2.len());
+    // SAFETY: the caller's
+    at_path_len!(n; z0, z1, z2, p => unsafe { dot3x3_run([z0, z1, z2], p, x3) })
 }
 
-/// [`dot3x3`]'s loop (over the shorter of `l` and `p`).
+/// [`dot3x3`]'s loop (over the shortest of `zs` and `p`): rows 0 and 1 side
+/// by side in two SSE2 lanes (x86_64), row 2 alone; each lane the scalar
+/// loop's products and sums in its order.
+///
+/// # Safety
+/// As [`dot3x3`]'s.
 #[inline(always)]
-fn dot3x3_run(l: &[[f64; 4]], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 4]; 3] {
-    debug_assert!(p.iter().all(|&k| k < x3.len()));
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+unsafe fn dot3x3_run([z0, z1, z2]: [&[f64]; 3], p: &[usize], x3: &[[f64; 3]]) -> [[f64; 3]; 3] {
+    let n = p.len().min(z0.len()).min(z1.len()).min(z2.len());
+    debug_assert!(p[..n].iter().all(|&k| k < x3.len()));
+    let mut s = [[0.0f64; 3]; 3];
+    #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::*;
-        let mut s = [[0.0f64; 4]; 3];
-        // SAFETY: avx is enabled at compile time; every k < x3.len() (a
-        // path's dofs are < nv); `l`'s entries are 4 f64 each
+        // SAFETY: SSE2 is part of x86_64; t < n ≤ every slice's length, and
+        // every k < x3.len() (a path's dofs are < nv)
         unsafe {
-            let (mut a0, mut a1, mut a2) = (
-                _mm256_setzero_pd(),
-                _mm256_setzero_pd(),
-                _mm256_setzero_pd(),
-            );
-            for (lt, &k) in l.iter().zip(p) {
-                let z = _mm256_loadu_pd(lt.as_ptr());
-                let xk = x3.get_unchecked(k);
-                a0 = _mm256_add_pd(a0, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[0])));
-                a1 = _mm256_add_pd(a1, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[1])));
-                a2 = _mm256_add_pd(a2, _mm256_mul_pd(z, _mm256_broadcast_sd(&xk[2])));
-            }
-            _mm256_storeu_pd(s[0].as_mut_ptr(), a0);
-            _mm256_storeu_pd(s[1].as_mut_ptr(), a1);
-            _mm256_storeu_pd(s[2].as_mut_ptr(), a2);
-        }
-        s
-    }
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
-    {
-        let mut s = [[0.0f64; 4]; 3];
-        for (lt, &k) in l.iter().zip(p) {
-            let xk = x3[k];
-            for (si, &xi) in s.iter_mut().zip(&xk) {
-                for (sij, &zj) in si.iter_mut().zip(lt) {
-                    *sij += zj * xi;
+            let mut a01 = [_mm_setzero_pd(); 3];
+            let mut a2 = [0.0f64; 3];
+            for t in 0..n {
+                let xk = x3.get_unchecked(*p.get_unchecked(t));
+                let z01 = _mm_loadh_pd(_mm_load_sd(z0.as_ptr().add(t)), z1.as_ptr().add(t));
+                let z2t = *z2.get_unchecked(t);
+                for i in 0..3 {
+                    a01[i] = _mm_add_pd(a01[i], _mm_mul_pd(z01, _mm_set1_pd(xk[i])));
+                    a2[i] += z2t * xk[i];
                 }
             }
+            for i in 0..3 {
+                _mm_storeu_pd(s[i].as_mut_ptr(), a01[i]);
+                s[i][2] = a2[i];
+            }
         }
-        s
     }
+    #[cfg(not(target_arch = "x86_64"))]
+    for t in 0..n {
+        let (xk, zt) = (x3[p[t]], [z0[t], z1[t], z2[t]]);
+        for (si, &xi) in s.iter_mut().zip(&xk) {
+            for (sij, &zj) in si.iter_mut().zip(&zt) {
+                *sij += zj * xi;
+            }
+        }
+    }
+    s
 }

@@ -29,7 +29,6 @@ const RANGES: usize = 4 * PARTS;
 #[derive(Clone, Copy)]
 struct Shared {
     y: (*mut f64, usize),
-    ylanes: (*mut [f64; 4], usize),
     c: (*mut f64, usize),
     w: (*mut f64, usize),
     w_block: (*mut [f64; 3], usize),
@@ -40,7 +39,7 @@ struct Shared {
 // SAFETY: a thread given a `Shared` writes only the rows of the ranges it
 // took (each range taken once, an atomic counter) and its own part of
 // `lanes` (thread k: entries k·stride.., k < PARTS): a range's blocks write
-// only their own rows' entries of y, ylanes, c, w, w_block, is_block and
+// only their own rows' entries of y, c, w, w_block, is_block and
 // winv (a block never reaches past its range's end: [`Former::walk`]'s
 // `end`, and ranges begin at block starts, `cuts`), so no element is
 // written by two threads, and none that one writes is read by another.
@@ -106,7 +105,6 @@ pub(super) fn form(rows: &mut Rows, f: &MassFactor, vfree: &[f64], team: &Team) 
         table,
         j,
         y,
-        ylanes,
         c,
         w,
         w_block,
@@ -118,7 +116,6 @@ pub(super) fn form(rows: &mut Rows, f: &MassFactor, vfree: &[f64], team: &Team) 
     let (kind, path, table, j) = (&kind[..], &path[..], &table[..], &j[..]);
     let sh = Shared {
         y: (y.as_mut_ptr(), y.len()),
-        ylanes: (ylanes.as_mut_ptr(), ylanes.len()),
         c: (c.as_mut_ptr(), c.len()),
         w: (w.as_mut_ptr(), w.len()),
         w_block: (w_block.as_mut_ptr(), w_block.len()),
@@ -145,7 +142,6 @@ pub(super) fn form(rows: &mut Rows, f: &MassFactor, vfree: &[f64], team: &Team) 
                 table,
                 j,
                 y: std::slice::from_raw_parts_mut(sh.y.0, sh.y.1),
-                ylanes: std::slice::from_raw_parts_mut(sh.ylanes.0, sh.ylanes.1),
                 c: std::slice::from_raw_parts_mut(sh.c.0, sh.c.1),
                 w: std::slice::from_raw_parts_mut(sh.w.0, sh.w.1),
                 w_block: std::slice::from_raw_parts_mut(sh.w_block.0, sh.w_block.1),

@@ -1,8 +1,8 @@
 //! [`Former::form_pair`] on chains of zeros (factor/zeros.rs): where L is
 //! zero on the pair's chains and its rows are plain, no elimination step
 //! changes a bit and Y = J·D^-½ entry by entry (docs/theory.md §"Tree-sparse
-//! LTDL"). The six rows are then formed slot by slot straight from J into Y,
-//! its lanes and the sums, without the gather into lanes and the store back:
+//! LTDL"). The six rows are then formed slot by slot straight from J into Y
+//! and the sums, without the gather into lanes and the store back:
 //! every value the lanes' form gives, each sum in path order as there
 //! (`gather_six`, `store_six`).
 
@@ -13,7 +13,7 @@ impl Former<'_> {
     /// Contacts r's and r + 3's rows (six rows of J, N path slots; chains
     /// ending at `path[A − 1]` and `path[N − 1]`) formed where L is zero on
     /// both chains and the rows plain ([`MassFactor::zero_scale`]): Y's six
-    /// rows, their lanes, c = J v*, W's diagonal and the blocks'
+    /// rows, c = J v*, W's diagonal and the blocks'
     /// off-diagonal entries. False, nothing written, elsewhere.
     #[inline(always)]
     pub(super) fn form_zero_pair<const A: usize, const N: usize>(
@@ -39,12 +39,8 @@ impl Former<'_> {
         let Some(s) = f.zero_scale::<A, N>(path, &rows) else {
             return false;
         };
-        // Y's six rows, N slots each; the two contacts' lanes
+        // Y's six rows, N slots each
         let Some(y) = self.y.get_mut(r * st..(r + 6) * st) else {
-            return false;
-        };
-        let lanes = self.ylanes.get_mut(r * st..(r + 3) * st + N);
-        let Some((l0, l1)) = lanes.map(|l| l.split_at_mut(3 * st)) else {
             return false;
         };
         let mut ys = y.chunks_exact_mut(st).map(|q| &mut q[..N]);
@@ -58,7 +54,6 @@ impl Former<'_> {
         ) else {
             return false;
         };
-        let (l0, l1) = (&mut l0[..N], &mut l1[..N]);
         // c = J v* from 0, W's diagonal and off-diagonal sums from −0, each in
         // path order (gather_six's and store_six's order)
         let (mut c, mut d, mut o) = ([0.0f64; 6], [-0.0f64; 6], [-0.0f64; 6]);
@@ -74,8 +69,6 @@ impl Former<'_> {
             add_w_six(&mut d, &mut o, &e);
             (y0[t], y1[t], y2[t]) = (e[0], e[1], e[2]);
             (y3[t], y4[t], y5[t]) = (e[3], e[4], e[5]);
-            l0[t] = [e[0], e[1], e[2], 0.0];
-            l1[t] = [e[3], e[4], e[5], 0.0];
         }
         for (k, q) in [(0, r), (3, r + 3)] {
             self.c[q..q + 3].copy_from_slice(&c[k..k + 3]);
