@@ -34,6 +34,28 @@ pub(super) unsafe fn dot3_from(s0: [f64; 3], ys: [&[f64]; 3], p: &[usize], x: &[
     at_path_len!(n; y0, y1, y2, p => unsafe { dot3_run(s0, [y0, y1, y2], p, x, n) })
 }
 
+/// [`dot3`] of the contact whose three rows of y begin at `y[o..]`, `st`
+/// apart (one pointer and the stride, not three pointers: the sweeps'
+/// registers), each the same sum.
+///
+/// # Safety
+/// `o + 2·st + p.len() ≤ y.len()`, and every index of `p` is < `x.len()`.
+#[inline(always)]
+pub(super) unsafe fn dot3_at(y: &[f64], o: usize, st: usize, p: &[usize], x: &[f64]) -> [f64; 3] {
+    let n = p.len();
+    // SAFETY: the caller's (rows o.., o + st.., o + 2·st.., n entries each)
+    let (y0, y1, y2) = unsafe {
+        let b = y.as_ptr().add(o);
+        (
+            std::slice::from_raw_parts(b, n),
+            std::slice::from_raw_parts(b.add(st), n),
+            std::slice::from_raw_parts(b.add(2 * st), n),
+        )
+    };
+    // SAFETY: the caller's
+    unsafe { dot3([y0, y1, y2], p, x) }
+}
+
 /// [`dot3_from`]'s loop over the first `n` slots.
 ///
 /// # Safety

@@ -2,7 +2,7 @@
 //! contact's three rows taken in one pass and the exact Coulomb slide onto
 //! the friction disc.
 
-use super::dot3::dot3;
+use super::dot3::dot3_at;
 use super::kernels::{axpy3_path, pinned_until, slide_onto_cone, warm_rows, Path};
 use super::loop_block::{BlockRows, LoopBlock};
 use super::subspace::{subspace_step, Solved, Subspace};
@@ -291,16 +291,14 @@ impl Rows {
                         // `table` and are at most `st` long (checked above), and
                         // r + 2 < n (a contact's rows), so (r + 2)·st + len ≤
                         // n·st ≤ y.len()
-                        let (p, ys) = unsafe {
+                        let p = unsafe {
                             let (s, l) = *paths.get_unchecked(r);
-                            let o = r * st;
-                            let yr = |i: usize| y.get_unchecked(o + i * st..o + i * st + l);
-                            (table.get_unchecked(s..s + l), [yr(0), yr(1), yr(2)])
+                            table.get_unchecked(s..s + l)
                         };
                         // the three dots side by side over their rows of y
                         // (each a sum from 0 in path order)
-                        // SAFETY: the path's dofs < nv ≤ dv.len() (checked above)
-                        let [dn, d1, d2] = unsafe { dot3(ys, p, dv) };
+                        // SAFETY: as above; the path's dofs < nv ≤ dv.len()
+                        let [dn, d1, d2] = unsafe { dot3_at(y, r * st, st, p, dv) };
                         let [wn1, wn2, w12] = w_block[r];
                         let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
                         let on = lambda[r];
@@ -347,8 +345,13 @@ impl Rows {
                         let (dl1, dl2) = (t1 - o1, t2 - o2);
                         if dln != 0.0 || dl1 != 0.0 || dl2 != 0.0 {
                             // Δv' += Δλₙ yₙ + Δλ₁ y₁ + Δλ₂ y₂ over the path
+                            let l = p.len();
+                            // SAFETY: r + 2 < n and l ≤ st (checked above), and
+                            // y holds n·st entries
+                            let yr = |q: usize| unsafe { y.get_unchecked(q * st..q * st + l) };
                             let at = Path::of(p);
-                            // SAFETY: each of ys is the path's length
+                            let ys = [yr(r), yr(r + 1), yr(r + 2)];
+                            // SAFETY: each of ys is l = the path's length
                             unsafe { axpy3_path([dln, dl1, dl2], ys, at, dv) };
                             if SKIP && armed {
                                 drift += dln.abs() * wnn.sqrt()
