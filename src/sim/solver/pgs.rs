@@ -289,8 +289,8 @@ impl Rows {
                         // normal's change left (through the block's entries)
                         // SAFETY: r is a row of `runs`, whose paths lie in
                         // `table` and are at most `st` long (checked above), and
-                        // r + 2 < n (a contact's rows), so (r + 2)·st + len ≤
-                        // n·st ≤ y.len()
+                        // r + 2 < n (tested above), so (r + 2)·st + len ≤ n·st
+                        // ≤ y.len()
                         let p = unsafe {
                             let (s, l) = *paths.get_unchecked(r);
                             table.get_unchecked(s..s + l)
