@@ -1,8 +1,8 @@
-use crate::model::joint::{dispatch_of, Dispatch};
+use crate::model::joint::{dispatch_of, Dispatch, FreeJ};
 use crate::model::{dispatch_keyed, Data, FrameId, JointModel, Model, NameError};
 use crate::spatial::ops::mat_mat;
-use crate::spatial::{quat_to_matrix, rodrigues, sin_cos, skew, Scalar, Se3};
-use nalgebra::{DVector, Vector3};
+use crate::spatial::{rodrigues, sin_cos, skew, Scalar, Se3};
+use nalgebra::DVector;
 
 /// Forward kinematics of every body: `liMi = X_tree,i · X_J(q_i)` and
 /// `oMi = oM_λ(i) · liMi`.
@@ -62,10 +62,8 @@ fn fk_pass<T: Scalar, const KEYED: bool>(model: &Model<T>, data: &mut Data<T>, q
     for i in 1..nb {
         let op = o_m_i[parent[i]];
         if lone && parent[i] == 0 && ident[i] && zt[i] && matches!(keys[i].0, Dispatch::Free) {
-            // M = (R(quaternion), p), `FreeJ::placement`'s
-            let qs = &q[joints[i].iq..joints[i].iq + 7];
-            let r = quat_to_matrix(qs[3], qs[4], qs[5], qs[6]);
-            let m = Se3::new(r, Vector3::new(qs[0], qs[1], qs[2]));
+            // M = X_J(q), the pose `FreeJ::placement` composes
+            let m = FreeJ { j: &joints[i] }.joint_pose(q);
             if plain_pose(&m) {
                 li_m_i[i] = m;
                 o_m_i[i] = m;

@@ -13,6 +13,17 @@ pub(crate) struct FreeJ<'j, T: Scalar> {
 }
 
 impl<'j, T: Scalar> FreeJ<'j, T> {
+    /// The joint's own pose X_J(q) = (R(quaternion), p) from its 7
+    /// coordinates of `q` (`λ(i)Mi` at an identity placement).
+    #[inline(always)]
+    pub(crate) fn joint_pose(&self, q: &[T]) -> Se3<T> {
+        let q = &q[self.j.iq..self.j.iq + 7];
+        Se3::new(
+            quat_to_matrix(q[3], q[4], q[5], q[6]),
+            Vector3::new(q[0], q[1], q[2]),
+        )
+    }
+
     /// `S x` for the free joint's 6 coordinates of `x` (linear first in `x`).
     #[inline(always)]
     fn motion(&self, x: &[T]) -> Motion<T> {
@@ -32,12 +43,7 @@ impl<'j, T: Scalar> JointModel<T> for FreeJ<'j, T> {
     }
     #[inline(always)]
     fn placement(&self, xt: &Se3<T>, q: &[T]) -> Se3<T> {
-        let q = &q[self.j.iq..self.j.iq + 7];
-        let m = Se3::new(
-            quat_to_matrix(q[3], q[4], q[5], q[6]),
-            Vector3::new(q[0], q[1], q[2]),
-        );
-        xt.compose(&m)
+        xt.compose(&self.joint_pose(q))
     }
     #[inline(always)]
     fn add_motion(&self, m: &mut Motion<T>, x: &[T]) {

@@ -4,7 +4,7 @@
 
 use super::dense::{ldlt_dropping, ldlt_dropping_solve};
 use super::subspace::{Subspace, DEPENDENT};
-use super::wff::Lanes;
+use super::wff::OwnBlocks;
 use super::{RowKind, Rows, SUBSPACE_MAX};
 
 impl Rows {
@@ -125,12 +125,14 @@ impl Rows {
         }
         // W_FF's lower triangle (as the subspace step forms it)
         sm.forget();
-        let lanes = Lanes {
+        let own_blocks = OwnBlocks {
             contact: &self.is_block,
             diag: (&self.w, &self.w_block),
         };
         sm.group(&self.path);
-        if !sm.form_w_ff(&self.y, st, &self.path, table, lanes, self.nv, 0, false) {
+        if !sm.form_w_ff(
+            &self.y, st, &self.path, table, own_blocks, self.nv, 0, false,
+        ) {
             return false;
         }
         ldlt_dropping(&mut sm.w, ld, m, 0, DEPENDENT);

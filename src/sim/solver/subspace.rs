@@ -5,7 +5,7 @@ use super::dense::{ldlt_dropping, ldlt_dropping_solve};
 use super::dot3::dot3_from;
 use super::kernels::{axpy1, axpy2, dot1_from};
 use super::loop_block::LoopBlock;
-use super::wff::Lanes;
+use super::wff::OwnBlocks;
 use super::{RowKind, SUBSPACE_MAX};
 
 /// Preallocated scratch of [`subspace_step`]: the free rows, their dense
@@ -110,7 +110,7 @@ pub(super) struct Solved<'a> {
     pub(super) c: &'a [f64],
     pub(super) b: &'a [f64],
     /// W's diagonal and contact blocks (`Rows::w`, `Rows::w_block`: Y Yᵀ's,
-    /// not the loop block's reduced ones), [`Lanes::diag`].
+    /// not the loop block's reduced ones), [`OwnBlocks::diag`].
     pub(super) diag: (&'a [f64], &'a [[f64; 3]]),
 }
 
@@ -241,7 +241,7 @@ pub(super) fn subspace_step(
         RowKind::Tangent { .. } | RowKind::Tangent2 => 0.0,
         _ => b[r],
     };
-    let lanes = Lanes { contact, diag };
+    let own_blocks = OwnBlocks { contact, diag };
     sm.group(paths);
     let mut a = 0;
     while a < m {
@@ -285,7 +285,7 @@ pub(super) fn subspace_step(
         if sm.factored {
             sm.map_old();
         }
-        if !sm.form_w_ff(y, st, paths, table, lanes, nv, kept, sm.factored) {
+        if !sm.form_w_ff(y, st, paths, table, own_blocks, nv, kept, sm.factored) {
             sm.forget();
             return false;
         }

@@ -87,7 +87,7 @@ impl Subspace {
         st: usize,
         paths: &[(usize, usize)],
         table: &[usize],
-        lanes: Lanes,
+        own_blocks: OwnBlocks,
         nv: usize,
         from: usize,
         reuse: bool,
@@ -155,7 +155,7 @@ impl Subspace {
                     // entry here is the same products in the same order from
                     // +0: the same bits but for a sum of −0, which + 0.0 makes
                     // the +0 the sum here gives)
-                    if let Some(own) = lanes.own(r, sa) {
+                    if let Some(own) = own_blocks.own(r, sa) {
                         for (i, oi) in own.iter().enumerate().take(sa) {
                             for (j, &oij) in oi.iter().enumerate().take(i + 1) {
                                 put(a + i, a + j, oij + 0.0);
@@ -273,12 +273,12 @@ const NEW: usize = usize::MAX;
 /// (`Rows::w`, `Rows::w_block`, as `Rows::form` made them: not the loop
 /// block's reduced ones), for [`Subspace::form_w_ff`].
 #[derive(Clone, Copy)]
-pub(super) struct Lanes<'a> {
+pub(super) struct OwnBlocks<'a> {
     pub(super) contact: &'a [bool],
     pub(super) diag: (&'a [f64], &'a [[f64; 3]]),
 }
 
-impl<'a> Lanes<'a> {
+impl<'a> OwnBlocks<'a> {
     /// W's own block of the free-row group at row `r` (`s` rows: a contact's
     /// three, or one row), lower triangle, each entry Σₜ yᵢₜ yⱼₜ over the
     /// row's path in its order from −0 (`Rows::form`: W's diagonal ‖yᵣ‖²,
