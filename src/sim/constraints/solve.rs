@@ -30,7 +30,6 @@ impl Constraints {
         solver: Solver,
     ) -> Impulses<'_> {
         self.clear_forces();
-        self.dv.as_mut_slice().fill(0.0);
         // torsion and rolling rows (spin.rs) couple a point's rotation to its
         // normal: a step with them may take twice the sweeps before the cap
         let iterations = iterations * if self.counts.spin > 0 { 2 } else { 1 };
@@ -54,13 +53,16 @@ impl Constraints {
             let dv = self.dv.as_mut_slice();
             let args = (iterations, tol, relaxation);
             // every island's warm start, made in the grouping: the first
-            // solves take it ([`Islands::warm`])
+            // solves take it ([`Islands::warm`]), every entry of Δv' written;
+            // else Δv' from zeros (a dof on no island's rows stays 0)
             let mut given = false;
             if let Some(w) = self.islands.warm()
                 && w.len() == dv.len()
             {
                 dv.copy_from_slice(w);
                 given = true;
+            } else {
+                dv.fill(0.0);
             }
             // every island, then those a left-out contact that failed its
             // check joined (src/sim/islands/split.rs), until none fails
@@ -134,6 +136,7 @@ impl Constraints {
             // Newton: the whole scene at once; a solve stopped by the cap is
             // scaled onto the exact solution's energy bound, never swept
             let dv = self.dv.as_mut_slice();
+            dv.fill(0.0);
             let mut s = self.newton.solve(rows, f, dv, iterations, tol);
             if s >= iterations {
                 f.apply_r(vfree.as_slice(), &mut self.a);
