@@ -159,6 +159,9 @@ pub(crate) struct Constraints {
     dv: DVector<f64>,
     push: DVector<f64>,
     tau_joint: DVector<f64>,
+    /// Some entry of `tau_joint` may be nonzero (a joint row's force added
+    /// since it was last zeroed).
+    tau_written: bool,
     fext: Vec<Force>,
     contact_forces: Vec<ContactForce>,
     /// R v* (the energy-safe exit's work).
@@ -265,6 +268,7 @@ impl Constraints {
             dv: DVector::zeros(nv),
             push: DVector::zeros(nv),
             tau_joint: DVector::zeros(nv),
+            tau_written: false,
             fext: vec![Force::zero(); model.nbodies],
             contact_forces: Vec::with_capacity(max_points),
             a: vec![0.0; nv],
@@ -332,7 +336,11 @@ impl Constraints {
     pub fn clear_forces(&mut self) {
         self.fext.iter_mut().for_each(|f| *f = Force::zero());
         self.contact_forces.clear();
-        self.tau_joint.as_mut_slice().fill(0.0);
+        // (zeros already where no joint row added to it: a pile's steps)
+        if self.tau_written {
+            self.tau_joint.as_mut_slice().fill(0.0);
+            self.tau_written = false;
+        }
     }
 
     /// Rows of the last assembly.

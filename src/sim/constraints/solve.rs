@@ -199,6 +199,7 @@ impl Constraints {
         for w in self.warm_joint.iter_mut() {
             *w = [0.0; 5];
         }
+        self.tau_written |= !self.joint_rows.is_empty();
         for (k, &(d, which)) in self.joint_rows.iter().enumerate() {
             let r = self.first_joint_row + k;
             let lam = rows.lambda[r];
