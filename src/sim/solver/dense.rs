@@ -38,10 +38,13 @@ pub(crate) fn ldlt_dropping(a: &mut [f64], ld: usize, m: usize, from: usize, dro
         }
         return;
     }
-    let mut d = [0.0f64; CAP];
+    // the pivots (dₖ, k < m: each written at its column before any read,
+    // so not cleared first)
+    let mut d = [std::mem::MaybeUninit::<f64>::uninit(); CAP];
     // SAFETY: every index read or written below is i·ld + k with i < m and
     // k ≤ j < m, at most (m − 1)·ld + m − 1 < m·ld ≤ a.len() (checked above);
-    // d's indices are < m ≤ CAP
+    // d's indices are < m ≤ CAP, dⱼ written at column j before the columns
+    // after it read it
     unsafe { factor(a.as_mut_ptr(), ld, m, from, drop, &mut d) }
 }
 
@@ -53,12 +56,21 @@ pub(crate) fn ldlt_dropping(a: &mut [f64], ld: usize, m: usize, from: usize, dro
 /// (the library's `s / dⱼ` not taken: no sum then).
 ///
 /// # Safety
-/// `a` must hold m · ld entries, ld ≥ m, from ≤ m ≤ CAP.
+/// `a` must hold m · ld entries, ld ≥ m, from ≤ m ≤ CAP. `d` need not be
+/// initialised: dⱼ is written at column j, before any read of it.
 #[inline(always)]
-unsafe fn factor(a: *mut f64, ld: usize, m: usize, from: usize, drop: f64, d: &mut [f64; CAP]) {
-    // SAFETY: the caller's contract (every index within a and d)
+unsafe fn factor(
+    a: *mut f64,
+    ld: usize,
+    m: usize,
+    from: usize,
+    drop: f64,
+    d: &mut [std::mem::MaybeUninit<f64>; CAP],
+) {
+    // SAFETY: the caller's contract (every index within a and d; d[k] read
+    // for k < j only, written at column k)
     unsafe {
-        let d = d.as_mut_ptr();
+        let d = d.as_mut_ptr().cast::<f64>();
         for j in 0..m {
             let rj = a.add(j * ld);
             let dj = if j < from {
@@ -202,18 +214,16 @@ pub(crate) fn ldlt_dropping_solve(a: &[f64], ld: usize, m: usize, x: &mut [f64])
             }
             *x.add(i) = s;
         }
-        // z /= D
-        for i in 0..m {
-            let d = *a.add(i * ld + i);
-            *x.add(i) = if d != 0.0 { *x.add(i) / d } else { 0.0 };
-        }
-        // Lᵀ x = z: entry i's sum over k > i in order, down column i of L
+        // z /= D, then Lᵀ x = z: entry i's zᵢ/dᵢ, less its sum over k > i in
+        // order, down column i of L (each xₖ, k > i, final by then: the same
+        // operations on each entry as the two passes one after the other)
         for i in (0..m).rev() {
-            if *a.add(i * ld + i) == 0.0 {
+            let d = *a.add(i * ld + i);
+            if d == 0.0 {
                 *x.add(i) = 0.0;
                 continue;
             }
-            let mut s = *x.add(i);
+            let mut s = *x.add(i) / d;
             let mut k = i + 1;
             while k + 1 < m {
                 s -= *a.add(k * ld + i) * *x.add(k);

@@ -242,7 +242,12 @@ pub(super) fn subspace_step(
         _ => b[r],
     };
     let own_blocks = OwnBlocks { contact, diag };
-    sm.group(paths);
+    // a try on the free rows of this solve's last factor: their groups are
+    // the ones `three` holds from that try
+    let again = sm.factored && sm.factored_rows == sm.rows;
+    if !again {
+        sm.group(paths);
+    }
     let mut a = 0;
     while a < m {
         let r = sm.rows[a];
@@ -271,7 +276,9 @@ pub(super) fn subspace_step(
     // (a leading block's factor, the same bits, dense.rs)
     // and forms and factors the rows after them only (all of them on the same
     // free rows), their entries with rows of that W_FF copied from it
-    let kept = if sm.factored {
+    let kept = if again {
+        m
+    } else if sm.factored {
         let same = sm
             .factored_rows
             .iter()
@@ -292,7 +299,9 @@ pub(super) fn subspace_step(
         sm.keep_w_ff(kept);
         ldlt_dropping(&mut sm.w, sm.ld, m, kept, DEPENDENT);
     }
-    sm.factored_rows.clone_from(&sm.rows);
+    if !again {
+        sm.factored_rows.clone_from(&sm.rows);
+    }
     sm.factored = true;
     ldlt_dropping_solve(&sm.w, sm.ld, m, &mut sm.rhs[..m]);
     // the new impulses (none taken if one is not finite)
