@@ -43,6 +43,8 @@ pub(super) struct Subspace {
     pub(super) factored: bool,
     pub(super) factored_rows: Vec<usize>,
     pub(super) wf: Vec<f64>,
+    /// The W_FF before it, while a try forms its own ([`Subspace::keep_old`]).
+    pub(super) wold: Vec<f64>,
     /// At a free row: its place in `factored_rows` (`usize::MAX`: not there).
     pub(super) old: Vec<usize>,
     /// Each row: the sweeps' `drift` up to which it is pinned at its bound
@@ -69,6 +71,7 @@ impl Subspace {
             factored: false,
             factored_rows: Vec::with_capacity(m),
             wf: vec![0.0; m * m],
+            wold: vec![0.0; m * m],
             old: Vec::with_capacity(m),
             until: vec![f64::NEG_INFINITY; cap],
         }
@@ -291,12 +294,12 @@ pub(super) fn subspace_step(
     if kept < m {
         if sm.factored {
             sm.map_old();
+            sm.keep_old(kept);
         }
-        if !sm.form_w_ff(y, st, paths, table, own_blocks, nv, kept, sm.factored) {
+        if !sm.form_w_ff_kept(y, st, paths, table, own_blocks, nv, kept, sm.factored) {
             sm.forget();
             return false;
         }
-        sm.keep_w_ff(kept);
         ldlt_dropping(&mut sm.w, sm.ld, m, kept, DEPENDENT);
     }
     if !again {

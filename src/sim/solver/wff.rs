@@ -63,23 +63,7 @@ impl Subspace {
         }
     }
 
-    /// The lower triangle of W_FF = Y_F Y_Fᵀ over `self.rows` (m of them) into
-    /// `self.w` (row a at `w[a * ld..]`), its rows from `from` on (a group's
-    /// start, [`Subspace::group`], which must have been run on these rows):
-    /// row r scattered onto its path's dofs in `x` (zeros elsewhere, put back
-    /// after), each entry then a sum over the other row's path in its order.
-    /// A dof off r's path adds y·0 = ±0, which leaves every partial sum as it
-    /// was: the same bits as summing over the two paths' common dofs only,
-    /// without the merge's branches (the cost follows the rows' paths, never
-    /// nv). Rows `r` of `y` have room `st`; row r's dofs are
-    /// `table[paths[r]]`, each < nv (the sweeps' check). `x` must hold nv
-    /// entries, `w` m · ld. A contact's three rows q are summed side by side
-    /// in vector lanes ([`dot3x3`], `dot3::dot3`): each the same sum in the
-    /// same order. With `reuse`
-    /// (`old` mapped, [`Subspace::map_old`]), an entry between two groups of
-    /// rows all in the last W_FF (`wf`) is copied from there: the same sum,
-    /// whichever group it was summed in. Returns whether it was formed
-    /// (false: the scratch does not fit these rows).
+    /// [`Subspace::form_lower`] into `self.w`.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn form_w_ff(
         &mut self,
@@ -92,13 +76,65 @@ impl Subspace {
         from: usize,
         reuse: bool,
     ) -> bool {
+        self.form_lower::<false>(y, st, paths, table, own_blocks, nv, (from, reuse))
+    }
+
+    /// [`Subspace::form_lower`] into `self.w` (to be factored there) and
+    /// `self.wf`, where it is kept for the solve's later tries: the rows of
+    /// `wf` before `from` are this solve's last W_FF's (see
+    /// [`Subspace::keep_old`]).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn form_w_ff_kept(
+        &mut self,
+        y: &[f64],
+        st: usize,
+        paths: &[(usize, usize)],
+        table: &[usize],
+        own_blocks: OwnBlocks,
+        nv: usize,
+        from: usize,
+        reuse: bool,
+    ) -> bool {
+        self.form_lower::<true>(y, st, paths, table, own_blocks, nv, (from, reuse))
+    }
+
+    /// The lower triangle of W_FF = Y_F Y_Fᵀ over `self.rows` (m of them) into
+    /// `self.w` (row a at `w[a * ld..]`; with `KEPT` into `self.wf` too), its
+    /// rows from `from` on (a group's
+    /// start, [`Subspace::group`], which must have been run on these rows):
+    /// row r scattered onto its path's dofs in `x` (zeros elsewhere, put back
+    /// after), each entry then a sum over the other row's path in its order.
+    /// A dof off r's path adds y·0 = ±0, which leaves every partial sum as it
+    /// was: the same bits as summing over the two paths' common dofs only,
+    /// without the merge's branches (the cost follows the rows' paths, never
+    /// nv). Rows `r` of `y` have room `st`; row r's dofs are
+    /// `table[paths[r]]`, each < nv (the sweeps' check). `x` must hold nv
+    /// entries, `w` m · ld. A contact's three rows q are summed side by side
+    /// in vector lanes ([`dot3x3`], `dot3::dot3`): each the same sum in the
+    /// same order. With `reuse`
+    /// (`old` mapped, [`Subspace::map_old`]), an entry between two groups of
+    /// rows all in the last W_FF (`wold`, [`Subspace::keep_old`]) is copied
+    /// from there: the same sum, whichever group it was summed in. Returns
+    /// whether it was formed (false: the scratch does not fit these rows).
+    #[allow(clippy::too_many_arguments)]
+    fn form_lower<const KEPT: bool>(
+        &mut self,
+        y: &[f64],
+        st: usize,
+        paths: &[(usize, usize)],
+        table: &[usize],
+        own_blocks: OwnBlocks,
+        nv: usize,
+        (from, reuse): (usize, bool),
+    ) -> bool {
         let (m, ld) = (self.rows.len(), self.ld);
         if m > ld
             || self.w.len() < m * ld
+            || self.wf.len() < m * ld
             || self.three.len() != m
             || self.x.len() < nv
             || self.x3.len() < nv
-            || (reuse && (self.old.len() != m || self.wf.len() < m * ld))
+            || (reuse && (self.old.len() != m || self.wold.len() < m * ld))
         {
             return false;
         }
@@ -107,20 +143,27 @@ impl Subspace {
             three,
             w,
             wf,
+            wold,
             old,
             x,
             x3,
             ..
         } = self;
-        let (rows, three, wf, old) = (&rows[..], &three[..], &wf[..], &old[..]);
+        let (rows, three, wold, old) = (&rows[..], &three[..], &wold[..], &old[..]);
         let path = |r: usize| {
             let (s, l) = paths[r];
             &table[s..s + l]
         };
-        let w = &mut w[..m * ld];
+        let (w, wf) = (&mut w[..m * ld], &mut wf[..m * ld]);
         let yrow = |q: usize, len: usize| &y[q * st..q * st + len];
         // SAFETY (the writes below): every (i, j) written has i < m, j ≤ i
-        let mut put = |i: usize, j: usize, v: f64| unsafe { *w.get_unchecked_mut(i * ld + j) = v };
+        // (and with `KEPT` into wf, of the same length)
+        let mut put = |i: usize, j: usize, v: f64| unsafe {
+            *w.get_unchecked_mut(i * ld + j) = v;
+            if KEPT {
+                *wf.get_unchecked_mut(i * ld + j) = v;
+            }
+        };
         let known = |a: usize, s: usize| reuse && old[a..a + s].iter().all(|&o| o != NEW);
         let mut a = 0;
         while a < m {
@@ -142,7 +185,7 @@ impl Subspace {
                     for i in 0..sa {
                         for j in 0..sb {
                             if bb + j <= a + i {
-                                put(a + i, bb + j, wf[old[a + i] * ld + old[bb + j]]);
+                                put(a + i, bb + j, wold[old[a + i] * ld + old[bb + j]]);
                             }
                         }
                     }
@@ -254,13 +297,16 @@ impl Subspace {
         true
     }
 
-    /// Keeps W_FF's rows `from..` (in `w`, about to be factored) in `wf`.
-    pub(super) fn keep_w_ff(&mut self, from: usize) {
-        let (m, ld) = (self.rows.len().min(self.ld), self.ld);
+    /// Before a try on other free rows than the last factor's: the last
+    /// W_FF (`wf`) moved to `wold`, where [`Subspace::form_w_ff_kept`] reads
+    /// the entries it copies, and its rows before `kept` (the rows this try
+    /// keeps) back in `wf`.
+    pub(super) fn keep_old(&mut self, kept: usize) {
+        std::mem::swap(&mut self.wf, &mut self.wold);
         // whole rows in one copy (their entries past the diagonal are never
-        // read from `wf`: [`Subspace::form_w_ff`] reads its lower triangle)
-        let (s, e) = (from.min(m) * ld, m * ld);
-        if let (Some(d), Some(s)) = (self.wf.get_mut(s..e), self.w.get(s..e)) {
+        // read: a W_FF is read by its lower triangle)
+        let e = kept.min(self.ld) * self.ld;
+        if let (Some(d), Some(s)) = (self.wf.get_mut(..e), self.wold.get(..e)) {
             d.copy_from_slice(s);
         }
     }
