@@ -79,27 +79,10 @@ impl Subspace {
         self.form_lower::<false>(y, st, paths, table, own_blocks, nv, (from, reuse))
     }
 
-    /// [`Subspace::form_lower`] into `self.w` (to be factored there) and
-    /// `self.wf`, where it is kept for the solve's later tries: the rows of
-    /// `wf` before `from` are this solve's last W_FF's (see
-    /// [`Subspace::keep_old`]).
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn form_w_ff_kept(
-        &mut self,
-        y: &[f64],
-        st: usize,
-        paths: &[(usize, usize)],
-        table: &[usize],
-        own_blocks: OwnBlocks,
-        nv: usize,
-        from: usize,
-        reuse: bool,
-    ) -> bool {
-        self.form_lower::<true>(y, st, paths, table, own_blocks, nv, (from, reuse))
-    }
-
     /// The lower triangle of W_FF = Y_F Y_Fᵀ over `self.rows` (m of them) into
-    /// `self.w` (row a at `w[a * ld..]`; with `KEPT` into `self.wf` too), its
+    /// `self.w` (row a at `w[a * ld..]`), and with `KEPT` into `self.wf` too,
+    /// where it is kept for the solve's later tries (the rows of `wf` before
+    /// `from` are this solve's last W_FF's, [`Subspace::keep_old`]), its
     /// rows from `from` on (a group's
     /// start, [`Subspace::group`], which must have been run on these rows):
     /// row r scattered onto its path's dofs in `x` (zeros elsewhere, put back
@@ -117,7 +100,7 @@ impl Subspace {
     /// from there: the same sum, whichever group it was summed in. Returns
     /// whether it was formed (false: the scratch does not fit these rows).
     #[allow(clippy::too_many_arguments)]
-    fn form_lower<const KEPT: bool>(
+    pub(super) fn form_lower<const KEPT: bool>(
         &mut self,
         y: &[f64],
         st: usize,
@@ -298,7 +281,7 @@ impl Subspace {
     }
 
     /// Before a try on other free rows than the last factor's: the last
-    /// W_FF (`wf`) moved to `wold`, where [`Subspace::form_w_ff_kept`] reads
+    /// W_FF (`wf`) moved to `wold`, where [`Subspace::form_lower`] reads
     /// the entries it copies, and its rows before `kept` (the rows this try
     /// keeps) back in `wf`.
     pub(super) fn keep_old(&mut self, kept: usize) {
