@@ -130,7 +130,7 @@ impl Rows {
             diag: (&self.w, &self.w_block),
         };
         sm.group(&self.path);
-        if !sm.form_w_ff(
+        if !sm.form_w_ff::<false>(
             &self.y, st, &self.path, table, own_blocks, self.nv, 0, false,
         ) {
             return false;

@@ -296,7 +296,7 @@ pub(super) fn subspace_step(
             sm.map_old();
             sm.keep_old(kept);
         }
-        if !sm.form_lower::<true>(y, st, paths, table, own_blocks, nv, (kept, sm.factored)) {
+        if !sm.form_w_ff::<true>(y, st, paths, table, own_blocks, nv, kept, sm.factored) {
             sm.forget();
             return false;
         }

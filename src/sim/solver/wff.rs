@@ -63,22 +63,6 @@ impl Subspace {
         }
     }
 
-    /// [`Subspace::form_lower`] into `self.w`.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn form_w_ff(
-        &mut self,
-        y: &[f64],
-        st: usize,
-        paths: &[(usize, usize)],
-        table: &[usize],
-        own_blocks: OwnBlocks,
-        nv: usize,
-        from: usize,
-        reuse: bool,
-    ) -> bool {
-        self.form_lower::<false>(y, st, paths, table, own_blocks, nv, (from, reuse))
-    }
-
     /// The lower triangle of W_FF = Y_F Y_Fᵀ over `self.rows` (m of them) into
     /// `self.w` (row a at `w[a * ld..]`), and with `KEPT` into `self.wf` too,
     /// where it is kept for the solve's later tries (the rows of `wf` before
@@ -100,7 +84,7 @@ impl Subspace {
     /// from there: the same sum, whichever group it was summed in. Returns
     /// whether it was formed (false: the scratch does not fit these rows).
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn form_lower<const KEPT: bool>(
+    pub(super) fn form_w_ff<const KEPT: bool>(
         &mut self,
         y: &[f64],
         st: usize,
@@ -108,7 +92,8 @@ impl Subspace {
         table: &[usize],
         own_blocks: OwnBlocks,
         nv: usize,
-        (from, reuse): (usize, bool),
+        from: usize,
+        reuse: bool,
     ) -> bool {
         let (m, ld) = (self.rows.len(), self.ld);
         if m > ld
@@ -281,7 +266,7 @@ impl Subspace {
     }
 
     /// Before a try on other free rows than the last factor's: the last
-    /// W_FF (`wf`) moved to `wold`, where [`Subspace::form_lower`] reads
+    /// W_FF (`wf`) moved to `wold`, where [`Subspace::form_w_ff`] reads
     /// the entries it copies, and its rows before `kept` (the rows this try
     /// keeps) back in `wf`.
     pub(super) fn keep_old(&mut self, kept: usize) {
