@@ -19,6 +19,7 @@
 use super::solver::Rows;
 use crate::model::Model;
 
+mod by_tree;
 mod split;
 
 /// A group's key while it is left out of the solve (split.rs).
@@ -91,6 +92,15 @@ pub(crate) struct Islands {
     /// (no union path: `cached`): the islands are a function of them.
     last: Vec<(usize, usize)>,
     cached: bool,
+    /// Each tree's dofs, a range (empty: the trees' ranges are not
+    /// ascending, and the islands' dofs are sorted, by_tree.rs); per tree,
+    /// the island whose path reached it in this grouping (`usize::MAX`:
+    /// none); scratch of the trees by island, and each island's count.
+    tree_v: Vec<(usize, usize)>,
+    tree_isl: Vec<usize>,
+    tree_flag: Vec<u8>,
+    tree_buf: Vec<usize>,
+    tcount: Vec<usize>,
 }
 
 /// One island of this step: its row runs and its dofs.
@@ -174,6 +184,11 @@ impl Islands {
             chain_len: chain_lengths(&model.dof_parent, model.nv),
             last: Vec::with_capacity(rows),
             cached: false,
+            tree_isl: vec![usize::MAX; nt],
+            tree_flag: vec![0; nt],
+            tree_buf: Vec::with_capacity(nt),
+            tcount: Vec::with_capacity(nt + 1),
+            tree_v: by_tree::tree_ranges(model).unwrap_or_default(),
         }
     }
 
@@ -363,7 +378,11 @@ impl Islands {
         self.dofs.clear();
         let table = rows.table();
         let path = &rows.path[..rows.n.min(self.group_at.len())];
-        let mut i = 0;
+        // the trees' islands read off by tree (by_tree.rs), the rest here
+        let mut i = match self.tree_v.is_empty() {
+            true => 0,
+            false => self.tree_islands(table, path),
+        };
         while i < self.runs.len() {
             let k = self.runs[i].0;
             let (r0, d0) = (i, self.dofs.len());
