@@ -37,6 +37,8 @@ pub(crate) struct Islands {
     /// and each group's island root tree (`usize::MAX`: a row on no dof).
     groups: Vec<(usize, usize)>,
     gkey: Vec<usize>,
+    /// Per group: its rows are whole contacts' (found by the grouping).
+    triples: Vec<bool>,
     /// Each group's first tree (`usize::MAX`: a row on no dof; [`LEFT`]: a
     /// contact group all left out of the solve).
     gtree: Vec<usize>,
@@ -159,6 +161,7 @@ impl Islands {
             parent: (0..nt).collect(),
             groups: Vec::with_capacity(rows),
             gkey: Vec::with_capacity(rows),
+            triples: Vec::with_capacity(rows),
             gtree: Vec::with_capacity(rows),
             left: Vec::with_capacity(rows),
             out: vec![false; rows],
@@ -243,17 +246,26 @@ impl Islands {
         }
         // rows on the same path as the row before them (a contact's tangents,
         // the points of one pair) join the same trees: one group, looked at once
+        // (a contact's tangents share its normal's path: not compared; a
+        // group of whole contacts is known to be one, `triples`)
         self.groups.clear();
+        self.triples.clear();
         let path = &rows.path[..n];
         let mut r = 0;
         while r < n {
             let s = r;
-            r += 1;
+            let mut k = rows.rows_at(r);
+            let mut triples = k == 3;
+            r += k;
             while r < n && path[r] == path[s] {
-                r += 1;
+                k = rows.rows_at(r);
+                triples &= k == 3;
+                r += k;
             }
+            debug_assert!(path[s..r].iter().all(|&p| p == path[s]));
             self.group_at[s] = self.groups.len();
             self.groups.push((s, r));
+            self.triples.push(triples);
         }
         self.gtree.clear();
         for &(r, _, _, _) in &self.left {

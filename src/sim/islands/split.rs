@@ -59,7 +59,7 @@ impl Islands {
         a: usize,
         b: usize,
     ) -> bool {
-        if !rows.contacts_only(s, e) {
+        if !self.triples[g] && !rows.contacts_only(s, e) {
             return true;
         }
         let (mut kept, mut part) = (false, false);

@@ -413,6 +413,16 @@ impl Rows {
         self.path[r..r + 3].fill(path);
         Some(r)
     }
+    /// The rows from row `r` that share its path for certain: a contact's
+    /// three (formed as one, [`Rows::form_on`]) or the row alone.
+    #[inline(always)]
+    pub(crate) fn rows_at(&self, r: usize) -> usize {
+        if r + 3 <= self.n && self.is_block.get(r) == Some(&true) {
+            3
+        } else {
+            1
+        }
+    }
     /// Rows `s..e` are contact triples.
     pub(crate) fn contacts_only(&self, s: usize, e: usize) -> bool {
         e <= self.n && (e - s) % 3 == 0 && (s..e).step_by(3).all(|r| self.is_block[r])
