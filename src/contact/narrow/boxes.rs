@@ -208,12 +208,6 @@ fn basis(n: &Vector3<f64>) -> [Vector3<f64>; 2] {
     ]
 }
 
-/// a × b's z (2-D cross product).
-#[inline]
-fn perp(a: Vector2<f64>, b: Vector2<f64>) -> f64 {
-    a.x * b.y - a.y * b.x
-}
-
 /// Whether `a` and `b` are equal within f64::EPSILON or 4 ulps (approx's
 /// `ulps_eq!` with its defaults).
 fn ulps_eq(a: f64, b: f64) -> bool {
@@ -264,11 +258,37 @@ fn cross_lines(e1: [Vector2<f64>; 2], e2: [Vector2<f64>; 2]) -> Option<(f64, f64
 /// `s[i][j]` = (q[j+1] − q[j]) × (p[i] − q[j]) (2-D cross product), the
 /// numbers parry's inside test computes.
 fn sides(q: &[Vector2<f64>; 4], p: &[Vector2<f64>; 4]) -> [[f64; 4]; 4] {
+    // (the edges e = q[j+1] − q[j]; e × (x − q[j]) = eₓ (x − q[j])_y −
+    // e_y (x − q[j])ₓ, a point at a time, edges 0, 1 and 2, 3 in two lanes)
+    let (mut qx, mut qy, mut ex, mut ey) = ([0.0; 4], [0.0; 4], [0.0; 4], [0.0; 4]);
+    for j in 0..4 {
+        let k = (j + 1) % 4;
+        (qx[j], qy[j]) = (q[j].x, q[j].y);
+        (ex[j], ey[j]) = (q[k].x - q[j].x, q[k].y - q[j].y);
+    }
     let mut s = [[0.0; 4]; 4];
-    for (i, pi) in p.iter().enumerate() {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_loadu_pd, _mm_mul_pd, _mm_set1_pd, _mm_storeu_pd, _mm_sub_pd};
+        // SAFETY: SSE2 is part of x86_64; each load and store is two
+        // entries at 0 or 2 of a local [f64; 4]
+        unsafe {
+            let half = |a: &[f64; 4], h: usize| _mm_loadu_pd(a.as_ptr().add(2 * h));
+            let lanes = [0, 1].map(|h| (half(&qx, h), half(&qy, h), half(&ex, h), half(&ey, h)));
+            for (si, pi) in s.iter_mut().zip(p) {
+                let (px, py) = (_mm_set1_pd(pi.x), _mm_set1_pd(pi.y));
+                for (h, &(qx, qy, ex, ey)) in lanes.iter().enumerate() {
+                    let a = _mm_mul_pd(ex, _mm_sub_pd(py, qy));
+                    let b = _mm_mul_pd(ey, _mm_sub_pd(px, qx));
+                    _mm_storeu_pd(si.as_mut_ptr().add(2 * h), _mm_sub_pd(a, b));
+                }
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    for (si, pi) in s.iter_mut().zip(p) {
         for j in 0..4 {
-            let k = (j + 1) % 4;
-            s[i][j] = perp(q[k] - q[j], *pi - q[j]);
+            si[j] = ex[j] * (pi.y - qy[j]) - ey[j] * (pi.x - qx[j]);
         }
     }
     s
@@ -401,22 +421,29 @@ fn clip_faces(
     // lie strictly on either side of the other's line can cross within
     // both (others: parry's fractions fall outside (0, 1), or, a corner on
     // a line to rounding, at a point already found)
+    // (bit 4j + i: b's edge j and a's edge i straddle each other's lines,
+    // the tests in lanes; then the pairs in that order, j then i)
+    let mut straddle = 0u32;
     for j in 0..4 {
         let j1 = (j + 1) % 4;
-        let e2 = [q2[j], q2[j1]];
         for i in 0..4 {
             let i1 = (i + 1) % 4;
-            if !(s21[j][i] * s21[j1][i] < 0.0 && s12[i][j] * s12[i1][j] < 0.0) {
-                continue;
-            }
-            let e1 = [q1[i], q1[i1]];
-            if let Some((s, k)) = cross_lines(e1, e2) {
-                if s > 0.0 && s < 1.0 && k > 0.0 && k < 1.0 {
-                    let x1 = f1.v[i] * (1.0 - s) + f1.v[i1] * s;
-                    let x2 = v2[j] * (1.0 - k) + v2[j1] * k;
-                    let dist = (x2 - x1).dot(n);
-                    push(x1, x2, f1.eids[i], f2.eids[j], dist);
-                }
+            let b_on = s21[j][i] * s21[j1][i] < 0.0;
+            let a_on = s12[i][j] * s12[i1][j] < 0.0;
+            straddle |= u32::from(b_on & a_on) << (4 * j + i);
+        }
+    }
+    while straddle != 0 {
+        let bit = straddle.trailing_zeros() as usize;
+        straddle &= straddle - 1;
+        let (j, i) = (bit / 4, bit % 4);
+        let (j1, i1) = ((j + 1) % 4, (i + 1) % 4);
+        if let Some((s, k)) = cross_lines([q1[i], q1[i1]], [q2[j], q2[j1]]) {
+            if s > 0.0 && s < 1.0 && k > 0.0 && k < 1.0 {
+                let x1 = f1.v[i] * (1.0 - s) + f1.v[i1] * s;
+                let x2 = v2[j] * (1.0 - k) + v2[j1] * k;
+                let dist = (x2 - x1).dot(n);
+                push(x1, x2, f1.eids[i], f2.eids[j], dist);
             }
         }
     }
