@@ -125,6 +125,14 @@ impl Island<'_> {
     }
 }
 
+/// The dof path of row `q` (`path`: the rows' (start, length) in `table`;
+/// empty when out of it).
+#[inline(always)]
+fn group_path<'t>(table: &'t [usize], path: &[(usize, usize)], q: usize) -> &'t [usize] {
+    let (ps, pl) = path[q];
+    table.get(ps..ps + pl).unwrap_or(&[])
+}
+
 /// Each dof's path length to the root, itself included, along `parent`
 /// (`usize::MAX` where `parent` has no entry for it or does not reach a root
 /// in nv steps).
@@ -402,20 +410,14 @@ impl Islands {
             let (mut lo, mut hi) = (usize::MAX, 0);
             while i < self.runs.len() && self.runs[i].0 == k {
                 let (_, s, e) = self.runs[i];
-                // the run's groups (a run starts a group), one path each
-                let mut g = self.group_at[s];
-                while let Some(&(q, _)) = self.groups.get(g)
-                    && q < e
-                {
-                    g += 1;
-                    let (ps, pl) = path[q];
-                    let p = table.get(ps..ps + pl).unwrap_or(&[]);
+                for g in self.run_groups(s, e) {
+                    let p = group_path(table, path, self.groups[g].0);
                     // a path is closed under dof parents (a dof's path to the
                     // root, a union of two, or every dof), and so are the
                     // marks: a path as long as its last dof's chain is that
                     // chain, marked from its end up to the first dof marked
                     if let Some(&d) = p.last()
-                        && self.chain_len.get(d) == Some(&pl)
+                        && self.chain_len.get(d) == Some(&p.len())
                     {
                         let mut x = d;
                         while let Some(m) = self.mark.get_mut(x)
@@ -469,6 +471,20 @@ impl Islands {
         }
         self.todo.clear();
         self.todo.extend(0..self.islands.len());
+    }
+
+    /// The groups of the run of rows `s..e`, one path each: a run starts a
+    /// group (or a group's kept triples, the group recorded at its first row
+    /// in `group_at`) and holds whole groups after it.
+    fn run_groups(&self, s: usize, e: usize) -> std::ops::Range<usize> {
+        let g0 = self.group_at[s];
+        let mut g = g0;
+        while let Some(&(q, _)) = self.groups.get(g)
+            && q < e
+        {
+            g += 1;
+        }
+        g0..g
     }
 
     /// The islands to solve ([`Islands::join_failed`]).

@@ -13,7 +13,7 @@
 //! reach a dof outside its two trees (no model's does), the marks left
 //! behind are counted, cleared, and the islands made the general way.
 
-use super::Islands;
+use super::{group_path, Islands};
 use crate::model::Model;
 
 /// A tree's flags in a grouping: some path held all its dofs; some path
@@ -45,14 +45,8 @@ impl Islands {
             let (r0, isl) = (i, self.islands.len());
             while i < self.runs.len() && self.runs[i].0 == k {
                 let (_, s, e) = self.runs[i];
-                // the run's groups (a run starts a group), one path each
-                let mut g = self.group_at[s];
-                while let Some(&(q, _)) = self.groups.get(g)
-                    && q < e
-                {
-                    g += 1;
-                    let (ps, pl) = path[q];
-                    let p = table.get(ps..ps + pl).unwrap_or(&[]);
+                for g in self.run_groups(s, e) {
+                    let p = group_path(table, path, self.groups[g].0);
                     let (Some(&first), Some(&last)) = (p.first(), p.last()) else {
                         continue;
                     };
@@ -62,8 +56,8 @@ impl Islands {
                     // every dof of its trees (ascending, distinct, within
                     // them: as many as they hold): the trees whole, no mark
                     let whole = match a == b {
-                        true => pl == len(a),
-                        false => len(a).checked_add(len(b)) == Some(pl),
+                        true => p.len() == len(a),
+                        false => len(a).checked_add(len(b)) == Some(p.len()),
                     };
                     debug_assert!(p.iter().all(|&d| tree(d) == a || tree(d) == b));
                     if !whole {
