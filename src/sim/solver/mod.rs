@@ -413,15 +413,10 @@ impl Rows {
         self.path[r..r + 3].fill(path);
         Some(r)
     }
-    /// The rows from row `r` that share its path for certain: a contact's
-    /// three (formed as one, [`Rows::form_on`]) or the row alone.
+    /// The rows from `r` sharing its path for certain: a formed contact's 3, or 1.
     #[inline(always)]
     pub(crate) fn rows_at(&self, r: usize) -> usize {
-        if r + 3 <= self.n && self.is_block.get(r) == Some(&true) {
-            3
-        } else {
-            1
-        }
+        1 + 2 * usize::from(r + 3 <= self.n && self.is_block.get(r) == Some(&true))
     }
     /// Rows `s..e` are contact triples.
     pub(crate) fn contacts_only(&self, s: usize, e: usize) -> bool {
