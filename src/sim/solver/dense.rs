@@ -45,7 +45,28 @@ pub(crate) fn ldlt_dropping(a: &mut [f64], ld: usize, m: usize, from: usize, dro
     // k ≤ j < m, at most (m − 1)·ld + m − 1 < m·ld ≤ a.len() (checked above);
     // d's indices are < m ≤ CAP, dⱼ written at column j before the columns
     // after it read it
-    unsafe { factor(a.as_mut_ptr(), ld, m, from, drop, &mut d) }
+    let a = a.as_mut_ptr();
+    unsafe {
+        fixed(
+            m,
+            #[inline(always)]
+            |m| factor(a, ld, m, from, drop, &mut d),
+        )
+    }
+}
+
+/// `f(m)`, with m a constant in the arms of the small m most tries have (one
+/// or two contacts: 3 to 6 rows), so that `f`'s loops, inlined there, lose
+/// their per-column set-up: the same operations in the same order.
+#[inline(always)]
+fn fixed<R>(m: usize, mut f: impl FnMut(usize) -> R) -> R {
+    match m {
+        3 => f(3),
+        4 => f(4),
+        5 => f(5),
+        6 => f(6),
+        _ => f(m),
+    }
 }
 
 /// [`ldlt_dropping`]'s loops on `a` (m rows of `ld`, the first `from`
@@ -189,6 +210,24 @@ pub(crate) fn ldlt_dropping_solve(a: &[f64], ld: usize, m: usize, x: &mut [f64])
     // SAFETY: every index read or written below is i·ld + k (i, k < m) in `a`,
     // at most (m − 1)·ld + m − 1 < a.len(), and i < m ≤ x.len() in `x`
     let (a, x) = (a.as_ptr(), x.as_mut_ptr());
+    unsafe {
+        fixed(
+            m,
+            #[inline(always)]
+            |m| solve(a, ld, m, x),
+        )
+    }
+}
+
+/// [`ldlt_dropping_solve`]'s two passes on `x` (m entries) with the factor
+/// `a` (m rows of `ld`).
+///
+/// # Safety
+/// `a` must hold (m − 1)·ld + m entries, ld ≥ m ≥ 1, and `x` m entries.
+#[inline(always)]
+unsafe fn solve(a: *const f64, ld: usize, m: usize, x: *mut f64) {
+    // SAFETY: the caller's contract (every index i·ld + k, i, k < m, in `a`,
+    // and i < m in `x`)
     unsafe {
         // L z = b: row i's sum over k < i in order, rows i and i + 1 side
         // by side (two chains) over k < i, then row i + 1's term k = i
