@@ -41,7 +41,17 @@ fn lower(a: &[f64], ld: usize, m: usize) -> Vec<u64> {
 fn strided_and_appended_factor_match_the_library_bits() {
     let ld = 16;
     let mut drops = 0;
-    for (m, k, seed) in [(16, 16, 1), (16, 11, 2), (13, 9, 3), (9, 12, 4), (16, 5, 5)] {
+    for (m, k, seed) in [
+        (16, 16, 1),
+        (16, 11, 2),
+        (13, 9, 3),
+        (9, 12, 4),
+        (16, 5, 5),
+        (3, 3, 6),
+        (4, 2, 7),
+        (5, 5, 8),
+        (6, 4, 9),
+    ] {
         let w = gram(m, k, ld, seed);
         // the library on the packed copy
         let mut packed = vec![0.0; m * m];
