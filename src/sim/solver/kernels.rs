@@ -111,6 +111,33 @@ pub(super) unsafe fn axpy3_path(a: [f64; 3], ys: [&[f64]; 3], p: Path, x: &mut [
     }
 }
 
+/// yᵣ·x = Σₜ yₜ x[pₜ] from 0 in path order (`y` a row, `p` its path; the
+/// scalar loop `d += y x`), an entry past x's end read as 0 (a checked
+/// gather); a path of [`Runs`] read as slices of x, checked once a run.
+pub(super) fn dot_checked(y: &[f64], p: &[usize], x: &[f64]) -> f64 {
+    let six = |s: &[f64], a: usize| -> Option<[f64; 6]> { s.get(a..)?.get(..6)?.try_into().ok() };
+    // d + Σₜ yₜ xₜ over six slots, in order
+    let dot6 = |d: f64, y: [f64; 6], x: [f64; 6]| (0..6).fold(d, |d, t| d + y[t] * x[t]);
+    match Path::of(p) {
+        Path::One(Runs([a])) => {
+            if let (Some(ys), Some(xs)) = (six(y, 0), six(x, a)) {
+                return dot6(0.0, ys, xs);
+            }
+        }
+        Path::Two(Runs([a, b])) => {
+            if let (Some(y0), Some(y1), Some(x0), Some(x1)) =
+                (six(y, 0), six(y, 6), six(x, a), six(x, b))
+            {
+                return dot6(dot6(0.0, y0, x0), y1, x1);
+            }
+        }
+        Path::Any(_) => {}
+    }
+    y.iter()
+        .zip(p)
+        .fold(0.0, |d, (&v, &k)| d + v * x.get(k).copied().unwrap_or(0.0))
+}
+
 /// Δv' += Σᵣ λᵣ yᵣ over rows `s..e` in row order, a contact's three rows in
 /// one pass over their path ([`warm3`]) when all three λ ≠ 0: the warm start
 /// of an island's runs in its sweeps (pgs.rs) and of every row at once

@@ -484,11 +484,7 @@ impl Rows {
         let (ps, pl) = *self.path.get(r)?;
         let p = self.table.get(ps..ps + pl)?;
         let y = self.y.get(r * st..r * st + pl)?;
-        let mut d = 0.0;
-        for (&v, &k) in y.iter().zip(p) {
-            d += v * x.get(k).copied().unwrap_or(0.0);
-        }
-        Some(d)
+        Some(kernels::dot_checked(y, p, x))
     }
     /// The normal of the contact at row `r` holds at λ = 0 to `tol` for the
     /// Δv' `x` (src/sim/islands/split.rs): uₙ = cₙ + yₙ·x ≥ bₙ − tol. A row
