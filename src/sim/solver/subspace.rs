@@ -343,61 +343,77 @@ pub(super) fn subspace_step(
     // the free rows are a subsequence of this walk's rows (the scan above
     // took them in this order, each once): a cursor finds a row's place
     let mut next = 0;
+    let mut at = |r: usize| {
+        let here = sm.rows.get(next) == Some(&r);
+        next += usize::from(here);
+        here.then(|| next - 1)
+    };
     'walk: for &(_, s, e) in runs {
-        let mut skip = s;
-        for r in s..e {
+        let mut r = s;
+        while r < e {
             if r + 1 >= n {
                 break 'walk;
             }
-            if r < skip {
-                // (a passed contact's tangents: not free, so not on the cursor)
-                continue;
-            }
-            if contact[r] && sm.rows.get(next) != Some(&r) && passed(lambda, false, r, e) {
-                skip = r + 3;
-                continue;
-            }
-            let at = if sm.rows.get(next) == Some(&r) {
-                next += 1;
-                Some(next - 1)
-            } else {
-                None
-            };
-            let RowKind::Tangent { normal, mu } = kinds[r] else {
-                continue;
-            };
-            let lim = mu * lambda.get(normal).copied().unwrap_or(0.0).max(0.0);
-            let free = at;
-            let (t1, t2) = match free {
-                Some(a) if winv[r + 1] == 0.0 => (sm.lam[a], 0.0),
-                Some(a) if a + 1 < m => (sm.lam[a], sm.lam[a + 1]),
-                _ => (lambda[r], lambda[r + 1]),
-            };
-            let norm = (t1 * t1 + t2 * t2).sqrt();
-            let s = if norm > lim || (free.is_none() && sm.sliding[r]) {
-                if norm > 0.0 {
-                    lim / norm
+            // the pair's first row q (its place among the free rows) and the
+            // rows this step takes: a contact's three (Normal, then its
+            // tangent pair on one path, `Rows::is_block`) at once, with the
+            // row-by-row walk's cursor; one not free whose tangents are 0
+            // passed by
+            let (q, free, step) = if contact[r] && r + 3 <= e {
+                debug_assert!(
+                    matches!(kinds[r + 1], RowKind::Tangent { normal, .. } if normal == r)
+                );
+                if at(r).is_none() && passed(lambda, false, r, e) {
+                    (None, None, 3)
                 } else {
-                    0.0
+                    let free = at(r + 1);
+                    at(r + 2);
+                    (Some(r + 1), free, 3)
                 }
             } else {
-                1.0
+                (Some(r), at(r), 1)
             };
-            let (n1, n2) = (t1 * s, t2 * s);
-            let (d1, d2) = (n1 - lambda[r], n2 - lambda[r + 1]);
-            lambda[r] = n1;
-            lambda[r + 1] = n2;
-            let p = path(r);
-            if d1 != 0.0 && d2 != 0.0 && paths[r + 1] == paths[r] {
-                // the pair on one path (a contact's) in one pass: each entry
-                // (x + d₁y₁) + d₂y₂, the row-by-row order
-                // (a path's dofs are < nv ≤ dv.len(): the sweeps' check)
-                axpy2([d1, d2], yrow(r, p.len()), yrow(r + 1, p.len()), p, dv);
-            } else {
-                add(p, yrow(r, p.len()), d1, dv);
-                let p2 = path(r + 1);
-                add(p2, yrow(r + 1, p2.len()), d2, dv);
+            if let Some(r) = q
+                && let RowKind::Tangent { normal, mu } = kinds[r]
+            {
+                let lim = mu * lambda.get(normal).copied().unwrap_or(0.0).max(0.0);
+                let (t1, t2) = match free {
+                    Some(a) if winv[r + 1] == 0.0 => (sm.lam[a], 0.0),
+                    Some(a) if a + 1 < m => (sm.lam[a], sm.lam[a + 1]),
+                    _ => (lambda[r], lambda[r + 1]),
+                };
+                let norm = (t1 * t1 + t2 * t2).sqrt();
+                let s = if norm > lim || (free.is_none() && sm.sliding[r]) {
+                    if norm > 0.0 {
+                        lim / norm
+                    } else {
+                        0.0
+                    }
+                } else {
+                    1.0
+                };
+                let (n1, n2) = (t1 * s, t2 * s);
+                let (d1, d2) = (n1 - lambda[r], n2 - lambda[r + 1]);
+                lambda[r] = n1;
+                lambda[r + 1] = n2;
+                let p = path(r);
+                if d1 != 0.0 && d2 != 0.0 && paths[r + 1] == paths[r] {
+                    // the pair on one path (a contact's) in one pass: each entry
+                    // (x + d₁y₁) + d₂y₂, the row-by-row order
+                    // (a path's dofs are < nv ≤ dv.len(): the sweeps' check)
+                    axpy2([d1, d2], yrow(r, p.len()), yrow(r + 1, p.len()), p, dv);
+                } else {
+                    add(p, yrow(r, p.len()), d1, dv);
+                    let p2 = path(r + 1);
+                    add(p2, yrow(r + 1, p2.len()), d2, dv);
+                }
             }
+            // (a contact's last row the last row: the row-by-row walk
+            // stopped there)
+            if step == 3 && r + 3 >= n {
+                break 'walk;
+            }
+            r += step;
         }
     }
     true
