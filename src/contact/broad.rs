@@ -24,6 +24,9 @@
 //! way the pairs reported are exactly those whose boxes overlap (in another
 //! order: the caller sorts them).
 
+mod width;
+use width::Width;
+
 /// "No pair" in the pair table.
 pub(crate) const NO_PAIR: u32 = u32::MAX;
 /// A pair the filter allows whose state is not made yet (made when its boxes
@@ -113,12 +116,12 @@ pub struct SweepAndPrune {
     /// Each shape's strip (strips only), and whether it is wider than a strip.
     strip: Vec<i64>,
     big: Vec<bool>,
-    /// Scratch: the y-extents (for their median), the shapes wider than a
-    /// strip, and two strips merged by lower x (lower x, shape, in the
-    /// lower strip).
-    ext: Vec<f64>,
+    /// The strips' width's scratch (width.rs); the shapes wider than a
+    /// strip, and two strips merged by lower x (lower x, shape, [`LOWER`]
+    /// or the lower strip's shapes before it).
+    width: Width,
     wide: Vec<u32>,
-    merged: Vec<(f64, u32, bool)>,
+    merged: Vec<(f64, u32, u32)>,
     /// The sweep's pairs whose boxes overlap, in the sweep's order, before
     /// the table is read (then read a few ahead of use).
     cand: Vec<(u32, u32)>,
@@ -144,7 +147,7 @@ impl SweepAndPrune {
             order: (0..n as u32).collect(),
             strip: vec![0; n],
             big: vec![false; n],
-            ext: Vec::with_capacity(n),
+            width: Width::new(n),
             wide: Vec::with_capacity(n),
             merged: Vec::with_capacity(n),
             cand: Vec::new(),
@@ -223,7 +226,7 @@ impl SweepAndPrune {
                     break;
                 }
                 let j = j as usize;
-                if meet_yz(li, hi, self.lo[j], self.hi[j]) {
+                if meet_yz(&li, &hi, &self.lo[j], &self.hi[j]) {
                     cand.push((i as u32, j as u32));
                 }
             }
@@ -234,25 +237,8 @@ impl SweepAndPrune {
     /// Strips along y, each swept along x with the next (module docs).
     fn sweep_strips(&mut self, cand: &mut Vec<(u32, u32)>) {
         let n = self.lo.len();
-        // the strips' width: the widest ordinary y-extent
-        self.ext.clear();
-        self.ext.extend(
-            (0..n)
-                .map(|i| self.hi[i][1] - self.lo[i][1])
-                .filter(|e| e.is_finite()),
-        );
-        let w = if self.ext.is_empty() {
-            f64::INFINITY
-        } else {
-            let mid = self.ext.len() / 2;
-            let med = *self.ext.select_nth_unstable_by(mid, f64::total_cmp).1;
-            self.ext
-                .iter()
-                .copied()
-                .filter(|&e| e <= BIG * med)
-                .fold(0.0f64, f64::max)
-        };
-        let w = if w > 0.0 { w } else { f64::INFINITY };
+        // the strips' width: the widest ordinary y-extent (width.rs)
+        let w = self.width.of(&self.lo, &self.hi, BIG);
         self.wide.clear();
         // (the boxes, flags and strips read as one pass of slices, no index
         // tests: every per-shape vector holds n entries)
@@ -271,9 +257,29 @@ impl SweepAndPrune {
             }
         }
         // the ordinary shapes by (strip, lower x): last step's order, the
-        // wide ones out, then an insertion sort (nearly sorted)
-        let big = &self.big;
-        self.order.retain(|&i| !big[i as usize]);
+        // wide ones out, then an insertion sort (nearly sorted); the sort's
+        // keys, (strip, lower x), gathered in the same pass and sorted with
+        // it (the same compares, the same swaps)
+        let mut keys = std::mem::take(&mut self.keys);
+        keys.clear();
+        // (a NaN lower x: the strips may not be sorted by it)
+        let mut nan = false;
+        {
+            let (big, strip, lo) = (&self.big[..n], &self.strip[..n], &self.lo[..n]);
+            let mut kept = 0;
+            for x in 0..self.order.len() {
+                let i = self.order[x] as usize;
+                if let (Some(false), Some(&s), Some(l)) =
+                    (big.get(i).copied(), strip.get(i), lo.get(i))
+                {
+                    self.order[kept] = i as u32;
+                    keys.push((s, l[0]));
+                    nan |= l[0].is_nan();
+                    kept += 1;
+                }
+            }
+            self.order.truncate(kept);
+        }
         if self.order.len() + self.wide.len() < n {
             // a shape wide last step and ordinary now (or at the start)
             let mut seen = vec![false; n];
@@ -283,18 +289,11 @@ impl SweepAndPrune {
             for (i, (&seen, &big)) in seen.iter().zip(&self.big).enumerate() {
                 if !seen && !big {
                     self.order.push(i as u32);
+                    keys.push((self.strip[i], self.lo[i][0]));
+                    nan |= self.lo[i][0].is_nan();
                 }
             }
         }
-        // (the sort's keys, (strip, lower x), gathered once in last step's
-        // order and sorted with it: the same compares, the same swaps)
-        let mut keys = std::mem::take(&mut self.keys);
-        keys.clear();
-        keys.extend(
-            self.order
-                .iter()
-                .map(|&i| (self.strip[i as usize], self.lo[i as usize][0])),
-        );
         let len = self.order.len();
         {
             let (order, keys) = (&mut self.order[..len], &mut keys[..len]);
@@ -313,51 +312,57 @@ impl SweepAndPrune {
         // each strip merged with the next by lower x, swept
         let mut merged = std::mem::take(&mut self.merged);
         let (order, ks) = (&self.order[..len], &keys[..len]);
+        // (the end of strip s, found once: the next strip's start)
+        let run_end = |a: usize| a + ks[a..].iter().take_while(|k| k.0 == ks[a].0).count();
         let mut a = 0;
+        let mut b = if len > 0 { run_end(0) } else { 0 };
         while a < len {
             let s = ks[a].0;
-            let mut b = a;
-            while b < len && ks[b].0 == s {
-                b += 1;
-            }
-            let mut c = b;
-            if b < len && ks[b].0 == s + 1 {
-                while c < len && ks[c].0 == s + 1 {
-                    c += 1;
-                }
-            }
-            merged.clear();
-            let (mut i, mut j) = (a, b);
-            while i < b || j < c {
-                // (as the sort: i first unless its lower x is greater)
-                let take_i = j >= c
-                    || (i < b
-                        && ks[i].1.partial_cmp(&ks[j].1) != Some(std::cmp::Ordering::Greater));
-                if take_i {
-                    merged.push((ks[i].1, order[i], true));
-                    i += 1;
-                } else {
-                    merged.push((ks[j].1, order[j], false));
-                    j += 1;
-                }
-            }
+            let c = if b < len && ks[b].0 == s + 1 {
+                run_end(b)
+            } else {
+                b
+            };
+            let (lower, upper) = ((&ks[a..b], &order[a..b]), (&ks[b..c], &order[b..c]));
+            let merged = merge_strips(lower, upper, &mut merged);
             for k in 0..merged.len() {
-                let (_, i, in_s) = merged[k];
+                let (_, i, from) = merged[k];
                 let i = i as usize;
                 // (i's box read once for the shapes it meets)
-                let (li, hi) = (self.lo[i], self.hi[i]);
+                let (li, hi) = (&self.lo[i], &self.hi[i]);
                 let hx = hi[0];
-                for &(x, j, jn_s) in &merged[k + 1..] {
+                if from != LOWER && !nan {
+                    // i of strip s + 1 meets strip s's shapes only: those
+                    // after it by lower x, strip s's from `from` on (sorted:
+                    // the first past hx is the merged list's first of s past
+                    // it, and the pairs in the merged list's order)
+                    let (xs, js) = lower;
+                    let from = from as usize;
+                    let (xs, js) = (xs.get(from..).unwrap_or(&[]), js.get(from..).unwrap_or(&[]));
+                    for (&(_, x), &j) in xs.iter().zip(js) {
+                        if x > hx {
+                            break;
+                        }
+                        let j = j as usize;
+                        if meet_yz(li, hi, &self.lo[j], &self.hi[j]) {
+                            cand.push((i as u32, j as u32));
+                        }
+                    }
+                    continue;
+                }
+                let in_s = from == LOWER;
+                for &(x, j, jfrom) in &merged[k + 1..] {
                     if x > hx {
                         break;
                     }
                     let j = j as usize;
-                    if (in_s || jn_s) && meet_yz(li, hi, self.lo[j], self.hi[j]) {
+                    if (in_s || jfrom == LOWER) && meet_yz(li, hi, &self.lo[j], &self.hi[j]) {
                         cand.push((i as u32, j as u32));
                     }
                 }
             }
             a = b;
+            b = if c > b || b >= len { c } else { run_end(b) };
         }
         self.merged = merged;
         self.keys = keys;
@@ -373,7 +378,7 @@ impl SweepAndPrune {
                 if lj[0] > hi[0] || li[0] > hj[0] {
                     continue;
                 }
-                if meet_yz(li, hi, *lj, *hj) {
+                if meet_yz(&li, &hi, lj, hj) {
                     cand.push((i as u32, j as u32));
                 }
             }
@@ -381,9 +386,54 @@ impl SweepAndPrune {
     }
 }
 
+/// A merged entry of strip s ([`merge_strips`]).
+const LOWER: u32 = u32::MAX;
+
+/// Strips `l` and `u` ((strip, lower x) keys and shapes, each by lower x)
+/// merged by lower x into `out` as (lower x, shape, [`LOWER`] for one of
+/// `l`, else how many of `l` precede it): one of `l` first unless its lower
+/// x is greater (as the sort: `l` before `u` on a tie).
+#[inline(always)]
+fn merge_strips<'m>(
+    (lk, lo): (&[(i64, f64)], &[u32]),
+    (uk, uo): (&[(i64, f64)], &[u32]),
+    out: &'m mut Vec<(f64, u32, u32)>,
+) -> &'m [(f64, u32, u32)] {
+    let (nl, nu) = (lk.len().min(lo.len()), uk.len().min(uo.len()));
+    let (lk, lo, uk, uo) = (&lk[..nl], &lo[..nl], &uk[..nu], &uo[..nu]);
+    // (written in place: room for both, kept from step to step)
+    if out.len() < nl + nu {
+        out.resize(nl + nu, (0.0, 0, 0));
+    }
+    let out = &mut out[..nl + nu];
+    let (mut i, mut j) = (0, 0);
+    while i < nl && j < nu {
+        let (x, y) = (lk[i].1, uk[j].1);
+        if x > y {
+            out[i + j] = (y, uo[j], i as u32);
+            j += 1;
+        } else {
+            out[i + j] = (x, lo[i], LOWER);
+            i += 1;
+        }
+    }
+    // (the rest of the one not used up)
+    for (o, (&(_, x), &s)) in out[i + j..].iter_mut().zip(lk[i..].iter().zip(&lo[i..])) {
+        *o = (x, s, LOWER);
+    }
+    let at = nl + j;
+    for (o, (&(_, x), &s)) in out[at.min(nl + nu)..]
+        .iter_mut()
+        .zip(uk[j..].iter().zip(&uo[j..]))
+    {
+        *o = (x, s, nl as u32);
+    }
+    out
+}
+
 /// Two boxes (lower, upper corners; known to overlap in x) overlap in y and z.
 #[inline(always)]
-fn meet_yz(li: [f64; 3], hi: [f64; 3], lj: [f64; 3], hj: [f64; 3]) -> bool {
+fn meet_yz(li: &[f64; 3], hi: &[f64; 3], lj: &[f64; 3], hj: &[f64; 3]) -> bool {
     !(lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2])
 }
 
