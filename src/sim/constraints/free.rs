@@ -96,7 +96,7 @@ fn write_path(plan: Plan, j: [&mut [f64]; 3], sw: &[[Motion; 6]], pt: &ContactPo
                 return false;
             };
             // rows n = z, t₁ = x, t₂ = y: the point velocity's components
-            put(j, 0, s, p, |i, v| v[[2, 0, 1][i]])
+            put(j, 0, s, p, |i, v, r| component([2, 0, 1][i], v, r))
         }
         Plan::Pair { a, b } => {
             let (Some(sa), Some(sb)) = (sw.get(pt.body), sw.get(pt.other)) else {
@@ -109,8 +109,11 @@ fn write_path(plan: Plan, j: [&mut [f64]; 3], sw: &[[Motion; 6]], pt: &ContactPo
             // J = J_a − J_b along (n, t₁, t₂), n from b toward a
             let (n, (t1, t2)) = (pt.normal, tangents(&pt.normal));
             let axes = [n, t1, t2];
-            put([j0, j1, j2], a, sa, p, |i, v| along::<false>(&axes[i], v))
-                && put([j0, j1, j2], b, sb, p, |i, v| along::<true>(&axes[i], v))
+            put([j0, j1, j2], a, sa, p, |i, v, r| {
+                along::<false>(&axes[i], v, r)
+            }) && put([j0, j1, j2], b, sb, p, |i, v, r| {
+                along::<true>(&axes[i], v, r)
+            })
         }
     }
 }
@@ -118,6 +121,7 @@ fn write_path(plan: Plan, j: [&mut [f64]; 3], sw: &[[Motion; 6]], pt: &ContactPo
 /// The six point velocities at `p` of a free body's world columns `sw` by
 /// component (`v[c][k]`: component c of column k's): [`super::tables`]'
 /// `point_velocity` of each, side by side.
+#[cfg(not(target_arch = "x86_64"))]
 #[inline(always)]
 fn velocities(sw: &[Motion; 6], p: &Vector3<f64>) -> [[f64; 6]; 3] {
     let mut v = [[0.0; 6]; 3];
@@ -144,44 +148,156 @@ fn velocities(sw: &[Motion; 6], p: &Vector3<f64>) -> [[f64; 6]; 3] {
 }
 
 /// Row i's six entries at `t0` of `j[i]` are `row(i, v)` + 0.0 for the point
-/// velocities `v` at `p` of `sw` ([`velocities`]). False, nothing written,
-/// where a row is too short.
+/// velocities `v` at `p` of `sw` ([`velocities`]; on x86_64 [`lanes::Vel`],
+/// row i's `row` writing them). False, nothing written, where a row is too
+/// short.
 #[inline(always)]
 fn put(
     j: [&mut [f64]; 3],
     t0: usize,
     sw: &[Motion; 6],
     p: &Vector3<f64>,
-    row: impl Fn(usize, &[[f64; 6]; 3]) -> [f64; 6],
+    row: impl Fn(usize, &Vel, &mut [f64; 6]),
 ) -> bool {
     let [j0, j1, j2] = j;
     let (Some(r0), Some(r1), Some(r2)) = (
-        j0.get_mut(t0..t0 + 6),
-        j1.get_mut(t0..t0 + 6),
-        j2.get_mut(t0..t0 + 6),
+        j0.get_mut(t0..t0 + 6)
+            .and_then(|r| <&mut [f64; 6]>::try_from(r).ok()),
+        j1.get_mut(t0..t0 + 6)
+            .and_then(|r| <&mut [f64; 6]>::try_from(r).ok()),
+        j2.get_mut(t0..t0 + 6)
+            .and_then(|r| <&mut [f64; 6]>::try_from(r).ok()),
     ) else {
         return false;
     };
     let v = velocities(sw, p);
     for (i, r) in [r0, r1, r2].into_iter().enumerate() {
-        for (x, e) in r.iter_mut().zip(row(i, &v)) {
-            // (a zero's sign as the sum onto the +0 of a zeroed row leaves it)
-            *x = e + 0.0;
-        }
+        row(i, &v, r);
     }
     true
 }
 
-/// The entries `a·v` of the six point velocities `v` along `a` (nalgebra's
-/// dot, (aₓvₓ + a_yv_y) + a_zv_z), negated with `NEG`.
+/// The point velocities [`put`]'s rows read.
+#[cfg(not(target_arch = "x86_64"))]
+type Vel = [[f64; 6]; 3];
+
+/// Row `r` = component `c` of the point velocities `v`, each + 0.0 (a
+/// zero's sign as the sum onto the +0 of a zeroed row leaves it).
+#[cfg(not(target_arch = "x86_64"))]
 #[inline(always)]
-fn along<const NEG: bool>(a: &Vector3<f64>, v: &[[f64; 6]; 3]) -> [f64; 6] {
-    let mut e = [0.0; 6];
-    for (k, x) in e.iter_mut().enumerate() {
-        let d = a.x * v[0][k] + a.y * v[1][k] + a.z * v[2][k];
-        *x = if NEG { -d } else { d };
+fn component(c: usize, v: &Vel, r: &mut [f64; 6]) {
+    for (x, &e) in r.iter_mut().zip(&v[c.min(2)]) {
+        *x = e + 0.0;
     }
-    e
+}
+
+/// Row `r` = the entries `a·v` of the six point velocities `v` along `a`
+/// (nalgebra's dot, (aₓvₓ + a_yv_y) + a_zv_z), negated with `NEG`, each +
+/// 0.0.
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+fn along<const NEG: bool>(a: &Vector3<f64>, v: &Vel, r: &mut [f64; 6]) {
+    for (k, x) in r.iter_mut().enumerate() {
+        let d = a.x * v[0][k] + a.y * v[1][k] + a.z * v[2][k];
+        let e = if NEG { -d } else { d };
+        *x = e + 0.0;
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+use lanes::{along, component, velocities, Vel};
+
+/// [`velocities`], [`component`] and [`along`] two columns a lane (SSE2):
+/// per entry the same operations in the same order as the scalar forms.
+#[cfg(target_arch = "x86_64")]
+mod lanes {
+    use crate::spatial::Motion;
+    use nalgebra::Vector3;
+    use std::arch::x86_64::{
+        __m128d, _mm_add_pd, _mm_mul_pd, _mm_set1_pd, _mm_set_pd, _mm_setzero_pd, _mm_storeu_pd,
+        _mm_sub_pd, _mm_xor_pd,
+    };
+
+    /// The six point velocities by component, columns (0, 1), (2, 3), (4, 5)
+    /// a register: `Vel(v)`, `v[c][h]` component c of columns 2h, 2h + 1.
+    #[derive(Clone, Copy)]
+    pub(super) struct Vel([[__m128d; 3]; 3]);
+
+    /// The point velocities at `p` of a free body's world columns `sw`: the
+    /// linear columns' `lin`, the angular ones' `lin + ω × p` (nalgebra's
+    /// cross, ω_y p_z − ω_z p_y, …, added to `lin`).
+    #[inline(always)]
+    pub(super) fn velocities(sw: &[Motion; 6], p: &Vector3<f64>) -> Vel {
+        let [s0, s1, s2, s3, s4, s5] = sw;
+        // column 3's point velocity (alone in its register's high lane)
+        let (w, l) = (&s3.ang, &s3.lin);
+        let v3 = [
+            l.x + (w.y * p.z - w.z * p.y),
+            l.y + (w.z * p.x - w.x * p.z),
+            l.z + (w.x * p.y - w.y * p.x),
+        ];
+        // SAFETY: SSE2 is part of x86_64; no memory is read or written
+        // through a pointer here
+        unsafe {
+            let pair = |a: f64, b: f64| _mm_set_pd(b, a);
+            let (px, py, pz) = (_mm_set1_pd(p.x), _mm_set1_pd(p.y), _mm_set1_pd(p.z));
+            let (wx, wy, wz) = (
+                pair(s4.ang.x, s5.ang.x),
+                pair(s4.ang.y, s5.ang.y),
+                pair(s4.ang.z, s5.ang.z),
+            );
+            let cross = [
+                _mm_sub_pd(_mm_mul_pd(wy, pz), _mm_mul_pd(wz, py)),
+                _mm_sub_pd(_mm_mul_pd(wz, px), _mm_mul_pd(wx, pz)),
+                _mm_sub_pd(_mm_mul_pd(wx, py), _mm_mul_pd(wy, px)),
+            ];
+            let by = |c: usize| {
+                [
+                    pair(s0.lin[c], s1.lin[c]),
+                    pair(s2.lin[c], v3[c]),
+                    _mm_add_pd(pair(s4.lin[c], s5.lin[c]), cross[c]),
+                ]
+            };
+            Vel([by(0), by(1), by(2)])
+        }
+    }
+
+    /// Row `r` = component `c` (0 to 2) of the point velocities `v`, each +
+    /// 0.0 (a zero's sign as the sum onto the +0 of a zeroed row leaves it).
+    #[inline(always)]
+    pub(super) fn component(c: usize, v: &Vel, r: &mut [f64; 6]) {
+        let vc = &v.0[c.min(2)];
+        // SAFETY: SSE2 is part of x86_64; each store is two entries at 0, 2
+        // or 4 of the six of `r`
+        unsafe {
+            let zero = _mm_setzero_pd();
+            for (h, &x) in vc.iter().enumerate() {
+                _mm_storeu_pd(r.as_mut_ptr().add(2 * h), _mm_add_pd(x, zero));
+            }
+        }
+    }
+
+    /// Row `r` = the entries `a·v` of the six point velocities `v` along `a`
+    /// (nalgebra's dot, (aₓvₓ + a_yv_y) + a_zv_z), negated with `NEG` (the
+    /// sign bit flipped, as `-d`), each + 0.0.
+    #[inline(always)]
+    pub(super) fn along<const NEG: bool>(a: &Vector3<f64>, v: &Vel, r: &mut [f64; 6]) {
+        // SAFETY: SSE2 is part of x86_64; each store is two entries at 0, 2
+        // or 4 of the six of `r`
+        unsafe {
+            let (ax, ay, az) = (_mm_set1_pd(a.x), _mm_set1_pd(a.y), _mm_set1_pd(a.z));
+            let (zero, sign) = (_mm_setzero_pd(), _mm_set1_pd(-0.0));
+            let [vx, vy, vz] = &v.0;
+            for h in 0..3 {
+                let d = _mm_add_pd(
+                    _mm_add_pd(_mm_mul_pd(ax, vx[h]), _mm_mul_pd(ay, vy[h])),
+                    _mm_mul_pd(az, vz[h]),
+                );
+                let d = if NEG { _mm_xor_pd(d, sign) } else { d };
+                _mm_storeu_pd(r.as_mut_ptr().add(2 * h), _mm_add_pd(d, zero));
+            }
+        }
+    }
 }
 
 /// The tests' hook (`urdyn::testing::constraints::free_rows`): a contact's
