@@ -306,14 +306,12 @@ fn strips_find_the_pairs_in_the_order_of_round_38() {
     // holds the new one) and now and then jumping (it does not): the pairs
     // not made yet come out in the order the sweep found them, which must be
     // round 38's sweep's (the order the pairs are made in)
-    let n = 400;
-    let mut s = sap_new(n);
-    let mut table = table_new(n);
-    for i in 0..n {
-        for j in i + 1..n {
-            table_allow(&mut table, i, j);
-        }
-    }
+    let (n, mut s) = (400, sap_new(400));
+    // (every pair allowed, none made: each found one is `fresh`)
+    let table = (0..n).fold(table_new(n), |mut t, i| {
+        (i + 1..n).for_each(|j| table_allow(&mut t, i, j));
+        t
+    });
     let mut lcg = Lcg(4242);
     let walls = [
         ([-2.05, 0.0, 0.3], [0.05, 2.1, 0.3]),
