@@ -31,6 +31,7 @@ mod subspace;
 mod wff;
 
 pub(crate) use pgs::{IslandOut, Scratch};
+use position::PosRow;
 pub(crate) use position::PosWarm;
 
 use super::factor::MassFactor;
@@ -138,17 +139,6 @@ pub struct Rows {
     solves: u64,
     /// This solve sheds the self-stress of its jointed islands.
     shed_now: bool,
-}
-
-/// A row the position pass updates (position.rs): its index, its path's
-/// start and length in the table (checked to lie there), and whether it is
-/// a loop row (bilateral: μ free).
-#[derive(Clone, Copy, Debug)]
-struct PosRow {
-    r: usize,
-    ps: usize,
-    pl: usize,
-    bilateral: bool,
 }
 
 /// Every how many steps a jointed island's self-stress is shed (stress.rs).

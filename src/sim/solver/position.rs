@@ -1,8 +1,31 @@
 //! The position pass (split impulse) on the solve's rows.
 
+use super::kernels::{Dofs, Path, Runs};
 use super::loop_block::BlockRows;
-use super::{MassFactor, PosRow, RowKind, Rows};
+use super::{MassFactor, RowKind, Rows};
 use crate::contact::ContactPoint;
+
+/// A row the position pass updates: its index, where its path's dofs lie
+/// (checked to lie in the table), its path's length, and whether it is a
+/// loop row (bilateral: μ free).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PosRow {
+    r: usize,
+    at: At,
+    pl: usize,
+    bilateral: bool,
+}
+
+/// Where a [`PosRow`]'s path lies in w' ([`Path::of`] kept by value): one
+/// run of six consecutive dofs from the first, two such runs (a free
+/// body's path, two free bodies': the piles' rows), or the table's entries
+/// from this start (gathered).
+#[derive(Clone, Copy, Debug)]
+enum At {
+    One(usize),
+    Two(usize, usize),
+    Table(usize),
+}
 
 impl Rows {
     /// The position pass (split impulse): projected Gauss–Seidel on the same
@@ -132,9 +155,15 @@ impl Rows {
                 if table.get(ps..ps + pl).is_none() || y.get(r * st..r * st + pl).is_none() {
                     continue;
                 }
+                // SAFETY: ps..ps + pl lies in the table (checked above)
+                let at = match Path::of(unsafe { table.get_unchecked(ps..ps + pl) }) {
+                    Path::One(Runs([a])) => At::One(a),
+                    Path::Two(Runs([a, b])) => At::Two(a, b),
+                    Path::Any(_) => At::Table(ps),
+                };
                 list.push(PosRow {
                     r,
-                    ps,
+                    at,
                     pl,
                     bilateral,
                 });
@@ -147,7 +176,7 @@ impl Rows {
         if let Some(warm) = warm {
             for &PosRow {
                 r,
-                ps,
+                at,
                 pl,
                 bilateral,
             } in &list
@@ -157,16 +186,12 @@ impl Rows {
                     continue;
                 }
                 mu[r] = m;
+                // w' += μᵣ yᵣ
                 // SAFETY: as in the sweeps below (checked when listed)
-                let (p, yr) = unsafe {
-                    (
-                        table.get_unchecked(ps..ps + pl),
-                        y.get_unchecked(r * st..r * st + pl),
-                    )
+                unsafe {
+                    let yr = y.get_unchecked(r * st..r * st + pl);
+                    on_path!(at, pl, yr, table; yr, p, n => path_add(yr, p, n, m, dw))
                 };
-                for (a, &k) in yr.iter().zip(p) {
-                    unsafe { *dw.get_unchecked_mut(k) += m * a };
-                }
             }
         }
         let loops = &mut self.sm.loops;
@@ -176,33 +201,22 @@ impl Rows {
             let mut change: f64 = 0.0;
             for &PosRow {
                 r,
-                ps,
+                at,
                 pl,
                 bilateral,
             } in &list
             {
-                let wrr = w[r];
+                let (wrr, b) = (w[r], bpos[r]);
+                let mur = &mut mu[r];
                 // SAFETY: the row's path and y were checked to lie in
-                // `table` and `y` when listed (neither changes in the pass)
-                let (p, yr) = unsafe {
-                    (
-                        table.get_unchecked(ps..ps + pl),
-                        y.get_unchecked(r * st..r * st + pl),
-                    )
+                // `table` and `y` when listed (neither changes in the pass);
+                // the path's dofs are < nv = dw.len() (the factor's table
+                // and its unions, as above)
+                let d = unsafe {
+                    let yr = y.get_unchecked(r * st..r * st + pl);
+                    on_path!(at, pl, yr, table; yr, p, n => project(yr, p, n, dw, mur, b, wrr, bilateral))
                 };
-                // uᵣ = yᵣ·w' over the row's path
-                // SAFETY: the path's dofs are < nv = dw.len() (the factor's
-                // table and its unions, as above)
-                let u = unsafe { path_dot(yr, p, dw) };
-                let old = mu[r];
-                let x = old - (u - bpos[r]) / wrr;
-                let new = if bilateral { x } else { x.max(0.0) };
-                let d = new - old;
                 if d != 0.0 {
-                    mu[r] = new;
-                    // w' += Δμ yᵣ
-                    // SAFETY: as for `path_dot`
-                    unsafe { path_add(yr, p, d, dw) };
                     change = change.max((d * wrr).abs());
                 }
             }
@@ -225,61 +239,80 @@ impl Rows {
     }
 }
 
-/// yᵣ·x over a row's path `p` (its y `yr`, as long), in the path's order
-/// as `Iterator::sum` adds (from −0, term after term): unrolled for the
-/// paths of one and two free bodies (6 and 12 dofs), the pass's rows on the
-/// piles, the same additions in the same order (bit for bit the loop's).
+/// `$run` with `$yr` a row's y (`$y`, at least `$pl` long) and `$p` its
+/// path at `$at` (`$pl` long, in `$table`) as [`Dofs`], `$n` their length:
+/// a run or two of six dofs as [`Runs`] at the fixed length 6 or 12 (the
+/// loops below unrolled whole, the dofs read without the table), else the
+/// table's entries. The same dofs in the same order either way. Unsafe to
+/// use: the caller vouches for the lengths.
+macro_rules! on_path {
+    ($at:expr, $pl:expr, $y:expr, $table:expr; $yr:ident, $p:ident, $n:ident => $run:expr) => {
+        match $at {
+            At::One(a) => {
+                let ($yr, $p, $n) = ($y.get_unchecked(..6), Runs([a]), 6);
+                $run
+            }
+            At::Two(a, b) => {
+                let ($yr, $p, $n) = ($y.get_unchecked(..12), Runs([a, b]), 12);
+                $run
+            }
+            At::Table(ps) => {
+                let ($yr, $p, $n) = (
+                    $y.get_unchecked(..$pl),
+                    $table.get_unchecked(ps..ps + $pl),
+                    $pl,
+                );
+                $run
+            }
+        }
+    };
+}
+use on_path;
+
+/// One row's projection, returning Δμᵣ: uᵣ = yᵣ·w' over its path (in path
+/// order from −0, as `Iterator::sum` adds), μᵣ ← max(0, μᵣ − (uᵣ −
+/// b_posᵣ)/Wᵣᵣ) (a loop row's unclamped), and w' += Δμᵣ yᵣ if it moved.
 ///
 /// # Safety
-/// Every entry of `p` is < `x.len()`.
+/// `yr` and `p` hold `n` entries; every dof of `p` is < `x.len()`.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-unsafe fn path_dot(yr: &[f64], p: &[usize], x: &[f64]) -> f64 {
-    #[inline(always)]
-    unsafe fn fixed<const N: usize>(yr: &[f64; N], p: &[usize; N], x: &[f64]) -> f64 {
-        let mut u = -0.0;
-        for j in 0..N {
-            // SAFETY: the caller's
-            u += yr[j] * unsafe { *x.get_unchecked(p[j]) };
-        }
-        u
-    }
-    // SAFETY (the three): the caller's
-    if let (Ok(y), Ok(q)) = (<&[f64; 12]>::try_from(yr), <&[usize; 12]>::try_from(p)) {
-        return unsafe { fixed(y, q, x) };
-    }
-    if let (Ok(y), Ok(q)) = (<&[f64; 6]>::try_from(yr), <&[usize; 6]>::try_from(p)) {
-        return unsafe { fixed(y, q, x) };
-    }
-    yr.iter()
-        .zip(p)
+unsafe fn project<D: Dofs>(
+    yr: &[f64],
+    p: D,
+    n: usize,
+    x: &mut [f64],
+    mu: &mut f64,
+    b: f64,
+    wrr: f64,
+    bilateral: bool,
+) -> f64 {
+    let mut u = -0.0;
+    for j in 0..n {
         // SAFETY: the caller's
-        .map(|(a, &k)| a * unsafe { *x.get_unchecked(k) })
-        .sum()
+        u += yr[j] * unsafe { *x.get_unchecked(p.at(j)) };
+    }
+    let old = *mu;
+    let z = old - (u - b) / wrr;
+    let new = if bilateral { z } else { z.max(0.0) };
+    let d = new - old;
+    if d != 0.0 {
+        *mu = new;
+        // SAFETY: the caller's
+        unsafe { path_add(yr, p, n, d, x) };
+    }
+    d
 }
 
-/// x += d yᵣ over a row's path `p` ([`path_dot`]'s unrolling).
+/// x += d yᵣ over a row's path `p` (`n` slots, in path order).
 ///
 /// # Safety
-/// Every entry of `p` is < `x.len()`.
+/// `yr` and `p` hold `n` entries; every dof of `p` is < `x.len()`.
 #[inline(always)]
-unsafe fn path_add(yr: &[f64], p: &[usize], d: f64, x: &mut [f64]) {
-    #[inline(always)]
-    unsafe fn fixed<const N: usize>(yr: &[f64; N], p: &[usize; N], d: f64, x: &mut [f64]) {
-        for j in 0..N {
-            // SAFETY: the caller's
-            unsafe { *x.get_unchecked_mut(p[j]) += d * yr[j] };
-        }
-    }
-    // SAFETY (the three): the caller's
-    if let (Ok(y), Ok(q)) = (<&[f64; 12]>::try_from(yr), <&[usize; 12]>::try_from(p)) {
-        return unsafe { fixed(y, q, d, x) };
-    }
-    if let (Ok(y), Ok(q)) = (<&[f64; 6]>::try_from(yr), <&[usize; 6]>::try_from(p)) {
-        return unsafe { fixed(y, q, d, x) };
-    }
-    for (a, &k) in yr.iter().zip(p) {
+unsafe fn path_add<D: Dofs>(yr: &[f64], p: D, n: usize, d: f64, x: &mut [f64]) {
+    for j in 0..n {
         // SAFETY: the caller's
-        unsafe { *x.get_unchecked_mut(k) += d * a };
+        unsafe { *x.get_unchecked_mut(p.at(j)) += d * yr[j] };
     }
 }
 
