@@ -289,7 +289,13 @@ impl Former<'_> {
         let (Some(path), Some(j)) = (path.get(..N), self.j.get(r * st..(r + 3) * st)) else {
             return false;
         };
-        if N != A + B || N > st || path.iter().any(|&d| d >= vfree.len()) {
+        // (the shape first: a pile's 6 + 6 path is tried as a 12-dof chain
+        // before it is tried as two, and its rows are not gathered twice)
+        let shape = match B {
+            0 => f.is_chain_of::<N>(path),
+            _ => f.two_chains::<A, B>(path),
+        };
+        if N != A + B || N > st || !shape || path.iter().any(|&d| d >= vfree.len()) {
             return false;
         }
         let mut w = [[0.0f64; 4]; N];
