@@ -18,8 +18,8 @@ use crate::model::Model;
 
 /// A tree's flags in a grouping: some path held all its dofs; some path
 /// marked dofs of it one by one.
-pub(super) const WHOLE: u8 = 1;
-pub(super) const MARKED: u8 = 2;
+const WHOLE: u8 = 1;
+const MARKED: u8 = 2;
 
 /// The trees' dof ranges when they are ascending and disjoint, in tree
 /// order (`None`: the islands' dofs are made by the general pass).
