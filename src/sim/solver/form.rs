@@ -102,12 +102,17 @@ impl Former<'_> {
             // in one pass over the factor
             let block = self.is_contact(r);
             let k = if block { 3 } else { 1 };
-            for q in r..(r + k).min(self.is_block.len()) {
-                self.is_block[q] = block && q == r;
+            // (a contact's three flags in one store: its normal's alone set)
+            match self.is_block.get_mut(r..r + k) {
+                Some(f) if block => f.copy_from_slice(&[true, false, false]),
+                Some(f) => f.fill(false),
+                None => (self.is_block.iter_mut().skip(r).enumerate())
+                    .for_each(|(i, f)| *f = block && i == 0),
             }
             // two contacts between the same two free bodies (6 + 6 dofs, the
             // same path): formed together, one walk of L for both
-            let same = |(qs, ql): (usize, usize)| table.get(qs..qs + ql) == Some(path);
+            // (the same table entries first: a pair's contacts share their union)
+            let same = |q: (usize, usize)| q == (ps, pl) || table.get(q.0..q.0 + q.1) == Some(path);
             // (likewise two contacts of one free body on the ground: 6 dofs)
             if block
                 && (pl == 12 || pl == 6)
@@ -118,9 +123,7 @@ impl Former<'_> {
                     _ => self.form_pair::<0, 6>(f, r, path, vfree),
                 }
             {
-                for q in r + 3..r + 6 {
-                    self.is_block[q] = q == r + 3;
-                }
+                self.is_block[r + 3..r + 6].copy_from_slice(&[true, false, false]);
                 r += 6;
                 continue;
             }

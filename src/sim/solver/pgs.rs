@@ -149,28 +149,26 @@ impl Rows {
         out.sm.0.forget();
         // the loop rows as one exact block, every other row seen through them
         // (the reduced W', loop_block.rs): taken out for the solve
-        // (without a bilateral row not even taken: nothing to move)
-        let mut lb = if self.bilateral {
-            std::mem::take(&mut out.sm.0.loops)
-        } else {
-            LoopBlock::default()
-        };
+        // (without a bilateral row not even taken, none made: nothing to move)
+        let mut own = self.bilateral.then(|| std::mem::take(&mut out.sm.0.loops));
         let view = BlockRows {
             st,
             y,
             paths,
             table,
         };
-        let block = self.bilateral && lb.prepare(&view, runs, kinds, &self.w[..n]);
-        if block {
+        let block = own
+            .as_mut()
+            .is_some_and(|lb| lb.prepare(&view, runs, kinds, &self.w[..n]));
+        if let Some(lb) = own.as_mut().filter(|_| block) {
             let (w, wb, wi) = (&self.w[..n], &self.w_block[..n], &self.winv[..n]);
             lb.reduce(&view, runs, kinds, contact, w, wb, wi);
         }
-        let lb = lb;
-        let (w, w_block, winv) = if block {
-            (&lb.wr[..n], &lb.wblockr[..n], &lb.winvr[..n])
-        } else {
-            (&self.w[..n], &self.w_block[..n], &self.winv[..n])
+        // (the block when it is in the solve)
+        let lb: Option<&LoopBlock> = own.as_ref().filter(|_| block);
+        let (w, w_block, winv) = match lb {
+            Some(lb) => (&lb.wr[..n], &lb.wblockr[..n], &lb.winvr[..n]),
+            None => (&self.w[..n], &self.w_block[..n], &self.winv[..n]),
         };
         // a row no impulse can move keeps 0
         let live = |r: usize| if winv[r] != 0.0 { 1.0 } else { 0.0 };
@@ -242,7 +240,7 @@ impl Rows {
             // SAFETY: the paths and y checked above (rdot/raxpy's)
             unsafe { warm_rows(lambda, contact, paths, table, y, st, (s, e), dv) };
         }
-        if block {
+        if let Some(lb) = lb {
             lb.solve(&view, Some(c), b, lambda, dv);
         }
         let mut it = 0;
@@ -358,7 +356,7 @@ impl Rows {
                                     + dl1.abs() * w11.sqrt()
                                     + dl2.abs() * w22.sqrt();
                             }
-                            if block {
+                            if let Some(lb) = lb {
                                 lb.follow(&view, r, &[dln, dl1, dl2], lambda, dv);
                             }
                         }
@@ -417,7 +415,7 @@ impl Rows {
                                     0.0
                                 };
                             }
-                            if block {
+                            if let Some(lb) = lb {
                                 lb.follow(&view, r, &[d1, d2], lambda, dv);
                             }
                             change =
@@ -463,7 +461,7 @@ impl Rows {
                         if SKIP && armed {
                             drift += d.abs() * wrr.sqrt();
                         }
-                        if block && lb.couples(r) {
+                        if let Some(lb) = lb.filter(|lb| lb.couples(r)) {
                             lb.follow(&view, r, &[d], lambda, dv);
                         }
                     } else if skip && winv[r] != 0.0 {
@@ -481,7 +479,7 @@ impl Rows {
                     r += 1;
                 }
             }
-            if block {
+            if let Some(lb) = lb {
                 // (rounding only: every update above kept the loop rows on target)
                 change = most(change, lb.solve(&view, Some(c), b, lambda, dv));
             }
@@ -526,7 +524,7 @@ impl Rows {
                         }
                         (drift, armed) = (0.0, false);
                     }
-                    if block {
+                    if let Some(lb) = lb {
                         lb.solve(&view, Some(c), b, lambda, dv);
                     }
                 }
@@ -536,7 +534,7 @@ impl Rows {
         if converged && !block && self.sheds(dofs) {
             self.shed_self_stress(&mut out.sm.0, runs, lambda, dv, tol);
         }
-        if self.bilateral {
+        if let Some(lb) = own {
             out.sm.0.loops = lb;
         }
         if SKIP && armed {
