@@ -51,6 +51,10 @@ fn strided_and_appended_factor_match_the_library_bits() {
         (4, 2, 7),
         (5, 5, 8),
         (6, 4, 9),
+        (7, 7, 10),
+        (7, 5, 11),
+        (8, 8, 12),
+        (8, 6, 13),
     ] {
         let w = gram(m, k, ld, seed);
         // the library on the packed copy

@@ -56,7 +56,8 @@ pub(crate) fn ldlt_dropping(a: &mut [f64], ld: usize, m: usize, from: usize, dro
 }
 
 /// `f(m)`, with m a constant in the arms of the small m most tries have (one
-/// or two contacts: 3 to 6 rows), so that `f`'s loops, inlined there, lose
+/// or two contacts: 3 to 6 rows; two contacts and one or two sliding
+/// ones' normals: 7 and 8), so that `f`'s loops, inlined there, lose
 /// their per-column set-up: the same operations in the same order.
 #[inline(always)]
 fn fixed<R>(m: usize, mut f: impl FnMut(usize) -> R) -> R {
@@ -65,6 +66,8 @@ fn fixed<R>(m: usize, mut f: impl FnMut(usize) -> R) -> R {
         4 => f(4),
         5 => f(5),
         6 => f(6),
+        7 => f(7),
+        8 => f(8),
         _ => f(m),
     }
 }
