@@ -55,6 +55,10 @@ fn strided_and_appended_factor_match_the_library_bits() {
         (7, 5, 11),
         (8, 8, 12),
         (8, 6, 13),
+        (9, 9, 14),
+        (10, 7, 15),
+        (11, 11, 16),
+        (12, 8, 17),
     ] {
         let w = gram(m, k, ld, seed);
         // the library on the packed copy

@@ -57,7 +57,8 @@ pub(crate) fn ldlt_dropping(a: &mut [f64], ld: usize, m: usize, from: usize, dro
 
 /// `f(m)`, with m a constant in the arms of the small m most tries have (one
 /// or two contacts: 3 to 6 rows; two contacts and one or two sliding
-/// ones' normals: 7 and 8), so that `f`'s loops, inlined there, lose
+/// ones' normals: 7 and 8; three or four contacts: 9 to 12), so that `f`'s
+/// loops, inlined there, lose
 /// their per-column set-up: the same operations in the same order.
 #[inline(always)]
 fn fixed<R>(m: usize, mut f: impl FnMut(usize) -> R) -> R {
@@ -68,6 +69,10 @@ fn fixed<R>(m: usize, mut f: impl FnMut(usize) -> R) -> R {
         6 => f(6),
         7 => f(7),
         8 => f(8),
+        9 => f(9),
+        10 => f(10),
+        11 => f(11),
+        12 => f(12),
         _ => f(m),
     }
 }
