@@ -133,6 +133,57 @@ impl Subspace {
             }
         };
         let known = |a: usize, s: usize| reuse && old[a..a + s].iter().all(|&o| o != NEW);
+        // a group's own block (`OwnBlocks::own`) at (a, a): the entries
+        // `Rows::form` summed as W's diagonal and a contact's w_block, from
+        // −0 (an entry here is the same products in the same order from +0:
+        // the same bits but for a sum of −0, which + 0.0 makes the +0 the sum
+        // here gives)
+        #[inline(always)]
+        fn put_own(
+            put: &mut impl FnMut(usize, usize, f64),
+            a: usize,
+            own: [[f64; 3]; 3],
+            s: usize,
+        ) {
+            for (i, oi) in own.iter().enumerate().take(s) {
+                for (j, &oij) in oi.iter().enumerate().take(i + 1) {
+                    put(a + i, a + j, oij + 0.0);
+                }
+            }
+        }
+        // one contact's rows or two contacts', none in the last W_FF (a lone
+        // contact's island, two contacts'): the entries the loop below
+        // writes, the same sums, without its bookkeeping — each own block,
+        // and the second contact's rows scattered against the first's
+        if from == 0 && !reuse && (m == 3 || (m == 6 && three[3])) && three[0] {
+            let r0 = rows[0];
+            if let Some(o0) = own_blocks.own(r0, 3) {
+                let r1 = rows[m - 3];
+                let o1 = if m == 6 {
+                    own_blocks.own(r1, 3)
+                } else {
+                    Some(o0)
+                };
+                if let Some(o1) = o1 {
+                    put_own(&mut put, 0, o0, 3);
+                    if m == 6 {
+                        let (p0, p1) = (path(r0), path(r1));
+                        let ys = |q: usize, l: usize| [yrow(q, l), yrow(q + 1, l), yrow(q + 2, l)];
+                        scatter3(x3, p1, ys(r1, p1.len()));
+                        // SAFETY: k < nv ≤ x3.len() (the sweeps' check)
+                        let sum = unsafe { dot3x3(ys(r0, p0.len()), p0, x3) };
+                        clear3(x3, p1);
+                        for (i, si) in sum.iter().enumerate() {
+                            for (j, &sij) in si.iter().enumerate() {
+                                put(3 + i, j, sij);
+                            }
+                        }
+                        put_own(&mut put, 3, o1, 3);
+                    }
+                    return true;
+                }
+            }
+        }
         let mut a = 0;
         while a < m {
             let sa = if three[a] { 3 } else { 1 };
@@ -161,17 +212,9 @@ impl Subspace {
                     continue;
                 }
                 if bb == a {
-                    // the group's own block: the entries `Rows::form` summed
-                    // as W's diagonal and a contact's w_block, from −0 (an
-                    // entry here is the same products in the same order from
-                    // +0: the same bits but for a sum of −0, which + 0.0 makes
-                    // the +0 the sum here gives)
+                    // the group's own block
                     if let Some(own) = own_blocks.own(r, sa) {
-                        for (i, oi) in own.iter().enumerate().take(sa) {
-                            for (j, &oij) in oi.iter().enumerate().take(i + 1) {
-                                put(a + i, a + j, oij + 0.0);
-                            }
-                        }
+                        put_own(&mut put, a, own, sa);
                         bb += sb;
                         continue;
                     }
@@ -179,14 +222,8 @@ impl Subspace {
                 if !scattered {
                     scattered = true;
                     if sa == 3 {
-                        let (y0, y1, y2) = (
-                            yrow(r, pa.len()),
-                            yrow(r + 1, pa.len()),
-                            yrow(r + 2, pa.len()),
-                        );
-                        for (t, &k) in pa.iter().enumerate() {
-                            x3[k] = [y0[t], y1[t], y2[t]];
-                        }
+                        let l = pa.len();
+                        scatter3(x3, pa, [yrow(r, l), yrow(r + 1, l), yrow(r + 2, l)]);
                     } else {
                         for (&yt, &k) in yrow(r, pa.len()).iter().zip(pa) {
                             x[k] = yt;
@@ -251,9 +288,7 @@ impl Subspace {
             }
             if scattered {
                 if sa == 3 {
-                    for &k in pa {
-                        x3[k] = [0.0; 3];
-                    }
+                    clear3(x3, pa);
                 } else {
                     for &k in pa {
                         x[k] = 0.0;
@@ -277,6 +312,23 @@ impl Subspace {
         if let (Some(d), Some(s)) = (self.wf.get_mut(..e), self.wold.get(..e)) {
             d.copy_from_slice(s);
         }
+    }
+}
+
+/// A contact's three rows `ys` (over its path `p`) scattered side by side
+/// onto their dofs in `x3` (`Subspace::x3`).
+#[inline(always)]
+fn scatter3(x3: &mut [[f64; 3]], p: &[usize], [y0, y1, y2]: [&[f64]; 3]) {
+    for (t, &k) in p.iter().enumerate() {
+        x3[k] = [y0[t], y1[t], y2[t]];
+    }
+}
+
+/// [`scatter3`]'s entries put back to zero (`x3` zero between uses).
+#[inline(always)]
+fn clear3(x3: &mut [[f64; 3]], p: &[usize]) {
+    for &k in p {
+        x3[k] = [0.0; 3];
     }
 }
 
