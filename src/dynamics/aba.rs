@@ -11,7 +11,7 @@ use nalgebra::{DVector, Matrix3, Matrix6, Matrix6x3, Vector3, Vector6};
 /// model's `inertias_origin`, computed at load), docs/theory.md §"Spatial inertia":
 /// `[I_o, h*; h*ᵀ, m 1]` with `h = m c` and `I_o = I_c − m c*c*`.
 #[inline(always)]
-fn inertia_matrix<T: Scalar>(y: &CompositeInertia<T>) -> Matrix6<T> {
+pub(super) fn inertia_matrix<T: Scalar>(y: &CompositeInertia<T>) -> Matrix6<T> {
     // entry by entry (nalgebra's block copies went through an out-of-line
     // iterator): [I_o, h*; h*ᵀ, m 1] with h* = [0 −h_z h_y; h_z 0 −h_x; −h_y h_x 0]
     let (io, h, z) = (&y.io, &y.h, T::zero());
@@ -259,7 +259,7 @@ fn mvec<T: Scalar>(m: &Motion<T>) -> Vector6<T> {
     Vector6::new(m.ang.x, m.ang.y, m.ang.z, m.lin.x, m.lin.y, m.lin.z)
 }
 #[inline(always)]
-fn fvec<T: Scalar>(f: &Force<T>) -> Vector6<T> {
+pub(super) fn fvec<T: Scalar>(f: &Force<T>) -> Vector6<T> {
     Vector6::new(f.ang.x, f.ang.y, f.ang.z, f.lin.x, f.lin.y, f.lin.z)
 }
 #[inline(always)]

@@ -366,12 +366,37 @@ pub(crate) fn spd6_solve<T: Scalar>(
     b: &nalgebra::Vector6<T>,
 ) -> Option<nalgebra::Vector6<T>> {
     let (l, dinv) = spd6_ldl(a)?;
-    // L y = b, z = D⁻¹ y, Lᵀ x = z
+    Some(ldl6_solve(|i, k| l[i][k], &dinv, b))
+}
+
+/// `A = L D Lᵀ` of [`spd6_solve`] for a caller that keeps it: L's strict
+/// lower triangle packed by rows (`L[i, k]` at `i (i − 1) / 2 + k`, k < i)
+/// and D⁻¹; `None` as [`spd6_solve`].
+#[inline]
+pub(crate) fn spd6_factor(a: &nalgebra::Matrix6<f64>) -> Option<([f64; 15], [f64; 6])> {
+    let (l, dinv) = spd6_ldl(a)?;
+    let mut packed = [0.0; 15];
+    for i in 1..6 {
+        for k in 0..i {
+            packed[i * (i - 1) / 2 + k] = l[i][k];
+        }
+    }
+    Some((packed, dinv))
+}
+
+/// `x = A⁻¹ b` from `A = L D Lᵀ` (`l(i, k)` = L's entry, k < i; `dinv` = D⁻¹):
+/// L y = b, z = D⁻¹ y, Lᵀ x = z, with fixed loop bounds (unrolled).
+#[inline(always)]
+pub(crate) fn ldl6_solve<T: Scalar>(
+    l: impl Fn(usize, usize) -> T,
+    dinv: &[T; 6],
+    b: &nalgebra::Vector6<T>,
+) -> nalgebra::Vector6<T> {
     let mut x = [T::zero(); 6];
     for i in 0..6 {
         let mut s = b[i];
         for k in 0..i {
-            s = madd(-l[i][k], x[k], s);
+            s = madd(-l(i, k), x[k], s);
         }
         x[i] = s;
     }
@@ -381,9 +406,9 @@ pub(crate) fn spd6_solve<T: Scalar>(
     for i in (0..6).rev() {
         let mut s = x[i];
         for k in (i + 1)..6 {
-            s = madd(-l[k][i], x[k], s);
+            s = madd(-l(k, i), x[k], s);
         }
         x[i] = s;
     }
-    Some(nalgebra::Vector6::from_column_slice(&x))
+    nalgebra::Vector6::from_column_slice(&x)
 }

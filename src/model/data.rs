@@ -96,6 +96,11 @@ pub struct Data<T: Scalar = f64> {
     pub aba_uq: Vec<T>,
     /// ABA: velocity-product acceleration `c = v × S q̇` of each body.
     pub aba_c: Vec<Motion<T>>,
+    /// ABA on lone free bodies (`dynamics::aba_lone`): each body's `Iᴬ = Î`
+    /// factored, kept from call to call (a lone body's articulated inertia
+    /// in its own frame is its rigid inertia, a constant), with the inertia
+    /// it is the factor of (made again when that changes).
+    pub(crate) aba_kept: Vec<KeptLdl6>,
 
     /// Every joint's world Jacobian, 6 × nv (`joint_jacobians`).
     pub jacobians: DMatrix<T>,
@@ -353,6 +358,7 @@ impl<T: Scalar> Data<T> {
             aba_dinv: vec![T::zero(); nb],
             aba_uq: vec![T::zero(); nb],
             aba_c: vec![Motion::zero(); nb],
+            aba_kept: vec![KeptLdl6::NONE; nb],
             jacobians: DMatrix::zeros(6, nv),
             dtau_dq: lazy_zeros(nv, nv),
             dtau_dv: lazy_zeros(nv, nv),
@@ -498,4 +504,24 @@ fn all_lone_free<T: Scalar>(
                 && matches!(dispatch.get(i), Some((super::joint::Dispatch::Free, _, _)))
                 && model.joints.get(i).is_some_and(|j| j.iv == 6 * (i - 1))
         })
+}
+
+/// A body's `Iᴬ = Î` (6 × 6, angular first, from its origin-form inertia)
+/// factored as `L D Lᵀ` (`dynamics::linalg::spd6_factor`), kept for ABA on
+/// lone free bodies.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct KeptLdl6 {
+    /// The inertia (origin form) the factor is of, or none yet.
+    pub(crate) of: Option<CompositeInertia<f64>>,
+    /// L's strict lower triangle packed by rows and D⁻¹; `None`: that
+    /// inertia is not positive definite (ABA's singular pivot).
+    pub(crate) ldl: Option<([f64; 15], [f64; 6])>,
+}
+
+impl KeptLdl6 {
+    /// Nothing factored yet.
+    pub(crate) const NONE: Self = Self {
+        of: None,
+        ldl: None,
+    };
 }

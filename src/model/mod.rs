@@ -21,6 +21,7 @@ pub use names::{edit_distance, nearest, BodyId, FrameId, JointId, NameError};
 pub use actuators::{Actuator, Keyframe};
 pub use constraints::{Attachment, Constraint, ConstraintError, ConstraintKind, Constraints};
 pub use data::Data;
+pub(crate) use data::KeptLdl6;
 pub(crate) use joint::{dispatch_joint, dispatch_keyed, JointModel};
 pub use joint::{Axis, Joint, JointKind};
 pub use topology::{FdMethod, Topology};

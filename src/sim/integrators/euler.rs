@@ -6,7 +6,7 @@
 //! (λ the impulses, w the position pass's pseudo-velocity: [`super::super::constraints`]).
 
 use super::solve_rows;
-use crate::dynamics::{bias, bias_at_placements_ahead, forward_dynamics};
+use crate::dynamics::{aba_lone_placed, bias, bias_at_placements_ahead, forward_dynamics};
 use crate::model::configuration::{integrate_config_held, rotate_base_velocity_held};
 use crate::sim::{SimError, Simulation};
 use nalgebra::{DVector, Vector3};
@@ -112,9 +112,25 @@ impl Simulation {
                 .and_then(|_| self.factor_mass(h))
                 .map(|_| self.mass.f.solve(&mut tau))
         } else {
-            forward_dynamics(&self.model, &mut self.data, &self.q, &self.v, &tau, None)
-                .map(|a| tau.copy_from(a))
-                .map_err(SimError::from)
+            // lone free bodies with the placements of forward kinematics at
+            // this q (the last step's contact refresh): ABA's one pass, q̈
+            // written over τ
+            let lone = if self.fk_valid {
+                aba_lone_placed(
+                    &self.model,
+                    &mut self.data,
+                    self.v.as_slice(),
+                    tau.as_mut_slice(),
+                )
+            } else {
+                None
+            };
+            match lone {
+                Some(r) => r.map_err(SimError::from),
+                None => forward_dynamics(&self.model, &mut self.data, &self.q, &self.v, &tau, None)
+                    .map(|a| tau.copy_from(a))
+                    .map_err(SimError::from),
+            }
         };
         if free.is_ok() {
             // v* = h a·1 + 1·v (`axpy`'s products and sum over a copy of v,
