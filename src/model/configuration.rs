@@ -54,6 +54,45 @@ pub fn integrate_config_held(
             integrate_free(q, v, h, f.iq, f.iv);
         }
     }
+    integrate_dofs(model, q, v, h);
+}
+
+/// [`integrate_config_held`] (q ⊕ h w) and [`rotate_base_velocity_held`]
+/// (v's linear part turned by exp(−h ω), ω from `w`) in one pass over the
+/// free joints: each joint's q ⊕ h w and its v's turn, their h ω and |h ω|
+/// made once (the same numbers both made: the same products of the same
+/// entries); then the other joints' as the two functions take them.
+pub fn integrate_rotate_held(
+    model: &Model,
+    q: &mut DVector<f64>,
+    v: &mut DVector<f64>,
+    w: &DVector<f64>,
+    h: f64,
+    held: &[bool],
+) {
+    for f in &model.free_joints {
+        if held.get(f.body) == Some(&true) {
+            continue;
+        }
+        let (Some(qs), Some(&[vx, vy, vz, wx, wy, wz]), Some(vl)) = (
+            q.as_mut_slice().get_mut(f.iq..f.iq + 7),
+            w.as_slice().get(f.iv..f.iv + 6),
+            v.as_mut_slice().get_mut(f.iv..f.iv + 3),
+        ) else {
+            continue;
+        };
+        let (wv, th) = free_q_step(qs, [vx, vy, vz, wx, wy, wz], h);
+        if let Some(r) = turned_lin(Vector3::new(vl[0], vl[1], vl[2]), &wv, th) {
+            vl.copy_from_slice(r.as_slice());
+        }
+    }
+    integrate_dofs(model, q, w, h);
+    rotate_dofs(model, v, w, h);
+}
+
+/// The joints of `model.dofs` in [`integrate_config_held`] (q ⊕ h v).
+#[inline(always)]
+fn integrate_dofs(model: &Model, q: &mut DVector<f64>, v: &DVector<f64>, h: f64) {
     for d in &model.dofs {
         let (iq, iv) = (d.iq, d.iv);
         match &d.kind {
@@ -81,13 +120,24 @@ pub fn integrate_free(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize,
     ) else {
         return;
     };
+    free_q_step(qs, [vx, vy, vz, wx, wy, wz], h);
+}
+
+/// One free joint's q (`qs`, seven entries) ⊕ h v (`v` = [v_lin, ω]):
+/// p += h R v_lin, quaternion ⊗ exp(h ω / 2); returns h ω and |h ω|.
+#[inline(always)]
+fn free_q_step(qs: &mut [f64], v: [f64; 6], h: f64) -> (Vector3<f64>, f64) {
+    let [vx, vy, vz, wx, wy, wz] = v;
     let (p, quat) = qs.split_at_mut(3);
     let r = quat_to_matrix(quat[0], quat[1], quat[2], quat[3]);
     let dp = r * Vector3::new(vx, vy, vz) * h;
     p[0] += dp.x;
     p[1] += dp.y;
     p[2] += dp.z;
-    quat_step(quat, [wx, wy, wz], h);
+    let w = Vector3::new(wx, wy, wz) * h;
+    let th = w.norm();
+    quat_turn(quat, &w, th);
+    (w, th)
 }
 
 /// The quaternion `q[iq..iq + 4]` ← itself ⊗ exp(h ω / 2), ω = `v[iv..iv + 3]`
@@ -106,6 +156,12 @@ fn integrate_quat(q: &mut DVector<f64>, v: &DVector<f64>, h: f64, iq: usize, iv:
 fn quat_step(quat: &mut [f64], omega: [f64; 3], h: f64) {
     let w = Vector3::new(omega[0], omega[1], omega[2]) * h;
     let th = w.norm();
+    quat_turn(quat, &w, th);
+}
+
+/// `quat` (x, y, z, w) ← itself ⊗ exp(w / 2), renormalised, for `th` = |w|.
+#[inline(always)]
+fn quat_turn(quat: &mut [f64], w: &Vector3<f64>, th: f64) {
     let (s, c) = if th > 1e-12 {
         let (s, c) = sin_cos(th / 2.0);
         (s / th, c)
@@ -142,34 +198,55 @@ pub fn rotate_base_velocity_held(
     h: f64,
     held: &[bool],
 ) {
-    // (the joints of `coordinate_joints` in its order, the kinds matched by
-    // reference: no copy of a 1-DoF joint's kind to skip it)
+    // (the joints of `coordinate_joints` in its order: the free roots, then
+    // the others, the kinds matched by reference)
     let frees = model
         .free_joints
         .iter()
         .filter(|f| held.get(f.body) != Some(&true))
         .map(|f| (true, f.iv));
+    for (free, iv) in frees {
+        turn_joint(v, w, h, free, iv);
+    }
+    rotate_dofs(model, v, w, h);
+}
+
+/// The joints of `model.dofs` in [`rotate_base_velocity_held`].
+#[inline(always)]
+fn rotate_dofs(model: &Model, v: &mut DVector<f64>, w: &DVector<f64>, h: f64) {
     let others = model.dofs.iter().filter_map(|d| match &d.kind {
         JointKind::Free => Some((true, d.iv)),
         JointKind::Planar => Some((false, d.iv)),
         _ => None,
     });
-    for (free, iv) in frees.chain(others) {
-        let (wv, n) = if free {
-            (Vector3::new(w[iv + 3], w[iv + 4], w[iv + 5]) * h, 3)
-        } else {
-            (Vector3::new(0.0, 0.0, w[iv + 2] * h), 2)
-        };
-        let th = wv.norm();
-        if th > 0.0 {
-            let r = axis_angle(&(wv / th), th);
-            let vl = r.transpose()
-                * Vector3::new(v[iv], v[iv + 1], if n == 3 { v[iv + 2] } else { 0.0 });
-            for k in 0..n {
-                v[iv + k] = vl[k];
-            }
+    for (free, iv) in others {
+        turn_joint(v, w, h, free, iv);
+    }
+}
+
+/// One free (`free`) or planar joint's linear velocity at `iv` turned by
+/// exp(−h ω) (ω from `w`: a free joint's three, a planar joint's one about z).
+#[inline(always)]
+fn turn_joint(v: &mut DVector<f64>, w: &DVector<f64>, h: f64, free: bool, iv: usize) {
+    let (wv, n) = if free {
+        (Vector3::new(w[iv + 3], w[iv + 4], w[iv + 5]) * h, 3)
+    } else {
+        (Vector3::new(0.0, 0.0, w[iv + 2] * h), 2)
+    };
+    let th = wv.norm();
+    let vl = Vector3::new(v[iv], v[iv + 1], if n == 3 { v[iv + 2] } else { 0.0 });
+    if let Some(vl) = turned_lin(vl, &wv, th) {
+        for k in 0..n {
+            v[iv + k] = vl[k];
         }
     }
+}
+
+/// `vl` turned by exp(−wv): exp(wv)ᵀ vl for `th` = |wv| > 0, else `None`
+/// (no turn).
+#[inline(always)]
+fn turned_lin(vl: Vector3<f64>, wv: &Vector3<f64>, th: f64) -> Option<Vector3<f64>> {
+    (th > 0.0).then(|| axis_angle(&(wv / th), th).transpose() * vl)
 }
 
 /// Writes q̇ into `dy[0..nq]`: a free joint's ṗ = R(q̂) v_lin (q̂ = `qn`,

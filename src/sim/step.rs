@@ -297,35 +297,32 @@ impl Simulation {
                 .unwrap_or_else(|| format!("v[{k_max}]")),
         })
     }
-
-    /// Applied generalized force with joint torques clamped to effort limits.
-    pub(super) fn clamped_tau(&self, out: &mut DVector<f64>) {
-        let (out, tau) = (out.as_mut_slice(), self.tau_applied.as_slice());
-        // (`f64::clamp` without its test of the bounds at every entry: an
-        // effort limit is +∞ or positive, build.rs)
-        for ((o, &t), &e) in out.iter_mut().zip(tau).zip(&self.effort) {
-            let mut x = t;
-            if x < -e {
-                x = -e;
-            }
-            if x > e {
-                x = e;
-            }
-            *o = x;
-        }
-    }
 }
 
-/// Every entry finite, without an early exit (the compares run in vector lanes).
+/// Every entry finite, without an early exit: x − x is +0 for a finite x and
+/// NaN for ±∞ or NaN, so a sum of them is +0 exactly when every entry is
+/// finite, in any order — summed in four lanes side by side.
 #[inline]
 fn all_finite(x: &[f64]) -> bool {
-    x.iter().fold(true, |ok, v| ok & v.is_finite())
+    let mut s = [0.0f64; 4];
+    let mut quads = x.chunks_exact(4);
+    for c in &mut quads {
+        for k in 0..4 {
+            s[k] += c[k] - c[k];
+        }
+    }
+    for &v in quads.remainder() {
+        s[0] += v - v;
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) == 0.0
 }
 
-/// Some entry non-zero (NaN counts), without an early exit.
+/// Some entry non-zero (NaN counts), without an early exit: x ≠ ±0 exactly
+/// when its bits but the sign are not all zero, so the bits shifted past the
+/// sign are or-ed (an integer reduction, in vector lanes).
 #[inline]
-fn any_nonzero(x: &[f64]) -> bool {
-    x.iter().fold(false, |any, &v| any | (v != 0.0))
+pub(in crate::sim) fn any_nonzero(x: &[f64]) -> bool {
+    x.iter().fold(0u64, |any, v| any | (v.to_bits() << 1)) != 0
 }
 
 /// `out = a + b` entry by entry (the sum `out.copy_from(a); out += b` makes).

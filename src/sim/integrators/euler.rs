@@ -7,7 +7,7 @@
 
 use super::solve_rows;
 use crate::dynamics::{aba_lone_placed, bias, bias_at_placements_ahead, forward_dynamics};
-use crate::model::configuration::{integrate_config_held, rotate_base_velocity_held};
+use crate::model::configuration::integrate_rotate_held;
 use crate::sim::{SimError, Simulation};
 use nalgebra::{DVector, Vector3};
 
@@ -69,10 +69,16 @@ impl Simulation {
             Some(_) => &self.sleep.body_asleep[..],
             None => &[],
         };
-        integrate_config_held(&self.model, &mut self.q, &self.mass.vtot, h, held);
-        // the base's linear velocity, found in the start frame R, expressed in
-        // the new frame R⁺ = R exp(h ω_total)
-        rotate_base_velocity_held(&self.model, &mut self.v, &self.mass.vtot, h, held);
+        // q ⊕ h vtot, and the base's linear velocity, found in the start frame
+        // R, expressed in the new frame R⁺ = R exp(h ω_total) (one pass)
+        integrate_rotate_held(
+            &self.model,
+            &mut self.q,
+            &mut self.v,
+            &self.mass.vtot,
+            h,
+            held,
+        );
         Ok(())
     }
 
@@ -86,18 +92,12 @@ impl Simulation {
         }
         let nv = self.model.nv;
         let mut tau = std::mem::replace(&mut self.mass.tau, DVector::zeros(0));
-        self.clamped_tau(&mut tau);
-        self.servo.applied.copy_from(&tau);
-        // τ − D v
-        let (d, v) = (self.damping.as_slice(), self.v.as_slice());
-        for ((t, &d), &v) in tau.as_mut_slice()[..nv].iter_mut().zip(d).zip(v) {
-            *t -= d * v;
-        }
-        let free = if dense {
-            // C(q, v); when forward kinematics ran at this q (the last step's
-            // contact refresh), its joint placements are reused (and the energy
-            // guard's pass at this state, when it ran one)
-            let c = if self.fk_valid && self.v.len() == nv {
+        // C(q, v) when `dense` (it reads q and v only); when forward
+        // kinematics ran at this q (the last step's contact refresh), its
+        // joint placements are reused (and the energy guard's pass at this
+        // state, when it ran one)
+        let c = dense.then(|| {
+            if self.fk_valid && self.v.len() == nv {
                 Ok(bias_at_placements_ahead(
                     &self.model,
                     &mut self.data,
@@ -106,9 +106,25 @@ impl Simulation {
                 ))
             } else {
                 bias(&self.model, &mut self.data, &self.q, &self.v, None)
-            };
-            c.map_err(SimError::from)
-                .map(|c| tau -= c)
+            }
+        });
+        // sat(τ) (kept as the servo's applied force) − D v − C in one pass
+        let c_ok = match &c {
+            Some(Ok(c)) => Some(c.as_slice()),
+            _ => None,
+        };
+        free_force(
+            tau.as_mut_slice(),
+            self.tau_applied.as_slice(),
+            self.effort.as_slice(),
+            self.servo.applied.as_mut_slice(),
+            self.damping.as_slice(),
+            self.v.as_slice(),
+            c_ok,
+        );
+        let free = if let Some(c) = c {
+            c.map(|_| ())
+                .map_err(SimError::from)
                 .and_then(|_| self.factor_mass(h))
                 .map(|_| self.mass.f.solve(&mut tau))
         } else {
@@ -176,4 +192,65 @@ pub(in crate::sim) fn add_frame_rate(
     *nx += d.x;
     *ny += d.y;
     *nz += d.z;
+}
+
+/// `out = sat(τ) − D v − C` (`c`: C, or none), `applied = sat(τ)`, entry by
+/// entry with the operations of the passes it stands for (τ clamped to
+/// ±effort by two tests, copied, then x − d v, then x − c), all slices nv
+/// long.
+#[inline(always)]
+fn free_force(
+    out: &mut [f64],
+    tau: &[f64],
+    effort: &[f64],
+    applied: &mut [f64],
+    damping: &[f64],
+    v: &[f64],
+    c: Option<&[f64]>,
+) {
+    let n = out.len();
+    debug_assert!([
+        tau.len(),
+        effort.len(),
+        applied.len(),
+        damping.len(),
+        v.len()
+    ]
+    .iter()
+    .all(|&l| l == n));
+    // (an effort limit is +∞ or positive, build.rs: no test of the bounds)
+    let sat = |t: f64, e: f64| {
+        let mut x = t;
+        if x < -e {
+            x = -e;
+        }
+        if x > e {
+            x = e;
+        }
+        x
+    };
+    let (tau, effort, applied, damping, v) = (
+        &tau[..n],
+        &effort[..n],
+        &mut applied[..n],
+        &damping[..n],
+        &v[..n],
+    );
+    match c {
+        Some(c) => {
+            let c = &c[..n];
+            for k in 0..n {
+                let x = sat(tau[k], effort[k]);
+                applied[k] = x;
+                out[k] = x - damping[k] * v[k] - c[k];
+            }
+        }
+        None => {
+            for k in 0..n {
+                let x = sat(tau[k], effort[k]);
+                applied[k] = x;
+                out[k] = x - damping[k] * v[k];
+            }
+        }
+    }
 }

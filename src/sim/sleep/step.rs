@@ -54,6 +54,22 @@ impl super::super::Simulation {
         // body, not found again from the joint at each use)
         use crate::model::JointModel as _;
         data.v[0] = crate::spatial::Motion::zero();
+        if data.lone_free {
+            // (every body a free body on the world: v̂ᵢ = 0 + ŝᵢ q̇ᵢ, no
+            // parent's velocity and no joint kind to match)
+            for &t in self.sleep.awake_trees() {
+                for i in model.trees[t].bodies.clone() {
+                    let mut vi = crate::spatial::Motion::zero();
+                    crate::model::joint::FreeJ {
+                        j: &model.joints[i],
+                    }
+                    .add_motion(&mut vi, vw);
+                    data.v[i] = vi;
+                }
+            }
+            self.account_sleep(h);
+            return;
+        }
         for &t in self.sleep.awake_trees() {
             let tree = &model.trees[t];
             for i in tree.bodies.clone() {
@@ -104,7 +120,7 @@ impl super::super::Simulation {
         // force and no servo, the common case, none: found by one pass over
         // tau instead of a slice test a tree (`mark_forced`)
         let tau = self.tau_applied.as_slice();
-        if !self.servo.active && !tau.iter().fold(false, |any, &x| any | (x != 0.0)) {
+        if !self.servo.active && !crate::sim::step::any_nonzero(tau) {
             // (the sleeping trees' entries are not read: each is set here
             // again before its tree is counted awake)
             self.sleep_forced.fill(false);
