@@ -418,6 +418,7 @@ impl Rows {
     /// contact's three rows in one pass when all three are nonzero; rows of
     /// other islands touch other dofs). Leaves `x` untouched if the rows are
     /// not well formed (the sweeps' checks).
+    #[inline]
     pub(crate) fn warm_velocity(&self, x: &mut [f64]) {
         let (table, n, st) = (&self.table[..], self.n, self.stride);
         if x.len() < self.nv
@@ -451,6 +452,7 @@ impl Rows {
     /// normal not violated (b_pos = 0), and its normal velocity both free
     /// (cᵣ) and at the warm start's Δv' (`warm`) at least `margin` above
     /// its target.
+    #[inline]
     pub(crate) fn contact_idle(&self, r: usize, warm: &[f64], margin: f64) -> bool {
         let l = &self.lambda[r..r + 3];
         if !(self.c[r] >= self.b[r])
@@ -469,6 +471,7 @@ impl Rows {
     /// yᵣ·x over row `r`'s path, in the path's order (None: the row's path
     /// or y out of range). A row's path holds dof indices < nv ≤ x.len()
     /// (the sweeps' invariant); a short `x` reads 0 past its end.
+    #[inline]
     fn y_dot(&self, r: usize, x: &[f64]) -> Option<f64> {
         let st = self.stride;
         let (ps, pl) = *self.path.get(r)?;
@@ -479,6 +482,7 @@ impl Rows {
     /// The normal of the contact at row `r` holds at λ = 0 to `tol` for the
     /// Δv' `x` (src/sim/islands/split.rs): uₙ = cₙ + yₙ·x ≥ bₙ − tol. A row
     /// no impulse moves (Wᵣᵣ = 0) holds.
+    #[inline]
     pub(crate) fn contact_holds(&self, r: usize, x: &[f64], tol: f64) -> bool {
         if r >= self.n || self.winv[r] == 0.0 {
             return true;
