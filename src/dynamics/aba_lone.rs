@@ -18,8 +18,8 @@ use super::aba::{fvec, inertia_matrix};
 use super::linalg::{ldl6_solve, spd6_factor};
 use super::DynamicsError;
 use crate::model::joint::FreeJ;
-use crate::model::{Data, FdMethod, JointModel, KeptLdl6, Model};
-use crate::spatial::{CompositeInertia, Force, Motion};
+use crate::model::{Data, FdMethod, Joint, JointModel, KeptLdl6, Model};
+use crate::spatial::{CompositeInertia, Force, Inertia, Motion, Se3};
 use nalgebra::Vector3;
 
 /// q̈ by [`super::aba`] (no external forces) on a model with
@@ -48,16 +48,9 @@ pub(crate) fn aba_lone_placed(
     {
         return None;
     }
-    let (Some(joints), Some(inertias), Some(inertias_o)) = (
-        model.joints.get(..nb),
-        model.inertias.get(..nb),
+    let (Some((joints, inertias, li_m_i, vel)), Some(inertias_o), Some(acc), Some(kept)) = (
+        lone_parts(model, &data.li_m_i, &mut data.v),
         model.inertias_origin.get(..nb),
-    ) else {
-        return None;
-    };
-    let (Some(li_m_i), Some(vel), Some(acc), Some(kept)) = (
-        data.li_m_i.get(..nb),
-        data.v.get_mut(..nb),
         data.a.get_mut(..nb),
         data.aba_kept.get_mut(..nb),
     ) else {
@@ -137,4 +130,28 @@ fn same_bits(a: &CompositeInertia<f64>, b: &CompositeInertia<f64>) -> bool {
         }
     }
     same
+}
+
+/// The per-body slices the pass reads (every one `model.nbodies` long): the
+/// joints, the inertias, the joint placements `li_m_i` and the body
+/// velocities `v` it writes; `None` where one is shorter.
+#[allow(clippy::type_complexity)]
+#[inline(always)]
+fn lone_parts<'a>(
+    model: &'a Model<f64>,
+    li_m_i: &'a [Se3<f64>],
+    v: &'a mut [Motion<f64>],
+) -> Option<(
+    &'a [Joint<f64>],
+    &'a [Inertia<f64>],
+    &'a [Se3<f64>],
+    &'a mut [Motion<f64>],
+)> {
+    let nb = model.nbodies;
+    Some((
+        model.joints.get(..nb)?,
+        model.inertias.get(..nb)?,
+        li_m_i.get(..nb)?,
+        v.get_mut(..nb)?,
+    ))
 }
