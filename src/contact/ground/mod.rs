@@ -489,10 +489,7 @@ fn plain_points(
         let (rx, ry, rz) = (r[(2, 0)], r[(2, 1)], r[(2, 2)]);
         let tz = o_m_g.trans.z - ground;
         let height = |v: &Vector3<f64>| rx * v.x + ry * v.y + rz * v.z + tz;
-        let mut candidate = |k: usize| {
-            let p = o_m_g.act_point(&s.verts[k]);
-            scratch.push(s.contact_at(si, base + k, p, ground));
-        };
+        let point = |k: usize| s.contact_at(si, base + k, o_m_g.act_point(&s.verts[k]), ground);
         // a small vertex set: scanned whole (up to a box's 8 vertices, the
         // heights kept for the second pass: the same values)
         let small = s.verts.len() <= SMALL_SET;
@@ -511,6 +508,20 @@ fn plain_points(
         if low > margin {
             return;
         }
+        if small {
+            // no more candidates than `reduce` keeps: they are its output
+            // (all of them, in vertex order), made in place
+            let hs = &hs[..s.verts.len()];
+            if hs.iter().filter(|&&h| h <= margin).count() <= cx.maxp {
+                for (k, &h) in hs.iter().enumerate() {
+                    if h <= margin {
+                        out.push(point(k));
+                    }
+                }
+                return;
+            }
+        }
+        let mut candidate = |k: usize| scratch.push(point(k));
         for (k, v) in s.verts.iter().enumerate() {
             let h = if small { hs[k % SMALL_SET] } else { height(v) };
             if h <= margin {
