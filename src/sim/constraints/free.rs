@@ -56,6 +56,28 @@ pub(super) fn plan(
     (a != b && path.len() == 12 && on(a, ta) && on(b, tb)).then_some(Plan::Pair { a: ta, b: tb })
 }
 
+/// The tangents of the last normal asked for (a pair's points share their
+/// normal: its tangents are made once, not once a point; the same bits).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Frame {
+    /// The normal's bits (none asked yet: `None`).
+    n: Option<[u64; 3]>,
+    t: (Vector3<f64>, Vector3<f64>),
+}
+
+impl Frame {
+    /// [`tangents`] of `n`, kept for a normal of the same bits.
+    #[inline(always)]
+    pub(super) fn tangents(&mut self, n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let bits = [n.x.to_bits(), n.y.to_bits(), n.z.to_bits()];
+        if self.n != Some(bits) {
+            self.n = Some(bits);
+            self.t = tangents(n);
+        }
+        self.t
+    }
+}
+
 /// Writes contact `pt`'s three rows `j` by `plan` (every entry of the path:
 /// the entries' old values are overwritten, none read), `sw` each body's
 /// world columns; `stale`: how many entries of each row the last assembly
@@ -69,14 +91,20 @@ pub(super) fn write(
     stale: usize,
     sw: &[[Motion; 6]],
     pt: &ContactPoint,
+    frame: &mut Frame,
 ) -> bool {
     let [j0, j1, j2] = j;
     let pl = match plan {
         Plan::Ground => 6,
         Plan::Pair { .. } => 12,
     };
-    let done = write_path(plan, [&mut *j0, &mut *j1, &mut *j2], sw, pt);
+    let done = write_path(plan, [&mut *j0, &mut *j1, &mut *j2], sw, pt, frame);
     let from = if done { pl } else { 0 };
+    // (nothing past the path when the last rows were no longer: a pile's
+    // contact on the same bodies or a ground contact after a ground one)
+    if stale <= from {
+        return done;
+    }
     for r in [j0, j1, j2] {
         let end = stale.min(r.len());
         if let Some(x) = r.get_mut(from.min(end)..end) {
@@ -88,7 +116,13 @@ pub(super) fn write(
 
 /// [`write`]'s entries on the path.
 #[inline(always)]
-fn write_path(plan: Plan, j: [&mut [f64]; 3], sw: &[[Motion; 6]], pt: &ContactPoint) -> bool {
+fn write_path(
+    plan: Plan,
+    j: [&mut [f64]; 3],
+    sw: &[[Motion; 6]],
+    pt: &ContactPoint,
+    frame: &mut Frame,
+) -> bool {
     let p = &pt.point;
     match plan {
         Plan::Ground => {
@@ -107,7 +141,7 @@ fn write_path(plan: Plan, j: [&mut [f64]; 3], sw: &[[Motion; 6]], pt: &ContactPo
                 return false;
             }
             // J = J_a − J_b along (n, t₁, t₂), n from b toward a
-            let (n, (t1, t2)) = (pt.normal, tangents(&pt.normal));
+            let (n, (t1, t2)) = (pt.normal, frame.tangents(&pt.normal));
             let axes = [n, t1, t2];
             put([j0, j1, j2], a, sa, p, |i, v, r| {
                 along::<false>(&axes[i], v, r)
@@ -339,5 +373,5 @@ pub(crate) fn free_rows(
     let plan = plan(&heads, &path, 12, &pt)?;
     let mut j = [vec![stale; 12], vec![stale; 12], vec![stale; 12]];
     let [j0, j1, j2] = &mut j;
-    write(plan, [j0, j1, j2], 12, &sw, &pt).then_some(j)
+    write(plan, [j0, j1, j2], 12, &sw, &pt, &mut Frame::default()).then_some(j)
 }

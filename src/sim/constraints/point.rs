@@ -6,10 +6,10 @@
 //! columns and writes only its own three rows, so points may be written in
 //! any order, on any thread, with the same bits.
 
-use super::free::{self, Plan};
+use super::free::{self, Frame, Plan};
 use super::tables::{add_body, BodyHead};
 use super::{common_ancestor, pos_target, speculative, Constraints, RowCounts, RowParams};
-use crate::contact::{tangents, ContactPoint};
+use crate::contact::ContactPoint;
 use crate::model::Model;
 use crate::sim::factor::MassFactor;
 use crate::spatial::{Motion, Se3};
@@ -45,10 +45,11 @@ pub(super) fn write(
     plan: Option<Plan>,
     stale: usize,
     pt: &ContactPoint,
+    frame: &mut Frame,
 ) -> (f64, f64) {
     let at = &pt.point;
     if let Some(plan) = plan
-        && free::write(plan, [&mut *j0, &mut *j1, &mut *j2], stale, x.sw, pt)
+        && free::write(plan, [&mut *j0, &mut *j1, &mut *j2], stale, x.sw, pt, frame)
     {
         // (written whole)
     } else if pt.other == 0 && pt.normal == Vector3::z() {
@@ -69,7 +70,7 @@ pub(super) fn write(
         // entry as zeroed, so each walk stops at the first of them);
         // b's entries are −(n·vp), the values of n·(−vp) but for
         // the sign of a zero, which the sum onto +0 drops
-        let (n, (t1, t2)) = (pt.normal, tangents(&pt.normal));
+        let (n, (t1, t2)) = (pt.normal, frame.tangents(&pt.normal));
         let lca = common_ancestor(x.parent, pt.body, pt.other);
         for (start, neg) in [(pt.body, false), (pt.other, true)] {
             let (mut b, mut hi) = (start, on_path.len());
@@ -132,8 +133,13 @@ impl Constraints {
         // world-frame motion subspace columns of the bodies the points'
         // rows reach (each point's two bodies and their ancestors), once
         // (the columns in the body frame are the joint's constants, kept
-        // from the start: `cols`)
+        // from the start: `cols`); a point on the last one's two bodies
+        // finds them done (a pair's points, a body's ground points, in a row)
+        let mut last = None;
         for pt in points {
+            if last.replace((pt.body, pt.other)) == Some((pt.body, pt.other)) {
+                continue;
+            }
             for start in [pt.body, pt.other] {
                 let mut i = start;
                 while i != 0
@@ -169,6 +175,7 @@ impl Constraints {
             h,
         };
         let rows = &mut self.rows;
+        let mut frame = Frame::default();
         for (pi, (pt, &warm)) in points.iter().zip(&self.warm_points).enumerate() {
             // the body's path to the root: its joint's last dof and every
             // ancestor; against another body, the union with that body's
@@ -205,7 +212,7 @@ impl Constraints {
             let on_path = tab.get(ps..ps + pl).unwrap_or(&[]);
             let (j0, rest) = jall[rn * st..(rn + 3) * st].split_at_mut(st);
             let (j1, j2) = rest.split_at_mut(st);
-            let (bn, bpos) = write(&x, [j0, j1, j2], on_path, plan, stale, pt);
+            let (bn, bpos) = write(&x, [j0, j1, j2], on_path, plan, stale, pt, &mut frame);
             rows.b[rn] = bn;
             rows.bpos[rn] = bpos;
             if bpos > 0.0 {

@@ -199,7 +199,7 @@ impl Constraints {
                 p,
                 h,
             };
-            let mut bad = 0;
+            let (mut bad, mut frame) = (0, super::free::Frame::default());
             loop {
                 let c = next.fetch_add(1, Ordering::Relaxed);
                 if c >= nc {
@@ -264,7 +264,8 @@ impl Constraints {
                     bpos.fill(0.0);
                     path.fill(fx.path);
                     let on_path = on.unwrap_or(&[]);
-                    let (bn, bp) = point::write(&x, [j0, j1, j2], on_path, plan, stale, pt);
+                    let (bn, bp) =
+                        point::write(&x, [j0, j1, j2], on_path, plan, stale, pt, &mut frame);
                     b[0] = bn;
                     bpos[0] = bp;
                     bad += usize::from(bp > 0.0);
