@@ -468,7 +468,10 @@ pub(crate) fn reuse(
     if -n1.dot(&n2) < cos {
         return false;
     }
-    for c in &man.points {
+    // (the gaps the test measures are the new ones: kept, not measured
+    // again, for the first `KEPT`, a box pair's most points)
+    let mut gaps = [0.0; KEPT];
+    for (k, c) in man.points.iter().enumerate() {
         // p₂ in a's frame; its gap along n₁; the foot p₂ − gap·n₁ near p₁
         let p2 = r * from_pvec(c.local_p2) + t;
         let p1 = from_pvec(c.local_p1);
@@ -479,10 +482,19 @@ pub(crate) fn reuse(
         if (p1 - (p2 - n1 * dist)).norm_squared() > slide2 {
             return false;
         }
+        if let Some(g) = gaps.get_mut(k) {
+            *g = dist;
+        }
     }
-    for c in man.points.iter_mut() {
-        let p2 = r * from_pvec(c.local_p2) + t;
-        c.dist = (p2 - from_pvec(c.local_p1)).dot(&n1);
+    for (k, c) in man.points.iter_mut().enumerate() {
+        c.dist = match gaps.get(k) {
+            Some(&g) => g,
+            None => (r * from_pvec(c.local_p2) + t - from_pvec(c.local_p1)).dot(&n1),
+        };
     }
     true
 }
+
+/// The most points [`reuse`] keeps its gaps of (a box pair's clip finds at
+/// most 16: each face's four corners and eight edge crossings).
+const KEPT: usize = 16;
