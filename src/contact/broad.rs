@@ -261,7 +261,10 @@ impl SweepAndPrune {
         // keys, (strip, lower x), gathered in the same pass and sorted with
         // it (the same compares, the same swaps)
         let mut keys = std::mem::take(&mut self.keys);
-        keys.clear();
+        // (written in place, as many as the order holds, then cut)
+        if keys.len() < self.order.len() {
+            keys.resize(self.order.len(), (0, 0.0));
+        }
         // (a NaN lower x: the strips may not be sorted by it)
         let mut nan = false;
         {
@@ -273,12 +276,13 @@ impl SweepAndPrune {
                     (big.get(i).copied(), strip.get(i), lo.get(i))
                 {
                     self.order[kept] = i as u32;
-                    keys.push((s, l[0]));
+                    keys[kept] = (s, l[0]);
                     nan |= l[0].is_nan();
                     kept += 1;
                 }
             }
             self.order.truncate(kept);
+            keys.truncate(kept);
         }
         if self.order.len() + self.wide.len() < n {
             // a shape wide last step and ordinary now (or at the start)

@@ -36,7 +36,6 @@ pub(crate) struct Islands {
     /// contact's three rows, the points of one pair), as (first row, end),
     /// and each group's island root tree (`usize::MAX`: a row on no dof).
     groups: Vec<(usize, usize)>,
-    gkey: Vec<usize>,
     /// Per group: its rows are whole contacts' (found by the grouping).
     triples: Vec<bool>,
     /// Each group's first tree (`usize::MAX`: a row on no dof; [`LEFT`]: a
@@ -99,6 +98,8 @@ pub(crate) struct Islands {
     /// the island whose path reached it in this grouping (`usize::MAX`:
     /// none); scratch of the trees by island, and each island's count.
     tree_v: Vec<(usize, usize)>,
+    /// Each dof's own number (a whole tree's dofs copied from it).
+    iota: Vec<usize>,
     tree_isl: Vec<usize>,
     tree_flag: Vec<u8>,
     tree_buf: Vec<usize>,
@@ -168,7 +169,6 @@ impl Islands {
             tree_of_dof,
             parent: (0..nt).collect(),
             groups: Vec::with_capacity(rows),
-            gkey: Vec::with_capacity(rows),
             triples: Vec::with_capacity(rows),
             gtree: Vec::with_capacity(rows),
             left: Vec::with_capacity(rows),
@@ -195,6 +195,7 @@ impl Islands {
             chain_len: chain_lengths(&model.dof_parent, model.nv),
             last: Vec::with_capacity(rows),
             cached: false,
+            iota: (0..model.nv).collect(),
             tree_isl: vec![usize::MAX; nt],
             tree_flag: vec![0; nt],
             tree_buf: Vec::with_capacity(nt),
@@ -321,19 +322,14 @@ impl Islands {
 
     /// The islands' runs and dofs from the groups' trees and the union-find.
     fn build(&mut self, rows: &Rows) {
-        self.gkey.clear();
-        for g in 0..self.gtree.len() {
-            let a = self.gtree[g];
-            let k = if a < LEFT { self.find(a) } else { a };
-            self.gkey.push(k);
-        }
         // runs of consecutive rows with one key (whole groups, but for the
         // contacts left out), then grouped by key (stable: row order within
-        // an island)
+        // an island); a group's key: its first tree's root
         self.runs.clear();
         let mut cur = (usize::MAX, 0, 0);
         for g in 0..self.groups.len() {
-            let k = self.gkey[g];
+            let a = self.gtree[g];
+            let k = if a < LEFT { self.find(a) } else { a };
             if k == LEFT {
                 continue;
             }
@@ -383,18 +379,30 @@ impl Islands {
         for b in 0..nk {
             self.count[b + 1] += self.count[b];
         }
-        self.sorted.clear();
-        self.sorted.resize(self.runs.len(), (0, 0, 0));
+        // (every entry below the runs' count written: `sorted`'s old ones
+        // not cleared, its tail cut after the swap)
+        let nr = self.runs.len();
+        if self.sorted.len() < nr {
+            self.sorted.resize(nr, (0, 0, 0));
+        }
         for &run in &self.runs {
             let at = &mut self.count[bucket(run.0)];
             self.sorted[*at] = run;
             *at += 1;
         }
         std::mem::swap(&mut self.runs, &mut self.sorted);
+        self.runs.truncate(nr);
         // each island's runs and dofs
         self.islands.clear();
+        // (`iof` is set only at the islands' roots: those cleared, the
+        // roots of islands a join emptied by it, split.rs)
+        for &k in &self.iroot {
+            if let Some(x) = self.iof.get_mut(k) {
+                *x = usize::MAX;
+            }
+        }
+        debug_assert!(self.iof.iter().all(|&x| x == usize::MAX));
         self.iroot.clear();
-        self.iof.fill(usize::MAX);
         self.dofs.clear();
         let table = rows.table();
         let path = &rows.path[..rows.n.min(self.group_at.len())];

@@ -98,8 +98,10 @@ impl Islands {
         for b in 0..n_isl {
             self.tcount[b + 1] += self.tcount[b];
         }
-        self.tree_buf.clear();
-        self.tree_buf.resize(self.tcount[n_isl], 0);
+        // (every entry below the count written: its old ones not cleared)
+        if self.tree_buf.len() < self.tcount[n_isl] {
+            self.tree_buf.resize(self.tcount[n_isl], 0);
+        }
         for (t, &x) in self.tree_isl.iter().enumerate() {
             if x < n_isl {
                 let at = &mut self.tcount[x];
@@ -118,7 +120,11 @@ impl Islands {
                 let (s, e) = self.tree_v[t];
                 let flag = std::mem::take(&mut self.tree_flag[t]);
                 if flag & WHOLE != 0 {
-                    self.dofs.extend(s..e);
+                    // (a free body's six at one copy of known length)
+                    match self.iota.get(s..e).map(<&[usize; 6]>::try_from) {
+                        Some(Ok(six)) => self.dofs.extend_from_slice(six),
+                        _ => self.dofs.extend_from_slice(&self.iota[s..e]),
+                    }
                     if flag & MARKED != 0 {
                         // (its marks, of a path within it, counted as read)
                         for m in &mut self.mark[s..e] {

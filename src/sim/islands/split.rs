@@ -176,6 +176,12 @@ impl Islands {
                         self.dofs.push(d);
                     }
                     self.islands[k] = ((s0, s0), (e0, e0));
+                    // (its root's entry cleared: it may root no island now)
+                    if let Some(x) = self.iof.get_mut(self.iroot[k])
+                        && *x == k
+                    {
+                        *x = usize::MAX;
+                    }
                     self.iroot[k] = LEFT;
                 } else {
                     self.runs.push((root, k, k + 3));
