@@ -46,10 +46,10 @@ impl MassFactor {
     /// plain: there each row's elimination changes no bit (above), and Y =
     /// J·D^-½ entry by entry. None elsewhere (the rows take the steps).
     #[inline(always)]
-    pub(crate) fn zero_scale<const A: usize, const N: usize>(
+    pub(crate) fn zero_scale<const A: usize, const N: usize, const R: usize>(
         &self,
         path: &[usize],
-        rows: &[&[f64; N]; 6],
+        rows: &[&[f64; N]; R],
     ) -> Option<[f64; N]> {
         let path: &[usize; N] = path.get(..N)?.try_into().ok()?;
         let zero = A >= 1 && A <= N && self.zero_chain(path[A - 1]) && self.zero_chain(path[N - 1]);

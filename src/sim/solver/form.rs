@@ -183,6 +183,16 @@ impl Former<'_> {
         if !f.is_tree() || pl > self.lanes.len() || self.j.len() < (r + 3) * st {
             return false;
         }
+        // (L zero on a free body's chain, or two's, and the rows plain: Y =
+        // J·D^-½ straight from J, zero.rs)
+        let zero = match pl {
+            6 => f.is_chain_of::<6>(path) && self.form_zero_three::<6, 6>(f, r, path, vfree),
+            12 => f.two_chains::<6, 6>(path) && self.form_zero_three::<6, 12>(f, r, path, vfree),
+            _ => false,
+        };
+        if zero {
+            return true;
+        }
         // a chain path (one body's: every contact of a robot on the ground)
         // of up to 13 dofs (a humanoid's foot): in registers, no scratch
         let done = match pl {
