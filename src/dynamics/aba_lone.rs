@@ -119,7 +119,7 @@ fn kept_factor<'k>(
 /// and +0 differ, a NaN equals only itself), without an early exit (fixed
 /// bounds, unrolled: no iterator call a body).
 #[inline(always)]
-fn same_bits(a: &CompositeInertia<f64>, b: &CompositeInertia<f64>) -> bool {
+pub(crate) fn same_bits(a: &CompositeInertia<f64>, b: &CompositeInertia<f64>) -> bool {
     let eq = |x: f64, y: f64| x.to_bits() == y.to_bits();
     let (ia, ib) = (&a.io.data.0, &b.io.data.0);
     let mut same = eq(a.m, b.m);

@@ -36,7 +36,7 @@ mod rnea_lone;
 pub use crate::spatial::CompositeInertia;
 pub use aba::aba;
 pub use aba_derivatives::aba_derivatives;
-pub(crate) use aba_lone::aba_lone_placed;
+pub(crate) use aba_lone::{aba_lone_placed, same_bits};
 pub use centroidal::centroidal_momentum;
 pub use com::{center_of_mass, center_of_mass_jacobian, center_of_mass_velocity};
 pub use constraint_dynamics::{

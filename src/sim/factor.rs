@@ -21,8 +21,8 @@ mod unroll;
 mod zeros;
 
 use super::factor_dense::{dense_backward, dense_forward};
-use crate::dynamics::crba_packed;
 use crate::dynamics::linalg::{by_size, cholesky_fast};
+use crate::dynamics::{crba_packed, same_bits};
 use crate::model::{Data, JointKind, Model};
 use crate::spatial::ops::madd;
 use crate::spatial::CompositeInertia;
@@ -301,27 +301,19 @@ impl MassFactor {
     }
 
     /// Whether H̃'s diagonal additions and the bodies' inertias are, bit for
-    /// bit, those of the held factor.
+    /// bit, those of the held factor: each entry's bits xor-ed with the held
+    /// one's, or-ed (zero iff every entry is the same), with no early exit
+    /// (vector lanes, no iterator call an entry; the same verdict).
     fn holds(&self, model: &Model, diag: &impl Fn(usize) -> f64) -> bool {
-        let same = |a: &CompositeInertia<f64>, b: &CompositeInertia<f64>| {
-            a.m.to_bits() == b.m.to_bits()
-                && a.h
-                    .iter()
-                    .zip(b.h.iter())
-                    .all(|(x, y)| x.to_bits() == y.to_bits())
-                && a.io
-                    .iter()
-                    .zip(b.io.iter())
-                    .all(|(x, y)| x.to_bits() == y.to_bits())
-        };
         let inertias = &model.inertias_origin;
-        self.held_diag.len() == self.n
-            && (0..self.n).all(|k| diag(k).to_bits() == self.held_diag[k].to_bits())
-            && inertias.len() == self.held_inertia.len()
-            && inertias
-                .iter()
-                .zip(&self.held_inertia)
-                .all(|(a, b)| same(a, b))
+        if self.held_diag.len() != self.n || inertias.len() != self.held_inertia.len() {
+            return false;
+        }
+        let d = (self.held_diag.iter().enumerate())
+            .fold(0u64, |acc, (k, h)| acc | (diag(k).to_bits() ^ h.to_bits()));
+        let i =
+            (inertias.iter().zip(&self.held_inertia)).fold(true, |s, (a, b)| s & same_bits(a, b));
+        d == 0 && i
     }
 
     /// Records the diagonal additions and inertias of the factor just made.
