@@ -186,8 +186,8 @@ impl Former<'_> {
         // (L zero on a free body's chain, or two's, and the rows plain: Y =
         // J·D^-½ straight from J, zero.rs)
         let zero = match pl {
-            6 => f.is_chain_of::<6>(path) && self.form_zero_three::<6, 6>(f, r, path, vfree),
-            12 => f.two_chains::<6, 6>(path) && self.form_zero_three::<6, 12>(f, r, path, vfree),
+            6 => f.is_chain_of::<6>(path) && self.form_zero::<6, 6, 3>(f, r, path, vfree),
+            12 => f.two_chains::<6, 6>(path) && self.form_zero::<6, 12, 3>(f, r, path, vfree),
             _ => false,
         };
         if zero {
@@ -359,7 +359,7 @@ impl Former<'_> {
             return false;
         }
         // (L zero on both chains and the rows plain: Y = J·D^-½, zero.rs)
-        if self.form_zero_pair::<6, N>(f, r, path, vfree) {
+        if self.form_zero::<6, N, 6>(f, r, path, vfree) {
             return true;
         }
         if SIX {
@@ -412,7 +412,7 @@ impl Former<'_> {
         // each sum in path order from −0, as store_block's
         let (mut d, mut o) = ([-0.0f64; 6], [-0.0f64; 6]);
         for bt in b {
-            add_w_six(&mut d, &mut o, bt);
+            add_w(&mut d, &mut o, bt);
         }
         for (k, q) in [(0, r), (3, r + 3)] {
             let y = &mut self.y[q * st..(q + 3) * st];
@@ -519,20 +519,18 @@ fn contact_at(kind: &[RowKind], path: &[(usize, usize)], end: usize, r: usize) -
 /// each; with AVX the two blocks' [f64; 4] are two registers a slot either way).
 const SIX: bool = cfg!(not(target_feature = "avx"));
 
-/// One path slot's transformed six rows `bt` added to W's diagonal `d`
-/// (d_i += y_i²) and the two blocks' off-diagonal entries `o` (y₀y₁, y₀y₂,
-/// y₁y₂ and y₃y₄, y₃y₅, y₄y₅): the sums' next terms, in path order.
+/// One path slot's transformed rows `bt` (one contact's three, `R` = 3, or
+/// two contacts' six, `R` = 6) added to W's diagonal `d` (d_i += y_i²) and
+/// each block's off-diagonal entries `o` (y₀y₁, y₀y₂, y₁y₂ and y₃y₄, y₃y₅,
+/// y₄y₅): the sums' next terms, in path order.
 #[inline(always)]
-fn add_w_six(d: &mut [f64; 6], o: &mut [f64; 6], bt: &[f64; 6]) {
-    let q = [
-        bt[0] * bt[1],
-        bt[0] * bt[2],
-        bt[1] * bt[2],
-        bt[3] * bt[4],
-        bt[3] * bt[5],
-        bt[4] * bt[5],
-    ];
-    for i in 0..6 {
+fn add_w<const R: usize>(d: &mut [f64; R], o: &mut [f64; R], bt: &[f64; R]) {
+    let mut q = [0.0f64; R];
+    for k in 0..R / 3 {
+        let k = 3 * k;
+        (q[k], q[k + 1], q[k + 2]) = (bt[k] * bt[k + 1], bt[k] * bt[k + 2], bt[k + 1] * bt[k + 2]);
+    }
+    for i in 0..R {
         d[i] += bt[i] * bt[i];
         o[i] += q[i];
     }
