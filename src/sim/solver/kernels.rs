@@ -447,69 +447,6 @@ fn path3_run<S: Sum3, D: Dofs>(a: [f64; 3], ys: [&[f64]; 3], p: D, x: &mut [f64]
     }
 }
 
-/// `s0` + Σₜ yₜ x[pₜ] over a row's path `p` (`y` its row; a sum in path
-/// order, the scalar loop `u += y x` from `u = s0`), at a fixed length of 6
-/// or 12 as [`axpy1`]; the indices of `p` must be < `x.len()`.
-#[inline(always)]
-pub(super) fn dot1_from(s0: f64, y: &[f64], p: &[usize], x: &[f64]) -> f64 {
-    at_path_len!(p.len().min(y.len()); y, p => dot1_run(s0, y, p, x))
-}
-
-/// [`dot1_from`]'s loop (over the shorter of `y` and `p`).
-#[inline(always)]
-fn dot1_run(s0: f64, y: &[f64], p: &[usize], x: &[f64]) -> f64 {
-    debug_assert!(p.iter().all(|&k| k < x.len()));
-    let mut u = s0;
-    for (&yt, &k) in y.iter().zip(p) {
-        // SAFETY: k < x.len() (the sweeps' check of the paths)
-        u += yt * unsafe { *x.get_unchecked(k) };
-    }
-    u
-}
-
-/// x[pₜ] += a yₜ over a row's path `p` (`y` its row, at least `p.len()`
-/// long; each entry one product and one sum, the scalar loop's), a free
-/// body's path (6 dofs) and two free bodies' (12) at that fixed length,
-/// unrolled whole; the indices of `p` must be < `x.len()` (a row's path:
-/// dof indices < nv).
-#[inline(always)]
-pub(super) fn axpy1(a: f64, y: &[f64], p: &[usize], x: &mut [f64]) {
-    at_path_len!(p.len().min(y.len()); y, p => axpy1_run(a, y, p, x))
-}
-
-/// [`axpy1`]'s loop (over the shorter of `y` and `p`).
-#[inline(always)]
-fn axpy1_run(a: f64, y: &[f64], p: &[usize], x: &mut [f64]) {
-    debug_assert!(p.iter().all(|&k| k < x.len()));
-    for (&yt, &k) in y.iter().zip(p) {
-        // SAFETY: k < x.len() (the sweeps' check of the paths)
-        unsafe { *x.get_unchecked_mut(k) += a * yt };
-    }
-}
-
-/// x[pₜ] = (x[pₜ] + a₀ y₀ₜ) + a₁ y₁ₜ over a tangent pair's path `p` (its
-/// two rows of y, each at least `p.len()` long: the row-by-row order), at
-/// a fixed length of 6 or 12 as [`axpy1`]; the indices of `p` must be
-/// < `x.len()`.
-#[inline(always)]
-pub(super) fn axpy2(a: [f64; 2], y0: &[f64], y1: &[f64], p: &[usize], x: &mut [f64]) {
-    let n = p.len().min(y0.len()).min(y1.len());
-    at_path_len!(n; y0, y1, p => axpy2_run(a, y0, y1, p, x))
-}
-
-/// [`axpy2`]'s loop (over the shortest of `y0`, `y1` and `p`).
-#[inline(always)]
-fn axpy2_run(a: [f64; 2], y0: &[f64], y1: &[f64], p: &[usize], x: &mut [f64]) {
-    debug_assert!(p.iter().all(|&k| k < x.len()));
-    for ((&u, &v), &k) in y0.iter().zip(y1).zip(p) {
-        // SAFETY: k < x.len() (the sweeps' check of the paths)
-        unsafe {
-            let xk = x.get_unchecked_mut(k);
-            *xk = (*xk + a[0] * u) + a[1] * v;
-        }
-    }
-}
-
 /// Below how much of its slack a pinned row is taken to be held, relative
 /// to 1 + |u|: room for the rounding of u and of Δv' (about 1e-15 of them).
 const PIN_MARGIN: f64 = 1e-9;

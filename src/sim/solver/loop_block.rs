@@ -244,6 +244,14 @@ impl LoopBlock {
         self.m > 0
     }
 
+    /// No block: what [`LoopBlock::prepare`] leaves on rows without a loop
+    /// row of nonzero diagonal (false).
+    pub(super) fn clear(&mut self) -> bool {
+        self.m = 0;
+        self.rows.clear();
+        false
+    }
+
     /// Collects the bilateral rows of `runs` whose diagonal is not zero and
     /// factors their W_bb = Y_b Y_bᵀ (L D Lᵀ, dependent rows dropped). No
     /// block (the sweeps take the rows one by one) when there are none or

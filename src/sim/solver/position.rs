@@ -2,24 +2,31 @@
 
 use super::kernels::{Dofs, Path, Runs};
 use super::loop_block::BlockRows;
+use super::subspace::runs::{add, dot_from};
 use super::{MassFactor, RowKind, Rows};
 use crate::contact::ContactPoint;
 
-/// A row the position pass updates: its index, where its path's dofs lie
-/// (checked to lie in the table), its path's length, and whether it is a
-/// loop row (bilateral: μ free).
+/// A row the position pass updates, with what its sweeps read of it: where
+/// its path's dofs lie (checked to lie in the table) and its length, where
+/// its y starts (checked to lie in `y`), Wᵣᵣ and b_posᵣ, its μᵣ through the
+/// sweeps (written back by row index at the pass's end), its index, and
+/// whether it is a loop row (bilateral: μ free).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct PosRow {
-    r: usize,
     at: At,
     pl: usize,
+    y0: usize,
+    wrr: f64,
+    b: f64,
+    mu: f64,
+    r: usize,
     bilateral: bool,
 }
 
 /// Where a [`PosRow`]'s path lies in w' ([`Path::of`] kept by value): one
-/// run of six consecutive dofs from the first, two such runs (a free
-/// body's path, two free bodies': the piles' rows), or the table's entries
-/// from this start (gathered).
+/// run of six consecutive dofs from the first, two such runs (a free body's
+/// path, two free bodies': the piles' rows), or the table's entries from
+/// this start (gathered).
 #[derive(Clone, Copy, Debug)]
 enum At {
     One(usize),
@@ -103,55 +110,43 @@ impl Rows {
         for &(_, s, e) in runs {
             self.mu[s..e].iter_mut().for_each(|x| *x = 0.0);
         }
-        // the loop rows as one exact block after each sweep (loop_block.rs):
-        // J_b w = b_pos,b to rounding at the pass's end
-        let view = BlockRows {
-            st,
-            y: &self.y,
-            paths: &self.path[..self.n],
-            table,
-        };
-        let block = self
-            .sm
-            .loops
-            .prepare(&view, runs, &self.kind[..self.n], &self.w[..self.n]);
-        // SAFETY (unchecked reads of dw below): every path lies in `table`
-        // (checked here) and holds dof indices < nv (the factor's table and
-        // its unions, as the velocity sweeps rely on, pgs.rs)
         let n = self.n;
-        if runs.iter().any(|&(_, s, e)| {
-            e > n
-                || self.path[s..e]
-                    .iter()
-                    .any(|&(s, l)| s + l > table.len() || l > st)
-        }) {
-            return 0;
-        }
-        debug_assert!(table.iter().all(|&k| k < nv), "a dof path beyond nv");
         // the rows read-only and μ apart (no reload of the rows' fields after
         // each write of μ)
         let (kinds, w, paths) = (&self.kind[..n], &self.w[..n], &self.path[..n]);
         let (y, bpos) = (&self.y[..], &self.bpos[..n]);
+        let view = BlockRows {
+            st,
+            y,
+            paths,
+            table,
+        };
         // the rows a sweep updates, listed once in sweep order: the contact
-        // normals and joint limits (and the loop rows when not one block)
-        // with a diagonal W above 1e-14 and their path and y in range (the
-        // rows every sweep skipped are left out of the sweeps)
+        // normals and joint limits and the loop rows (left out below when
+        // they are one block) with a diagonal W above 1e-14 and their path
+        // and y in range (the rows every sweep skipped are left out of the
+        // sweeps); and whether every path lies in `table` within a row's
+        // room, which the unchecked reads of dw below rely on
         let mut list = std::mem::take(&mut self.pos_rows);
         list.clear();
-        for &(_, s, e) in runs {
+        let (mut inside, mut loop_rows) = (true, false);
+        'rows: for &(_, s, e) in runs {
             for r in s..e {
+                let (ps, pl) = paths[r];
+                if ps + pl > table.len() || pl > st {
+                    inside = false;
+                    break 'rows;
+                }
                 let kind = kinds[r];
                 let bilateral = kind == RowKind::Bilateral;
-                if bilateral && block {
-                    continue;
-                }
                 if !bilateral && !matches!(kind, RowKind::Normal | RowKind::Unilateral) {
                     continue;
                 }
                 if !(w[r] > 1e-14) {
                     continue;
                 }
-                let (ps, pl) = paths[r];
+                // (a loop row LoopBlock::prepare collects)
+                loop_rows |= bilateral;
                 if table.get(ps..ps + pl).is_none() || y.get(r * st..r * st + pl).is_none() {
                     continue;
                 }
@@ -162,71 +157,78 @@ impl Rows {
                     Path::Any(_) => At::Table(ps),
                 };
                 list.push(PosRow {
-                    r,
                     at,
                     pl,
+                    y0: r * st,
+                    wrr: w[r],
+                    b: bpos[r],
+                    mu: 0.0,
+                    r,
                     bilateral,
                 });
             }
         }
-        let mu = &mut self.mu[..n];
+        // the loop rows as one exact block after each sweep (loop_block.rs):
+        // J_b w = b_pos,b to rounding at the pass's end (without loop rows
+        // none: what prepare would find)
+        let loops = &mut self.sm.loops;
+        let block = match loop_rows || !inside {
+            true => loops.prepare(&view, runs, kinds, w),
+            false => loops.clear(),
+        };
+        // SAFETY (unchecked reads of dw below): every path lies in `table`
+        // (checked above) and holds dof indices < nv (the factor's table and
+        // its unions, as the velocity sweeps rely on, pgs.rs)
+        if !inside {
+            self.pos_rows = list;
+            return 0;
+        }
+        debug_assert!(table.iter().all(|&k| k < nv), "a dof path beyond nv");
+        if block {
+            list.retain(|p| !p.bilateral);
+        }
         // the warm start: μ of the unilateral rows from the last pass (by
         // contact slot and joint limit), w' = Σ μᵣ yᵣ; from there the same
         // sweeps to the same complementarity conditions
         if let Some(warm) = warm {
-            for &PosRow {
-                r,
-                at,
-                pl,
-                bilateral,
-            } in &list
-            {
+            for row in list.iter_mut() {
+                let PosRow {
+                    at,
+                    pl,
+                    y0,
+                    r,
+                    bilateral,
+                    ..
+                } = *row;
                 let m = warm.get(r).copied().unwrap_or(0.0);
                 if bilateral || !(m > 0.0) {
                     continue;
                 }
-                mu[r] = m;
+                row.mu = m;
                 // w' += μᵣ yᵣ
                 // SAFETY: as in the sweeps below (checked when listed)
                 unsafe {
-                    let yr = y.get_unchecked(r * st..r * st + pl);
-                    on_path!(at, pl, yr, table; yr, p, n => path_add(yr, p, n, m, dw))
+                    let yr = y.get_unchecked(y0..y0 + pl);
+                    on_path!(at, pl, yr, table; yr, p, n => add(m, yr, p, n, dw))
                 };
             }
         }
-        let loops = &mut self.sm.loops;
+        let mu = &mut self.mu[..n];
+        let free = !block && list.iter().any(|p| p.bilateral);
         let mut it = 0;
         while it < max_iter {
             it += 1;
-            let mut change: f64 = 0.0;
-            for &PosRow {
-                r,
-                at,
-                pl,
-                bilateral,
-            } in &list
-            {
-                let (wrr, b) = (w[r], bpos[r]);
-                let mur = &mut mu[r];
-                // SAFETY: the row's path and y were checked to lie in
-                // `table` and `y` when listed (neither changes in the pass);
-                // the path's dofs are < nv = dw.len() (the factor's table
-                // and its unions, as above)
-                let d = unsafe {
-                    let yr = y.get_unchecked(r * st..r * st + pl);
-                    on_path!(at, pl, yr, table; yr, p, n => project(yr, p, n, dw, mur, b, wrr, bilateral))
-                };
-                if d != 0.0 {
-                    change = change.max((d * wrr).abs());
+            // SAFETY: each row's path and y were checked to lie in `table`
+            // and `y` when listed (neither changes in the pass); the paths'
+            // dofs are < nv = dw.len() (the factor's table and its unions)
+            let mut change = unsafe {
+                match free {
+                    true => sweep::<true>(&mut list, y, table, dw),
+                    false => sweep::<false>(&mut list, y, table, dw),
                 }
-            }
+            };
             if block {
-                let view = BlockRows {
-                    st,
-                    y,
-                    paths,
-                    table,
-                };
+                // (the block's rows are not listed: their μ is `mu`'s)
                 let moved = loops.solve(&view, None, bpos, mu, dw);
                 change = change.max(moved);
             }
@@ -234,9 +236,55 @@ impl Rows {
                 break;
             }
         }
+        for p in &list {
+            mu[p.r] = p.mu;
+        }
         self.pos_rows = list;
         it
     }
+}
+
+/// One sweep of the position pass over `list` (in order): each row's
+/// [`project`] with its μ kept in its entry; returns the largest |Δμᵣ| Wᵣᵣ
+/// of the rows that moved (0 if none; as `change.max(x)` over them, a NaN
+/// never taken). `BILATERAL`: some row is a loop row (else every μ is
+/// clamped at 0 without the test).
+///
+/// # Safety
+/// Each row's y (`y0..y0 + pl`) lies in `y` and its path in `table` (an
+/// `At::Table` path at `ps..ps + pl`); every dof of a path is < `dw.len()`.
+#[inline(always)]
+unsafe fn sweep<const BILATERAL: bool>(
+    list: &mut [PosRow],
+    y: &[f64],
+    table: &[usize],
+    dw: &mut [f64],
+) -> f64 {
+    let mut change: f64 = 0.0;
+    for row in list.iter_mut() {
+        let PosRow {
+            at,
+            pl,
+            y0,
+            wrr,
+            b,
+            bilateral,
+            ..
+        } = *row;
+        let bilateral = BILATERAL && bilateral;
+        let mur = &mut row.mu;
+        // SAFETY: the caller's
+        let d = unsafe {
+            let yr = y.get_unchecked(y0..y0 + pl);
+            on_path!(at, pl, yr, table; yr, p, n => project(yr, p, n, dw, mur, b, wrr, bilateral))
+        };
+        // (|d Wᵣᵣ| > change is false for d = 0 and for a NaN)
+        let x = (d * wrr).abs();
+        if x > change {
+            change = x;
+        }
+    }
+    change
 }
 
 /// `$run` with `$yr` a row's y (`$y`, at least `$pl` long) and `$p` its
@@ -287,11 +335,8 @@ unsafe fn project<D: Dofs>(
     wrr: f64,
     bilateral: bool,
 ) -> f64 {
-    let mut u = -0.0;
-    for j in 0..n {
-        // SAFETY: the caller's
-        u += yr[j] * unsafe { *x.get_unchecked(p.at(j)) };
-    }
+    // SAFETY: the caller's
+    let u = unsafe { dot_from(-0.0, yr, p, n, x) };
     let old = *mu;
     let z = old - (u - b) / wrr;
     let new = if bilateral { z } else { z.max(0.0) };
@@ -299,21 +344,9 @@ unsafe fn project<D: Dofs>(
     if d != 0.0 {
         *mu = new;
         // SAFETY: the caller's
-        unsafe { path_add(yr, p, n, d, x) };
+        unsafe { add(d, yr, p, n, x) };
     }
     d
-}
-
-/// x += d yᵣ over a row's path `p` (`n` slots, in path order).
-///
-/// # Safety
-/// `yr` and `p` hold `n` entries; every dof of `p` is < `x.len()`.
-#[inline(always)]
-unsafe fn path_add<D: Dofs>(yr: &[f64], p: D, n: usize, d: f64, x: &mut [f64]) {
-    for j in 0..n {
-        // SAFETY: the caller's
-        unsafe { *x.get_unchecked_mut(p.at(j)) += d * yr[j] };
-    }
 }
 
 /// The position pass's warm start (μ of the last pass): the contact

@@ -3,10 +3,12 @@
 
 use super::dense::{ldlt_dropping, ldlt_dropping_solve};
 use super::dot3::dot3_from;
-use super::kernels::{axpy1, axpy2, dot1_from};
 use super::loop_block::LoopBlock;
 use super::wff::OwnBlocks;
 use super::{RowKind, SUBSPACE_MAX};
+use runs::by_runs;
+
+pub(super) mod runs;
 
 /// Preallocated scratch of [`subspace_step`]: the free rows, their dense
 /// Delassus block and right-hand side, their Y rows scattered to full width.
@@ -165,29 +167,35 @@ pub(super) fn subspace_step(
     fn passed(lambda: &[f64], normal: bool, r: usize, e: usize) -> bool {
         !normal && r + 3 <= e && lambda[r + 1] == 0.0 && lambda[r + 2] == 0.0
     }
-    // F: the free rows
-    sm.rows.clear();
+    // F: the free rows (`free`, and `sliding` as a slice: no reload of
+    // either after the other's writes)
+    let (free, sliding) = (&mut sm.rows, &mut sm.sliding[..]);
+    free.clear();
     for &(_, s, e) in runs {
         let mut r = s;
         while r < e {
             let live = |q: usize| winv[q] != 0.0;
             if contact[r] {
+                // (its three rows' λ and 1 / W, each read once: lambda[r + 2]
+                // is read on every path through here)
+                let (l, wi) = (&lambda[r..r + 3], &winv[r..r + 3]);
                 let mu = match kinds[r + 1] {
                     RowKind::Tangent { mu, .. } => mu,
                     _ => 0.0,
                 };
-                let normal = lambda[r] > 0.0 && live(r);
+                let normal = l[0] > 0.0 && wi[0] != 0.0;
+                let slides = &mut sliding[r + 1];
                 // (not needed where the walk below passes the contact by)
                 if !passed(lambda, normal, r, e) {
-                    sm.sliding[r + 1] = !inside(lambda[r + 1], lambda[r + 2], lambda[r], mu);
+                    *slides = !inside(l[1], l[2], l[0], mu);
                 }
                 if normal {
-                    sm.rows.push(r);
-                    if !sm.sliding[r + 1] && live(r + 1) && live(r + 2) {
-                        sm.rows.push(r + 1);
-                        sm.rows.push(r + 2);
+                    free.push(r);
+                    if !*slides && wi[1] != 0.0 && wi[2] != 0.0 {
+                        free.push(r + 1);
+                        free.push(r + 2);
                     }
-                    if sm.rows.len() > SUBSPACE_MAX {
+                    if free.len() > SUBSPACE_MAX {
                         return false;
                     }
                 }
@@ -197,13 +205,13 @@ pub(super) fn subspace_step(
             match kinds[r] {
                 RowKind::Tangent { normal, mu } if r + 1 < e => {
                     let ln = lambda.get(normal).copied().unwrap_or(0.0);
-                    sm.sliding[r] = !inside(lambda[r], lambda[r + 1], ln, mu);
-                    if ln > 0.0 && !sm.sliding[r] && live(r) {
-                        sm.rows.push(r);
+                    sliding[r] = !inside(lambda[r], lambda[r + 1], ln, mu);
+                    if ln > 0.0 && !sliding[r] && live(r) {
+                        free.push(r);
                         // a one-row cone (torsion: its partner row is empty,
                         // sim/constraints/spin.rs) is free on its own row
                         if live(r + 1) {
-                            sm.rows.push(r + 1);
+                            free.push(r + 1);
                         }
                     }
                     r += 2;
@@ -212,22 +220,22 @@ pub(super) fn subspace_step(
                 RowKind::Tangent2 | RowKind::Tangent { .. } => {}
                 RowKind::Normal | RowKind::Unilateral => {
                     if lambda[r] > 0.0 && live(r) {
-                        sm.rows.push(r);
+                        free.push(r);
                     }
                 }
                 RowKind::Box { limit } => {
                     if lambda[r].abs() < limit * (1.0 - 1e-9) && live(r) {
-                        sm.rows.push(r);
+                        free.push(r);
                     }
                 }
                 RowKind::Bilateral => {
                     if live(r) {
-                        sm.rows.push(r);
+                        free.push(r);
                     }
                 }
             }
             r += 1;
-            if sm.rows.len() > SUBSPACE_MAX {
+            if free.len() > SUBSPACE_MAX {
                 return false;
             }
         }
@@ -267,8 +275,9 @@ pub(super) fn subspace_step(
             a += 3;
             continue;
         }
-        // (a path's dofs are < nv ≤ dv.len(): checked above)
-        let u = dot1_from(c[r], yr(0), pa, dv);
+        // SAFETY: a path's dofs are < nv ≤ dv.len() (checked above)
+        let (y0, s0) = (yr(0), c[r]);
+        let u = by_runs!(pa; y0; q, l => unsafe { runs::dot_from(s0, y0, q, l, dv) });
         sm.rhs[a] = target(r) - u;
         a += 1;
     }
@@ -319,12 +328,15 @@ pub(super) fn subspace_step(
     // normals and limits ≥ 0, friction in its box; then the tangent pairs, a
     // sticking pair into the cone of its new normal, a sliding one (held in
     // the solve) along its direction onto that cone's boundary, μλₙ
-    // Δv' += d yᵣ over row r's path
-    // (a path's dofs are < nv ≤ dv.len(): the sweeps' check)
+    // Δv' += d yᵣ over row r's path (`yr` as long as `p`)
+    //
+    // # Safety
+    // Every dof of `p` is < `dv.len()`.
     #[inline(always)]
-    fn add(p: &[usize], yr: &[f64], d: f64, dv: &mut [f64]) {
+    unsafe fn add(p: &[usize], yr: &[f64], d: f64, dv: &mut [f64]) {
         if d != 0.0 {
-            axpy1(d, yr, p, dv);
+            // SAFETY: the caller's
+            by_runs!(p; yr; q, n => unsafe { runs::add(d, yr, q, n, dv) });
         }
     }
     let yrow = |r: usize, l: usize| &y[r * st..r * st + l];
@@ -338,7 +350,9 @@ pub(super) fn subspace_step(
         let d = x - lambda[r];
         lambda[r] = x;
         let p = path(r);
-        add(p, yrow(r, p.len()), d, dv);
+        // SAFETY: a path's dofs are < nv ≤ dv.len() (checked above; the
+        // sweeps' check of the paths)
+        unsafe { add(p, yrow(r, p.len()), d, dv) };
     }
     // the free rows are a subsequence of this walk's rows (the scan above
     // took them in this order, each once): a cursor finds a row's place
@@ -400,12 +414,16 @@ pub(super) fn subspace_step(
                 if d1 != 0.0 && d2 != 0.0 && paths[r + 1] == paths[r] {
                     // the pair on one path (a contact's) in one pass: each entry
                     // (x + d₁y₁) + d₂y₂, the row-by-row order
-                    // (a path's dofs are < nv ≤ dv.len(): the sweeps' check)
-                    axpy2([d1, d2], yrow(r, p.len()), yrow(r + 1, p.len()), p, dv);
+                    let (y0, y1) = (yrow(r, p.len()), yrow(r + 1, p.len()));
+                    // SAFETY: a path's dofs are < nv ≤ dv.len() (as above)
+                    by_runs!(p; y0, y1; q, l => unsafe { runs::add2([d1, d2], y0, y1, q, l, dv) });
                 } else {
-                    add(p, yrow(r, p.len()), d1, dv);
                     let p2 = path(r + 1);
-                    add(p2, yrow(r + 1, p2.len()), d2, dv);
+                    // SAFETY: as above
+                    unsafe {
+                        add(p, yrow(r, p.len()), d1, dv);
+                        add(p2, yrow(r + 1, p2.len()), d2, dv);
+                    }
                 }
             }
             // (a contact's last row the last row: the row-by-row walk
