@@ -408,15 +408,20 @@ impl PosWarm {
         joint_rows: &[(usize, u8)],
         warm_joint: &[[f64; 5]],
     ) -> &[f64] {
-        self.start.clear();
-        self.start.resize(n, 0.0);
-        for (c, &pi) in row_point.iter().enumerate() {
-            if let (Some(pt), Some(x)) = (points.get(pi), self.start.get_mut(3 * c))
-                && !pt.fresh
-            {
-                *x = self.decay * warm_contact.get(pt.slot).map_or(0.0, |w| w[3]);
-            }
+        // the contacts' rows (3c, 3c + 1, 3c + 2 of contact c < n / 3) in one
+        // pass, each (μ of its normal, 0, 0), then the other rows 0: no fill
+        // of zeros written over
+        let (start, decay) = (&mut self.start, self.decay);
+        start.clear();
+        start.reserve(n);
+        for &pi in row_point.iter().take(n.div_ceil(3)) {
+            let mu = match points.get(pi) {
+                Some(pt) if !pt.fresh => decay * warm_contact.get(pt.slot).map_or(0.0, |w| w[3]),
+                _ => 0.0,
+            };
+            start.extend_from_slice(&[mu, 0.0, 0.0]);
         }
+        start.resize(n, 0.0);
         for (k, &(d, which)) in joint_rows.iter().enumerate() {
             if let (Some(w), Some(x)) = (warm_joint.get(d), self.start.get_mut(first_joint + k)) {
                 *x = if which > 0 {

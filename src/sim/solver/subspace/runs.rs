@@ -62,7 +62,13 @@ pub(in crate::sim::solver) unsafe fn dot_from<D: Dofs>(
 /// # Safety
 /// `y` and `p` hold `n` entries; every dof of `p` is < `x.len()`.
 #[inline(always)]
-pub(in crate::sim::solver) unsafe fn add<D: Dofs>(a: f64, y: &[f64], p: D, n: usize, x: &mut [f64]) {
+pub(in crate::sim::solver) unsafe fn add<D: Dofs>(
+    a: f64,
+    y: &[f64],
+    p: D,
+    n: usize,
+    x: &mut [f64],
+) {
     // SAFETY: the caller's
     debug_assert!((0..n).all(|j| unsafe { p.at(j) } < x.len()));
     for j in 0..n {
