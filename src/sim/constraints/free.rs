@@ -31,13 +31,28 @@ pub(super) enum Plan {
 
 /// The plan of contact `pt` on `path` (its dofs, ascending; at most
 /// `stride` of them), or `None` where its bodies are not root free bodies
-/// whose dofs make up the path back to back (the general walk then).
+/// whose dofs make up the path back to back (the general walk then):
+/// [`plan_bodies`] of its bodies, a ground contact's only along +z.
 #[inline]
 pub(super) fn plan(
     heads: &[BodyHead],
     path: &[usize],
     stride: usize,
     pt: &ContactPoint,
+) -> Option<Plan> {
+    plan_bodies(heads, path, stride, pt.body, pt.other).filter(|p| p.holds(pt))
+}
+
+/// [`plan`] of every contact between bodies `a` and `other` (0: the
+/// ground) on `path` but for the normal, which [`Plan::holds`] tests: a
+/// pair's points share their bodies and path, so their plan is made once.
+#[inline]
+pub(super) fn plan_bodies(
+    heads: &[BodyHead],
+    path: &[usize],
+    stride: usize,
+    a: usize,
+    other: usize,
 ) -> Option<Plan> {
     if path.len() > stride {
         return None;
@@ -47,13 +62,25 @@ pub(super) fn plan(
             h.free && path.get(t) == Some(&h.iv) && path.get(t + 5) == Some(&(h.iv + 5))
         })
     };
-    let (a, b) = (pt.body, pt.other);
+    let b = other;
     if b == 0 {
-        return (pt.normal == Vector3::z() && path.len() == 6 && on(a, 0)).then_some(Plan::Ground);
+        return (path.len() == 6 && on(a, 0)).then_some(Plan::Ground);
     }
     let (ha, hb) = (heads.get(a)?, heads.get(b)?);
     let (ta, tb) = if ha.iv < hb.iv { (0, 6) } else { (6, 0) };
     (a != b && path.len() == 12 && on(a, ta) && on(b, tb)).then_some(Plan::Pair { a: ta, b: tb })
+}
+
+impl Plan {
+    /// Whether the plan of `pt`'s bodies holds for `pt`: a ground contact's
+    /// rows are written by components only along n = +z.
+    #[inline(always)]
+    pub(super) fn holds(self, pt: &ContactPoint) -> bool {
+        match self {
+            Plan::Ground => pt.normal == Vector3::z(),
+            Plan::Pair { .. } => true,
+        }
+    }
 }
 
 /// The tangents of the last normal asked for (a pair's points share their

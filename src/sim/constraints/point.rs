@@ -176,22 +176,32 @@ impl Constraints {
         };
         let rows = &mut self.rows;
         let mut frame = Frame::default();
+        // the points by runs on the same two bodies (a pair's points, a
+        // body's ground points): a run's path and plan are its bodies', made
+        // once (`union_path` would find the run's union as its last one)
+        let mut run = (usize::MAX, usize::MAX);
+        let mut path = (0, 0);
+        let mut bodies_plan = None;
         for (pi, (pt, &warm)) in points.iter().zip(&self.warm_points).enumerate() {
-            // the body's path to the root: its joint's last dof and every
-            // ancestor; against another body, the union with that body's
-            let path = if pt.other == 0 {
-                body_path(pt.body)
-            } else {
-                rows.union_path(body_path(pt.body), body_path(pt.other))
-            };
+            if run != (pt.body, pt.other) {
+                run = (pt.body, pt.other);
+                // the body's path to the root: its joint's last dof and every
+                // ancestor; against another body, the union with that body's
+                path = if pt.other == 0 {
+                    body_path(pt.body)
+                } else {
+                    rows.union_path(body_path(pt.body), body_path(pt.other))
+                };
+                let (ps, pl) = path;
+                bodies_plan = (rows.table().get(ps..ps + pl)).and_then(|on| {
+                    free::plan_bodies(&self.heads, on, rows.stride, pt.body, pt.other)
+                });
+            }
             // root free bodies' rows are written whole ([`free`]): of the
             // last assembly's entries there, only those past the path are
             // zeroed (its length `stale`); any other's are zeroed first
             let (ps, pl) = path;
-            let plan = rows
-                .table()
-                .get(ps..ps + pl)
-                .and_then(|on| free::plan(&self.heads, on, rows.stride, pt));
+            let plan = bodies_plan.filter(|p| p.holds(pt));
             let stale = match rows.path.get(rows.n) {
                 Some(&(_, l)) if rows.n + 3 <= keep => l,
                 _ => 0,
