@@ -535,13 +535,23 @@ fn plain_points(
     // directly (a sphere's and a capsule's lowest points, a cylinder's
     // lowest rim points, where its lowest point always lies, and its
     // rim samples); none within the margin, no contact
+    let down = Vector3::new(0.0, 0.0, -1.0);
+    if let Manifold::Sphere(r) = s.manifold
+        && cx.maxp >= 1
+    {
+        // one candidate: `reduce`'s output as it stands, made in place
+        let p = o_m_g.trans + down * r;
+        if p.z - ground <= margin {
+            out.push(s.contact_at(si, base, p, ground));
+        }
+        return;
+    }
     let mut push = |slot: usize, p: Vector3<f64>| {
         let gap = p.z - ground;
         if gap <= margin {
             scratch.push(s.contact_at(si, base + slot, p, ground));
         }
     };
-    let down = Vector3::new(0.0, 0.0, -1.0);
     match s.manifold {
         Manifold::Vertices => {
             for (k, v) in s.verts.iter().enumerate() {
