@@ -284,7 +284,12 @@ fn push_points(
                 let point = (p1 + p2) * 0.5;
                 // parry may give one point twice (a cylinder cap's square
                 // vertex, clipped): one row a point
-                if raw.iter().any(|r| (r.point - point).norm_squared() < 1e-18) {
+                // (|Δ|² ≥ Δx² with terms ≥ 0: Δx² ≥ 1e-18 decides "apart")
+                let near = |r: &Raw| {
+                    let dx = r.point.x - point.x;
+                    dx * dx < 1e-18 && (r.point - point).norm_squared() < 1e-18
+                };
+                if raw.iter().any(near) {
                     continue;
                 }
                 raw.push(Raw {
