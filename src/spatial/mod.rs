@@ -105,6 +105,7 @@ pub fn quat_to_matrix<T: Scalar>(x: T, y: T, z: T, w: T) -> Matrix3<T> {
 }
 
 /// Rotation by angle `q` about a unit axis `u` (Rodrigues).
+#[inline]
 pub fn axis_angle<T: Scalar>(u: &Vector3<T>, q: T) -> Matrix3<T> {
     let (s, c) = sin_cos(q);
     let k = skew(u);
