@@ -65,6 +65,9 @@ pub(crate) struct Islands {
     /// and the pieces of the new islands (root, island or row).
     fails: Vec<(usize, usize, usize, usize)>,
     pieces: Vec<(usize, usize, usize)>,
+    /// Per tree: the island it roots is among the pieces already (scratch
+    /// of a join, split.rs; all false outside one).
+    pieced: Vec<bool>,
     /// The islands to solve: every one after a grouping, the ones a join
     /// made after it.
     todo: Vec<usize>,
@@ -182,6 +185,7 @@ impl Islands {
             check_all: false,
             fails: Vec::with_capacity(rows),
             pieces: Vec::with_capacity(rows),
+            pieced: vec![false; nt],
             todo: Vec::with_capacity(rows.min(nt + 1)),
             group_at: vec![0; rows],
             runs: Vec::with_capacity(rows),

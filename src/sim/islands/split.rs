@@ -115,13 +115,11 @@ impl Islands {
             let (r, _, a, b) = self.fails[i];
             for t in [a, b] {
                 let ri = self.find(t);
-                let k = self.iof[ri];
-                if k != usize::MAX {
-                    self.pieces.push((t, 0, k));
-                }
+                self.piece_island(t, ri);
             }
             self.pieces.push((a, 1, r));
         }
+        self.unpiece();
         for i in 0..self.fails.len() {
             let (r, g, a, b) = self.fails[i];
             let (ra, rb) = (self.find(a), self.find(b));
@@ -137,6 +135,27 @@ impl Islands {
         true
     }
 
+    /// Lists the island rooted at `root` (if any) among the join's pieces as
+    /// (`t`, 0, island), once: a second listing maps to the same root in
+    /// [`Islands::merge`] and would be dropped there as a duplicate.
+    fn piece_island(&mut self, t: usize, root: usize) {
+        let k = self.iof[root];
+        if k != usize::MAX && !self.pieced[root] {
+            self.pieced[root] = true;
+            self.pieces.push((t, 0, k));
+        }
+    }
+
+    /// Clears the pieces' marks (`pieced`, at their islands' roots).
+    fn unpiece(&mut self) {
+        for &(_, kind, k) in &self.pieces {
+            if kind == 0 {
+                self.pieced[self.iroot[k]] = false;
+            }
+        }
+        debug_assert!(self.pieced.iter().all(|&p| !p));
+    }
+
     /// The new islands of a join from its `pieces` (tree, 0, an island of
     /// its root before the join) and (tree, 1, a joined contact's first
     /// row): per root (after the join's unions) one new island, its runs
@@ -150,7 +169,9 @@ impl Islands {
             let t = self.pieces[i].0;
             self.pieces[i].0 = self.find(t);
         }
-        self.pieces.sort_unstable();
+        // (sorted as a merge of its ascending stretches: a join's rows are
+        // listed in row order, pass by pass, mostly onto one root)
+        merge_stretches(&mut self.pieces, &mut self.sorted, |&p| p);
         self.pieces.dedup();
         self.todo.clear();
         let (table, path) = (rows.table(), &rows.path[..]);
@@ -276,12 +297,12 @@ impl Islands {
                 // trees' roots (each a root before the join: a union's root
                 // is one of its two) and its rows
                 for t in [ra, rb] {
-                    let k = self.iof[t];
-                    if k != usize::MAX {
-                        self.pieces.push((t, 0, k));
-                    }
+                    self.piece_island(t, t);
                 }
                 self.pieces.push((a, 1, r));
+                // (the touched trees grow when one side was not: else no
+                // contact skipped in this pass joins in the next)
+                more |= !(self.touched[ra] && self.touched[rb]);
                 if ra != rb {
                     self.parent[ra.max(rb)] = ra.min(rb);
                     self.touched[ra.min(rb)] = true;
@@ -290,14 +311,14 @@ impl Islands {
                 if self.gtree[g] == LEFT {
                     self.gtree[g] = a;
                 }
-                more = true;
+                any = true;
             }
             self.left.truncate(keep);
-            any |= more;
             if !more {
                 break;
             }
         }
+        self.unpiece();
         if any {
             // (the pass reads a pushed island's dofs only to zero its w'
             // there: listed once each, not sorted)
@@ -318,7 +339,7 @@ impl Islands {
 /// into `tmp` until one is left, O(n log m) for m stretches; nothing is
 /// allocated while `tmp` holds `v.len()` (the islands' scratch is sized
 /// for every row and dof). Equal keys keep their order.
-fn merge_stretches<T: Copy>(v: &mut [T], tmp: &mut Vec<T>, key: impl Fn(&T) -> usize) {
+fn merge_stretches<T: Copy, K: Ord>(v: &mut [T], tmp: &mut Vec<T>, key: impl Fn(&T) -> K) {
     let n = v.len();
     if n < 2 {
         return;
