@@ -294,10 +294,9 @@ impl Rows {
                             table.get_unchecked(s..s + l)
                         };
                         // the three dots side by side over their rows of y
-                        // (each a sum from 0 in path order), along the path's
-                        // runs (the update's below)
+                        // (each a sum from 0 in path order)
                         // SAFETY: as above; the path's dofs < nv ≤ dv.len()
-                        let [dn, d1, d2] = unsafe { dot3_at(y, r * st, st, Path::of(p), dv) };
+                        let [dn, d1, d2] = unsafe { dot3_at(y, r * st, st, p, dv) };
                         let [wn1, wn2, w12] = w_block[r];
                         let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
                         let on = lambda[r];
