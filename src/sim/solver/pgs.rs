@@ -2,11 +2,13 @@
 //! contact's three rows taken in one pass and the exact Coulomb slide onto
 //! the friction disc.
 
-use super::dot3::dot3_at;
-use super::kernels::{axpy3_path, pinned_until, slide_onto_cone, warm_rows, Path};
+use super::kernels::{pinned_until, slide_onto_cone, warm_rows};
 use super::loop_block::{BlockRows, LoopBlock};
 use super::subspace::{subspace_step, Solved, Subspace};
 use super::{MassFactor, RowKind, Rows, SUBSPACE_MAX};
+use contact::{visit, Carry, Fixed};
+
+mod contact;
 
 impl Rows {
     /// Projected Gauss–Seidel on W = Y Yᵀ, kept implicit: Δv' = Yᵀλ is carried
@@ -170,27 +172,7 @@ impl Rows {
             Some(lb) => (&lb.wr[..n], &lb.wblockr[..n], &lb.winvr[..n]),
             None => (&self.w[..n], &self.w_block[..n], &self.winv[..n]),
         };
-        // a row no impulse can move keeps 0
-        let live = |r: usize| if winv[r] != 0.0 { 1.0 } else { 0.0 };
         let u_prev = &mut out.u_prev[..n];
-        // a row's convergence measure: its own residual |Δλ|·Wᵣᵣ, or, when
-        // smaller, how much its velocity moved since the last sweep (redundant
-        // contacts can trade impulse among themselves for many sweeps while no
-        // velocity changes: that is converged)
-        // (on the first sweep the residual alone: `moved` taken as ∞; the
-        // smaller of the two by one compare, `minsd`: a NaN `moved` leaves the
-        // residual, as `f64::min` did)
-        #[inline(always)]
-        fn measure(first: bool, residual: f64, u: f64, prev: &mut f64) -> f64 {
-            let moved = (u - *prev).abs();
-            *prev = u;
-            let moved = if first { f64::INFINITY } else { moved };
-            if moved < residual {
-                moved
-            } else {
-                residual
-            }
-        }
         let lambda = &mut out.lambda[..n];
         // rows pinned at a bound skipped while provably still pinned
         // ([`pinned_until`]): `drift` bounds ‖Δv'‖ since the first was
@@ -253,6 +235,22 @@ impl Rows {
         let mut attempts = 0;
         let mut polished = false;
         let mut converged = false;
+        // what a contact's visit reads (contact.rs)
+        let fixed = Fixed {
+            y,
+            st,
+            paths,
+            table,
+            kinds,
+            w,
+            w_block,
+            winv,
+            c,
+            b,
+            lb,
+            view: &view,
+            skip,
+        };
         // every row of the island fits one subspace step
         let small = runs.iter().map(|&(_, s, e)| e - s).sum::<usize>() <= SUBSPACE_MAX;
         while it < max_iter {
@@ -282,98 +280,37 @@ impl Rows {
                             r += 3;
                             continue;
                         }
-                        // a contact's three rows in one pass over its path: the
-                        // normal, then the tangent pair from the velocity the
-                        // normal's change left (through the block's entries)
+                        // a contact's three rows in one pass over its path
+                        // (contact.rs), the copy without `live`'s factors when
+                        // all three rows are live, without `relax` in a plain
+                        // sweep
+                        let alive = winv[r] != 0.0 && winv[r + 1] != 0.0 && winv[r + 2] != 0.0;
+                        let mut carry = Carry {
+                            u_prev: &mut u_prev[..],
+                            until: &mut until[..],
+                            change,
+                            drift,
+                            armed,
+                        };
+                        let (l, dv) = (&mut lambda[..], &mut dv[..]);
                         // SAFETY: r is a row of `runs`, whose paths lie in
-                        // `table` and are at most `st` long (checked above), and
-                        // r + 2 < n (tested above), so (r + 2)·st + len ≤ n·st
-                        // ≤ y.len()
-                        let p = unsafe {
-                            let (s, l) = *paths.get_unchecked(r);
-                            table.get_unchecked(s..s + l)
-                        };
-                        // the three dots side by side over their rows of y
-                        // (each a sum from 0 in path order)
-                        // SAFETY: as above; the path's dofs < nv ≤ dv.len()
-                        let [dn, d1, d2] = unsafe { dot3_at(y, r * st, st, p, dv) };
-                        let [wn1, wn2, w12] = w_block[r];
-                        let (wnn, w11, w22) = (w[r], w[r + 1], w[r + 2]);
-                        let on = lambda[r];
-                        let un = c[r] + dn;
-                        let nn = (on - relax * (un - b[r]) * winv[r]).max(0.0) * live(r);
-                        let dln = nn - on;
-                        lambda[r] = nn;
-                        let (o1, o2) = (lambda[r + 1], lambda[r + 2]);
-                        let u1 = c[r + 1] + d1 + dln * wn1;
-                        let u2 = c[r + 2] + d2 + dln * wn2;
-                        if on == 0.0 && nn == 0.0 && o1 == 0.0 && o2 == 0.0 {
-                            // an inactive contact that stays so (λₙ = 0, uₙ ≥ bₙ):
-                            // μλₙ = 0 pins both tangents at 0, nothing moves, and
-                            // each row's measure is its residual 0; only the
-                            // velocities are kept for the next sweep's measure
-                            // (the tangents may keep a zero of the other sign)
-                            u_prev[r] = un;
-                            u_prev[r + 1] = u1;
-                            u_prev[r + 2] = u2;
-                            if skip {
-                                until[r] = pinned_until(drift, un - b[r], un, wnn);
-                                armed |= until[r] > f64::NEG_INFINITY;
-                            }
-                            r += 3;
-                            continue;
-                        }
-                        let mu = match kinds[r + 1] {
-                            RowKind::Tangent { mu, .. } => mu,
-                            _ => 0.0,
-                        };
-                        let mut t1 = (o1 - u1 * winv[r + 1]) * live(r + 1);
-                        let mut t2 = (o2 - u2 * winv[r + 2]) * live(r + 2);
-                        let lim = mu * nn;
-                        if t1 * t1 + t2 * t2 > lim * lim {
-                            // w̄ = (W₁₁ + W₂₂)/2 + √(((W₁₁ − W₂₂)/2)² + W₁₂²)
-                            let half = 0.5 * (w11 - w22);
-                            let wbar = 0.5 * (w11 + w22) + (half * half + w12 * w12).sqrt();
-                            (t1, t2) = slide_onto_cone(o1, o2, u1, u2, wbar, lim);
-                            t1 *= live(r + 1);
-                            t2 *= live(r + 2);
-                        }
-                        lambda[r + 1] = t1;
-                        lambda[r + 2] = t2;
-                        let (dl1, dl2) = (t1 - o1, t2 - o2);
-                        if dln != 0.0 || dl1 != 0.0 || dl2 != 0.0 {
-                            // Δv' += Δλₙ yₙ + Δλ₁ y₁ + Δλ₂ y₂ over the path
-                            let l = p.len();
-                            // SAFETY: r + 2 < n and l ≤ st (checked above), and
-                            // y holds n·st entries
-                            let yr = |q: usize| unsafe { y.get_unchecked(q * st..q * st + l) };
-                            let at = Path::of(p);
-                            let ys = [yr(r), yr(r + 1), yr(r + 2)];
-                            // SAFETY: each of ys is l = the path's length
-                            unsafe { axpy3_path([dln, dl1, dl2], ys, at, dv) };
-                            if SKIP && armed {
-                                drift += dln.abs() * wnn.sqrt()
-                                    + dl1.abs() * w11.sqrt()
-                                    + dl2.abs() * w22.sqrt();
-                            }
-                            if let Some(lb) = lb {
-                                lb.follow(&view, r, &[dln, dl1, dl2], lambda, dv);
+                        // `table` and are at most `st` long, their dofs < nv ≤
+                        // dv.len() (checked above), and r + 2 < n (tested
+                        // above); y holds n·st entries
+                        unsafe {
+                            match (alive, plain) {
+                                (true, true) => visit::<SKIP, true, true>(
+                                    &fixed, r, relax, first, tol, l, dv, &mut carry,
+                                ),
+                                (true, false) => visit::<SKIP, true, false>(
+                                    &fixed, r, relax, first, tol, l, dv, &mut carry,
+                                ),
+                                (false, _) => visit::<SKIP, false, false>(
+                                    &fixed, r, relax, first, tol, l, dv, &mut carry,
+                                ),
                             }
                         }
-                        if change > tol {
-                            // a sweep over `tol` already stays over whatever
-                            // its other rows measure (`change` only grows):
-                            // their velocities kept for the next, no measure
-                            (u_prev[r], u_prev[r + 1], u_prev[r + 2]) = (un, u1, u2);
-                        } else {
-                            let up = &mut u_prev[r..r + 3];
-                            change =
-                                most(change, measure(first, (dln * wnn).abs(), un, &mut up[0]));
-                            change =
-                                most(change, measure(first, (dl1 * w11).abs(), u1, &mut up[1]));
-                            change =
-                                most(change, measure(first, (dl2 * w22).abs(), u2, &mut up[2]));
-                        }
+                        (change, drift, armed) = (carry.change, carry.drift, carry.armed);
                         r += 3;
                         continue;
                     }
@@ -546,6 +483,25 @@ impl Rows {
             out.sm.0.until = until;
         }
         (it, polished)
+    }
+}
+
+/// A row's convergence measure: its own residual |Δλ|·Wᵣᵣ, or, when
+/// smaller, how much its velocity moved since the last sweep (redundant
+/// contacts can trade impulse among themselves for many sweeps while no
+/// velocity changes: that is converged)
+/// (on the first sweep the residual alone: `moved` taken as ∞; the
+/// smaller of the two by one compare, `minsd`: a NaN `moved` leaves the
+/// residual, as `f64::min` did)
+#[inline(always)]
+fn measure(first: bool, residual: f64, u: f64, prev: &mut f64) -> f64 {
+    let moved = (u - *prev).abs();
+    *prev = u;
+    let moved = if first { f64::INFINITY } else { moved };
+    if moved < residual {
+        moved
+    } else {
+        residual
     }
 }
 
