@@ -413,7 +413,7 @@ pub mod contact {
     /// `SweepAndPrune::overlaps`.
     pub fn sap_overlaps(
         s: &mut SweepAndPrune,
-        table: &PairTable,
+        table: &mut PairTable,
         out: &mut Vec<u32>,
         fresh: &mut Vec<(u32, u32)>,
     ) {

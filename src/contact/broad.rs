@@ -24,70 +24,11 @@
 //! way the pairs reported are exactly those whose boxes overlap (in another
 //! order: the caller sorts them).
 
+mod table;
 mod width;
+pub use table::PairTable;
+pub(crate) use table::{LAZY_PAIR, NO_PAIR};
 use width::Width;
-
-/// "No pair" in the pair table.
-pub(crate) const NO_PAIR: u32 = u32::MAX;
-/// A pair the filter allows whose state is not made yet (made when its boxes
-/// first overlap: a pile of n shapes allows n²/2 pairs and ever touches O(n)).
-pub(crate) const LAZY_PAIR: u32 = u32::MAX - 1;
-
-/// The pairs of shapes the filter allows, and the index of those made: one
-/// entry a pair of shapes (`idx[i·n + j]`: a pair index, [`LAZY_PAIR`] or
-/// [`NO_PAIR`]).
-#[derive(Clone, Debug, Default)]
-pub struct PairTable {
-    n: usize,
-    idx: Vec<u32>,
-}
-
-impl PairTable {
-    /// No pair allowed among `n` shapes.
-    pub(crate) fn new(n: usize) -> Self {
-        Self {
-            n,
-            idx: vec![NO_PAIR; n * n],
-        }
-    }
-    /// Allows the pair of shapes i, j (not made yet).
-    pub(crate) fn allow(&mut self, i: usize, j: usize) {
-        if i < self.n && j < self.n {
-            self.idx[i * self.n + j] = LAZY_PAIR;
-            self.idx[j * self.n + i] = LAZY_PAIR;
-        }
-    }
-    /// Whether the pair of shapes i, j is allowed.
-    #[inline]
-    pub(crate) fn allowed(&self, i: usize, j: usize) -> bool {
-        self.get(i, j) != NO_PAIR
-    }
-    /// The pair of shapes i, j: its index, [`LAZY_PAIR`] (allowed, not made)
-    /// or [`NO_PAIR`].
-    #[inline]
-    pub(crate) fn get(&self, i: usize, j: usize) -> u32 {
-        if i < self.n && j < self.n {
-            self.idx[i * self.n + j]
-        } else {
-            NO_PAIR
-        }
-    }
-    /// Asks the cache for the entry of shapes i, j (a table of a thousand
-    /// shapes is 4 MB: an entry read cold is a cache miss).
-    #[inline(always)]
-    fn fetch(&self, i: usize, j: usize) {
-        if let Some(x) = self.idx.get(i * self.n + j) {
-            prefetch(x);
-        }
-    }
-    /// Records pair `p` made for the allowed shapes i, j.
-    pub(crate) fn set(&mut self, i: usize, j: usize, p: u32) {
-        if self.allowed(i, j) {
-            self.idx[i * self.n + j] = p;
-            self.idx[j * self.n + i] = p;
-        }
-    }
-}
 
 /// Asks the cache for the line holding `x` (no effect on any result).
 #[inline(always)]
@@ -168,7 +109,7 @@ impl SweepAndPrune {
     /// [`LAZY_PAIR`] (allowed, not made yet) as shapes (i, j) to `fresh`.
     pub(crate) fn overlaps(
         &mut self,
-        table: &PairTable,
+        table: &mut PairTable,
         out: &mut Vec<u32>,
         fresh: &mut Vec<(u32, u32)>,
     ) {
@@ -180,14 +121,15 @@ impl SweepAndPrune {
         } else {
             self.sweep_strips(&mut cand);
         }
-        // the table read in the sweep's order, eight pairs ahead fetched
+        // the table read through the shapes' lines (table.rs) in the
+        // sweep's order, the lines of eight pairs ahead fetched
         const AHEAD: usize = 8;
         for k in 0..cand.len() {
             if let Some(&(i, j)) = cand.get(k + AHEAD) {
-                table.fetch(i as usize, j as usize);
+                table.fetch(i, j);
             }
             let (i, j) = cand[k];
-            match table.get(i as usize, j as usize) {
+            match table.get_kept(i, j) {
                 LAZY_PAIR => fresh.push((i, j)),
                 NO_PAIR => {}
                 p => out.push(p),

@@ -25,13 +25,13 @@ fn finds_exactly_the_overlapping_allowed_pairs() {
     };
     let mut table = every();
     let mut out = Vec::new();
-    sap_overlaps(&mut s, &table, &mut out, &mut Vec::new());
+    sap_overlaps(&mut s, &mut table, &mut out, &mut Vec::new());
     out.sort();
     assert_eq!(out, vec![12, 23]);
     // moved apart in z: none
     sap_set(&mut s, 2, [1.5, 0.0, 5.0], [1.0; 3]);
     out.clear();
-    sap_overlaps(&mut s, &table, &mut out, &mut Vec::new());
+    sap_overlaps(&mut s, &mut table, &mut out, &mut Vec::new());
     assert!(out.is_empty(), "{out:?}");
     // a pair the filter forbids is not reported
     sap_set(&mut s, 2, [1.5, 0.0, 0.0], [1.0; 3]);
@@ -41,13 +41,13 @@ fn finds_exactly_the_overlapping_allowed_pairs() {
         table_set(&mut table, i, j, (10 * i + j) as u32);
     }
     out.clear();
-    sap_overlaps(&mut s, &table, &mut out, &mut Vec::new());
+    sap_overlaps(&mut s, &mut table, &mut out, &mut Vec::new());
     assert_eq!(out, vec![23]);
     // a pair allowed but not made yet is reported by its shapes
     table_allow(&mut table, 1, 2);
     out.clear();
     let mut fresh = Vec::new();
-    sap_overlaps(&mut s, &table, &mut out, &mut fresh);
+    sap_overlaps(&mut s, &mut table, &mut out, &mut fresh);
     assert_eq!(out, vec![23]);
     let fresh: Vec<_> = fresh.iter().map(|&(i, j)| (i.min(j), i.max(j))).collect();
     assert_eq!(fresh, vec![(1, 2)]);
@@ -88,7 +88,7 @@ fn strips_find_exactly_the_overlapping_pairs() {
             }
         }
         let (mut out, mut fresh) = (Vec::new(), Vec::new());
-        sap_overlaps(&mut s, &table, &mut out, &mut fresh);
+        sap_overlaps(&mut s, &mut table, &mut out, &mut fresh);
         let mut got: Vec<(usize, usize)> = fresh
             .iter()
             .map(|&(i, j)| ((i as usize).min(j as usize), (i as usize).max(j as usize)))
@@ -200,7 +200,7 @@ fn still_shapes_keep_their_pairs_as_some_move() {
                 }
             }
             let (mut out, mut fresh) = (Vec::new(), Vec::new());
-            sap_overlaps(&mut s, &table, &mut out, &mut fresh);
+            sap_overlaps(&mut s, &mut table, &mut out, &mut fresh);
             assert!(fresh.is_empty());
             let mut got: Vec<(usize, usize)> = out
                 .iter()
@@ -308,7 +308,7 @@ fn strips_find_the_pairs_in_the_order_of_round_38() {
     // round 38's sweep's (the order the pairs are made in)
     let (n, mut s) = (400, sap_new(400));
     // (every pair allowed, none made: each found one is `fresh`)
-    let table = (0..n).fold(table_new(n), |mut t, i| {
+    let mut table = (0..n).fold(table_new(n), |mut t, i| {
         (i + 1..n).for_each(|j| table_allow(&mut t, i, j));
         t
     });
@@ -346,10 +346,85 @@ fn strips_find_the_pairs_in_the_order_of_round_38() {
             sap_set(&mut s, i, c, h);
         }
         let (mut out, mut fresh) = (Vec::new(), Vec::new());
-        sap_overlaps(&mut s, &table, &mut out, &mut fresh);
+        sap_overlaps(&mut s, &mut table, &mut out, &mut fresh);
         assert!(out.is_empty());
         let want = strips_reference(&s.lo, &s.hi);
         assert!(want.len() > 100, "{}", want.len());
         assert_eq!(fresh, want, "step {step}");
     }
+}
+
+#[test]
+fn pair_lines_give_the_tables_entries_as_pairs_are_made_and_renumbered() {
+    // boxes jostling in a bin; every pair allowed but those of shapes 5k and
+    // 5k + 1 (never reported); each fresh pair made with the next index, and
+    // every sixth step all made pairs renumbered (the lines hold stale
+    // entries unless the writes empty them): each step's pairs are the
+    // overlapping allowed ones with their current index
+    let n = 300;
+    let mut s = sap_new(n);
+    let forbidden = |i: usize, j: usize| i / 5 == j / 5 && i.min(j) % 5 == 0 && i.abs_diff(j) == 1;
+    let mut table = table_new(n);
+    for i in 0..n {
+        for j in i + 1..n {
+            if !forbidden(i, j) {
+                table_allow(&mut table, i, j);
+            }
+        }
+    }
+    let mut lcg = Lcg(77);
+    let mut made = std::collections::BTreeMap::new();
+    let mut next = 0u32;
+    let mut boxes: Vec<[f64; 3]> = (0..n)
+        .map(|_| {
+            [
+                lcg.uniform(-1.0, 1.0),
+                lcg.uniform(-1.0, 1.0),
+                lcg.uniform(0.0, 0.5),
+            ]
+        })
+        .collect();
+    for step in 0..40 {
+        for c in boxes.iter_mut() {
+            for x in c.iter_mut() {
+                *x += 0.02 * lcg.uniform(-1.0, 1.0);
+            }
+        }
+        for (i, &c) in boxes.iter().enumerate() {
+            sap_set(&mut s, i, c, [0.06; 3]);
+        }
+        let (mut out, mut fresh) = (Vec::new(), Vec::new());
+        sap_overlaps(&mut s, &mut table, &mut out, &mut fresh);
+        let mut want: Vec<u32> = Vec::new();
+        for (i, j) in strips_reference(&s.lo, &s.hi) {
+            let key = (i.min(j) as usize, i.max(j) as usize);
+            if let Some(&p) = made.get(&key) {
+                want.push(p);
+            } else {
+                assert!(
+                    forbidden(key.0, key.1)
+                        || fresh
+                            .iter()
+                            .any(|&(a, b)| (a.min(b), a.max(b)) == (i.min(j), i.max(j)))
+                );
+            }
+        }
+        out.sort_unstable();
+        want.sort_unstable();
+        assert_eq!(out, want, "step {step}");
+        for &(i, j) in &fresh {
+            let key = (i.min(j) as usize, i.max(j) as usize);
+            assert!(!forbidden(key.0, key.1) && !made.contains_key(&key));
+            table_set(&mut table, key.0, key.1, next);
+            made.insert(key, next);
+            next += 1;
+        }
+        if step % 6 == 5 {
+            for (&(i, j), p) in made.iter_mut() {
+                *p += 100_000;
+                table_set(&mut table, i, j, *p);
+            }
+        }
+    }
+    assert!(made.len() > 200, "{}", made.len());
 }

@@ -477,7 +477,8 @@ impl PairContact {
             self.fresh.clear();
             let mut ids = std::mem::take(&mut self.sap_ids);
             ids.clear();
-            self.sap.overlaps(&self.table, &mut ids, &mut self.fresh);
+            self.sap
+                .overlaps(&mut self.table, &mut ids, &mut self.fresh);
             for f in 0..self.fresh.len() {
                 let (i, j) = self.fresh[f];
                 ids.push(self.make_pair(i as usize, j as usize));
