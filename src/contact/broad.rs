@@ -63,6 +63,11 @@ pub struct SweepAndPrune {
     width: Width,
     wide: Vec<u32>,
     merged: Vec<(f64, u32, u32)>,
+    /// The y and z intervals (lower y, upper y, lower z, upper z) of the
+    /// sorted shapes, in their order, and of the merged list's, in its
+    /// order: a sweep reads them in turn, not through the shapes' indices.
+    yz: Vec<[f64; 4]>,
+    merged_yz: Vec<[f64; 4]>,
     /// The sweep's pairs whose boxes overlap, in the sweep's order, before
     /// the table is read (then read a few ahead of use).
     cand: Vec<(u32, u32)>,
@@ -91,6 +96,8 @@ impl SweepAndPrune {
             width: Width::new(n),
             wide: Vec::with_capacity(n),
             merged: Vec::with_capacity(n),
+            yz: Vec::with_capacity(n),
+            merged_yz: Vec::with_capacity(n),
             cand: Vec::new(),
             xs: Vec::with_capacity(n),
             keys: Vec::with_capacity(n),
@@ -115,12 +122,15 @@ impl SweepAndPrune {
     ) {
         let n = self.lo.len();
         let mut cand = std::mem::take(&mut self.cand);
-        cand.clear();
-        if n < STRIPS_FROM {
+        let found = if n < STRIPS_FROM {
+            cand.clear();
             self.sweep_x(&mut cand);
+            cand.len()
         } else {
-            self.sweep_strips(&mut cand);
-        }
+            self.sweep_strips(&mut cand)
+        };
+        let cand_all = cand;
+        let cand = &cand_all[..found.min(cand_all.len())];
         // the table read through the shapes' lines (table.rs) in the
         // sweep's order, the lines of eight pairs ahead fetched
         const AHEAD: usize = 8;
@@ -135,7 +145,7 @@ impl SweepAndPrune {
                 p => out.push(p),
             }
         }
-        self.cand = cand;
+        self.cand = cand_all;
     }
 
     /// One sweep along x over every shape.
@@ -176,8 +186,11 @@ impl SweepAndPrune {
         self.xs = buf;
     }
 
-    /// Strips along y, each swept along x with the next (module docs).
-    fn sweep_strips(&mut self, cand: &mut Vec<(u32, u32)>) {
+    /// Strips along y, each swept along x with the next (module docs): the
+    /// pairs written to `cand` from its start, how many returned (the rest of
+    /// `cand` is stale).
+    fn sweep_strips(&mut self, cand: &mut Vec<(u32, u32)>) -> usize {
+        let mut cand = Found { buf: cand, len: 0 };
         let n = self.lo.len();
         // the strips' width: the widest ordinary y-extent (width.rs)
         let w = self.width.of(&self.lo, &self.hi, BIG);
@@ -255,9 +268,18 @@ impl SweepAndPrune {
                 }
             }
         }
+        // the sorted shapes' y and z intervals in their order (each box
+        // read once here, not once a shape it meets)
+        let mut yz = std::mem::take(&mut self.yz);
+        yz.clear();
+        yz.extend(self.order.iter().map(|&i| {
+            let (l, h) = (&self.lo[i as usize], &self.hi[i as usize]);
+            [l[1], h[1], l[2], h[2]]
+        }));
         // each strip merged with the next by lower x, swept
         let mut merged = std::mem::take(&mut self.merged);
-        let (order, ks) = (&self.order[..len], &keys[..len]);
+        let mut merged_yz = std::mem::take(&mut self.merged_yz);
+        let (order, ks, yz_all) = (&self.order[..len], &keys[..len], &yz[..len]);
         // (the end of strip s, found once: the next strip's start)
         let run_end = |a: usize| a + ks[a..].iter().take_while(|k| k.0 == ks[a].0).count();
         let mut a = 0;
@@ -269,49 +291,48 @@ impl SweepAndPrune {
             } else {
                 b
             };
-            let (lower, upper) = ((&ks[a..b], &order[a..b]), (&ks[b..c], &order[b..c]));
-            let merged = merge_strips(lower, upper, &mut merged);
-            for k in 0..merged.len() {
-                let (_, i, from) = merged[k];
+            let lower = (&ks[a..b], &order[a..b], &yz_all[a..b]);
+            let upper = (&ks[b..c], &order[b..c], &yz_all[b..c]);
+            let (merged, merged_yz) = merge_strips(lower, upper, (&mut merged, &mut merged_yz));
+            for (k, (&(_, i, from), yi)) in merged.iter().zip(merged_yz).enumerate() {
                 let i = i as usize;
-                // (i's box read once for the shapes it meets)
-                let (li, hi) = (&self.lo[i], &self.hi[i]);
-                let hx = hi[0];
+                // (i's upper x read once for the shapes it meets)
+                let hx = self.hi[i][0];
                 if from != LOWER && !nan {
                     // i of strip s + 1 meets strip s's shapes only: those
                     // after it by lower x, strip s's from `from` on (sorted:
                     // the first past hx is the merged list's first of s past
                     // it, and the pairs in the merged list's order)
-                    let (xs, js) = lower;
+                    let (xs, js, yzs) = lower;
                     let from = from as usize;
-                    let (xs, js) = (xs.get(from..).unwrap_or(&[]), js.get(from..).unwrap_or(&[]));
-                    for (&(_, x), &j) in xs.iter().zip(js) {
+                    let rest = (xs.get(from..), js.get(from..), yzs.get(from..));
+                    let (Some(xs), Some(js), Some(yzs)) = rest else {
+                        continue;
+                    };
+                    for ((&(_, x), &j), yj) in xs.iter().zip(js).zip(yzs) {
                         if x > hx {
                             break;
                         }
-                        let j = j as usize;
-                        if meet_yz(li, hi, &self.lo[j], &self.hi[j]) {
-                            cand.push((i as u32, j as u32));
-                        }
+                        cand.put(i, j as usize, meet4(yi, yj));
                     }
                     continue;
                 }
                 let in_s = from == LOWER;
-                for &(x, j, jfrom) in &merged[k + 1..] {
+                let rest = merged[k + 1..].iter().zip(&merged_yz[k + 1..]);
+                for (&(x, j, jfrom), yj) in rest {
                     if x > hx {
                         break;
                     }
-                    let j = j as usize;
-                    if (in_s || jfrom == LOWER) && meet_yz(li, hi, &self.lo[j], &self.hi[j]) {
-                        cand.push((i as u32, j as u32));
-                    }
+                    cand.put(i, j as usize, (in_s | (jfrom == LOWER)) & meet4(yi, yj));
                 }
             }
             a = b;
             b = if c > b || b >= len { c } else { run_end(b) };
         }
         self.merged = merged;
+        self.merged_yz = merged_yz;
         self.keys = keys;
+        self.yz = yz;
         // the wide shapes against every shape (a pair of two wide ones once)
         for wi in 0..self.wide.len() {
             let i = self.wide[wi] as usize;
@@ -324,63 +345,106 @@ impl SweepAndPrune {
                 if lj[0] > hi[0] || li[0] > hj[0] {
                     continue;
                 }
-                if meet_yz(&li, &hi, lj, hj) {
-                    cand.push((i as u32, j as u32));
-                }
+                cand.put(i, j, meet_yz(&li, &hi, lj, hj));
             }
         }
+        cand.len
+    }
+}
+
+/// The strips' sweep's pairs, written without a branch on the test: each
+/// pair tested is written after those kept, and kept (counted) when its
+/// boxes overlap.
+struct Found<'a> {
+    buf: &'a mut Vec<(u32, u32)>,
+    len: usize,
+}
+
+impl Found<'_> {
+    /// Writes shapes (i, j) after the pairs kept, kept when `keep`.
+    #[inline(always)]
+    fn put(&mut self, i: usize, j: usize, keep: bool) {
+        if self.len >= self.buf.len() {
+            let room = 2 * self.buf.len() + 64;
+            self.buf.resize(room, (0, 0));
+        }
+        if let Some(x) = self.buf.get_mut(self.len) {
+            *x = (i as u32, j as u32);
+        }
+        self.len += usize::from(keep);
     }
 }
 
 /// A merged entry of strip s ([`merge_strips`]).
 const LOWER: u32 = u32::MAX;
 
-/// Strips `l` and `u` ((strip, lower x) keys and shapes, each by lower x)
-/// merged by lower x into `out` as (lower x, shape, [`LOWER`] for one of
-/// `l`, else how many of `l` precede it): one of `l` first unless its lower
-/// x is greater (as the sort: `l` before `u` on a tie).
+/// A strip: its shapes' (strip, lower x) keys, shapes and y and z
+/// intervals, by lower x.
+type Strip<'a> = (&'a [(i64, f64)], &'a [u32], &'a [[f64; 4]]);
+
+/// Strips `l` and `u` merged by lower x into `out` as (lower x, shape,
+/// [`LOWER`] for one of `l`, else how many of `l` precede it), and their y
+/// and z intervals beside: one of `l` first unless its lower x is greater
+/// (as the sort: `l` before `u` on a tie).
 #[inline(always)]
 fn merge_strips<'m>(
-    (lk, lo): (&[(i64, f64)], &[u32]),
-    (uk, uo): (&[(i64, f64)], &[u32]),
-    out: &'m mut Vec<(f64, u32, u32)>,
-) -> &'m [(f64, u32, u32)] {
-    let (nl, nu) = (lk.len().min(lo.len()), uk.len().min(uo.len()));
-    let (lk, lo, uk, uo) = (&lk[..nl], &lo[..nl], &uk[..nu], &uo[..nu]);
+    (lk, lo, lyz): Strip,
+    (uk, uo, uyz): Strip,
+    (out, out_yz): (&'m mut Vec<(f64, u32, u32)>, &'m mut Vec<[f64; 4]>),
+) -> (&'m [(f64, u32, u32)], &'m [[f64; 4]]) {
+    let nl = lk.len().min(lo.len()).min(lyz.len());
+    let nu = uk.len().min(uo.len()).min(uyz.len());
+    let (lk, lo, lyz) = (&lk[..nl], &lo[..nl], &lyz[..nl]);
+    let (uk, uo, uyz) = (&uk[..nu], &uo[..nu], &uyz[..nu]);
     // (written in place: room for both, kept from step to step)
     if out.len() < nl + nu {
         out.resize(nl + nu, (0.0, 0, 0));
     }
-    let out = &mut out[..nl + nu];
+    if out_yz.len() < nl + nu {
+        out_yz.resize(nl + nu, [0.0; 4]);
+    }
+    let (out, out_yz) = (&mut out[..nl + nu], &mut out_yz[..nl + nu]);
     let (mut i, mut j) = (0, 0);
     while i < nl && j < nu {
         let (x, y) = (lk[i].1, uk[j].1);
         if x > y {
             out[i + j] = (y, uo[j], i as u32);
+            out_yz[i + j] = uyz[j];
             j += 1;
         } else {
             out[i + j] = (x, lo[i], LOWER);
+            out_yz[i + j] = lyz[i];
             i += 1;
         }
     }
     // (the rest of the one not used up)
-    for (o, (&(_, x), &s)) in out[i + j..].iter_mut().zip(lk[i..].iter().zip(&lo[i..])) {
-        *o = (x, s, LOWER);
-    }
-    let at = nl + j;
-    for (o, (&(_, x), &s)) in out[at.min(nl + nu)..]
-        .iter_mut()
-        .zip(uk[j..].iter().zip(&uo[j..]))
+    let rest = lk[i..].iter().zip(&lo[i..]).zip(&lyz[i..]);
+    for ((o, oyz), ((&(_, x), &s), yz)) in
+        out[i + j..].iter_mut().zip(&mut out_yz[i + j..]).zip(rest)
     {
-        *o = (x, s, nl as u32);
+        *o = (x, s, LOWER);
+        *oyz = *yz;
     }
-    out
+    let at = (nl + j).min(nl + nu);
+    let rest = uk[j..].iter().zip(&uo[j..]).zip(&uyz[j..]);
+    for ((o, oyz), ((&(_, x), &s), yz)) in out[at..].iter_mut().zip(&mut out_yz[at..]).zip(rest) {
+        *o = (x, s, nl as u32);
+        *oyz = *yz;
+    }
+    (out, out_yz)
 }
 
 /// Two boxes (lower, upper corners; known to overlap in x) overlap in y and z.
 #[inline(always)]
 fn meet_yz(li: &[f64; 3], hi: &[f64; 3], lj: &[f64; 3], hj: &[f64; 3]) -> bool {
     !(lj[1] > hi[1] || li[1] > hj[1] || lj[2] > hi[2] || li[2] > hj[2])
+}
+
+/// [`meet_yz`] of two boxes' y and z intervals (lower y, upper y, lower z,
+/// upper z): the same four comparisons, all made (no branch).
+#[inline(always)]
+fn meet4(i: &[f64; 4], j: &[f64; 4]) -> bool {
+    !((j[0] > i[1]) | (i[0] > j[1]) | (j[2] > i[3]) | (i[2] > j[3]))
 }
 
 /// The broad phase of fewer than 64 shapes whose allowed pairs are all
