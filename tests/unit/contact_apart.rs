@@ -64,3 +64,60 @@ fn still_apart_is_never_wrong_and_not_vacuous() {
         "{kept} {asked} {touching}"
     );
 }
+
+#[test]
+fn apart_along_is_parrys_support_gap_bit_for_bit() {
+    // the gap from the numbers kept beside the shapes (a box's half
+    // extents, a cylinder's and a ball's sizes) must be the one from parry's
+    // support points, bit for bit, axes with ±0 components too
+    use parry3d_f64::math::Vector as PVec;
+    use parry3d_f64::shape::SupportMap;
+    let to_pvec = |v: &Vector3<f64>| PVec::new(v.x, v.y, v.z);
+    let from_pvec = |v: PVec| Vector3::new(v.x, v.y, v.z);
+    let mut lcg = Lcg(31);
+    let mut rnd = |a: f64, b: f64| lcg.uniform(a, b);
+    for k in 0..3000 {
+        // boxes, cylinders and balls (each kind against each)
+        let mut shape = |kind: usize| {
+            let s = match kind % 3 {
+                0 => SharedShape::cuboid(rnd(0.01, 0.3), rnd(0.01, 0.3), rnd(0.01, 0.3)),
+                1 => SharedShape::cylinder(rnd(0.01, 0.3), rnd(0.01, 0.3)),
+                _ => SharedShape::ball(rnd(0.01, 0.3)),
+            };
+            Member {
+                geom: 0,
+                body: 1,
+                placement: Se3::identity(),
+                shape: pair_shape(s, Se3::identity(), true),
+            }
+        };
+        let (a, b) = (shape(k), shape(k / 3));
+        let pose = |r: &mut dyn FnMut(f64, f64) -> f64| {
+            let axis = Unit::new_normalize(Vector3::new(r(-1.0, 1.0), r(-1.0, 1.0), r(-1.0, 1.0)));
+            let rot = Rotation3::from_axis_angle(&axis, r(-3.0, 3.0)).into_inner();
+            Se3::new(rot, Vector3::new(r(-1.0, 1.0), r(-1.0, 1.0), r(-1.0, 1.0)))
+        };
+        let (wa, wb) = (pose(&mut rnd), pose(&mut rnd));
+        let mut u = Vector3::new(rnd(-1.0, 1.0), rnd(-1.0, 1.0), rnd(-1.0, 1.0)).normalize();
+        // some components exactly ±0 (the sign picks the corner; a
+        // cylinder's axis: no radial direction)
+        match (k / 9) % 5 {
+            1 => u.x = 0.0,
+            2 => u.y = -0.0,
+            3 => (u.x, u.z) = (-0.0, 0.0),
+            4 => (u.x, u.z) = (0.0, -0.0),
+            _ => {}
+        }
+        let gap = apart_along(&u, &a, &b, &wa, &wb);
+        let (sa, sb) = (
+            a.shape.shape.as_support_map().unwrap(),
+            b.shape.shape.as_support_map().unwrap(),
+        );
+        let a_m_b = wa.inverse().compose(&wb);
+        let top_a = u.dot(&from_pvec(sa.local_support_point(to_pvec(&u))));
+        let d = a_m_b.rot.transpose() * (-u);
+        let low_b = u.dot(&a_m_b.act_point(&from_pvec(sb.local_support_point(to_pvec(&d)))));
+        let want = low_b - top_a;
+        assert_eq!(gap.to_bits(), want.to_bits(), "case {k}: {gap} vs {want}");
+    }
+}
