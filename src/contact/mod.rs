@@ -63,6 +63,7 @@
 
 pub mod broad;
 pub(crate) mod face;
+pub(crate) mod fetch;
 pub mod filter;
 pub mod frame;
 pub mod ground;

@@ -287,6 +287,7 @@ impl GroundContact {
             travel: super::Travel::new(&params, vec![false; nshapes]),
             hulls,
             parts: Vec::new(),
+            reached: Vec::with_capacity(nshapes),
         }))
     }
 }

@@ -6,6 +6,7 @@
 mod build;
 mod patch;
 mod reduce;
+mod serial;
 mod team;
 pub(crate) use team::Side;
 
@@ -195,6 +196,9 @@ pub struct GroundContact {
     hulls: bool,
     /// The chunks of shapes of a detection on a team ([`team`]).
     parts: Vec<team::Part>,
+    /// Scratch of a detection on one thread ([`serial`]): the shapes within
+    /// reach and their margins.
+    reached: Vec<(usize, f64)>,
 }
 
 impl GroundShape {
@@ -330,53 +334,6 @@ impl GroundContact {
             }
         }
         self.keep_picks(out);
-    }
-
-    /// The search of every shape on this thread, its points into `out`.
-    fn detect_serial(
-        &mut self,
-        o_m_i: &[Se3<f64>],
-        out: &mut Vec<ContactPoint>,
-        asleep: &[bool],
-        step: (f64, bool),
-    ) {
-        let ground = self.ground;
-        let maxp = self.params.max_points_per_shape.max(1);
-        // (the shapes never change: held apart from `self`, which the search mutates)
-        let shapes = std::sync::Arc::clone(&self.shapes);
-        let cull = std::sync::Arc::clone(&self.cull);
-        for (si, (s, cu)) in shapes.iter().zip(cull.iter()).enumerate() {
-            let Some(o_m_b) = o_m_i.get(cu.body) else {
-                continue;
-            };
-            if asleep.get(cu.body) == Some(&true) {
-                continue;
-            }
-            let (ts, delta, c) = self.travel.split();
-            let anchor = &mut self.anchor[si];
-            let Some(margin) = reach(cu, o_m_b, ground, step, anchor, ts.get_mut(si), (delta, c))
-            else {
-                continue;
-            };
-            let o_m_g = s.pose(o_m_b);
-            self.queries += 1;
-            // a hull or point set: its lowest vertex is its support point toward
-            // −z; only the heights are needed to find it and the candidates
-            // (one dot product a vertex, no parry query)
-            if s.manifold == Manifold::Vertices && !s.adj.is_empty() {
-                // a hull: its patch from its vertex graph ([`patch`])
-                self.hull_patch(si, s, &o_m_g, margin, maxp, out);
-                continue;
-            }
-            let cx = Plain {
-                ground,
-                maxp,
-                slot_offset: &self.slot_offset,
-                prev_flag: &self.prev_flag,
-                reduce_dirs: &self.reduce_dirs,
-            };
-            plain_points(s, si, &o_m_g, margin, &cx, &mut self.scratch, out);
-        }
     }
 
     /// The slots of this detection's points `out` kept for the next one
