@@ -21,10 +21,17 @@ const AHEAD: usize = 6;
 /// vertices fill three; a hull's search reads only a few of its own).
 const VERT_LINES: usize = 4;
 
-/// Shape `s`'s record fetched into the cache.
+/// The lines of shape `s`'s record its search reads fetched into the cache
+/// (its pose's, its kind's, its vertices' and its points' template; not the
+/// whole record, a dozen lines: fetched a shape, they pushed the broad
+/// phase's arrays, read next, out of the cache).
 #[inline(always)]
 fn fetch_shape(s: &GroundShape) {
-    fetch_lines(s, std::mem::size_of::<GroundShape>());
+    fetch_lines(&s.template, std::mem::size_of::<ContactPoint>());
+    fetch_lines(&s.at_body, 1);
+    fetch_lines(&s.manifold, 1);
+    fetch_lines(&s.verts, 1);
+    fetch_lines(&s.adj, 1);
 }
 
 /// Shape `s`'s first vertices fetched into the cache (its record read).
