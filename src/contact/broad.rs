@@ -30,20 +30,6 @@ pub use table::PairTable;
 pub(crate) use table::{LAZY_PAIR, NO_PAIR};
 use width::Width;
 
-/// Asks the cache for the line holding `x` (no effect on any result).
-#[inline(always)]
-pub(crate) fn prefetch<T>(x: &T) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        // SAFETY: a prefetch is a hint (it reads nothing into the program
-        // and cannot fault); SSE is part of x86_64.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast::<i8>()) };
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
-}
-
 /// The sweep's state.
 #[derive(Clone, Debug, Default)]
 pub struct SweepAndPrune {

@@ -13,7 +13,7 @@
 //! An entry allowed and not made yet ([`LAZY_PAIR`]) is not kept: it is
 //! written as the pair is made.
 
-use super::prefetch;
+use crate::contact::fetch::prefetch;
 
 /// "No pair" in the pair table.
 pub(crate) const NO_PAIR: u32 = u32::MAX;

@@ -10,7 +10,7 @@
 use super::apart::{apart_along, still_apart_at, Apart};
 use super::order::assign_slots;
 use super::{Member, Pair, PairContact, NO_KEY};
-use crate::contact::broad::prefetch;
+use crate::contact::fetch::prefetch;
 use crate::contact::narrow::prim::{round_points_at, Round};
 use crate::contact::narrow::{face_points, parry_points, reduce_pair, FaceScratch, Raw};
 use crate::contact::shapes::from_pvec;
