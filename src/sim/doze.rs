@@ -67,6 +67,11 @@ pub(crate) struct Doze {
     /// hull (hector's quadrotor) finds one ground point too high at its first
     /// full step after a doze and falls 56 µm into the ground.
     lone: Vec<bool>,
+    /// Per lone tree: its free joint's first q and v coordinates when its q
+    /// and v are that joint's seven and six (`None` else: the tree's ranges
+    /// are read from the model). Read by `doze_step` in place of the tree
+    /// and its joint, two scattered records of the model a dozing tree.
+    at: Vec<Option<(usize, usize)>>,
     /// Per island root: it may doze (scratch of `after_step`, read by
     /// `begin_doze`).
     pub(super) may: Vec<bool>,
@@ -101,9 +106,19 @@ impl Doze {
                     && !t.bodies.clone().any(mesh)
             })
             .collect();
+        let at = model
+            .trees
+            .iter()
+            .zip(&lone)
+            .map(|(t, &l)| {
+                let f = t.free.and_then(|f| model.free_joints.get(f))?;
+                (l && t.q == (f.iq..f.iq + 7) && t.v == (f.iv..f.iv + 6)).then_some((f.iq, f.iv))
+            })
+            .collect();
         Self {
             on,
             lone,
+            at,
             left: vec![0; nt],
             fresh: vec![false; nt],
             root: (0..nt).collect(),
@@ -293,14 +308,22 @@ impl Sleep {
             if d.left[t] == 0 {
                 continue;
             }
-            let tree = &model.trees[t];
-            // (a tree's coordinates are one range: slice copies)
-            copy_range(v, &d.v_held, tree.v.clone());
-            copy_range(q, &self.q_frozen, tree.q.clone());
-            if let Some(f) = tree.free.and_then(|f| model.free_joints.get(f)) {
-                integrate_free(q, v, h, f.iq, f.iv);
+            // (a tree's coordinates are one range: slice copies; a lone
+            // tree's are its joint's, `Doze::at`, the model not read)
+            let (rq, rv, joint) = match d.at.get(t) {
+                Some(&Some((iq, iv))) => (iq..iq + 7, iv..iv + 6, Some((iq, iv))),
+                _ => {
+                    let tree = &model.trees[t];
+                    let f = tree.free.and_then(|f| model.free_joints.get(f));
+                    (tree.q.clone(), tree.v.clone(), f.map(|f| (f.iq, f.iv)))
+                }
+            };
+            copy_range(v, &d.v_held, rv);
+            copy_range(q, &self.q_frozen, rq.clone());
+            if let Some((iq, iv)) = joint {
+                integrate_free(q, v, h, iq, iv);
             }
-            copy_range(&mut self.q_frozen, q, tree.q.clone());
+            copy_range(&mut self.q_frozen, q, rq);
             d.tree_steps += 1;
             d.left[t] -= 1;
             ended |= d.left[t] == 0;

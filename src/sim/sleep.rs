@@ -23,6 +23,10 @@ use crate::model::Model;
 use crate::spatial::Force;
 use nalgebra::{DVector, Vector3};
 
+mod frozen;
+pub(crate) use frozen::Frozen;
+mod ranges;
+pub(super) use ranges::{copy_range, zero_range};
 mod step;
 mod still;
 
@@ -75,8 +79,8 @@ pub(crate) struct Sleep {
     /// The configuration the sleeping trees are held at.
     pub q_frozen: DVector<f64>,
     /// The sleeping islands' last contact points and forces.
-    pub frozen_points: Vec<ContactPoint>,
-    pub frozen_forces: Vec<ContactForce>,
+    pub frozen_points: Frozen<ContactPoint>,
+    pub frozen_forces: Frozen<ContactForce>,
     /// The masked (sleeping or dozing) bodies' kept contact wrenches (per
     /// body: set when the body falls asleep or begins to doze).
     pub(super) frozen_body: Vec<Force>,
@@ -186,8 +190,8 @@ impl Sleep {
             island: vec![0; nt],
             verdict: vec![0; nt],
             q_frozen: DVector::zeros(model.nq),
-            frozen_points: Vec::new(),
-            frozen_forces: Vec::new(),
+            frozen_points: Frozen::default(),
+            frozen_forces: Frozen::default(),
             frozen_body: vec![Force::zero(); model.nbodies],
             all_forces: std::sync::OnceLock::new(),
             all_body: std::sync::OnceLock::new(),
@@ -298,8 +302,8 @@ impl Sleep {
     pub(super) fn drop_unmasked_frozen(&mut self) {
         let masked = &self.body_asleep;
         let keep = |b: usize| masked.get(b) == Some(&true);
-        self.frozen_points.retain(|p| keep(p.body));
-        self.frozen_forces.retain(|f| keep(f.point.body));
+        self.frozen_points.retain_bodies(keep);
+        self.frozen_forces.retain_bodies(keep);
     }
 
     /// Whether a point of `points` has a side asleep or dozing (else
@@ -477,9 +481,7 @@ impl Sleep {
         // (a tree's coordinates are one range: one slice fill and one copy,
         // not a bounds test an entry)
         for (tree, _) in model.trees.iter().zip(&self.asleep).filter(|&(_, &a)| a) {
-            if let Some(v) = v.as_mut_slice().get_mut(tree.v.clone()) {
-                v.fill(0.0);
-            }
+            zero_range(v, tree.v.clone());
             copy_range(q, &self.q_frozen, tree.q.clone());
         }
     }
@@ -571,14 +573,5 @@ impl Sleep {
         } else {
             self.awake_sum / self.steps as f64
         }
-    }
-}
-
-/// `to[r] = from[r]` (a range out of either: nothing copied): a tree's
-/// coordinates, one range of q or v.
-#[inline]
-pub(super) fn copy_range(to: &mut DVector<f64>, from: &DVector<f64>, r: std::ops::Range<usize>) {
-    if let (Some(t), Some(f)) = (to.as_mut_slice().get_mut(r.clone()), from.as_slice().get(r)) {
-        t.copy_from_slice(f);
     }
 }
