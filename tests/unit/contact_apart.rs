@@ -71,7 +71,6 @@ fn apart_along_is_parrys_support_gap_bit_for_bit() {
     // extents, a cylinder's and a ball's sizes) must be the one from parry's
     // support points, bit for bit, axes with ±0 components too
     use parry3d_f64::math::Vector as PVec;
-    use parry3d_f64::shape::SupportMap;
     let to_pvec = |v: &Vector3<f64>| PVec::new(v.x, v.y, v.z);
     let from_pvec = |v: PVec| Vector3::new(v.x, v.y, v.z);
     let mut lcg = Lcg(31);
